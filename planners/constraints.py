@@ -1,0 +1,207 @@
+"""``PathConstraints``: every limit of a robot along a path, on a grid of s, computed once.
+
+The one meeting point of dynamics and timing (DESIGN.md). With x = sd^2 (sd = ds/dt) and
+u = sdd = d2s/dt2, the joint velocity, acceleration and torque along q(s) are
+
+    qd   = q' sd
+    qdd  = q' u + q'' x
+    tau  = M(q) q' u + (M(q) q'' + C(q, q') q') x + g(q) + D q' sd + F sign(q')
+
+(Jeong & Lee eq. (3.4b)/(3.6); Yamamoto et al. eq. (10)). Velocity limits give first-order
+bounds sd <= sd_max(s); acceleration and torque limits give second-order rows
+``a u + b x + c + d sd in [lower, upper]`` (d: viscous friction, zero for acceleration rows).
+At a corner of the path (a kink, where q' jumps) the motion must stop, so sd_max = 0 there, and
+the rows seen from the interval that ends there (``*_left``) differ from those of the interval
+that starts there.
+The torque coefficients come from Pinocchio's RNEA: a = rnea(q, 0, q') - g,
+b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never see a robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.paths.base import GeometricPath
+from robots import JointLimits, Robot
+
+CONSTRAINT_KINDS = ("velocity", "acceleration", "torque")
+
+
+@dataclass(frozen=True)
+class PathConstraints:
+    """Limits along a path on a grid of N + 1 values of s.
+
+    Attributes:
+        s: Grid, shape (N + 1,), increasing from 0 to 1.
+        sd_max: First-order bound on sd = ds/dt, shape (N + 1,), in 1/s; ``inf`` where none.
+        a, b, c, d: Second-order rows ``a u + b x + c + d sd`` with u = sdd, x = sd^2, each of
+            shape (N + 1, m); units of the limited quantity (rad/s^2 or N m). At a kink these
+            hold the side of the interval that starts there.
+        a_left, b_left, c_left, d_left: The same rows as seen from the interval that ends at each
+            grid point; the very arrays ``a, b, c, d`` when the path has no kink.
+        lower, upper: Bounds of the rows, shape (N + 1, m); ``-inf``/``inf`` where none.
+        rows: (kind, joint index) of each of the m rows, kind "acceleration" or "torque".
+        joint_names: Joint names, for messages.
+    """
+
+    s: np.ndarray
+    sd_max: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
+    a_left: np.ndarray
+    b_left: np.ndarray
+    c_left: np.ndarray
+    d_left: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    rows: tuple[tuple[str, int], ...]
+    joint_names: tuple[str, ...]
+
+    @property
+    def has_friction(self) -> bool:
+        """Whether any row has a term linear in sd (viscous joint friction)."""
+        return bool(np.any(self.d != 0.0))
+
+    def linearized(self, x_ref: np.ndarray, side: str = "right") -> "LinearRows":
+        """Rows linear in (u, x), a conservative inner approximation of these constraints.
+
+        A viscous term d sd = d sqrt(x) is replaced by a bound that can only tighten the row:
+        against the upper bound, d sqrt(x) <= d (x + x_ref) / (2 sqrt(x_ref)) for d > 0 (tangent to
+        the concave sqrt at x_ref, exact there) and d sqrt(x) <= 0 for d < 0; mirrored against the
+        lower bound. Without friction the rows are returned unchanged.
+
+        Args:
+            x_ref: Shape (N + 1,), the x at which the tangent is taken (a good guess of the
+                solution makes the approximation exact where it matters), in 1/s^2.
+            side: "right" for the rows ``a, b, c, d``, "left" for ``a_left, ...``.
+        """
+        if side == "left":
+            a, b, c, d = self.a_left, self.b_left, self.c_left, self.d_left
+        else:
+            a, b, c, d = self.a, self.b, self.c, self.d
+        if not self.has_friction:
+            return LinearRows(a, b, c, self.lower, self.upper)
+        root = np.sqrt(np.maximum(x_ref, 1e-6))[:, None]
+        positive, negative = np.maximum(d, 0.0), np.minimum(d, 0.0)
+        upper_rows = (b + positive / (2 * root), c + positive * root / 2)
+        lower_rows = (b + negative / (2 * root), c + negative * root / 2)
+        infinite = np.full_like(self.lower, np.inf)
+        return LinearRows(
+            a=np.concatenate([a, a], axis=1),
+            b=np.concatenate([upper_rows[0], lower_rows[0]], axis=1),
+            c=np.concatenate([upper_rows[1], lower_rows[1]], axis=1),
+            lower=np.concatenate([-infinite, self.lower], axis=1),
+            upper=np.concatenate([self.upper, infinite], axis=1),
+        )
+
+    def describe_row(self, row: int) -> str:
+        """'torque of joint elbow_joint' for row ``row`` of these (or the linearized) rows."""
+        kind, joint = self.rows[row % len(self.rows)]
+        return f"{kind} of joint {self.joint_names[joint]!r}"
+
+
+@dataclass(frozen=True)
+class LinearRows:
+    """Second-order rows ``a u + b x + c in [lower, upper]``, each of shape (N + 1, m)."""
+
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+
+def path_dynamics(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray):
+    """Torque coefficients along a path: ``tau = a u + b x + c + d sd`` for sd > 0.
+
+    Args:
+        q, dq, ddq: Path and its s-derivatives, each (n_samples, n_dof).
+
+    Returns:
+        a, b, c, d: Each (n_samples, n_dof), in N m (N for prismatic joints).
+    """
+    model, data = robot.model, robot.data
+    configurations = robot.configuration(q)
+    n_samples, n_dof = dq.shape
+    zero = np.zeros(n_dof)
+    a, b, c = (np.empty((n_samples, n_dof)) for _ in range(3))
+    for k in range(n_samples):
+        gravity = pin.rnea(model, data, configurations[k], zero, zero)
+        c[k] = gravity
+        a[k] = pin.rnea(model, data, configurations[k], zero, dq[k]) - gravity
+        b[k] = pin.rnea(model, data, configurations[k], dq[k], ddq[k]) - gravity
+    c += robot.coulomb_friction * np.sign(dq)
+    d = robot.viscous_friction * dq
+    return a, b, c, d
+
+
+def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str):
+    points = path.evaluate(s, side)
+    blocks, rows = [], []
+    n_dof = path.dof
+    if "acceleration" in kinds:
+        bound = np.broadcast_to(limits.acceleration, points.dq.shape)
+        blocks.append((points.dq, points.ddq, np.zeros_like(points.dq), np.zeros_like(points.dq), bound))
+        rows += [("acceleration", j) for j in range(n_dof)]
+    if "torque" in kinds:
+        a, b, c, d = path_dynamics(robot, points.q, points.dq, points.ddq)
+        blocks.append((a, b, c, d, np.broadcast_to(limits.torque, a.shape)))
+        rows += [("torque", j) for j in range(n_dof)]
+    if not blocks:
+        empty = np.zeros((len(s), 0))
+        return points, (empty,) * 5, tuple(rows)
+    stacked = tuple(np.concatenate([block[i] for block in blocks], axis=1) for i in range(5))
+    finite = np.isfinite(stacked[4][0])  # a row with an infinite limit constrains nothing
+    stacked = tuple(array[:, finite] for array in stacked)
+    return points, stacked, tuple(row for row, keep in zip(rows, finite) if keep)
+
+
+def build_path_constraints(
+    path: GeometricPath,
+    robot: Robot,
+    limits: JointLimits,
+    kinds: tuple[str, ...],
+    s: np.ndarray,
+    deadline: Deadline = NO_DEADLINE,
+) -> PathConstraints:
+    """Evaluate the requested ``kinds`` of limits (subset of velocity, acceleration, torque)
+    along ``path`` at the grid ``s`` (which must hold the path's kinks)."""
+    points, (a, b, c, d, bound), rows = _second_order_rows(path, robot, limits, kinds, s, "right")
+    deadline.check()
+    sd_max = np.full(len(s), np.inf)
+    if "velocity" in kinds:
+        with np.errstate(divide="ignore"):
+            per_joint = limits.velocity / np.abs(points.dq)
+        sd_max = np.min(per_joint, axis=1)
+    a_left, b_left, c_left, d_left = a, b, c, d
+    kink_index = np.flatnonzero(np.isin(s, path.kinks))
+    if kink_index.size:
+        sd_max[kink_index] = 0.0
+        _, (a_k, b_k, c_k, d_k, _), _ = _second_order_rows(
+            path, robot, limits, kinds, s[kink_index], "left"
+        )
+        a_left, b_left, c_left, d_left = a.copy(), b.copy(), c.copy(), d.copy()
+        a_left[kink_index], b_left[kink_index] = a_k, b_k
+        c_left[kink_index], d_left[kink_index] = c_k, d_k
+    return PathConstraints(
+        s=s,
+        sd_max=sd_max,
+        a=a,
+        b=b,
+        c=c,
+        d=d,
+        a_left=a_left,
+        b_left=b_left,
+        c_left=c_left,
+        d_left=d_left,
+        lower=-bound,
+        upper=bound.copy(),
+        rows=rows,
+        joint_names=robot.joint_names,
+    )

@@ -1,0 +1,41 @@
+"""Planning errors: each says what is wrong and where along the path."""
+
+from __future__ import annotations
+
+from robots.errors import ToptrajError
+
+
+class InvalidRequest(ToptrajError):
+    """A request that cannot be planned as given: wrong lengths, non-finite numbers, too few or
+    coincident waypoints, waypoints outside the joint limits, unknown methods, absurd sizes."""
+
+    title = "Invalid request"
+
+
+class InfeasiblePath(ToptrajError):
+    """No timing can follow the path within the limits.
+
+    Attributes:
+        s: Path parameter in [0, 1] where it fails.
+        joint: Name of the joint whose limit cannot be met there, if one is to blame.
+    """
+
+    title = "Path cannot be followed within the limits"
+
+    def __init__(self, detail: str, s: float | None = None, joint: str | None = None):
+        super().__init__(detail)
+        self.s = s
+        self.joint = joint
+
+
+class TimingFailed(ToptrajError):
+    """A timing method's solver failed on a problem that is feasible at its grid points."""
+
+    title = "Timing method failed"
+
+
+class BudgetExceeded(ToptrajError):
+    """The computation ran past its time budget."""
+
+    status = 504
+    title = "Computation over its time budget"

@@ -1,0 +1,46 @@
+"""The geometric path q(s), s in [0, 1]: geometry only, never time (lecture seed: a *path* is
+geometry, a *trajectory* is a path plus a timing s(t))."""
+
+from __future__ import annotations
+
+import abc
+from typing import NamedTuple
+
+import numpy as np
+
+
+class PathPoints(NamedTuple):
+    """A path and its s-derivatives at n_samples values of s, each of shape (n_samples, n_dof).
+
+    Units: q in the joint units (rad, m); dq = dq/ds and ddq = d2q/ds2 in those units (s is
+    dimensionless).
+    """
+
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+
+
+class GeometricPath(abc.ABC):
+    """A joint path on s in [0, 1], C2 except at its ``kinks``.
+
+    Attributes:
+        dof: Number of joints.
+        knots: Increasing s values (including 0 and 1) that any grid over the path should hold:
+            waypoints and the breaks of the piecewise definition.
+        kinks: Interior s values where dq/ds jumps (corners): the motion must stop there, and
+            the two sides have different derivatives.
+    """
+
+    dof: int
+    knots: np.ndarray
+    kinks: np.ndarray
+
+    @abc.abstractmethod
+    def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
+        """q, dq/ds and d2q/ds2 at ``s`` (shape (n_samples,)); at a kink, the one-sided derivatives
+        of ``side`` ("left" or "right")."""
+
+    def __call__(self, s: np.ndarray) -> np.ndarray:
+        """q(s), shape (n_samples, n_dof)."""
+        return self.evaluate(np.atleast_1d(np.asarray(s, dtype=float))).q

@@ -1,0 +1,9 @@
+"""Timing methods: each reads ``PathConstraints`` and returns a ``TimeScaling``."""
+
+from planners.timing.base import TimeScaling, TimingMethod
+from planners.timing.toppra_method import ToppraMethod
+
+#: ``timing.method`` name -> method.
+METHODS: dict[str, TimingMethod] = {method.name: method for method in (ToppraMethod(),)}
+
+__all__ = ["METHODS", "TimeScaling", "TimingMethod", "ToppraMethod"]

@@ -1,0 +1,161 @@
+"""``toppra``: the TOPP-RA package (Pham & Pham, "A New Approach to Time-Optimal Path
+Parameterization Based on Reachability Analysis", IEEE T-RO 2018) on our ``PathConstraints``.
+
+The adapter hands toppra the precomputed rows as one canonical linear constraint, so toppra never
+re-derives dynamics; the rows are handed over in toppra's interpolation discretization (each
+interval's u_i checked at s_i and, through x_i+1 = x_i + 2 ds_i u_i, at s_i+1, with the rows as
+seen from that interval, which matters at the corners of a path), keeping the limits between grid
+points. Its failure signals
+(``None``, NaN controllable sets, return codes) become toptraj errors here.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from planners.constraints import LinearRows, PathConstraints
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.errors import InfeasiblePath, TimingFailed
+from planners.mvc import admissible_set
+from planners.timing.base import TimeScaling, TimingMethod
+
+logging.getLogger("toppra").setLevel(logging.ERROR)
+
+#: Stand-in for an unlimited bound: toppra's LP solver needs finite numbers.
+_UNBOUNDED = 1e12
+
+
+def _toppra_classes():
+    """toppra's algorithm and constraint classes (imported lazily: the import costs ~0.3 s)."""
+    import toppra.algorithm
+    import toppra.constraint
+    from toppra.interpolator import AbstractGeometricPath
+
+    class GridPath(AbstractGeometricPath):
+        """The path interval toppra asks for; the geometry itself lives in the constraint rows."""
+
+        def __init__(self, s: np.ndarray):
+            self._s = s
+
+        @property
+        def path_interval(self):
+            return np.array([self._s[0], self._s[-1]])
+
+        @property
+        def dof(self):
+            return 1
+
+        @property
+        def waypoints(self):
+            return self._s
+
+        def __call__(self, path_positions, order=0):
+            raise TimingFailed("toppra asked for path geometry, which the adapter does not hold")
+
+    class PrecomputedRows(toppra.constraint.LinearConstraint):
+        """Rows ``lower <= a u + b x + c <= upper`` and bounds ``x <= x_bound`` given as arrays,
+        already in the interpolation discretization."""
+
+        def __init__(self, right: LinearRows, left: LinearRows, x_bound: np.ndarray):
+            super().__init__()
+            self._right, self._left = right, left
+            self._x_bound = x_bound
+
+        def compute_constraint_params(self, path, gridpoints, *args, **kwargs):
+            right, left = self._right, self._left
+            n_points, n_rows = right.a.shape
+            xbound = np.column_stack([np.zeros(n_points), np.minimum(self._x_bound, _UNBOUNDED)])
+            if n_rows == 0:
+                return None, None, None, None, None, None, xbound
+            delta = np.append(np.diff(gridpoints), 0.0)[:, None]
+            # Interval i: rows at s_i on (u_i, x_i), and rows at s_i+1 on (u_i, x_i + 2 ds_i u_i).
+            next_a = np.vstack([left.a[1:] + 2 * delta[:-1] * left.b[1:], right.a[-1:]])
+            a = np.hstack([right.a, next_a])
+            b = np.hstack([right.b, np.vstack([left.b[1:], right.b[-1:]])])
+            c = np.hstack([right.c, np.vstack([left.c[1:], right.c[-1:]])])
+            upper = np.hstack([right.upper, np.vstack([right.upper[1:], right.upper[-1:]])])
+            lower = np.hstack([right.lower, np.vstack([right.lower[1:], right.lower[-1:]])])
+            identity = np.eye(2 * n_rows)
+            F = np.broadcast_to(np.vstack([identity, -identity]), (n_points, 4 * n_rows, 2 * n_rows))
+            g = np.hstack([np.minimum(upper, _UNBOUNDED), np.minimum(-lower, _UNBOUNDED)])
+            return a, b, c, F, g, None, xbound
+
+    return toppra.algorithm.TOPPRA, PrecomputedRows, GridPath
+
+
+class ToppraMethod(TimingMethod):
+    """Time-optimal timing by TOPP-RA with toppra's Seidel LP solver."""
+
+    name = "toppra"
+
+    def solve(
+        self,
+        constraints: PathConstraints,
+        sd_start: float = 0.0,
+        sd_end: float = 0.0,
+        deadline: Deadline = NO_DEADLINE,
+    ) -> TimeScaling:
+        TOPPRA, PrecomputedRows, GridPath = _toppra_classes()
+        x_bound = constraints.sd_max**2
+        x_ref = _reference_x(constraints, x_bound)
+        scaling = None
+        for _ in range(2 if constraints.has_friction else 1):
+            rows = constraints.linearized(x_ref)
+            left_rows = constraints.linearized(x_ref, side="left")
+            deadline.check()
+            instance = TOPPRA(
+                [PrecomputedRows(rows, left_rows, x_bound)],
+                GridPath(constraints.s),
+                gridpoints=constraints.s,
+                solver_wrapper="seidel",
+            )
+            sdd, sd, _, K = instance.compute_parameterization(sd_start, sd_end, return_data=True)
+            if sd is None:
+                raise _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end)
+            scaling = TimeScaling(constraints.s, np.asarray(sd, dtype=float))
+            x_ref = scaling.sd**2
+        return scaling
+
+
+def _reference_x(constraints: PathConstraints, x_bound: np.ndarray) -> np.ndarray:
+    """A first guess of the optimal x for linearizing friction: the MVC without friction."""
+    if not constraints.has_friction:
+        return x_bound
+    frictionless = LinearRows(constraints.a, constraints.b, constraints.c, constraints.lower, constraints.upper)
+    x_max = admissible_set(frictionless, x_bound).x_max
+    return np.where(np.isfinite(x_max) & (x_max > 0), x_max, 1.0)
+
+
+def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Exception:
+    """Turn toppra's failure into an error that says where along the path it fails."""
+    admissible = admissible_set(rows, x_bound)
+    empty = np.flatnonzero(admissible.x_max < admissible.x_min)
+    if empty.size:
+        point = int(empty[0])
+        first, second = admissible.blocking_rows[point]
+        what = constraints.describe_row(first)
+        if second != first:
+            what += f" and {constraints.describe_row(second)}"
+        return InfeasiblePath(
+            f"no motion along the path can meet the {what} at s = {constraints.s[point]:.4f} "
+            f"(grid point {point} of {len(constraints.s) - 1}), not even at rest",
+            s=float(constraints.s[point]),
+            joint=constraints.joint_names[constraints.rows[first % len(constraints.rows)][1]],
+        )
+    if sd_start**2 > admissible.x_max[0] or sd_end**2 > admissible.x_max[-1]:
+        return InfeasiblePath(
+            f"the boundary path speeds ({sd_start}, {sd_end}) 1/s exceed the maximum velocity curve "
+            f"({admissible.sd_max[0]:.6g}, {admissible.sd_max[-1]:.6g}) 1/s"
+        )
+    if K is not None:
+        bad = np.flatnonzero(np.isnan(K).any(axis=1))
+        if bad.size:
+            point = int(bad[-1])
+            return InfeasiblePath(
+                f"the path cannot be followed within the limits: from s = {constraints.s[point]:.4f} "
+                "on, no admissible motion reaches the end",
+                s=float(constraints.s[point]),
+            )
+    return TimingFailed("toppra failed to parameterize the path")

@@ -1,0 +1,117 @@
+"""Joint limits of a robot: what its URDF carries, what ``data/limits.toml`` adds, and what a
+request overrides or scales.
+
+URDFs carry position, velocity and effort limits but no acceleration or jerk limits. The data file
+holds those per robot, with their source, and a default rule for every other robot.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+
+import numpy as np
+
+from robots.errors import InvalidLimits
+
+LIMIT_KINDS = ("position_lower", "position_upper", "velocity", "acceleration", "jerk", "torque")
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """Per-joint limits, each an array of shape (n_dof,), in the Pinocchio model's joint order.
+
+    Units: rad, rad/s, rad/s^2, rad/s^3 and N m for revolute joints (m, m/s, m/s^2, m/s^3 and N for
+    prismatic ones). ``inf`` means unlimited; symmetric limits are given by their magnitude.
+    """
+
+    position_lower: np.ndarray
+    position_upper: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    jerk: np.ndarray
+    torque: np.ndarray
+
+    def as_lists(self) -> dict[str, list[float | None]]:
+        """The limits as JSON-friendly lists, ``None`` standing for unlimited."""
+        return {
+            kind: [float(v) if math.isfinite(v) else None for v in getattr(self, kind)]
+            for kind in LIMIT_KINDS
+        }
+
+    def with_request(
+        self,
+        overrides: dict[str, list[float] | None] | None = None,
+        scales: dict[str, float] | None = None,
+    ) -> "JointLimits":
+        """These limits with a request's per-joint ``overrides`` replacing and ``scales``
+        multiplying the velocity, acceleration, jerk and torque limits.
+
+        Raises:
+            InvalidLimits: an override of the wrong length, or a non-positive value or scale.
+        """
+        n_dof = self.velocity.shape[0]
+        values = {kind: getattr(self, kind) for kind in LIMIT_KINDS}
+        for kind, given in (overrides or {}).items():
+            if given is None:
+                continue
+            array = np.asarray(given, dtype=float)
+            if array.shape != (n_dof,):
+                raise InvalidLimits(
+                    f"timing.limits.{kind} has {array.size} values; the robot has {n_dof} joints"
+                )
+            if np.any(np.isnan(array)) or np.any(array <= 0.0):
+                bad = int(np.flatnonzero(np.isnan(array) | (array <= 0.0))[0])
+                raise InvalidLimits(f"timing.limits.{kind}[{bad}] must be positive, got {array[bad]}")
+            values[kind] = array
+        for kind, factor in (scales or {}).items():
+            if factor is None:
+                continue
+            if not (math.isfinite(factor) and factor > 0.0):
+                raise InvalidLimits(f"timing.limits.{kind}_scale must be positive and finite, got {factor}")
+            values[kind] = values[kind] * factor
+        return JointLimits(**values)
+
+
+@cache
+def _limit_table() -> dict:
+    text = resources.files("robots").joinpath("data/limits.toml").read_text()
+    return tomllib.loads(text)
+
+
+def limits_for(
+    robot_name: str,
+    position_lower: np.ndarray,
+    position_upper: np.ndarray,
+    velocity: np.ndarray,
+    torque: np.ndarray,
+) -> JointLimits:
+    """Complete a robot's URDF limits with the data file's entry for ``robot_name`` (or the
+    default rule when it has none)."""
+    table = _limit_table()
+    entry = table.get(robot_name, {})
+    rule = table["default"]
+    values = {
+        "position_lower": np.asarray(position_lower, dtype=float),
+        "position_upper": np.asarray(position_upper, dtype=float),
+        "velocity": np.asarray(velocity, dtype=float),
+        "torque": np.asarray(torque, dtype=float),
+    }
+    for kind in ("position_lower", "position_upper", "velocity", "torque"):
+        if kind in entry:
+            values[kind] = np.asarray(entry[kind], dtype=float)
+    with np.errstate(invalid="ignore"):
+        default_acceleration = values["velocity"] / rule["seconds_to_full_speed"]
+    values["acceleration"] = np.asarray(entry.get("acceleration", default_acceleration), dtype=float)
+    default_jerk = values["acceleration"] / rule["seconds_to_full_acceleration"]
+    values["jerk"] = np.asarray(entry.get("jerk", default_jerk), dtype=float)
+    return JointLimits(**values)
+
+
+def replace(limits: JointLimits, **changes: np.ndarray) -> JointLimits:
+    """A copy of ``limits`` with some arrays replaced."""
+    return dataclasses.replace(limits, **changes)

@@ -1,0 +1,126 @@
+"""The ``Robot``: a Pinocchio model with its joint names, end effector and limits.
+
+Joint coordinates inside toptraj are always the model's tangent coordinates, one angle (or
+length) per degree of freedom, shape ``(n_dof,)`` or ``(n_samples, n_dof)``. Continuous joints,
+which Pinocchio stores as a (cos, sin) pair, are converted at this boundary, so an elbow may turn
+through -2 pi without any wrap-around.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from robots.limits import JointLimits
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A fixed-base arm ready for dynamics.
+
+    Attributes:
+        name: Catalog name.
+        model: The Pinocchio model (public contract: ``robots.load(name).model``).
+        source: ``"bundled"``, ``"example-robot-data"`` or ``"upload"``.
+        joint_names: Names of the actuated joints, in model order, length n_dof.
+        end_effector: Name of the frame used for Cartesian paths and conditioning.
+        limits: Joint limits, URDF values completed by ``robots/data/limits.toml``.
+        continuous: Boolean mask, shape (n_dof,): joints without position limits.
+        viscous_friction: Joint damping from the URDF, shape (n_dof,), in N m s/rad.
+        coulomb_friction: Joint dry friction from the URDF, shape (n_dof,), in N m.
+    """
+
+    name: str
+    model: pin.Model
+    source: str
+    joint_names: tuple[str, ...]
+    end_effector: str
+    limits: JointLimits
+    continuous: np.ndarray
+    viscous_friction: np.ndarray
+    coulomb_friction: np.ndarray
+    _cos_index: np.ndarray = field(repr=False)
+    _angle_index_of_pair: np.ndarray = field(repr=False)
+    _plain_q_index: np.ndarray = field(repr=False)
+    _plain_v_index: np.ndarray = field(repr=False)
+    _local: threading.local = field(default_factory=threading.local, repr=False, compare=False)
+
+    @classmethod
+    def from_model(
+        cls,
+        name: str,
+        model: pin.Model,
+        source: str,
+        end_effector: str,
+        limits: JointLimits,
+    ) -> "Robot":
+        """Wrap ``model``, precomputing the map from tangent coordinates to Pinocchio's q."""
+        cos_index, pair_angle, plain_q, plain_v = [], [], [], []
+        continuous = np.zeros(model.nv, dtype=bool)
+        for joint in model.joints[1:]:
+            if joint.nq == 2 and joint.nv == 1:
+                cos_index.append(joint.idx_q)
+                pair_angle.append(joint.idx_v)
+                continuous[joint.idx_v] = True
+            else:
+                plain_q.extend(range(joint.idx_q, joint.idx_q + joint.nq))
+                plain_v.extend(range(joint.idx_v, joint.idx_v + joint.nv))
+        return cls(
+            name=name,
+            model=model,
+            source=source,
+            joint_names=tuple(model.names[1:]),
+            end_effector=end_effector,
+            limits=limits,
+            continuous=continuous,
+            viscous_friction=np.asarray(model.damping, dtype=float).copy(),
+            coulomb_friction=np.asarray(model.friction, dtype=float).copy(),
+            _cos_index=np.asarray(cos_index, dtype=int),
+            _angle_index_of_pair=np.asarray(pair_angle, dtype=int),
+            _plain_q_index=np.asarray(plain_q, dtype=int),
+            _plain_v_index=np.asarray(plain_v, dtype=int),
+        )
+
+    @property
+    def dof(self) -> int:
+        """Number of degrees of freedom (actuated joints)."""
+        return self.model.nv
+
+    @property
+    def data(self) -> pin.Data:
+        """Pinocchio workspace of the calling thread (models are shared, data never is)."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self.model.createData()
+        return data
+
+    def configuration(self, q: np.ndarray) -> np.ndarray:
+        """Pinocchio configuration(s) of shape (..., nq) from joint coordinates (..., n_dof)."""
+        q = np.asarray(q, dtype=float)
+        out = np.empty(q.shape[:-1] + (self.model.nq,))
+        out[..., self._plain_q_index] = q[..., self._plain_v_index]
+        angles = q[..., self._angle_index_of_pair]
+        out[..., self._cos_index] = np.cos(angles)
+        out[..., self._cos_index + 1] = np.sin(angles)
+        return out
+
+    def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Joint torques for rows of ``q, qd, qdd`` (each (n_samples, n_dof)): Pinocchio's RNEA
+        plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``."""
+        q, qd, qdd = np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(qdd)
+        configurations = self.configuration(q)
+        data = self.data
+        tau = np.empty_like(qd)
+        for k in range(q.shape[0]):
+            tau[k] = pin.rnea(self.model, data, configurations[k], qd[k], qdd[k])
+        tau += self.viscous_friction * qd + self.coulomb_friction * np.sign(qd)
+        return tau
+
+    def frame_id(self, frame: str) -> int:
+        """Index of ``frame`` in the model; ``KeyError`` when it has no such frame."""
+        if not self.model.existFrame(frame):
+            raise KeyError(frame)
+        return self.model.getFrameId(frame)
