@@ -1,0 +1,23 @@
+"""Planners: geometric paths, path constraints, timing methods and trajectory sampling."""
+
+from planners.constraints import PathConstraints, build_path_constraints
+from planners.deadline import Deadline
+from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
+from planners.plan import PlannedTrajectory, Timing, WaypointPath, plan
+from planners.timing import METHODS, TimeScaling
+
+__all__ = [
+    "METHODS",
+    "BudgetExceeded",
+    "Deadline",
+    "InfeasiblePath",
+    "InvalidRequest",
+    "PathConstraints",
+    "PlannedTrajectory",
+    "TimeScaling",
+    "Timing",
+    "TimingFailed",
+    "WaypointPath",
+    "build_path_constraints",
+    "plan",
+]

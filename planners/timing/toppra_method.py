@@ -149,13 +149,45 @@ def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Excepti
             f"the boundary path speeds ({sd_start}, {sd_end}) 1/s exceed the maximum velocity curve "
             f"({admissible.sd_max[0]:.6g}, {admissible.sd_max[-1]:.6g}) 1/s"
         )
-    if K is not None:
-        bad = np.flatnonzero(np.isnan(K).any(axis=1))
-        if bad.size:
-            point = int(bad[-1])
-            return InfeasiblePath(
-                f"the path cannot be followed within the limits: from s = {constraints.s[point]:.4f} "
-                "on, no admissible motion reaches the end",
-                s=float(constraints.s[point]),
-            )
+    if K is not None and np.isnan(K).any():
+        return _uncontrollable(constraints, np.flatnonzero(np.isnan(K).any(axis=1)).max())
+    if K is not None and not K[0, 0] <= sd_start**2 + 1e-9:
+        detail, joint = _static_load(constraints, 0)
+        return InfeasiblePath(
+            f"the motion cannot start at path speed {sd_start:g} 1/s at s = 0: every admissible "
+            f"motion there needs sd >= {np.sqrt(K[0, 0]):.4g} 1/s{detail}",
+            s=0.0,
+            joint=joint,
+        )
     return TimingFailed("toppra failed to parameterize the path")
+
+
+def _static_load(constraints: PathConstraints, point: int) -> tuple[str, str | None]:
+    """A clause naming the joint whose torque at rest is the largest share of its limit at grid
+    point ``point`` (empty when every joint can hold still there), and that joint's name."""
+    torque_rows = [k for k, (kind, _) in enumerate(constraints.rows) if kind == "torque"]
+    if not torque_rows:
+        return "", None
+    load = np.abs(constraints.c[point, torque_rows]) / constraints.upper[point, torque_rows]
+    worst = torque_rows[int(np.argmax(load))]
+    joint = constraints.joint_names[constraints.rows[worst][1]]
+    if load.max() <= 1.0:
+        return "", joint
+    return (
+        f": holding still at s = {constraints.s[point]:.4f} needs {abs(constraints.c[point, worst]):.4g} N m "
+        f"on joint {joint!r}, above its limit of {constraints.upper[point, worst]:.4g} N m",
+        joint,
+    )
+
+
+def _uncontrollable(constraints: PathConstraints, last_bad: int) -> InfeasiblePath:
+    """From grid point ``last_bad`` backwards no motion reaches the end of the path at the
+    required speed: say where, and which joint cannot hold its load there."""
+    where = min(last_bad + 1, len(constraints.s) - 1)
+    detail, joint = _static_load(constraints, where)
+    return InfeasiblePath(
+        f"no motion can follow the path from s = {constraints.s[last_bad]:.4f} to its end: the "
+        f"limits cannot bring the motion to the required speed by s = {constraints.s[where]:.4f}{detail}",
+        s=float(constraints.s[last_bad]),
+        joint=joint,
+    )

@@ -1,0 +1,246 @@
+"""``plan``: from a robot and a motion request to a timed trajectory with torques.
+
+Data flow (DESIGN.md): request -> GeometricPath q(s) -> PathConstraints on a grid (once) ->
+timing method -> TimeScaling s(t) -> samples, phase plane and peak utilization.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planners.constraints import CONSTRAINT_KINDS, build_path_constraints
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.errors import InfeasiblePath, InvalidRequest
+from planners.grid import MAX_POINTS, path_grid
+from planners.mvc import admissible_set
+from planners.paths import GeometricPath, SplinePath, StopAndGoPath
+from planners.timing import METHODS
+from planners.trajectory import Samples, peak_utilization, sample_trajectory
+from robots import JointLimits, Robot
+
+INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
+MAX_WAYPOINTS = 1_000
+MAX_SAMPLES = 200_000
+#: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
+MAX_PHASE_PLANE_POINTS = 2_000
+
+
+@dataclass(frozen=True)
+class WaypointPath:
+    """A joint path through ``waypoints`` (shape (n_waypoints, n_dof), joint units), interpolated
+    by ``"spline"`` (C2 cubic) or ``"linear"`` (straight segments, stopping at each waypoint)."""
+
+    waypoints: np.ndarray
+    interpolation: str = "spline"
+
+
+@dataclass(frozen=True)
+class Timing:
+    """How to time the path.
+
+    Attributes:
+        method: A ``timing.method`` name (see ``planners.timing.METHODS``).
+        constraints: Which limits to respect, among velocity, acceleration and torque.
+        limit_overrides: Per-joint replacements, keys ``velocity``, ``acceleration``, ``jerk``,
+            ``torque``.
+        limit_scales: Factors on those limits, same keys.
+        grid_points: Number of grid intervals; ``None`` chooses one from the path.
+        start_velocity, end_velocity: Joint velocities at the ends (rad/s), tangent to the path;
+            ``None`` is rest.
+    """
+
+    method: str = "toppra"
+    constraints: tuple[str, ...] = CONSTRAINT_KINDS
+    limit_overrides: dict[str, list[float] | None] = field(default_factory=dict)
+    limit_scales: dict[str, float | None] = field(default_factory=dict)
+    grid_points: int | None = None
+    start_velocity: np.ndarray | None = None
+    end_velocity: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class PhasePlane:
+    """The (s, sd) picture: the timing's path speed and the maximum velocity curve, in 1/s."""
+
+    s: np.ndarray
+    sd: np.ndarray
+    sd_max: np.ndarray
+    switch_points: tuple[tuple[float, str], ...]
+
+
+@dataclass(frozen=True)
+class PlannedTrajectory:
+    """What ``plan`` returns: samples and diagnostics of one timed path."""
+
+    robot: str
+    method: str
+    joint_names: tuple[str, ...]
+    duration: float
+    samples: Samples
+    phase_plane: PhasePlane
+    peak_utilization: dict[str, np.ndarray]
+    solve_ms: float
+    warnings: tuple[str, ...]
+
+
+def _finite_array(value, name: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidRequest(f"{name} must be numbers") from None
+    if shape is not None and array.shape != shape:
+        raise InvalidRequest(f"{name} has shape {list(array.shape)}, expected {list(shape)}")
+    bad = np.argwhere(~np.isfinite(array))
+    if bad.size:
+        where = "".join(f"[{i}]" for i in bad[0])
+        raise InvalidRequest(f"{name}{where} is {array[tuple(bad[0])]}, not a finite number")
+    return array
+
+
+def make_path(robot: Robot, spec: WaypointPath) -> GeometricPath:
+    """The geometric path of ``spec``, after checking the waypoints against the robot."""
+    if spec.interpolation not in INTERPOLATIONS:
+        raise InvalidRequest(
+            f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted(INTERPOLATIONS)}"
+        )
+    waypoints = np.asarray(spec.waypoints, dtype=float) if np.ndim(spec.waypoints) == 2 else None
+    if waypoints is None:
+        raise InvalidRequest("path.waypoints must be a list of joint vectors (a 2-D array)")
+    count, width = waypoints.shape
+    if count < 2:
+        raise InvalidRequest(f"path.waypoints holds {count} waypoint(s); at least 2 are needed")
+    if count > MAX_WAYPOINTS:
+        raise InvalidRequest(f"path.waypoints holds {count} waypoints; at most {MAX_WAYPOINTS} are served")
+    if width != robot.dof:
+        raise InvalidRequest(
+            f"path.waypoints[0] has {width} values; {robot.name} has {robot.dof} joints "
+            f"({', '.join(robot.joint_names)})"
+        )
+    waypoints = _finite_array(waypoints, "path.waypoints")
+    lower, upper = robot.limits.position_lower, robot.limits.position_upper
+    outside = (waypoints < lower - 1e-9) | (waypoints > upper + 1e-9)
+    if outside.any():
+        index, joint = (int(v) for v in np.argwhere(outside)[0])
+        raise InvalidRequest(
+            f"path.waypoints[{index}][{joint}] = {waypoints[index, joint]:.6g} is outside the limits "
+            f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
+        )
+    return INTERPOLATIONS[spec.interpolation](waypoints)
+
+
+def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:
+    """Splines may overshoot between waypoints: refuse a path that leaves the joint range."""
+    dense = np.linspace(0.0, 1.0, 4 * len(s) + 1)
+    q = path(dense)
+    lower, upper = robot.limits.position_lower, robot.limits.position_upper
+    outside = (q < lower - 1e-9) | (q > upper + 1e-9)
+    if outside.any():
+        index, joint = (int(v) for v in np.argwhere(outside)[0])
+        raise InfeasiblePath(
+            f"the interpolated path leaves the range [{lower[joint]:.6g}, {upper[joint]:.6g}] of joint "
+            f"{robot.joint_names[joint]!r} at s = {dense[index]:.4f} (q = {q[index, joint]:.6g}); "
+            "add waypoints or use interpolation 'linear'",
+            s=float(dense[index]),
+            joint=robot.joint_names[joint],
+        )
+
+
+def _path_speed(path: GeometricPath, velocity, s_end: float, name: str) -> float:
+    """The path speed sd >= 0 with q'(s) sd equal to the joint ``velocity``.
+
+    Raises:
+        InvalidRequest: the velocity is not tangent to the path there (or points backwards).
+    """
+    if velocity is None:
+        return 0.0
+    tangent = path.evaluate(np.array([s_end])).dq[0]
+    velocity = _finite_array(velocity, name, tangent.shape)
+    sd = float(velocity @ tangent / (tangent @ tangent))
+    residual = np.linalg.norm(velocity - sd * tangent)
+    if residual > 1e-6 * max(1.0, np.linalg.norm(velocity)) or sd < 0.0:
+        raise InvalidRequest(
+            f"{name} is not tangent to the path at s = {s_end:g}: the path's direction there is "
+            f"{np.round(tangent / np.linalg.norm(tangent), 6).tolist()}"
+        )
+    return sd
+
+
+def _check_constraint_kinds(kinds) -> tuple[str, ...]:
+    unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
+    if unknown:
+        raise InvalidRequest(
+            f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}"
+        )
+    return tuple(dict.fromkeys(kinds))
+
+
+def plan(
+    robot: Robot,
+    path_spec: WaypointPath,
+    timing: Timing = Timing(),
+    dt: float = 0.01,
+    deadline: Deadline = NO_DEADLINE,
+) -> PlannedTrajectory:
+    """Plan the timed trajectory of ``robot`` along ``path_spec``.
+
+    Raises:
+        InvalidRequest: malformed input (the message names the field).
+        InfeasiblePath: no timing can follow the path within the limits (says where).
+        TimingFailed: the timing method failed.
+        BudgetExceeded: ``deadline`` passed.
+    """
+    started = time.perf_counter()
+    method = METHODS.get(timing.method)
+    if method is None:
+        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
+    kinds = _check_constraint_kinds(timing.constraints)
+    if not (np.isfinite(dt) and dt > 0.0):
+        raise InvalidRequest(f"output.dt must be a positive number of seconds, got {dt}")
+    if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
+        raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
+    limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
+    path = make_path(robot, path_spec)
+    s = path_grid(path, timing.grid_points)
+    _check_path_within_limits(robot, path, s)
+    sd_start = _path_speed(path, timing.start_velocity, 0.0, "timing.boundary.start_velocity")
+    sd_end = _path_speed(path, timing.end_velocity, 1.0, "timing.boundary.end_velocity")
+    if not kinds:
+        raise InvalidRequest("timing.constraints is empty: without limits the time-optimal motion is instantaneous")
+    constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
+    deadline.check()
+    scaling = method.solve(constraints, sd_start, sd_end, deadline)
+    deadline.check()
+    if scaling.duration / dt > MAX_SAMPLES:
+        raise InvalidRequest(
+            f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {scaling.duration:.4g} s"
+        )
+    samples = sample_trajectory(path, scaling, robot, dt)
+    utilization = peak_utilization(path, scaling, robot, limits)
+    mvc = admissible_set(constraints.linearized(scaling.sd**2), constraints.sd_max**2).sd_max
+    keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
+    return PlannedTrajectory(
+        robot=robot.name,
+        method=method.name,
+        joint_names=robot.joint_names,
+        duration=scaling.duration,
+        samples=samples,
+        phase_plane=PhasePlane(s[keep], scaling.sd[keep], mvc[keep], scaling.switch_points),
+        peak_utilization=utilization,
+        solve_ms=(time.perf_counter() - started) * 1e3,
+        warnings=tuple(_warnings(utilization, kinds)),
+    )
+
+
+def _warnings(utilization: dict[str, np.ndarray], kinds: tuple[str, ...]) -> list[str]:
+    notes = []
+    for kind in kinds:
+        worst = int(np.argmax(utilization[kind]))
+        if utilization[kind][worst] > 1.005:
+            notes.append(
+                f"{kind} limit exceeded by {100 * (utilization[kind][worst] - 1):.2f} % on joint index "
+                f"{worst} between grid points; raise timing.grid_points"
+            )
+    return notes

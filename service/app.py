@@ -1,0 +1,46 @@
+"""``create_app()``: the FastAPI application (public contract)."""
+
+from __future__ import annotations
+
+from contextlib import asynccontextmanager
+
+from fastapi import FastAPI
+from starlette.concurrency import run_in_threadpool
+
+import robots
+from service.body_limit import BodySizeLimit
+from service.problems import install_problem_handlers
+from service.routes import health, robots as robot_routes, trajectories
+from service.settings import Settings
+
+
+def _warm_up() -> None:
+    """Build every catalog robot and import toppra once, so first requests are fast."""
+    for name in robots.catalog_names():
+        robots.load(name)
+    import toppra  # noqa: F401
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    """The toptraj HTTP service."""
+    settings = settings or Settings()
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI):
+        if settings.preload_robots:
+            await run_in_threadpool(_warm_up)
+        yield
+
+    app = FastAPI(
+        title="toptraj",
+        summary="Time-optimal trajectories with torques for URDF robot arms.",
+        version="0.1.0",
+        lifespan=lifespan,
+    )
+    app.state.settings = settings
+    install_problem_handlers(app)
+    app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)
+    app.include_router(health.router)
+    app.include_router(robot_routes.router)
+    app.include_router(trajectories.router)
+    return app

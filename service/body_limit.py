@@ -1,0 +1,66 @@
+"""ASGI middleware that answers 413 to request bodies over a size cap, whether or not the client
+announced a Content-Length. Past the cap the body is cut off (the app sees an end of body) and
+whatever the app answers is replaced by the 413 problem."""
+
+from __future__ import annotations
+
+import json
+
+
+class BodySizeLimit:
+    """Wraps an ASGI app; bodies over ``max_bytes`` get a problem+json 413."""
+
+    def __init__(self, app, max_bytes: int):
+        self.app = app
+        self.max_bytes = max_bytes
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        announced = dict(scope.get("headers") or []).get(b"content-length")
+        if announced is not None and announced.isdigit() and int(announced) > self.max_bytes:
+            await self._refuse(send)
+            return
+        state = {"received": 0, "too_large": False, "answered": False}
+
+        async def limited_receive():
+            if state["too_large"]:
+                return {"type": "http.request", "body": b"", "more_body": False}
+            message = await receive()
+            if message["type"] == "http.request":
+                state["received"] += len(message.get("body", b""))
+                if state["received"] > self.max_bytes:
+                    state["too_large"] = True
+                    return {"type": "http.request", "body": b"", "more_body": False}
+            return message
+
+        async def guarded_send(message):
+            if not state["too_large"]:
+                await send(message)
+            elif not state["answered"]:
+                state["answered"] = True
+                await self._refuse(send)
+
+        await self.app(scope, limited_receive, guarded_send)
+
+    async def _refuse(self, send):
+        body = json.dumps(
+            {
+                "type": "about:blank",
+                "title": "Request body too large",
+                "status": 413,
+                "detail": f"the request body exceeds {self.max_bytes} bytes",
+            }
+        ).encode()
+        await send(
+            {
+                "type": "http.response.start",
+                "status": 413,
+                "headers": [
+                    (b"content-type", b"application/problem+json"),
+                    (b"content-length", str(len(body)).encode()),
+                ],
+            }
+        )
+        await send({"type": "http.response.body", "body": body})

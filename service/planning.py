@@ -1,0 +1,99 @@
+"""The bridge between the HTTP schemas and ``planners.plan``: request -> library call ->
+response dict, and the time budget that keeps a long computation off the event loop."""
+
+from __future__ import annotations
+
+import asyncio
+import math
+
+import numpy as np
+from starlette.concurrency import run_in_threadpool
+
+import robots
+from planners import Deadline, PlannedTrajectory, Timing, WaypointPath, plan
+from planners.errors import BudgetExceeded, InvalidRequest
+from service.schemas.trajectories import TrajectoryRequest
+
+
+def _timing(request: TrajectoryRequest) -> Timing:
+    timing = request.timing
+    method = timing.method
+    for name, given in (
+        ("timing.duration", timing.duration),
+        ("timing.boundary.start_acceleration", timing.boundary.start_acceleration),
+        ("timing.boundary.end_acceleration", timing.boundary.end_acceleration),
+    ):
+        if given is not None:
+            raise InvalidRequest(f"{name} is not used by timing.method {method!r}; leave it out")
+    if timing.cost.torque_weight != 0.0:
+        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {method!r}")
+    limits = timing.limits
+    return Timing(
+        method=method,
+        constraints=tuple(timing.constraints),
+        limit_overrides={
+            kind: getattr(limits, kind) for kind in ("velocity", "acceleration", "jerk", "torque")
+        },
+        limit_scales={
+            kind: getattr(limits, f"{kind}_scale") for kind in ("velocity", "acceleration", "jerk", "torque")
+        },
+        grid_points=timing.grid_points,
+        start_velocity=timing.boundary.start_velocity,
+        end_velocity=timing.boundary.end_velocity,
+    )
+
+
+def plan_request(request: TrajectoryRequest, deadline: Deadline | None = None) -> PlannedTrajectory:
+    """Plan ``request`` with the library (no HTTP involved)."""
+    robot = robots.load(request.robot)
+    rows = request.path.waypoints
+    for index, row in enumerate(rows):
+        if len(row) != robot.dof:
+            raise InvalidRequest(
+                f"path.waypoints[{index}] has {len(row)} values; {robot.name} has {robot.dof} joints "
+                f"({', '.join(robot.joint_names)})"
+            )
+    path = WaypointPath(np.asarray(rows, dtype=float), request.path.interpolation)
+    return plan(robot, path, _timing(request), request.output.dt, deadline or Deadline())
+
+
+def _finite_or_none(values: np.ndarray) -> list[float | None]:
+    return [float(v) if math.isfinite(v) else None for v in values]
+
+
+def trajectory_body(result: PlannedTrajectory) -> dict:
+    """The JSON body of a planned trajectory (DESIGN.md contract)."""
+    samples = result.samples
+    return {
+        "robot": result.robot,
+        "method": result.method,
+        "joint_names": list(result.joint_names),
+        "duration": result.duration,
+        "samples": {
+            "t": samples.t.tolist(),
+            "q": samples.q.tolist(),
+            "qd": samples.qd.tolist(),
+            "qdd": samples.qdd.tolist(),
+            "tau": samples.tau.tolist(),
+        },
+        "phase_plane": {
+            "s": result.phase_plane.s.tolist(),
+            "sd": result.phase_plane.sd.tolist(),
+            "sd_max": _finite_or_none(result.phase_plane.sd_max),
+            "switch_points": [{"s": s, "kind": kind} for s, kind in result.phase_plane.switch_points],
+        },
+        "peak_utilization": {kind: values.tolist() for kind, values in result.peak_utilization.items()},
+        "solve_ms": result.solve_ms,
+        "warnings": list(result.warnings),
+    }
+
+
+async def run_with_budget(function, budget_s: float):
+    """Run ``function(deadline)`` in the thread pool; past ``budget_s`` seconds, cancel it (it
+    stops at its next deadline check) and raise ``BudgetExceeded``."""
+    deadline = Deadline(budget_s)
+    try:
+        return await asyncio.wait_for(run_in_threadpool(function, deadline), timeout=budget_s)
+    except asyncio.TimeoutError:
+        deadline.cancel()
+        raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s") from None

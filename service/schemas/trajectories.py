@@ -1,0 +1,132 @@
+"""Schemas of ``POST /v1/trajectories`` (DESIGN.md, HTTP contract)."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, Field
+
+from service.schemas.common import Schema
+
+MAX_WAYPOINTS = 1_000
+MAX_JOINTS = 64
+
+JointVector = Annotated[list[float], Field(min_length=1, max_length=MAX_JOINTS)]
+Positive = Annotated[float, Field(gt=0.0)]
+
+
+class WaypointsPath(Schema):
+    """Joint waypoints, interpolated by a C2 cubic spline or by straight segments that stop at
+    each waypoint."""
+
+    kind: Literal["waypoints"] = "waypoints"
+    waypoints: list[JointVector] = Field(
+        min_length=2, max_length=MAX_WAYPOINTS, description="Joint configurations (rad, m), one row each."
+    )
+    interpolation: Literal["spline", "linear"] = "spline"
+
+
+class LimitsRequest(Schema):
+    """Per-joint overrides and scale factors of the robot's limits (SI units)."""
+
+    velocity: JointVector | None = None
+    acceleration: JointVector | None = None
+    jerk: JointVector | None = None
+    torque: JointVector | None = None
+    velocity_scale: Positive | None = None
+    acceleration_scale: Positive | None = None
+    jerk_scale: Positive | None = None
+    torque_scale: Positive | None = None
+
+
+class Boundary(Schema):
+    """Joint velocities at the ends (rad/s), tangent to the path; absent means rest."""
+
+    start_velocity: JointVector | None = None
+    end_velocity: JointVector | None = None
+    start_acceleration: JointVector | None = None
+    end_acceleration: JointVector | None = None
+
+
+class CostRequest(Schema):
+    """Weights of the cost integral of (1 + beta |tau|^2) dt."""
+
+    torque_weight: Annotated[float, Field(ge=0.0)] = 0.0
+
+
+class TimingRequest(Schema):
+    """How to time the path."""
+
+    method: str = Field(default="toppra", description="Timing method, e.g. `toppra`.")
+    constraints: list[Literal["velocity", "acceleration", "torque"]] = Field(
+        default=["velocity", "acceleration", "torque"], max_length=3
+    )
+    limits: LimitsRequest = LimitsRequest()
+    duration: Positive | None = Field(default=None, description="Seconds, for the classical time laws.")
+    boundary: Boundary = Boundary()
+    cost: CostRequest = CostRequest()
+    grid_points: Annotated[int, Field(ge=2, le=20_000)] | None = Field(
+        default=None, description="Number of grid intervals over the path; default chosen from it."
+    )
+
+
+class OutputRequest(Schema):
+    """Sampling of the returned trajectory."""
+
+    dt: Annotated[float, Field(gt=0.0, le=10.0)] = Field(default=0.01, description="Sample period (s).")
+
+
+class TrajectoryRequest(Schema):
+    """A motion to plan."""
+
+    robot: str = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
+    path: WaypointsPath
+    timing: TimingRequest = TimingRequest()
+    output: OutputRequest = OutputRequest()
+
+
+class SamplesPublic(BaseModel):
+    """Time samples; ``q[k]`` holds one value per joint at ``t[k]``."""
+
+    t: list[float]
+    q: list[list[float]]
+    qd: list[list[float]]
+    qdd: list[list[float]]
+    tau: list[list[float]]
+
+
+class SwitchPoint(BaseModel):
+    s: float
+    kind: str
+
+
+class PhasePlanePublic(BaseModel):
+    """The timing in the phase plane: path speed ``sd`` and maximum velocity curve ``sd_max``
+    (1/s) over s in [0, 1]."""
+
+    s: list[float]
+    sd: list[float]
+    sd_max: list[float | None]
+    switch_points: list[SwitchPoint] = []
+
+
+class UtilizationPublic(BaseModel):
+    """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds)."""
+
+    velocity: list[float]
+    acceleration: list[float]
+    torque: list[float]
+
+
+class TrajectoryResponse(BaseModel):
+    """A timed joint trajectory with its torques."""
+
+    robot: str
+    method: str
+    joint_names: list[str]
+    duration: float
+    samples: SamplesPublic
+    phase_plane: PhasePlanePublic
+    peak_utilization: UtilizationPublic
+    solve_ms: float
+    warnings: list[str]
