@@ -63,6 +63,11 @@ def check_urdf(urdf: str) -> pin.Model:
         raise InvalidURDF(f"the root element is <{root.tag}>, expected <robot>")
     links = {link.get("name"): link for link in root.findall("link")}
     joints = root.findall("joint")
+    for joint in joints:
+        if joint.get("type") not in (*MOVING_JOINTS, "fixed"):
+            raise InvalidURDF(
+                f"joint {joint.get('name')!r}: type {joint.get('type')!r} is not supported (fixed-base arms only)"
+            )
     moving = [joint for joint in joints if joint.get("type") in MOVING_JOINTS]
     if not moving:
         raise InvalidURDF("the URDF has no revolute, continuous or prismatic joint")
@@ -72,8 +77,6 @@ def check_urdf(urdf: str) -> pin.Model:
     for joint in joints:
         where = f"joint {joint.get('name')!r}"
         kind = joint.get("type")
-        if kind not in (*MOVING_JOINTS, "fixed"):
-            raise InvalidURDF(f"{where}: type {kind!r} is not supported (fixed-base arms only)")
         parent, child = joint.find("parent"), joint.find("child")
         if parent is None or child is None:
             raise InvalidURDF(f"{where}: needs <parent link=...> and <child link=...>")
