@@ -1,0 +1,59 @@
+# toptraj: time-optimal trajectories over HTTP.
+#
+#   docker build -t toptraj .
+#   docker run --rm -p 8000:8000 toptraj           # serve on :8000
+#   docker run --rm toptraj python -m pytest -q    # run the test suite in the image
+#
+# Any Debian-like image with Python >= 3.11 (and the venv module) works as a base:
+#   docker build --build-arg BASE_IMAGE=<image> .
+ARG BASE_IMAGE=python:3.11-slim
+FROM ${BASE_IMAGE}
+
+# CA bundle used by pip and Python's ssl module. The default is the system bundle
+# of Debian-based images; point it elsewhere when a build needs another one.
+ARG CA_BUNDLE=/etc/ssl/certs/ca-certificates.crt
+
+ENV PYTHONDONTWRITEBYTECODE=1 \
+    PYTHONUNBUFFERED=1 \
+    PIP_NO_CACHE_DIR=1 \
+    PIP_DISABLE_PIP_VERSION_CHECK=1 \
+    PIP_CERT=${CA_BUNDLE} \
+    SSL_CERT_FILE=${CA_BUNDLE} \
+    VIRTUAL_ENV=/opt/venv \
+    PATH=/opt/venv/bin:${PATH}
+
+# libgomp1: OpenMP runtime that the pinocchio wheels link against (not bundled in them).
+# Unprivileged runtime user; /app is its working directory (pytest keeps its cache there).
+# hadolint ignore=DL3008
+RUN apt-get update \
+    && apt-get install -y --no-install-recommends libgomp1 \
+    && rm -rf /var/lib/apt/lists/* \
+    && groupadd --gid 10001 toptraj \
+    && useradd --create-home --uid 10001 --gid 10001 --shell /usr/sbin/nologin toptraj \
+    && python3 -m venv /opt/venv \
+    && mkdir /app \
+    && chown toptraj:toptraj /app
+
+WORKDIR /app
+
+# Dependencies first, in their own layer: it is rebuilt only when pyproject.toml changes.
+# They are read from [project.dependencies] and the "test" extra, so the test suite can run
+# in the image.
+COPY pyproject.toml README.md ./
+RUN python -c "import tomllib; p = tomllib.load(open('pyproject.toml', 'rb'))['project']; print('\n'.join(p.get('dependencies', []) + p.get('optional-dependencies', {}).get('test', [])))" > /tmp/requirements.txt \
+    && pip install -r /tmp/requirements.txt \
+    && rm /tmp/requirements.txt
+
+# The code (and tests/), then the package itself without touching the dependencies.
+COPY . .
+RUN pip install --no-deps . \
+    && rm -rf build ./*.egg-info
+
+USER 10001:10001
+
+EXPOSE 8000
+
+HEALTHCHECK --interval=30s --timeout=5s --start-period=30s --retries=3 \
+    CMD ["python", "-c", "import sys, urllib.request; sys.exit(0 if urllib.request.urlopen('http://127.0.0.1:8000/health', timeout=4).status == 200 else 1)"]
+
+CMD ["toptraj", "serve", "--host", "0.0.0.0", "--port", "8000"]
