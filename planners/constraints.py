@@ -19,7 +19,8 @@ b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never se
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 import pinocchio as pin
@@ -62,6 +63,39 @@ class PathConstraints:
     upper: np.ndarray
     rows: tuple[tuple[str, int], ...]
     joint_names: tuple[str, ...]
+    evaluate: Callable[[np.ndarray], "PathConstraints"] | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def can_refine(self) -> bool:
+        """Whether rows can be evaluated at new values of s (``with_points``)."""
+        return self.evaluate is not None
+
+    def with_points(self, extra_s: np.ndarray) -> "PathConstraints":
+        """These constraints on the grid refined by ``extra_s`` (values strictly inside grid
+        intervals, never at a corner), evaluating the rows only at the new points."""
+        extra = self.evaluate(np.asarray(extra_s, dtype=float))
+        order = np.argsort(np.concatenate([self.s, extra.s]), kind="stable")
+
+        def merge(mine, theirs):
+            return np.concatenate([mine, theirs])[order]
+
+        return PathConstraints(
+            s=merge(self.s, extra.s),
+            sd_max=merge(self.sd_max, extra.sd_max),
+            a=merge(self.a, extra.a),
+            b=merge(self.b, extra.b),
+            c=merge(self.c, extra.c),
+            d=merge(self.d, extra.d),
+            a_left=merge(self.a_left, extra.a),
+            b_left=merge(self.b_left, extra.b),
+            c_left=merge(self.c_left, extra.c),
+            d_left=merge(self.d_left, extra.d),
+            lower=merge(self.lower, extra.lower),
+            upper=merge(self.upper, extra.upper),
+            rows=self.rows,
+            joint_names=self.joint_names,
+            evaluate=self.evaluate,
+        )
 
     @property
     def has_friction(self) -> bool:
@@ -204,4 +238,5 @@ def build_path_constraints(
         upper=bound.copy(),
         rows=rows,
         joint_names=robot.joint_names,
+        evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),
     )

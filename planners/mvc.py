@@ -6,7 +6,7 @@ section 3.2 (the limit that the torque bounds (3.6) place on mu = lambda-dot).
 Each row ``lower <= a u + b x + c <= upper`` with a != 0 bounds u between two functions linear
 in x, l_k(x) <= u <= h_k(x). Some u exists iff l_i(x) <= h_j(x) for every pair (i, j): each pair
 is one linear inequality in x, and rows with a = 0 bound x directly. The admissible x therefore
-form one interval per grid point, found here for all grid points at once.
+form one interval per grid point (``planners.kernels.admissible_intervals``).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.constraints import LinearRows
+from planners.kernels import admissible_intervals
 
 #: |a| below this fraction of the row's scale counts as zero (a zero-inertia point).
 ZERO_INERTIA = 1e-10
@@ -39,66 +40,74 @@ class AdmissibleSet:
         return np.sqrt(np.maximum(self.x_max, 0.0))
 
 
-def admissible_set(rows: LinearRows, x_bound: np.ndarray) -> AdmissibleSet:
-    """Admissible x at every grid point for ``rows`` and the first-order bound ``x <= x_bound``."""
+@dataclass(frozen=True)
+class AccelerationBounds:
+    """Each row with a != 0 as bounds on u linear in x: ``p + q x <= u <= r + w x``, each of
+    shape (N + 1, m); ``-inf``/``inf`` intercepts mark a missing bound. ``singular`` marks rows
+    with a = 0 (zero inertia), which bound x alone and are left out of p, q, r, w."""
+
+    p: np.ndarray
+    q: np.ndarray
+    r: np.ndarray
+    w: np.ndarray
+    singular: np.ndarray
+
+    def lowest(self, x: np.ndarray) -> np.ndarray:
+        """The least admissible u at each grid point for the given x (shape (N + 1,))."""
+        return np.max(self.p + self.q * x[:, None], axis=1)
+
+    def highest(self, x: np.ndarray) -> np.ndarray:
+        """The greatest admissible u at each grid point for the given x."""
+        return np.min(self.r + self.w * x[:, None], axis=1)
+
+
+def acceleration_bounds(rows: LinearRows) -> AccelerationBounds:
+    """Solve every row of ``rows`` for u (Jeong & Lee eq. (3.6) divided by its u-coefficient)."""
     a, b, c, lower, upper = rows.a, rows.b, rows.c, rows.lower, rows.upper
-    n_points, n_rows = a.shape
     scale = np.maximum(np.abs(a) + np.abs(b), 1e-300)
     singular = np.abs(a) <= ZERO_INERTIA * scale
     safe_a = np.where(singular, 1.0, a)
     with np.errstate(invalid="ignore", divide="ignore"):
-        # u >= p + q x and u <= r + w x for each row with a != 0.
-        from_upper = ((upper - c) / safe_a, -b / safe_a)
-        from_lower = ((lower - c) / safe_a, -b / safe_a)
+        from_upper = (upper - c) / safe_a
+        from_lower = (lower - c) / safe_a
+        slope = np.where(singular, 0.0, -b / safe_a)
     positive = a > 0
-    p = np.where(positive, from_lower[0], from_upper[0])
-    r = np.where(positive, from_upper[0], from_lower[0])
-    q = w = from_upper[1]
+    p = np.where(positive, from_lower, from_upper)
+    r = np.where(positive, from_upper, from_lower)
     p = np.where(singular | np.isnan(p), -np.inf, p)
     r = np.where(singular | np.isnan(r), np.inf, r)
+    return AccelerationBounds(p=p, q=slope, r=r, w=slope, singular=singular)
 
-    x_min = np.zeros(n_points)
-    x_max = np.asarray(x_bound, dtype=float).copy()
-    blocking = np.full((n_points, 2), -1)
 
-    # Pairs (i, j): p_i + q_i x <= r_j + w_j x, i.e. (q_i - w_j) x <= r_j - p_i.
-    alpha = q[:, :, None] - w[:, None, :]
-    beta = r[:, None, :] - p[:, :, None]
-    vacuous = ~np.isfinite(beta) & (beta > 0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = beta / alpha
-    upper_cut = np.where((alpha > 0) & ~vacuous, ratio, np.inf)
-    lower_cut = np.where((alpha < 0) & ~vacuous, ratio, -np.inf)
-    never = (alpha == 0) & (beta < 0) & ~vacuous
-    flat_upper = upper_cut.reshape(n_points, -1)
-    flat_lower = lower_cut.reshape(n_points, -1)
-    x_max = np.minimum(x_max, flat_upper.min(axis=1))
-    x_min = np.maximum(x_min, flat_lower.max(axis=1))
-    pair_blocked = never.reshape(n_points, -1).any(axis=1)
-
+def admissible_set(rows: LinearRows, x_bound: np.ndarray) -> AdmissibleSet:
+    """Admissible x at every grid point for ``rows`` and the first-order bound ``x <= x_bound``."""
+    b, c, lower, upper = rows.b, rows.c, rows.lower, rows.upper
+    bounds = acceleration_bounds(rows)
+    singular = bounds.singular
     # Rows with a = 0 bound x itself: lower <= b x + c <= upper.
     with np.errstate(invalid="ignore", divide="ignore"):
         cut_high = np.where(b > 0, (upper - c) / b, np.where(b < 0, (lower - c) / b, np.inf))
         cut_low = np.where(b > 0, (lower - c) / b, np.where(b < 0, (upper - c) / b, -np.inf))
-    static_fail = singular & (b == 0) & ((c > upper) | (c < lower))
-    cut_high = np.where(singular & (b != 0), cut_high, np.inf)
-    cut_low = np.where(singular & (b != 0), cut_low, -np.inf)
-    x_max = np.minimum(x_max, cut_high.min(axis=1))
-    x_min = np.maximum(x_min, cut_low.max(axis=1))
-
-    empty = (x_min > x_max) | pair_blocked | static_fail.any(axis=1)
+    static_fail = (singular & (b == 0) & ((c > upper) | (c < lower))).any(axis=1)
+    x_high = np.minimum(np.asarray(x_bound, dtype=float), np.where(singular & (b != 0), cut_high, np.inf).min(axis=1))
+    x_low = np.maximum(0.0, np.where(singular & (b != 0), cut_low, -np.inf).max(axis=1))
+    x_low, x_high = admissible_intervals(
+        bounds.p, bounds.q, bounds.r, bounds.w, np.ascontiguousarray(x_low), np.ascontiguousarray(x_high)
+    )
+    empty = (x_low > x_high) | static_fail
+    blocking = np.full((len(x_low), 2), -1)
     for point in np.flatnonzero(empty):
-        blocking[point] = _blocking_pair(point, p, q, r, w, x_min, static_fail, singular)
-    x_max = np.where(empty, -1.0, x_max)
-    return AdmissibleSet(x_min=x_min, x_max=x_max, blocking_rows=blocking)
+        blocking[point] = _blocking_pair(point, bounds, x_low, static_fail, singular, rows)
+    return AdmissibleSet(x_min=x_low, x_max=np.where(empty, -1.0, x_high), blocking_rows=blocking)
 
 
-def _blocking_pair(point, p, q, r, w, x_min, static_fail, singular):
+def _blocking_pair(point, bounds, x_min, static_fail, singular, rows):
     """The two rows whose bounds on u conflict most at ``point`` (at the lowest admissible x)."""
-    if static_fail[point].any():
-        row = int(np.flatnonzero(static_fail[point])[0])
+    if static_fail[point]:
+        failing = (rows.c[point] > rows.upper[point]) | (rows.c[point] < rows.lower[point])
+        row = int(np.flatnonzero(singular[point] & failing)[0])
         return row, row
     x = max(x_min[point], 0.0)
-    low = np.where(singular[point], -np.inf, p[point] + q[point] * x)
-    high = np.where(singular[point], np.inf, r[point] + w[point] * x)
+    low = bounds.p[point] + bounds.q[point] * x
+    high = bounds.r[point] + bounds.w[point] * x
     return int(np.argmax(low)), int(np.argmin(high))

@@ -1,9 +1,10 @@
 """Timing methods: each reads ``PathConstraints`` and returns a ``TimeScaling``."""
 
 from planners.timing.base import TimeScaling, TimingMethod
+from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.toppra_method import ToppraMethod
 
 #: ``timing.method`` name -> method.
-METHODS: dict[str, TimingMethod] = {method.name: method for method in (ToppraMethod(),)}
+METHODS: dict[str, TimingMethod] = {method.name: method for method in (PhasePlaneMethod(), ToppraMethod())}
 
-__all__ = ["METHODS", "TimeScaling", "TimingMethod", "ToppraMethod"]
+__all__ = ["METHODS", "PhasePlaneMethod", "TimeScaling", "TimingMethod", "ToppraMethod"]

@@ -1,0 +1,215 @@
+"""``phase_plane``: time-optimal path timing by numerical integration in the (s, sd) phase plane.
+
+The method of Bobrow, Dubowsky & Gibson, Shin & McKay and Pfeiffer & Johanni as Jeong & Lee
+section 3 describe it: along the path the limits bound the path acceleration u = sdd between
+alpha(s, x) and beta(s, x) (x = sd^2; Jeong & Lee eq. (3.6) solved for mu-dot), the optimal
+profile accelerates at beta as long as it can and decelerates at alpha when it must, and it
+touches the maximum velocity curve (MVC) only at switching points: tangent points, points where
+the MVC jumps, and singular points where the u-coefficient of a binding row vanishes (zero
+inertia).
+
+The integration runs in its reachability form, which makes every switching point fall out of
+two sweeps instead of a search:
+
+1. Backward, from the end state, at maximum deceleration alpha, restarted from the MVC wherever
+   the backward curve would cross it: the envelope K(s) of every maximum-deceleration curve
+   that ends at the end state or leaves the MVC. Below K the end is reachable; above it, not.
+2. Forward, from the start state, at maximum acceleration beta, capped by K.
+
+Where the forward curve meets K it switches from acceleration to deceleration; where it leaves K
+it starts accelerating from a point of the MVC or of a deceleration curve through one, which is
+exactly a switching point of the classical method. At a singular point the admissible u-interval
+collapses to one value and the sweeps take it: no chattering, no special case.
+
+Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
+row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
+point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
+(``planners.kernels``): no LP is solved anywhere. This constant-u scheme is conservative by a
+first-order amount, so the grid is refined where it costs time: the midpoint discretization on
+the same grid (second-order accurate, but not conservative) estimates the error of each interval,
+and the worst intervals are split, with the constraint rows evaluated anew there, until the
+estimated duration error is below the tolerance.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from planners.constraints import LinearRows, PathConstraints
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.errors import InfeasiblePath
+from planners.kernels import backward_envelope, forward_profile
+from planners.mvc import acceleration_bounds, admissible_set
+from planners.timing.base import TimeScaling, TimingMethod
+
+#: Relative slack when comparing x values computed along different routes.
+_SLACK = 1e-9
+
+
+def interval_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> LinearRows:
+    """Rows of each interval i (shape (N, 2m)) on its start state (u_i, x_i): every row at s_i,
+    ``a_i u + b_i x_i + c_i``, and at s_i+1 as seen from the interval,
+    ``a_i+1 u + b_i+1 (x_i + 2 ds u) + c_i+1`` (the interpolation discretization)."""
+    ds = np.diff(s)[:, None]
+    return LinearRows(
+        a=np.hstack([right.a[:-1], left.a[1:] + 2.0 * ds * left.b[1:]]),
+        b=np.hstack([right.b[:-1], left.b[1:]]),
+        c=np.hstack([right.c[:-1], left.c[1:]]),
+        lower=np.hstack([right.lower[:-1], right.lower[1:]]),
+        upper=np.hstack([right.upper[:-1], right.upper[1:]]),
+    )
+
+
+def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> LinearRows:
+    """Rows of each interval i (shape (N, m)) on its start state (u_i, x_i): every row taken at
+    the interval's midpoint, ``a_m u + b_m (x_i + ds u) + c_m``, with the coefficients averaged
+    from the two ends (the right-hand side of s_i, the left-hand side of s_i+1)."""
+    ds = np.diff(s)[:, None]
+    a_mid = 0.5 * (right.a[:-1] + left.a[1:])
+    b_mid = 0.5 * (right.b[:-1] + left.b[1:])
+    c_mid = 0.5 * (right.c[:-1] + left.c[1:])
+    return LinearRows(
+        a=a_mid + ds * b_mid,
+        b=b_mid,
+        c=c_mid,
+        lower=right.lower[:-1],
+        upper=right.upper[:-1],
+    )
+
+
+class PhasePlaneMethod(TimingMethod):
+    """Time-optimal timing by phase-plane integration (see the module docstring).
+
+    Args:
+        tolerance: Relative duration error at which grid refinement stops. The error is
+            estimated by the midpoint discretization on the same grid (second order, so it
+            stands for the exact answer); intervals where the two disagree most are split, with
+            the constraint rows evaluated anew at the new points, until the estimate falls
+            below ``tolerance`` or ``max_refinements`` rounds are done.
+        max_refinements: Rounds of refinement; 0 keeps the given grid.
+    """
+
+    name = "phase_plane"
+
+    def __init__(self, tolerance: float = 2e-4, max_refinements: int = 3):
+        self.tolerance = tolerance
+        self.max_refinements = max_refinements
+
+    def solve(
+        self,
+        constraints: PathConstraints,
+        sd_start: float = 0.0,
+        sd_end: float = 0.0,
+        deadline: Deadline = NO_DEADLINE,
+    ) -> TimeScaling:
+        for round_ in range(self.max_refinements + 1):
+            scaling = self._solve_on_grid(constraints, sd_start, sd_end, deadline, interval_rows)
+            if round_ == self.max_refinements or not constraints.can_refine:
+                return scaling
+            split = self._intervals_to_split(constraints, scaling, sd_start, sd_end, deadline)
+            if split.size == 0:
+                return scaling
+            deadline.check()
+            constraints = constraints.with_points(0.5 * (constraints.s[split] + constraints.s[split + 1]))
+        return scaling
+
+    def _intervals_to_split(self, constraints, scaling, sd_start, sd_end, deadline) -> np.ndarray:
+        """Intervals whose time the midpoint discretization (second order) finds shorter by the
+        most, when the total difference exceeds the tolerance."""
+        try:
+            reference = self._solve_on_grid(constraints, sd_start, sd_end, deadline, midpoint_stage_rows)
+        except InfeasiblePath:
+            return np.empty(0, dtype=int)
+        excess = np.diff(scaling.t) - np.diff(reference.t)
+        if excess.sum() <= self.tolerance * reference.duration:
+            return np.empty(0, dtype=int)
+        order = np.argsort(excess)[::-1]
+        covered = np.cumsum(excess[order])
+        count = int(np.searchsorted(covered, 0.7 * excess.sum())) + 1
+        return np.sort(order[:count])
+
+    @staticmethod
+    def _solve_on_grid(constraints, sd_start, sd_end, deadline, discretize) -> TimeScaling:
+        x_bound = constraints.sd_max**2
+        x_ref = np.minimum(x_bound, 1e6)
+        scaling = None
+        for _ in range(2 if constraints.has_friction else 1):
+            stage = discretize(
+                constraints.s, constraints.linearized(x_ref), constraints.linearized(x_ref, "left")
+            )
+            scaling = _integrate(constraints, stage, x_bound, sd_start**2, sd_end**2, deadline)
+            x_ref = scaling.sd**2
+        return scaling
+
+
+def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline) -> TimeScaling:
+    s = constraints.s
+    ds = np.ascontiguousarray(np.diff(s))
+    admissible = admissible_set(stage, x_bound[:-1])
+    bounds = acceleration_bounds(stage)
+    if x_end > x_bound[-1] * (1 + _SLACK) + _SLACK:
+        raise InfeasiblePath(
+            f"the end path speed {np.sqrt(x_end):.6g} 1/s is above the maximum velocity curve "
+            f"({np.sqrt(x_bound[-1]):.6g} 1/s) at s = 1",
+            s=1.0,
+        )
+    deadline.check()
+    envelope, failed = backward_envelope(
+        ds, bounds.p, bounds.q, admissible.x_min, admissible.x_max, float(x_end), _SLACK
+    )
+    if failed >= 0:
+        raise _stuck(constraints, admissible, stage, int(failed))
+    if x_start > envelope[0] * (1 + 1e-7) + 1e-12:
+        raise InfeasiblePath(
+            f"the start path speed {np.sqrt(x_start):.6g} 1/s is above what the limits allow at s = 0 "
+            f"({np.sqrt(max(envelope[0], 0.0)):.6g} 1/s: the maximum velocity curve or the fastest "
+            "speed from which the rest of the path can still be followed)",
+            s=0.0,
+        )
+    deadline.check()
+    x, capped = forward_profile(ds, bounds.r, bounds.w, envelope, float(min(x_start, envelope[0])))
+    x[-1] = x_end
+    switches = _switch_points(s, capped, envelope, admissible.x_max, stage)
+    return TimeScaling(s, np.sqrt(np.maximum(x, 0.0)), switches)
+
+
+def _switch_points(s, capped, envelope, x_high, stage) -> tuple[tuple[float, str], ...]:
+    """Where the profile changes between accelerating (at beta) and following the envelope."""
+    points = []
+    scale = np.maximum(np.abs(stage.a) + np.abs(stage.b), 1e-300)
+    for i in np.flatnonzero(np.diff(capped.astype(int)) != 0) + 1:
+        if capped[i]:
+            points.append((float(s[i]), "deceleration"))
+            continue
+        # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
+        on_mvc = envelope[i] >= x_high[min(i, len(x_high) - 1)] * (1 - 1e-6)
+        if not on_mvc:
+            points.append((float(s[i]), "acceleration"))
+        elif np.any(np.abs(stage.a[min(i, len(x_high) - 1)]) <= 1e-6 * scale[min(i, len(x_high) - 1)]):
+            points.append((float(s[i]), "singular"))
+        elif i >= 1 and i + 1 < len(x_high) and abs(x_high[i + 1] - x_high[i - 1]) > 0.25 * max(x_high[i], 1e-12):
+            points.append((float(s[i]), "discontinuity"))
+        else:
+            points.append((float(s[i]), "tangent"))
+    return tuple(points)
+
+
+def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) -> InfeasiblePath:
+    """No admissible state at interval ``i`` lets the motion reach the end: say where and why."""
+    s = constraints.s
+    if admissible.x_max[i] < admissible.x_min[i]:
+        first, second = admissible.blocking_rows[i]
+        what = constraints.describe_row(first)
+        if second != first:
+            what += f" and {constraints.describe_row(second)}"
+        return InfeasiblePath(
+            f"no motion along the path can meet the {what} between s = {s[i]:.4f} and "
+            f"s = {s[i + 1]:.4f}, not even at rest",
+            s=float(s[i]),
+            joint=constraints.joint_names[constraints.rows[first % len(constraints.rows)][1]],
+        )
+    return InfeasiblePath(
+        f"no motion can follow the path from s = {s[i]:.4f} to its end: the limits cannot slow "
+        f"the motion down in time after s = {s[i + 1]:.4f}",
+        s=float(s[i]),
+    )
