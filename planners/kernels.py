@@ -50,40 +50,58 @@ def admissible_intervals(p, q, r, w, x_low, x_high):  # pragma: no cover - compi
 
 
 @njit(cache=True)
-def backward_envelope(ds, p, q, x_low, x_high, x_end, slack):  # pragma: no cover - compiled
-    """Maximum-deceleration sweep from the end: K_N = x_end and, for i = N-1 .. 0, the largest
-    admissible x_i from which the least u (u = max_k p_k + q_k x) keeps x_i + 2 ds_i u <= K_i+1.
+def backward_envelope(ds, p, q, r, w, x_low, x_high, x_end, slack):  # pragma: no cover - compiled
+    """The controllable sets, swept backward from the end state: for i = N-1 .. 0 the interval
+    [lower_i, upper_i] of admissible x_i from which some u in [alpha_i(x_i), beta_i(x_i)] lands
+    x_i + 2 ds_i u inside [lower_i+1, upper_i+1]. The upper end uses the least u (maximum
+    deceleration, u = max_k p_k + q_k x), the lower end the greatest (u = min_j r_j + w_j x).
 
-    Returns the envelope K (N + 1,) and the index of the first interval (from the end) where no
-    admissible x exists, or -1.
+    Returns upper (N + 1,), lower (N + 1,) and the index of the first interval (from the end)
+    whose set is empty, or -1.
     """
     n_stages, n_rows = p.shape
-    envelope = np.empty(n_stages + 1)
-    envelope[n_stages] = x_end
+    upper = np.empty(n_stages + 1)
+    lower = np.empty(n_stages + 1)
+    upper[n_stages] = x_end
+    lower[n_stages] = x_end
     for i in range(n_stages - 1, -1, -1):
-        target = envelope[i + 1]
         step = 2.0 * ds[i]
+        ceiling = upper[i + 1]
+        floor = lower[i + 1]
         high = x_high[i]
         low = x_low[i]
         for k in range(n_rows):
             pk = p[i, k]
-            if pk == -_INF:
-                continue
-            denominator = 1.0 + step * q[i, k]
-            bound = (target - step * pk) / denominator if denominator != 0.0 else _INF
-            if denominator > 0.0:
-                if bound < high:
-                    high = bound
-            elif denominator < 0.0:
-                if bound > low:
-                    low = bound
-            elif target - step * pk < 0.0:
-                high = -1.0
+            if pk != -_INF:
+                # x + step (p_k + q_k x) <= ceiling
+                denominator = 1.0 + step * q[i, k]
+                numerator = ceiling - step * pk
+                if denominator > 0.0:
+                    if numerator / denominator < high:
+                        high = numerator / denominator
+                elif denominator < 0.0:
+                    if numerator / denominator > low:
+                        low = numerator / denominator
+                elif numerator < 0.0:
+                    high = -1.0
+            rk = r[i, k]
+            if rk != _INF:
+                # x + step (r_k + w_k x) >= floor
+                denominator = 1.0 + step * w[i, k]
+                numerator = floor - step * rk
+                if denominator > 0.0:
+                    if numerator / denominator > low:
+                        low = numerator / denominator
+                elif denominator < 0.0:
+                    if numerator / denominator < high:
+                        high = numerator / denominator
+                elif numerator > 0.0:
+                    high = -1.0
+        upper[i] = high
+        lower[i] = low
         if high < low - slack * (1.0 + abs(low)):
-            envelope[i] = high
-            return envelope, i
-        envelope[i] = high
-    return envelope, -1
+            return upper, lower, i
+    return upper, lower, -1
 
 
 @njit(cache=True)

@@ -37,6 +37,7 @@ import numpy as np
 
 from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
+from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.kernels import backward_envelope, forward_profile
 from planners.mvc import acceleration_bounds, admissible_set
@@ -91,7 +92,7 @@ class PhasePlaneMethod(TimingMethod):
 
     name = "phase_plane"
 
-    def __init__(self, tolerance: float = 2e-4, max_refinements: int = 3):
+    def __init__(self, tolerance: float = 5e-4, max_refinements: int = 3):
         self.tolerance = tolerance
         self.max_refinements = max_refinements
 
@@ -114,19 +115,19 @@ class PhasePlaneMethod(TimingMethod):
         return scaling
 
     def _intervals_to_split(self, constraints, scaling, sd_start, sd_end, deadline) -> np.ndarray:
-        """Intervals whose time the midpoint discretization (second order) finds shorter by the
-        most, when the total difference exceeds the tolerance."""
+        """Intervals whose time the midpoint discretization (second order) finds shorter by more
+        than their share of the tolerance, when the total difference exceeds the tolerance.
+        Halving an interval quarters its (second-order local) excess, so this equidistributes
+        the error over the grid."""
         try:
             reference = self._solve_on_grid(constraints, sd_start, sd_end, deadline, midpoint_stage_rows)
         except InfeasiblePath:
             return np.empty(0, dtype=int)
         excess = np.diff(scaling.t) - np.diff(reference.t)
-        if excess.sum() <= self.tolerance * reference.duration:
+        budget = self.tolerance * reference.duration
+        if excess.sum() <= budget:
             return np.empty(0, dtype=int)
-        order = np.argsort(excess)[::-1]
-        covered = np.cumsum(excess[order])
-        count = int(np.searchsorted(covered, 0.7 * excess.sum())) + 1
-        return np.sort(order[:count])
+        return np.flatnonzero(excess > 0.5 * budget / len(excess))
 
     @staticmethod
     def _solve_on_grid(constraints, sd_start, sd_end, deadline, discretize) -> TimeScaling:
@@ -154,11 +155,19 @@ def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline
             s=1.0,
         )
     deadline.check()
-    envelope, failed = backward_envelope(
-        ds, bounds.p, bounds.q, admissible.x_min, admissible.x_max, float(x_end), _SLACK
+    envelope, floor, failed = backward_envelope(
+        ds, bounds.p, bounds.q, bounds.r, bounds.w, admissible.x_min, admissible.x_max, float(x_end), _SLACK
     )
     if failed >= 0:
         raise _stuck(constraints, admissible, stage, int(failed))
+    if x_start < floor[0] * (1 - 1e-7) - 1e-12:
+        raise InfeasiblePath(
+            f"the motion cannot start at path speed {np.sqrt(x_start):.6g} 1/s at s = 0: every "
+            f"motion that can follow the path needs at least {np.sqrt(floor[0]):.6g} 1/s there"
+            + static_load(constraints, 0)[0],
+            s=0.0,
+            joint=static_load(constraints, 0)[1],
+        )
     if x_start > envelope[0] * (1 + 1e-7) + 1e-12:
         raise InfeasiblePath(
             f"the start path speed {np.sqrt(x_start):.6g} 1/s is above what the limits allow at s = 0 "
@@ -208,8 +217,10 @@ def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) 
             s=float(s[i]),
             joint=constraints.joint_names[constraints.rows[first % len(constraints.rows)][1]],
         )
+    clause, joint = static_load(constraints, i + 1)
     return InfeasiblePath(
-        f"no motion can follow the path from s = {s[i]:.4f} to its end: the limits cannot slow "
-        f"the motion down in time after s = {s[i + 1]:.4f}",
+        f"no motion can follow the path from s = {s[i]:.4f} to its end: the limits cannot bring "
+        f"the motion to the required speed by s = {s[i + 1]:.4f}{clause}",
         s=float(s[i]),
+        joint=joint,
     )

@@ -17,6 +17,7 @@ import numpy as np
 
 from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
+from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.mvc import admissible_set
 from planners.timing.base import TimeScaling, TimingMethod
@@ -152,7 +153,7 @@ def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Excepti
     if K is not None and np.isnan(K).any():
         return _uncontrollable(constraints, np.flatnonzero(np.isnan(K).any(axis=1)).max())
     if K is not None and not K[0, 0] <= sd_start**2 + 1e-9:
-        detail, joint = _static_load(constraints, 0)
+        detail, joint = static_load(constraints, 0)
         return InfeasiblePath(
             f"the motion cannot start at path speed {sd_start:g} 1/s at s = 0: every admissible "
             f"motion there needs sd >= {np.sqrt(K[0, 0]):.4g} 1/s{detail}",
@@ -162,29 +163,11 @@ def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Excepti
     return TimingFailed("toppra failed to parameterize the path")
 
 
-def _static_load(constraints: PathConstraints, point: int) -> tuple[str, str | None]:
-    """A clause naming the joint whose torque at rest is the largest share of its limit at grid
-    point ``point`` (empty when every joint can hold still there), and that joint's name."""
-    torque_rows = [k for k, (kind, _) in enumerate(constraints.rows) if kind == "torque"]
-    if not torque_rows:
-        return "", None
-    load = np.abs(constraints.c[point, torque_rows]) / constraints.upper[point, torque_rows]
-    worst = torque_rows[int(np.argmax(load))]
-    joint = constraints.joint_names[constraints.rows[worst][1]]
-    if load.max() <= 1.0:
-        return "", joint
-    return (
-        f": holding still at s = {constraints.s[point]:.4f} needs {abs(constraints.c[point, worst]):.4g} N m "
-        f"on joint {joint!r}, above its limit of {constraints.upper[point, worst]:.4g} N m",
-        joint,
-    )
-
-
 def _uncontrollable(constraints: PathConstraints, last_bad: int) -> InfeasiblePath:
     """From grid point ``last_bad`` backwards no motion reaches the end of the path at the
     required speed: say where, and which joint cannot hold its load there."""
     where = min(last_bad + 1, len(constraints.s) - 1)
-    detail, joint = _static_load(constraints, where)
+    detail, joint = static_load(constraints, where)
     return InfeasiblePath(
         f"no motion can follow the path from s = {constraints.s[last_bad]:.4f} to its end: the "
         f"limits cannot bring the motion to the required speed by s = {constraints.s[where]:.4f}{detail}",

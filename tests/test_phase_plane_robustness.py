@@ -1,0 +1,60 @@
+"""1,000 seeded random paths on three robots: the phase-plane method fails on none where TOPP-RA
+succeeds, is never longer, and holds every limit; the set holds zero-inertia points and MVC
+discontinuities (corners of stop-and-go paths)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robots
+from planners.constraints import build_path_constraints
+from planners.errors import InfeasiblePath, TimingFailed
+from planners.grid import path_grid
+from planners.paths import SplinePath, StopAndGoPath
+from planners.timing import PhasePlaneMethod, ToppraMethod
+from planners.trajectory import peak_utilization
+
+CASES = {"ur5": 334, "panda": 333, "yamamoto_2r": 333}
+
+
+def _attempt(method, constraints):
+    try:
+        return method.solve(constraints)
+    except (InfeasiblePath, TimingFailed):
+        return None
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_phase_plane_never_fails_where_toppra_succeeds(name):
+    robot = robots.load(name)
+    rng = np.random.default_rng(2024 + len(name))
+    lower = np.maximum(robot.limits.position_lower, -3.0)
+    upper = np.minimum(robot.limits.position_upper, 3.0)
+    kinds = ("torque",) if name == "yamamoto_2r" else ("velocity", "acceleration", "torque")
+    phase_plane, toppra = PhasePlaneMethod(), ToppraMethod()
+    counts = {"both": 0, "neither": 0, "only_phase_plane": 0, "zero_inertia": 0, "corners": 0}
+    for _ in range(CASES[name]):
+        while True:
+            waypoints = rng.uniform(lower + 0.1 * (upper - lower), upper - 0.1 * (upper - lower), (int(rng.integers(2, 5)), robot.dof))
+            path = (StopAndGoPath if rng.random() < 0.3 else SplinePath)(waypoints)
+            q = path(np.linspace(0.0, 1.0, 400))
+            if np.all(q >= lower) and np.all(q <= upper):
+                break
+        limits = robot.limits.with_request(None, {"torque": float(rng.choice([0.25, 1.0, 4.0]))})
+        constraints = build_path_constraints(path, robot, limits, kinds, path_grid(path))
+        torque_rows = [k for k, (kind, _) in enumerate(constraints.rows) if kind == "torque"]
+        a = constraints.a[:, torque_rows]
+        counts["zero_inertia"] += bool(np.any(np.sign(a[1:]) * np.sign(a[:-1]) < 0))
+        counts["corners"] += bool(path.kinks.size)
+        ours, theirs = _attempt(phase_plane, constraints), _attempt(toppra, constraints)
+        if theirs is not None:
+            assert ours is not None, f"phase_plane failed where toppra succeeded: {waypoints.tolist()}"
+            assert ours.duration <= theirs.duration * (1 + 1e-9)
+        if ours is not None:
+            utilization = peak_utilization(path, ours, robot, limits)
+            assert max(utilization[kind].max() for kind in kinds) <= 1.005
+        key = "both" if ours and theirs else "neither" if not (ours or theirs) else "only_phase_plane"
+        counts[key] += 1
+    assert counts["both"] >= CASES[name] // 2
+    assert counts["zero_inertia"] >= 20 and counts["corners"] >= 50
