@@ -15,37 +15,82 @@ _INF = np.inf
 
 
 @njit(cache=True)
+def _gap(p, q, r, w, i, x):  # pragma: no cover - compiled
+    """phi(x) = min_j (r_j + w_j x) - max_k (p_k + q_k x) at point i, its slope there, and the
+    intercept of the active piece (so its root is -intercept / slope without cancellation)."""
+    n_rows = p.shape[1]
+    lowest = -_INF
+    low_slope = 0.0
+    low_intercept = 0.0
+    highest = _INF
+    high_slope = 0.0
+    high_intercept = 0.0
+    for k in range(n_rows):
+        if p[i, k] != -_INF:
+            value = p[i, k] + q[i, k] * x
+            if value > lowest:
+                lowest = value
+                low_slope = q[i, k]
+                low_intercept = p[i, k]
+        if r[i, k] != _INF:
+            value = r[i, k] + w[i, k] * x
+            if value < highest:
+                highest = value
+                high_slope = w[i, k]
+                high_intercept = r[i, k]
+    return highest - lowest, high_slope - low_slope, high_intercept - low_intercept
+
+
+#: Stand-in for an unbounded x = sd^2 in the root search (sd = 1e6 1/s).
+_X_FAR = 1e12
+
+
+@njit(cache=True)
 def admissible_intervals(p, q, r, w, x_low, x_high):  # pragma: no cover - compiled
     """Narrow ``[x_low, x_high]`` (each (N,), updated in place and returned) at every point to
-    the x for which some u lies between every lower and every upper line: for each pair,
-    p_k + q_k x <= r_j + w_j x."""
-    n_points, n_rows = p.shape
+    the x for which some u lies between every lower and every upper line.
+
+    phi(x) = min_j (r_j + w_j x) - max_k (p_k + q_k x) is concave and piecewise linear, and the
+    admissible x are where phi >= 0. Started right of the interval (where phi < 0 falls), Newton's
+    method on a concave piecewise-linear function steps along one linear piece at a time without
+    overshooting the largest root; started left of it, likewise to the smallest root. A few
+    steps find each end exactly. An empty interval is marked by x_high = -1.
+    """
+    n_points = p.shape[0]
     for i in range(n_points):
         low = x_low[i]
         high = x_high[i]
-        for k in range(n_rows):
-            pk = p[i, k]
-            if pk == -_INF:
-                continue
-            qk = q[i, k]
-            for j in range(n_rows):
-                rj = r[i, j]
-                if rj == _INF:
-                    continue
-                alpha = qk - w[i, j]
-                beta = rj - pk
-                if alpha > 0.0:
-                    bound = beta / alpha
-                    if bound < high:
-                        high = bound
-                elif alpha < 0.0:
-                    bound = beta / alpha
-                    if bound > low:
-                        low = bound
-                elif beta < 0.0:
-                    high = -1.0
-        x_low[i] = low
-        x_high[i] = high
+        unbounded = high > _X_FAR
+        x = _X_FAR if unbounded else high
+        if x < low:
+            x_high[i] = -1.0
+            continue
+        empty = False
+        for _ in range(100):
+            gap, slope, intercept = _gap(p, q, r, w, i, x)
+            if gap >= -1e-12 * (1.0 + abs(x)):
+                break
+            if slope >= 0.0:
+                empty = True
+                break
+            x = -intercept / slope
+            if x < low - 1e-12 * (1.0 + abs(low)):
+                empty = True
+                break
+        if empty:
+            x_high[i] = -1.0
+            continue
+        x_high[i] = high if (unbounded and x == _X_FAR) else x
+        x = low
+        for _ in range(100):
+            gap, slope, intercept = _gap(p, q, r, w, i, x)
+            if gap >= -1e-12 * (1.0 + abs(x)):
+                break
+            if slope <= 0.0:
+                x_high[i] = -1.0
+                break
+            x = -intercept / slope
+        x_low[i] = x
     return x_low, x_high
 
 

@@ -52,7 +52,7 @@ class Timing:
             ``None`` is rest.
     """
 
-    method: str = "toppra"
+    method: str = "phase_plane"
     constraints: tuple[str, ...] = CONSTRAINT_KINDS
     limit_overrides: dict[str, list[float] | None] = field(default_factory=dict)
     limit_scales: dict[str, float | None] = field(default_factory=dict)
@@ -219,7 +219,9 @@ def plan(
         )
     samples = sample_trajectory(path, scaling, robot, dt)
     utilization = peak_utilization(path, scaling, robot, limits)
-    mvc = admissible_set(constraints.linearized(scaling.sd**2), constraints.sd_max**2).sd_max
+    # The phase plane on the constraints' grid (a method that refines keeps every point of it).
+    sd = np.interp(s, scaling.s, scaling.sd)
+    mvc = admissible_set(constraints.linearized(sd**2), constraints.sd_max**2).sd_max
     keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
     return PlannedTrajectory(
         robot=robot.name,
@@ -227,7 +229,7 @@ def plan(
         joint_names=robot.joint_names,
         duration=scaling.duration,
         samples=samples,
-        phase_plane=PhasePlane(s[keep], scaling.sd[keep], mvc[keep], scaling.switch_points),
+        phase_plane=PhasePlane(s[keep], sd[keep], mvc[keep], scaling.switch_points),
         peak_utilization=utilization,
         solve_ms=(time.perf_counter() - started) * 1e3,
         warnings=tuple(_warnings(utilization, kinds)),

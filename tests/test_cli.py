@@ -13,7 +13,7 @@ def test_plan_prints_the_response(tmp_path, capsys):
     request.write_text(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}}))
     assert main(["plan", str(request)]) == 0
     body = json.loads(capsys.readouterr().out)
-    assert body["robot"] == "ur5" and body["method"] == "toppra" and body["duration"] > 0
+    assert body["robot"] == "ur5" and body["method"] == "phase_plane" and body["duration"] > 0
     assert len(body["samples"]["q"][0]) == 6
 
 

@@ -12,12 +12,12 @@ from tests.conftest import UR5_WAYPOINTS
 DT = 0.0005
 
 
-@pytest.fixture(scope="module")
-def ur5_result(client):
+@pytest.fixture(scope="module", params=["phase_plane", "toppra"])
+def ur5_result(client, request):
     body = {
         "robot": "ur5",
         "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS, "interpolation": "spline"},
-        "timing": {"method": "toppra", "constraints": ["velocity", "acceleration", "torque"]},
+        "timing": {"method": request.param, "constraints": ["velocity", "acceleration", "torque"]},
         "output": {"dt": DT},
     }
     response = client.post("/v1/trajectories", json=body)
@@ -74,12 +74,15 @@ def test_ur5_limits_hold_on_a_dense_resampling(ur5_result):
 
 def test_ur5_phase_plane_stays_under_the_mvc(ur5_result):
     plane = ur5_result["phase_plane"]
+    if ur5_result["method"] == "phase_plane":
+        assert {point["kind"] for point in plane["switch_points"]} & {"tangent", "singular", "discontinuity"}
     sd, sd_max = np.array(plane["sd"]), np.array(plane["sd_max"], dtype=float)
     assert plane["s"][0] == 0.0 and plane["s"][-1] == 1.0
     assert sd[0] == 0.0 and sd[-1] == 0.0
     assert np.all(sd <= sd_max * (1 + 1e-6) + 1e-9)
 
 
+@pytest.mark.parametrize("method", ["phase_plane", "toppra"])
 @pytest.mark.parametrize(
     "robot, waypoints",
     [
@@ -87,11 +90,11 @@ def test_ur5_phase_plane_stays_under_the_mvc(ur5_result):
         ("yamamoto_2r", np.radians([[45.0, -90.0], [-90.0, 0.0]]).tolist()),
     ],
 )
-def test_paper_arm_torque_limited_straight_line(client, robot, waypoints):
+def test_paper_arm_torque_limited_straight_line(client, robot, waypoints, method):
     body = {
         "robot": robot,
         "path": {"kind": "waypoints", "waypoints": waypoints},
-        "timing": {"method": "toppra", "constraints": ["torque"], "grid_points": 1000},
+        "timing": {"method": method, "constraints": ["torque"], "grid_points": 1000},
         "output": {"dt": 0.001},
     }
     response = client.post("/v1/trajectories", json=body)

@@ -33,6 +33,8 @@ estimated duration error is below the tolerance.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from planners.constraints import LinearRows, PathConstraints
@@ -103,49 +105,68 @@ class PhasePlaneMethod(TimingMethod):
         sd_end: float = 0.0,
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:
+        boundary = (sd_start**2, sd_end**2)
         for round_ in range(self.max_refinements + 1):
-            scaling = self._solve_on_grid(constraints, sd_start, sd_end, deadline, interval_rows)
+            profile = _solve_on_grid(constraints, boundary, deadline, interval_rows)
             if round_ == self.max_refinements or not constraints.can_refine:
-                return scaling
-            split = self._intervals_to_split(constraints, scaling, sd_start, sd_end, deadline)
+                break
+            split = self._intervals_to_split(constraints, profile, boundary, deadline)
             if split.size == 0:
-                return scaling
+                break
             deadline.check()
             constraints = constraints.with_points(0.5 * (constraints.s[split] + constraints.s[split + 1]))
-        return scaling
+        switches = _switch_points(constraints.s, profile)
+        return TimeScaling(constraints.s, np.sqrt(profile.x), switches)
 
-    def _intervals_to_split(self, constraints, scaling, sd_start, sd_end, deadline) -> np.ndarray:
+    def _intervals_to_split(self, constraints, profile, boundary, deadline) -> np.ndarray:
         """Intervals whose time the midpoint discretization (second order) finds shorter by more
         than their share of the tolerance, when the total difference exceeds the tolerance.
         Halving an interval quarters its (second-order local) excess, so this equidistributes
         the error over the grid."""
         try:
-            reference = self._solve_on_grid(constraints, sd_start, sd_end, deadline, midpoint_stage_rows)
+            reference = _solve_on_grid(constraints, boundary, deadline, midpoint_stage_rows, profile.x)
         except InfeasiblePath:
             return np.empty(0, dtype=int)
-        excess = np.diff(scaling.t) - np.diff(reference.t)
-        budget = self.tolerance * reference.duration
+        excess = _interval_times(constraints.s, profile.x) - _interval_times(constraints.s, reference.x)
+        budget = self.tolerance * _interval_times(constraints.s, reference.x).sum()
         if excess.sum() <= budget:
             return np.empty(0, dtype=int)
         return np.flatnonzero(excess > 0.5 * budget / len(excess))
 
-    @staticmethod
-    def _solve_on_grid(constraints, sd_start, sd_end, deadline, discretize) -> TimeScaling:
-        x_bound = constraints.sd_max**2
+
+class _Profile(NamedTuple):
+    """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
+    envelope (N + 1,), the interval rows and their admissible upper x (N,)."""
+
+    x: np.ndarray
+    capped: np.ndarray
+    envelope: np.ndarray
+    stage: LinearRows
+    x_high: np.ndarray
+
+
+def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
+    root = np.sqrt(x)
+    return 2.0 * np.diff(s) / np.maximum(root[:-1] + root[1:], 1e-300)
+
+
+def _solve_on_grid(constraints, boundary, deadline, discretize, x_ref=None) -> _Profile:
+    """Integrate on the constraints' own grid. Viscous friction is linearized around ``x_ref``
+    (default: a first pass linearized around the velocity bound, then one around its answer)."""
+    x_bound = constraints.sd_max**2
+    passes = 1
+    if x_ref is None:
         x_ref = np.minimum(x_bound, 1e6)
-        scaling = None
-        for _ in range(2 if constraints.has_friction else 1):
-            stage = discretize(
-                constraints.s, constraints.linearized(x_ref), constraints.linearized(x_ref, "left")
-            )
-            scaling = _integrate(constraints, stage, x_bound, sd_start**2, sd_end**2, deadline)
-            x_ref = scaling.sd**2
-        return scaling
+        passes = 2 if constraints.has_friction else 1
+    for _ in range(passes):
+        stage = discretize(constraints.s, constraints.linearized(x_ref), constraints.linearized(x_ref, "left"))
+        profile = _integrate(constraints, stage, x_bound, *boundary, deadline)
+        x_ref = profile.x
+    return profile
 
 
-def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline) -> TimeScaling:
-    s = constraints.s
-    ds = np.ascontiguousarray(np.diff(s))
+def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline) -> _Profile:
+    ds = np.ascontiguousarray(np.diff(constraints.s))
     admissible = admissible_set(stage, x_bound[:-1])
     bounds = acceleration_bounds(stage)
     if x_end > x_bound[-1] * (1 + _SLACK) + _SLACK:
@@ -161,12 +182,12 @@ def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline
     if failed >= 0:
         raise _stuck(constraints, admissible, stage, int(failed))
     if x_start < floor[0] * (1 - 1e-7) - 1e-12:
+        clause, joint = static_load(constraints, 0)
         raise InfeasiblePath(
             f"the motion cannot start at path speed {np.sqrt(x_start):.6g} 1/s at s = 0: every "
-            f"motion that can follow the path needs at least {np.sqrt(floor[0]):.6g} 1/s there"
-            + static_load(constraints, 0)[0],
+            f"motion that can follow the path needs at least {np.sqrt(floor[0]):.6g} 1/s there{clause}",
             s=0.0,
-            joint=static_load(constraints, 0)[1],
+            joint=joint,
         )
     if x_start > envelope[0] * (1 + 1e-7) + 1e-12:
         raise InfeasiblePath(
@@ -178,12 +199,12 @@ def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline
     deadline.check()
     x, capped = forward_profile(ds, bounds.r, bounds.w, envelope, float(min(x_start, envelope[0])))
     x[-1] = x_end
-    switches = _switch_points(s, capped, envelope, admissible.x_max, stage)
-    return TimeScaling(s, np.sqrt(np.maximum(x, 0.0)), switches)
+    return _Profile(np.maximum(x, 0.0), capped, envelope, stage, admissible.x_max)
 
 
-def _switch_points(s, capped, envelope, x_high, stage) -> tuple[tuple[float, str], ...]:
+def _switch_points(s, profile: _Profile) -> tuple[tuple[float, str], ...]:
     """Where the profile changes between accelerating (at beta) and following the envelope."""
+    capped, envelope, x_high, stage = profile.capped, profile.envelope, profile.x_high, profile.stage
     points = []
     scale = np.maximum(np.abs(stage.a) + np.abs(stage.b), 1e-300)
     for i in np.flatnonzero(np.diff(capped.astype(int)) != 0) + 1:
