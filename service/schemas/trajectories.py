@@ -57,7 +57,7 @@ class CostRequest(Schema):
 class TimingRequest(Schema):
     """How to time the path."""
 
-    method: str = Field(default="toppra", description="Timing method, e.g. `toppra`.")
+    method: str = Field(default="phase_plane", description="Timing method: `phase_plane` (in-house, default) or `toppra`.")
     constraints: list[Literal["velocity", "acceleration", "torque"]] = Field(
         default=["velocity", "acceleration", "torque"], max_length=3
     )
