@@ -29,7 +29,7 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
 from robots import JointLimits, Robot
 
-CONSTRAINT_KINDS = ("velocity", "acceleration", "torque")
+CONSTRAINT_KINDS = ("velocity", "acceleration", "torque", "jerk")
 
 
 @dataclass(frozen=True)
@@ -47,6 +47,13 @@ class PathConstraints:
         lower, upper: Bounds of the rows, shape (N + 1, m); ``-inf``/``inf`` where none.
         rows: (kind, joint index) of each of the m rows, kind "acceleration" or "torque".
         joint_names: Joint names, for messages.
+        jerk: When jerk is limited, (dq, ddq, dddq, limit): the path's first three
+            s-derivatives, each (N + 1, n_dof), and the jerk limit (n_dof,) in rad/s^3. The
+            jerk dq sddd + 3 ddq sd sdd + dddq sd^3 involves sddd, so only the time laws and
+            ruckig read it.
+        velocity_joint: Index of the joint whose velocity limit sets sd_max at each point
+            (N + 1,), -1 where no velocity limit applies.
+        evaluate: Builds the same constraints at other values of s (for methods that refine).
     """
 
     s: np.ndarray
@@ -63,6 +70,8 @@ class PathConstraints:
     upper: np.ndarray
     rows: tuple[tuple[str, int], ...]
     joint_names: tuple[str, ...]
+    jerk: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+    velocity_joint: np.ndarray | None = None
     evaluate: Callable[[np.ndarray], "PathConstraints"] | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -94,6 +103,11 @@ class PathConstraints:
             upper=merge(self.upper, extra.upper),
             rows=self.rows,
             joint_names=self.joint_names,
+            velocity_joint=None if self.velocity_joint is None else merge(self.velocity_joint, extra.velocity_joint),
+            jerk=None if self.jerk is None else (
+                *(merge(mine, theirs) for mine, theirs in zip(self.jerk[:3], extra.jerk[:3])),
+                self.jerk[3],
+            ),
             evaluate=self.evaluate,
         )
 
@@ -209,10 +223,12 @@ def build_path_constraints(
     points, (a, b, c, d, bound), rows = _second_order_rows(path, robot, limits, kinds, s, "right")
     deadline.check()
     sd_max = np.full(len(s), np.inf)
+    velocity_joint = np.full(len(s), -1)
     if "velocity" in kinds:
         with np.errstate(divide="ignore"):
             per_joint = limits.velocity / np.abs(points.dq)
         sd_max = np.min(per_joint, axis=1)
+        velocity_joint = np.where(np.isfinite(sd_max), np.argmin(per_joint, axis=1), -1)
     a_left, b_left, c_left, d_left = a, b, c, d
     kink_index = np.flatnonzero(np.isin(s, path.kinks))
     if kink_index.size:
@@ -238,5 +254,7 @@ def build_path_constraints(
         upper=bound.copy(),
         rows=rows,
         joint_names=robot.joint_names,
+        jerk=(points.dq, points.ddq, path.third_derivative(s), limits.jerk) if "jerk" in kinds else None,
+        velocity_joint=velocity_joint,
         evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),
     )

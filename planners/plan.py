@@ -17,7 +17,11 @@ from planners.errors import InfeasiblePath, InvalidRequest
 from planners.grid import MAX_POINTS, path_grid
 from planners.mvc import admissible_set
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
+from planners.boundary import path_acceleration, path_speed
 from planners.timing import METHODS
+from planners.timing.base import Binding, Boundary, TimingMethod
+from planners.timing.classical import ClassicalMethod
+from planners.timing.laws import TrapezoidalProfile
 from planners.trajectory import Samples, peak_utilization, sample_trajectory
 from robots import JointLimits, Robot
 
@@ -50,15 +54,24 @@ class Timing:
         grid_points: Number of grid intervals; ``None`` chooses one from the path.
         start_velocity, end_velocity: Joint velocities at the ends (rad/s), tangent to the path;
             ``None`` is rest.
+        start_acceleration, end_acceleration: Joint accelerations at the ends (rad/s^2), for the
+            laws that take them (quintic).
+        duration: Seconds, for the time laws; ``None`` asks for the shortest within the limits.
+        trapezoid_fractions: (tau1, tau2), the trapezoidal law's ends of acceleration and of
+            cruise as fractions of the duration.
     """
 
     method: str = "phase_plane"
-    constraints: tuple[str, ...] = CONSTRAINT_KINDS
+    constraints: tuple[str, ...] = ("velocity", "acceleration", "torque")
     limit_overrides: dict[str, list[float] | None] = field(default_factory=dict)
     limit_scales: dict[str, float | None] = field(default_factory=dict)
     grid_points: int | None = None
     start_velocity: np.ndarray | None = None
     end_velocity: np.ndarray | None = None
+    start_acceleration: np.ndarray | None = None
+    end_acceleration: np.ndarray | None = None
+    duration: float | None = None
+    trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
 
 
 @dataclass(frozen=True)
@@ -84,20 +97,7 @@ class PlannedTrajectory:
     peak_utilization: dict[str, np.ndarray]
     solve_ms: float
     warnings: tuple[str, ...]
-
-
-def _finite_array(value, name: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidRequest(f"{name} must be numbers") from None
-    if shape is not None and array.shape != shape:
-        raise InvalidRequest(f"{name} has shape {list(array.shape)}, expected {list(shape)}")
-    bad = np.argwhere(~np.isfinite(array))
-    if bad.size:
-        where = "".join(f"[{i}]" for i in bad[0])
-        raise InvalidRequest(f"{name}{where} is {array[tuple(bad[0])]}, not a finite number")
-    return array
+    binding: Binding | None = None
 
 
 def make_path(robot: Robot, spec: WaypointPath) -> GeometricPath:
@@ -119,7 +119,9 @@ def make_path(robot: Robot, spec: WaypointPath) -> GeometricPath:
             f"path.waypoints[0] has {width} values; {robot.name} has {robot.dof} joints "
             f"({', '.join(robot.joint_names)})"
         )
-    waypoints = _finite_array(waypoints, "path.waypoints")
+    bad = np.argwhere(~np.isfinite(waypoints))
+    if bad.size:
+        raise InvalidRequest(f"path.waypoints[{bad[0][0]}][{bad[0][1]}] is not a finite number")
     lower, upper = robot.limits.position_lower, robot.limits.position_upper
     outside = (waypoints < lower - 1e-9) | (waypoints > upper + 1e-9)
     if outside.any():
@@ -148,33 +150,52 @@ def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) 
         )
 
 
-def _path_speed(path: GeometricPath, velocity, s_end: float, name: str) -> float:
-    """The path speed sd >= 0 with q'(s) sd equal to the joint ``velocity``.
-
-    Raises:
-        InvalidRequest: the velocity is not tangent to the path there (or points backwards).
-    """
-    if velocity is None:
-        return 0.0
-    tangent = path.evaluate(np.array([s_end])).dq[0]
-    velocity = _finite_array(velocity, name, tangent.shape)
-    sd = float(velocity @ tangent / (tangent @ tangent))
-    residual = np.linalg.norm(velocity - sd * tangent)
-    if residual > 1e-6 * max(1.0, np.linalg.norm(velocity)) or sd < 0.0:
-        raise InvalidRequest(
-            f"{name} is not tangent to the path at s = {s_end:g}: the path's direction there is "
-            f"{np.round(tangent / np.linalg.norm(tangent), 6).tolist()}"
-        )
-    return sd
-
-
-def _check_constraint_kinds(kinds) -> tuple[str, ...]:
+def _check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
     unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
     if unknown:
+        raise InvalidRequest(f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}")
+    unsupported = [kind for kind in kinds if kind not in method.kinds]
+    if unsupported:
         raise InvalidRequest(
-            f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}"
+            f"timing.method {method.name!r} cannot limit {unsupported[0]}; it handles "
+            f"{sorted(method.kinds)} (jerk: use a time law or ruckig)"
         )
+    if not kinds:
+        raise InvalidRequest("timing.constraints is empty: without limits the time-optimal motion is instantaneous")
     return tuple(dict.fromkeys(kinds))
+
+
+def timing_method(timing: Timing) -> TimingMethod:
+    """The method named by ``timing.method`` (with its per-request options)."""
+    if timing.method == "trapezoidal":
+        tau1, tau2 = timing.trapezoid_fractions
+        if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
+            raise InvalidRequest(f"timing.trapezoid needs 0 < tau1 <= tau2 < 1, got {tau1}, {tau2}")
+        return ClassicalMethod(TrapezoidalProfile(tau1, tau2))
+    method = METHODS.get(timing.method)
+    if method is None:
+        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
+    return method
+
+
+def _boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
+    if (timing.start_acceleration is not None or timing.end_acceleration is not None) and not method.takes_acceleration_boundary:
+        raise InvalidRequest(
+            f"timing.boundary accelerations are not used by timing.method {method.name!r}; use quintic"
+        )
+    if timing.duration is not None and not method.takes_duration:
+        raise InvalidRequest(
+            f"timing.duration is not used by timing.method {method.name!r}, which finds the shortest "
+            "duration itself; leave it out or use a time law"
+        )
+    sd_start = path_speed(path, timing.start_velocity, 0.0, "timing.boundary.start_velocity")
+    sd_end = path_speed(path, timing.end_velocity, 1.0, "timing.boundary.end_velocity")
+    return Boundary(
+        sd_start=sd_start,
+        sd_end=sd_end,
+        sdd_start=path_acceleration(path, timing.start_acceleration, sd_start, 0.0, "timing.boundary.start_acceleration"),
+        sdd_end=path_acceleration(path, timing.end_acceleration, sd_end, 1.0, "timing.boundary.end_acceleration"),
+    )
 
 
 def plan(
@@ -193,56 +214,55 @@ def plan(
         BudgetExceeded: ``deadline`` passed.
     """
     started = time.perf_counter()
-    method = METHODS.get(timing.method)
-    if method is None:
-        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
-    kinds = _check_constraint_kinds(timing.constraints)
+    method = timing_method(timing)
+    kinds = _check_constraint_kinds(timing.constraints, method)
     if not (np.isfinite(dt) and dt > 0.0):
         raise InvalidRequest(f"output.dt must be a positive number of seconds, got {dt}")
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
         raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
+    if timing.duration is not None and not (np.isfinite(timing.duration) and timing.duration > 0):
+        raise InvalidRequest(f"timing.duration must be a positive number of seconds, got {timing.duration}")
     limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
     path = make_path(robot, path_spec)
     s = path_grid(path, timing.grid_points)
     _check_path_within_limits(robot, path, s)
-    sd_start = _path_speed(path, timing.start_velocity, 0.0, "timing.boundary.start_velocity")
-    sd_end = _path_speed(path, timing.end_velocity, 1.0, "timing.boundary.end_velocity")
-    if not kinds:
-        raise InvalidRequest("timing.constraints is empty: without limits the time-optimal motion is instantaneous")
+    boundary = _boundary(path, timing, method)
     constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
     deadline.check()
-    scaling = method.solve(constraints, sd_start, sd_end, deadline)
+    result = method.solve(constraints, boundary, timing.duration, deadline)
     deadline.check()
-    if scaling.duration / dt > MAX_SAMPLES:
+    if result.duration / dt > MAX_SAMPLES:
         raise InvalidRequest(
-            f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {scaling.duration:.4g} s"
+            f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {result.duration:.4g} s"
         )
-    samples = sample_trajectory(path, scaling, robot, dt)
-    utilization = peak_utilization(path, scaling, robot, limits)
-    # The phase plane on the constraints' grid (a method that refines keeps every point of it).
-    sd = np.interp(s, scaling.s, scaling.sd)
+    samples = sample_trajectory(path, result, robot, dt)
+    utilization = peak_utilization(path, result, robot, limits)
+    sd = result.speed_at(s)
     mvc = admissible_set(constraints.linearized(sd**2), constraints.sd_max**2).sd_max
     keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
     return PlannedTrajectory(
         robot=robot.name,
         method=method.name,
         joint_names=robot.joint_names,
-        duration=scaling.duration,
+        duration=result.duration,
         samples=samples,
-        phase_plane=PhasePlane(s[keep], sd[keep], mvc[keep], scaling.switch_points),
+        phase_plane=PhasePlane(s[keep], sd[keep], mvc[keep], result.switch_points),
         peak_utilization=utilization,
         solve_ms=(time.perf_counter() - started) * 1e3,
-        warnings=tuple(_warnings(utilization, kinds)),
+        warnings=tuple(_warnings(utilization, kinds, robot)),
+        binding=result.binding,
     )
 
 
-def _warnings(utilization: dict[str, np.ndarray], kinds: tuple[str, ...]) -> list[str]:
+def _warnings(utilization: dict[str, np.ndarray], kinds: tuple[str, ...], robot: Robot) -> list[str]:
     notes = []
     for kind in kinds:
+        if kind not in utilization:
+            continue
         worst = int(np.argmax(utilization[kind]))
         if utilization[kind][worst] > 1.005:
             notes.append(
-                f"{kind} limit exceeded by {100 * (utilization[kind][worst] - 1):.2f} % on joint index "
-                f"{worst} between grid points; raise timing.grid_points"
+                f"{kind} limit of joint {robot.joint_names[worst]!r} exceeded by "
+                f"{100 * (utilization[kind][worst] - 1):.2f} %"
             )
     return notes

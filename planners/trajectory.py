@@ -11,11 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.paths.base import GeometricPath
-from planners.timing.base import TimeScaling
+from planners.timing.base import PathTiming
 from robots import JointLimits, Robot
-
-#: Points per grid interval (both ends included) of the dense resampling that checks limits.
-DENSE_FRACTIONS = np.linspace(0.0, 1.0, 5)
 
 
 @dataclass(frozen=True)
@@ -36,7 +33,7 @@ def _joint_motion(path: GeometricPath, s, sd, sdd, side: str = "right"):
     return points.q, qd, qdd
 
 
-def sample_trajectory(path: GeometricPath, scaling: TimeScaling, robot: Robot, dt: float) -> Samples:
+def sample_trajectory(path: GeometricPath, scaling: PathTiming, robot: Robot, dt: float) -> Samples:
     """Samples every ``dt`` seconds from 0, plus the final instant."""
     duration = scaling.duration
     t = np.arange(0.0, duration, dt)
@@ -48,22 +45,33 @@ def sample_trajectory(path: GeometricPath, scaling: TimeScaling, robot: Robot, d
 
 
 def peak_utilization(
-    path: GeometricPath, scaling: TimeScaling, robot: Robot, limits: JointLimits
+    path: GeometricPath, timing: PathTiming, robot: Robot, limits: JointLimits
 ) -> dict[str, np.ndarray]:
-    """max |value| / limit per joint for velocity, acceleration and torque, over a dense
-    resampling of every grid interval (both sides of each grid point); 0 where unlimited."""
-    n_intervals = len(scaling.s) - 1
-    interval = np.repeat(np.arange(n_intervals), len(DENSE_FRACTIONS))
-    fraction = np.tile(DENSE_FRACTIONS, n_intervals)
-    s, sd, sdd = scaling.at_path(interval, fraction)
-    # The samples at fraction 1 belong to the interval that ends there: the left side of a corner.
-    ends = fraction == 1.0
-    q, qd, qdd = _joint_motion(path, s, sd, sdd)
-    if np.any(ends) and path.kinks.size:
-        _, qd[ends], qdd[ends] = _joint_motion(path, s[ends], sd[ends], sdd[ends], side="left")
-    tau = robot.inverse_dynamics(q, qd, qdd)
+    """max |value| / limit per joint for velocity, acceleration and torque (and jerk, when the
+    timing has a finite one), over the timing's dense states, both sides of every corner; 0
+    where unlimited."""
+    states = timing.dense_states()
+    q = path(states.s)
+    qd, qdd = np.empty_like(q), np.empty_like(q)
+    jerk = np.empty_like(q) if states.sddd is not None else None
+    for side, mask in (("right", ~states.left), ("left", states.left)):
+        if not np.any(mask):
+            continue
+        s, sd, sdd = states.s[mask], states.sd[mask], states.sdd[mask]
+        points = path.evaluate(s, side)
+        qd[mask] = points.dq * sd[:, None]
+        qdd[mask] = points.dq * sdd[:, None] + points.ddq * (sd**2)[:, None]
+        if jerk is not None:
+            jerk[mask] = (
+                path.third_derivative(s, side) * (sd**3)[:, None]
+                + 3.0 * points.ddq * (sd * sdd)[:, None]
+                + points.dq * states.sddd[mask][:, None]
+            )
+    values = [("velocity", qd), ("acceleration", qdd), ("torque", robot.inverse_dynamics(q, qd, qdd))]
+    if jerk is not None:
+        values.append(("jerk", jerk))
     with np.errstate(divide="ignore", invalid="ignore"):
         return {
             kind: np.nan_to_num(np.max(np.abs(value), axis=0) / getattr(limits, kind), nan=0.0)
-            for kind, value in (("velocity", qd), ("acceleration", qdd), ("torque", tau))
+            for kind, value in values
         }

@@ -17,29 +17,22 @@ from service.schemas.trajectories import TrajectoryRequest
 
 def _timing(request: TrajectoryRequest) -> Timing:
     timing = request.timing
-    method = timing.method
-    for name, given in (
-        ("timing.duration", timing.duration),
-        ("timing.boundary.start_acceleration", timing.boundary.start_acceleration),
-        ("timing.boundary.end_acceleration", timing.boundary.end_acceleration),
-    ):
-        if given is not None:
-            raise InvalidRequest(f"{name} is not used by timing.method {method!r}; leave it out")
     if timing.cost.torque_weight != 0.0:
-        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {method!r}")
+        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}")
     limits = timing.limits
+    kinds = ("velocity", "acceleration", "jerk", "torque")
     return Timing(
-        method=method,
+        method=timing.method,
         constraints=tuple(timing.constraints),
-        limit_overrides={
-            kind: getattr(limits, kind) for kind in ("velocity", "acceleration", "jerk", "torque")
-        },
-        limit_scales={
-            kind: getattr(limits, f"{kind}_scale") for kind in ("velocity", "acceleration", "jerk", "torque")
-        },
+        limit_overrides={kind: getattr(limits, kind) for kind in kinds},
+        limit_scales={kind: getattr(limits, f"{kind}_scale") for kind in kinds},
         grid_points=timing.grid_points,
         start_velocity=timing.boundary.start_velocity,
         end_velocity=timing.boundary.end_velocity,
+        start_acceleration=timing.boundary.start_acceleration,
+        end_acceleration=timing.boundary.end_acceleration,
+        duration=timing.duration,
+        trapezoid_fractions=(timing.trapezoid.tau1, timing.trapezoid.tau2),
     )
 
 
@@ -83,6 +76,9 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "switch_points": [{"s": s, "kind": kind} for s, kind in result.phase_plane.switch_points],
         },
         "peak_utilization": {kind: values.tolist() for kind, values in result.peak_utilization.items()},
+        "binding": None if result.binding is None else {
+            "kind": result.binding.kind, "joint": result.binding.joint, "s": result.binding.s
+        },
         "solve_ms": result.solve_ms,
         "warnings": list(result.warnings),
     }

@@ -41,6 +41,10 @@ class GeometricPath(abc.ABC):
         """q, dq/ds and d2q/ds2 at ``s`` (shape (n_samples,)); at a kink, the one-sided derivatives
         of ``side`` ("left" or "right")."""
 
+    @abc.abstractmethod
+    def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
+        """d3q/ds3 at ``s``, shape (n_samples, n_dof) (for jerk)."""
+
     def __call__(self, s: np.ndarray) -> np.ndarray:
         """q(s), shape (n_samples, n_dof)."""
         return self.evaluate(np.atleast_1d(np.asarray(s, dtype=float))).q

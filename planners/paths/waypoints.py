@@ -49,10 +49,14 @@ class SplinePath(GeometricPath):
         self._spline = CubicSpline(self.knots, self.waypoints, axis=0, bc_type="natural")
         self._d1 = self._spline.derivative(1)
         self._d2 = self._spline.derivative(2)
+        self._d3 = self._spline.derivative(3)
 
     def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
         s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
         return PathPoints(self._spline(s), self._d1(s), self._d2(s))
+
+    def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
+        return self._d3(np.clip(np.asarray(s, dtype=float), 0.0, 1.0))
 
 
 class StopAndGoPath(GeometricPath):
@@ -79,3 +83,6 @@ class StopAndGoPath(GeometricPath):
         slope = self._slopes[segment]
         q = self.waypoints[segment] + slope * (s - self.knots[segment])[:, None]
         return PathPoints(q, slope, np.zeros_like(slope))
+
+    def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
+        return np.zeros((np.size(s), self.dof))

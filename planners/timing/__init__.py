@@ -1,10 +1,13 @@
 """Timing methods: each reads ``PathConstraints`` and returns a ``TimeScaling``."""
 
 from planners.timing.base import TimeScaling, TimingMethod
+from planners.timing.classical import ClassicalMethod, classical_methods
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.toppra_method import ToppraMethod
 
 #: ``timing.method`` name -> method.
-METHODS: dict[str, TimingMethod] = {method.name: method for method in (PhasePlaneMethod(), ToppraMethod())}
+METHODS: dict[str, TimingMethod] = {
+    method.name: method for method in (PhasePlaneMethod(), ToppraMethod(), *classical_methods())
+}
 
-__all__ = ["METHODS", "PhasePlaneMethod", "TimeScaling", "TimingMethod", "ToppraMethod"]
+__all__ = ["METHODS", "ClassicalMethod", "PhasePlaneMethod", "TimeScaling", "TimingMethod", "ToppraMethod"]

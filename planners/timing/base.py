@@ -1,5 +1,6 @@
-"""The timing side of a trajectory: ``TimeScaling`` s(t), and the interface every timing method
-implements (read ``PathConstraints``, return a ``TimeScaling``)."""
+"""The timing side of a trajectory: ``PathTiming`` s(t) (a grid-based ``TimeScaling`` for the
+time-optimal methods, time laws for the classical ones), and the interface every timing method
+implements (read ``PathConstraints``, return a ``PathTiming``)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,64 @@ from planners.errors import TimingFailed
 
 
 @dataclass(frozen=True)
-class TimeScaling:
+class Boundary:
+    """Path speed (1/s) and acceleration (1/s^2) at the ends; ``None`` accelerations are free
+    for the time-optimal methods and zero for the time laws."""
+
+    sd_start: float = 0.0
+    sd_end: float = 0.0
+    sdd_start: float | None = None
+    sdd_end: float | None = None
+
+
+@dataclass(frozen=True)
+class DenseStates:
+    """Path states for checking limits between samples, each of shape (n,): s, sd, sdd, and
+    sddd (1/s^3) when the timing has a finite jerk; ``left`` marks states that belong to the
+    interval ending at their s (the left-hand side of a corner of the path)."""
+
+    s: np.ndarray
+    sd: np.ndarray
+    sdd: np.ndarray
+    sddd: np.ndarray | None
+    left: np.ndarray
+
+
+@dataclass(frozen=True)
+class Binding:
+    """The limit that sets a minimal duration: its kind, joint and place along the path."""
+
+    kind: str
+    joint: str | None
+    s: float
+
+
+class PathTiming(abc.ABC):
+    """s(t) on [0, duration], from s = 0 to s = 1."""
+
+    switch_points: tuple[tuple[float, str], ...] = ()
+    binding: Binding | None = None
+
+    @property
+    @abc.abstractmethod
+    def duration(self) -> float:
+        """Total time, in s."""
+
+    @abc.abstractmethod
+    def at_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """s, sd and sdd at times ``t`` (shape (n,), clipped to [0, duration])."""
+
+    @abc.abstractmethod
+    def dense_states(self) -> DenseStates:
+        """States dense enough to check every limit between samples."""
+
+    @abc.abstractmethod
+    def speed_at(self, s: np.ndarray) -> np.ndarray:
+        """Path speed sd (1/s) at the given values of s, for the phase-plane picture."""
+
+
+@dataclass(frozen=True)
+class TimeScaling(PathTiming):
     """A time scaling s(t) with piecewise-constant path acceleration.
 
     Between grid points s_i and s_i+1 the path acceleration is constant,
@@ -69,27 +127,50 @@ class TimeScaling:
         s = self.s[interval] + self.sd[interval] * tau + 0.5 * sdd * tau**2
         return np.minimum(s, self.s[interval + 1]), np.maximum(sd, 0.0), sdd
 
-    def at_path(self, interval: np.ndarray, fraction: np.ndarray):
-        """s, sd and sdd at ``fraction`` (in [0, 1]) of grid interval ``interval``: both sides of
-        a grid point are reached as fraction 1 of one interval and 0 of the next."""
+    def dense_states(self) -> DenseStates:
+        """Five states per grid interval, both ends included: a grid point is reached as the end
+        of one interval (``left``) and the start of the next, each with its own sdd."""
+        fractions = np.linspace(0.0, 1.0, 5)
+        n_intervals = len(self.s) - 1
+        interval = np.repeat(np.arange(n_intervals), len(fractions))
+        fraction = np.tile(fractions, n_intervals)
         s0, s1 = self.s[interval], self.s[interval + 1]
-        s = s0 + fraction * (s1 - s0)
         x = self.sd[interval] ** 2 + fraction * (self.sd[interval + 1] ** 2 - self.sd[interval] ** 2)
-        return s, np.sqrt(np.maximum(x, 0.0)), self.sdd[interval]
+        return DenseStates(
+            s=s0 + fraction * (s1 - s0),
+            sd=np.sqrt(np.maximum(x, 0.0)),
+            sdd=self.sdd[interval],
+            sddd=None,
+            left=fraction == 1.0,
+        )
+
+    def speed_at(self, s: np.ndarray) -> np.ndarray:
+        x = np.interp(s, self.s, self.sd**2)
+        return np.sqrt(np.maximum(x, 0.0))
 
 
 class TimingMethod(abc.ABC):
-    """A way to time a path: reads ``PathConstraints``, returns a ``TimeScaling``."""
+    """A way to time a path: reads ``PathConstraints``, returns a ``PathTiming``.
 
-    #: The ``timing.method`` name.
+    Attributes:
+        name: The ``timing.method`` name.
+        kinds: The limit kinds the method can respect.
+        takes_duration: Whether a requested duration is honoured.
+        takes_acceleration_boundary: Whether boundary path accelerations are honoured.
+    """
+
     name: str
+    kinds: frozenset[str] = frozenset({"velocity", "acceleration", "torque"})
+    takes_duration: bool = False
+    takes_acceleration_boundary: bool = False
 
     @abc.abstractmethod
     def solve(
         self,
         constraints: PathConstraints,
-        sd_start: float = 0.0,
-        sd_end: float = 0.0,
+        boundary: Boundary = Boundary(),
+        duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
-    ) -> TimeScaling:
-        """Time the path of ``constraints`` from path speed ``sd_start`` to ``sd_end`` (1/s)."""
+    ) -> PathTiming:
+        """Time the path of ``constraints`` between the ``boundary`` states, in ``duration``
+        seconds when given and supported, else as fast as the method allows."""

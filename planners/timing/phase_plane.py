@@ -43,7 +43,7 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.kernels import backward_envelope, forward_profile
 from planners.mvc import acceleration_bounds, admissible_set
-from planners.timing.base import TimeScaling, TimingMethod
+from planners.timing.base import Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
 _SLACK = 1e-9
@@ -101,11 +101,11 @@ class PhasePlaneMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        sd_start: float = 0.0,
-        sd_end: float = 0.0,
+        boundary: Boundary = Boundary(),
+        duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:
-        boundary = (sd_start**2, sd_end**2)
+        boundary = (boundary.sd_start**2, boundary.sd_end**2)
         for round_ in range(self.max_refinements + 1):
             profile = _solve_on_grid(constraints, boundary, deadline, interval_rows)
             if round_ == self.max_refinements or not constraints.can_refine:

@@ -20,7 +20,7 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.mvc import admissible_set
-from planners.timing.base import TimeScaling, TimingMethod
+from planners.timing.base import Boundary, TimeScaling, TimingMethod
 
 logging.getLogger("toppra").setLevel(logging.ERROR)
 
@@ -94,11 +94,12 @@ class ToppraMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        sd_start: float = 0.0,
-        sd_end: float = 0.0,
+        boundary: Boundary = Boundary(),
+        duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:
         TOPPRA, PrecomputedRows, GridPath = _toppra_classes()
+        sd_start, sd_end = boundary.sd_start, boundary.sd_end
         x_bound = constraints.sd_max**2
         x_ref = _reference_x(constraints, x_bound)
         scaling = None

@@ -54,17 +54,32 @@ class CostRequest(Schema):
     torque_weight: Annotated[float, Field(ge=0.0)] = 0.0
 
 
+class TrapezoidRequest(Schema):
+    """Switching fractions of the trapezoidal law (Angeles 6.1): acceleration ends at tau1 and
+    deceleration starts at tau2, as fractions of the duration."""
+
+    tau1: Annotated[float, Field(gt=0.0, lt=1.0)] = 1.0 / 3.0
+    tau2: Annotated[float, Field(gt=0.0, lt=1.0)] = 2.0 / 3.0
+
+
 class TimingRequest(Schema):
     """How to time the path."""
 
-    method: str = Field(default="phase_plane", description="Timing method: `phase_plane` (in-house, default) or `toppra`.")
-    constraints: list[Literal["velocity", "acceleration", "torque"]] = Field(
-        default=["velocity", "acceleration", "torque"], max_length=3
+    method: str = Field(
+        default="phase_plane",
+        description="`phase_plane` (time-optimal, default), `toppra`, or a time law: `cubic`, "
+        "`quintic`, `trapezoidal`, `cycloidal`.",
+    )
+    constraints: list[Literal["velocity", "acceleration", "torque", "jerk"]] = Field(
+        default=["velocity", "acceleration", "torque"],
+        max_length=4,
+        description="Limits to respect; jerk only with the time laws and ruckig.",
     )
     limits: LimitsRequest = LimitsRequest()
     duration: Positive | None = Field(default=None, description="Seconds, for the classical time laws.")
     boundary: Boundary = Boundary()
     cost: CostRequest = CostRequest()
+    trapezoid: TrapezoidRequest = TrapezoidRequest()
     grid_points: Annotated[int, Field(ge=2, le=20_000)] | None = Field(
         default=None, description="Number of grid intervals over the path; default chosen from it."
     )
@@ -111,11 +126,21 @@ class PhasePlanePublic(BaseModel):
 
 
 class UtilizationPublic(BaseModel):
-    """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds)."""
+    """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds); jerk
+    for timings with a finite jerk (time laws, ruckig)."""
 
     velocity: list[float]
     acceleration: list[float]
     torque: list[float]
+    jerk: list[float] | None = None
+
+
+class BindingPublic(BaseModel):
+    """The limit that set a minimal duration (time laws): its kind, joint and place."""
+
+    kind: str
+    joint: str | None
+    s: float
 
 
 class TrajectoryResponse(BaseModel):
@@ -128,5 +153,6 @@ class TrajectoryResponse(BaseModel):
     samples: SamplesPublic
     phase_plane: PhasePlanePublic
     peak_utilization: UtilizationPublic
+    binding: BindingPublic | None = None
     solve_ms: float
     warnings: list[str]

@@ -1,0 +1,65 @@
+"""Joint boundary states (velocity, acceleration) turned into path states (sd, sdd).
+
+With q' = dq/ds and q'' = d2q/ds2 at an end of the path: qd = q' sd and
+qdd = q' sdd + q'' sd^2 (Yamamoto et al. eqs. (8), (9)). A joint state is admissible only when
+it is of that form: the velocity along the tangent, the acceleration's part off the tangent equal
+to the curvature term.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from planners.errors import InvalidRequest
+from planners.paths.base import GeometricPath
+
+
+def finite_vector(value, name: str, length: int) -> np.ndarray:
+    """``value`` as a float vector of ``length`` finite numbers (InvalidRequest otherwise)."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidRequest(f"{name} must be a list of numbers") from None
+    if array.shape != (length,):
+        raise InvalidRequest(f"{name} has {array.size} values; the robot has {length} joints")
+    bad = np.flatnonzero(~np.isfinite(array))
+    if bad.size:
+        raise InvalidRequest(f"{name}[{bad[0]}] is {array[bad[0]]}, not a finite number")
+    return array
+
+
+def _tolerance(vector: np.ndarray) -> float:
+    return 1e-6 * max(1.0, float(np.linalg.norm(vector)))
+
+
+def path_speed(path: GeometricPath, velocity, s_end: float, name: str) -> float:
+    """sd >= 0 with q'(s_end) sd equal to the joint ``velocity`` (0 when ``None``)."""
+    if velocity is None:
+        return 0.0
+    tangent = path.evaluate(np.array([s_end])).dq[0]
+    velocity = finite_vector(velocity, name, tangent.size)
+    sd = float(velocity @ tangent / (tangent @ tangent))
+    if np.linalg.norm(velocity - sd * tangent) > _tolerance(velocity) or sd < 0.0:
+        raise InvalidRequest(
+            f"{name} is not tangent to the path at s = {s_end:g}: the path's direction there is "
+            f"{np.round(tangent / np.linalg.norm(tangent), 6).tolist()}"
+        )
+    return sd
+
+
+def path_acceleration(path: GeometricPath, acceleration, sd: float, s_end: float, name: str) -> float | None:
+    """sdd with q' sdd + q'' sd^2 equal to the joint ``acceleration`` (None when not given)."""
+    if acceleration is None:
+        return None
+    points = path.evaluate(np.array([s_end]))
+    tangent, curvature = points.dq[0], points.ddq[0]
+    acceleration = finite_vector(acceleration, name, tangent.size)
+    along = acceleration - curvature * sd**2
+    sdd = float(along @ tangent / (tangent @ tangent))
+    if np.linalg.norm(along - sdd * tangent) > _tolerance(acceleration):
+        raise InvalidRequest(
+            f"{name} does not fit the path at s = {s_end:g}: at path speed {sd:.6g} 1/s every "
+            f"admissible joint acceleration is {np.round(curvature * sd**2, 6).tolist()} plus a "
+            f"multiple of the tangent {np.round(tangent, 6).tolist()}"
+        )
+    return sdd
