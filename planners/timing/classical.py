@@ -146,13 +146,24 @@ class ClassicalMethod(TimingMethod):
         return constraints.evaluate(inside)
 
     def _rest_segment(self, constraints, start, end):
-        tau = np.union1d(np.linspace(0.0, 1.0, 401), self.profile.knots())
-        sigma, d1, d2, d3 = self.profile.derivatives(tau)
+        """Shortest rest-to-rest segment: y* over 401 samples of tau, then twice over 33 samples
+        between the neighbours of the binding sample (the extremum lies between them)."""
         span = end - start
-        rows = self._samples(constraints, start, end, start + span * sigma)
-        y, (kind, index, sample) = _largest_inverse_duration(rows, span, d1, d2, d3)
-        if not np.isfinite(y):
-            raise InvalidRequest(f"no requested limit bounds the {self.name} law's speed: add a velocity or acceleration limit")
+        tau = np.union1d(np.linspace(0.0, 1.0, 401), self.profile.knots())
+        best = np.inf
+        for _ in range(3):
+            sigma, d1, d2, d3 = self.profile.derivatives(tau)
+            rows = self._samples(constraints, start, end, start + span * sigma)
+            y, where = _largest_inverse_duration(rows, span, d1, d2, d3)
+            if where is None:
+                raise InvalidRequest(
+                    f"no requested limit bounds the {self.name} law's speed: add a velocity or acceleration limit"
+                )
+            if y <= best:
+                best, (kind, index, sample), binding_rows = y, where, rows
+                around = tau[max(where[2] - 1, 0)], tau[min(where[2] + 1, len(tau) - 1)]
+            tau = np.linspace(*around, 33)
+        y, rows = best, binding_rows
         if y <= 0.0:
             clause, joint = static_load(rows, sample)
             raise InfeasiblePath(

@@ -11,7 +11,7 @@ from planners.timing.base import Binding, DenseStates, PathTiming
 from planners.timing.laws import NormalizedProfile, polynomial_derivatives
 
 #: Samples per segment (in normalized time) for checking limits.
-SAMPLES_PER_SEGMENT = 400
+SAMPLES_PER_SEGMENT = 1000
 
 
 @dataclass(frozen=True)

@@ -67,8 +67,9 @@ class NormalizedProfile(abc.ABC):
         """sigma, sigma', sigma'' and sigma''' at ``tau`` (derivatives with respect to tau)."""
 
     def knots(self) -> np.ndarray:
-        """tau values where sigma'' or sigma''' jumps (a sampling grid should hold them)."""
-        return np.array([0.0, 1.0])
+        """tau values a sampling grid should hold: jumps of sigma'' or sigma''', and extrema of
+        sigma' and sigma''."""
+        return np.array([0.0, 0.5, 1.0])
 
     def tau_at(self, sigma: np.ndarray) -> np.ndarray:
         """The tau with sigma(tau) = ``sigma`` (sigma is increasing): bisection to 1e-13."""
@@ -101,6 +102,9 @@ class QuinticProfile(NormalizedProfile):
     """sigma = 10 tau^3 - 15 tau^4 + 6 tau^5: rest-to-rest with zero acceleration at the ends."""
 
     name = "quintic"
+
+    def knots(self):
+        return np.array([0.0, (3 - np.sqrt(3)) / 6, 0.5, (3 + np.sqrt(3)) / 6, 1.0])
 
     def derivatives(self, tau):
         tau = np.asarray(tau, dtype=float)
@@ -148,6 +152,9 @@ class CycloidalProfile(NormalizedProfile):
     both ends, peak acceleration 2 pi."""
 
     name = "cycloidal"
+
+    def knots(self):
+        return np.array([0.0, 0.25, 0.5, 0.75, 1.0])
 
     def derivatives(self, tau):
         tau = np.asarray(tau, dtype=float)
