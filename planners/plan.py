@@ -160,9 +160,10 @@ def _check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
             f"timing.method {method.name!r} cannot limit {unsupported[0]}; it handles "
             f"{sorted(method.kinds)} (jerk: use a time law or ruckig)"
         )
+    kinds = tuple(dict.fromkeys([*kinds, *sorted(method.required_kinds)]))
     if not kinds:
         raise InvalidRequest("timing.constraints is empty: without limits the time-optimal motion is instantaneous")
-    return tuple(dict.fromkeys(kinds))
+    return kinds
 
 
 def timing_method(timing: Timing) -> TimingMethod:
@@ -223,6 +224,12 @@ def plan(
     if timing.duration is not None and not (np.isfinite(timing.duration) and timing.duration > 0):
         raise InvalidRequest(f"timing.duration must be a positive number of seconds, got {timing.duration}")
     limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
+    if method.two_waypoints_only and len(path_spec.waypoints) != 2:
+        raise InvalidRequest(
+            f"timing.method {method.name!r} plans state-to-state motions: give exactly 2 waypoints, not "
+            f"{len(path_spec.waypoints)} (the offline library has no intermediate waypoints); use "
+            "phase_plane or a time law through several waypoints"
+        )
     path = make_path(robot, path_spec)
     s = path_grid(path, timing.grid_points)
     _check_path_within_limits(robot, path, s)

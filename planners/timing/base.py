@@ -157,12 +157,16 @@ class TimingMethod(abc.ABC):
         kinds: The limit kinds the method can respect.
         takes_duration: Whether a requested duration is honoured.
         takes_acceleration_boundary: Whether boundary path accelerations are honoured.
+        required_kinds: Limit kinds the method always applies, requested or not.
+        two_waypoints_only: Whether the method times only a straight move between two states.
     """
 
     name: str
     kinds: frozenset[str] = frozenset({"velocity", "acceleration", "torque"})
+    required_kinds: frozenset[str] = frozenset()
     takes_duration: bool = False
     takes_acceleration_boundary: bool = False
+    two_waypoints_only: bool = False
 
     @abc.abstractmethod
     def solve(
