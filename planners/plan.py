@@ -156,9 +156,10 @@ def _check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
         raise InvalidRequest(f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}")
     unsupported = [kind for kind in kinds if kind not in method.kinds]
     if unsupported:
+        hint = " (for jerk, use a time law or ruckig)" if unsupported[0] == "jerk" else ""
         raise InvalidRequest(
             f"timing.method {method.name!r} cannot limit {unsupported[0]}; it handles "
-            f"{sorted(method.kinds)} (jerk: use a time law or ruckig)"
+            f"{sorted(method.kinds)}{hint}"
         )
     kinds = tuple(dict.fromkeys([*kinds, *sorted(method.required_kinds)]))
     if not kinds:

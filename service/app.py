@@ -7,7 +7,10 @@ from contextlib import asynccontextmanager
 from fastapi import FastAPI
 from starlette.concurrency import run_in_threadpool
 
+import numpy as np
+
 import robots
+from planners import Timing, WaypointPath, plan
 from service.body_limit import BodySizeLimit
 from service.problems import install_problem_handlers
 from service.routes import health, robots as robot_routes, trajectories
@@ -15,10 +18,14 @@ from service.settings import Settings
 
 
 def _warm_up() -> None:
-    """Build every catalog robot and import toppra once, so first requests are fast."""
+    """Build every catalog robot, import toppra and load the compiled phase-plane kernels once,
+    so that first requests are fast."""
     for name in robots.catalog_names():
         robots.load(name)
     import toppra  # noqa: F401
+
+    arm = robots.load("yamamoto_2r")
+    plan(arm, WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:

@@ -11,8 +11,9 @@ from starlette.concurrency import run_in_threadpool
 
 import robots
 from planners import Deadline, PlannedTrajectory, Timing, WaypointPath, plan
-from planners.errors import BudgetExceeded, InvalidRequest
-from service.schemas.trajectories import TrajectoryRequest
+from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
+from robots import InvalidLimits, UnknownRobot
+from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest
 
 
 def _timing(request: TrajectoryRequest) -> Timing:
@@ -48,6 +49,29 @@ def plan_request(request: TrajectoryRequest, deadline: Deadline | None = None) -
             )
     path = WaypointPath(np.asarray(rows, dtype=float), request.path.interpolation)
     return plan(robot, path, _timing(request), request.output.dt, deadline or Deadline())
+
+
+def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
+    """Run every method of ``request`` on the same path and limits; a method's own failure is
+    reported in its entry instead of failing the comparison."""
+    results = []
+    for method in request.methods:
+        single = TrajectoryRequest(
+            robot=request.robot,
+            path=request.path,
+            timing=request.timing.model_copy(update={"method": method}),
+            output=OutputRequest(dt=1.0),
+        )
+        try:
+            result = plan_request(single, deadline)
+        except UnknownRobot:
+            raise
+        except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:
+            results.append({"method": method, "error": {"status": error.status, "title": error.title, "detail": error.detail}})
+            continue
+        body = trajectory_body(result)
+        results.append({key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms")})
+    return {"results": results}
 
 
 def _finite_or_none(values: np.ndarray) -> list[float | None]:

@@ -5,9 +5,9 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 from fastapi.responses import JSONResponse
 
-from service.planning import plan_request, run_with_budget, trajectory_body
+from service.planning import compare_request, plan_request, run_with_budget, trajectory_body
 from service.schemas.common import Problem
-from service.schemas.trajectories import TrajectoryRequest, TrajectoryResponse
+from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
 
 router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
 
@@ -26,3 +26,12 @@ async def create_trajectory(body: TrajectoryRequest, request: Request) -> JSONRe
     settings = request.app.state.settings
     result = await run_with_budget(lambda deadline: plan_request(body, deadline), settings.plan_budget_s)
     return JSONResponse(trajectory_body(result))
+
+
+@router.post("/compare", summary="Compare timing methods on one path", response_model=CompareResponse, responses=_ERRORS)
+async def compare_trajectories(body: CompareRequest, request: Request) -> JSONResponse:
+    """Time one path under several methods (e.g. ``phase_plane`` against ``quintic``) and return
+    each one's duration, peak utilization and solve time: what time-optimality buys."""
+    settings = request.app.state.settings
+    result = await run_with_budget(lambda deadline: compare_request(body, deadline), settings.plan_budget_s)
+    return JSONResponse(result)

@@ -156,3 +156,29 @@ class TrajectoryResponse(BaseModel):
     binding: BindingPublic | None = None
     solve_ms: float
     warnings: list[str]
+
+
+class CompareRequest(Schema):
+    """One path under several timing methods."""
+
+    robot: str
+    path: WaypointsPath
+    methods: list[str] = Field(
+        min_length=1, max_length=10, description="Timing methods to run, e.g. [\"phase_plane\", \"quintic\"]."
+    )
+    timing: TimingRequest = TimingRequest()
+
+
+class CompareResult(BaseModel):
+    """One method's answer: its duration, peak utilization and solve time, or its error."""
+
+    method: str
+    duration: float | None = None
+    peak_utilization: UtilizationPublic | None = None
+    binding: BindingPublic | None = None
+    solve_ms: float | None = None
+    error: dict | None = None
+
+
+class CompareResponse(BaseModel):
+    results: list[CompareResult]
