@@ -3,12 +3,14 @@
 from planners.constraints import PathConstraints, build_path_constraints
 from planners.deadline import Deadline
 from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
+from planners.paths.cartesian import CartesianLine
 from planners.plan import PlannedTrajectory, Timing, WaypointPath, plan
 from planners.timing import METHODS, TimeScaling
 
 __all__ = [
     "METHODS",
     "BudgetExceeded",
+    "CartesianLine",
     "Deadline",
     "InfeasiblePath",
     "InvalidRequest",

@@ -17,6 +17,7 @@ from planners.errors import InfeasiblePath, InvalidRequest
 from planners.grid import MAX_POINTS, path_grid
 from planners.mvc import admissible_set
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
+from planners.paths.cartesian import CartesianLine, cartesian_path
 from planners.boundary import path_acceleration, path_speed
 from planners.timing import METHODS
 from planners.timing.base import Binding, Boundary, TimingMethod
@@ -100,8 +101,10 @@ class PlannedTrajectory:
     binding: Binding | None = None
 
 
-def make_path(robot: Robot, spec: WaypointPath) -> GeometricPath:
-    """The geometric path of ``spec``, after checking the waypoints against the robot."""
+def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
+    """The geometric path of ``spec``, after checking it against the robot."""
+    if isinstance(spec, CartesianLine):
+        return cartesian_path(robot, spec)
     if spec.interpolation not in INTERPOLATIONS:
         raise InvalidRequest(
             f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted(INTERPOLATIONS)}"
@@ -202,7 +205,7 @@ def _boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boun
 
 def plan(
     robot: Robot,
-    path_spec: WaypointPath,
+    path_spec: "WaypointPath | CartesianLine",
     timing: Timing = Timing(),
     dt: float = 0.01,
     deadline: Deadline = NO_DEADLINE,
@@ -225,11 +228,12 @@ def plan(
     if timing.duration is not None and not (np.isfinite(timing.duration) and timing.duration > 0):
         raise InvalidRequest(f"timing.duration must be a positive number of seconds, got {timing.duration}")
     limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
-    if method.two_waypoints_only and len(path_spec.waypoints) != 2:
+    if method.two_waypoints_only and (not isinstance(path_spec, WaypointPath) or len(path_spec.waypoints) != 2):
+        given = f"{len(path_spec.waypoints)} waypoints" if isinstance(path_spec, WaypointPath) else "a cartesian path"
         raise InvalidRequest(
             f"timing.method {method.name!r} plans state-to-state motions: give exactly 2 waypoints, not "
-            f"{len(path_spec.waypoints)} (the offline library has no intermediate waypoints); use "
-            "phase_plane or a time law through several waypoints"
+            f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
+            "law through several waypoints"
         )
     path = make_path(robot, path_spec)
     s = path_grid(path, timing.grid_points)

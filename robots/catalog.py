@@ -23,7 +23,7 @@ from robots.robot import Robot
 from robots.urdf_check import check_urdf
 
 #: Bundled URDFs: name -> end-effector frame.
-BUNDLED = {"geering_2r": "hand", "yamamoto_2r": "tip"}
+BUNDLED = {"geering_2r": "hand", "yamamoto_2r": "tip", "lecture_3r": "hand"}
 
 
 @dataclass(frozen=True)

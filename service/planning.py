@@ -10,7 +10,7 @@ import numpy as np
 from starlette.concurrency import run_in_threadpool
 
 import robots
-from planners import Deadline, PlannedTrajectory, Timing, WaypointPath, plan
+from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
 from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
 from robots import InvalidLimits, UnknownRobot
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest
@@ -40,15 +40,26 @@ def _timing(request: TrajectoryRequest) -> Timing:
 def plan_request(request: TrajectoryRequest, deadline: Deadline | None = None) -> PlannedTrajectory:
     """Plan ``request`` with the library (no HTTP involved)."""
     robot = robots.load(request.robot)
-    rows = request.path.waypoints
-    for index, row in enumerate(rows):
+    return plan(robot, _path(request.path, robot), _timing(request), request.output.dt, deadline or Deadline())
+
+
+def _path(spec, robot: robots.Robot) -> WaypointPath | CartesianLine:
+    if spec.kind == "cartesian":
+        if len(spec.start) != robot.dof:
+            raise InvalidRequest(f"path.start has {len(spec.start)} values; {robot.name} has {robot.dof} joints")
+        return CartesianLine(
+            start=np.asarray(spec.start, dtype=float),
+            positions=None if spec.positions is None else np.asarray(spec.positions, dtype=float),
+            poses=None if spec.poses is None else np.asarray(spec.poses, dtype=float),
+            frame=spec.frame,
+        )
+    for index, row in enumerate(spec.waypoints):
         if len(row) != robot.dof:
             raise InvalidRequest(
                 f"path.waypoints[{index}] has {len(row)} values; {robot.name} has {robot.dof} joints "
                 f"({', '.join(robot.joint_names)})"
             )
-    path = WaypointPath(np.asarray(rows, dtype=float), request.path.interpolation)
-    return plan(robot, path, _timing(request), request.output.dt, deadline or Deadline())
+    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation)
 
 
 def compare_request(request: CompareRequest, deadline: Deadline) -> dict:

@@ -23,8 +23,14 @@ def problem(status: int, title: str, detail: str, **extra) -> JSONResponse:
     return JSONResponse(body, status_code=status, media_type=PROBLEM_JSON)
 
 
+#: Tags of the path union that pydantic puts in error locations: path.<tag>.<field>.
+_PATH_TAGS = ("waypoints", "cartesian")
+
+
 def _location(loc) -> str:
     parts = [str(part) for part in loc if part not in ("body",)]
+    if len(parts) > 2 and parts[0] == "path" and parts[1] in _PATH_TAGS:
+        del parts[1]
     text = ""
     for part in parts:
         text += f"[{part}]" if part.isdigit() else (f".{part}" if text else part)

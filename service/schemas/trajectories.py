@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Discriminator, Field, Tag
 
 from service.schemas.common import Schema
 
@@ -24,6 +24,34 @@ class WaypointsPath(Schema):
         min_length=2, max_length=MAX_WAYPOINTS, description="Joint configurations (rad, m), one row each."
     )
     interpolation: Literal["spline", "linear"] = "spline"
+
+
+class CartesianPathRequest(Schema):
+    """Straight lines of a frame through positions (orientation free) or poses (orientation by
+    slerp), from the pose of the start configuration; joint path by inverse kinematics."""
+
+    kind: Literal["cartesian"]
+    frame: str | None = Field(default=None, description="Frame to move; default the robot's end effector.")
+    start: JointVector = Field(description="Start joint configuration (rad, m).")
+    positions: list[Annotated[list[float], Field(min_length=3, max_length=3)]] | None = Field(
+        default=None, min_length=1, max_length=MAX_WAYPOINTS, description="[x, y, z] in m, world frame."
+    )
+    poses: list[Annotated[list[float], Field(min_length=7, max_length=7)]] | None = Field(
+        default=None, min_length=1, max_length=MAX_WAYPOINTS, description="[x, y, z, qx, qy, qz, qw]."
+    )
+
+
+def _path_kind(value) -> str:
+    """The path's ``kind``; waypoints when the request leaves it out."""
+    if isinstance(value, dict):
+        return value.get("kind", "waypoints")
+    return getattr(value, "kind", "waypoints")
+
+
+PathRequest = Annotated[
+    Annotated[WaypointsPath, Tag("waypoints")] | Annotated[CartesianPathRequest, Tag("cartesian")],
+    Discriminator(_path_kind, custom_error_type="path_kind", custom_error_message="path.kind must be 'waypoints' or 'cartesian'"),
+]
 
 
 class LimitsRequest(Schema):
@@ -95,7 +123,7 @@ class TrajectoryRequest(Schema):
     """A motion to plan."""
 
     robot: str = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
-    path: WaypointsPath
+    path: PathRequest
     timing: TimingRequest = TimingRequest()
     output: OutputRequest = OutputRequest()
 
@@ -162,7 +190,7 @@ class CompareRequest(Schema):
     """One path under several timing methods."""
 
     robot: str
-    path: WaypointsPath
+    path: PathRequest
     methods: list[str] = Field(
         min_length=1, max_length=10, description="Timing methods to run, e.g. [\"phase_plane\", \"quintic\"]."
     )
