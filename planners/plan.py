@@ -15,6 +15,7 @@ from planners.constraints import CONSTRAINT_KINDS, build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.grid import MAX_POINTS, path_grid
+from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.mvc import admissible_set
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.paths.cartesian import CartesianLine, cartesian_path
@@ -86,6 +87,16 @@ class PhasePlane:
 
 
 @dataclass(frozen=True)
+class Conditioning:
+    """Frobenius condition number of the end effector's Jacobian along the trajectory
+    (``planners.kinematics.conditioning``), with the characteristic length L in m."""
+
+    kappa_min: float
+    kappa_max: float
+    characteristic_length: float
+
+
+@dataclass(frozen=True)
 class PlannedTrajectory:
     """What ``plan`` returns: samples and diagnostics of one timed path."""
 
@@ -99,6 +110,7 @@ class PlannedTrajectory:
     solve_ms: float
     warnings: tuple[str, ...]
     binding: Binding | None = None
+    conditioning: Conditioning | None = None
 
 
 def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
@@ -249,6 +261,13 @@ def plan(
         )
     samples = sample_trajectory(path, result, robot, dt)
     utilization = peak_utilization(path, result, robot, limits)
+    kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
+    notes = _warnings(utilization, kinds, robot)
+    if kappa_max > NEAR_SINGULAR_KAPPA:
+        notes.append(
+            f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} "
+            f"at t = {samples.t[worst]:.4g} s"
+        )
     sd = result.speed_at(s)
     mvc = admissible_set(constraints.linearized(sd**2), constraints.sd_max**2).sd_max
     keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
@@ -261,8 +280,9 @@ def plan(
         phase_plane=PhasePlane(s[keep], sd[keep], mvc[keep], result.switch_points),
         peak_utilization=utilization,
         solve_ms=(time.perf_counter() - started) * 1e3,
-        warnings=tuple(_warnings(utilization, kinds, robot)),
+        warnings=tuple(notes),
         binding=result.binding,
+        conditioning=Conditioning(kappa_min, kappa_max, length),
     )
 
 

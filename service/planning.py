@@ -114,6 +114,11 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         "binding": None if result.binding is None else {
             "kind": result.binding.kind, "joint": result.binding.joint, "s": result.binding.s
         },
+        "conditioning": {
+            "kappa_min": _finite_or_none([result.conditioning.kappa_min])[0],
+            "kappa_max": _finite_or_none([result.conditioning.kappa_max])[0],
+            "characteristic_length": result.conditioning.characteristic_length,
+        },
         "solve_ms": result.solve_ms,
         "warnings": list(result.warnings),
     }

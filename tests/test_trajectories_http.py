@@ -69,7 +69,8 @@ def test_ur5_limits_hold_on_a_dense_resampling(ur5_result):
         assert np.array(ur5_result["peak_utilization"][kind]).max() <= 1.005
         assert np.array(ur5_result["peak_utilization"][kind]) == pytest.approx(ratio, abs=5e-3)
     assert max(ratio.max() for ratio in ratios.values()) >= 0.995
-    assert ur5_result["warnings"] == []
+    assert not [note for note in ur5_result["warnings"] if "limit" in note]
+    assert ur5_result["conditioning"]["kappa_max"] is None  # the start has the wrist singular (q5 = 0)
 
 
 def test_ur5_phase_plane_stays_under_the_mvc(ur5_result):

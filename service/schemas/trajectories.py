@@ -171,6 +171,15 @@ class BindingPublic(BaseModel):
     s: float
 
 
+class ConditioningPublic(BaseModel):
+    """Frobenius condition number of the end effector's Jacobian along the trajectory (1:
+    isotropic; null: singular), translations over the characteristic length L (m)."""
+
+    kappa_min: float | None
+    kappa_max: float | None
+    characteristic_length: float
+
+
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
@@ -182,6 +191,7 @@ class TrajectoryResponse(BaseModel):
     phase_plane: PhasePlanePublic
     peak_utilization: UtilizationPublic
     binding: BindingPublic | None = None
+    conditioning: ConditioningPublic
     solve_ms: float
     warnings: list[str]
 

@@ -1,0 +1,67 @@
+"""Kinematic conditioning: the condition number of the Jacobian in the Frobenius norm (Angeles,
+*Fundamentals of Robotic Mechanical Systems*, ch. 5, problems 5.14-5.17).
+
+With the weighted norm ||J|| = sqrt(tr(J W J^T)), W = 1 / n, and singular values sigma_i,
+
+    kappa_F = ||J|| ||J^-1|| = (1 / n) sqrt(sum sigma_i^2 * sum sigma_i^-2),
+
+1 for an isotropic Jacobian, infinite at a singularity. A Jacobian mixing rotations (rad) and
+translations (m) is made dimensionally homogeneous by dividing its translational rows by a
+characteristic length L. Arms of at most three joints are conditioned on the position of their
+end effector alone (3 rows); longer arms on the whole twist (6 rows, translation over L), using
+the n largest singular values when n < 6.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from robots import Robot
+
+#: A warning is raised above this condition number.
+NEAR_SINGULAR_KAPPA = 100.0
+
+
+def frobenius_condition_number(jacobian: np.ndarray) -> float:
+    """kappa_F of a full-rank (m x n) Jacobian over its n largest singular values (m >= n), or
+    of its transpose when m < n; infinite when rank-deficient."""
+    singular_values = np.linalg.svd(np.atleast_2d(jacobian), compute_uv=False)
+    count = min(jacobian.shape)
+    values = singular_values[:count]
+    if values.min() <= 1e-12 * max(values.max(), 1e-300):
+        return float("inf")
+    return float(np.sqrt(np.sum(values**2) * np.sum(values**-2)) / count)
+
+
+def characteristic_length(robot: Robot) -> float:
+    """Default L: distance from the first joint to the end effector at the neutral posture
+    (at least 5 cm)."""
+    data = robot.data
+    pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
+    tip = data.oMf[robot.frame_id(robot.end_effector)].translation
+    base = data.oMi[1].translation
+    return float(max(np.linalg.norm(tip - base), 0.05))
+
+
+def task_jacobian(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> np.ndarray:
+    """The end effector's Jacobian at ``q`` as conditioned here: 3 translational rows for arms
+    of up to three joints; else angular rows over translational rows divided by ``length``."""
+    data = robot.data
+    pin.computeJointJacobians(robot.model, data, robot.configuration(q))
+    pin.updateFramePlacements(robot.model, data)
+    jacobian = pin.getFrameJacobian(robot.model, data, frame_id, pin.LOCAL_WORLD_ALIGNED)
+    if robot.dof <= 3:
+        return jacobian[:3]
+    return np.vstack([jacobian[3:], jacobian[:3] / length])
+
+
+def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tuple[float, float, float, float]:
+    """(kappa_min, kappa_max, L, index of kappa_max in ``q``) over at most ``max_points``
+    evenly spaced rows of ``q`` (n_samples, n_dof)."""
+    length = characteristic_length(robot)
+    frame_id = robot.frame_id(robot.end_effector)
+    rows = np.unique(np.linspace(0, len(q) - 1, min(len(q), max_points)).round().astype(int))
+    kappas = np.array([frobenius_condition_number(task_jacobian(robot, q[k], frame_id, length)) for k in rows])
+    worst = int(np.argmax(kappas))
+    return float(kappas.min()), float(kappas.max()), length, int(rows[worst])
