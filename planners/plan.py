@@ -24,6 +24,7 @@ from planners.timing import METHODS
 from planners.timing.base import Binding, Boundary, TimingMethod
 from planners.timing.classical import ClassicalMethod
 from planners.timing.laws import TrapezoidalProfile
+from planners.via_points import via_point_trajectory
 from planners.trajectory import Samples, peak_utilization, sample_trajectory
 from robots import JointLimits, Robot
 
@@ -37,7 +38,9 @@ MAX_PHASE_PLANE_POINTS = 2_000
 @dataclass(frozen=True)
 class WaypointPath:
     """A joint path through ``waypoints`` (shape (n_waypoints, n_dof), joint units), interpolated
-    by ``"spline"`` (C2 cubic) or ``"linear"`` (straight segments, stopping at each waypoint)."""
+    by ``"spline"`` (C2 cubic), ``"linear"`` (straight segments, stopping at each waypoint), or
+    ``"via"`` (per-joint cubic or quintic segments in time through the via points, the law named
+    by the timing method)."""
 
     waypoints: np.ndarray
     interpolation: str = "spline"
@@ -113,13 +116,14 @@ class PlannedTrajectory:
     conditioning: Conditioning | None = None
 
 
-def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
-    """The geometric path of ``spec``, after checking it against the robot."""
+def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath | None:
+    """The geometric path of ``spec``, after checking it against the robot (``None`` for via
+    points, whose geometry depends on their timing)."""
     if isinstance(spec, CartesianLine):
         return cartesian_path(robot, spec)
-    if spec.interpolation not in INTERPOLATIONS:
+    if spec.interpolation not in (*INTERPOLATIONS, "via"):
         raise InvalidRequest(
-            f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted(INTERPOLATIONS)}"
+            f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted([*INTERPOLATIONS, 'via'])}"
         )
     waypoints = np.asarray(spec.waypoints, dtype=float) if np.ndim(spec.waypoints) == 2 else None
     if waypoints is None:
@@ -145,6 +149,8 @@ def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPa
             f"path.waypoints[{index}][{joint}] = {waypoints[index, joint]:.6g} is outside the limits "
             f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
         )
+    if spec.interpolation == "via":
+        return None
     return INTERPOLATIONS[spec.interpolation](waypoints)
 
 
@@ -248,12 +254,22 @@ def plan(
             "law through several waypoints"
         )
     path = make_path(robot, path_spec)
-    s = path_grid(path, timing.grid_points)
-    _check_path_within_limits(robot, path, s)
-    boundary = _boundary(path, timing, method)
-    constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
-    deadline.check()
-    result = method.solve(constraints, boundary, timing.duration, deadline)
+    if path is None:
+        if timing.start_velocity is not None or timing.end_velocity is not None:
+            raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
+        path, result = via_point_trajectory(
+            robot, np.asarray(path_spec.waypoints, dtype=float), method.name, limits, kinds, timing.duration
+        )
+        s = path_grid(path, timing.grid_points)
+        _check_path_within_limits(robot, path, s)
+        constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
+    else:
+        s = path_grid(path, timing.grid_points)
+        _check_path_within_limits(robot, path, s)
+        boundary = _boundary(path, timing, method)
+        constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
+        deadline.check()
+        result = method.solve(constraints, boundary, timing.duration, deadline)
     deadline.check()
     if result.duration / dt > MAX_SAMPLES:
         raise InvalidRequest(

@@ -23,7 +23,11 @@ class WaypointsPath(Schema):
     waypoints: list[JointVector] = Field(
         min_length=2, max_length=MAX_WAYPOINTS, description="Joint configurations (rad, m), one row each."
     )
-    interpolation: Literal["spline", "linear"] = "spline"
+    interpolation: Literal["spline", "linear", "via"] = Field(
+        default="spline",
+        description="`spline` (C2 cubic), `linear` (straight, stopping at each waypoint) or `via` "
+        "(per-joint cubic/quintic segments through via points; with timing.method cubic or quintic).",
+    )
 
 
 class CartesianPathRequest(Schema):
