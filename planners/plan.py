@@ -142,9 +142,9 @@ def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPa
     if bad.size:
         raise InvalidRequest(f"path.waypoints[{bad[0][0]}][{bad[0][1]}] is not a finite number")
     lower, upper = robot.limits.position_lower, robot.limits.position_upper
-    outside = (waypoints < lower - 1e-9) | (waypoints > upper + 1e-9)
-    if outside.any():
-        index, joint = (int(v) for v in np.argwhere(outside)[0])
+    outside = robot.outside_position_limits(waypoints)
+    if outside is not None:
+        index, joint = outside
         raise InvalidRequest(
             f"path.waypoints[{index}][{joint}] = {waypoints[index, joint]:.6g} is outside the limits "
             f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
@@ -159,9 +159,9 @@ def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) 
     dense = np.linspace(0.0, 1.0, 4 * len(s) + 1)
     q = path(dense)
     lower, upper = robot.limits.position_lower, robot.limits.position_upper
-    outside = (q < lower - 1e-9) | (q > upper + 1e-9)
-    if outside.any():
-        index, joint = (int(v) for v in np.argwhere(outside)[0])
+    outside = robot.outside_position_limits(q)
+    if outside is not None:
+        index, joint = outside
         raise InfeasiblePath(
             f"the interpolated path leaves the range [{lower[joint]:.6g}, {upper[joint]:.6g}] of joint "
             f"{robot.joint_names[joint]!r} at s = {dense[index]:.4f} (q = {q[index, joint]:.6g}); "

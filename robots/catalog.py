@@ -19,7 +19,7 @@ import pinocchio as pin
 
 from robots.errors import RobotConflict, UnknownRobot
 from robots.limits import limits_for
-from robots.robot import Robot
+from robots.robot import Robot, tangent_position_limits
 from robots.urdf_check import check_urdf
 
 #: Bundled URDFs: name -> end-effector frame.
@@ -71,17 +71,7 @@ def _last_body_frame(model: pin.Model) -> str:
 
 
 def _robot_from_model(name: str, model: pin.Model, source: str, end_effector: str | None) -> Robot:
-    continuous = np.zeros(model.nv, dtype=bool)
-    for joint in model.joints[1:]:
-        if joint.nq == 2 and joint.nv == 1:
-            continuous[joint.idx_v] = True
-    # Pinocchio's position limits are indexed by nq; map them to one value per degree of freedom.
-    lower = np.full(model.nv, -np.inf)
-    upper = np.full(model.nv, np.inf)
-    for joint in model.joints[1:]:
-        if not continuous[joint.idx_v]:
-            lower[joint.idx_v] = model.lowerPositionLimit[joint.idx_q]
-            upper[joint.idx_v] = model.upperPositionLimit[joint.idx_q]
+    lower, upper = tangent_position_limits(model)
     limits = limits_for(name, lower, upper, np.array(model.velocityLimit), np.array(model.effortLimit))
     return Robot.from_model(name, model, source, end_effector or _last_body_frame(model), limits)
 

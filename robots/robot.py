@@ -17,6 +17,23 @@ import pinocchio as pin
 from robots.limits import JointLimits
 
 
+def _is_continuous(joint) -> bool:
+    """A joint that Pinocchio stores as a (cos, sin) pair: a revolute joint without limits."""
+    return joint.nq == 2 and joint.nv == 1
+
+
+def tangent_position_limits(model: pin.Model) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper position limits per degree of freedom, shape (n_dof,) each; continuous
+    joints unlimited (Pinocchio indexes its limits by configuration coordinate)."""
+    lower = np.full(model.nv, -np.inf)
+    upper = np.full(model.nv, np.inf)
+    for joint in model.joints[1:]:
+        if not _is_continuous(joint):
+            lower[joint.idx_v : joint.idx_v + joint.nv] = model.lowerPositionLimit[joint.idx_q : joint.idx_q + joint.nq]
+            upper[joint.idx_v : joint.idx_v + joint.nv] = model.upperPositionLimit[joint.idx_q : joint.idx_q + joint.nq]
+    return lower, upper
+
+
 @dataclass(frozen=True)
 class Robot:
     """A fixed-base arm ready for dynamics.
@@ -61,7 +78,7 @@ class Robot:
         cos_index, pair_angle, plain_q, plain_v = [], [], [], []
         continuous = np.zeros(model.nv, dtype=bool)
         for joint in model.joints[1:]:
-            if joint.nq == 2 and joint.nv == 1:
+            if _is_continuous(joint):
                 cos_index.append(joint.idx_q)
                 pair_angle.append(joint.idx_v)
                 continuous[joint.idx_v] = True
@@ -118,6 +135,16 @@ class Robot:
             tau[k] = pin.rnea(self.model, data, configurations[k], qd[k], qdd[k])
         tau += self.viscous_friction * qd + self.coulomb_friction * np.sign(qd)
         return tau
+
+    def outside_position_limits(self, q: np.ndarray, slack: float = 1e-9) -> tuple[int, int] | None:
+        """(row, joint) of the first value of ``q`` (n_samples, n_dof) outside the joint's
+        position limits by more than ``slack``, or ``None`` when all are inside."""
+        q = np.atleast_2d(q)
+        outside = (q < self.limits.position_lower - slack) | (q > self.limits.position_upper + slack)
+        if not outside.any():
+            return None
+        row, joint = np.argwhere(outside)[0]
+        return int(row), int(joint)
 
     def frame_id(self, frame: str) -> int:
         """Index of ``frame`` in the model; ``KeyError`` when it has no such frame."""

@@ -92,9 +92,9 @@ def cartesian_path(robot: Robot, line: CartesianLine) -> GeometricPath:
     start = np.asarray(line.start, dtype=float)
     if start.shape != (robot.dof,) or not np.all(np.isfinite(start)):
         raise InvalidRequest(f"path.start must hold {robot.dof} finite joint values")
-    outside = (start < robot.limits.position_lower - 1e-9) | (start > robot.limits.position_upper + 1e-9)
-    if outside.any():
-        joint = int(np.flatnonzero(outside)[0])
+    outside = robot.outside_position_limits(start)
+    if outside is not None:
+        joint = outside[1]
         raise InvalidRequest(f"path.start[{joint}] = {start[joint]:.6g} is outside the limits of joint {robot.joint_names[joint]!r}")
     field, offset, positions, rotations = _targets(line, frame_pose(robot, start, frame_id))
     pieces, lengths = [], []
