@@ -32,23 +32,24 @@ def _requests() -> dict[str, dict]:
     panda_12 = np.clip(rng.normal(0.0, 0.6, (12, 7)) + [0, 0, 0, -1.6, 0, 1.8, 0], -1.5, 1.5)
     panda_12[:, 3] = np.clip(panda_12[:, 3], -3.0, -0.2)
     panda_12[:, 5] = np.clip(panda_12[:, 5], 0.0, 3.5)
-    return {
-        "small: ur5, 2 waypoints, torque": {
+    requests = {}
+    for method in ("phase_plane", "toppra"):
+        requests[f"small: ur5, 2 waypoints, torque, {method}"] = {
             "robot": "ur5",
             "path": {"kind": "waypoints", "waypoints": UR5_4[:2]},
-            "timing": {"method": "toppra", "constraints": ["torque"]},
-        },
-        "target: ur5, 4 waypoints, torque": {
+            "timing": {"method": method, "constraints": ["torque"]},
+        }
+        requests[f"target: ur5, 4 waypoints, torque, {method}"] = {
             "robot": "ur5",
             "path": {"kind": "waypoints", "waypoints": UR5_4},
-            "timing": {"method": "toppra", "constraints": ["torque"]},
-        },
-        "large: panda, 12 waypoints, vel+acc+torque": {
+            "timing": {"method": method, "constraints": ["torque"]},
+        }
+        requests[f"large: panda, 12 wp, vel+acc+torque, {method}"] = {
             "robot": "panda",
             "path": {"kind": "waypoints", "waypoints": panda_12.tolist()},
-            "timing": {"method": "toppra", "constraints": ["velocity", "acceleration", "torque"]},
-        },
-    }
+            "timing": {"method": method, "constraints": ["velocity", "acceleration", "torque"]},
+        }
+    return requests
 
 
 def _free_port() -> int:
@@ -84,7 +85,7 @@ def main() -> int:
     try:
         _wait_for(port)
         connection = http.client.HTTPConnection("127.0.0.1", port, timeout=60)
-        print(f"{'request':45s} {'p50 ms':>8s} {'p95 ms':>8s} {'solve ms':>9s} {'duration s':>10s}")
+        print(f"{'request':50s} {'p50 ms':>8s} {'p95 ms':>8s} {'solve ms':>9s} {'duration s':>10s}")
         for label, body in _requests().items():
             payload = json.dumps(body).encode()
             times, solve = [], []
@@ -101,7 +102,7 @@ def main() -> int:
                     solve.append(json.loads(data)["solve_ms"])
             result = json.loads(data)
             print(
-                f"{label:45s} {np.percentile(times, 50):8.1f} {np.percentile(times, 95):8.1f} "
+                f"{label:50s} {np.percentile(times, 50):8.1f} {np.percentile(times, 95):8.1f} "
                 f"{np.median(solve):9.1f} {result['duration']:10.4f}"
             )
     finally:

@@ -23,15 +23,17 @@ from robots import Robot
 NEAR_SINGULAR_KAPPA = 100.0
 
 
-def frobenius_condition_number(jacobian: np.ndarray) -> float:
-    """kappa_F of a full-rank (m x n) Jacobian over its n largest singular values (m >= n), or
-    of its transpose when m < n; infinite when rank-deficient."""
-    singular_values = np.linalg.svd(np.atleast_2d(jacobian), compute_uv=False)
-    count = min(jacobian.shape)
-    values = singular_values[:count]
-    if values.min() <= 1e-12 * max(values.max(), 1e-300):
-        return float("inf")
-    return float(np.sqrt(np.sum(values**2) * np.sum(values**-2)) / count)
+def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
+    """kappa_F of a full-rank (m x n) Jacobian over its min(m, n) singular values; infinite when
+    rank-deficient. A stack (k, m, n) gives k values."""
+    jacobian = np.asarray(jacobian, dtype=float)
+    values = np.linalg.svd(jacobian, compute_uv=False)
+    count = values.shape[-1]
+    with np.errstate(divide="ignore"):
+        kappa = np.sqrt(np.sum(values**2, axis=-1) * np.sum(values**-2.0, axis=-1)) / count
+    singular = values.min(axis=-1) <= 1e-12 * np.maximum(values.max(axis=-1), 1e-300)
+    kappa = np.where(singular, np.inf, kappa)
+    return float(kappa) if kappa.ndim == 0 else kappa
 
 
 def characteristic_length(robot: Robot) -> float:
@@ -62,6 +64,6 @@ def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tu
     length = characteristic_length(robot)
     frame_id = robot.frame_id(robot.end_effector)
     rows = np.unique(np.linspace(0, len(q) - 1, min(len(q), max_points)).round().astype(int))
-    kappas = np.array([frobenius_condition_number(task_jacobian(robot, q[k], frame_id, length)) for k in rows])
+    kappas = frobenius_condition_number(np.array([task_jacobian(robot, q[k], frame_id, length) for k in rows]))
     worst = int(np.argmax(kappas))
     return float(kappas.min()), float(kappas.max()), length, int(rows[worst])

@@ -128,9 +128,9 @@ class TimeScaling(PathTiming):
         return np.minimum(s, self.s[interval + 1]), np.maximum(sd, 0.0), sdd
 
     def dense_states(self) -> DenseStates:
-        """Five states per grid interval, both ends included: a grid point is reached as the end
+        """Three states per grid interval, both ends included: a grid point is reached as the end
         of one interval (``left``) and the start of the next, each with its own sdd."""
-        fractions = np.linspace(0.0, 1.0, 5)
+        fractions = np.linspace(0.0, 1.0, 3)
         n_intervals = len(self.s) - 1
         interval = np.repeat(np.arange(n_intervals), len(fractions))
         fraction = np.tile(fractions, n_intervals)
