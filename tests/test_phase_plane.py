@@ -98,7 +98,7 @@ def test_torque_limited_pendulum_against_quadrature(theta_goal):
     exact = _pendulum_time_by_quadrature(theta_goal)
     path = WaypointPath(np.array([[0.0, 0.0], [theta_goal, 0.0]]))
     result = plan(arm, path, Timing(method="phase_plane", constraints=("torque",)))
-    assert exact <= result.duration <= exact * (1 + 5e-4)  # the method's default tolerance
+    assert exact <= result.duration <= exact * (1 + 1e-3)  # the 0.1 % standard of DESIGN.md
     constraints = build_path_constraints(path_of(path), arm, arm.limits, ("torque",), path_grid(path_of(path)))
     tight = PhasePlaneMethod(tolerance=2e-5, max_refinements=8).solve(constraints)
     assert exact <= tight.duration <= exact * (1 + 3e-5)

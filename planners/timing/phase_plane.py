@@ -94,7 +94,7 @@ class PhasePlaneMethod(TimingMethod):
 
     name = "phase_plane"
 
-    def __init__(self, tolerance: float = 1e-3, max_refinements: int = 3):
+    def __init__(self, tolerance: float = 6e-4, max_refinements: int = 3):
         self.tolerance = tolerance
         self.max_refinements = max_refinements
 
