@@ -23,6 +23,7 @@ from planners.boundary import path_acceleration, path_speed
 from planners.timing import METHODS
 from planners.timing.base import Binding, Boundary, TimingMethod
 from planners.timing.classical import ClassicalMethod
+from planners.timing.min_cost import MinCostMethod
 from planners.timing.laws import TrapezoidalProfile
 from planners.via_points import via_point_trajectory
 from planners.trajectory import Samples, peak_utilization, sample_trajectory
@@ -64,6 +65,8 @@ class Timing:
         duration: Seconds, for the time laws; ``None`` asks for the shortest within the limits.
         trapezoid_fractions: (tau1, tau2), the trapezoidal law's ends of acceleration and of
             cruise as fractions of the duration.
+        torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
+            ``min_cost``.
     """
 
     method: str = "phase_plane"
@@ -77,6 +80,7 @@ class Timing:
     end_acceleration: np.ndarray | None = None
     duration: float | None = None
     trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
+    torque_weight: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -114,6 +118,7 @@ class PlannedTrajectory:
     warnings: tuple[str, ...]
     binding: Binding | None = None
     conditioning: Conditioning | None = None
+    cost: float | None = None
 
 
 def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath | None:
@@ -195,6 +200,12 @@ def timing_method(timing: Timing) -> TimingMethod:
         if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
             raise InvalidRequest(f"timing.trapezoid needs 0 < tau1 <= tau2 < 1, got {tau1}, {tau2}")
         return ClassicalMethod(TrapezoidalProfile(tau1, tau2))
+    if timing.torque_weight != 0.0 and timing.method != "min_cost":
+        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}; use min_cost")
+    if timing.method == "min_cost":
+        if not (np.isfinite(timing.torque_weight) and timing.torque_weight >= 0.0):
+            raise InvalidRequest(f"timing.cost.torque_weight must be a non-negative number, got {timing.torque_weight}")
+        return MinCostMethod(timing.torque_weight)
     method = METHODS.get(timing.method)
     if method is None:
         raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
@@ -299,6 +310,7 @@ def plan(
         warnings=tuple(notes),
         binding=result.binding,
         conditioning=Conditioning(kappa_min, kappa_max, length),
+        cost=getattr(result, "cost", None),
     )
 
 

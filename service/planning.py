@@ -18,8 +18,6 @@ from service.schemas.trajectories import CompareRequest, OutputRequest, Trajecto
 
 def _timing(request: TrajectoryRequest) -> Timing:
     timing = request.timing
-    if timing.cost.torque_weight != 0.0:
-        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}")
     limits = timing.limits
     kinds = ("velocity", "acceleration", "jerk", "torque")
     return Timing(
@@ -34,6 +32,7 @@ def _timing(request: TrajectoryRequest) -> Timing:
         end_acceleration=timing.boundary.end_acceleration,
         duration=timing.duration,
         trapezoid_fractions=(timing.trapezoid.tau1, timing.trapezoid.tau2),
+        torque_weight=timing.cost.torque_weight,
     )
 
 
@@ -119,6 +118,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "kappa_max": _finite_or_none([result.conditioning.kappa_max])[0],
             "characteristic_length": result.conditioning.characteristic_length,
         },
+        "cost": result.cost,
         "solve_ms": result.solve_ms,
         "warnings": list(result.warnings),
     }

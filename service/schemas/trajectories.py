@@ -81,7 +81,7 @@ class Boundary(Schema):
 
 
 class CostRequest(Schema):
-    """Weights of the cost integral of (1 + beta |tau|^2) dt."""
+    """Weights of the cost integral of (1 + beta |tau|^2) dt (min_cost): beta in 1/(N m)^2."""
 
     torque_weight: Annotated[float, Field(ge=0.0)] = 0.0
 
@@ -99,8 +99,9 @@ class TimingRequest(Schema):
 
     method: str = Field(
         default="phase_plane",
-        description="`phase_plane` (time-optimal, default), `toppra`, or a time law: `cubic`, "
-        "`quintic`, `trapezoidal`, `cycloidal`.",
+        description="`phase_plane` (time-optimal, default), `toppra`, `min_cost` (minimum of the "
+        "integral of 1 + beta |tau|^2), `ruckig` (jerk-limited, two waypoints), or a time law: "
+        "`cubic`, `quintic`, `trapezoidal`, `cycloidal`.",
     )
     constraints: list[Literal["velocity", "acceleration", "torque", "jerk"]] = Field(
         default=["velocity", "acceleration", "torque"],
@@ -196,6 +197,7 @@ class TrajectoryResponse(BaseModel):
     peak_utilization: UtilizationPublic
     binding: BindingPublic | None = None
     conditioning: ConditioningPublic
+    cost: float | None = Field(default=None, description="min_cost: the integral of (1 + beta |tau|^2) dt, in s.")
     solve_ms: float
     warnings: list[str]
 
