@@ -1,0 +1,301 @@
+"""Direct collocation of a free motion from start to goal at rest (Jeong & Lee section 4, after
+Geering et al.; Yamamoto et al. section 5): joint positions, velocities and accelerations at
+K + 1 instants of a free duration T, minimizing T or the integral of (1 + beta |tau|^2) dt under
+torque, velocity and joint-range limits.
+
+Between instants the acceleration is linear in time, so the motion is a C2 piecewise cubic
+integrated exactly:
+
+    q_k+1 = q_k + h v_k + h^2 (2 a_k + a_k+1) / 6,    v_k+1 = v_k + h (a_k + a_k+1) / 2,
+
+with h = T / K, and the torque at each instant is the robot's own inverse dynamics,
+tau_k = RNEA(q_k, v_k, a_k) from its Pinocchio model (URDF), with exact first derivatives from
+Pinocchio's analytical RNEA derivatives. The nonlinear program is solved by SLSQP (scipy), a
+sequential quadratic programming method fed with those exact gradients; for these sizes (a few
+joints, tens of instants) a dense SQP converges in tens of iterations.
+
+Several initial guesses are tried: the straight joint line to the goal and, for continuous
+joints, to the goal shifted by +-2 pi (the elbow turning a full revolution, as in the Geering
+arm's larger moves), each timed time-optimally along its line; the best solution wins.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from scipy.optimize import minimize
+
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.errors import InfeasiblePath, InvalidRequest
+from robots import JointLimits, Robot
+
+DEFAULT_INTERVALS = 40
+
+
+@dataclass(frozen=True)
+class FreeMotion:
+    """Start and goal configurations (n_dof,), optional boundary velocities, and for each
+    continuous joint whether the goal may be reached one revolution either way."""
+
+    start: np.ndarray
+    goal: np.ndarray
+    start_velocity: np.ndarray | None = None
+    end_velocity: np.ndarray | None = None
+    intervals: int = DEFAULT_INTERVALS
+
+
+@dataclass(frozen=True)
+class CollocationResult:
+    """The optimized motion at K + 1 instants: times (K+1,), q, v, a, tau (K+1, n_dof); its cost
+    J (s), the solver's status and iteration count, and the winning initial guess."""
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    cost: float
+    status: str
+    iterations: int
+    initial_guess: str
+    solve_s: float
+
+
+class _Problem:
+    """The collocation NLP: z = [T, q (K+1, n), v (K+1, n), a (K+1, n)] flattened."""
+
+    def __init__(self, robot: Robot, limits: JointLimits, motion: FreeMotion, goal: np.ndarray, beta: float):
+        self.robot, self.limits, self.beta = robot, limits, beta
+        self.n, self.K = robot.dof, motion.intervals
+        self.start, self.goal = motion.start, goal
+        zero = np.zeros(self.n)
+        self.v_start = zero if motion.start_velocity is None else motion.start_velocity
+        self.v_end = zero if motion.end_velocity is None else motion.end_velocity
+        self.weights = np.ones(self.K + 1)
+        self.weights[[0, -1]] = 0.5
+        self._cache_key = None
+
+    def unpack(self, z):
+        n, K = self.n, self.K
+        size = (K + 1) * n
+        q = z[1 : 1 + size].reshape(K + 1, n)
+        v = z[1 + size : 1 + 2 * size].reshape(K + 1, n)
+        a = z[1 + 2 * size :].reshape(K + 1, n)
+        return z[0], q, v, a
+
+    def pack(self, T, q, v, a):
+        return np.concatenate([[T], q.ravel(), v.ravel(), a.ravel()])
+
+    def _dynamics(self, z):
+        """tau (K+1, n) and its derivatives with respect to q, v, a at every instant."""
+        if self._cache_key is not None and np.array_equal(self._cache_key, z):
+            return self._cache
+        _, q, v, a = self.unpack(z)
+        model, data = self.robot.model, self.robot.data
+        configurations = self.robot.configuration(q)
+        tau = np.empty_like(q)
+        dq, dv, da = (np.empty((self.K + 1, self.n, self.n)) for _ in range(3))
+        for k in range(self.K + 1):
+            pin.computeRNEADerivatives(model, data, configurations[k], v[k], a[k])
+            tau[k] = pin.rnea(model, data, configurations[k], v[k], a[k])
+            dq[k], dv[k] = data.dtau_dq, data.dtau_dv
+            mass = data.M
+            da[k] = np.triu(mass) + np.triu(mass, 1).T
+        self._cache_key, self._cache = z.copy(), (tau, dq, dv, da)
+        return self._cache
+
+    # Objective ------------------------------------------------------------------------------
+    def cost(self, z):
+        T = z[0]
+        if self.beta == 0.0:
+            return T
+        tau = self._dynamics(z)[0]
+        return T / self.K * np.sum(self.weights * (1.0 + self.beta * np.sum(tau**2, axis=1)))
+
+    def cost_gradient(self, z):
+        gradient = np.zeros_like(z)
+        if self.beta == 0.0:
+            gradient[0] = 1.0
+            return gradient
+        T = z[0]
+        tau, dq, dv, da = self._dynamics(z)
+        gradient[0] = self.cost(z) / T
+        factor = (T / self.K) * self.weights[:, None] * 2.0 * self.beta * tau
+        size = (self.K + 1) * self.n
+        gradient[1 : 1 + size] = np.einsum("ki,kij->kj", factor, dq).ravel()
+        gradient[1 + size : 1 + 2 * size] = np.einsum("ki,kij->kj", factor, dv).ravel()
+        gradient[1 + 2 * size :] = np.einsum("ki,kij->kj", factor, da).ravel()
+        return gradient
+
+    # Equalities: exact integration of piecewise-linear accelerations, and the boundary states --
+    def defects(self, z):
+        T, q, v, a = self.unpack(z)
+        h = T / self.K
+        position = q[1:] - q[:-1] - h * v[:-1] - h**2 * (2 * a[:-1] + a[1:]) / 6
+        velocity = v[1:] - v[:-1] - h * (a[:-1] + a[1:]) / 2
+        ends = np.concatenate([q[0] - self.start, q[-1] - self.goal, v[0] - self.v_start, v[-1] - self.v_end])
+        return np.concatenate([position.ravel(), velocity.ravel(), ends])
+
+    def defects_jacobian(self, z):
+        T, q, v, a = self.unpack(z)
+        n, K = self.n, self.K
+        h = T / K
+        size = (K + 1) * n
+        rows = 2 * K * n + 4 * n
+        J = np.zeros((rows, z.size))
+        eye = np.eye(n)
+        for k in range(K):
+            r = k * n
+            qk, qk1 = 1 + k * n, 1 + (k + 1) * n
+            vk, vk1 = 1 + size + k * n, 1 + size + (k + 1) * n
+            ak, ak1 = 1 + 2 * size + k * n, 1 + 2 * size + (k + 1) * n
+            J[r : r + n, qk1 : qk1 + n] = eye
+            J[r : r + n, qk : qk + n] = -eye
+            J[r : r + n, vk : vk + n] = -h * eye
+            J[r : r + n, ak : ak + n] = -(h**2) / 3 * eye
+            J[r : r + n, ak1 : ak1 + n] = -(h**2) / 6 * eye
+            J[r : r + n, 0] = (-v[k] - 2 * h * (2 * a[k] + a[k + 1]) / 6) / K
+            r2 = K * n + k * n
+            J[r2 : r2 + n, vk1 : vk1 + n] = eye
+            J[r2 : r2 + n, vk : vk + n] = -eye
+            J[r2 : r2 + n, ak : ak + n] = -h / 2 * eye
+            J[r2 : r2 + n, ak1 : ak1 + n] = -h / 2 * eye
+            J[r2 : r2 + n, 0] = -(a[k] + a[k + 1]) / 2 / K
+        base = 2 * K * n
+        J[base : base + n, 1 : 1 + n] = eye
+        J[base + n : base + 2 * n, 1 + K * n : 1 + (K + 1) * n] = eye
+        J[base + 2 * n : base + 3 * n, 1 + size : 1 + size + n] = eye
+        J[base + 3 * n : base + 4 * n, 1 + size + K * n : 1 + size + (K + 1) * n] = eye
+        return J
+
+    # Inequalities: |tau| <= limit at every instant ----------------------------------------------
+    def torque_margin(self, z):
+        tau = self._dynamics(z)[0]
+        return np.concatenate([(self.limits.torque - tau).ravel(), (self.limits.torque + tau).ravel()])
+
+    def torque_margin_jacobian(self, z):
+        _, dq, dv, da = self._dynamics(z)
+        n, K = self.n, self.K
+        size = (K + 1) * n
+        J = np.zeros(((K + 1) * n, z.size))
+        for k in range(K + 1):
+            r = k * n
+            J[r : r + n, 1 + k * n : 1 + (k + 1) * n] = dq[k]
+            J[r : r + n, 1 + size + k * n : 1 + size + (k + 1) * n] = dv[k]
+            J[r : r + n, 1 + 2 * size + k * n : 1 + 2 * size + (k + 1) * n] = da[k]
+        return np.vstack([-J, J])
+
+    def bounds(self):
+        K = self.K
+        lower, upper = self.limits.position_lower, self.limits.position_upper
+        velocity = self.limits.velocity
+        box = [(1e-3, 1e3)]
+        box += [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in zip(np.tile(lower, K + 1), np.tile(upper, K + 1))]
+        box += [(-v if np.isfinite(v) else None, v if np.isfinite(v) else None) for v in np.tile(velocity, K + 1)]
+        box += [(None, None)] * ((K + 1) * self.n)
+        return box
+
+
+def _line_guess(problem: _Problem, duration: float) -> np.ndarray:
+    """The straight joint line from start to the (possibly shifted) goal, timed by a quintic of
+    the given duration: a smooth, rest-to-rest first guess."""
+    K = problem.K
+    tau = np.linspace(0.0, 1.0, K + 1)
+    sigma = tau**3 * (10 - 15 * tau + 6 * tau**2)
+    speed = 30 * tau**2 * (1 - tau) ** 2 / duration
+    accel = 60 * tau * (1 - tau) * (1 - 2 * tau) / duration**2
+    delta = problem.goal - problem.start
+    return problem.pack(duration, problem.start + np.outer(sigma, delta), np.outer(speed, delta), np.outer(accel, delta))
+
+
+def _guess_duration(problem: _Problem) -> float:
+    """A duration at which the quintic line roughly meets the torque limits (scanned)."""
+    for duration in np.geomspace(0.05, 60.0, 40):
+        z = _line_guess(problem, duration)
+        if np.all(problem.torque_margin(z) >= 0.0):
+            return float(duration)
+    raise InfeasiblePath("no motion along the straight joint line meets the torque limits, not even a slow one")
+
+
+def _goals(robot: Robot, motion: FreeMotion) -> list[tuple[str, np.ndarray]]:
+    """The straight-line goal and, for continuous joints, the goal one revolution either way."""
+    options = [("straight line", motion.goal)]
+    continuous = np.flatnonzero(robot.continuous)
+    for shifts in itertools.product((-2 * np.pi, 0.0, 2 * np.pi), repeat=len(continuous)):
+        if not any(shifts):
+            continue
+        goal = motion.goal.copy()
+        goal[continuous] += shifts
+        label = ", ".join(f"{robot.joint_names[j]} {shift:+.4f} rad" for j, shift in zip(continuous, shifts) if shift)
+        options.append((f"goal shifted: {label}", goal))
+    return options
+
+
+def optimize_motion(
+    robot: Robot,
+    limits: JointLimits,
+    motion: FreeMotion,
+    torque_weight: float = 0.0,
+    deadline: Deadline = NO_DEADLINE,
+    max_iterations: int = 400,
+) -> CollocationResult:
+    """Minimize T (``torque_weight`` = 0) or the integral of (1 + beta |tau|^2) dt from start to
+    goal over every initial guess; the best solution that meets the constraints wins.
+
+    Raises:
+        InvalidRequest: a start or goal outside the joint limits, or a robot with non-revolute
+            (prismatic) joints and boundary problems the method does not handle.
+        InfeasiblePath: no initial guess leads to a solution.
+    """
+    if robot.outside_position_limits(motion.start) is not None:
+        raise InvalidRequest("path.start is outside the joint limits")
+    if robot.outside_position_limits(motion.goal) is not None:
+        raise InvalidRequest("path.goal is outside the joint limits")
+    best, tried = None, []
+    started = time.perf_counter()
+    for label, goal in _goals(robot, motion):
+        deadline.check()
+        problem = _Problem(robot, limits, motion, goal, torque_weight)
+        try:
+            z0 = _line_guess(problem, _guess_duration(problem))
+        except InfeasiblePath as error:
+            tried.append(f"{label}: {error.detail}")
+            continue
+        result = minimize(
+            problem.cost,
+            z0,
+            jac=problem.cost_gradient,
+            method="SLSQP",
+            bounds=problem.bounds(),
+            constraints=[
+                {"type": "eq", "fun": problem.defects, "jac": problem.defects_jacobian},
+                {"type": "ineq", "fun": problem.torque_margin, "jac": problem.torque_margin_jacobian},
+            ],
+            options={"maxiter": max_iterations, "ftol": 1e-10},
+            callback=lambda _: deadline.check(),
+        )
+        feasible = np.abs(problem.defects(result.x)).max() < 1e-6 and problem.torque_margin(result.x).min() > -1e-6
+        tried.append(f"{label}: {result.message} (cost {result.fun:.6g})")
+        if feasible and (best is None or result.fun < best[0].fun):
+            best = (result, problem, label)
+    if best is None:
+        raise InfeasiblePath("the collocation found no feasible motion from any initial guess: " + "; ".join(tried))
+    result, problem, label = best
+    T, q, v, a = problem.unpack(result.x)
+    tau = problem._dynamics(result.x)[0]
+    return CollocationResult(
+        t=np.linspace(0.0, T, problem.K + 1),
+        q=q.copy(),
+        v=v.copy(),
+        a=a.copy(),
+        tau=tau.copy(),
+        cost=float(result.fun),
+        status=str(result.message),
+        iterations=int(result.nit),
+        initial_guess=label,
+        solve_s=time.perf_counter() - started,
+    )
