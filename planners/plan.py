@@ -6,6 +6,7 @@ timing method -> TimeScaling s(t) -> samples, phase plane and peak utilization.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -18,12 +19,15 @@ from planners.grid import MAX_POINTS, path_grid
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.mvc import admissible_set
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
+from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.paths.cartesian import CartesianLine, cartesian_path
 from planners.boundary import path_acceleration, path_speed
 from planners.timing import METHODS
 from planners.timing.base import Binding, Boundary, TimingMethod
 from planners.timing.classical import ClassicalMethod
 from planners.timing.min_cost import MinCostMethod
+from planners.timing.collocation_method import CollocationMethod
+from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.laws import TrapezoidalProfile
 from planners.via_points import via_point_trajectory
 from planners.trajectory import Samples, peak_utilization, sample_trajectory
@@ -119,6 +123,7 @@ class PlannedTrajectory:
     binding: Binding | None = None
     conditioning: Conditioning | None = None
     cost: float | None = None
+    solver: dict | None = None
 
 
 def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath | None:
@@ -176,6 +181,33 @@ def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) 
         )
 
 
+def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
+    """Path and timing optimized together (``path.kind = "free"`` with ``collocation``)."""
+    if not isinstance(path_spec, FreeMotion) or method.name != "collocation":
+        raise InvalidRequest("a free path (start and goal only) needs timing.method 'collocation', and collocation a free path")
+    if timing.grid_points is not None and not 4 <= timing.grid_points <= 100:
+        raise InvalidRequest(f"timing.grid_points sets the collocation intervals, 4 to 100; got {timing.grid_points}")
+    if timing.grid_points is not None:
+        path_spec = dataclasses.replace(path_spec, intervals=timing.grid_points)
+    unlimited = np.full(robot.dof, np.inf)
+    limits = dataclasses.replace(
+        limits,
+        velocity=limits.velocity if "velocity" in timing.constraints else unlimited,
+        acceleration=limits.acceleration if "acceleration" in timing.constraints else unlimited,
+    )
+    result = optimize_motion(robot, limits, path_spec, timing.torque_weight, deadline)
+    path, _ = collocation_path(result)
+    solver = {
+        "cost": result.cost,
+        "duration": float(result.t[-1]),
+        "status": result.status,
+        "iterations": result.iterations,
+        "initial_guess": result.initial_guess,
+        "solve_s": result.solve_s,
+    }
+    return path, solver
+
+
 def _check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
     unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
     if unknown:
@@ -200,12 +232,14 @@ def timing_method(timing: Timing) -> TimingMethod:
         if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
             raise InvalidRequest(f"timing.trapezoid needs 0 < tau1 <= tau2 < 1, got {tau1}, {tau2}")
         return ClassicalMethod(TrapezoidalProfile(tau1, tau2))
-    if timing.torque_weight != 0.0 and timing.method != "min_cost":
+    if timing.torque_weight != 0.0 and timing.method not in ("min_cost", "collocation"):
         raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}; use min_cost")
     if timing.method == "min_cost":
         if not (np.isfinite(timing.torque_weight) and timing.torque_weight >= 0.0):
             raise InvalidRequest(f"timing.cost.torque_weight must be a non-negative number, got {timing.torque_weight}")
         return MinCostMethod(timing.torque_weight)
+    if timing.method == "collocation":
+        return CollocationMethod()
     method = METHODS.get(timing.method)
     if method is None:
         raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
@@ -264,8 +298,17 @@ def plan(
             f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
             "law through several waypoints"
         )
-    path = make_path(robot, path_spec)
-    if path is None:
+    solver = None
+    if isinstance(path_spec, FreeMotion) or method.name == "collocation":
+        # The optimized path, re-timed exactly along itself: every limit then holds between the
+        # collocation instants too, and the duration checks the collocation's own.
+        path, solver = _free_motion(robot, path_spec, method, timing, limits, deadline)
+        method = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
+        s = path_grid(path, None)
+        constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
+        result = method.solve(constraints, _boundary(path, timing, method), None, deadline)
+        method = CollocationMethod()
+    elif (path := make_path(robot, path_spec)) is None:
         if timing.start_velocity is not None or timing.end_velocity is not None:
             raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
         path, result = via_point_trajectory(
@@ -310,7 +353,8 @@ def plan(
         warnings=tuple(notes),
         binding=result.binding,
         conditioning=Conditioning(kappa_min, kappa_max, length),
-        cost=getattr(result, "cost", None),
+        cost=getattr(result, "cost", None) if solver is None or timing.torque_weight else result.duration,
+        solver=solver,
     )
 
 

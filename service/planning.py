@@ -4,6 +4,7 @@ response dict, and the time budget that keeps a long computation off the event l
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import math
 
 import numpy as np
@@ -11,6 +12,7 @@ from starlette.concurrency import run_in_threadpool
 
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
+from planners.free_path import FreeMotion
 from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
 from robots import InvalidLimits, UnknownRobot
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest
@@ -39,10 +41,25 @@ def _timing(request: TrajectoryRequest) -> Timing:
 def plan_request(request: TrajectoryRequest, deadline: Deadline | None = None) -> PlannedTrajectory:
     """Plan ``request`` with the library (no HTTP involved)."""
     robot = robots.load(request.robot)
-    return plan(robot, _path(request.path, robot), _timing(request), request.output.dt, deadline or Deadline())
+    timing = _timing(request)
+    if request.path.kind == "free":
+        timing = dataclasses.replace(timing, start_velocity=None, end_velocity=None)
+    return plan(robot, _path(request.path, robot, request), timing, request.output.dt, deadline or Deadline())
 
 
-def _path(spec, robot: robots.Robot) -> WaypointPath | CartesianLine:
+def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath | CartesianLine | FreeMotion:
+    if spec.kind == "free":
+        for name in ("start", "goal"):
+            if len(getattr(spec, name)) != robot.dof:
+                raise InvalidRequest(f"path.{name} has {len(getattr(spec, name))} values; {robot.name} has {robot.dof} joints")
+        boundary = request.timing.boundary
+        return FreeMotion(
+            start=np.asarray(spec.start, dtype=float),
+            goal=np.asarray(spec.goal, dtype=float),
+            start_velocity=None if boundary.start_velocity is None else np.asarray(boundary.start_velocity, dtype=float),
+            end_velocity=None if boundary.end_velocity is None else np.asarray(boundary.end_velocity, dtype=float),
+            revolutions=spec.revolutions,
+        )
     if spec.kind == "cartesian":
         if len(spec.start) != robot.dof:
             raise InvalidRequest(f"path.start has {len(spec.start)} values; {robot.name} has {robot.dof} joints")
@@ -119,6 +136,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "characteristic_length": result.conditioning.characteristic_length,
         },
         "cost": result.cost,
+        "solver": result.solver,
         "solve_ms": result.solve_ms,
         "warnings": list(result.warnings),
     }

@@ -24,7 +24,7 @@ def problem(status: int, title: str, detail: str, **extra) -> JSONResponse:
 
 
 #: Tags of the path union that pydantic puts in error locations: path.<tag>.<field>.
-_PATH_TAGS = ("waypoints", "cartesian")
+_PATH_TAGS = ("waypoints", "cartesian", "free")
 
 
 def _location(loc) -> str:

@@ -16,7 +16,8 @@ joints, tens of instants) a dense SQP converges in tens of iterations.
 
 Several initial guesses are tried: the straight joint line to the goal and, for continuous
 joints, to the goal shifted by +-2 pi (the elbow turning a full revolution, as in the Geering
-arm's larger moves), each timed time-optimally along its line; the best solution wins.
+arm's larger moves), each also bent mid-way one joint at a time, and each timed time-optimally
+along itself by the phase-plane method; all are solved on a coarse grid and the best is refined.
 """
 
 from __future__ import annotations
@@ -29,23 +30,29 @@ import numpy as np
 import pinocchio as pin
 from scipy.optimize import minimize
 
+from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
-from planners.errors import InfeasiblePath, InvalidRequest
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.grid import path_grid
+from planners.paths.waypoints import SplinePath
+from planners.timing.phase_plane import PhasePlaneMethod
 from robots import JointLimits, Robot
 
-DEFAULT_INTERVALS = 40
+DEFAULT_INTERVALS = 30
 
 
 @dataclass(frozen=True)
 class FreeMotion:
-    """Start and goal configurations (n_dof,), optional boundary velocities, and for each
-    continuous joint whether the goal may be reached one revolution either way."""
+    """Start and goal configurations (n_dof,), optional boundary velocities (rad/s), the number
+    of collocation intervals, and whether continuous joints may reach their goal one revolution
+    either way (``revolutions``)."""
 
     start: np.ndarray
     goal: np.ndarray
     start_velocity: np.ndarray | None = None
     end_velocity: np.ndarray | None = None
     intervals: int = DEFAULT_INTERVALS
+    revolutions: bool = True
 
 
 @dataclass(frozen=True)
@@ -196,35 +203,56 @@ class _Problem:
         box = [(1e-3, 1e3)]
         box += [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in zip(np.tile(lower, K + 1), np.tile(upper, K + 1))]
         box += [(-v if np.isfinite(v) else None, v if np.isfinite(v) else None) for v in np.tile(velocity, K + 1)]
-        box += [(None, None)] * ((K + 1) * self.n)
+        acceleration = self.limits.acceleration
+        box += [(-v if np.isfinite(v) else None, v if np.isfinite(v) else None) for v in np.tile(acceleration, K + 1)]
         return box
 
 
-def _line_guess(problem: _Problem, duration: float) -> np.ndarray:
-    """The straight joint line from start to the (possibly shifted) goal, timed by a quintic of
-    the given duration: a smooth, rest-to-rest first guess."""
-    K = problem.K
-    tau = np.linspace(0.0, 1.0, K + 1)
-    sigma = tau**3 * (10 - 15 * tau + 6 * tau**2)
-    speed = 30 * tau**2 * (1 - tau) ** 2 / duration
-    accel = 60 * tau * (1 - tau) * (1 - 2 * tau) / duration**2
-    delta = problem.goal - problem.start
-    return problem.pack(duration, problem.start + np.outer(sigma, delta), np.outer(speed, delta), np.outer(accel, delta))
+COARSE_INTERVALS = 12
+#: Amplitude (rad or m) of the bends added to the straight line in the initial guesses.
+BEND = 1.0
 
 
-def _guess_duration(problem: _Problem) -> float:
-    """A duration at which the quintic line roughly meets the torque limits (scanned)."""
-    for duration in np.geomspace(0.05, 60.0, 40):
-        z = _line_guess(problem, duration)
-        if np.all(problem.torque_margin(z) >= 0.0):
-            return float(duration)
-    raise InfeasiblePath("no motion along the straight joint line meets the torque limits, not even a slow one")
+def _timed_guess(problem: _Problem, bend: np.ndarray) -> np.ndarray:
+    """The bent line timed time-optimally along itself (phase-plane method, torque and velocity
+    limits): a dynamically feasible first guess whose duration bounds the optimum from above."""
+    sigma = np.linspace(0.0, 1.0, 25)
+    points = problem.start + np.outer(sigma, problem.goal - problem.start) + np.outer(np.sin(np.pi * sigma), bend)
+    path = SplinePath(points)
+    kinds = ("torque", "velocity") if np.all(np.isfinite(problem.limits.velocity)) else ("torque",)
+    constraints = build_path_constraints(path, problem.robot, problem.limits, kinds, path_grid(path, 200))
+    timing = PhasePlaneMethod(max_refinements=0).solve(constraints)
+    t = np.linspace(0.0, timing.duration, problem.K + 1)
+    s, sd, sdd = timing.at_times(t)
+    geometry = path.evaluate(s)
+    return problem.pack(
+        timing.duration,
+        geometry.q,
+        geometry.dq * sd[:, None],
+        geometry.dq * sdd[:, None] + geometry.ddq * (sd**2)[:, None],
+    )
+
+
+def _refined(coarse: _Problem, z: np.ndarray, fine: _Problem) -> np.ndarray:
+    """The coarse solution resampled at the fine instants (exactly, on its piecewise cubic)."""
+    T, q, v, a = coarse.unpack(z)
+    h = T / coarse.K
+    t = np.linspace(0.0, T, fine.K + 1)
+    k = np.clip((t / h).astype(int), 0, coarse.K - 1)
+    r = (t - k * h)[:, None]
+    jerk = (a[k + 1] - a[k]) / h
+    return fine.pack(
+        T,
+        q[k] + v[k] * r + a[k] * r**2 / 2 + jerk * r**3 / 6,
+        v[k] + a[k] * r + jerk * r**2 / 2,
+        a[k] + jerk * r,
+    )
 
 
 def _goals(robot: Robot, motion: FreeMotion) -> list[tuple[str, np.ndarray]]:
     """The straight-line goal and, for continuous joints, the goal one revolution either way."""
     options = [("straight line", motion.goal)]
-    continuous = np.flatnonzero(robot.continuous)
+    continuous = np.flatnonzero(robot.continuous) if motion.revolutions else np.empty(0, dtype=int)
     for shifts in itertools.product((-2 * np.pi, 0.0, 2 * np.pi), repeat=len(continuous)):
         if not any(shifts):
             continue
@@ -235,56 +263,80 @@ def _goals(robot: Robot, motion: FreeMotion) -> list[tuple[str, np.ndarray]]:
     return options
 
 
+def _bends(n_dof: int) -> list[tuple[str, np.ndarray]]:
+    """Straight, and bent one joint at a time both ways (all joints together beyond three)."""
+    options = [("", np.zeros(n_dof))]
+    directions = np.eye(n_dof) if n_dof <= 3 else np.ones((1, n_dof))
+    for direction in directions:
+        for sign in (1.0, -1.0):
+            joints = "all joints" if n_dof > 3 else f"joint {int(np.argmax(direction))}"
+            options.append((f", bent {'+' if sign > 0 else '-'}{BEND:g} at {joints}", sign * BEND * direction))
+    return options
+
+
+def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int, deadline: Deadline):
+    result = minimize(
+        problem.cost,
+        z0,
+        jac=problem.cost_gradient,
+        method="SLSQP",
+        bounds=problem.bounds(),
+        constraints=[
+            {"type": "eq", "fun": problem.defects, "jac": problem.defects_jacobian},
+            {"type": "ineq", "fun": problem.torque_margin, "jac": problem.torque_margin_jacobian},
+        ],
+        options={"maxiter": max_iterations, "ftol": 1e-10},
+        callback=lambda _: deadline.check(),
+    )
+    feasible = np.abs(problem.defects(result.x)).max() < 1e-6 and problem.torque_margin(result.x).min() > -1e-6
+    return result, feasible
+
+
 def optimize_motion(
     robot: Robot,
     limits: JointLimits,
     motion: FreeMotion,
     torque_weight: float = 0.0,
     deadline: Deadline = NO_DEADLINE,
-    max_iterations: int = 400,
+    max_iterations: int = 1000,
 ) -> CollocationResult:
     """Minimize T (``torque_weight`` = 0) or the integral of (1 + beta |tau|^2) dt from start to
-    goal over every initial guess; the best solution that meets the constraints wins.
+    goal. Every initial guess (goal shifts times bends) is first solved on a coarse grid of
+    ``COARSE_INTERVALS``; the best is then refined on ``motion.intervals``.
 
     Raises:
-        InvalidRequest: a start or goal outside the joint limits, or a robot with non-revolute
-            (prismatic) joints and boundary problems the method does not handle.
-        InfeasiblePath: no initial guess leads to a solution.
+        InvalidRequest: a start or goal outside the joint limits.
+        InfeasiblePath: no initial guess leads to a feasible motion.
     """
     if robot.outside_position_limits(motion.start) is not None:
         raise InvalidRequest("path.start is outside the joint limits")
     if robot.outside_position_limits(motion.goal) is not None:
         raise InvalidRequest("path.goal is outside the joint limits")
-    best, tried = None, []
     started = time.perf_counter()
-    for label, goal in _goals(robot, motion):
+    best, tried = None, []
+    coarse_motion = FreeMotion(
+        motion.start, motion.goal, motion.start_velocity, motion.end_velocity, min(COARSE_INTERVALS, motion.intervals)
+    )
+    for (goal_label, goal), (bend_label, bend) in itertools.product(_goals(robot, motion), _bends(robot.dof)):
         deadline.check()
-        problem = _Problem(robot, limits, motion, goal, torque_weight)
+        label = goal_label + bend_label
+        coarse = _Problem(robot, limits, coarse_motion, goal, torque_weight)
         try:
-            z0 = _line_guess(problem, _guess_duration(problem))
-        except InfeasiblePath as error:
+            z0 = _timed_guess(coarse, bend)
+        except (InfeasiblePath, TimingFailed) as error:
             tried.append(f"{label}: {error.detail}")
             continue
-        result = minimize(
-            problem.cost,
-            z0,
-            jac=problem.cost_gradient,
-            method="SLSQP",
-            bounds=problem.bounds(),
-            constraints=[
-                {"type": "eq", "fun": problem.defects, "jac": problem.defects_jacobian},
-                {"type": "ineq", "fun": problem.torque_margin, "jac": problem.torque_margin_jacobian},
-            ],
-            options={"maxiter": max_iterations, "ftol": 1e-10},
-            callback=lambda _: deadline.check(),
-        )
-        feasible = np.abs(problem.defects(result.x)).max() < 1e-6 and problem.torque_margin(result.x).min() > -1e-6
+        result, feasible = _solve(coarse, z0, max_iterations, deadline)
         tried.append(f"{label}: {result.message} (cost {result.fun:.6g})")
         if feasible and (best is None or result.fun < best[0].fun):
-            best = (result, problem, label)
+            best = (result, coarse, label, goal)
     if best is None:
         raise InfeasiblePath("the collocation found no feasible motion from any initial guess: " + "; ".join(tried))
-    result, problem, label = best
+    coarse_result, coarse, label, goal = best
+    problem = _Problem(robot, limits, motion, goal, torque_weight)
+    result, feasible = _solve(problem, _refined(coarse, coarse_result.x, problem), max_iterations, deadline)
+    if not feasible:
+        raise InfeasiblePath(f"the collocation did not converge on the fine grid from its best guess ({label}): {result.message}")
     T, q, v, a = problem.unpack(result.x)
     tau = problem._dynamics(result.x)[0]
     return CollocationResult(
@@ -295,7 +347,20 @@ def optimize_motion(
         tau=tau.copy(),
         cost=float(result.fun),
         status=str(result.message),
-        iterations=int(result.nit),
+        iterations=int(coarse_result.nit + result.nit),
         initial_guess=label,
         solve_s=time.perf_counter() - started,
     )
+
+
+def collocation_path(result: CollocationResult):
+    """The optimized motion as a path with constant-speed timing: on each interval the exact
+    cubic q_k + v_k t + a_k t^2 / 2 + (a_k+1 - a_k) t^3 / (6 h)."""
+    from planners.via_points import ConstantSpeedTiming, ViaPath
+
+    h = np.diff(result.t)
+    jerk_term = (result.a[1:] - result.a[:-1]) / (6 * h[:, None])
+    zeros = np.zeros_like(jerk_term)
+    coefficients = np.stack([result.q[:-1], result.v[:-1], result.a[:-1] / 2, jerk_term, zeros, zeros], axis=2)
+    path = ViaPath(coefficients, h)
+    return path, ConstantSpeedTiming(path.total, path.knots)

@@ -45,6 +45,19 @@ class CartesianPathRequest(Schema):
     )
 
 
+class FreePathRequest(Schema):
+    """Start and goal only: the path and its timing are optimized together (timing.method
+    `collocation`)."""
+
+    kind: Literal["free"]
+    start: JointVector = Field(description="Start configuration (rad, m), at rest unless timing.boundary says otherwise.")
+    goal: JointVector = Field(description="Goal configuration (rad, m).")
+    revolutions: bool = Field(
+        default=True, description="Whether continuous joints may reach their goal one revolution either way."
+    )
+    obstacles: list[dict] = Field(default=[], max_length=0, description="Not supported yet: must be empty.")
+
+
 def _path_kind(value) -> str:
     """The path's ``kind``; waypoints when the request leaves it out."""
     if isinstance(value, dict):
@@ -53,8 +66,12 @@ def _path_kind(value) -> str:
 
 
 PathRequest = Annotated[
-    Annotated[WaypointsPath, Tag("waypoints")] | Annotated[CartesianPathRequest, Tag("cartesian")],
-    Discriminator(_path_kind, custom_error_type="path_kind", custom_error_message="path.kind must be 'waypoints' or 'cartesian'"),
+    Annotated[WaypointsPath, Tag("waypoints")]
+    | Annotated[CartesianPathRequest, Tag("cartesian")]
+    | Annotated[FreePathRequest, Tag("free")],
+    Discriminator(
+        _path_kind, custom_error_type="path_kind", custom_error_message="path.kind must be 'waypoints', 'cartesian' or 'free'"
+    ),
 ]
 
 
@@ -100,8 +117,8 @@ class TimingRequest(Schema):
     method: str = Field(
         default="phase_plane",
         description="`phase_plane` (time-optimal, default), `toppra`, `min_cost` (minimum of the "
-        "integral of 1 + beta |tau|^2), `ruckig` (jerk-limited, two waypoints), or a time law: "
-        "`cubic`, `quintic`, `trapezoidal`, `cycloidal`.",
+        "integral of 1 + beta |tau|^2), `ruckig` (jerk-limited, two waypoints), a time law "
+        "(`cubic`, `quintic`, `trapezoidal`, `cycloidal`), or `collocation` (free path).",
     )
     constraints: list[Literal["velocity", "acceleration", "torque", "jerk"]] = Field(
         default=["velocity", "acceleration", "torque"],
@@ -197,7 +214,8 @@ class TrajectoryResponse(BaseModel):
     peak_utilization: UtilizationPublic
     binding: BindingPublic | None = None
     conditioning: ConditioningPublic
-    cost: float | None = Field(default=None, description="min_cost: the integral of (1 + beta |tau|^2) dt, in s.")
+    cost: float | None = Field(default=None, description="min_cost, collocation: the integral of (1 + beta |tau|^2) dt, in s.")
+    solver: dict | None = Field(default=None, description="collocation: status, iterations, the winning initial guess.")
     solve_ms: float
     warnings: list[str]
 

@@ -1,0 +1,26 @@
+"""``collocation``: the name under which a free motion is optimized (path and timing together,
+``planners.free_path``). It does not time a given path, so ``solve`` refuses one."""
+
+from __future__ import annotations
+
+from planners.constraints import PathConstraints
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.errors import InvalidRequest
+from planners.timing.base import Boundary, PathTiming, TimingMethod
+
+
+class CollocationMethod(TimingMethod):
+    """Direct collocation of path and timing from start to goal (see ``planners.free_path``)."""
+
+    name = "collocation"
+    kinds = frozenset({"velocity", "acceleration", "torque"})
+    required_kinds = frozenset({"torque"})
+
+    def solve(
+        self,
+        constraints: PathConstraints,
+        boundary: Boundary = Boundary(),
+        duration: float | None = None,
+        deadline: Deadline = NO_DEADLINE,
+    ) -> PathTiming:
+        raise InvalidRequest("collocation optimizes the path itself: give a free path (start and goal)")

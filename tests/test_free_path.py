@@ -1,0 +1,91 @@
+"""Free-path motions by direct collocation: the Geering arm's time-optimal motions (Jeong & Lee
+section 4) and Yamamoto's minimum-cost free path, with the robots' Pinocchio models."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robots
+from planners import Timing, plan
+from planners.free_path import FreeMotion
+
+
+def _geering(goal, revolutions=True):
+    arm = robots.load("geering_2r")
+    motion = FreeMotion(np.zeros(2), np.array(goal, dtype=float), revolutions=revolutions)
+    return arm, plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002)
+
+
+@pytest.mark.parametrize(
+    "goal, revolutions, paper_T, elbow_end",
+    [
+        ((0.76, 0.0), True, 0.9755, -2 * np.pi),  # type 3: the elbow turns a full revolution
+        ((0.98, 0.0), False, 1.085, 0.0),  # type 1/2, elbow back to 0
+        ((np.pi, 0.0), True, 1.252, -2 * np.pi),  # type 4
+    ],
+)
+def test_geering_time_optimal_motions(goal, revolutions, paper_T, elbow_end):
+    arm, result = _geering(goal, revolutions)
+    collocation_T = result.solver["duration"]
+    assert collocation_T == pytest.approx(paper_T, rel=1e-2)
+    assert result.duration == pytest.approx(paper_T, rel=1e-2)
+    # The path-constrained time-optimal duration along the returned path (phase plane) agrees
+    # with the collocation's own duration.
+    assert result.duration == pytest.approx(collocation_T, rel=1e-2)
+    assert result.samples.q[-1] == pytest.approx([goal[0], elbow_end], abs=1e-9)
+    assert ("psi -6.2832" in result.solver["initial_guess"]) == (elbow_end != 0.0)
+    # Bang-bang: some torque saturated most of the time, and no limit exceeded.
+    ratio = np.abs(result.samples.tau) / arm.limits.torque
+    assert ratio.max() <= 1.005
+    assert np.mean(ratio.max(axis=1) >= 0.98) >= 0.7
+
+
+def test_geering_larger_moves_prefer_the_revolution():
+    """At phi_b = 0.98 with the elbow free, the revolution (type 3) beats the type-1 motion."""
+    _, free = _geering((0.98, 0.0), revolutions=True)
+    _, fixed = _geering((0.98, 0.0), revolutions=False)
+    assert free.samples.q[-1][1] == pytest.approx(-2 * np.pi)
+    assert free.duration < fixed.duration
+
+
+def test_yamamoto_free_path_cost_and_minimum_time():
+    arm = robots.load("yamamoto_2r")
+    motion = FreeMotion(np.radians([45.0, -90.0]), np.radians([-90.0, 0.0]))
+    cheap = plan(arm, motion, Timing(method="collocation", constraints=("torque",), torque_weight=0.03))
+    assert cheap.solver["cost"] <= 0.5777  # the paper's sixth iterate, 0.57766, bounds the optimum
+    assert cheap.cost <= 0.5777 * 1.01  # re-timed along the returned path by min_cost
+    assert cheap.peak_utilization["torque"].max() <= 1.005
+    fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
+    assert fast.duration < cheap.duration
+    assert fast.duration == pytest.approx(fast.solver["duration"], rel=1e-2)
+
+
+def test_ur5_smoke(client):
+    body = {
+        "robot": "ur5",
+        "path": {"kind": "free", "start": [0.0, -1.2, 1.0, 0.0, 0.3, 0.0], "goal": [0.8, -1.0, 1.4, -0.5, 0.6, 0.3]},
+        "timing": {"method": "collocation", "constraints": ["velocity", "torque"], "grid_points": 8},
+    }
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 200, response.text
+    result = response.json()
+    assert result["solver"]["status"].startswith("Optimization terminated")
+    assert result["samples"]["q"][-1] == pytest.approx(body["path"]["goal"], abs=1e-9)
+    assert max(result["peak_utilization"]["torque"]) <= 1.005
+
+
+@pytest.mark.parametrize(
+    "path, timing, words",
+    [
+        ({"kind": "free", "start": [0, 0], "goal": [1, 0]}, {"method": "phase_plane"}, ["collocation"]),
+        ({"kind": "free", "start": [0, 0], "goal": [1, 0], "obstacles": [{"sphere": [0, 0, 0, 1]}]}, {"method": "collocation"}, ["obstacles"]),
+        ({"waypoints": [[0, 0], [1, 0]]}, {"method": "collocation"}, ["free path"]),
+        ({"kind": "free", "start": [0, 0, 0], "goal": [1, 0]}, {"method": "collocation"}, ["path.start has 3 values"]),
+    ],
+)
+def test_free_path_errors(client, path, timing, words):
+    response = client.post("/v1/trajectories", json={"robot": "geering_2r", "path": path, "timing": timing})
+    assert response.status_code == 422, response.text
+    for word in words:
+        assert word in response.json()["detail"]
