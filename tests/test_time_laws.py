@@ -135,3 +135,18 @@ def test_given_duration_and_boundary_states():
     theta = np.degrees(result.samples.q[:, 0] - start[0]) + 30.0
     expected = polynomial_derivatives(np.array([30.0, 0.0, 2.5, 1.6, -0.58, 0.0464]), np.arange(6.0), 1)[0]
     assert theta == pytest.approx(expected, abs=1e-9)
+
+
+@pytest.mark.parametrize("law", ["cubic", "quintic"])
+def test_shortest_law_with_boundary_velocity(law):
+    """A law that starts moving: the boundary velocity is honoured and the shortest duration
+    keeps every limit, with one limit binding."""
+    start = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
+    goal = start + np.array([1.0, 0.5, 0, 0, 0, 0])
+    direction = (goal - start) / np.linalg.norm(goal - start)
+    timing = Timing(method=law, constraints=("velocity", "acceleration"), start_velocity=0.5 * direction)
+    result = plan(UR5, WaypointPath(np.array([start, goal])), timing)
+    assert result.samples.qd[0] == pytest.approx(0.5 * direction, abs=1e-9)
+    assert result.samples.qd[-1] == pytest.approx(np.zeros(6), abs=1e-9)
+    top = max(result.peak_utilization[kind].max() for kind in ("velocity", "acceleration"))
+    assert 0.99 <= top <= 1.005
