@@ -35,6 +35,8 @@ from robots import JointLimits, Robot
 
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
 MAX_WAYPOINTS = 1_000
+#: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
+MAX_COORDINATE = 1e4
 MAX_SAMPLES = 200_000
 #: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
 MAX_PHASE_PLANE_POINTS = 2_000
@@ -148,9 +150,12 @@ def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPa
             f"path.waypoints[0] has {width} values; {robot.name} has {robot.dof} joints "
             f"({', '.join(robot.joint_names)})"
         )
-    bad = np.argwhere(~np.isfinite(waypoints))
+    bad = np.argwhere(~np.isfinite(waypoints) | (np.abs(waypoints) > MAX_COORDINATE))
     if bad.size:
-        raise InvalidRequest(f"path.waypoints[{bad[0][0]}][{bad[0][1]}] is not a finite number")
+        raise InvalidRequest(
+            f"path.waypoints[{bad[0][0]}][{bad[0][1]}] is {waypoints[tuple(bad[0])]:.6g}: not a finite "
+            f"number within +-{MAX_COORDINATE:g} (rad or m)"
+        )
     lower, upper = robot.limits.position_lower, robot.limits.position_upper
     outside = robot.outside_position_limits(waypoints)
     if outside is not None:

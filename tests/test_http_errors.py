@@ -44,6 +44,12 @@ def _post(client, body, **kwargs):
         ({"robot": "ur5", "path": GOOD_PATH, "timing": {"duration": 2.0}}, 422, ["timing.duration is not used"]),
         ({"robot": "ur5", "path": GOOD_PATH, "surprise": 1}, 422, ["surprise"]),
         ({"path": GOOD_PATH}, 422, ["robot", "Field required"]),
+        ({"robot": "geering_2r", "path": {"waypoints": [[0, 0], [0, 1e300]]}}, 422, ["path.waypoints[1][1]", "within"]),
+        ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "min_cost", "cost": {"torque_weight": 1e12}}}, 422, ["timing.cost.torque_weight"]),
+        ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "trapezoidal", "trapezoid": {"tau1": 0.8, "tau2": 0.2}}}, 422, ["tau1 <= tau2"]),
+        ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "ruckig"}}, 422, ["cannot limit torque"]),
+        ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "phase_plane", "constraints": ["jerk"]}}, 422, ["cannot limit jerk"]),
+        ({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS, "interpolation": "via"}, "timing": {"method": "toppra"}}, 422, ["via points need"]),
     ],
 )
 def test_bad_input_is_a_clear_4xx(client, body, status, words):

@@ -100,7 +100,7 @@ class Boundary(Schema):
 class CostRequest(Schema):
     """Weights of the cost integral of (1 + beta |tau|^2) dt (min_cost): beta in 1/(N m)^2."""
 
-    torque_weight: Annotated[float, Field(ge=0.0)] = 0.0
+    torque_weight: Annotated[float, Field(ge=0.0, le=1e3)] = 0.0
 
 
 class TrapezoidRequest(Schema):
