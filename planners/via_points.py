@@ -168,7 +168,7 @@ def via_point_trajectory(
         velocity_time = np.nan_to_num(np.abs(steps) / limits.velocity, posinf=0.0).max(axis=1) * 1.5
         accel_time = np.sqrt(np.nan_to_num(6 * np.abs(steps) / limits.acceleration, posinf=0.0).max(axis=1))
     durations = np.maximum(np.maximum(velocity_time, accel_time), 1e-3)
-    for round_ in range(ROUNDS + 1):
+    for _ in range(ROUNDS + 1):
         slopes = steps / durations[:, None]
         velocities = np.zeros((n_segments + 1, n_dof))
         accelerations = np.zeros((n_segments + 1, n_dof))

@@ -7,7 +7,6 @@ holds those per robot, with their source, and a default rule for every other rob
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass
@@ -110,8 +109,3 @@ def limits_for(
     default_jerk = values["acceleration"] / rule["seconds_to_full_acceleration"]
     values["jerk"] = np.asarray(entry.get("jerk", default_jerk), dtype=float)
     return JointLimits(**values)
-
-
-def replace(limits: JointLimits, **changes: np.ndarray) -> JointLimits:
-    """A copy of ``limits`` with some arrays replaced."""
-    return dataclasses.replace(limits, **changes)

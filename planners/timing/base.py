@@ -25,6 +25,10 @@ class Boundary:
     sdd_end: float | None = None
 
 
+#: At rest at both ends, accelerations free: the default boundary.
+AT_REST = Boundary()
+
+
 @dataclass(frozen=True)
 class DenseStates:
     """Path states for checking limits between samples, each of shape (n,): s, sd, sdd, and
@@ -172,7 +176,7 @@ class TimingMethod(abc.ABC):
     def solve(
         self,
         constraints: PathConstraints,
-        boundary: Boundary = Boundary(),
+        boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> PathTiming:

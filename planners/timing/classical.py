@@ -27,7 +27,7 @@ from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, InvalidRequest
-from planners.timing.base import Binding, Boundary, TimingMethod
+from planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
 from planners.timing.law_timing import LawSegment, LawTiming
 from planners.timing.laws import (
     CubicProfile,
@@ -105,7 +105,7 @@ class ClassicalMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        boundary: Boundary = Boundary(),
+        boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> LawTiming:

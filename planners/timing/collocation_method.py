@@ -6,7 +6,7 @@ from __future__ import annotations
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
-from planners.timing.base import Boundary, PathTiming, TimingMethod
+from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
 
 
 class CollocationMethod(TimingMethod):
@@ -19,7 +19,7 @@ class CollocationMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        boundary: Boundary = Boundary(),
+        boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> PathTiming:

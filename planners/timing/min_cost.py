@@ -26,7 +26,7 @@ import numpy as np
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.timing.base import Boundary, TimeScaling, TimingMethod
+from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,7 @@ class MinCostMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        boundary: Boundary = Boundary(),
+        boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> CostTimeScaling:

@@ -43,7 +43,7 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.kernels import backward_envelope, forward_profile
 from planners.mvc import acceleration_bounds, admissible_set
-from planners.timing.base import Boundary, TimeScaling, TimingMethod
+from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
 _SLACK = 1e-9
@@ -101,7 +101,7 @@ class PhasePlaneMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        boundary: Boundary = Boundary(),
+        boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:

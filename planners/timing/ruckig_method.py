@@ -20,7 +20,7 @@ from ruckig import InputParameter, Result, Ruckig, Trajectory
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
-from planners.timing.base import Boundary, DenseStates, PathTiming, TimingMethod
+from planners.timing.base import AT_REST, Boundary, DenseStates, PathTiming, TimingMethod
 
 #: Stand-in for an unlimited bound (ruckig needs finite numbers).
 _UNLIMITED = 1e12
@@ -76,7 +76,7 @@ class RuckigMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        boundary: Boundary = Boundary(),
+        boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> RuckigTiming:

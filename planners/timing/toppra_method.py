@@ -20,7 +20,7 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.mvc import admissible_set
-from planners.timing.base import Boundary, TimeScaling, TimingMethod
+from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 logging.getLogger("toppra").setLevel(logging.ERROR)
 
@@ -94,7 +94,7 @@ class ToppraMethod(TimingMethod):
     def solve(
         self,
         constraints: PathConstraints,
-        boundary: Boundary = Boundary(),
+        boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:
