@@ -18,10 +18,11 @@ from service.settings import Settings
 
 
 def _warm_up() -> None:
-    """Build every catalog robot, import toppra and load the compiled phase-plane kernels once,
-    so that first requests are fast."""
+    """Build every catalog robot, import toppra and cvxpy, and load the compiled phase-plane
+    kernels once, so that first requests are fast."""
     for name in robots.catalog_names():
         robots.load(name)
+    import cvxpy  # noqa: F401
     import toppra  # noqa: F401
 
     arm = robots.load("yamamoto_2r")
