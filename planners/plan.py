@@ -186,6 +186,13 @@ def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) 
         )
 
 
+def _moving(velocity):
+    """A boundary velocity, or ``None`` for rest (a zero vector included)."""
+    if velocity is None or not np.any(np.asarray(velocity) != 0.0):
+        return None
+    return velocity
+
+
 def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
     """Path and timing optimized together (``path.kind = "free"`` with ``collocation``)."""
     if not isinstance(path_spec, FreeMotion) or method.name != "collocation":
@@ -201,7 +208,7 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
         acceleration=limits.acceleration if "acceleration" in timing.constraints else unlimited,
     )
     result = optimize_motion(robot, limits, path_spec, timing.torque_weight, deadline)
-    path, _ = collocation_path(result)
+    path, timed = collocation_path(result)
     solver = {
         "cost": result.cost,
         "duration": float(result.t[-1]),
@@ -210,7 +217,7 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
         "initial_guess": result.initial_guess,
         "solve_s": result.solve_s,
     }
-    return path, solver
+    return path, solver, timed
 
 
 def _check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
@@ -303,15 +310,27 @@ def plan(
             f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
             "law through several waypoints"
         )
-    solver = None
+    solver, notes = None, []
     if isinstance(path_spec, FreeMotion) or method.name == "collocation":
         # The optimized path, re-timed exactly along itself: every limit then holds between the
         # collocation instants too, and the duration checks the collocation's own.
-        path, solver = _free_motion(robot, path_spec, method, timing, limits, deadline)
+        path, solver, collocation_timing = _free_motion(robot, path_spec, method, timing, limits, deadline)
         method = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
         s = path_grid(path, None)
         constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
-        result = method.solve(constraints, _boundary(path, timing, method), None, deadline)
+        moving = dataclasses.replace(
+            timing,
+            start_velocity=_moving(path_spec.start_velocity),
+            end_velocity=_moving(path_spec.end_velocity),
+            duration=None,
+        )
+        try:
+            result = method.solve(constraints, _boundary(path, moving, method), None, deadline)
+        except InfeasiblePath as error:
+            # A boundary state right at a limit may be out of reach of the conservative re-timing;
+            # the collocation's own timing is then returned as it is.
+            result = collocation_timing
+            notes.append(f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})")
         method = CollocationMethod()
     elif (path := make_path(robot, path_spec)) is None:
         if timing.start_velocity is not None or timing.end_velocity is not None:
@@ -337,7 +356,7 @@ def plan(
     samples = sample_trajectory(path, result, robot, dt)
     utilization = peak_utilization(path, result, robot, limits)
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
-    notes = _warnings(utilization, kinds, robot)
+    notes += _warnings(utilization, kinds, robot)
     if kappa_max > NEAR_SINGULAR_KAPPA:
         notes.append(
             f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} "

@@ -89,3 +89,18 @@ def test_free_path_errors(client, path, timing, words):
     assert response.status_code == 422, response.text
     for word in words:
         assert word in response.json()["detail"]
+
+
+def test_free_path_with_a_start_velocity(client):
+    body = {
+        "robot": "geering_2r",
+        "path": {"kind": "free", "start": [0.0, 0.0], "goal": [0.5, 0.0], "revolutions": False},
+        "timing": {"method": "collocation", "constraints": ["torque"], "boundary": {"start_velocity": [1.0, 0.0]}},
+        "output": {"dt": 0.001},
+    }
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 200, response.text
+    result = response.json()
+    assert result["samples"]["qd"][0] == pytest.approx([1.0, 0.0], abs=1e-6)
+    assert result["samples"]["qd"][-1] == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert result["duration"] == pytest.approx(result["solver"]["duration"], rel=1e-2)
