@@ -4,7 +4,9 @@ from planners.constraints import PathConstraints, build_path_constraints
 from planners.deadline import Deadline
 from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
 from planners.paths.cartesian import CartesianLine
-from planners.plan import PlannedTrajectory, Timing, WaypointPath, plan
+from planners.plan import plan
+from planners.requests import Timing, WaypointPath
+from planners.results import PlannedTrajectory
 from planners.timing import METHODS, TimeScaling
 
 __all__ = [

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
-from planners.constraints import CONSTRAINT_KINDS, build_path_constraints
+from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.grid import MAX_POINTS, path_grid
@@ -22,15 +22,14 @@ from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.paths.cartesian import CartesianLine, cartesian_path
 from planners.boundary import path_acceleration, path_speed
-from planners.timing import METHODS
-from planners.timing.base import Binding, Boundary, TimingMethod
-from planners.timing.classical import ClassicalMethod
+from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
+from planners.results import Conditioning, PhasePlane, PlannedTrajectory
+from planners.constraints import PathConstraints
+from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.min_cost import MinCostMethod
-from planners.timing.collocation_method import CollocationMethod
 from planners.timing.phase_plane import PhasePlaneMethod
-from planners.timing.laws import TrapezoidalProfile
+from planners.trajectory import peak_utilization, sample_trajectory
 from planners.via_points import via_point_trajectory
-from planners.trajectory import Samples, peak_utilization, sample_trajectory
 from robots import JointLimits, Robot
 
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
@@ -42,97 +41,8 @@ MAX_SAMPLES = 200_000
 MAX_PHASE_PLANE_POINTS = 2_000
 
 
-@dataclass(frozen=True)
-class WaypointPath:
-    """A joint path through ``waypoints`` (shape (n_waypoints, n_dof), joint units), interpolated
-    by ``"spline"`` (C2 cubic), ``"linear"`` (straight segments, stopping at each waypoint), or
-    ``"via"`` (per-joint cubic or quintic segments in time through the via points, the law named
-    by the timing method)."""
-
-    waypoints: np.ndarray
-    interpolation: str = "spline"
-
-
-@dataclass(frozen=True)
-class Timing:
-    """How to time the path.
-
-    Attributes:
-        method: A ``timing.method`` name (see ``planners.timing.METHODS``).
-        constraints: Which limits to respect, among velocity, acceleration and torque.
-        limit_overrides: Per-joint replacements, keys ``velocity``, ``acceleration``, ``jerk``,
-            ``torque``.
-        limit_scales: Factors on those limits, same keys.
-        grid_points: Number of grid intervals; ``None`` chooses one from the path.
-        start_velocity, end_velocity: Joint velocities at the ends (rad/s), tangent to the path;
-            ``None`` is rest.
-        start_acceleration, end_acceleration: Joint accelerations at the ends (rad/s^2), for the
-            laws that take them (quintic).
-        duration: Seconds, for the time laws; ``None`` asks for the shortest within the limits.
-        trapezoid_fractions: (tau1, tau2), the trapezoidal law's ends of acceleration and of
-            cruise as fractions of the duration.
-        torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
-            ``min_cost``.
-    """
-
-    method: str = "phase_plane"
-    constraints: tuple[str, ...] = ("velocity", "acceleration", "torque")
-    limit_overrides: dict[str, list[float] | None] = field(default_factory=dict)
-    limit_scales: dict[str, float | None] = field(default_factory=dict)
-    grid_points: int | None = None
-    start_velocity: np.ndarray | None = None
-    end_velocity: np.ndarray | None = None
-    start_acceleration: np.ndarray | None = None
-    end_acceleration: np.ndarray | None = None
-    duration: float | None = None
-    trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
-    torque_weight: float = 0.0
-
-
-@dataclass(frozen=True)
-class PhasePlane:
-    """The (s, sd) picture: the timing's path speed and the maximum velocity curve, in 1/s."""
-
-    s: np.ndarray
-    sd: np.ndarray
-    sd_max: np.ndarray
-    switch_points: tuple[tuple[float, str], ...]
-
-
-@dataclass(frozen=True)
-class Conditioning:
-    """Frobenius condition number of the end effector's Jacobian along the trajectory
-    (``planners.kinematics.conditioning``), with the characteristic length L in m."""
-
-    kappa_min: float
-    kappa_max: float
-    characteristic_length: float
-
-
-@dataclass(frozen=True)
-class PlannedTrajectory:
-    """What ``plan`` returns: samples and diagnostics of one timed path."""
-
-    robot: str
-    method: str
-    joint_names: tuple[str, ...]
-    duration: float
-    samples: Samples
-    phase_plane: PhasePlane
-    peak_utilization: dict[str, np.ndarray]
-    solve_ms: float
-    warnings: tuple[str, ...]
-    binding: Binding | None = None
-    conditioning: Conditioning | None = None
-    cost: float | None = None
-    solver: dict | None = None
-
-
-def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath | None:
-    """The geometric path of ``spec``, after checking it against the robot (``None`` for via
-    points, whose geometry depends on their timing)."""
-    if isinstance(spec, CartesianLine):
-        return cartesian_path(robot, spec)
+def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
+    """The waypoints of ``spec`` as an (n, n_dof) array, checked against the robot."""
     if spec.interpolation not in (*INTERPOLATIONS, "via"):
         raise InvalidRequest(
             f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted([*INTERPOLATIONS, 'via'])}"
@@ -164,9 +74,15 @@ def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPa
             f"path.waypoints[{index}][{joint}] = {waypoints[index, joint]:.6g} is outside the limits "
             f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
         )
-    if spec.interpolation == "via":
-        return None
-    return INTERPOLATIONS[spec.interpolation](waypoints)
+    return waypoints
+
+
+def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
+    """The geometric path of a Cartesian line, or of joint waypoints interpolated by spline or
+    linear segments (via points are timed and shaped together, in ``via_points``)."""
+    if isinstance(spec, CartesianLine):
+        return cartesian_path(robot, spec)
+    return INTERPOLATIONS[spec.interpolation](checked_waypoints(robot, spec))
 
 
 def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:
@@ -220,44 +136,6 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
     return path, solver, timed
 
 
-def _check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
-    unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
-    if unknown:
-        raise InvalidRequest(f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}")
-    unsupported = [kind for kind in kinds if kind not in method.kinds]
-    if unsupported:
-        hint = " (for jerk, use a time law or ruckig)" if unsupported[0] == "jerk" else ""
-        raise InvalidRequest(
-            f"timing.method {method.name!r} cannot limit {unsupported[0]}; it handles "
-            f"{sorted(method.kinds)}{hint}"
-        )
-    kinds = tuple(dict.fromkeys([*kinds, *sorted(method.required_kinds)]))
-    if not kinds:
-        raise InvalidRequest("timing.constraints is empty: without limits the time-optimal motion is instantaneous")
-    return kinds
-
-
-def timing_method(timing: Timing) -> TimingMethod:
-    """The method named by ``timing.method`` (with its per-request options)."""
-    if timing.method == "trapezoidal":
-        tau1, tau2 = timing.trapezoid_fractions
-        if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
-            raise InvalidRequest(f"timing.trapezoid needs 0 < tau1 <= tau2 < 1, got {tau1}, {tau2}")
-        return ClassicalMethod(TrapezoidalProfile(tau1, tau2))
-    if timing.torque_weight != 0.0 and timing.method not in ("min_cost", "collocation"):
-        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}; use min_cost")
-    if timing.method == "min_cost":
-        if not (np.isfinite(timing.torque_weight) and timing.torque_weight >= 0.0):
-            raise InvalidRequest(f"timing.cost.torque_weight must be a non-negative number, got {timing.torque_weight}")
-        return MinCostMethod(timing.torque_weight)
-    if timing.method == "collocation":
-        return CollocationMethod()
-    method = METHODS.get(timing.method)
-    if method is None:
-        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
-    return method
-
-
 def _boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
     if (timing.start_acceleration is not None or timing.end_acceleration is not None) and not method.takes_acceleration_boundary:
         raise InvalidRequest(
@@ -278,6 +156,61 @@ def _boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boun
     )
 
 
+class _Timed(NamedTuple):
+    """A path with its timing, the constraints it was timed under, and what to tell about it."""
+
+    path: GeometricPath
+    timing: PathTiming
+    constraints: PathConstraints
+    method: str
+    notes: tuple[str, ...] = ()
+    cost: float | None = None
+    solver: dict | None = None
+
+
+def _timed_path(robot, path, method, timing, kinds, limits, deadline) -> _Timed:
+    """A given path timed by ``method``."""
+    s = path_grid(path, timing.grid_points)
+    _check_path_within_limits(robot, path, s)
+    boundary = _boundary(path, timing, method)
+    constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
+    deadline.check()
+    result = method.solve(constraints, boundary, timing.duration, deadline)
+    return _Timed(path, result, constraints, method.name, cost=getattr(result, "cost", None))
+
+
+def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline) -> _Timed:
+    """Via points: segments shaped and timed together by the limits."""
+    if timing.start_velocity is not None or timing.end_velocity is not None:
+        raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
+    path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration)
+    s = path_grid(path, timing.grid_points)
+    _check_path_within_limits(robot, path, s)
+    constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
+    return _Timed(path, result, constraints, method.name)
+
+
+def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline) -> _Timed:
+    """A free motion: the collocation's path, re-timed exactly along itself (phase_plane, or
+    min_cost for beta > 0) so that every limit holds between the collocation instants too."""
+    path, solver, collocation_timing = _free_motion(robot, spec, method, timing, limits, deadline)
+    retimer = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
+    constraints = build_path_constraints(path, robot, limits, kinds, path_grid(path, None), deadline)
+    moving = dataclasses.replace(
+        timing, start_velocity=_moving(spec.start_velocity), end_velocity=_moving(spec.end_velocity), duration=None
+    )
+    notes = ()
+    try:
+        result = retimer.solve(constraints, _boundary(path, moving, retimer), None, deadline)
+    except InfeasiblePath as error:
+        # A boundary state right at a limit may be out of reach of the conservative re-timing;
+        # the collocation's own timing is then returned as it is.
+        result = collocation_timing
+        notes = (f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})",)
+    cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
+    return _Timed(path, result, constraints, "collocation", notes, cost, solver)
+
+
 def plan(
     robot: Robot,
     path_spec: "WaypointPath | CartesianLine",
@@ -295,7 +228,7 @@ def plan(
     """
     started = time.perf_counter()
     method = timing_method(timing)
-    kinds = _check_constraint_kinds(timing.constraints, method)
+    kinds = check_constraint_kinds(timing.constraints, method)
     if not (np.isfinite(dt) and dt > 0.0):
         raise InvalidRequest(f"output.dt must be a positive number of seconds, got {dt}")
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
@@ -310,44 +243,14 @@ def plan(
             f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
             "law through several waypoints"
         )
-    solver, notes = None, []
     if isinstance(path_spec, FreeMotion) or method.name == "collocation":
-        # The optimized path, re-timed exactly along itself: every limit then holds between the
-        # collocation instants too, and the duration checks the collocation's own.
-        path, solver, collocation_timing = _free_motion(robot, path_spec, method, timing, limits, deadline)
-        method = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
-        s = path_grid(path, None)
-        constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
-        moving = dataclasses.replace(
-            timing,
-            start_velocity=_moving(path_spec.start_velocity),
-            end_velocity=_moving(path_spec.end_velocity),
-            duration=None,
-        )
-        try:
-            result = method.solve(constraints, _boundary(path, moving, method), None, deadline)
-        except InfeasiblePath as error:
-            # A boundary state right at a limit may be out of reach of the conservative re-timing;
-            # the collocation's own timing is then returned as it is.
-            result = collocation_timing
-            notes.append(f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})")
-        method = CollocationMethod()
-    elif (path := make_path(robot, path_spec)) is None:
-        if timing.start_velocity is not None or timing.end_velocity is not None:
-            raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
-        path, result = via_point_trajectory(
-            robot, np.asarray(path_spec.waypoints, dtype=float), method.name, limits, kinds, timing.duration
-        )
-        s = path_grid(path, timing.grid_points)
-        _check_path_within_limits(robot, path, s)
-        constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
+        timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline)
+    elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
+        timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline)
     else:
-        s = path_grid(path, timing.grid_points)
-        _check_path_within_limits(robot, path, s)
-        boundary = _boundary(path, timing, method)
-        constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
-        deadline.check()
-        result = method.solve(constraints, boundary, timing.duration, deadline)
+        timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline)
+    path, result, constraints, notes = timed.path, timed.timing, timed.constraints, list(timed.notes)
+    s = constraints.s
     deadline.check()
     if result.duration / dt > MAX_SAMPLES:
         raise InvalidRequest(
@@ -367,7 +270,7 @@ def plan(
     keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
     return PlannedTrajectory(
         robot=robot.name,
-        method=method.name,
+        method=timed.method,
         joint_names=robot.joint_names,
         duration=result.duration,
         samples=samples,
@@ -377,8 +280,8 @@ def plan(
         warnings=tuple(notes),
         binding=result.binding,
         conditioning=Conditioning(kappa_min, kappa_max, length),
-        cost=getattr(result, "cost", None) if solver is None or timing.torque_weight else result.duration,
-        solver=solver,
+        cost=timed.cost,
+        solver=timed.solver,
     )
 
 
