@@ -52,14 +52,6 @@ class AccelerationBounds:
     w: np.ndarray
     singular: np.ndarray
 
-    def lowest(self, x: np.ndarray) -> np.ndarray:
-        """The least admissible u at each grid point for the given x (shape (N + 1,))."""
-        return np.max(self.p + self.q * x[:, None], axis=1)
-
-    def highest(self, x: np.ndarray) -> np.ndarray:
-        """The greatest admissible u at each grid point for the given x."""
-        return np.min(self.r + self.w * x[:, None], axis=1)
-
 
 def acceleration_bounds(rows: LinearRows) -> AccelerationBounds:
     """Solve every row of ``rows`` for u (Jeong & Lee eq. (3.6) divided by its u-coefficient)."""
@@ -89,8 +81,8 @@ def admissible_set(rows: LinearRows, x_bound: np.ndarray) -> AdmissibleSet:
         cut_high = np.where(b > 0, (upper - c) / b, np.where(b < 0, (lower - c) / b, np.inf))
         cut_low = np.where(b > 0, (lower - c) / b, np.where(b < 0, (upper - c) / b, -np.inf))
     static_fail = (singular & (b == 0) & ((c > upper) | (c < lower))).any(axis=1)
-    x_high = np.minimum(np.asarray(x_bound, dtype=float), np.where(singular & (b != 0), cut_high, np.inf).min(axis=1))
-    x_low = np.maximum(0.0, np.where(singular & (b != 0), cut_low, -np.inf).max(axis=1))
+    x_high = np.minimum(np.asarray(x_bound, dtype=float), np.where(singular & (b != 0), cut_high, np.inf).min(axis=1, initial=np.inf))
+    x_low = np.maximum(0.0, np.where(singular & (b != 0), cut_low, -np.inf).max(axis=1, initial=-np.inf))
     x_low, x_high = admissible_intervals(
         bounds.p, bounds.q, bounds.r, bounds.w, np.ascontiguousarray(x_low), np.ascontiguousarray(x_high)
     )

@@ -12,6 +12,7 @@ from starlette.concurrency import run_in_threadpool
 
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
+from planners.boundary import finite_vector
 from planners.free_path import FreeMotion
 from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
 from robots import InvalidLimits, UnknownRobot
@@ -53,11 +54,16 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
             if len(getattr(spec, name)) != robot.dof:
                 raise InvalidRequest(f"path.{name} has {len(getattr(spec, name))} values; {robot.name} has {robot.dof} joints")
         boundary = request.timing.boundary
+
+        def velocity(name):
+            value = getattr(boundary, name)
+            return None if value is None else finite_vector(value, f"timing.boundary.{name}", robot.dof)
+
         return FreeMotion(
             start=np.asarray(spec.start, dtype=float),
             goal=np.asarray(spec.goal, dtype=float),
-            start_velocity=None if boundary.start_velocity is None else np.asarray(boundary.start_velocity, dtype=float),
-            end_velocity=None if boundary.end_velocity is None else np.asarray(boundary.end_velocity, dtype=float),
+            start_velocity=velocity("start_velocity"),
+            end_velocity=velocity("end_velocity"),
             revolutions=spec.revolutions,
         )
     if spec.kind == "cartesian":

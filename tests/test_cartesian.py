@@ -119,6 +119,7 @@ def test_ur5_pose_line_keeps_orientation(client):
         ([[0.0, 0.5, 0.3]], ["leaves the workspace"]),
         ([[0.0, 0.0, 0.6]], ["singularity"]),
         ([[0.0, 0.5]], ["path.positions[0]"]),
+        ([[1e9, 0.1, 0.2]], ["m long", "leaves the workspace"]),
     ],
 )
 def test_bad_lines_are_422(client, points, words):

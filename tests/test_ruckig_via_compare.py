@@ -79,3 +79,10 @@ def test_compare_endpoint(client):
     for method in ("phase_plane", "toppra", "quintic", "trapezoidal"):
         assert max(max(values) for values in results[method]["peak_utilization"].values() if values) <= 1.005
         assert results[method]["solve_ms"] > 0
+
+
+def test_ruckig_with_jerk_alone():
+    """ruckig always limits jerk, even when the request lists no limit at all."""
+    path = WaypointPath(np.array(UR5_WAYPOINTS[:2]))
+    result = plan(UR5, path, Timing(method="ruckig", constraints=()))
+    assert result.peak_utilization["jerk"].max() == pytest.approx(1.0, abs=5e-3)

@@ -34,6 +34,8 @@ ROTATION_TOLERANCE = 1e-3
 SINGULAR_VALUE_FLOOR = 1e-3
 #: Largest joint move between two consecutive IK points (rad or m).
 MAX_JOINT_STEP = 0.25
+#: Most IK points along one line (40 m at 2 mm): far beyond any arm's reach.
+MAX_STEPS_PER_LINE = 20_000
 
 
 @dataclass(frozen=True)
@@ -100,6 +102,11 @@ def cartesian_path(robot: Robot, line: CartesianLine) -> GeometricPath:
     pieces, lengths = [], []
     q = start
     for k in range(len(positions) - 1):
+        span = np.linalg.norm(positions[k + 1] - positions[k])
+        if span / STEP_LENGTH_M > MAX_STEPS_PER_LINE:
+            raise InvalidRequest(
+                f"the line to {field}[{k + offset}] is {span:.4g} m long: it leaves the workspace of {robot.name}"
+            )
         samples = _line_samples(positions[k], positions[k + 1], rotations[k], rotations[k + 1])
         if samples is None:
             raise InvalidRequest(f"{field}[{k + offset}] repeats the previous point")
