@@ -103,3 +103,15 @@ def _blocking_pair(point, bounds, x_min, static_fail, singular, rows):
     low = bounds.p[point] + bounds.q[point] * x
     high = bounds.r[point] + bounds.w[point] * x
     return int(np.argmax(low)), int(np.argmin(high))
+
+
+def friction_reference(constraints) -> np.ndarray:
+    """A first guess of the optimal x = sd^2 (N + 1,) around which viscous friction is
+    linearized (``PathConstraints.linearized``): the maximum velocity curve without friction,
+    capped by the first-order bound; without friction, that bound itself (it is not used)."""
+    x_bound = constraints.sd_max**2
+    if not constraints.has_friction:
+        return x_bound
+    frictionless = LinearRows(constraints.a, constraints.b, constraints.c, constraints.lower, constraints.upper)
+    x_max = admissible_set(frictionless, x_bound).x_max
+    return np.where(np.isfinite(x_max) & (x_max > 0), x_max, 1.0)

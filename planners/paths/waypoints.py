@@ -33,7 +33,16 @@ def chord_knots(waypoints: np.ndarray) -> np.ndarray:
     return knots
 
 
-class SplinePath(GeometricPath):
+class _ThroughWaypoints(GeometricPath):
+    """A path that passes its waypoints at chord-length values of s (``knots``)."""
+
+    def __init__(self, waypoints: np.ndarray):
+        self.waypoints = np.asarray(waypoints, dtype=float)
+        self.dof = self.waypoints.shape[1]
+        self.knots = chord_knots(self.waypoints)
+
+
+class SplinePath(_ThroughWaypoints):
     """C2 cubic spline through the waypoints, natural ends (d2q/ds2 = 0): two waypoints give the
     straight joint line at uniform speed in s.
 
@@ -42,9 +51,7 @@ class SplinePath(GeometricPath):
     """
 
     def __init__(self, waypoints: np.ndarray):
-        self.waypoints = np.asarray(waypoints, dtype=float)
-        self.dof = self.waypoints.shape[1]
-        self.knots = chord_knots(self.waypoints)
+        super().__init__(waypoints)
         self.kinks = np.empty(0)
         self._spline = CubicSpline(self.knots, self.waypoints, axis=0, bc_type="natural")
         self._d1 = self._spline.derivative(1)
@@ -59,7 +66,7 @@ class SplinePath(GeometricPath):
         return self._d3(np.clip(np.asarray(s, dtype=float), 0.0, 1.0))
 
 
-class StopAndGoPath(GeometricPath):
+class StopAndGoPath(_ThroughWaypoints):
     """Straight joint-space segments between waypoints, the motion stopping at each of them.
 
     Segment k runs over s in [s_k, s_k+1] as q = w_k + (w_k+1 - w_k) (s - s_k) / (s_k+1 - s_k).
@@ -70,9 +77,7 @@ class StopAndGoPath(GeometricPath):
     """
 
     def __init__(self, waypoints: np.ndarray):
-        self.waypoints = np.asarray(waypoints, dtype=float)
-        self.dof = self.waypoints.shape[1]
-        self.knots = chord_knots(self.waypoints)
+        super().__init__(waypoints)
         self.kinks = self.knots[1:-1].copy()
         self._slopes = np.diff(self.waypoints, axis=0) / np.diff(self.knots)[:, None]
 

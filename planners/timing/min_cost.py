@@ -26,6 +26,7 @@ import numpy as np
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, TimingFailed
+from planners.mvc import friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 
@@ -60,7 +61,7 @@ class MinCostMethod(TimingMethod):
         ds = np.diff(s)
         n = len(ds)
         x_bound = constraints.sd_max**2
-        reference = np.minimum(x_bound, 1e6)
+        reference = friction_reference(constraints)
         right, left = constraints.linearized(reference), constraints.linearized(reference, "left")
         # The end values of b are data, not variables: an interior-point solver then never has
         # to sit on the boundary of the cone sqrt(b) >= 0 at a motion that starts from rest.

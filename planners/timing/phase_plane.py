@@ -42,7 +42,7 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.kernels import backward_envelope, forward_profile
-from planners.mvc import acceleration_bounds, admissible_set
+from planners.mvc import acceleration_bounds, admissible_set, friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
@@ -152,11 +152,11 @@ def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def _solve_on_grid(constraints, boundary, deadline, discretize, x_ref=None) -> _Profile:
     """Integrate on the constraints' own grid. Viscous friction is linearized around ``x_ref``
-    (default: a first pass linearized around the velocity bound, then one around its answer)."""
+    (default: a first pass around ``friction_reference``, then one around its answer)."""
     x_bound = constraints.sd_max**2
     passes = 1
     if x_ref is None:
-        x_ref = np.minimum(x_bound, 1e6)
+        x_ref = friction_reference(constraints)
         passes = 2 if constraints.has_friction else 1
     for _ in range(passes):
         stage = discretize(constraints.s, constraints.linearized(x_ref), constraints.linearized(x_ref, "left"))

@@ -19,7 +19,7 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.mvc import admissible_set
+from planners.mvc import admissible_set, friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 logging.getLogger("toppra").setLevel(logging.ERROR)
@@ -101,7 +101,7 @@ class ToppraMethod(TimingMethod):
         TOPPRA, PrecomputedRows, GridPath = _toppra_classes()
         sd_start, sd_end = boundary.sd_start, boundary.sd_end
         x_bound = constraints.sd_max**2
-        x_ref = _reference_x(constraints, x_bound)
+        x_ref = friction_reference(constraints)
         scaling = None
         for _ in range(2 if constraints.has_friction else 1):
             rows = constraints.linearized(x_ref)
@@ -119,15 +119,6 @@ class ToppraMethod(TimingMethod):
             scaling = TimeScaling(constraints.s, np.asarray(sd, dtype=float))
             x_ref = scaling.sd**2
         return scaling
-
-
-def _reference_x(constraints: PathConstraints, x_bound: np.ndarray) -> np.ndarray:
-    """A first guess of the optimal x for linearizing friction: the MVC without friction."""
-    if not constraints.has_friction:
-        return x_bound
-    frictionless = LinearRows(constraints.a, constraints.b, constraints.c, constraints.lower, constraints.upper)
-    x_max = admissible_set(frictionless, x_bound).x_max
-    return np.where(np.isfinite(x_max) & (x_max > 0), x_max, 1.0)
 
 
 def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Exception:
