@@ -19,6 +19,7 @@ b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never se
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -109,6 +110,25 @@ class PathConstraints:
                 self.jerk[3],
             ),
             evaluate=self.evaluate,
+        )
+
+    def time_scaled(self, kappa: float) -> "PathConstraints":
+        """The same limits in a scaled time: with x = kappa x' and u = kappa u' (time runs
+        sqrt(kappa) times slower), the rows ``(kappa a) u' + (kappa b) x' + c + (sqrt(kappa) d) sd'``
+        and the bound sd' <= sd_max / sqrt(kappa). A solver that works with absolute tolerances
+        sees x' of order one when ``kappa`` is the typical x of the path (``speed_scale``)."""
+        root = np.sqrt(kappa)
+        return dataclasses.replace(
+            self,
+            sd_max=self.sd_max / root,
+            a=self.a * kappa,
+            b=self.b * kappa,
+            d=self.d * root,
+            a_left=self.a_left * kappa,
+            b_left=self.b_left * kappa,
+            d_left=self.d_left * root,
+            jerk=None,
+            evaluate=None,
         )
 
     @property

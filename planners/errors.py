@@ -18,14 +18,17 @@ class InfeasiblePath(ToptrajError):
     Attributes:
         s: Path parameter in [0, 1] where it fails.
         joint: Name of the joint whose limit cannot be met there, if one is to blame.
+        limit: The kind of limit that cannot be met ("velocity", "acceleration", "torque",
+            "jerk"), when one is to blame.
     """
 
     title = "Path cannot be followed within the limits"
 
-    def __init__(self, detail: str, s: float | None = None, joint: str | None = None):
+    def __init__(self, detail: str, s: float | None = None, joint: str | None = None, limit: str | None = None):
         super().__init__(detail)
         self.s = s
         self.joint = joint
+        self.limit = limit
 
 
 class TimingFailed(ToptrajError):

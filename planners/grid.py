@@ -1,27 +1,53 @@
-"""The grid of s on which constraints are evaluated and paths are timed."""
+"""The grid of s on which constraints are evaluated and paths are timed.
+
+Every stretch of path between two knots (waypoints, breaks of a piecewise definition) is
+resolved on its own, however short it is: the knots are grid points, and each stretch gets at
+least ``MIN_POINTS_PER_SEGMENT`` intervals. A short stretch of a spline is where its curvature
+and third derivative are largest, so spreading points evenly over s would leave exactly the
+places where the limits change fastest unsampled.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
+from planners.errors import InvalidRequest
 from planners.paths.base import GeometricPath
 
 #: Intervals per path segment (between consecutive knots) when the request names no grid size.
 DEFAULT_POINTS_PER_SEGMENT = 100
+#: Fewest intervals of any segment, whatever grid size a request names.
+MIN_POINTS_PER_SEGMENT = 8
 MIN_POINTS = 100
 MAX_POINTS = 20_000
 
 
 def path_grid(path: GeometricPath, n_intervals: int | None = None) -> np.ndarray:
-    """An increasing grid over [0, 1] holding every knot of ``path``, with about ``n_intervals``
-    intervals (default: ``DEFAULT_POINTS_PER_SEGMENT`` per segment) spread evenly over s."""
-    knots = path.knots
+    """An increasing grid over [0, 1] holding every knot of ``path``.
+
+    Args:
+        path: The path; its ``knots`` become grid points.
+        n_intervals: About this many intervals, spread over the segments in proportion to their
+            length in s, each segment getting at least ``MIN_POINTS_PER_SEGMENT``; ``None``:
+            ``DEFAULT_POINTS_PER_SEGMENT`` per segment (at least ``MIN_POINTS`` in all). Either
+            way at most ``MAX_POINTS`` intervals, fewer per segment on paths with very many
+            segments.
+
+    Returns:
+        s, shape (N + 1,), from 0 to 1.
+    """
+    knots = np.asarray(path.knots, dtype=float)
+    if knots.ndim != 1 or len(knots) < 2 or not np.all(np.isfinite(knots)) or np.any(np.diff(knots) <= 0.0):
+        raise InvalidRequest("the path's parameterization is degenerate (coincident or non-finite waypoints)")
+    lengths = np.diff(knots)
+    segments = len(lengths)
+    floor = max(1, min(MIN_POINTS_PER_SEGMENT, MAX_POINTS // segments))
     if n_intervals is None:
-        n_intervals = max(MIN_POINTS, DEFAULT_POINTS_PER_SEGMENT * (len(knots) - 1))
-    n_intervals = int(min(max(n_intervals, len(knots) - 1), MAX_POINTS))
-    pieces = []
-    for start, end in zip(knots[:-1], knots[1:]):
-        count = max(1, int(round(n_intervals * (end - start))))
-        pieces.append(np.linspace(start, end, count + 1)[:-1])
+        per_segment = max(floor, min(DEFAULT_POINTS_PER_SEGMENT, MAX_POINTS // segments))
+        counts = np.full(segments, max(per_segment, -(-MIN_POINTS // segments)))
+    else:
+        total = min(max(int(n_intervals), segments), MAX_POINTS)
+        counts = np.maximum(floor, np.round(total * lengths).astype(int))
+    pieces = [np.linspace(start, end, count + 1)[:-1] for start, end, count in zip(knots[:-1], knots[1:], counts)]
     pieces.append([1.0])
     return np.concatenate(pieces)

@@ -115,3 +115,18 @@ def friction_reference(constraints) -> np.ndarray:
     frictionless = LinearRows(constraints.a, constraints.b, constraints.c, constraints.lower, constraints.upper)
     x_max = admissible_set(frictionless, x_bound).x_max
     return np.where(np.isfinite(x_max) & (x_max > 0), x_max, 1.0)
+
+
+def speed_scale(constraints) -> float:
+    """A typical x = sd^2 of the path (1/s^2), or 1 when the limits give none: the median over
+    the grid of the smaller of the maximum velocity curve (without friction) and the largest
+    path acceleration u available from rest, which bounds the x reachable over a stretch of
+    unit length (x = 2 u s). Paths whose s runs over a tiny stretch of joint space have x of 1e6
+    and more; dividing by this scale brings the numbers a solver sees to order one
+    (``PathConstraints.time_scaled``)."""
+    frictionless = LinearRows(constraints.a, constraints.b, constraints.c, constraints.lower, constraints.upper)
+    x_max = admissible_set(frictionless, constraints.sd_max**2).x_max
+    u_max = acceleration_bounds(frictionless).r.min(axis=1, initial=np.inf)
+    typical = np.minimum(x_max, np.abs(u_max))
+    usable = typical[np.isfinite(typical) & (typical > 0)]
+    return float(np.median(usable)) if usable.size else 1.0

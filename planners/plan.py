@@ -12,23 +12,27 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.constraints import build_path_constraints
+from planners.boundary import path_acceleration, path_speed
+from planners.constraints import PathConstraints, build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
-from planners.errors import InfeasiblePath, InvalidRequest
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.grid import MAX_POINTS, path_grid
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
+from planners.limit_check import Excess, LimitCheck, check_limits
 from planners.mvc import admissible_set
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
-from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.paths.cartesian import CartesianLine, cartesian_path
-from planners.boundary import path_acceleration, path_speed
+from planners.paths.stretch import stretches
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.results import Conditioning, PhasePlane, PlannedTrajectory
-from planners.constraints import PathConstraints
-from planners.timing.base import Boundary, PathTiming, TimingMethod
+from planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
+from planners.timing.law_timing import LawTiming
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
-from planners.trajectory import peak_utilization, sample_trajectory
+from planners.timing.scaled import solve_well_scaled
+from planners.timing.segmented import SegmentedTiming
+from planners.trajectory import sample_trajectory
 from planners.via_points import via_point_trajectory
 from robots import JointLimits, Robot
 
@@ -39,6 +43,13 @@ MAX_COORDINATE = 1e4
 MAX_SAMPLES = 200_000
 #: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
 MAX_PHASE_PLANE_POINTS = 2_000
+#: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is
+#: 0.5 %; the gate is tighter, since a client's own resampling falls between the check's states.
+LIMIT_TOLERANCE = 1.003
+#: Rounds of grid refinement where the dense check finds a limit exceeded.
+GATE_ROUNDS = 4
+#: Largest timing.limit_margin (a fraction of every limit kept in reserve).
+MAX_LIMIT_MARGIN = 0.5
 
 
 def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
@@ -157,29 +168,150 @@ def _boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boun
 
 
 class _Timed(NamedTuple):
-    """A path with its timing, the constraints it was timed under, and what to tell about it."""
+    """A path with its timing, its stretches as they were timed and checked, and what to tell
+    about it."""
 
     path: GeometricPath
     timing: PathTiming
-    constraints: PathConstraints
+    stretches: tuple["_TimedStretch", ...]
     method: str
     notes: tuple[str, ...] = ()
     cost: float | None = None
     solver: dict | None = None
 
 
-def _timed_path(robot, path, method, timing, kinds, limits, deadline) -> _Timed:
-    """A given path timed by ``method``."""
-    s = path_grid(path, timing.grid_points)
-    _check_path_within_limits(robot, path, s)
-    boundary = _boundary(path, timing, method)
-    constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
+def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool) -> Boundary:
+    """The boundary of one stretch in its own parameter (sigma-dot = s-dot / w): the path's
+    boundary at the path's ends, rest at its corners."""
+    def scaled(value):
+        return None if value is None else value / width
+
+    return Boundary(
+        sd_start=boundary.sd_start / width if first else 0.0,
+        sd_end=boundary.sd_end / width if last else 0.0,
+        sdd_start=scaled(boundary.sdd_start) if first else None,
+        sdd_end=scaled(boundary.sdd_end) if last else None,
+    )
+
+
+def _refinement(timing: PathTiming, intervals: np.ndarray) -> np.ndarray:
+    """Points that split each listed grid interval of ``timing`` in four."""
+    s = timing.s
+    quarters = np.array([0.25, 0.5, 0.75])
+    return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
+
+
+def _gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline):
+    """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
+    exceeded by more than ``threshold``, refine the grid there and time the path again.
+
+    Returns:
+        (timing, constraints, check): the timing that holds the limits, the constraints it was
+        timed on, and its ``LimitCheck``.
+
+    Raises:
+        InfeasiblePath: the limits still do not hold after ``GATE_ROUNDS`` refinements, or the
+            method's timing cannot be refined; says where, which joint and which limit.
+    """
+    result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+    for _ in range(GATE_ROUNDS + 1):
+        deadline.check()
+        check = check_limits(path, result, robot, limits, kinds, threshold)
+        if check.worst is None or check.worst.ratio <= threshold:
+            return result, constraints, check
+        if isinstance(result, LawTiming) and duration is None:
+            # The shortest time law was found on samples of its profile; the dense check sees
+            # between them. Slowing a law down by a factor f divides velocities by f,
+            # accelerations (and the inertial part of torques) by f^2, jerks by f^3.
+            power = {"velocity": 1.0, "jerk": 3.0}.get(check.worst.kind, 2.0)
+            result = result.slowed(check.worst.ratio ** (1.0 / power) * (1 + 1e-6))
+            if result is None:
+                break
+            continue
+        if not (isinstance(result, TimeScaling) and constraints.can_refine and check.intervals_over.size):
+            break
+        extra = _refinement(result, check.intervals_over)
+        extra = np.unique(extra[~np.isin(extra, constraints.s)])
+        if extra.size == 0:
+            break
+        constraints = constraints.with_points(extra)
+        result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+    raise _limit_exceeded(method.name, check.worst, robot, path)
+
+
+def _limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> InfeasiblePath:
+    s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
+    joint = robot.joint_names[worst.joint]
+    return InfeasiblePath(
+        f"the {method} timing exceeds the {worst.kind} limit of joint {joint!r} by "
+        f"{100 * (worst.ratio - 1):.2f} % at s = {s:.4f}, and refining the grid there did not bring "
+        "it back within the limits; use another timing method, a lower limit scale or more grid points",
+        s=s,
+        joint=joint,
+        limit=worst.kind,
+    )
+
+
+class _TimedStretch(NamedTuple):
+    stretch: GeometricPath
+    timing: PathTiming
+    constraints: PathConstraints
+    check: LimitCheck
+
+
+def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, duration, threshold, deadline):
+    s = path_grid(stretch, grid_points)
+    constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
     deadline.check()
-    result = method.solve(constraints, boundary, timing.duration, deadline)
-    return _Timed(path, result, constraints, method.name, cost=getattr(result, "cost", None))
+    timing, constraints, check = _gated(
+        robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline
+    )
+    return _TimedStretch(stretch, timing, constraints, check)
 
 
-def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline) -> _Timed:
+def _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold) -> _Timed:
+    """A given path timed by ``method``; each stretch between corners (where the motion stops)
+    on its own, as its own rest-to-rest problem, and every one through the limit gate."""
+    _check_path_within_limits(robot, path, path_grid(path, timing.grid_points))
+    boundary = _boundary(path, timing, method)
+    parts = stretches(path)
+    widths = [getattr(part, "width", 1.0) for part in parts]
+    grid = [None if timing.grid_points is None else max(1, round(timing.grid_points * w)) for w in widths]
+    boundaries = [
+        _stretch_boundary(boundary, w, k == 0, k == len(parts) - 1) if len(parts) > 1 else boundary
+        for k, w in enumerate(widths)
+    ]
+    durations = [None] * len(parts)
+    if timing.duration is not None and len(parts) > 1:
+        shortest = [
+            method.solve(build_path_constraints(part, robot, limits, kinds, path_grid(part, n), deadline), b, None, deadline).duration
+            for part, n, b in zip(parts, grid, boundaries)
+        ]
+        durations = [timing.duration * T / sum(shortest) for T in shortest]
+    elif timing.duration is not None:
+        durations = [timing.duration]
+    timed = [
+        _time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, deadline)
+        for part, n, b, T in zip(parts, grid, boundaries, durations)
+    ]
+    if len(timed) == 1:
+        result = timed[0].timing
+    else:
+        edges = np.concatenate(([0.0], [part.end for part in parts]))
+        result = SegmentedTiming(edges, tuple(item.timing for item in timed))
+    return _Timed(path, result, tuple(timed), method.name, cost=getattr(result, "cost", None))
+
+
+def _checked(robot, path, result, method, kinds, limits, threshold, constraints) -> _TimedStretch:
+    """A timing that cannot be refined, through the limit gate: kept when it holds the limits,
+    refused (with where, which joint and which limit) when it does not."""
+    check = check_limits(path, result, robot, limits, kinds, threshold)
+    if check.worst is not None and check.worst.ratio > threshold:
+        raise _limit_exceeded(method, check.worst, robot, path)
+    return _TimedStretch(path, result, constraints, check)
+
+
+def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, threshold) -> _Timed:
     """Via points: segments shaped and timed together by the limits."""
     if timing.start_velocity is not None or timing.end_velocity is not None:
         raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
@@ -187,10 +319,11 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline) -> _
     s = path_grid(path, timing.grid_points)
     _check_path_within_limits(robot, path, s)
     constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
-    return _Timed(path, result, constraints, method.name)
+    stretch = _checked(robot, path, result, method.name, kinds, limits, threshold, constraints)
+    return _Timed(path, result, (stretch,), method.name)
 
 
-def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline) -> _Timed:
+def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, threshold) -> _Timed:
     """A free motion: the collocation's path, re-timed exactly along itself (phase_plane, or
     min_cost for beta > 0) so that every limit holds between the collocation instants too."""
     path, solver, collocation_timing = _free_motion(robot, spec, method, timing, limits, deadline)
@@ -201,14 +334,65 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline) -> 
     )
     notes = ()
     try:
-        result = retimer.solve(constraints, _boundary(path, moving, retimer), None, deadline)
+        result, constraints, check = _gated(
+            robot, path, retimer, constraints, _boundary(path, moving, retimer), None, kinds, limits, threshold, deadline
+        )
+        stretch = _TimedStretch(path, result, constraints, check)
     except InfeasiblePath as error:
         # A boundary state right at a limit may be out of reach of the conservative re-timing;
-        # the collocation's own timing is then returned as it is.
+        # the collocation's own timing is then returned, if it holds the limits.
         result = collocation_timing
+        stretch = _checked(robot, path, result, "collocation", kinds, limits, threshold, constraints)
         notes = (f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})",)
     cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
-    return _Timed(path, result, constraints, "collocation", notes, cost, solver)
+    return _Timed(path, result, (stretch,), "collocation", notes, cost, solver)
+
+
+def _gate_threshold(margin: float) -> float:
+    """Largest |value| / limit the gate lets through, against the limits tightened by
+    ``margin``: ``LIMIT_TOLERANCE`` without a margin; with one, never above the untightened
+    limit itself."""
+    if margin == 0.0:
+        return LIMIT_TOLERANCE
+    return min(LIMIT_TOLERANCE, (1.0 - 1e-9) / (1.0 - margin))
+
+
+def _phase_plane(stretches_: tuple[_TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """s, sd and the maximum velocity curve (1/s) over the grids the stretches were timed on,
+    in the path's own s."""
+    pieces = []
+    for item in stretches_:
+        constraints = item.constraints
+        sd = item.timing.speed_at(constraints.s)
+        mvc = admissible_set(constraints.linearized(sd**2), constraints.sd_max**2).sd_max
+        start, width = getattr(item.stretch, "start", 0.0), getattr(item.stretch, "width", 1.0)
+        pieces.append((start + width * constraints.s, width * sd, width * mvc))
+    s, sd, mvc = (np.concatenate([piece[i] for piece in pieces]) for i in range(3))
+    keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
+    return s[keep], sd[keep], mvc[keep]
+
+
+def _utilization(stretches_, margin: float) -> dict[str, np.ndarray]:
+    """Peak |value| / limit per kind and joint over every stretch, against the limits as
+    requested (before any margin)."""
+    kinds = stretches_[0].check.utilization.keys()
+    return {
+        kind: (1.0 - margin) * np.max([item.check.utilization[kind] for item in stretches_], axis=0)
+        for kind in kinds
+    }
+
+
+def _samples_exceed(samples, limits: JointLimits, threshold: float, kinds) -> tuple[str, int, int] | None:
+    """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit."""
+    for kind, values in (("velocity", samples.qd), ("acceleration", samples.qdd), ("torque", samples.tau)):
+        if kind not in kinds:
+            continue
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.nan_to_num(np.abs(values) / getattr(limits, kind), nan=0.0)
+        if ratio.size and ratio.max() > threshold:
+            sample, joint = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            return kind, int(sample), int(joint)
+    return None
 
 
 def plan(
@@ -220,9 +404,14 @@ def plan(
 ) -> PlannedTrajectory:
     """Plan the timed trajectory of ``robot`` along ``path_spec``.
 
+    Every answer holds the requested limits on a dense resampling within ``LIMIT_TOLERANCE``
+    (with ``timing.limit_margin`` > 0, strictly within the limits): the gate refines the grid
+    where a limit is exceeded and refuses an answer that still exceeds one.
+
     Raises:
         InvalidRequest: malformed input (the message names the field).
-        InfeasiblePath: no timing can follow the path within the limits (says where).
+        InfeasiblePath: no timing can follow the path within the limits (says where, which
+            joint and which limit).
         TimingFailed: the timing method failed.
         BudgetExceeded: ``deadline`` passed.
     """
@@ -235,7 +424,12 @@ def plan(
         raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
     if timing.duration is not None and not (np.isfinite(timing.duration) and timing.duration > 0):
         raise InvalidRequest(f"timing.duration must be a positive number of seconds, got {timing.duration}")
-    limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
+    margin = timing.limit_margin
+    if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
+        raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
+    requested: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
+    limits = requested.tightened(margin) if margin else requested
+    threshold = _gate_threshold(margin)
     if method.two_waypoints_only and (not isinstance(path_spec, WaypointPath) or len(path_spec.waypoints) != 2):
         given = f"{len(path_spec.waypoints)} waypoints" if isinstance(path_spec, WaypointPath) else "a cartesian path"
         raise InvalidRequest(
@@ -244,37 +438,40 @@ def plan(
             "law through several waypoints"
         )
     if isinstance(path_spec, FreeMotion) or method.name == "collocation":
-        timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline)
+        timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
     elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
-        timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline)
+        timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
     else:
-        timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline)
-    path, result, constraints, notes = timed.path, timed.timing, timed.constraints, list(timed.notes)
-    s = constraints.s
+        timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline, threshold)
+    path, result, notes = timed.path, timed.timing, list(timed.notes)
     deadline.check()
     if result.duration / dt > MAX_SAMPLES:
         raise InvalidRequest(
             f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {result.duration:.4g} s"
         )
     samples = sample_trajectory(path, result, robot, dt)
-    utilization = peak_utilization(path, result, robot, limits)
+    beyond = _samples_exceed(samples, limits, threshold, kinds)
+    if beyond is not None:
+        kind, sample, joint = beyond
+        raise TimingFailed(
+            f"the {timed.method} timing's sample at t = {samples.t[sample]:.6g} s exceeds the {kind} limit "
+            f"of joint {robot.joint_names[joint]!r} although its dense check holds; use more grid points"
+        )
+    utilization = _utilization(timed.stretches, margin)
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
-    notes += _warnings(utilization, kinds, robot)
     if kappa_max > NEAR_SINGULAR_KAPPA:
         notes.append(
             f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} "
             f"at t = {samples.t[worst]:.4g} s"
         )
-    sd = result.speed_at(s)
-    mvc = admissible_set(constraints.linearized(sd**2), constraints.sd_max**2).sd_max
-    keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
+    s, sd, mvc = _phase_plane(timed.stretches)
     return PlannedTrajectory(
         robot=robot.name,
         method=timed.method,
         joint_names=robot.joint_names,
         duration=result.duration,
         samples=samples,
-        phase_plane=PhasePlane(s[keep], sd[keep], mvc[keep], result.switch_points),
+        phase_plane=PhasePlane(s, sd, mvc, result.switch_points),
         peak_utilization=utilization,
         solve_ms=(time.perf_counter() - started) * 1e3,
         warnings=tuple(notes),
@@ -283,17 +480,3 @@ def plan(
         cost=timed.cost,
         solver=timed.solver,
     )
-
-
-def _warnings(utilization: dict[str, np.ndarray], kinds: tuple[str, ...], robot: Robot) -> list[str]:
-    notes = []
-    for kind in kinds:
-        if kind not in utilization:
-            continue
-        worst = int(np.argmax(utilization[kind]))
-        if utilization[kind][worst] > 1.005:
-            notes.append(
-                f"{kind} limit of joint {robot.joint_names[worst]!r} exceeded by "
-                f"{100 * (utilization[kind][worst] - 1):.2f} %"
-            )
-    return notes

@@ -48,6 +48,9 @@ class Timing:
             cruise as fractions of the duration.
         torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
             ``min_cost``.
+        limit_margin: Fraction of every velocity, acceleration, jerk and torque limit kept in
+            reserve (0 to 0.5): the timing is planned under the limits times (1 - margin), and
+            with a positive margin no returned state exceeds the limits themselves.
     """
 
     method: str = "phase_plane"
@@ -62,6 +65,7 @@ class Timing:
     duration: float | None = None
     trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
     torque_weight: float = 0.0
+    limit_margin: float = 0.0
 
 
 def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:

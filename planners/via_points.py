@@ -83,7 +83,7 @@ class ConstantSpeedTiming(PathTiming):
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.total)
         return t / self.total, np.full_like(t, 1.0 / self.total), np.zeros_like(t)
 
-    def dense_states(self) -> DenseStates:
+    def dense_states(self, points_per_interval: int = 3) -> DenseStates:
         s = np.union1d(np.linspace(0.0, 1.0, 2001), self.knots)
         left = np.isin(s, self.knots[1:-1])
         s = np.concatenate([s, s[left]])

@@ -7,6 +7,7 @@ holds those per robot, with their source, and a default rule for every other rob
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass
@@ -74,6 +75,18 @@ class JointLimits:
                 raise InvalidLimits(f"timing.limits.{kind}_scale must be positive and finite, got {factor}")
             values[kind] = values[kind] * factor
         return JointLimits(**values)
+
+    def tightened(self, margin: float) -> "JointLimits":
+        """These limits with the velocity, acceleration, jerk and torque limits reduced by the
+        fraction ``margin`` (0 <= margin < 1); position limits unchanged."""
+        factor = 1.0 - margin
+        return dataclasses.replace(
+            self,
+            velocity=self.velocity * factor,
+            acceleration=self.acceleration * factor,
+            jerk=self.jerk * factor,
+            torque=self.torque * factor,
+        )
 
 
 @cache

@@ -36,6 +36,7 @@ def _timing(request: TrajectoryRequest) -> Timing:
         duration=timing.duration,
         trapezoid_fractions=(timing.trapezoid.tau1, timing.trapezoid.tau2),
         torque_weight=timing.cost.torque_weight,
+        limit_margin=timing.limit_margin,
     )
 
 

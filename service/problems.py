@@ -38,7 +38,7 @@ def _location(loc) -> str:
 
 
 def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
-    extra = {key: getattr(error, key) for key in ("s", "joint") if hasattr(error, key)}
+    extra = {key: getattr(error, key) for key in ("s", "joint", "limit") if hasattr(error, key)}
     return problem(error.status, error.title, error.detail, **extra)
 
 

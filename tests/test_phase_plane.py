@@ -14,7 +14,7 @@ from planners.errors import InfeasiblePath
 from planners.grid import path_grid
 from planners.paths import SplinePath
 from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.trajectory import peak_utilization
+from planners.limit_check import check_limits
 
 UR5 = robots.load("ur5")
 START = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
@@ -147,7 +147,7 @@ def test_agrees_with_fine_toppra_on_random_paths(name):
         worst = max(worst, gap)
         assert gap <= 1e-3
         assert ours.duration <= baseline.duration * (1 + 1e-9)
-        utilization = peak_utilization(path, ours, robot, robot.limits)
+        utilization = check_limits(path, ours, robot, robot.limits).utilization
         assert max(value.max() for value in utilization.values()) <= 1.005
     assert worst < 1e-3
 

@@ -13,7 +13,7 @@ from planners.errors import InfeasiblePath, TimingFailed
 from planners.grid import path_grid
 from planners.paths import SplinePath, StopAndGoPath
 from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.trajectory import peak_utilization
+from planners.limit_check import check_limits
 
 CASES = {"ur5": 334, "panda": 333, "yamamoto_2r": 333}
 
@@ -52,7 +52,7 @@ def test_phase_plane_never_fails_where_toppra_succeeds(name):
             assert ours is not None, f"phase_plane failed where toppra succeeded: {waypoints.tolist()}"
             assert ours.duration <= theirs.duration * (1 + 1e-9)
         if ours is not None:
-            utilization = peak_utilization(path, ours, robot, limits)
+            utilization = check_limits(path, ours, robot, limits).utilization
             assert max(utilization[kind].max() for kind in kinds) <= 1.005
         key = "both" if ours and theirs else "neither" if not (ours or theirs) else "only_phase_plane"
         counts[key] += 1

@@ -52,7 +52,8 @@ def task_jacobian(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> 
     data = robot.data
     pin.computeJointJacobians(robot.model, data, robot.configuration(q))
     pin.updateFramePlacements(robot.model, data)
-    jacobian = pin.getFrameJacobian(robot.model, data, frame_id, pin.LOCAL_WORLD_ALIGNED)
+    # Pinocchio returns a (6,) vector, not a (6, 1) matrix, for a one-joint model.
+    jacobian = np.asarray(pin.getFrameJacobian(robot.model, data, frame_id, pin.LOCAL_WORLD_ALIGNED)).reshape(6, robot.dof)
     if robot.dof <= 3:
         return jacobian[:3]
     return np.vstack([jacobian[3:], jacobian[:3] / length])

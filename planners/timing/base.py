@@ -33,13 +33,15 @@ AT_REST = Boundary()
 class DenseStates:
     """Path states for checking limits between samples, each of shape (n,): s, sd, sdd, and
     sddd (1/s^3) when the timing has a finite jerk; ``left`` marks states that belong to the
-    interval ending at their s (the left-hand side of a corner of the path)."""
+    interval ending at their s (the left-hand side of a corner of the path); ``interval``, for
+    timings on a grid of s, the grid interval each state lies in (a refinement names those)."""
 
     s: np.ndarray
     sd: np.ndarray
     sdd: np.ndarray
     sddd: np.ndarray | None
     left: np.ndarray
+    interval: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -67,8 +69,9 @@ class PathTiming(abc.ABC):
         """s, sd and sdd at times ``t`` (shape (n,), clipped to [0, duration])."""
 
     @abc.abstractmethod
-    def dense_states(self) -> DenseStates:
-        """States dense enough to check every limit between samples."""
+    def dense_states(self, points_per_interval: int = 3) -> DenseStates:
+        """States dense enough to check every limit between samples; timings on a grid of s
+        take ``points_per_interval`` states per grid interval, both ends included."""
 
     @abc.abstractmethod
     def speed_at(self, s: np.ndarray) -> np.ndarray:
@@ -131,10 +134,11 @@ class TimeScaling(PathTiming):
         s = self.s[interval] + self.sd[interval] * tau + 0.5 * sdd * tau**2
         return np.minimum(s, self.s[interval + 1]), np.maximum(sd, 0.0), sdd
 
-    def dense_states(self) -> DenseStates:
-        """Three states per grid interval, both ends included: a grid point is reached as the end
-        of one interval (``left``) and the start of the next, each with its own sdd."""
-        fractions = np.linspace(0.0, 1.0, 3)
+    def dense_states(self, points_per_interval: int = 3) -> DenseStates:
+        """``points_per_interval`` states per grid interval, evenly spaced in s, both ends
+        included: a grid point is reached as the end of one interval (``left``) and the start of
+        the next, each with its own sdd. Within an interval x = sd^2 is linear in s."""
+        fractions = np.linspace(0.0, 1.0, max(points_per_interval, 2))
         n_intervals = len(self.s) - 1
         interval = np.repeat(np.arange(n_intervals), len(fractions))
         fraction = np.tile(fractions, n_intervals)
@@ -146,6 +150,7 @@ class TimeScaling(PathTiming):
             sdd=self.sdd[interval],
             sddd=None,
             left=fraction == 1.0,
+            interval=interval,
         )
 
     def speed_at(self, s: np.ndarray) -> np.ndarray:
@@ -163,6 +168,8 @@ class TimingMethod(abc.ABC):
         takes_acceleration_boundary: Whether boundary path accelerations are honoured.
         required_kinds: Limit kinds the method always applies, requested or not.
         two_waypoints_only: Whether the method times only a straight move between two states.
+        absolute_tolerances: Whether the method's solver works with absolute tolerances, so
+            that it needs path speeds of order one (``planners.timing.scaled``).
     """
 
     name: str
@@ -171,6 +178,7 @@ class TimingMethod(abc.ABC):
     takes_duration: bool = False
     takes_acceleration_boundary: bool = False
     two_waypoints_only: bool = False
+    absolute_tolerances: bool = False
 
     @abc.abstractmethod
     def solve(

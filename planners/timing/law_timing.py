@@ -72,6 +72,17 @@ class LawTiming(PathTiming):
     def duration(self) -> float:
         return float(sum(segment.duration for segment in self.segments))
 
+    def slowed(self, factor: float) -> "LawTiming | None":
+        """The same rest-to-rest laws, each ``factor`` times longer (velocities divide by the
+        factor, accelerations by its square); ``None`` when a segment is a polynomial fitted to
+        boundary speeds, which a longer duration would change."""
+        if any(segment.profile is None for segment in self.segments):
+            return None
+        return LawTiming(
+            tuple(LawSegment(seg.s_start, seg.s_end, seg.duration * factor, profile=seg.profile) for seg in self.segments),
+            binding=self.binding,
+        )
+
     @property
     def _starts(self) -> np.ndarray:
         return np.concatenate(([0.0], np.cumsum([segment.duration for segment in self.segments])))
@@ -88,7 +99,7 @@ class LawTiming(PathTiming):
                 s[mine], sd[mine], sdd[mine] = values[0], values[1], values[2]
         return s, sd, sdd
 
-    def dense_states(self) -> DenseStates:
+    def dense_states(self, points_per_interval: int = 3) -> DenseStates:
         pieces = []
         for segment in self.segments:
             t = segment.sample_times()

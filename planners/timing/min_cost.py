@@ -42,6 +42,7 @@ class MinCostMethod(TimingMethod):
     """Minimum of the integral of (1 + beta |tau|^2) dt along the path (beta in 1/(N m)^2)."""
 
     name = "min_cost"
+    absolute_tolerances = True
     required_kinds = frozenset({"torque"})
     takes_cost = True
 

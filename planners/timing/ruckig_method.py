@@ -52,7 +52,7 @@ class RuckigTiming(PathTiming):
         s, sd, sdd, _ = self._states(t)
         return s, sd, sdd
 
-    def dense_states(self) -> DenseStates:
+    def dense_states(self, points_per_interval: int = 3) -> DenseStates:
         switches = np.concatenate(([0.0], np.cumsum(self.phase_durations)))
         t = np.union1d(np.linspace(0.0, self.duration, 2001), np.clip(switches, 0.0, self.duration))
         s, sd, sdd, sddd = self._states(t)

@@ -90,6 +90,7 @@ class ToppraMethod(TimingMethod):
     """Time-optimal timing by TOPP-RA with toppra's Seidel LP solver."""
 
     name = "toppra"
+    absolute_tolerances = True
 
     def solve(
         self,

@@ -1,0 +1,111 @@
+"""``SegmentedTiming``: one s(t) made of the timings of a path's stretches between corners.
+
+Each stretch [a_k, b_k] of the path is timed in its own parameter sigma in [0, 1]
+(``planners.paths.stretch``), s = a_k + w_k sigma with w_k = b_k - a_k, so
+
+    s-dot = w_k sigma-dot,  s-ddot = w_k sigma-ddot,  s-dddot = w_k sigma-dddot,
+
+and the stretches follow one another in time, each starting when the previous one stopped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from planners.timing.base import Binding, DenseStates, PathTiming
+
+
+@dataclass(frozen=True)
+class SegmentedTiming(PathTiming):
+    """Consecutive stretch timings covering s from 0 to 1.
+
+    Attributes:
+        edges: Stretch ends in s, shape (K + 1,), from 0 to 1.
+        parts: The K stretch timings, each over its own sigma in [0, 1].
+    """
+
+    edges: np.ndarray
+    parts: tuple[PathTiming, ...]
+
+    @property
+    def widths(self) -> np.ndarray:
+        return np.diff(self.edges)
+
+    @property
+    def starts(self) -> np.ndarray:
+        """Start time of each stretch, shape (K + 1,) with the total duration last, in s."""
+        return np.concatenate(([0.0], np.cumsum([part.duration for part in self.parts])))
+
+    @property
+    def duration(self) -> float:
+        return float(self.starts[-1])
+
+    @property
+    def switch_points(self) -> tuple[tuple[float, str], ...]:
+        return tuple(
+            (float(a + w * sigma), kind)
+            for a, w, part in zip(self.edges, self.widths, self.parts)
+            for sigma, kind in part.switch_points
+        )
+
+    @property
+    def binding(self) -> Binding | None:
+        """The binding limit of the longest stretch, in the path's s."""
+        slowest = int(np.argmax([part.duration for part in self.parts]))
+        binding = self.parts[slowest].binding
+        if binding is None:
+            return None
+        a, w = self.edges[slowest], self.widths[slowest]
+        return Binding(binding.kind, binding.joint, float(a + w * binding.s))
+
+    @property
+    def cost(self) -> float | None:
+        """The summed cost of the stretches, for methods that report one."""
+        costs = [getattr(part, "cost", None) for part in self.parts]
+        return None if any(cost is None for cost in costs) else float(sum(costs))
+
+    def at_times(self, t: np.ndarray):
+        t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        starts = self.starts
+        index = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.parts) - 1)
+        s, sd, sdd = np.empty_like(t), np.empty_like(t), np.empty_like(t)
+        for k, part in enumerate(self.parts):
+            mine = index == k
+            if np.any(mine):
+                sigma, sigma_d, sigma_dd = part.at_times(t[mine] - starts[k])
+                w = self.widths[k]
+                s[mine] = np.where(sigma >= 1.0, self.edges[k + 1], self.edges[k] + w * sigma)
+                sd[mine], sdd[mine] = w * sigma_d, w * sigma_dd
+        return s, sd, sdd
+
+    def dense_states(self, points_per_interval: int = 3) -> DenseStates:
+        pieces = []
+        for a, b, part in zip(self.edges[:-1], self.edges[1:], self.parts):
+            states = part.dense_states(points_per_interval)
+            w, end = b - a, states.s >= 1.0
+            pieces.append((
+                np.where(end, b, a + w * states.s),
+                w * states.sd,
+                w * states.sdd,
+                None if states.sddd is None else w * states.sddd,
+                states.left | end,
+            ))
+        jerk = all(piece[3] is not None for piece in pieces)
+        return DenseStates(
+            s=np.concatenate([piece[0] for piece in pieces]),
+            sd=np.concatenate([piece[1] for piece in pieces]),
+            sdd=np.concatenate([piece[2] for piece in pieces]),
+            sddd=np.concatenate([piece[3] for piece in pieces]) if jerk else None,
+            left=np.concatenate([piece[4] for piece in pieces]),
+        )
+
+    def speed_at(self, s: np.ndarray) -> np.ndarray:
+        s = np.asarray(s, dtype=float)
+        speed = np.zeros_like(s)
+        for a, b, part in zip(self.edges[:-1], self.edges[1:], self.parts):
+            mine = (s >= a) & (s <= b)
+            if np.any(mine):
+                speed[mine] = (b - a) * part.speed_at((s[mine] - a) / (b - a))
+        return speed
