@@ -2,6 +2,8 @@
 #
 #   docker build -t toptraj .
 #   docker run --rm -p 8000:8000 toptraj           # serve on :8000
+#   docker run --rm -p 8000:8000 -v toptraj-data:/home/toptraj/.local/share/toptraj toptraj
+#                                                   # ... keeping uploaded URDFs across containers
 #   docker run --rm toptraj python -m pytest -q    # run the test suite in the image
 #
 # Any Debian-like image with Python >= 3.11 (and the venv module) works as a base:

@@ -1,122 +1,427 @@
 """Checks an uploaded URDF before Pinocchio builds it, so that a bad upload gets an answer that
-says what and where instead of a crash or a silently wrong model.
+says what and where instead of a crash, a hang or a silently wrong model.
 
-A usable arm here is a tree of revolute, continuous and prismatic joints (fixed joints allowed),
-each with positive effort and velocity limits, revolute and prismatic joints with lower < upper,
-and positive mass behind every moving joint.
+A usable arm here is one tree of links (one root, each link the child of at most one joint, no
+cycle) joined by revolute, continuous and prismatic joints (fixed joints allowed), each moving
+joint with effort and velocity limits, revolute and prismatic joints with lower < upper, and
+inertia behind every moving joint. Every number Pinocchio reads must be a plain decimal number
+inside the bounds below (SI units), wide enough for any real arm and tight enough that nothing
+overflows or underflows in the dynamics:
+
+==========================================  =========================================
+origins ``xyz`` (joints, inertials, shapes)  each coordinate within +-100 m
+origins ``rpy``                              each angle within +-100 rad
+geometry sizes (box, cylinder, sphere)       0 to 100 m; mesh scale within +-1000
+mass                                         1e-12 to 1e6 kg (0 only for a massless link)
+inertia tensor entries                       within +-1e6 kg m^2
+effort limit                                 1e-6 to 1e6 N m (or N)
+velocity limit                               1e-6 to 1e6 rad/s (or m/s)
+position limits                              within +-1e4 rad (or m), lower < upper
+damping, friction                            0 to 1e6
+==========================================  =========================================
+
+The lower bound of 1e-6 on effort and velocity refuses limits such as 1e-308 that are positive
+in name only (no real drive is that weak; every duration would overflow). Every ``<inertial>``
+has a positive mass, except a massless frame (mass and tensor all zero, as Panda's
+``panda_link8``). An inertia tensor must be one that a body can have: positive definite, with
+principal moments that satisfy the triangle inequality ``I1 + I2 >= I3`` (up to a relative 1e-3
+for values printed to three digits). Two ideal limits that real URDFs use pass as well, because
+the triangle inequality allows them and refusing them would refuse arms of the catalog: a point
+mass (a zero tensor, TALOS's force-sensor links, SO-101's gripper frame) and a slender rod (one
+zero moment, the other two equal, ``finger_edu``'s lower link). Once built, the joint-space
+inertia matrix at the zero configuration must be positive definite (condition number at most
+1e10): every moving joint moves some inertia about its axis, which is what the planners need.
+
+At most 1000 links, 1000 joints and 64 moving joints; no ``<!DOCTYPE>`` (entities could make
+Pinocchio's parser read something else than this check did).
 """
 
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ElementTree
+from collections.abc import Iterable
 
+import numpy as np
 import pinocchio as pin
 
-from robots.errors import InvalidURDF
+from robots.errors import InvalidURDF, excerpt
 
 MOVING_JOINTS = ("revolute", "continuous", "prismatic")
-MAX_JOINTS = 64
+MAX_MOVING_JOINTS = 64
+MAX_LINKS = 1_000
+MAX_JOINTS = 1_000
+
+MAX_OFFSET = 100.0  # m, each coordinate of an origin
+MAX_ANGLE = 100.0  # rad, each angle of an origin's rpy
+MAX_SIZE = 100.0  # m, box sides, radii and lengths
+MAX_MESH_SCALE = 1e3
+MIN_MASS, MAX_MASS = 1e-12, 1e6  # kg
+MAX_INERTIA = 1e6  # kg m^2, each tensor entry
+EFFORT_RANGE = (1e-6, 1e6)  # N m (revolute) or N (prismatic)
+VELOCITY_RANGE = (1e-6, 1e6)  # rad/s or m/s
+MAX_POSITION = 1e4  # rad or m
+MAX_DAMPING = 1e6  # N m s/rad or N s/m
+MAX_FRICTION = 1e6  # N m or N
+MAX_OTHER = 1e6  # safety controller, calibration and mimic values
+TRIANGLE_TOLERANCE = 1e-3  # relative to the largest principal moment
+ROUND_OFF = 1e-9  # relative to the largest principal moment: what counts as a zero moment
+MAX_JOINT_SPACE_CONDITION = 1e10
+
+#: Decimal numbers as C++ parsers read them (no hex, no digit separators), plus the words that
+#: Python would read as non-finite values, so the answer can say "not finite".
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+_NON_FINITE = re.compile(r"[+-]?(nan|inf|infinity)", re.IGNORECASE)
 
 
-def _number(element: ElementTree.Element, attribute: str, where: str) -> float | None:
+def _parse(text: str, where: str, attribute: str) -> float:
+    if _NUMBER.fullmatch(text):
+        value = float(text)
+        if math.isfinite(value):
+            return value
+    elif not _NON_FINITE.fullmatch(text):
+        raise InvalidURDF(f"{where}: {attribute}={excerpt(text)} is not a number")
+    raise InvalidURDF(f"{where}: {attribute}={excerpt(text)} is not finite")
+
+
+def _scalar(element: ElementTree.Element, attribute: str, where: str) -> float | None:
+    """The attribute as a finite float, ``None`` when absent."""
+    text = element.get(attribute)
+    return None if text is None else _parse(text.strip(), where, attribute)
+
+
+def _vector(element: ElementTree.Element, attribute: str, where: str) -> np.ndarray | None:
+    """The attribute as three finite floats, ``None`` when absent."""
     text = element.get(attribute)
     if text is None:
         return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise InvalidURDF(f"{where}: {attribute}={text!r} is not a number") from None
-    if not math.isfinite(value):
-        raise InvalidURDF(f"{where}: {attribute}={text!r} is not finite")
-    return value
+    parts = text.split()
+    if len(parts) != 3:
+        raise InvalidURDF(f"{where}: {attribute}={excerpt(text)} must hold three numbers")
+    return np.array([_parse(part, where, attribute) for part in parts])
 
 
-def _link_mass(link: ElementTree.Element) -> float:
+def _within(value: float, lower: float, upper: float, where: str, what: str, unit: str) -> None:
+    if not lower <= value <= upper:
+        unit = f" {unit}" if unit else ""
+        raise InvalidURDF(f"{where}: {what} {value:g}{unit} is outside [{lower:g}, {upper:g}]")
+
+
+def _check_origin(element: ElementTree.Element, where: str) -> None:
+    origin = element.find("origin")
+    if origin is None:
+        return
+    xyz = _vector(origin, "xyz", f"{where} <origin>")
+    if xyz is not None and np.abs(xyz).max() > MAX_OFFSET:
+        raise InvalidURDF(f"{where}: <origin> xyz {_numbers(xyz)} m is farther than {MAX_OFFSET:g} m along an axis")
+    rpy = _vector(origin, "rpy", f"{where} <origin>")
+    if rpy is not None and np.abs(rpy).max() > MAX_ANGLE:
+        raise InvalidURDF(f"{where}: <origin> rpy {_numbers(rpy)} rad has an angle beyond +-{MAX_ANGLE:g} rad")
+
+
+def _numbers(values: Iterable[float]) -> str:
+    return ", ".join(f"{value:g}" for value in values)
+
+
+_SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh")
+
+
+def _check_geometry(link: ElementTree.Element, where: str) -> None:
+    for kind in ("visual", "collision"):
+        for part in link.findall(kind):
+            place = f"{where} <{kind}>"
+            _check_origin(part, place)
+            geometry = part.find("geometry")
+            if geometry is None:
+                continue
+            for shape in geometry:
+                if shape.tag not in _SHAPES:
+                    continue  # Pinocchio reads no other shape
+                shape_where = f"{place} <{shape.tag}>"
+                if shape.tag == "box":
+                    sizes = _vector(shape, "size", shape_where)
+                    sizes = [] if sizes is None else list(sizes)
+                elif shape.tag == "mesh":
+                    scale = _vector(shape, "scale", shape_where)
+                    if scale is not None and np.abs(scale).max() > MAX_MESH_SCALE:
+                        raise InvalidURDF(f"{shape_where}: scale {_numbers(scale)} is beyond +-{MAX_MESH_SCALE:g}")
+                    sizes = []
+                else:
+                    sizes = [
+                        value
+                        for value in (_scalar(shape, name, shape_where) for name in ("radius", "length"))
+                        if value is not None
+                    ]
+                for size in sizes:
+                    _within(size, 0.0, MAX_SIZE, shape_where, "size", "m")
+
+
+_INERTIA_ENTRIES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+def _link_mass(link: ElementTree.Element, where: str) -> float:
+    """Mass of ``link`` in kg (0 without ``<inertial>``), after checking its inertial."""
     inertial = link.find("inertial")
     if inertial is None:
         return 0.0
-    mass = inertial.find("mass")
+    _check_origin(inertial, f"{where} <inertial>")
+    mass_element = inertial.find("mass")
+    if mass_element is None:
+        raise InvalidURDF(f"{where}: <inertial> has no <mass>")
+    mass = _scalar(mass_element, "value", f"{where} <mass>")
     if mass is None:
-        raise InvalidURDF(f"link {link.get('name')!r}: <inertial> has no <mass>")
-    value = _number(mass, "value", f"link {link.get('name')!r} <mass>")
-    if value is None or value < 0.0:
-        raise InvalidURDF(f"link {link.get('name')!r}: mass must be a non-negative number")
+        raise InvalidURDF(f"{where}: <mass> has no value")
+    if mass != 0.0:
+        _within(mass, MIN_MASS, MAX_MASS, where, "mass", "kg")
     inertia = inertial.find("inertia")
-    if inertia is None and value > 0.0:
-        raise InvalidURDF(f"link {link.get('name')!r}: <inertial> has a mass but no <inertia>")
-    return value
+    if inertia is None:
+        if mass > 0.0:
+            raise InvalidURDF(f"{where}: <inertial> has a mass but no <inertia>")
+        return mass
+    entries = {}
+    for name in _INERTIA_ENTRIES:
+        value = _scalar(inertia, name, f"{where} <inertia>")
+        if value is None:
+            raise InvalidURDF(f"{where}: <inertia> needs all of {', '.join(_INERTIA_ENTRIES)}; {name} is missing")
+        if abs(value) > MAX_INERTIA:
+            raise InvalidURDF(f"{where}: <inertia> {name}={value:g} kg m^2 is beyond +-{MAX_INERTIA:g}")
+        entries[name] = value
+    if not any(entries.values()):
+        return mass  # a point mass, or with zero mass a massless frame
+    if mass == 0.0:
+        raise InvalidURDF(f"{where}: mass must be positive where the inertia tensor is not zero")
+    _check_tensor(entries, where)
+    return mass
+
+
+def _check_tensor(entries: dict[str, float], where: str) -> None:
+    """Positive (semi-)definite, principal moments obeying the triangle inequality."""
+    e = entries
+    tensor = np.array(
+        [[e["ixx"], e["ixy"], e["ixz"]], [e["ixy"], e["iyy"], e["iyz"]], [e["ixz"], e["iyz"], e["izz"]]]
+    )
+    moments = np.linalg.eigvalsh(tensor)  # ascending
+    if not (moments[2] > 0.0 and moments[0] >= -ROUND_OFF * moments[2]):
+        raise InvalidURDF(
+            f"{where}: the inertia tensor is not positive definite (principal moments {_numbers(moments)} kg m^2)"
+        )
+    if moments[0] + moments[1] < moments[2] * (1.0 - TRIANGLE_TOLERANCE):
+        raise InvalidURDF(
+            f"{where}: the principal moments of inertia {_numbers(moments)} kg m^2 break the triangle "
+            "inequality (no body has one moment larger than the sum of the other two)"
+        )
+
+
+def _check_limits(joint: ElementTree.Element, kind: str, where: str) -> None:
+    limit = joint.find("limit")
+    if limit is None:
+        if kind in MOVING_JOINTS:
+            raise InvalidURDF(f"{where}: has no <limit> (effort and velocity limits are required)")
+        return
+    place = f"{where} <limit>"
+    values = {name: _scalar(limit, name, place) for name in ("effort", "velocity", "lower", "upper")}
+    if kind not in MOVING_JOINTS:
+        return
+    for name, (lowest, highest), unit in (
+        ("effort", EFFORT_RANGE, "N m (N for prismatic)"),
+        ("velocity", VELOCITY_RANGE, "rad/s (m/s for prismatic)"),
+    ):
+        value = values[name]
+        if value is None:
+            raise InvalidURDF(f"{where}: <limit> has no {name}")
+        if value <= 0.0:
+            raise InvalidURDF(f"{where}: {name} limit must be positive, got {value:g}")
+        _within(value, lowest, highest, where, f"{name} limit", unit)
+    lower, upper = values["lower"], values["upper"]
+    if kind == "continuous":
+        return
+    if lower is None or upper is None or not lower < upper:
+        raise InvalidURDF(f"{where}: needs position limits lower < upper, got {lower}, {upper}")
+    for name in ("lower", "upper"):
+        _within(values[name], -MAX_POSITION, MAX_POSITION, where, f"{name} position limit", "rad (m for prismatic)")
+
+
+def _check_joint_numbers(joint: ElementTree.Element, kind: str, where: str) -> None:
+    _check_origin(joint, where)
+    axis_element = joint.find("axis")
+    if axis_element is not None:
+        axis = _vector(axis_element, "xyz", f"{where} <axis>")
+        if kind in MOVING_JOINTS and axis is not None and not 1e-6 <= np.abs(axis).max() <= MAX_OTHER:
+            raise InvalidURDF(f"{where}: <axis> xyz {_numbers(axis)} must be a direction (a unit vector)")
+    _check_limits(joint, kind, where)
+    dynamics = joint.find("dynamics")
+    if dynamics is not None:
+        for name, highest in (("damping", MAX_DAMPING), ("friction", MAX_FRICTION)):
+            value = _scalar(dynamics, name, f"{where} <dynamics>")
+            if value is not None:
+                _within(value, 0.0, highest, where, name, "")
+    for tag, names in (
+        ("safety_controller", ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity")),
+        ("calibration", ("rising", "falling", "reference_position")),
+        ("mimic", ("multiplier", "offset")),
+    ):
+        element = joint.find(tag)
+        for name in () if element is None else names:
+            value = _scalar(element, name, f"{where} <{tag}>")
+            if value is not None:
+                _within(value, -MAX_OTHER, MAX_OTHER, where, f"<{tag}> {name}", "")
+
+
+def _named(elements: list[ElementTree.Element], tag: str) -> dict[str, ElementTree.Element]:
+    named: dict[str, ElementTree.Element] = {}
+    for element in elements:
+        name = element.get("name")
+        if not name:
+            raise InvalidURDF(f"a <{tag}> has no name")
+        if name in named:
+            raise InvalidURDF(f"two <{tag}> elements are named {excerpt(name)}; names must be unique")
+        named[name] = element
+    return named
+
+
+def _parent_joints(links: dict, joints: dict) -> dict[str, str]:
+    """Map child link -> the one joint whose child it is; checks that the links form one tree.
+
+    Walks iteratively, so that a chain of any length is checked in linear time and constant stack.
+    """
+    parent_joint: dict[str, str] = {}
+    for name, joint in joints.items():
+        where = f"joint {excerpt(name)}"
+        parent, child = joint.find("parent"), joint.find("child")
+        if parent is None or child is None:
+            raise InvalidURDF(f"{where}: needs <parent link=...> and <child link=...>")
+        for end in (parent, child):
+            if end.get("link") not in links:
+                raise InvalidURDF(f"{where}: refers to link {excerpt(end.get('link'))}, which is not defined")
+        child_name = child.get("link")
+        if child_name in parent_joint:
+            raise InvalidURDF(
+                f"{where}: link {excerpt(child_name)} is already the child of joint "
+                f"{excerpt(parent_joint[child_name])}; a URDF is a tree, each link has at most one parent joint"
+            )
+        parent_joint[child_name] = name
+    roots = [name for name in links if name not in parent_joint]
+    if len(roots) > 1:
+        raise InvalidURDF(
+            f"links {excerpt(roots[0])} and {excerpt(roots[1])} both have no parent joint; "
+            "a URDF is one tree with a single root link"
+        )
+    children: dict[str, list[str]] = {}
+    for child_name, joint_name in parent_joint.items():
+        children.setdefault(joints[joint_name].find("parent").get("link"), []).append(child_name)
+    reached = set(roots)
+    stack = list(roots)
+    while stack:
+        for child_name in children.get(stack.pop(), []):
+            reached.add(child_name)
+            stack.append(child_name)
+    unreached = [name for name in links if name not in reached]
+    if unreached:
+        raise InvalidURDF(_cycle_message(unreached[0], parent_joint, joints))
+    return parent_joint
+
+
+def _cycle_message(start: str, parent_joint: dict[str, str], joints: dict) -> str:
+    """Follow parent joints from ``start`` (a link no root reaches) until a link repeats."""
+    seen: dict[str, int] = {}
+    path: list[str] = []
+    link = start
+    while link not in seen:
+        seen[link] = len(path)
+        path.append(parent_joint[link])
+        link = joints[parent_joint[link]].find("parent").get("link")
+    cycle = path[seen[link] :]
+    named = ", ".join(excerpt(name) for name in cycle[:5]) + (", ..." if len(cycle) > 5 else "")
+    return f"joint {excerpt(cycle[0])}: joints {named} form a cycle; a URDF is a tree without cycles"
+
+
+def _check_structure(root: ElementTree.Element) -> tuple[dict, dict, dict[str, str]]:
+    link_elements, joint_elements = root.findall("link"), root.findall("joint")
+    if len(link_elements) > MAX_LINKS:
+        raise InvalidURDF(f"the URDF has {len(link_elements)} links; at most {MAX_LINKS} are served")
+    if len(joint_elements) > MAX_JOINTS:
+        raise InvalidURDF(f"the URDF has {len(joint_elements)} joints; at most {MAX_JOINTS} are served")
+    links, joints = _named(link_elements, "link"), _named(joint_elements, "joint")
+    for name, joint in joints.items():
+        if joint.get("type") not in (*MOVING_JOINTS, "fixed"):
+            raise InvalidURDF(
+                f"joint {excerpt(name)}: type {excerpt(joint.get('type'))} is not supported (fixed-base arms only)"
+            )
+    moving = [name for name, joint in joints.items() if joint.get("type") in MOVING_JOINTS]
+    if not moving:
+        raise InvalidURDF("the URDF has no revolute, continuous or prismatic joint")
+    if len(moving) > MAX_MOVING_JOINTS:
+        raise InvalidURDF(f"the URDF has {len(moving)} moving joints; at most {MAX_MOVING_JOINTS} are served")
+    return links, joints, _parent_joints(links, joints)
+
+
+def _check_mass_behind_moving_joints(links: dict, joints: dict, masses: dict[str, float]) -> None:
+    rigid_children: dict[str, list[str]] = {}
+    for joint in joints.values():
+        if joint.get("type") == "fixed":
+            rigid_children.setdefault(joint.find("parent").get("link"), []).append(joint.find("child").get("link"))
+    for name, joint in joints.items():
+        if joint.get("type") not in MOVING_JOINTS:
+            continue
+        child = joint.find("child").get("link")
+        stack, total = [child], 0.0
+        while stack:
+            link = stack.pop()
+            total += masses[link]
+            stack.extend(rigid_children.get(link, []))
+        if total <= 0.0:
+            raise InvalidURDF(
+                f"joint {excerpt(name)}: link {excerpt(child)} has no <inertial> with positive mass"
+            )
+
+
+def _check_joint_space_inertia(model: pin.Model) -> None:
+    """The mass matrix at the zero configuration is positive definite and not near singular."""
+    inertia = pin.crba(model, model.createData(), pin.neutral(model))
+    inertia = np.triu(inertia) + np.triu(inertia, 1).T
+    values, vectors = np.linalg.eigh(inertia)
+    if not values[0] > values[-1] / MAX_JOINT_SPACE_CONDITION:
+        weakest = int(np.argmax(np.abs(vectors[:, 0])))
+        joint = next(name for name, j in zip(model.names[1:], model.joints[1:]) if j.idx_v <= weakest < j.idx_v + j.nv)
+        raise InvalidURDF(
+            f"joint {excerpt(joint)}: moves (almost) no inertia about its axis (the joint-space inertia "
+            f"matrix has eigenvalues from {values[0]:.3g} to {values[-1]:.3g}); give the links it moves "
+            "a mass off its axis or a rotational inertia"
+        )
 
 
 def check_urdf(urdf: str) -> pin.Model:
     """Validate ``urdf`` and return its Pinocchio model (fixed base).
 
     Raises:
-        InvalidURDF: malformed XML, no joints, an unsupported joint type, missing or non-positive
-            limits, a link without inertia behind a moving joint, or a model Pinocchio rejects.
+        InvalidURDF: malformed XML, a document type declaration, links that do not form one tree
+            (several parents, several roots, a cycle), too many links or joints, an unsupported
+            joint type, a number that is not finite or outside the module's bounds, missing
+            limits, a mass or inertia that no body has, no inertia behind a moving joint, or a
+            model Pinocchio rejects. The detail names the link or joint.
     """
+    if "<!DOCTYPE" in urdf:
+        raise InvalidURDF("the URDF holds a <!DOCTYPE> declaration; document types and entities are not accepted")
     try:
         root = ElementTree.fromstring(urdf)
     except ElementTree.ParseError as error:
-        raise InvalidURDF(f"malformed XML: {error}") from None
+        raise InvalidURDF(f"malformed XML: {excerpt(str(error), 200)}") from None
     if root.tag != "robot":
-        raise InvalidURDF(f"the root element is <{root.tag}>, expected <robot>")
-    links = {link.get("name"): link for link in root.findall("link")}
-    joints = root.findall("joint")
-    for joint in joints:
-        if joint.get("type") not in (*MOVING_JOINTS, "fixed"):
-            raise InvalidURDF(
-                f"joint {joint.get('name')!r}: type {joint.get('type')!r} is not supported (fixed-base arms only)"
-            )
-    moving = [joint for joint in joints if joint.get("type") in MOVING_JOINTS]
-    if not moving:
-        raise InvalidURDF("the URDF has no revolute, continuous or prismatic joint")
-    if len(moving) > MAX_JOINTS:
-        raise InvalidURDF(f"the URDF has {len(moving)} moving joints; at most {MAX_JOINTS} are served")
-    children: dict[str, list[ElementTree.Element]] = {}
-    for joint in joints:
-        where = f"joint {joint.get('name')!r}"
-        kind = joint.get("type")
-        parent, child = joint.find("parent"), joint.find("child")
-        if parent is None or child is None:
-            raise InvalidURDF(f"{where}: needs <parent link=...> and <child link=...>")
-        for end in (parent, child):
-            if end.get("link") not in links:
-                raise InvalidURDF(f"{where}: refers to link {end.get('link')!r}, which is not defined")
-        children.setdefault(parent.get("link"), []).append(joint)
-        if kind == "fixed":
-            continue
-        limit = joint.find("limit")
-        if limit is None:
-            raise InvalidURDF(f"{where}: has no <limit> (effort and velocity limits are required)")
-        for attribute in ("effort", "velocity"):
-            value = _number(limit, attribute, f"{where} <limit>")
-            if value is None:
-                raise InvalidURDF(f"{where}: <limit> has no {attribute}")
-            if value <= 0.0:
-                raise InvalidURDF(f"{where}: {attribute} limit must be positive, got {value}")
-        if kind != "continuous":
-            lower = _number(limit, "lower", f"{where} <limit>")
-            upper = _number(limit, "upper", f"{where} <limit>")
-            if lower is None or upper is None or not lower < upper:
-                raise InvalidURDF(f"{where}: needs position limits lower < upper, got {lower}, {upper}")
-
-    def subtree_mass(link_name: str) -> float:
-        """Mass of a link and of everything rigidly fixed to it."""
-        total = _link_mass(links[link_name])
-        for joint in children.get(link_name, []):
-            if joint.get("type") == "fixed":
-                total += subtree_mass(joint.find("child").get("link"))
-        return total
-
-    for joint in moving:
-        child = joint.find("child").get("link")
-        if subtree_mass(child) <= 0.0:
-            raise InvalidURDF(
-                f"joint {joint.get('name')!r}: link {child!r} has no <inertial> with positive mass"
-            )
+        tag = root.tag if len(root.tag) <= 40 else f"{root.tag[:40]}..."
+        raise InvalidURDF(f"the root element is <{tag}>, expected <robot>")
+    links, joints, _ = _check_structure(root)
+    masses = {}
+    for name, link in links.items():
+        where = f"link {excerpt(name)}"
+        masses[name] = _link_mass(link, where)
+        _check_geometry(link, where)
+    for name, joint in joints.items():
+        _check_joint_numbers(joint, joint.get("type"), f"joint {excerpt(name)}")
+    _check_mass_behind_moving_joints(links, joints, masses)
     try:
         model = pin.buildModelFromXML(urdf)
-    except (RuntimeError, ValueError) as error:
-        raise InvalidURDF(f"Pinocchio cannot build the model: {error}") from None
+    except Exception as error:  # Pinocchio's parser raises RuntimeError, ValueError and others
+        raise InvalidURDF(f"Pinocchio cannot build the model: {excerpt(str(error), 300)}") from None
+    _check_joint_space_inertia(model)
     return model

@@ -30,8 +30,15 @@ def _warm_up() -> None:
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
-    """The toptraj HTTP service."""
+    """The toptraj HTTP service. Its settings also choose where this process keeps uploads
+    (``robots.configure_uploads``): one upload store per process, the last app's."""
     settings = settings or Settings()
+    robots.configure_uploads(
+        settings.data_dir,
+        max_uploads=settings.max_uploads,
+        max_bytes=settings.max_upload_bytes,
+        cache_size=settings.upload_cache_size,
+    )
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):

@@ -2,16 +2,28 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
+
+from robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
+from robots.uploads import DEFAULT_CACHE_SIZE
 
 
 class Settings(BaseSettings):
-    """Limits of the HTTP edge.
+    """Limits of the HTTP edge and where data lives.
 
     Attributes:
         max_body_bytes: Largest request body accepted (413 beyond).
         plan_budget_s: Wall-clock budget of one planning request (504 beyond), in s.
         preload_robots: Build every catalog robot at start-up rather than on first use.
+        data_dir: Directory of the durable data (uploaded URDFs in ``uploads.sqlite3``); default
+            ``$XDG_DATA_HOME/toptraj`` or ``~/.local/share/toptraj``.
+        max_uploads: Most uploaded robots the store keeps (409 beyond).
+        max_upload_bytes: Most bytes of distinct URDF text the store keeps (409 beyond).
+        upload_cache_size: Most upload models a process keeps built in memory (least recently
+            used dropped first).
     """
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")
@@ -19,3 +31,7 @@ class Settings(BaseSettings):
     max_body_bytes: int = 2_000_000
     plan_budget_s: float = 20.0
     preload_robots: bool = True
+    data_dir: Path = Field(default_factory=default_data_dir)
+    max_uploads: int = Field(default=DEFAULT_MAX_UPLOADS, ge=1)
+    max_upload_bytes: int = Field(default=DEFAULT_MAX_BYTES, ge=1)
+    upload_cache_size: int = Field(default=DEFAULT_CACHE_SIZE, ge=1)

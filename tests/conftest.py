@@ -1,12 +1,20 @@
-"""Shared fixtures: one app and TestClient per test module."""
+"""Shared fixtures: one app and TestClient per test module, each with its own temporary data
+directory; ``TOPTRAJ_DATA_DIR`` points at a temporary directory too, so that no test (nor a
+process a test starts) reads or writes the user's data directory."""
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 import warnings
 
 import pytest
 
 warnings.filterwarnings("ignore", message=".*httpx2.*")
+
+_SESSION_DATA_DIR = tempfile.mkdtemp(prefix="toptraj-test-data-")
+os.environ["TOPTRAJ_DATA_DIR"] = _SESSION_DATA_DIR
 
 from fastapi.testclient import TestClient  # noqa: E402
 
@@ -21,7 +29,12 @@ UR5_WAYPOINTS = [
 ]
 
 
+def pytest_sessionfinish(session, exitstatus):
+    shutil.rmtree(_SESSION_DATA_DIR, ignore_errors=True)
+
+
 @pytest.fixture(scope="module")
-def client():
-    with TestClient(create_app(Settings(preload_robots=False))) as test_client:
+def client(tmp_path_factory):
+    settings = Settings(preload_robots=False, data_dir=tmp_path_factory.mktemp("data"))
+    with TestClient(create_app(settings)) as test_client:
         yield test_client

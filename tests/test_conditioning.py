@@ -8,7 +8,7 @@ import pytest
 from scipy.optimize import minimize
 
 from planners.kinematics.conditioning import frobenius_condition_number, task_jacobian
-from robots.catalog import _robot_from_model
+from robots.catalog import robot_from_model
 
 LINK = '<link name="{name}"><inertial><origin xyz="{com} 0 0"/><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
 
@@ -26,7 +26,7 @@ def _planar_2r(a1: float, a2: float):
       <joint name="tip_mount" type="fixed"><parent link="l2"/><child link="tip"/><origin xyz="{a2} 0 0"/></joint>
       <link name="tip"/>
     </robot>"""
-    return _robot_from_model("planar", pin.buildModelFromXML(urdf), "upload", "tip")
+    return robot_from_model("planar", pin.buildModelFromXML(urdf), "upload", "tip")
 
 
 def _orthogonal_3r(length: float):
@@ -45,7 +45,7 @@ def _orthogonal_3r(length: float):
       <joint name="tip_mount" type="fixed"><parent link="l2"/><child link="tip"/><origin xyz="{length} 0 0"/></joint>
       <link name="tip"/>
     </robot>"""
-    return _robot_from_model("orthogonal", pin.buildModelFromXML(urdf), "upload", "tip")
+    return robot_from_model("orthogonal", pin.buildModelFromXML(urdf), "upload", "tip")
 
 
 def _kappa(robot, q):

@@ -1,8 +1,8 @@
-"""``/v1/robots``: the catalog, one robot, and URDF uploads."""
+"""``/v1/robots``: the catalog and the uploads, one robot, URDF uploads and their deletion."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Response
 from starlette.concurrency import run_in_threadpool
 
 import robots
@@ -10,6 +10,11 @@ from service.schemas.common import Problem
 from service.schemas.robots import RobotCreate, RobotPublic, RobotSummary
 
 router = APIRouter(prefix="/v1/robots", tags=["robots"])
+
+
+def _problem(description: str) -> dict:
+    """An error answer as the OpenAPI declares it: an ``application/problem+json`` body."""
+    return {"description": description, "content": {"application/problem+json": {"schema": Problem.model_json_schema()}}}
 
 
 def robot_public(robot: robots.Robot) -> RobotPublic:
@@ -27,14 +32,16 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
 @router.get("", summary="List the robots")
 def list_robots() -> list[RobotSummary]:
     """Every robot the service can plan for: the bundled paper arms, the fixed-base arms of
-    example-robot-data and the uploaded URDFs."""
-    return [
+    example-robot-data and the uploaded URDFs (from the store, without building their models)."""
+    catalog = [
         RobotSummary(name=robot.name, dof=robot.dof, source=robot.source)
         for robot in map(robots.load, robots.catalog_names())
     ]
+    uploads = [RobotSummary(name=upload.name, dof=upload.dof, source="upload") for upload in robots.list_uploads()]
+    return catalog + uploads
 
 
-@router.get("/{name}", summary="Describe one robot", responses={404: {"model": Problem}})
+@router.get("/{name}", summary="Describe one robot", responses={404: _problem("No robot has that name.")})
 def get_robot(name: str) -> RobotPublic:
     """Joints, end effector and limits of robot ``name``."""
     return robot_public(robots.load(name))
@@ -44,10 +51,34 @@ def get_robot(name: str) -> RobotPublic:
     "",
     status_code=201,
     summary="Upload a URDF",
-    responses={409: {"model": Problem}, 413: {"model": Problem}, 422: {"model": Problem}},
+    responses={
+        409: _problem("The name is taken (a catalog robot, or an upload of a different URDF), or the store is full."),
+        413: _problem("The request body is too large."),
+        422: _problem("The URDF or the name is invalid; the detail names the link or joint and the reason."),
+        503: _problem("The upload store cannot be written (the server's data directory)."),
+    },
 )
 async def upload_robot(body: RobotCreate) -> RobotPublic:
-    """Parse a fixed-base arm's URDF with Pinocchio and keep it under ``name`` (default: a
-    content hash). Malformed XML, missing inertias or missing/zero limits are refused with 422."""
+    """Check a fixed-base arm's URDF (tree structure, finite and physically possible masses,
+    inertias, origins and limits), build it with Pinocchio and store it durably under ``name``
+    (default: a content hash). Uploading the same URDF under the same name again is harmless."""
     robot = await run_in_threadpool(robots.register_urdf, body.urdf, body.name)
     return robot_public(robot)
+
+
+@router.delete(
+    "/{name}",
+    status_code=204,
+    summary="Delete an uploaded robot",
+    response_class=Response,
+    responses={
+        404: _problem("No uploaded robot has that name."),
+        409: _problem("The robot belongs to the catalog, which cannot be deleted."),
+        503: _problem("The upload store cannot be written (the server's data directory)."),
+    },
+)
+def delete_robot(name: str) -> Response:
+    """Remove the upload ``name`` from the store; planning for it answers 404 afterwards. Catalog
+    robots cannot be deleted (409)."""
+    robots.delete_upload(name)
+    return Response(status_code=204)

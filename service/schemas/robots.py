@@ -6,6 +6,7 @@ from typing import Literal
 
 from pydantic import BaseModel, Field
 
+from robots.uploads import MAX_NAME_CHARS, NAME_PATTERN
 from service.schemas.common import Schema
 
 MAX_URDF_CHARS = 1_000_000
@@ -45,6 +46,10 @@ class RobotCreate(Schema):
     """An uploaded URDF, optionally under a chosen name."""
 
     name: str | None = Field(
-        default=None, description="Name to keep it under; default `urdf-` plus a content hash."
+        default=None,
+        max_length=MAX_NAME_CHARS,
+        pattern=f"^{NAME_PATTERN.pattern}$",
+        description="Name to keep it under (a letter, then up to 63 letters, digits, `_`, `.` or `-`); "
+        "default `urdf-` plus a content hash.",
     )
     urdf: str = Field(max_length=MAX_URDF_CHARS, description="The URDF text (fixed-base arm).")

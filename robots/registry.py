@@ -1,0 +1,23 @@
+"""Robots by name: the catalog first, then the uploads (``robots.load``, public contract)."""
+
+from __future__ import annotations
+
+from robots.catalog import catalog_names, is_catalog_robot, load_catalog_robot
+from robots.errors import UnknownRobot
+from robots.robot import Robot
+from robots.uploads import load_upload
+
+
+def load(name: str) -> Robot:
+    """The robot called ``name``: a catalog robot (built once per process) or an upload (read
+    from the store, its model kept in a bounded cache).
+
+    Raises:
+        UnknownRobot: no bundled, example-robot-data or uploaded robot has that name.
+    """
+    if is_catalog_robot(name):
+        return load_catalog_robot(name)
+    robot = load_upload(name)
+    if robot is None:
+        raise UnknownRobot(name, catalog_names())
+    return robot

@@ -1,0 +1,225 @@
+"""The durable store of uploaded URDFs: one SQLite database, ``uploads.sqlite3``, in the data
+directory.
+
+Why SQLite (Python's standard library) rather than files: an upload must check the name and the
+caps and then write, and two worker processes may upload at once. A transaction (``BEGIN
+IMMEDIATE``) makes that check-then-write atomic across processes without lock files, and a
+commit is atomic and durable (write-ahead log), which is what "write a temporary file, then
+``os.replace``" gives for one file but not for a file plus an index. The text is still content
+addressed: ``urdfs`` holds each distinct text once under its SHA-256, ``robots`` maps names to
+digests, so two names for one text store it once.
+
+Nothing is cached here: every call opens its own connection, so a process sees what another
+process committed, and a forked worker never shares a connection with its parent.
+"""
+
+from __future__ import annotations
+
+import os
+import sqlite3
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from robots.errors import RobotConflict, UploadStoreFull, UploadStoreUnavailable, excerpt
+
+DEFAULT_MAX_UPLOADS = 1_000
+DEFAULT_MAX_BYTES = 200_000_000
+DATABASE = "uploads.sqlite3"
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS urdfs (
+    digest TEXT PRIMARY KEY,      -- SHA-256 of the UTF-8 text, hex
+    urdf TEXT NOT NULL,
+    bytes INTEGER NOT NULL        -- length of the UTF-8 text
+);
+CREATE TABLE IF NOT EXISTS robots (
+    name TEXT PRIMARY KEY,
+    digest TEXT NOT NULL REFERENCES urdfs (digest),
+    dof INTEGER NOT NULL,
+    created REAL NOT NULL         -- Unix time, s
+);
+"""
+
+
+def default_data_dir() -> Path:
+    """``$TOPTRAJ_DATA_DIR``, else ``$XDG_DATA_HOME/toptraj``, else ``~/.local/share/toptraj``."""
+    explicit = os.environ.get("TOPTRAJ_DATA_DIR")
+    if explicit:
+        return Path(explicit).expanduser()
+    base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
+    return Path(base) / "toptraj"
+
+
+@dataclass(frozen=True)
+class StoredUpload:
+    """One stored upload: its name, the SHA-256 of its text, its degrees of freedom and when it
+    was stored (Unix time, s)."""
+
+    name: str
+    digest: str
+    dof: int
+    created: float
+
+
+@dataclass(frozen=True)
+class StoreUsage:
+    """What the store holds against its caps: uploads (names) and bytes of distinct texts."""
+
+    uploads: int
+    bytes: int
+    max_uploads: int
+    max_bytes: int
+
+
+class UploadStore:
+    """Uploaded URDF texts by name, in ``data_dir / "uploads.sqlite3"``, capped at
+    ``max_uploads`` names and ``max_bytes`` bytes of distinct texts.
+
+    Reading never creates anything: a store whose database does not exist yet is empty.
+    """
+
+    def __init__(self, data_dir: Path | str, max_uploads: int = DEFAULT_MAX_UPLOADS, max_bytes: int = DEFAULT_MAX_BYTES):
+        self.data_dir = Path(data_dir)
+        self.max_uploads = max_uploads
+        self.max_bytes = max_bytes
+        self.path = self.data_dir / DATABASE
+
+    def __repr__(self) -> str:
+        return f"UploadStore({str(self.path)!r}, max_uploads={self.max_uploads}, max_bytes={self.max_bytes})"
+
+    @contextmanager
+    def _connect(self, write: bool) -> Iterator[sqlite3.Connection | None]:
+        """A connection in autocommit mode (``None`` when reading a store that does not exist).
+
+        Raises:
+            UploadStoreUnavailable: SQLite or the file system failed, here or in the block.
+        """
+        if not write and not self.path.exists():
+            yield None
+            return
+        try:
+            if write:
+                self.data_dir.mkdir(parents=True, exist_ok=True)
+            connection = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+            try:
+                if write:
+                    connection.execute("PRAGMA auto_vacuum = INCREMENTAL")  # takes effect on a new database
+                    connection.execute("PRAGMA journal_mode = WAL")
+                    connection.executescript(_SCHEMA)
+                yield connection
+            finally:
+                connection.close()
+        except (sqlite3.Error, OSError) as error:
+            raise UploadStoreUnavailable(
+                f"the upload store cannot be used ({type(error).__name__}: {excerpt(str(error), 120)}); "
+                "its data directory (setting data_dir, TOPTRAJ_DATA_DIR) must be a writable directory"
+            ) from error
+
+    def digest(self, name: str) -> str | None:
+        """SHA-256 of the text stored under ``name``, ``None`` when there is none."""
+        with self._connect(write=False) as connection:
+            if connection is None:
+                return None
+            row = connection.execute("SELECT digest FROM robots WHERE name = ?", (name,)).fetchone()
+        return None if row is None else row[0]
+
+    def read(self, name: str) -> tuple[str, str] | None:
+        """``(digest, text)`` stored under ``name``, ``None`` when there is none."""
+        with self._connect(write=False) as connection:
+            if connection is None:
+                return None
+            row = connection.execute(
+                "SELECT robots.digest, urdfs.urdf FROM robots JOIN urdfs USING (digest) WHERE name = ?", (name,)
+            ).fetchone()
+        return None if row is None else (row[0], row[1])
+
+    def uploads(self) -> list[StoredUpload]:
+        """Every stored upload, by name."""
+        with self._connect(write=False) as connection:
+            if connection is None:
+                return []
+            rows = connection.execute("SELECT name, digest, dof, created FROM robots ORDER BY name").fetchall()
+        return [StoredUpload(*row) for row in rows]
+
+    def usage(self) -> StoreUsage:
+        """How many uploads and bytes the store holds, with its caps."""
+        with self._connect(write=False) as connection:
+            count, size = (0, 0) if connection is None else self._usage(connection)
+        return StoreUsage(count, size, self.max_uploads, self.max_bytes)
+
+    @staticmethod
+    def _usage(connection: sqlite3.Connection) -> tuple[int, int]:
+        count = connection.execute("SELECT COUNT(*) FROM robots").fetchone()[0]
+        size = connection.execute("SELECT COALESCE(SUM(bytes), 0) FROM urdfs").fetchone()[0]
+        return count, size
+
+    def put(self, name: str, digest: str, urdf: str, dof: int) -> bool:
+        """Store ``urdf`` (whose SHA-256 is ``digest``) under ``name``, atomically.
+
+        Returns:
+            ``True`` when stored, ``False`` when ``name`` already held this very text.
+
+        Raises:
+            RobotConflict: ``name`` holds a different text.
+            UploadStoreFull: storing it would pass the count or byte cap.
+        """
+        size = len(urdf.encode())
+        with self._connect(write=True) as connection:
+            connection.execute("BEGIN IMMEDIATE")
+            try:
+                row = connection.execute("SELECT digest FROM robots WHERE name = ?", (name,)).fetchone()
+                if row is not None:
+                    if row[0] != digest:
+                        raise RobotConflict(
+                            f"name {excerpt(name)} already holds a different URDF; choose another name, or "
+                            "DELETE /v1/robots/{name} first"
+                        )
+                    connection.execute("ROLLBACK")
+                    return False
+                count, stored = self._usage(connection)
+                known = connection.execute("SELECT 1 FROM urdfs WHERE digest = ?", (digest,)).fetchone()
+                added = 0 if known else size
+                if count + 1 > self.max_uploads or stored + added > self.max_bytes:
+                    raise UploadStoreFull(
+                        f"the upload store holds {count} uploads and {stored} bytes; its caps are "
+                        f"{self.max_uploads} uploads and {self.max_bytes} bytes, and this upload adds {added} "
+                        "bytes. Free space with DELETE /v1/robots/{name} (GET /v1/robots lists the uploads)."
+                    )
+                if not known:
+                    connection.execute("INSERT INTO urdfs (digest, urdf, bytes) VALUES (?, ?, ?)", (digest, urdf, size))
+                connection.execute(
+                    "INSERT INTO robots (name, digest, dof, created) VALUES (?, ?, ?, ?)", (name, digest, dof, time.time())
+                )
+                connection.execute("COMMIT")
+            except BaseException:
+                if connection.in_transaction:
+                    connection.execute("ROLLBACK")
+                raise
+        return True
+
+    def delete(self, name: str) -> bool:
+        """Remove ``name`` (and its text when no other name uses it); ``False`` if absent."""
+        if not self.path.exists():
+            return False
+        with self._connect(write=True) as connection:
+            connection.execute("BEGIN IMMEDIATE")
+            try:
+                row = connection.execute("SELECT digest FROM robots WHERE name = ?", (name,)).fetchone()
+                if row is None:
+                    connection.execute("ROLLBACK")
+                    return False
+                connection.execute("DELETE FROM robots WHERE name = ?", (name,))
+                connection.execute(
+                    "DELETE FROM urdfs WHERE digest = ? AND NOT EXISTS (SELECT 1 FROM robots WHERE digest = ?)",
+                    (row[0], row[0]),
+                )
+                connection.execute("COMMIT")
+            except BaseException:
+                if connection.in_transaction:
+                    connection.execute("ROLLBACK")
+                raise
+            connection.execute("PRAGMA incremental_vacuum")  # give the freed pages back to the file system
+        return True
