@@ -13,24 +13,22 @@ from typing import NamedTuple
 import numpy as np
 
 from planners.boundary import path_acceleration, path_speed
-from planners.constraints import PathConstraints, build_path_constraints
+from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.grid import MAX_POINTS, path_grid
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
-from planners.limit_check import Excess, LimitCheck, check_limits
+from planners.gate import TimedStretch, checked, gate_threshold, gated, samples_exceed
 from planners.mvc import admissible_set
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.paths.cartesian import CartesianLine, cartesian_path
 from planners.paths.stretch import stretches
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.results import Conditioning, PhasePlane, PlannedTrajectory
-from planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
-from planners.timing.law_timing import LawTiming
+from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
-from planners.timing.scaled import solve_well_scaled
 from planners.timing.segmented import SegmentedTiming
 from planners.trajectory import sample_trajectory
 from planners.via_points import via_point_trajectory
@@ -40,14 +38,11 @@ INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
 MAX_WAYPOINTS = 1_000
 #: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
 MAX_COORDINATE = 1e4
+#: Consecutive waypoints closer than this (joint-space norm, rad or m) are one waypoint.
+COINCIDENT = 1e-12
 MAX_SAMPLES = 200_000
 #: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
 MAX_PHASE_PLANE_POINTS = 2_000
-#: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is
-#: 0.5 %; the gate is tighter, since a client's own resampling falls between the check's states.
-LIMIT_TOLERANCE = 1.003
-#: Rounds of grid refinement where the dense check finds a limit exceeded.
-GATE_ROUNDS = 4
 #: Largest timing.limit_margin (a fraction of every limit kept in reserve).
 MAX_LIMIT_MARGIN = 0.5
 
@@ -86,6 +81,29 @@ def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
             f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
         )
     return waypoints
+
+
+def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
+    """``spec`` without waypoints that repeat the one before them (a recorded path that stands
+    still for a while), and a note saying which were dropped.
+
+    Raises:
+        InvalidRequest: every waypoint is the same: there is nothing to move.
+    """
+    waypoints = np.asarray(spec.waypoints, dtype=float)
+    if waypoints.ndim != 2 or len(waypoints) < 2 or not np.all(np.isfinite(waypoints)):
+        return spec, ()
+    repeats = np.flatnonzero(np.linalg.norm(np.diff(waypoints, axis=0), axis=1) <= COINCIDENT) + 1
+    if repeats.size == 0:
+        return spec, ()
+    if repeats.size == len(waypoints) - 1:
+        raise InvalidRequest(
+            f"path.waypoints[0] and path.waypoints[1] coincide, as do all {len(waypoints)} waypoints: "
+            "there is nothing to move"
+        )
+    shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
+    note = f"path.waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)"
+    return WaypointPath(np.delete(waypoints, repeats, axis=0), spec.interpolation), (note,)
 
 
 def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
@@ -173,7 +191,7 @@ class _Timed(NamedTuple):
 
     path: GeometricPath
     timing: PathTiming
-    stretches: tuple["_TimedStretch", ...]
+    stretches: tuple["TimedStretch", ...]
     method: str
     notes: tuple[str, ...] = ()
     cost: float | None = None
@@ -194,79 +212,14 @@ def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool)
     )
 
 
-def _refinement(timing: PathTiming, intervals: np.ndarray) -> np.ndarray:
-    """Points that split each listed grid interval of ``timing`` in four."""
-    s = timing.s
-    quarters = np.array([0.25, 0.5, 0.75])
-    return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
-
-
-def _gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline):
-    """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
-    exceeded by more than ``threshold``, refine the grid there and time the path again.
-
-    Returns:
-        (timing, constraints, check): the timing that holds the limits, the constraints it was
-        timed on, and its ``LimitCheck``.
-
-    Raises:
-        InfeasiblePath: the limits still do not hold after ``GATE_ROUNDS`` refinements, or the
-            method's timing cannot be refined; says where, which joint and which limit.
-    """
-    result = solve_well_scaled(method, constraints, boundary, duration, deadline)
-    for _ in range(GATE_ROUNDS + 1):
-        deadline.check()
-        check = check_limits(path, result, robot, limits, kinds, threshold)
-        if check.worst is None or check.worst.ratio <= threshold:
-            return result, constraints, check
-        if isinstance(result, LawTiming) and duration is None:
-            # The shortest time law was found on samples of its profile; the dense check sees
-            # between them. Slowing a law down by a factor f divides velocities by f,
-            # accelerations (and the inertial part of torques) by f^2, jerks by f^3.
-            power = {"velocity": 1.0, "jerk": 3.0}.get(check.worst.kind, 2.0)
-            result = result.slowed(check.worst.ratio ** (1.0 / power) * (1 + 1e-6))
-            if result is None:
-                break
-            continue
-        if not (isinstance(result, TimeScaling) and constraints.can_refine and check.intervals_over.size):
-            break
-        extra = _refinement(result, check.intervals_over)
-        extra = np.unique(extra[~np.isin(extra, constraints.s)])
-        if extra.size == 0:
-            break
-        constraints = constraints.with_points(extra)
-        result = solve_well_scaled(method, constraints, boundary, duration, deadline)
-    raise _limit_exceeded(method.name, check.worst, robot, path)
-
-
-def _limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> InfeasiblePath:
-    s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
-    joint = robot.joint_names[worst.joint]
-    return InfeasiblePath(
-        f"the {method} timing exceeds the {worst.kind} limit of joint {joint!r} by "
-        f"{100 * (worst.ratio - 1):.2f} % at s = {s:.4f}, and refining the grid there did not bring "
-        "it back within the limits; use another timing method, a lower limit scale or more grid points",
-        s=s,
-        joint=joint,
-        limit=worst.kind,
-    )
-
-
-class _TimedStretch(NamedTuple):
-    stretch: GeometricPath
-    timing: PathTiming
-    constraints: PathConstraints
-    check: LimitCheck
-
-
 def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, duration, threshold, deadline):
     s = path_grid(stretch, grid_points)
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
     deadline.check()
-    timing, constraints, check = _gated(
+    timing, constraints, check = gated(
         robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline
     )
-    return _TimedStretch(stretch, timing, constraints, check)
+    return TimedStretch(stretch, timing, constraints, check)
 
 
 def _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold) -> _Timed:
@@ -302,15 +255,6 @@ def _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold)
     return _Timed(path, result, tuple(timed), method.name, cost=getattr(result, "cost", None))
 
 
-def _checked(robot, path, result, method, kinds, limits, threshold, constraints) -> _TimedStretch:
-    """A timing that cannot be refined, through the limit gate: kept when it holds the limits,
-    refused (with where, which joint and which limit) when it does not."""
-    check = check_limits(path, result, robot, limits, kinds, threshold)
-    if check.worst is not None and check.worst.ratio > threshold:
-        raise _limit_exceeded(method, check.worst, robot, path)
-    return _TimedStretch(path, result, constraints, check)
-
-
 def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, threshold) -> _Timed:
     """Via points: segments shaped and timed together by the limits."""
     if timing.start_velocity is not None or timing.end_velocity is not None:
@@ -319,7 +263,7 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, thre
     s = path_grid(path, timing.grid_points)
     _check_path_within_limits(robot, path, s)
     constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
-    stretch = _checked(robot, path, result, method.name, kinds, limits, threshold, constraints)
+    stretch = checked(robot, path, result, method.name, kinds, limits, threshold, constraints)
     return _Timed(path, result, (stretch,), method.name)
 
 
@@ -334,30 +278,21 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
     )
     notes = ()
     try:
-        result, constraints, check = _gated(
+        result, constraints, check = gated(
             robot, path, retimer, constraints, _boundary(path, moving, retimer), None, kinds, limits, threshold, deadline
         )
-        stretch = _TimedStretch(path, result, constraints, check)
+        stretch = TimedStretch(path, result, constraints, check)
     except InfeasiblePath as error:
         # A boundary state right at a limit may be out of reach of the conservative re-timing;
         # the collocation's own timing is then returned, if it holds the limits.
         result = collocation_timing
-        stretch = _checked(robot, path, result, "collocation", kinds, limits, threshold, constraints)
+        stretch = checked(robot, path, result, "collocation", kinds, limits, threshold, constraints)
         notes = (f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})",)
     cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
     return _Timed(path, result, (stretch,), "collocation", notes, cost, solver)
 
 
-def _gate_threshold(margin: float) -> float:
-    """Largest |value| / limit the gate lets through, against the limits tightened by
-    ``margin``: ``LIMIT_TOLERANCE`` without a margin; with one, never above the untightened
-    limit itself."""
-    if margin == 0.0:
-        return LIMIT_TOLERANCE
-    return min(LIMIT_TOLERANCE, (1.0 - 1e-9) / (1.0 - margin))
-
-
-def _phase_plane(stretches_: tuple[_TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """s, sd and the maximum velocity curve (1/s) over the grids the stretches were timed on,
     in the path's own s."""
     pieces = []
@@ -380,19 +315,6 @@ def _utilization(stretches_, margin: float) -> dict[str, np.ndarray]:
         kind: (1.0 - margin) * np.max([item.check.utilization[kind] for item in stretches_], axis=0)
         for kind in kinds
     }
-
-
-def _samples_exceed(samples, limits: JointLimits, threshold: float, kinds) -> tuple[str, int, int] | None:
-    """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit."""
-    for kind, values in (("velocity", samples.qd), ("acceleration", samples.qdd), ("torque", samples.tau)):
-        if kind not in kinds:
-            continue
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.nan_to_num(np.abs(values) / getattr(limits, kind), nan=0.0)
-        if ratio.size and ratio.max() > threshold:
-            sample, joint = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-            return kind, int(sample), int(joint)
-    return None
 
 
 def plan(
@@ -429,7 +351,10 @@ def plan(
         raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
     requested: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
     limits = requested.tightened(margin) if margin else requested
-    threshold = _gate_threshold(margin)
+    threshold = gate_threshold(margin)
+    dropped: tuple[str, ...] = ()
+    if isinstance(path_spec, WaypointPath):
+        path_spec, dropped = without_repeats(path_spec)
     if method.two_waypoints_only and (not isinstance(path_spec, WaypointPath) or len(path_spec.waypoints) != 2):
         given = f"{len(path_spec.waypoints)} waypoints" if isinstance(path_spec, WaypointPath) else "a cartesian path"
         raise InvalidRequest(
@@ -443,14 +368,14 @@ def plan(
         timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
     else:
         timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline, threshold)
-    path, result, notes = timed.path, timed.timing, list(timed.notes)
+    path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
     deadline.check()
     if result.duration / dt > MAX_SAMPLES:
         raise InvalidRequest(
             f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {result.duration:.4g} s"
         )
     samples = sample_trajectory(path, result, robot, dt)
-    beyond = _samples_exceed(samples, limits, threshold, kinds)
+    beyond = samples_exceed(samples, limits, threshold, kinds)
     if beyond is not None:
         kind, sample, joint = beyond
         raise TimingFailed(

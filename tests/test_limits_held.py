@@ -183,3 +183,13 @@ def test_a_duration_too_short_for_the_limits_is_refused_with_where_and_which(cli
     problem = response.json()
     assert problem["limit"] in KINDS and problem["joint"] and 0.0 <= problem["s"] <= 1.0
     assert problem["limit"] in problem["detail"] and problem["joint"] in problem["detail"]
+
+
+def test_a_recorded_path_that_stands_still_drops_its_repeated_waypoints(client):
+    still = [0.0, -1.2, 1.0, 0.0, 0.5, 0.0]
+    waypoints = [still, still, still, [0.5, -1.0, 1.2, -0.2, 0.6, 0.1], [0.5, -1.0, 1.2, -0.2, 0.6, 0.1], [1.0, -0.8, 1.4, -0.5, 0.9, 0.3]]
+    for method in ("phase_plane", "ruckig"):
+        chosen = waypoints if method == "phase_plane" else [still, still, waypoints[-1]]
+        response = plan(client, "ur5", chosen, method, **({"constraints": ["velocity", "acceleration"]} if method == "ruckig" else {}))
+        assert response.status_code == 200, response.text
+        assert any("were dropped" in warning for warning in response.json()["warnings"])

@@ -1,0 +1,125 @@
+"""The limit gate every answer passes: a timing is checked on a dense resampling
+(``planners.limit_check``); where a limit is exceeded, the grid is refined there and the path
+timed again; a timing that still exceeds a limit, or that cannot be refined, is refused with the
+place, the joint and the limit.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from planners.constraints import PathConstraints
+from planners.errors import InfeasiblePath
+from planners.limit_check import Excess, LimitCheck, check_limits
+from planners.paths.base import GeometricPath
+from planners.timing.base import PathTiming, TimeScaling
+from planners.timing.law_timing import LawTiming
+from planners.timing.scaled import solve_well_scaled
+from robots import JointLimits, Robot
+
+#: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is
+#: 0.5 %; the gate is tighter, since a client's own resampling falls between the check's states.
+LIMIT_TOLERANCE = 1.003
+#: Rounds of grid refinement where the dense check finds a limit exceeded.
+GATE_ROUNDS = 4
+
+
+class TimedStretch(NamedTuple):
+    """One stretch of a path (or the whole path) with its timing, the constraints it was timed
+    on, and its dense limit check."""
+
+    stretch: GeometricPath
+    timing: PathTiming
+    constraints: PathConstraints
+    check: LimitCheck
+
+
+def gate_threshold(margin: float) -> float:
+    """Largest |value| / limit the gate lets through, against the limits tightened by
+    ``margin``: ``LIMIT_TOLERANCE`` without a margin; with one, never above the untightened
+    limit itself."""
+    if margin == 0.0:
+        return LIMIT_TOLERANCE
+    return min(LIMIT_TOLERANCE, (1.0 - 1e-9) / (1.0 - margin))
+
+
+def _refinement(timing: PathTiming, intervals: np.ndarray) -> np.ndarray:
+    """Points that split each listed grid interval of ``timing`` in four."""
+    s = timing.s
+    quarters = np.array([0.25, 0.5, 0.75])
+    return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
+
+
+def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline):
+    """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
+    exceeded by more than ``threshold``, refine the grid there and time the path again.
+
+    Returns:
+        (timing, constraints, check): the timing that holds the limits, the constraints it was
+        timed on, and its ``LimitCheck``.
+
+    Raises:
+        InfeasiblePath: the limits still do not hold after ``GATE_ROUNDS`` refinements, or the
+            method's timing cannot be refined; says where, which joint and which limit.
+    """
+    result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+    for _ in range(GATE_ROUNDS + 1):
+        deadline.check()
+        check = check_limits(path, result, robot, limits, kinds, threshold)
+        if check.worst is None or check.worst.ratio <= threshold:
+            return result, constraints, check
+        if isinstance(result, LawTiming) and duration is None:
+            # The shortest time law was found on samples of its profile; the dense check sees
+            # between them. Slowing a law down by a factor f divides velocities by f,
+            # accelerations (and the inertial part of torques) by f^2, jerks by f^3.
+            power = {"velocity": 1.0, "jerk": 3.0}.get(check.worst.kind, 2.0)
+            result = result.slowed(check.worst.ratio ** (1.0 / power) * (1 + 1e-6))
+            if result is None:
+                break
+            continue
+        if not (isinstance(result, TimeScaling) and constraints.can_refine and check.intervals_over.size):
+            break
+        extra = _refinement(result, check.intervals_over)
+        extra = np.unique(extra[~np.isin(extra, constraints.s)])
+        if extra.size == 0:
+            break
+        constraints = constraints.with_points(extra)
+        result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+    raise limit_exceeded(method.name, check.worst, robot, path)
+
+
+def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> InfeasiblePath:
+    s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
+    joint = robot.joint_names[worst.joint]
+    return InfeasiblePath(
+        f"the {method} timing exceeds the {worst.kind} limit of joint {joint!r} by "
+        f"{100 * (worst.ratio - 1):.2f} % at s = {s:.4f}, and refining the grid there did not bring "
+        "it back within the limits; use another timing method, a lower limit scale or more grid points",
+        s=s,
+        joint=joint,
+        limit=worst.kind,
+    )
+
+
+def checked(robot, path, result, method, kinds, limits, threshold, constraints) -> TimedStretch:
+    """A timing that cannot be refined, through the limit gate: kept when it holds the limits,
+    refused (with where, which joint and which limit) when it does not."""
+    check = check_limits(path, result, robot, limits, kinds, threshold)
+    if check.worst is not None and check.worst.ratio > threshold:
+        raise limit_exceeded(method, check.worst, robot, path)
+    return TimedStretch(path, result, constraints, check)
+
+
+def samples_exceed(samples, limits: JointLimits, threshold: float, kinds) -> tuple[str, int, int] | None:
+    """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit."""
+    for kind, values in (("velocity", samples.qd), ("acceleration", samples.qdd), ("torque", samples.tau)):
+        if kind not in kinds:
+            continue
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.nan_to_num(np.abs(values) / getattr(limits, kind), nan=0.0)
+        if ratio.size and ratio.max() > threshold:
+            sample, joint = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            return kind, int(sample), int(joint)
+    return None
