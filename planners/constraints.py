@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-import pinocchio as pin
 
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
@@ -194,16 +193,13 @@ def path_dynamics(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray):
     Returns:
         a, b, c, d: Each (n_samples, n_dof), in N m (N for prismatic joints).
     """
-    model, data = robot.model, robot.data
-    configurations = robot.configuration(q)
     n_samples, n_dof = dq.shape
-    zero = np.zeros(n_dof)
-    a, b, c = (np.empty((n_samples, n_dof)) for _ in range(3))
-    for k in range(n_samples):
-        gravity = pin.rnea(model, data, configurations[k], zero, zero)
-        c[k] = gravity
-        a[k] = pin.rnea(model, data, configurations[k], zero, dq[k]) - gravity
-        b[k] = pin.rnea(model, data, configurations[k], dq[k], ddq[k]) - gravity
+    zero = np.zeros((n_samples, n_dof))
+    # One batched RNEA over the three evaluations at every sample: g, M q' + g, M q'' + C q' + g.
+    stacked = robot.rnea(np.vstack([q, q, q]), np.vstack([zero, zero, dq]), np.vstack([zero, dq, ddq]))
+    c = stacked[:n_samples].copy()
+    a = stacked[n_samples : 2 * n_samples] - c
+    b = stacked[2 * n_samples :] - c
     c += robot.coulomb_friction * np.sign(dq)
     d = robot.viscous_friction * dq
     return a, b, c, d

@@ -124,15 +124,29 @@ class Robot:
         out[..., self._cos_index + 1] = np.sin(angles)
         return out
 
+    def rnea(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Pinocchio's RNEA for rows of ``q, qd, qdd`` (each (n_samples, n_dof)), in one batched
+        call on the calling thread's model pool; shape (n_samples, n_dof), N m (N)."""
+        q, qd, qdd = np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(qdd)
+        if q.shape[0] == 0:
+            return np.empty_like(qd, dtype=float)
+        pool = getattr(self._local, "pool", None)
+        if pool is None:
+            pool = self._local.pool = pin.ModelPool(self.model, 1)
+        tau = pin.rneaInParallel(
+            1,
+            pool,
+            np.asfortranarray(self.configuration(q).T),
+            np.asfortranarray(qd.T, dtype=float),
+            np.asfortranarray(qdd.T, dtype=float),
+        )
+        return np.asarray(tau).T.reshape(qd.shape)
+
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """Joint torques for rows of ``q, qd, qdd`` (each (n_samples, n_dof)): Pinocchio's RNEA
         plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``."""
-        q, qd, qdd = np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(qdd)
-        configurations = self.configuration(q)
-        data = self.data
-        tau = np.empty_like(qd)
-        for k in range(q.shape[0]):
-            tau[k] = pin.rnea(self.model, data, configurations[k], qd[k], qdd[k])
+        qd = np.atleast_2d(qd)
+        tau = self.rnea(q, qd, qdd)
         tau += self.viscous_friction * qd + self.coulomb_friction * np.sign(qd)
         return tau
 
