@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from planners.errors import TimingFailed
 from planners.paths.base import GeometricPath
 
 #: Intervals per path segment (between consecutive knots) when the request names no grid size.
@@ -16,6 +17,11 @@ def path_grid(path: GeometricPath, n_intervals: int | None = None) -> np.ndarray
     """An increasing grid over [0, 1] holding every knot of ``path``, with about ``n_intervals``
     intervals (default: ``DEFAULT_POINTS_PER_SEGMENT`` per segment) spread evenly over s."""
     knots = path.knots
+    if not (np.all(np.isfinite(knots)) and np.all(np.diff(knots) >= 0.0)):
+        raise TimingFailed(
+            "the path's segment boundaries in s are not an increasing sequence of finite numbers "
+            "(its segment lengths or durations overflowed); check the request's durations and limits"
+        )
     if n_intervals is None:
         n_intervals = max(MIN_POINTS, DEFAULT_POINTS_PER_SEGMENT * (len(knots) - 1))
     n_intervals = int(min(max(n_intervals, len(knots) - 1), MAX_POINTS))

@@ -14,16 +14,17 @@ import numpy as np
 
 from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
-from planners.errors import InfeasiblePath, InvalidRequest
+from planners.errors import InfeasiblePath, InvalidRequest, numerical_breakdown_is_failure
 from planners.grid import MAX_POINTS, path_grid
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.mvc import admissible_set
+from planners.ranges import COORDINATE, check_timing
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.paths.cartesian import CartesianLine, cartesian_path
 from planners.boundary import path_acceleration, path_speed
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
-from planners.results import Conditioning, PhasePlane, PlannedTrajectory
+from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
 from planners.constraints import PathConstraints
 from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.min_cost import MinCostMethod
@@ -35,7 +36,7 @@ from robots import JointLimits, Robot
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
 MAX_WAYPOINTS = 1_000
 #: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
-MAX_COORDINATE = 1e4
+MAX_COORDINATE = COORDINATE.high
 MAX_SAMPLES = 200_000
 #: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
 MAX_PHASE_PLANE_POINTS = 2_000
@@ -229,12 +230,9 @@ def plan(
     started = time.perf_counter()
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)
-    if not (np.isfinite(dt) and dt > 0.0):
-        raise InvalidRequest(f"output.dt must be a positive number of seconds, got {dt}")
+    check_timing(timing, dt)
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
         raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
-    if timing.duration is not None and not (np.isfinite(timing.duration) and timing.duration > 0):
-        raise InvalidRequest(f"timing.duration must be a positive number of seconds, got {timing.duration}")
     limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
     if method.two_waypoints_only and (not isinstance(path_spec, WaypointPath) or len(path_spec.waypoints) != 2):
         given = f"{len(path_spec.waypoints)} waypoints" if isinstance(path_spec, WaypointPath) else "a cartesian path"
@@ -243,21 +241,24 @@ def plan(
             f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
             "law through several waypoints"
         )
-    if isinstance(path_spec, FreeMotion) or method.name == "collocation":
-        timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline)
-    elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
-        timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline)
-    else:
-        timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline)
+    with numerical_breakdown_is_failure(method.name):
+        if isinstance(path_spec, FreeMotion) or method.name == "collocation":
+            timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline)
+        elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
+            timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline)
+        else:
+            timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline)
     path, result, constraints, notes = timed.path, timed.timing, timed.constraints, list(timed.notes)
     s = constraints.s
     deadline.check()
+    require_finite(timed.method, duration=result.duration)
     if result.duration / dt > MAX_SAMPLES:
         raise InvalidRequest(
             f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {result.duration:.4g} s"
         )
     samples = sample_trajectory(path, result, robot, dt)
     utilization = peak_utilization(path, result, robot, limits)
+    require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
     notes += _warnings(utilization, kinds, robot)
     if kappa_max > NEAR_SINGULAR_KAPPA:
@@ -267,6 +268,7 @@ def plan(
         )
     sd = result.speed_at(s)
     mvc = admissible_set(constraints.linearized(sd**2), constraints.sd_max**2).sd_max
+    require_finite(timed.method, path_speed=sd, cost=timed.cost)
     keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
     return PlannedTrajectory(
         robot=robot.name,

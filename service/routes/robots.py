@@ -6,7 +6,7 @@ from fastapi import APIRouter
 from starlette.concurrency import run_in_threadpool
 
 import robots
-from service.schemas.common import Problem
+from service.problems import problem_responses
 from service.schemas.robots import RobotCreate, RobotPublic, RobotSummary
 
 router = APIRouter(prefix="/v1/robots", tags=["robots"])
@@ -34,7 +34,7 @@ def list_robots() -> list[RobotSummary]:
     ]
 
 
-@router.get("/{name}", summary="Describe one robot", responses={404: {"model": Problem}})
+@router.get("/{name}", summary="Describe one robot", responses=problem_responses(404))
 def get_robot(name: str) -> RobotPublic:
     """Joints, end effector and limits of robot ``name``."""
     return robot_public(robots.load(name))
@@ -44,7 +44,7 @@ def get_robot(name: str) -> RobotPublic:
     "",
     status_code=201,
     summary="Upload a URDF",
-    responses={409: {"model": Problem}, 413: {"model": Problem}, 422: {"model": Problem}},
+    responses=problem_responses(409),
 )
 async def upload_robot(body: RobotCreate) -> RobotPublic:
     """Parse a fixed-base arm's URDF with Pinocchio and keep it under ``name`` (default: a
