@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
+import numpy as np
+
 from robots.errors import ToptrajError
 
 
@@ -42,3 +46,16 @@ class BudgetExceeded(ToptrajError):
 
     status = 504
     title = "Computation over its time budget"
+
+
+@contextmanager
+def numerical_breakdown_is_failure(method: str):
+    """Turn a numerical breakdown inside a timing method (an overflow or division by zero in
+    Python floats, a singular or non-converging linear-algebra routine) into ``TimingFailed``
+    naming the method, instead of an unexplained error."""
+    try:
+        yield
+    except (ArithmeticError, np.linalg.LinAlgError) as error:
+        raise TimingFailed(
+            f"timing method {method!r} failed: numerical breakdown ({type(error).__name__}: {error})"
+        ) from error

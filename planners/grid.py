@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.errors import InvalidRequest
+from planners.errors import TimingFailed
 from planners.paths.base import GeometricPath
 
 #: Intervals per path segment (between consecutive knots) when the request names no grid size.
@@ -37,8 +37,11 @@ def path_grid(path: GeometricPath, n_intervals: int | None = None) -> np.ndarray
         s, shape (N + 1,), from 0 to 1.
     """
     knots = np.asarray(path.knots, dtype=float)
-    if knots.ndim != 1 or len(knots) < 2 or not np.all(np.isfinite(knots)) or np.any(np.diff(knots) <= 0.0):
-        raise InvalidRequest("the path's parameterization is degenerate (coincident or non-finite waypoints)")
+    if knots.ndim != 1 or len(knots) < 2 or not (np.all(np.isfinite(knots)) and np.all(np.diff(knots) > 0.0)):
+        raise TimingFailed(
+            "the path's segment boundaries in s are not an increasing sequence of finite numbers "
+            "(its segment lengths or durations overflowed); check the request's durations and limits"
+        )
     lengths = np.diff(knots)
     segments = len(lengths)
     floor = max(1, min(MIN_POINTS_PER_SEGMENT, MAX_POINTS // segments))

@@ -15,17 +15,18 @@ import numpy as np
 from planners.boundary import path_acceleration, path_speed
 from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
-from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.grid import MAX_POINTS, path_grid
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.gate import TimedStretch, checked, gate_threshold, gated, samples_exceed
 from planners.mvc import admissible_set
+from planners.ranges import COORDINATE, check_timing
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.paths.cartesian import CartesianLine, cartesian_path
 from planners.paths.stretch import stretches
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
-from planners.results import Conditioning, PhasePlane, PlannedTrajectory
+from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
 from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
@@ -37,7 +38,7 @@ from robots import JointLimits, Robot
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
 MAX_WAYPOINTS = 1_000
 #: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
-MAX_COORDINATE = 1e4
+MAX_COORDINATE = COORDINATE.high
 #: Consecutive waypoints closer than this (joint-space norm, rad or m) are one waypoint.
 COINCIDENT = 1e-12
 MAX_SAMPLES = 200_000
@@ -340,12 +341,9 @@ def plan(
     started = time.perf_counter()
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)
-    if not (np.isfinite(dt) and dt > 0.0):
-        raise InvalidRequest(f"output.dt must be a positive number of seconds, got {dt}")
+    check_timing(timing, dt)
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
         raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
-    if timing.duration is not None and not (np.isfinite(timing.duration) and timing.duration > 0):
-        raise InvalidRequest(f"timing.duration must be a positive number of seconds, got {timing.duration}")
     margin = timing.limit_margin
     if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
         raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
@@ -362,19 +360,22 @@ def plan(
             f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
             "law through several waypoints"
         )
-    if isinstance(path_spec, FreeMotion) or method.name == "collocation":
-        timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
-    elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
-        timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
-    else:
-        timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline, threshold)
+    with numerical_breakdown_is_failure(method.name):
+        if isinstance(path_spec, FreeMotion) or method.name == "collocation":
+            timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
+        elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
+            timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
+        else:
+            timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline, threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
     deadline.check()
+    require_finite(timed.method, duration=result.duration)
     if result.duration / dt > MAX_SAMPLES:
         raise InvalidRequest(
             f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {result.duration:.4g} s"
         )
     samples = sample_trajectory(path, result, robot, dt)
+    require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
     beyond = samples_exceed(samples, limits, threshold, kinds)
     if beyond is not None:
         kind, sample, joint = beyond
@@ -390,6 +391,7 @@ def plan(
             f"at t = {samples.t[worst]:.4g} s"
         )
     s, sd, mvc = _phase_plane(timed.stretches)
+    require_finite(timed.method, path_speed=sd, cost=timed.cost)
     return PlannedTrajectory(
         robot=robot.name,
         method=timed.method,

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planners.errors import TimingFailed
 from planners.timing.base import Binding
 from planners.trajectory import Samples
 
@@ -47,3 +48,19 @@ class PlannedTrajectory:
     conditioning: Conditioning | None = None
     cost: float | None = None
     solver: dict | None = None
+
+
+def require_finite(method: str, **quantities) -> None:
+    """TimingFailed unless every number of every named quantity (arrays, scalars or ``None``)
+    is finite: a timing whose numbers overflowed is a failure of the method, never an answer."""
+    for name, values in quantities.items():
+        if values is None:
+            continue
+        array = np.asarray(values, dtype=float)
+        bad = np.flatnonzero(~np.isfinite(array.ravel()))
+        if bad.size:
+            raise TimingFailed(
+                f"timing method {method!r} failed: its {name} holds {array.ravel()[bad[0]]} "
+                f"({bad.size} non-finite values); the request's durations, limits or boundary states "
+                "lie too far apart for this method"
+            )

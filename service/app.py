@@ -12,7 +12,7 @@ import numpy as np
 import robots
 from planners import Timing, WaypointPath, plan
 from service.body_limit import BodySizeLimit
-from service.problems import install_problem_handlers
+from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.routes import health, robots as robot_routes, trajectories
 from service.settings import Settings
 
@@ -51,10 +51,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         summary="Time-optimal trajectories with torques for URDF robot arms.",
         version="0.1.0",
         lifespan=lifespan,
+        default_response_class=FiniteJSONResponse,
     )
     app.state.settings = settings
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)
+    app.add_middleware(UnexpectedErrors)  # last added, so outermost
     app.include_router(health.router)
     app.include_router(robot_routes.router)
     app.include_router(trajectories.router)

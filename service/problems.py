@@ -1,26 +1,94 @@
-"""Errors as ``application/problem+json`` (RFC 9457): one handler per family, never a bare 500
-for bad input."""
+"""Errors as ``application/problem+json`` (RFC 9457): one handler per family, an outermost guard
+for the unexpected, an encoder that refuses NaN and infinity, and the OpenAPI declaring all of it.
+
+* ``install_problem_handlers`` routes the error tree (``ToptrajError``), request validation and
+  Starlette's HTTP errors (404, 405 with its ``Allow`` header, ...) to problem answers.
+* ``UnexpectedErrors`` (pure ASGI, outermost) answers any other exception with a problem 500
+  and lets the server keep the connection: Starlette's own last-resort handler re-raises after
+  answering, and uvicorn then drops the keep-alive connection without ``Connection: close``,
+  so a client's next request on it fails.
+* ``FiniteJSONResponse`` refuses NaN and infinity (JSON has no such numbers) with a 422 that
+  says where the answer held one, instead of an encoder crash.
+* ``problem_responses`` and ``declare_problems`` make the OpenAPI say what the service answers:
+  problem+json bodies for 400, 404, 409, 413, 422 and 504, in place of FastAPI's default 422.
+"""
 
 from __future__ import annotations
 
+import json
 import logging
+import math
+from typing import Any
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.routing import Match
 
 from robots import ToptrajError
+from service.schemas.common import Problem
 
 PROBLEM_JSON = "application/problem+json"
 logger = logging.getLogger("toptraj")
 
+_TITLES = {
+    400: "Bad request",
+    404: "Not found",
+    405: "Method not allowed",
+    409: "Conflict",
+    413: "Request body too large",
+    422: "Invalid request",
+    500: "Internal error",
+    504: "Computation over its time budget",
+}
 
-def problem(status: int, title: str, detail: str, **extra) -> JSONResponse:
+
+class NonFiniteAnswer(ToptrajError):
+    """A computed answer holds NaN or infinity, which JSON cannot carry: the request's numbers
+    drove a computation out of the floating-point range."""
+
+    title = "Answer not representable"
+
+
+class FiniteJSONResponse(JSONResponse):
+    """JSON that never carries NaN or infinity: such a number is a ``NonFiniteAnswer`` (422)
+    naming where it is, never invalid JSON and never an encoder crash."""
+
+    def render(self, content: Any) -> bytes:
+        try:
+            return json.dumps(content, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode("utf-8")
+        except ValueError:
+            where, value = _first_non_finite(content, "")
+            if where is None:
+                raise
+            raise NonFiniteAnswer(
+                f"the computed answer holds {value} at {where or 'its top level'}, which JSON cannot "
+                "carry; the request's numbers lie too far apart (durations, limits, boundary states)"
+            ) from None
+
+
+def _first_non_finite(value: Any, where: str) -> tuple[str | None, float | None]:
+    if isinstance(value, float) and not math.isfinite(value):
+        return where, value
+    if isinstance(value, dict):
+        items = ((f"{where}.{key}" if where else str(key), item) for key, item in value.items())
+    elif isinstance(value, (list, tuple)):
+        items = ((f"{where}[{index}]", item) for index, item in enumerate(value))
+    else:
+        return None, None
+    for place, item in items:
+        found = _first_non_finite(item, place)
+        if found[0] is not None:
+            return found
+    return None, None
+
+
+def problem(status: int, title: str, detail: str, headers: dict[str, str] | None = None, **extra) -> JSONResponse:
     """A problem+json response."""
     body = {"type": "about:blank", "title": title, "status": status, "detail": detail}
     body.update({key: value for key, value in extra.items() if value is not None})
-    return JSONResponse(body, status_code=status, media_type=PROBLEM_JSON)
+    return JSONResponse(body, status_code=status, media_type=PROBLEM_JSON, headers=headers)
 
 
 #: Tags of the path union that pydantic puts in error locations: path.<tag>.<field>.
@@ -49,24 +117,131 @@ def _validation_error(request: Request, error: RequestValidationError) -> JSONRe
     detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:5])
     if len(errors) > 5:
         detail += f"; and {len(errors) - 5} more"
-    return problem(422, "Invalid request", detail, errors=errors)
+    return problem(422, "Invalid request", detail, errors=errors[:20])
 
 
 def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
-    return problem(error.status_code, _TITLES.get(error.status_code, "HTTP error"), str(error.detail))
+    headers = error.headers
+    if error.status_code == 405:
+        allowed = _allowed_methods(request)
+        headers = {**(headers or {}), "Allow": ", ".join(allowed)}
+        detail = f"{request.method} is not allowed on {request.url.path}; use {' or '.join(allowed)}"
+    else:
+        detail = str(error.detail)
+    return problem(error.status_code, _TITLES.get(error.status_code, "HTTP error"), detail, headers=headers)
 
 
-def _unexpected(request: Request, error: Exception) -> JSONResponse:
-    logger.exception("unexpected error on %s %s", request.method, request.url.path)
-    return problem(500, "Internal error", f"an unexpected {type(error).__name__} occurred")
+_METHODS = ("DELETE", "GET", "HEAD", "PATCH", "POST", "PUT")
 
 
-_TITLES = {400: "Bad request", 404: "Not found", 405: "Method not allowed", 413: "Request body too large"}
+def _allowed_methods(request: Request) -> list[str]:
+    """Every method some route serves at the request's path (Starlette's 405 names only the
+    first matching route's): each method is tried against the routes."""
+    routes = request.app.router.routes
+    return [
+        method
+        for method in _METHODS
+        if any(route.matches({**request.scope, "method": method})[0] == Match.FULL for route in routes)
+    ]
+
+
+class UnexpectedErrors:
+    """Outermost ASGI middleware: an exception no handler turned into an answer becomes a
+    problem+json 500, logged with its traceback, and the connection stays usable. When the
+    response had already started, nothing can be answered any more and the exception goes on
+    (the server then closes the connection, as it must)."""
+
+    def __init__(self, app):
+        self.app = app
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        started = False
+
+        async def tracking_send(message):
+            nonlocal started
+            if message["type"] == "http.response.start":
+                started = True
+            await send(message)
+
+        try:
+            await self.app(scope, receive, tracking_send)
+        except Exception as error:
+            if started:
+                raise
+            logger.exception("unexpected error on %s %s", scope.get("method"), scope.get("path"))
+            response = problem(500, _TITLES[500], f"an unexpected {type(error).__name__} occurred; it has been logged")
+            await response(scope, receive, send)
 
 
 def install_problem_handlers(app: FastAPI) -> None:
-    """Route every error family of ``app`` to a problem+json answer."""
+    """Route every error family of ``app`` to a problem+json answer and declare them in its
+    OpenAPI. Add ``UnexpectedErrors`` as the app's last (outermost) middleware."""
     app.add_exception_handler(ToptrajError, _toptraj_error)
     app.add_exception_handler(RequestValidationError, _validation_error)
     app.add_exception_handler(StarletteHTTPException, _http_error)
-    app.add_exception_handler(Exception, _unexpected)
+    declare_problems(app)
+
+
+# --- OpenAPI -------------------------------------------------------------------------------
+
+_REF = "#/components/schemas/"
+_DESCRIPTIONS = {
+    400: "The request body cannot be read.",
+    404: "No such resource (e.g. an unknown robot).",
+    409: "The name is taken.",
+    413: "The request body exceeds the size cap.",
+    422: "Malformed or impossible input: a field out of range, wrong lengths, NaN/inf, a path "
+    "that no timing can follow (the detail says where).",
+    503: "The service cannot do this now (e.g. its data directory cannot be written).",
+    504: "The computation ran past its time budget.",
+}
+#: What every operation with a body may answer, whatever it declares (FastAPI itself adds a
+#: 422 to operations with parameters; its content is replaced below).
+_WITH_BODY = (400, 413, 422)
+
+
+def _problem_content() -> dict:
+    return {PROBLEM_JSON: {"schema": {"$ref": _REF + "Problem"}}}
+
+
+def problem_responses(*statuses: int) -> dict[int, dict]:
+    """``responses=`` of a route: each status answered with a problem+json body."""
+    return {status: {"description": _DESCRIPTIONS[status], "content": _problem_content()} for status in statuses}
+
+
+def _problem_schemas() -> dict[str, dict]:
+    schema = Problem.model_json_schema(ref_template=_REF + "{model}")
+    definitions = schema.pop("$defs", {})
+    return {"Problem": schema, **definitions}
+
+
+def _declare(openapi: dict) -> dict:
+    components = openapi.setdefault("components", {}).setdefault("schemas", {})
+    components.update(_problem_schemas())
+    for operations in openapi.get("paths", {}).values():
+        for operation in operations.values():
+            if not isinstance(operation, dict) or "responses" not in operation:
+                continue
+            responses = operation["responses"]
+            for status in _WITH_BODY if "requestBody" in operation else ():
+                responses[str(status)] = problem_responses(status)[status]
+            for status, response in responses.items():
+                if status.isdigit() and int(status) >= 400:
+                    response["content"] = _problem_content()
+    for name in ("HTTPValidationError", "ValidationError"):
+        if f'"{_REF}{name}"' not in json.dumps(openapi):
+            components.pop(name, None)
+    return openapi
+
+
+def declare_problems(app: FastAPI) -> None:
+    """Make ``app``'s OpenAPI declare its error answers as problem+json (``Problem``), with
+    FastAPI's default 422 schema replaced."""
+
+    def openapi() -> dict:
+        return _declare(FastAPI.openapi(app))
+
+    app.openapi = openapi

@@ -28,23 +28,20 @@ def quintic_coefficients(
     p0: float, v0: float, a0: float, p1: float, v1: float, a1: float, duration: float
 ) -> np.ndarray:
     """c0..c5 of the fifth-order polynomial with position, velocity and acceleration given at
-    t = 0 and t = T (the lecture's six boundary conditions)."""
+    t = 0 and t = T (the lecture's six boundary conditions), solved in closed form: with
+    h = p1 - p0,
+
+    .. math::
+        c_3 = (20 h - (8 v_1 + 12 v_0) T - (3 a_0 - a_1) T^2) / (2 T^3),
+        c_4 = (-30 h + (14 v_1 + 16 v_0) T + (3 a_0 - 2 a_1) T^2) / (2 T^4),
+        c_5 = (12 h - 6 (v_1 + v_0) T + (a_1 - a_0) T^2) / (2 T^5).
+    """
     T = duration
-    matrix = np.array(
-        [
-            [T**3, T**4, T**5],
-            [3 * T**2, 4 * T**3, 5 * T**4],
-            [6 * T, 12 * T**2, 20 * T**3],
-        ]
-    )
-    rhs = np.array(
-        [
-            p1 - (p0 + v0 * T + 0.5 * a0 * T**2),
-            v1 - (v0 + a0 * T),
-            a1 - a0,
-        ]
-    )
-    return np.concatenate(([p0, v0, 0.5 * a0], np.linalg.solve(matrix, rhs)))
+    h = p1 - p0
+    c3 = (20 * h - (8 * v1 + 12 * v0) * T - (3 * a0 - a1) * T**2) / (2 * T**3)
+    c4 = (-30 * h + (14 * v1 + 16 * v0) * T + (3 * a0 - 2 * a1) * T**2) / (2 * T**4)
+    c5 = (12 * h - 6 * (v1 + v0) * T + (a1 - a0) * T**2) / (2 * T**5)
+    return np.array([p0, v0, 0.5 * a0, c3, c4, c5])
 
 
 def polynomial_derivatives(coefficients: np.ndarray, t: np.ndarray, orders: int = 4) -> list[np.ndarray]:

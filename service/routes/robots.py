@@ -6,15 +6,15 @@ from fastapi import APIRouter, Response
 from starlette.concurrency import run_in_threadpool
 
 import robots
-from service.schemas.common import Problem
+from service.problems import problem_responses
 from service.schemas.robots import RobotCreate, RobotPublic, RobotSummary
 
 router = APIRouter(prefix="/v1/robots", tags=["robots"])
 
 
-def _problem(description: str) -> dict:
+def _problem(status: int, description: str) -> dict:
     """An error answer as the OpenAPI declares it: an ``application/problem+json`` body."""
-    return {"description": description, "content": {"application/problem+json": {"schema": Problem.model_json_schema()}}}
+    return {**problem_responses(status)[status], "description": description}
 
 
 def robot_public(robot: robots.Robot) -> RobotPublic:
@@ -41,7 +41,7 @@ def list_robots() -> list[RobotSummary]:
     return catalog + uploads
 
 
-@router.get("/{name}", summary="Describe one robot", responses={404: _problem("No robot has that name.")})
+@router.get("/{name}", summary="Describe one robot", responses={404: _problem(404, "No robot has that name.")})
 def get_robot(name: str) -> RobotPublic:
     """Joints, end effector and limits of robot ``name``."""
     return robot_public(robots.load(name))
@@ -52,10 +52,10 @@ def get_robot(name: str) -> RobotPublic:
     status_code=201,
     summary="Upload a URDF",
     responses={
-        409: _problem("The name is taken (a catalog robot, or an upload of a different URDF), or the store is full."),
-        413: _problem("The request body is too large."),
-        422: _problem("The URDF or the name is invalid; the detail names the link or joint and the reason."),
-        503: _problem("The upload store cannot be written (the server's data directory)."),
+        409: _problem(409, "The name is taken (a catalog robot, or an upload of a different URDF), or the store is full."),
+        413: _problem(413, "The request body is too large."),
+        422: _problem(422, "The URDF or the name is invalid; the detail names the link or joint and the reason."),
+        503: _problem(503, "The upload store cannot be written (the server's data directory)."),
     },
 )
 async def upload_robot(body: RobotCreate) -> RobotPublic:
@@ -72,9 +72,9 @@ async def upload_robot(body: RobotCreate) -> RobotPublic:
     summary="Delete an uploaded robot",
     response_class=Response,
     responses={
-        404: _problem("No uploaded robot has that name."),
-        409: _problem("The robot belongs to the catalog, which cannot be deleted."),
-        503: _problem("The upload store cannot be written (the server's data directory)."),
+        404: _problem(404, "No uploaded robot has that name."),
+        409: _problem(409, "The robot belongs to the catalog, which cannot be deleted."),
+        503: _problem(503, "The upload store cannot be written (the server's data directory)."),
     },
 )
 def delete_robot(name: str) -> Response:

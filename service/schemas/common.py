@@ -1,8 +1,14 @@
-"""Shared pydantic configuration: reject unknown fields and NaN/inf at the edge."""
+"""Shared pydantic configuration: reject unknown fields, NaN/inf and numbers outside their
+physical range at the edge."""
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict
+from typing import Annotated, Any
+
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, WithJsonSchema
+from pydantic_core import PydanticCustomError
+
+from planners.ranges import Range
 
 
 class Schema(BaseModel):
@@ -11,10 +17,60 @@ class Schema(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
+def _range_error(value: float, shown: str) -> PydanticCustomError:
+    return PydanticCustomError(
+        "out_of_range", "{value} is not within the accepted range {range}", {"value": f"{value:g}", "range": shown}
+    )
+
+
+def bounded(accepted: Range) -> Any:
+    """A float in [low, high] of ``accepted`` (OpenAPI minimum and maximum; a 422 naming the
+    range otherwise)."""
+
+    def check(value: float) -> float:
+        if not accepted.holds(value):
+            raise _range_error(value, accepted.describe())
+        return value
+
+    return Annotated[
+        float,
+        AfterValidator(check),
+        WithJsonSchema({"type": "number", "minimum": accepted.low, "maximum": accepted.high}),
+    ]
+
+
+def signed(accepted: Range) -> Any:
+    """A float in [-high, high] of ``accepted``: a signed quantity of bounded magnitude."""
+    shown = f"[-{accepted.high:g}, {accepted.high:g}] {accepted.unit}".rstrip()
+
+    def check(value: float) -> float:
+        if not accepted.holds_signed(value):
+            raise _range_error(value, shown)
+        return value
+
+    return Annotated[
+        float,
+        AfterValidator(check),
+        WithJsonSchema({"type": "number", "minimum": -accepted.high, "maximum": accepted.high}),
+    ]
+
+
+class ValidationIssue(BaseModel):
+    """One field of a request that failed validation."""
+
+    field: str = Field(description="Where, e.g. `path.waypoints[1][2]`.")
+    message: str
+
+
 class Problem(BaseModel):
-    """An RFC 9457 problem, as every error answer carries it."""
+    """An RFC 9457 problem, as every error answer carries it (``application/problem+json``).
+    Extension members: ``errors`` (validation failures, one per field), ``s`` and ``joint``
+    (where along the path, and which joint, a limit cannot be met)."""
 
     type: str = "about:blank"
     title: str
     status: int
     detail: str
+    errors: list[ValidationIssue] | None = None
+    s: float | None = Field(default=None, description="Path parameter in [0, 1] where planning fails.")
+    joint: str | None = Field(default=None, description="Joint whose limit cannot be met.")

@@ -6,13 +6,22 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, Discriminator, Field, Tag
 
-from service.schemas.common import Schema
+from planners import ranges
+from service.schemas.common import Schema, bounded, signed
 
 MAX_WAYPOINTS = 1_000
 MAX_JOINTS = 64
+#: Longest robot, frame or method name accepted (names are echoed in error messages).
+MAX_NAME_CHARS = 256
 
-JointVector = Annotated[list[float], Field(min_length=1, max_length=MAX_JOINTS)]
-Positive = Annotated[float, Field(gt=0.0)]
+
+def _joint_vector(item) -> type:
+    """A list of one value per joint."""
+    return Annotated[list[item], Field(min_length=1, max_length=MAX_JOINTS)]
+
+
+JointVector = _joint_vector(signed(ranges.COORDINATE))
+Name = Annotated[str, Field(max_length=MAX_NAME_CHARS)]
 
 
 class WaypointsPath(Schema):
@@ -35,7 +44,7 @@ class CartesianPathRequest(Schema):
     slerp), from the pose of the start configuration; joint path by inverse kinematics."""
 
     kind: Literal["cartesian"]
-    frame: str | None = Field(default=None, description="Frame to move; default the robot's end effector.")
+    frame: Name | None = Field(default=None, description="Frame to move; default the robot's end effector.")
     start: JointVector = Field(description="Start joint configuration (rad, m).")
     positions: list[Annotated[list[float], Field(min_length=3, max_length=3)]] | None = Field(
         default=None, min_length=1, max_length=MAX_WAYPOINTS, description="[x, y, z] in m, world frame."
@@ -78,23 +87,24 @@ PathRequest = Annotated[
 class LimitsRequest(Schema):
     """Per-joint overrides and scale factors of the robot's limits (SI units)."""
 
-    velocity: JointVector | None = None
-    acceleration: JointVector | None = None
-    jerk: JointVector | None = None
-    torque: JointVector | None = None
-    velocity_scale: Positive | None = None
-    acceleration_scale: Positive | None = None
-    jerk_scale: Positive | None = None
-    torque_scale: Positive | None = None
+    velocity: _joint_vector(bounded(ranges.VELOCITY)) | None = None
+    acceleration: _joint_vector(bounded(ranges.ACCELERATION)) | None = None
+    jerk: _joint_vector(bounded(ranges.JERK)) | None = None
+    torque: _joint_vector(bounded(ranges.TORQUE)) | None = None
+    velocity_scale: bounded(ranges.SCALE) | None = None
+    acceleration_scale: bounded(ranges.SCALE) | None = None
+    jerk_scale: bounded(ranges.SCALE) | None = None
+    torque_scale: bounded(ranges.SCALE) | None = None
 
 
 class Boundary(Schema):
-    """Joint velocities at the ends (rad/s), tangent to the path; absent means rest."""
+    """Joint velocities (rad/s) and accelerations (rad/s^2) at the ends, tangent to the path;
+    absent means rest."""
 
-    start_velocity: JointVector | None = None
-    end_velocity: JointVector | None = None
-    start_acceleration: JointVector | None = None
-    end_acceleration: JointVector | None = None
+    start_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = None
+    end_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = None
+    start_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = None
+    end_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = None
 
 
 class CostRequest(Schema):
@@ -107,14 +117,14 @@ class TrapezoidRequest(Schema):
     """Switching fractions of the trapezoidal law (Angeles 6.1): acceleration ends at tau1 and
     deceleration starts at tau2, as fractions of the duration."""
 
-    tau1: Annotated[float, Field(gt=0.0, lt=1.0)] = 1.0 / 3.0
-    tau2: Annotated[float, Field(gt=0.0, lt=1.0)] = 2.0 / 3.0
+    tau1: bounded(ranges.TRAPEZOID_FRACTION) = 1.0 / 3.0
+    tau2: bounded(ranges.TRAPEZOID_FRACTION) = 2.0 / 3.0
 
 
 class TimingRequest(Schema):
     """How to time the path."""
 
-    method: str = Field(
+    method: Name = Field(
         default="phase_plane",
         description="`phase_plane` (time-optimal, default), `toppra`, `min_cost` (minimum of the "
         "integral of 1 + beta |tau|^2), `ruckig` (jerk-limited, two waypoints), a time law "
@@ -126,7 +136,9 @@ class TimingRequest(Schema):
         description="Limits to respect; jerk only with the time laws and ruckig.",
     )
     limits: LimitsRequest = LimitsRequest()
-    duration: Positive | None = Field(default=None, description="Seconds, for the classical time laws.")
+    duration: bounded(ranges.DURATION) | None = Field(
+        default=None, description="Seconds, for the classical time laws and via points."
+    )
     boundary: Boundary = Boundary()
     cost: CostRequest = CostRequest()
     trapezoid: TrapezoidRequest = TrapezoidRequest()
@@ -144,13 +156,13 @@ class TimingRequest(Schema):
 class OutputRequest(Schema):
     """Sampling of the returned trajectory."""
 
-    dt: Annotated[float, Field(gt=0.0, le=10.0)] = Field(default=0.01, description="Sample period (s).")
+    dt: bounded(ranges.DT) = Field(default=0.01, description="Sample period (s).")
 
 
 class TrajectoryRequest(Schema):
     """A motion to plan."""
 
-    robot: str = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
+    robot: Name = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
     path: PathRequest
     timing: TimingRequest = TimingRequest()
     output: OutputRequest = OutputRequest()
@@ -229,9 +241,9 @@ class TrajectoryResponse(BaseModel):
 class CompareRequest(Schema):
     """One path under several timing methods."""
 
-    robot: str
+    robot: Name = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
     path: PathRequest
-    methods: list[str] = Field(
+    methods: list[Name] = Field(
         min_length=1, max_length=10, description="Timing methods to run, e.g. [\"phase_plane\", \"quintic\"]."
     )
     timing: TimingRequest = TimingRequest()

@@ -1,0 +1,105 @@
+"""Accepted ranges of the physical numbers a request carries (SI units).
+
+The planners raise speeds to the second and third power and divide by the fifth power of a
+duration (a quintic's coefficients), so numbers far outside what any arm does overflow to inf or
+underflow to zero and no longer describe a motion: a duration of 1e-300 s, a boundary speed of
+1e300 rad/s or a switching fraction of 5e-324 turned into infinite samples and singular
+systems. Every such number is held to a range here, the service declares the same ranges in its
+schema (OpenAPI ``minimum``/``maximum``), and ``plan`` checks them for library callers.
+
+A ``Range`` bounds a magnitude: positive quantities (limits, durations, scale factors) lie in
+[low, high]; signed ones (boundary velocities and accelerations) in [-high, high].
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from planners.errors import InvalidRequest
+
+
+class Range(NamedTuple):
+    """Closed interval [low, high] of a quantity, with its unit for messages."""
+
+    low: float
+    high: float
+    unit: str
+
+    def describe(self) -> str:
+        """``[low, high] unit`` as a message shows it."""
+        return f"[{self.low:g}, {self.high:g}]{' ' + self.unit if self.unit else ''}"
+
+    def holds(self, value: float) -> bool:
+        """Whether ``value`` lies in the range (NaN never does)."""
+        return self.low <= value <= self.high
+
+    def holds_signed(self, value: float) -> bool:
+        """Whether ``value`` lies in [-high, high] (NaN never does)."""
+        return -self.high <= value <= self.high
+
+
+#: Joint coordinates (rad or m): a continuous joint may turn many times, not 1e300.
+COORDINATE = Range(0.0, 1e4, "rad or m")
+#: Duration of a time law or of the via-point motion (s).
+DURATION = Range(1e-3, 1e4, "s")
+#: Sample period of the returned trajectory (s): 1 MHz is faster than any drive's loop.
+DT = Range(1e-6, 10.0, "s")
+#: Per-joint limit overrides, and the magnitude of boundary states (rad or m, per s^k).
+VELOCITY = Range(1e-6, 1e3, "rad/s")
+ACCELERATION = Range(1e-6, 1e5, "rad/s^2")
+JERK = Range(1e-6, 1e8, "rad/s^3")
+TORQUE = Range(1e-6, 1e5, "N m")
+LIMITS = {"velocity": VELOCITY, "acceleration": ACCELERATION, "jerk": JERK, "torque": TORQUE}
+#: Factors on a robot's limits.
+SCALE = Range(1e-3, 1e3, "")
+#: Switching fractions of the trapezoidal law (acceleration ends at tau1, cruise at tau2).
+TRAPEZOID_FRACTION = Range(1e-3, 1.0 - 1e-3, "")
+
+
+def check(value: float, field: str, accepted: Range) -> None:
+    """InvalidRequest unless ``value`` lies in ``accepted``."""
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and accepted.holds(value)):
+        raise InvalidRequest(f"{field} = {value!r} is outside the accepted range {accepted.describe()}")
+
+
+def check_vector(values, field: str, accepted: Range, signed: bool = False) -> None:
+    """InvalidRequest unless every entry of ``values`` lies in ``accepted`` (by magnitude, and
+    any sign, when ``signed``)."""
+    try:
+        array = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise InvalidRequest(f"{field} must be a list of numbers") from None
+    inside = (np.abs(array) <= accepted.high) if signed else ((array >= accepted.low) & (array <= accepted.high))
+    bad = np.flatnonzero(~inside)
+    if bad.size:
+        shown = f"[-{accepted.high:g}, {accepted.high:g}] {accepted.unit}".rstrip() if signed else accepted.describe()
+        raise InvalidRequest(f"{field}[{bad[0]}] = {array[bad[0]]!r} is outside the accepted range {shown}")
+
+
+def check_timing(timing, dt: float) -> None:
+    """Hold every number of a ``planners.requests.Timing`` and the sample period ``dt`` to its
+    range (InvalidRequest naming the field and the range otherwise)."""
+    check(dt, "output.dt", DT)
+    if timing.duration is not None:
+        check(timing.duration, "timing.duration", DURATION)
+    if timing.method == "trapezoidal":
+        for name, value in zip(("tau1", "tau2"), timing.trapezoid_fractions):
+            check(value, f"timing.trapezoid.{name}", TRAPEZOID_FRACTION)
+    for kind, values in (timing.limit_overrides or {}).items():
+        if values is not None and kind in LIMITS:
+            check_vector(values, f"timing.limits.{kind}", LIMITS[kind])
+    for kind, factor in (timing.limit_scales or {}).items():
+        if factor is not None:
+            check(factor, f"timing.limits.{kind}_scale", SCALE)
+    for name, accepted in (
+        ("start_velocity", VELOCITY),
+        ("end_velocity", VELOCITY),
+        ("start_acceleration", ACCELERATION),
+        ("end_acceleration", ACCELERATION),
+    ):
+        values = getattr(timing, name)
+        if values is not None:
+            check_vector(values, f"timing.boundary.{name}", accepted, signed=True)
