@@ -47,6 +47,11 @@ from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
 _SLACK = 1e-9
+#: Relative slack of a boundary speed above the reachable envelope. A time-optimal motion that
+#: starts at a limit (the re-timing of a free path from a moving start) starts on the envelope,
+#: which the discretization places a few 1e-7 lower; the first interval then absorbs the
+#: difference, a relative change of its acceleration of that order.
+_BOUNDARY_SLACK = 1e-5
 
 
 def interval_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> LinearRows:
@@ -192,7 +197,7 @@ def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline
             s=0.0,
             joint=joint,
         )
-    if x_start > envelope[0] * (1 + 1e-7) + 1e-12:
+    if x_start > envelope[0] * (1 + _BOUNDARY_SLACK) + 1e-12:
         raise InfeasiblePath(
             f"the start path speed {np.sqrt(x_start):.6g} 1/s is above what the limits allow at s = 0 "
             f"({np.sqrt(max(envelope[0], 0.0)):.6g} 1/s: the maximum velocity curve or the fastest "
@@ -201,7 +206,7 @@ def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline
         )
     deadline.check()
     x, capped = forward_profile(ds, bounds.r, bounds.w, envelope, float(min(x_start, envelope[0])))
-    x[-1] = x_end
+    x[0], x[-1] = x_start, x_end
     return _Profile(np.maximum(x, 0.0), capped, envelope, stage, admissible.x_max)
 
 
