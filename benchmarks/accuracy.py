@@ -16,6 +16,7 @@ import numpy as np
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.constraints import build_path_constraints
+from planners.errors import InfeasiblePath
 from planners.grid import MAX_POINTS, path_grid
 from planners.paths import SplinePath
 from planners.timing.toppra_method import ToppraMethod
@@ -49,12 +50,19 @@ def main() -> None:
         robot = robots.load(name)
         rng = np.random.default_rng(args.seed)
         ratios = {method: [] for method in methods}
+        refused = 0
         for _ in range(args.paths):
             waypoints = random_waypoints(robot, rng)
-            reference = converged_duration(robot, waypoints)
+            try:
+                reference = converged_duration(robot, waypoints)
+            except InfeasiblePath:
+                refused += 1  # no timing can follow this path (the same 422 for every method)
+                continue
             for method in methods:
                 result = plan(robot, WaypointPath(waypoints), Timing(method=method, constraints=KINDS), dt=0.01)
                 ratios[method].append(result.duration / reference)
+        if refused:
+            print(f"{name:12s} {refused} of {args.paths} paths cannot be followed within the limits")
         for method, values in ratios.items():
             values = np.array(values)
             print(
