@@ -18,12 +18,13 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.grid import MAX_POINTS, path_grid
+from planners.waypoint_checks import checked_waypoints, make_path, without_repeats
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.gate import TimedStretch, checked, gate_threshold, gated, samples_exceed
 from planners.mvc import admissible_set
-from planners.ranges import COORDINATE, check_timing
-from planners.paths import GeometricPath, SplinePath, StopAndGoPath
-from planners.paths.cartesian import CartesianLine, cartesian_path
+from planners.ranges import check_timing
+from planners.paths import GeometricPath
+from planners.paths.cartesian import CartesianLine
 from planners.paths.stretch import stretches
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
@@ -35,84 +36,11 @@ from planners.trajectory import sample_trajectory
 from planners.via_points import via_point_trajectory
 from robots import JointLimits, Robot
 
-INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
-MAX_WAYPOINTS = 1_000
-#: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
-MAX_COORDINATE = COORDINATE.high
-#: Consecutive waypoints closer than this (joint-space norm, rad or m) are one waypoint.
-COINCIDENT = 1e-12
 MAX_SAMPLES = 200_000
 #: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
 MAX_PHASE_PLANE_POINTS = 2_000
 #: Largest timing.limit_margin (a fraction of every limit kept in reserve).
 MAX_LIMIT_MARGIN = 0.5
-
-
-def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
-    """The waypoints of ``spec`` as an (n, n_dof) array, checked against the robot."""
-    if spec.interpolation not in (*INTERPOLATIONS, "via"):
-        raise InvalidRequest(
-            f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted([*INTERPOLATIONS, 'via'])}"
-        )
-    waypoints = np.asarray(spec.waypoints, dtype=float) if np.ndim(spec.waypoints) == 2 else None
-    if waypoints is None:
-        raise InvalidRequest("path.waypoints must be a list of joint vectors (a 2-D array)")
-    count, width = waypoints.shape
-    if count < 2:
-        raise InvalidRequest(f"path.waypoints holds {count} waypoint(s); at least 2 are needed")
-    if count > MAX_WAYPOINTS:
-        raise InvalidRequest(f"path.waypoints holds {count} waypoints; at most {MAX_WAYPOINTS} are served")
-    if width != robot.dof:
-        raise InvalidRequest(
-            f"path.waypoints[0] has {width} values; {robot.name} has {robot.dof} joints "
-            f"({', '.join(robot.joint_names)})"
-        )
-    bad = np.argwhere(~np.isfinite(waypoints) | (np.abs(waypoints) > MAX_COORDINATE))
-    if bad.size:
-        raise InvalidRequest(
-            f"path.waypoints[{bad[0][0]}][{bad[0][1]}] is {waypoints[tuple(bad[0])]:.6g}: not a finite "
-            f"number within +-{MAX_COORDINATE:g} (rad or m)"
-        )
-    lower, upper = robot.limits.position_lower, robot.limits.position_upper
-    outside = robot.outside_position_limits(waypoints)
-    if outside is not None:
-        index, joint = outside
-        raise InvalidRequest(
-            f"path.waypoints[{index}][{joint}] = {waypoints[index, joint]:.6g} is outside the limits "
-            f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
-        )
-    return waypoints
-
-
-def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
-    """``spec`` without waypoints that repeat the one before them (a recorded path that stands
-    still for a while), and a note saying which were dropped.
-
-    Raises:
-        InvalidRequest: every waypoint is the same: there is nothing to move.
-    """
-    waypoints = np.asarray(spec.waypoints, dtype=float)
-    if waypoints.ndim != 2 or len(waypoints) < 2 or not np.all(np.isfinite(waypoints)):
-        return spec, ()
-    repeats = np.flatnonzero(np.linalg.norm(np.diff(waypoints, axis=0), axis=1) <= COINCIDENT) + 1
-    if repeats.size == 0:
-        return spec, ()
-    if repeats.size == len(waypoints) - 1:
-        raise InvalidRequest(
-            f"path.waypoints[0] and path.waypoints[1] coincide, as do all {len(waypoints)} waypoints: "
-            "there is nothing to move"
-        )
-    shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
-    note = f"path.waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)"
-    return WaypointPath(np.delete(waypoints, repeats, axis=0), spec.interpolation), (note,)
-
-
-def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
-    """The geometric path of a Cartesian line, or of joint waypoints interpolated by spline or
-    linear segments (via points are timed and shaped together, in ``via_points``)."""
-    if isinstance(spec, CartesianLine):
-        return cartesian_path(robot, spec)
-    return INTERPOLATIONS[spec.interpolation](checked_waypoints(robot, spec))
 
 
 def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:
