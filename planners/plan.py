@@ -7,6 +7,7 @@ timing method -> TimeScaling s(t) -> samples, phase plane and peak utilization.
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from typing import NamedTuple
 
@@ -77,11 +78,11 @@ def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
     return waypoints
 
 
-def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
+def make_path(robot: Robot, spec: "WaypointPath | CartesianLine", deadline: Deadline = NO_DEADLINE) -> GeometricPath:
     """The geometric path of a Cartesian line, or of joint waypoints interpolated by spline or
     linear segments (via points are timed and shaped together, in ``via_points``)."""
     if isinstance(spec, CartesianLine):
-        return cartesian_path(robot, spec)
+        return cartesian_path(robot, spec, deadline)
     return INTERPOLATIONS[spec.interpolation](checked_waypoints(robot, spec))
 
 
@@ -168,9 +169,17 @@ class _Timed(NamedTuple):
     solver: dict | None = None
 
 
+def _grid(path: GeometricPath, n_intervals: int | None, method: TimingMethod, robot: Robot) -> np.ndarray:
+    """The grid of ``path`` (``n_intervals``, else the default), within what ``method`` serves on
+    ``robot``: a long path's default grid is thinned to ``method.max_grid_intervals``."""
+    s = path_grid(path, n_intervals)
+    cap = method.max_grid_intervals(robot.dof)
+    return s if len(s) - 1 <= cap else path_grid(path, cap)
+
+
 def _timed_path(robot, path, method, timing, kinds, limits, deadline) -> _Timed:
     """A given path timed by ``method``."""
-    s = path_grid(path, timing.grid_points)
+    s = _grid(path, timing.grid_points, method, robot)
     _check_path_within_limits(robot, path, s)
     boundary = _boundary(path, timing, method)
     constraints = build_path_constraints(path, robot, limits, kinds, s, deadline)
@@ -183,8 +192,8 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline) -> _
     """Via points: segments shaped and timed together by the limits."""
     if timing.start_velocity is not None or timing.end_velocity is not None:
         raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
-    path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration)
-    s = path_grid(path, timing.grid_points)
+    path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration, deadline)
+    s = _grid(path, timing.grid_points, method, robot)
     _check_path_within_limits(robot, path, s)
     constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
     return _Timed(path, result, constraints, method.name)
@@ -195,7 +204,7 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline) -> 
     min_cost for beta > 0) so that every limit holds between the collocation instants too."""
     path, solver, collocation_timing = _free_motion(robot, spec, method, timing, limits, deadline)
     retimer = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
-    constraints = build_path_constraints(path, robot, limits, kinds, path_grid(path, None), deadline)
+    constraints = build_path_constraints(path, robot, limits, kinds, _grid(path, None, retimer, robot), deadline)
     moving = dataclasses.replace(
         timing, start_velocity=_moving(spec.start_velocity), end_velocity=_moving(spec.end_velocity), duration=None
     )
@@ -217,11 +226,14 @@ def plan(
     timing: Timing = Timing(),
     dt: float = 0.01,
     deadline: Deadline = NO_DEADLINE,
+    max_samples: int = MAX_SAMPLES,
 ) -> PlannedTrajectory:
-    """Plan the timed trajectory of ``robot`` along ``path_spec``.
+    """Plan the timed trajectory of ``robot`` along ``path_spec``, sampled every ``dt`` seconds
+    into at most ``max_samples`` samples.
 
     Raises:
-        InvalidRequest: malformed input (the message names the field).
+        InvalidRequest: malformed input (the message names the field), or a ``dt`` that gives
+            more than ``max_samples`` samples (the message names the smallest that fits).
         InfeasiblePath: no timing can follow the path within the limits (says where).
         TimingFailed: the timing method failed.
         BudgetExceeded: ``deadline`` passed.
@@ -233,6 +245,12 @@ def plan(
         raise InvalidRequest(f"output.dt must be a positive number of seconds, got {dt}")
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
         raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
+    if timing.grid_points is not None and timing.grid_points > method.max_grid_intervals(robot.dof):
+        raise InvalidRequest(
+            f"timing.grid_points = {timing.grid_points} is more than {method.name} serves on a "
+            f"{robot.dof}-joint robot (its memory grows with grid intervals times joints): use "
+            f"timing.grid_points <= {method.max_grid_intervals(robot.dof)}"
+        )
     if timing.duration is not None and not (np.isfinite(timing.duration) and timing.duration > 0):
         raise InvalidRequest(f"timing.duration must be a positive number of seconds, got {timing.duration}")
     limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
@@ -248,13 +266,15 @@ def plan(
     elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
         timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline)
     else:
-        timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline)
+        timed = _timed_path(robot, make_path(robot, path_spec, deadline), method, timing, kinds, limits, deadline)
     path, result, constraints, notes = timed.path, timed.timing, timed.constraints, list(timed.notes)
     s = constraints.s
     deadline.check()
-    if result.duration / dt > MAX_SAMPLES:
+    if result.duration / dt > max_samples - 2:
         raise InvalidRequest(
-            f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {result.duration:.4g} s"
+            f"output.dt = {dt:g} s gives {math.ceil(result.duration / dt) + 1} samples over the "
+            f"{result.duration:.4g} s motion; at most {max_samples} are served: use output.dt >= "
+            f"{_round_up(result.duration / (max_samples - 2)):g} s"
         )
     samples = sample_trajectory(path, result, robot, dt)
     utilization = peak_utilization(path, result, robot, limits)
@@ -283,6 +303,12 @@ def plan(
         cost=timed.cost,
         solver=timed.solver,
     )
+
+
+def _round_up(value: float, digits: int = 3) -> float:
+    """``value`` rounded up to ``digits`` significant digits."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.ceil(value / scale) * scale
 
 
 def _warnings(utilization: dict[str, np.ndarray], kinds: tuple[str, ...], robot: Robot) -> list[str]:

@@ -16,11 +16,11 @@ PROBLEM_JSON = "application/problem+json"
 logger = logging.getLogger("toptraj")
 
 
-def problem(status: int, title: str, detail: str, **extra) -> JSONResponse:
+def problem(status: int, title: str, detail: str, headers: dict[str, str] | None = None, **extra) -> JSONResponse:
     """A problem+json response."""
     body = {"type": "about:blank", "title": title, "status": status, "detail": detail}
     body.update({key: value for key, value in extra.items() if value is not None})
-    return JSONResponse(body, status_code=status, media_type=PROBLEM_JSON)
+    return JSONResponse(body, status_code=status, media_type=PROBLEM_JSON, headers=headers)
 
 
 #: Tags of the path union that pydantic puts in error locations: path.<tag>.<field>.
@@ -39,7 +39,9 @@ def _location(loc) -> str:
 
 def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     extra = {key: getattr(error, key) for key in ("s", "joint") if hasattr(error, key)}
-    return problem(error.status, error.title, error.detail, **extra)
+    retry_after = getattr(error, "retry_after", None)
+    headers = None if retry_after is None else {"Retry-After": str(retry_after)}
+    return problem(error.status, error.title, error.detail, headers, **extra)
 
 
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:

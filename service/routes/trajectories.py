@@ -3,15 +3,21 @@
 from __future__ import annotations
 
 from fastapi import APIRouter, Request
-from fastapi.responses import JSONResponse
+from fastapi.responses import Response
 
-from service.planning import compare_request, plan_request, run_with_budget, trajectory_body
+from service.planning import compare_request, encode_json, plan_request, trajectory_body
 from service.schemas.common import Problem
 from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
 
 router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
 
-_ERRORS = {404: {"model": Problem}, 413: {"model": Problem}, 422: {"model": Problem}, 504: {"model": Problem}}
+_ERRORS = {
+    404: {"model": Problem},
+    413: {"model": Problem},
+    422: {"model": Problem},
+    503: {"model": Problem, "description": "Every planning worker is busy (with `Retry-After`)"},
+    504: {"model": Problem},
+}
 
 
 @router.post(
@@ -20,18 +26,25 @@ _ERRORS = {404: {"model": Problem}, 413: {"model": Problem}, 422: {"model": Prob
     response_model=TrajectoryResponse,
     responses=_ERRORS,
 )
-async def create_trajectory(body: TrajectoryRequest, request: Request) -> JSONResponse:
+async def create_trajectory(body: TrajectoryRequest, request: Request) -> Response:
     """Time the path of ``body`` for its robot under the requested limits and return the
-    samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit."""
+    samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit.
+    The body is built and encoded in the planning thread, within the time budget."""
     settings = request.app.state.settings
-    result = await run_with_budget(lambda deadline: plan_request(body, deadline), settings.plan_budget_s)
-    return JSONResponse(trajectory_body(result))
+
+    def planned(deadline) -> bytes:
+        return encode_json(trajectory_body(plan_request(body, deadline, settings.max_response_bytes)))
+
+    content = await request.app.state.planning.run(planned, settings.plan_budget_s)
+    return Response(content, media_type="application/json")
 
 
 @router.post("/compare", summary="Compare timing methods on one path", response_model=CompareResponse, responses=_ERRORS)
-async def compare_trajectories(body: CompareRequest, request: Request) -> JSONResponse:
+async def compare_trajectories(body: CompareRequest, request: Request) -> Response:
     """Time one path under several methods (e.g. ``phase_plane`` against ``quintic``) and return
     each one's duration, peak utilization and solve time: what time-optimality buys."""
     settings = request.app.state.settings
-    result = await run_with_budget(lambda deadline: compare_request(body, deadline), settings.plan_budget_s)
-    return JSONResponse(result)
+    content = await request.app.state.planning.run(
+        lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s
+    )
+    return Response(content, media_type="application/json")
