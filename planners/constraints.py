@@ -205,7 +205,21 @@ def path_dynamics(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray):
     return a, b, c, d
 
 
-def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str):
+#: Grid points whose torque rows are computed between two deadline checks (about 20 ms).
+CHUNK_POINTS = 1024
+
+
+def _chunked_path_dynamics(robot: Robot, points, deadline: Deadline):
+    """``path_dynamics`` along ``points``, CHUNK_POINTS at a time, checking ``deadline``."""
+    parts = []
+    for start in range(0, len(points.q), CHUNK_POINTS):
+        deadline.check()
+        rows = slice(start, start + CHUNK_POINTS)
+        parts.append(path_dynamics(robot, points.q[rows], points.dq[rows], points.ddq[rows]))
+    return tuple(np.concatenate([part[i] for part in parts]) for i in range(4))
+
+
+def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline):
     points = path.evaluate(s, side)
     blocks, rows = [], []
     n_dof = path.dof
@@ -214,7 +228,7 @@ def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.nda
         blocks.append((points.dq, points.ddq, np.zeros_like(points.dq), np.zeros_like(points.dq), bound))
         rows += [("acceleration", j) for j in range(n_dof)]
     if "torque" in kinds:
-        a, b, c, d = path_dynamics(robot, points.q, points.dq, points.ddq)
+        a, b, c, d = _chunked_path_dynamics(robot, points, deadline)
         blocks.append((a, b, c, d, np.broadcast_to(limits.torque, a.shape)))
         rows += [("torque", j) for j in range(n_dof)]
     if not blocks:
@@ -236,7 +250,7 @@ def build_path_constraints(
 ) -> PathConstraints:
     """Evaluate the requested ``kinds`` of limits (subset of velocity, acceleration, torque)
     along ``path`` at the grid ``s`` (which must hold the path's kinks)."""
-    points, (a, b, c, d, bound), rows = _second_order_rows(path, robot, limits, kinds, s, "right")
+    points, (a, b, c, d, bound), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
     deadline.check()
     sd_max = np.full(len(s), np.inf)
     velocity_joint = np.full(len(s), -1)
@@ -250,7 +264,7 @@ def build_path_constraints(
     if kink_index.size:
         sd_max[kink_index] = 0.0
         _, (a_k, b_k, c_k, d_k, _), _ = _second_order_rows(
-            path, robot, limits, kinds, s[kink_index], "left"
+            path, robot, limits, kinds, s[kink_index], "left", deadline
         )
         a_left, b_left, c_left, d_left = a.copy(), b.copy(), c.copy(), d.copy()
         a_left[kink_index], b_left[kink_index] = a_k, b_k

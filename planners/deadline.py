@@ -21,6 +21,10 @@ class Deadline:
         """Make the next ``check()`` raise."""
         self._cancelled.set()
 
+    def remaining(self) -> float | None:
+        """Seconds left (at least 0), or ``None`` without a budget."""
+        return None if self._end is None else max(0.0, self._end - time.monotonic())
+
     def check(self) -> None:
         """Raise ``BudgetExceeded`` when the budget is spent or the caller cancelled."""
         if self._cancelled.is_set() or (self._end is not None and time.monotonic() > self._end):

@@ -7,6 +7,7 @@ timing method -> TimeScaling s(t) -> samples, phase plane and peak utilization.
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from typing import NamedTuple
 
@@ -127,6 +128,14 @@ class _Timed(NamedTuple):
     solver: dict | None = None
 
 
+def _grid(path: GeometricPath, n_intervals: int | None, method: TimingMethod, robot: Robot) -> np.ndarray:
+    """The grid of ``path`` (``n_intervals``, else the default), within what ``method`` serves on
+    ``robot``: a long path's default grid is thinned to ``method.max_grid_intervals``."""
+    s = path_grid(path, n_intervals)
+    cap = method.max_grid_intervals(robot.dof)
+    return s if len(s) - 1 <= cap else path_grid(path, cap)
+
+
 def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool) -> Boundary:
     """The boundary of one stretch in its own parameter (sigma-dot = s-dot / w): the path's
     boundary at the path's ends, rest at its corners."""
@@ -142,7 +151,7 @@ def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool)
 
 
 def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, duration, threshold, deadline):
-    s = path_grid(stretch, grid_points)
+    s = _grid(stretch, grid_points, method, robot)
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
     deadline.check()
     timing, constraints, check = gated(
@@ -188,8 +197,8 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, thre
     """Via points: segments shaped and timed together by the limits."""
     if timing.start_velocity is not None or timing.end_velocity is not None:
         raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
-    path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration)
-    s = path_grid(path, timing.grid_points)
+    path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration, deadline)
+    s = _grid(path, timing.grid_points, method, robot)
     _check_path_within_limits(robot, path, s)
     constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
     stretch = checked(robot, path, result, method.name, kinds, limits, threshold, constraints)
@@ -201,7 +210,7 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
     min_cost for beta > 0) so that every limit holds between the collocation instants too."""
     path, solver, collocation_timing = _free_motion(robot, spec, method, timing, limits, deadline)
     retimer = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
-    constraints = build_path_constraints(path, robot, limits, kinds, path_grid(path, None), deadline)
+    constraints = build_path_constraints(path, robot, limits, kinds, _grid(path, None, retimer, robot), deadline)
     moving = dataclasses.replace(
         timing, start_velocity=_moving(spec.start_velocity), end_velocity=_moving(spec.end_velocity), duration=None
     )
@@ -252,15 +261,18 @@ def plan(
     timing: Timing = Timing(),
     dt: float = 0.01,
     deadline: Deadline = NO_DEADLINE,
+    max_samples: int = MAX_SAMPLES,
 ) -> PlannedTrajectory:
-    """Plan the timed trajectory of ``robot`` along ``path_spec``.
+    """Plan the timed trajectory of ``robot`` along ``path_spec``, sampled every ``dt`` seconds
+    into at most ``max_samples`` samples.
 
     Every answer holds the requested limits on a dense resampling within ``LIMIT_TOLERANCE``
     (with ``timing.limit_margin`` > 0, strictly within the limits): the gate refines the grid
     where a limit is exceeded and refuses an answer that still exceeds one.
 
     Raises:
-        InvalidRequest: malformed input (the message names the field).
+        InvalidRequest: malformed input (the message names the field), or a ``dt`` that gives
+            more than ``max_samples`` samples (the message names the smallest that fits).
         InfeasiblePath: no timing can follow the path within the limits (says where, which
             joint and which limit).
         TimingFailed: the timing method failed.
@@ -272,6 +284,12 @@ def plan(
     check_timing(timing, dt)
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
         raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
+    if timing.grid_points is not None and timing.grid_points > method.max_grid_intervals(robot.dof):
+        raise InvalidRequest(
+            f"timing.grid_points = {timing.grid_points} is more than {method.name} serves on a "
+            f"{robot.dof}-joint robot (its memory grows with grid intervals times joints): use "
+            f"timing.grid_points <= {method.max_grid_intervals(robot.dof)}"
+        )
     margin = timing.limit_margin
     if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
         raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
@@ -294,13 +312,16 @@ def plan(
         elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
             timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
         else:
-            timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, limits, deadline, threshold)
+            path = make_path(robot, path_spec, deadline)
+            timed = _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
     deadline.check()
     require_finite(timed.method, duration=result.duration)
-    if result.duration / dt > MAX_SAMPLES:
+    if result.duration / dt > max_samples - 2:
         raise InvalidRequest(
-            f"output.dt = {dt} s gives more than {MAX_SAMPLES} samples over {result.duration:.4g} s"
+            f"output.dt = {dt:g} s gives {math.ceil(result.duration / dt) + 1} samples over the "
+            f"{result.duration:.4g} s motion; at most {max_samples} are served: use output.dt >= "
+            f"{_round_up(result.duration / (max_samples - 2)):g} s"
         )
     samples = sample_trajectory(path, result, robot, dt)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
@@ -335,3 +356,9 @@ def plan(
         cost=timed.cost,
         solver=timed.solver,
     )
+
+
+def _round_up(value: float, digits: int = 3) -> float:
+    """``value`` rounded up to ``digits`` significant digits."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.ceil(value / scale) * scale

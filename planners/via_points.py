@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.paths.base import GeometricPath, PathPoints
 from planners.timing.base import DenseStates, PathTiming
@@ -127,11 +128,12 @@ def _segment_ratio(robot, limits, kinds, coefficients, T) -> float:
     return float(max(np.nan_to_num(ratio, nan=0.0).max() for ratio in ratios))
 
 
-def _shortest(robot, limits, kinds, law, states, guess) -> float:
+def _shortest(robot, limits, kinds, law, states, guess, deadline: Deadline) -> float:
     """Shortest T for one segment between fixed boundary states (bisection on the ratio)."""
     q0, v0, a0, q1, v1, a1 = states
 
     def ratio(T):
+        deadline.check()
         return _segment_ratio(robot, limits, kinds, _segment(law, q0, v0, a0, q1, v1, a1, T), T)
 
     high = guess
@@ -154,9 +156,19 @@ def _shortest(robot, limits, kinds, law, states, guess) -> float:
 
 
 def via_point_trajectory(
-    robot: Robot, waypoints: np.ndarray, law: str, limits: JointLimits, kinds: tuple[str, ...], duration: float | None
+    robot: Robot,
+    waypoints: np.ndarray,
+    law: str,
+    limits: JointLimits,
+    kinds: tuple[str, ...],
+    duration: float | None,
+    deadline: Deadline = NO_DEADLINE,
 ) -> tuple[ViaPath, ConstantSpeedTiming]:
-    """The via-point trajectory through ``waypoints`` (n, n_dof) with ``law`` segments."""
+    """The via-point trajectory through ``waypoints`` (n, n_dof) with ``law`` segments.
+
+    Raises:
+        BudgetExceeded: ``deadline`` passed (checked before every limit evaluation).
+    """
     if law not in ("cubic", "quintic"):
         raise InvalidRequest(f"via points need timing.method 'cubic' or 'quintic', not {law!r}")
     steps = np.diff(waypoints, axis=0)
@@ -183,6 +195,7 @@ def via_point_trajectory(
                 robot, limits, kinds, law,
                 (waypoints[k], velocities[k], accelerations[k], waypoints[k + 1], velocities[k + 1], accelerations[k + 1]),
                 durations[k],
+                deadline,
             )
             for k in range(n_segments)
         ])

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.paths.cartesian import CartesianLine, cartesian_path
@@ -80,9 +81,9 @@ def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
     return WaypointPath(np.delete(waypoints, repeats, axis=0), spec.interpolation), (note,)
 
 
-def make_path(robot: Robot, spec: "WaypointPath | CartesianLine") -> GeometricPath:
+def make_path(robot: Robot, spec: "WaypointPath | CartesianLine", deadline: Deadline = NO_DEADLINE) -> GeometricPath:
     """The geometric path of a Cartesian line, or of joint waypoints interpolated by spline or
     linear segments (via points are timed and shaped together, in ``via_points``)."""
     if isinstance(spec, CartesianLine):
-        return cartesian_path(robot, spec)
+        return cartesian_path(robot, spec, deadline)
     return INTERPOLATIONS[spec.interpolation](checked_waypoints(robot, spec))

@@ -101,6 +101,11 @@ class Robot:
             _plain_v_index=np.asarray(plain_v, dtype=int),
         )
 
+    def __reduce__(self):
+        """Pickled as its model and metadata (the per-thread workspaces are rebuilt), so that a
+        robot can be sent to a worker process."""
+        return Robot.from_model, (self.name, self.model, self.source, self.end_effector, self.limits)
+
     @property
     def dof(self) -> int:
         """Number of degrees of freedom (actuated joints)."""

@@ -11,10 +11,12 @@ import numpy as np
 
 import robots
 from planners import Timing, WaypointPath, plan
+from planners.isolated import start_worker_server
 from service.body_limit import BodySizeLimit
 from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.routes import health, robots as robot_routes, trajectories
 from service.settings import Settings
+from service.workers import PlanningWorkers
 
 
 def _warm_up() -> None:
@@ -42,9 +44,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        await run_in_threadpool(start_worker_server)
         if settings.preload_robots:
             await run_in_threadpool(_warm_up)
         yield
+        app.state.planning.close()
 
     app = FastAPI(
         title="toptraj",
@@ -54,6 +58,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         default_response_class=FiniteJSONResponse,
     )
     app.state.settings = settings
+    app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue)
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)
     app.add_middleware(UnexpectedErrors)  # last added, so outermost

@@ -21,7 +21,7 @@ def _serve(args) -> int:
 
 def _plan(args) -> int:
     from robots import ToptrajError
-    from service.planning import plan_request, trajectory_body
+    from service.planning import encode_json, plan_request, trajectory_body
     from service.schemas.trajectories import TrajectoryRequest
 
     try:
@@ -38,8 +38,7 @@ def _plan(args) -> int:
     except ToptrajError as error:
         print(json.dumps({"title": error.title, "status": error.status, "detail": error.detail}))
         return 1
-    json.dump(body, sys.stdout)
-    sys.stdout.write("\n")
+    sys.stdout.write(encode_json(body).decode() + "\n")
     return 0
 
 

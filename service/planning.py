@@ -1,22 +1,30 @@
 """The bridge between the HTTP schemas and ``planners.plan``: request -> library call ->
-response dict, and the time budget that keeps a long computation off the event loop."""
+response body, encoded to JSON bytes in the planning thread (never on the event loop)."""
 
 from __future__ import annotations
 
-import asyncio
 import dataclasses
 import math
 
 import numpy as np
-from starlette.concurrency import run_in_threadpool
+import orjson
 
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
 from planners.boundary import finite_vector
+from planners.deadline import NO_DEADLINE
 from planners.free_path import FreeMotion
-from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.plan import MAX_SAMPLES
 from robots import InvalidLimits, UnknownRobot
+from service.problems import non_finite_answer
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest
+
+#: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.
+NUMBER_BYTES = 25
+#: Bytes of a trajectory body set aside for everything but the samples (phase plane of at
+#: most 2,000 points, utilization, conditioning, warnings).
+RESERVED_BYTES = 256_000
 
 
 def _timing(request: TrajectoryRequest) -> Timing:
@@ -40,13 +48,26 @@ def _timing(request: TrajectoryRequest) -> Timing:
     )
 
 
-def plan_request(request: TrajectoryRequest, deadline: Deadline | None = None) -> PlannedTrajectory:
-    """Plan ``request`` with the library (no HTTP involved)."""
+def samples_within(body_bytes: int, n_dof: int) -> int:
+    """The most time samples a trajectory body of at most ``body_bytes`` bytes can hold for a
+    robot with ``n_dof`` joints: each sample is t and a row of q, qd, qdd and tau, every number
+    counted at its longest (``NUMBER_BYTES``), after ``RESERVED_BYTES`` for the rest."""
+    per_sample = NUMBER_BYTES * (1 + 4 * n_dof) + 4 * 3  # and each row's brackets and comma
+    return max(2, (body_bytes - RESERVED_BYTES) // per_sample)
+
+
+def plan_request(
+    request: TrajectoryRequest, deadline: Deadline | None = None, max_body_bytes: int | None = None
+) -> PlannedTrajectory:
+    """Plan ``request`` with the library (no HTTP involved); with ``max_body_bytes``, refuse an
+    ``output.dt`` whose samples would not fit in a body of that size (422 naming the smallest
+    ``dt`` that fits)."""
     robot = robots.load(request.robot)
     timing = _timing(request)
     if request.path.kind == "free":
         timing = dataclasses.replace(timing, start_velocity=None, end_velocity=None)
-    return plan(robot, _path(request.path, robot, request), timing, request.output.dt, deadline or Deadline())
+    max_samples = MAX_SAMPLES if max_body_bytes is None else min(MAX_SAMPLES, samples_within(max_body_bytes, robot.dof))
+    return plan(robot, _path(request.path, robot, request), timing, request.output.dt, deadline or NO_DEADLINE, max_samples)
 
 
 def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath | CartesianLine | FreeMotion:
@@ -113,20 +134,15 @@ def _finite_or_none(values: np.ndarray) -> list[float | None]:
 
 
 def trajectory_body(result: PlannedTrajectory) -> dict:
-    """The JSON body of a planned trajectory (DESIGN.md contract)."""
+    """The JSON body of a planned trajectory (DESIGN.md contract); the samples stay numpy arrays
+    until ``encode_json``."""
     samples = result.samples
     return {
         "robot": result.robot,
         "method": result.method,
         "joint_names": list(result.joint_names),
         "duration": result.duration,
-        "samples": {
-            "t": samples.t.tolist(),
-            "q": samples.q.tolist(),
-            "qd": samples.qd.tolist(),
-            "qdd": samples.qdd.tolist(),
-            "tau": samples.tau.tolist(),
-        },
+        "samples": {"t": samples.t, "q": samples.q, "qd": samples.qd, "qdd": samples.qdd, "tau": samples.tau},
         "phase_plane": {
             "s": result.phase_plane.s.tolist(),
             "sd": result.phase_plane.sd.tolist(),
@@ -149,12 +165,21 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
     }
 
 
-async def run_with_budget(function, budget_s: float):
-    """Run ``function(deadline)`` in the thread pool; past ``budget_s`` seconds, cancel it (it
-    stops at its next deadline check) and raise ``BudgetExceeded``."""
-    deadline = Deadline(budget_s)
-    try:
-        return await asyncio.wait_for(run_in_threadpool(function, deadline), timeout=budget_s)
-    except asyncio.TimeoutError:
-        deadline.cancel()
-        raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s") from None
+def _plain(value):
+    """What orjson leaves to its caller: numpy arrays that are not C-contiguous."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serializable")
+
+
+def encode_json(body: dict) -> bytes:
+    """``body`` as JSON bytes: numpy arrays are written directly by orjson (no ``tolist()``).
+
+    Raises:
+        NonFiniteAnswer: a number is NaN or infinite (JSON cannot carry it; orjson would write
+            ``null``).
+    """
+    error = non_finite_answer(body)
+    if error is not None:
+        raise error
+    return orjson.dumps(body, default=_plain, option=orjson.OPT_SERIALIZE_NUMPY)

@@ -20,6 +20,7 @@ import logging
 import math
 from typing import Any
 
+import numpy as np
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
@@ -59,18 +60,32 @@ class FiniteJSONResponse(JSONResponse):
         try:
             return json.dumps(content, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode("utf-8")
         except ValueError:
-            where, value = _first_non_finite(content, "")
-            if where is None:
+            error = non_finite_answer(content)
+            if error is None:
                 raise
-            raise NonFiniteAnswer(
-                f"the computed answer holds {value} at {where or 'its top level'}, which JSON cannot "
-                "carry; the request's numbers lie too far apart (durations, limits, boundary states)"
-            ) from None
+            raise error from None
+
+
+def non_finite_answer(content: Any) -> NonFiniteAnswer | None:
+    """The ``NonFiniteAnswer`` naming the first NaN or infinity in ``content`` (dicts, lists
+    and numpy arrays), or ``None`` when every number is finite."""
+    where, value = _first_non_finite(content, "")
+    if where is None:
+        return None
+    return NonFiniteAnswer(
+        f"the computed answer holds {value} at {where or 'its top level'}, which JSON cannot "
+        "carry; the request's numbers lie too far apart (durations, limits, boundary states)"
+    )
 
 
 def _first_non_finite(value: Any, where: str) -> tuple[str | None, float | None]:
     if isinstance(value, float) and not math.isfinite(value):
         return where, value
+    if isinstance(value, np.ndarray):
+        bad = np.argwhere(~np.isfinite(value)) if value.dtype.kind == "f" else []
+        if len(bad) == 0:
+            return None, None
+        return where + "".join(f"[{i}]" for i in bad[0]), float(value[tuple(bad[0])])
     if isinstance(value, dict):
         items = ((f"{where}.{key}" if where else str(key), item) for key, item in value.items())
     elif isinstance(value, (list, tuple)):
@@ -107,7 +122,9 @@ def _location(loc) -> str:
 
 def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     extra = {key: getattr(error, key) for key in ("s", "joint", "limit") if hasattr(error, key)}
-    return problem(error.status, error.title, error.detail, **extra)
+    retry_after = getattr(error, "retry_after", None)
+    headers = None if retry_after is None else {"Retry-After": str(retry_after)}
+    return problem(error.status, error.title, error.detail, headers, **extra)
 
 
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:

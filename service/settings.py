@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from pydantic import Field
@@ -24,6 +25,11 @@ class Settings(BaseSettings):
         max_upload_bytes: Most bytes of distinct URDF text the store keeps (409 beyond).
         upload_cache_size: Most upload models a process keeps built in memory (least recently
             used dropped first).
+        max_response_bytes: Largest trajectory body served; an ``output.dt`` whose samples
+            would not fit gets 422 naming the smallest ``dt`` that does.
+        plan_workers: Plannings run at once (default: the number of cores).
+        plan_queue: Requests that may wait for a planning worker (within their budget); beyond,
+            503 with ``Retry-After``.
     """
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")
@@ -35,3 +41,6 @@ class Settings(BaseSettings):
     max_uploads: int = Field(default=DEFAULT_MAX_UPLOADS, ge=1)
     max_upload_bytes: int = Field(default=DEFAULT_MAX_BYTES, ge=1)
     upload_cache_size: int = Field(default=DEFAULT_CACHE_SIZE, ge=1)
+    max_response_bytes: int = Field(default=20_000_000, ge=1_000_000)
+    plan_workers: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
+    plan_queue: int = Field(default=8, ge=0)

@@ -34,6 +34,7 @@ from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.grid import path_grid
+from planners.isolated import run_isolated
 from planners.paths.waypoints import SplinePath
 from planners.timing.phase_plane import PhasePlaneMethod
 from robots import JointLimits, Robot
@@ -274,7 +275,7 @@ def _bends(n_dof: int) -> list[tuple[str, np.ndarray]]:
     return options
 
 
-def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int, deadline: Deadline):
+def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int):
     result = minimize(
         problem.cost,
         z0,
@@ -286,7 +287,6 @@ def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int, deadline: Dea
             {"type": "ineq", "fun": problem.torque_margin, "jac": problem.torque_margin_jacobian},
         ],
         options={"maxiter": max_iterations, "ftol": 1e-10},
-        callback=lambda _: deadline.check(),
     )
     feasible = np.abs(problem.defects(result.x)).max() < 1e-6 and problem.torque_margin(result.x).min() > -1e-6
     return result, feasible
@@ -304,10 +304,21 @@ def optimize_motion(
     goal. Every initial guess (goal shifts times bends) is first solved on a coarse grid of
     ``COARSE_INTERVALS``; the best is then refined on ``motion.intervals``.
 
+    SLSQP holds the interpreter for seconds at a time and cannot check a deadline, so under a
+    ``deadline`` the optimization runs in a worker process that is killed when it passes
+    (``planners.isolated``).
+
     Raises:
         InvalidRequest: a start or goal outside the joint limits.
         InfeasiblePath: no initial guess leads to a feasible motion.
+        BudgetExceeded: ``deadline`` passed.
     """
+    return run_isolated(_optimize_motion, robot, limits, motion, torque_weight, max_iterations, deadline=deadline)
+
+
+def _optimize_motion(
+    robot: Robot, limits: JointLimits, motion: FreeMotion, torque_weight: float, max_iterations: int
+) -> CollocationResult:
     if robot.outside_position_limits(motion.start) is not None:
         raise InvalidRequest("path.start is outside the joint limits")
     if robot.outside_position_limits(motion.goal) is not None:
@@ -318,7 +329,6 @@ def optimize_motion(
         motion.start, motion.goal, motion.start_velocity, motion.end_velocity, min(COARSE_INTERVALS, motion.intervals)
     )
     for (goal_label, goal), (bend_label, bend) in itertools.product(_goals(robot, motion), _bends(robot.dof)):
-        deadline.check()
         label = goal_label + bend_label
         coarse = _Problem(robot, limits, coarse_motion, goal, torque_weight)
         try:
@@ -326,7 +336,7 @@ def optimize_motion(
         except (InfeasiblePath, TimingFailed) as error:
             tried.append(f"{label}: {error.detail}")
             continue
-        result, feasible = _solve(coarse, z0, max_iterations, deadline)
+        result, feasible = _solve(coarse, z0, max_iterations)
         tried.append(f"{label}: {result.message} (cost {result.fun:.6g})")
         if feasible and (best is None or result.fun < best[0].fun):
             best = (result, coarse, label, goal)
@@ -334,7 +344,7 @@ def optimize_motion(
         raise InfeasiblePath("the collocation found no feasible motion from any initial guess: " + "; ".join(tried))
     coarse_result, coarse, label, goal = best
     problem = _Problem(robot, limits, motion, goal, torque_weight)
-    result, feasible = _solve(problem, _refined(coarse, coarse_result.x, problem), max_iterations, deadline)
+    result, feasible = _solve(problem, _refined(coarse, coarse_result.x, problem), max_iterations)
     if not feasible:
         raise InfeasiblePath(f"the collocation did not converge on the fine grid from its best guess ({label}): {result.message}")
     T, q, v, a = problem.unpack(result.x)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
 from planners.kinematics.ik import frame_pose, solve_ik
 from planners.paths.base import GeometricPath
@@ -80,12 +81,13 @@ def _targets(line: CartesianLine, start_pose: pin.SE3):
     return field, offset, np.vstack([start_pose.translation, positions]), [start_rotation, *rotations]
 
 
-def cartesian_path(robot: Robot, line: CartesianLine) -> GeometricPath:
+def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DEADLINE) -> GeometricPath:
     """The joint path that moves the frame along ``line``.
 
     Raises:
         InvalidRequest: malformed points, a frame the robot lacks, a start outside the joint
             limits, a line that leaves the workspace, crosses a singularity or needs a joint jump.
+        BudgetExceeded: ``deadline`` passed (checked at every point of the line).
     """
     frame = line.frame or robot.end_effector
     if not robot.model.existFrame(frame):
@@ -112,6 +114,7 @@ def cartesian_path(robot: Robot, line: CartesianLine) -> GeometricPath:
             raise InvalidRequest(f"{field}[{k + offset}] repeats the previous point")
         solutions = [q]
         for fraction, (position, rotation) in samples:
+            deadline.check()
             result = solve_ik(robot, solutions[-1], frame_id, position, rotation)
             where = f"{field}[{k + offset}] on the way to point {k + offset + 1}, {100 * fraction:.1f} % along (at {np.round(position, 4).tolist()} m)"
             if result.error > 1e-6:
@@ -127,7 +130,7 @@ def cartesian_path(robot: Robot, line: CartesianLine) -> GeometricPath:
             solutions.append(result.q)
         joint_points = np.array(solutions)
         piece = SplinePath(joint_points)
-        _check_deviation(robot, frame_id, piece, positions[k], positions[k + 1], field, k + offset)
+        _check_deviation(robot, frame_id, piece, positions[k], positions[k + 1], field, k + offset, deadline)
         pieces.append(piece)
         lengths.append(np.sum(np.linalg.norm(np.diff(joint_points, axis=0), axis=1)))
         q = joint_points[-1]
@@ -148,13 +151,15 @@ def _line_samples(p0, p1, r0, r1):
     return samples
 
 
-def _check_deviation(robot, frame_id, piece, p0, p1, field, index):
+def _check_deviation(robot, frame_id, piece, p0, p1, field, index, deadline):
     """The frame stays within POSITION_TOLERANCE of the straight line along the whole spline."""
     s = np.linspace(0.0, 1.0, 8 * len(piece.knots) + 1)
     direction = p1 - p0
     length = np.linalg.norm(direction)
     worst = 0.0
-    for q in piece(s):
+    for k, q in enumerate(piece(s)):
+        if k % 64 == 0:
+            deadline.check()
         offset = frame_pose(robot, q, frame_id).translation - p0
         if length > 0:
             along = np.clip(offset @ direction / length**2, 0.0, 1.0)

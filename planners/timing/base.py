@@ -170,6 +170,10 @@ class TimingMethod(abc.ABC):
         two_waypoints_only: Whether the method times only a straight move between two states.
         absolute_tolerances: Whether the method's solver works with absolute tolerances, so
             that it needs path speeds of order one (``planners.timing.scaled``).
+        grid_budget: The largest grid the method serves, in grid intervals times joints: its
+            memory grows with both (about 1.3 kB per interval and joint for phase_plane,
+            2.3 kB for toppra, 9 kB for min_cost; ``benchmarks/budgets.py``). 140,000 is
+            20,000 intervals on a 7-joint arm, about 300 MB at most.
     """
 
     name: str
@@ -179,6 +183,11 @@ class TimingMethod(abc.ABC):
     takes_acceleration_boundary: bool = False
     two_waypoints_only: bool = False
     absolute_tolerances: bool = False
+    grid_budget: int = 140_000
+
+    def max_grid_intervals(self, n_dof: int) -> int:
+        """The most grid intervals the method serves on a robot with ``n_dof`` joints."""
+        return self.grid_budget // max(n_dof, 1)
 
     @abc.abstractmethod
     def solve(

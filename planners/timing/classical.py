@@ -184,6 +184,7 @@ class ClassicalMethod(TimingMethod):
         """Shortest T for a boundary-conditioned polynomial: bisection on the limit check."""
 
         def worst(T):
+            deadline.check()
             segment = LawSegment(start, end, T, coefficients=self._polynomial(start, end, ends, T))
             t = np.linspace(0.0, T, 401)
             s, sd, sdd, sddd = segment.states(t)
@@ -207,7 +208,6 @@ class ClassicalMethod(TimingMethod):
             if worst(low)[0] > 1.0:
                 break
         for _ in range(50):
-            deadline.check()
             middle = 0.5 * (low + high)
             if worst(middle)[0] <= 1.0:
                 high = middle

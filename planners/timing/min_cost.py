@@ -23,9 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.constraints import PathConstraints
+from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, TimingFailed
+from planners.isolated import run_isolated
 from planners.mvc import friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
@@ -45,6 +46,9 @@ class MinCostMethod(TimingMethod):
     absolute_tolerances = True
     required_kinds = frozenset({"torque"})
     takes_cost = True
+    #: cvxpy and Clarabel take about 9 kB per grid interval and joint: 4,000 intervals on a
+    #: 6-joint arm is about 210 MB (and some 10 s).
+    grid_budget = 24_000
 
     def __init__(self, torque_weight: float = 0.0):
         self.torque_weight = torque_weight
@@ -56,60 +60,109 @@ class MinCostMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> CostTimeScaling:
-        import cvxpy as cp
-
         s = constraints.s
-        ds = np.diff(s)
-        n = len(ds)
-        x_bound = constraints.sd_max**2
         reference = friction_reference(constraints)
-        right, left = constraints.linearized(reference), constraints.linearized(reference, "left")
-        # The end values of b are data, not variables: an interior-point solver then never has
-        # to sit on the boundary of the cone sqrt(b) >= 0 at a motion that starts from rest.
-        interior = cp.Variable(n - 1, nonneg=True)
-        b = cp.hstack([np.array([boundary.sd_start**2]), interior, np.array([boundary.sd_end**2])])
-        a = cp.Variable(n)
-        limits = [b[1:] == b[:-1] + 2 * cp.multiply(ds, a)]
-        finite = np.isfinite(x_bound[1:-1])
-        if finite.any():
-            limits.append(interior[finite] <= x_bound[1:-1][finite])
-        for rows, index, b_at in ((right, slice(0, n), b[:-1]), (left, slice(1, n + 1), b[1:])):
-            for column in range(rows.a.shape[1]):
-                value = cp.multiply(rows.a[index, column], a) + cp.multiply(rows.b[index, column], b_at) + rows.c[index, column]
-                if np.isfinite(rows.upper[0, column]):
-                    limits.append(value <= rows.upper[index, column])
-                if np.isfinite(rows.lower[0, column]):
-                    limits.append(value >= rows.lower[index, column])
-        # z_i <= sqrt(b_i) + sqrt(b_i+1) is tight at the optimum, so 2 ds_i / z_i is the interval's
-        # time and 2 ds_i w_ij, with w_ij >= tau_ij^2 / z_i (a rotated second-order cone), its
-        # torque-squared integral. (Scaled so that z and w stay of order one for the solver.)
-        z = cp.Variable(n, nonneg=True)
-        roots = cp.hstack([np.array([boundary.sd_start]), cp.sqrt(interior), np.array([boundary.sd_end])])
-        limits.append(z <= roots[:-1] + roots[1:])
-        cost = cp.sum(cp.multiply(2 * ds, cp.inv_pos(z)))
-        if self.torque_weight > 0:
-            middle = 0.5 * (b[:-1] + b[1:])
-            for column, (kind, _) in enumerate(constraints.rows):
-                if kind != "torque":
-                    continue
-                A = 0.5 * (constraints.a[:-1, column] + constraints.a_left[1:, column])
-                B = 0.5 * (constraints.b[:-1, column] + constraints.b_left[1:, column])
-                C = 0.5 * (constraints.c[:-1, column] + constraints.c_left[1:, column])
-                tau = cp.multiply(A, a) + cp.multiply(B, middle) + C
-                w = cp.Variable(n, nonneg=True)
-                limits.append(cp.SOC(w + z, cp.vstack([2 * tau, w - z]), axis=0))
-                cost = cost + self.torque_weight * cp.sum(cp.multiply(2 * ds, w))
+        torque = [column for column, (kind, _) in enumerate(constraints.rows) if kind == "torque"]
+
+        def midpoint(right, left):
+            return 0.5 * (right[:-1, torque] + left[1:, torque])
+
+        program = MinCostProgram(
+            ds=np.diff(s),
+            x_bound=constraints.sd_max**2,
+            right=constraints.linearized(reference),
+            left=constraints.linearized(reference, "left"),
+            torque_a=midpoint(constraints.a, constraints.a_left),
+            torque_b=midpoint(constraints.b, constraints.b_left),
+            torque_c=midpoint(constraints.c, constraints.c_left),
+            sd_start=boundary.sd_start,
+            sd_end=boundary.sd_end,
+            torque_weight=self.torque_weight,
+        )
         deadline.check()
-        problem = cp.Problem(cp.Minimize(cost), limits)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", UserWarning)  # "inaccurate" is reported as the status
-                problem.solve(solver=cp.CLARABEL)
-        except cp.error.SolverError as error:
-            raise TimingFailed(f"the convex solver failed: {error}") from None
-        if problem.status in ("infeasible", "infeasible_inaccurate"):
-            raise InfeasiblePath("no timing along the path meets the limits (the convex program is infeasible)")
-        if interior.value is None or problem.status not in ("optimal", "optimal_inaccurate"):
-            raise TimingFailed(f"the convex solver stopped with status {problem.status!r}")
-        x = np.concatenate(([boundary.sd_start**2], np.maximum(interior.value, 0.0), [boundary.sd_end**2]))
-        return CostTimeScaling(s, np.sqrt(x), cost=float(problem.value), solver_status=problem.status)
+        # cvxpy's canonicalization and Clarabel cannot check a deadline: they run in a child
+        # process that is killed when the budget is spent, and whose memory is freed on exit.
+        interior, value, status = run_isolated(solve_program, program, deadline=deadline)
+        x = np.concatenate(([boundary.sd_start**2], interior, [boundary.sd_end**2]))
+        return CostTimeScaling(s, np.sqrt(x), cost=value, solver_status=status)
+
+
+@dataclass(frozen=True)
+class MinCostProgram:
+    """The data of the convex program, plain arrays (it is sent to a worker process).
+
+    Attributes:
+        ds: Grid intervals, shape (n,).
+        x_bound: First-order bound on b = sd^2 at the grid points, shape (n + 1,), in 1/s^2.
+        right, left: The linearized limit rows on both sides of each grid point, (n + 1, m).
+        torque_a, torque_b, torque_c: Torque coefficients at the interval midpoints, (n, k), one
+            column per torque row.
+        sd_start, sd_end: Path speed at the ends, in 1/s.
+        torque_weight: beta, in 1/(N m)^2.
+    """
+
+    ds: np.ndarray
+    x_bound: np.ndarray
+    right: LinearRows
+    left: LinearRows
+    torque_a: np.ndarray
+    torque_b: np.ndarray
+    torque_c: np.ndarray
+    sd_start: float
+    sd_end: float
+    torque_weight: float
+
+
+def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
+    """b = sd^2 at the interior grid points (n - 1,), the cost J and the solver status.
+
+    Raises:
+        InfeasiblePath: the program is infeasible.
+        TimingFailed: the solver failed or stopped short of an optimum.
+    """
+    import cvxpy as cp
+
+    ds, x_bound, right, left = program.ds, program.x_bound, program.right, program.left
+    n = len(ds)
+    # The end values of b are data, not variables: an interior-point solver then never has
+    # to sit on the boundary of the cone sqrt(b) >= 0 at a motion that starts from rest.
+    interior = cp.Variable(n - 1, nonneg=True)
+    b = cp.hstack([np.array([program.sd_start**2]), interior, np.array([program.sd_end**2])])
+    a = cp.Variable(n)
+    limits = [b[1:] == b[:-1] + 2 * cp.multiply(ds, a)]
+    finite = np.isfinite(x_bound[1:-1])
+    if finite.any():
+        limits.append(interior[finite] <= x_bound[1:-1][finite])
+    for rows, index, b_at in ((right, slice(0, n), b[:-1]), (left, slice(1, n + 1), b[1:])):
+        for column in range(rows.a.shape[1]):
+            value = cp.multiply(rows.a[index, column], a) + cp.multiply(rows.b[index, column], b_at) + rows.c[index, column]
+            if np.isfinite(rows.upper[0, column]):
+                limits.append(value <= rows.upper[index, column])
+            if np.isfinite(rows.lower[0, column]):
+                limits.append(value >= rows.lower[index, column])
+    # z_i <= sqrt(b_i) + sqrt(b_i+1) is tight at the optimum, so 2 ds_i / z_i is the interval's
+    # time and 2 ds_i w_ij, with w_ij >= tau_ij^2 / z_i (a rotated second-order cone), its
+    # torque-squared integral. (Scaled so that z and w stay of order one for the solver.)
+    z = cp.Variable(n, nonneg=True)
+    roots = cp.hstack([np.array([program.sd_start]), cp.sqrt(interior), np.array([program.sd_end])])
+    limits.append(z <= roots[:-1] + roots[1:])
+    cost = cp.sum(cp.multiply(2 * ds, cp.inv_pos(z)))
+    if program.torque_weight > 0:
+        middle = 0.5 * (b[:-1] + b[1:])
+        for column in range(program.torque_a.shape[1]):
+            tau = cp.multiply(program.torque_a[:, column], a) + cp.multiply(program.torque_b[:, column], middle) + program.torque_c[:, column]
+            w = cp.Variable(n, nonneg=True)
+            limits.append(cp.SOC(w + z, cp.vstack([2 * tau, w - z]), axis=0))
+            cost = cost + program.torque_weight * cp.sum(cp.multiply(2 * ds, w))
+    problem = cp.Problem(cp.Minimize(cost), limits)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "inaccurate" is reported as the status
+            problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError as error:
+        raise TimingFailed(f"the convex solver failed: {error}") from None
+    if problem.status in ("infeasible", "infeasible_inaccurate"):
+        raise InfeasiblePath("no timing along the path meets the limits (the convex program is infeasible)")
+    if interior.value is None or problem.status not in ("optimal", "optimal_inaccurate"):
+        raise TimingFailed(f"the convex solver stopped with status {problem.status!r}")
+    return np.maximum(interior.value, 0.0), float(problem.value), str(problem.status)

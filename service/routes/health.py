@@ -6,6 +6,7 @@ router = APIRouter(tags=["health"])
 
 
 @router.get("/health", summary="Liveness check")
-def health() -> dict[str, str]:
-    """Answers ``{"status": "ok"}`` while the service runs."""
+async def health() -> dict[str, str]:
+    """Answers ``{"status": "ok"}`` while the service runs; on the event loop itself, so that it
+    never waits for a thread behind planning."""
     return {"status": "ok"}

@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 from fastapi import APIRouter, Request
+from fastapi.responses import Response
 
-from service.planning import compare_request, plan_request, run_with_budget, trajectory_body
-from service.problems import FiniteJSONResponse, problem_responses
+from service.planning import compare_request, encode_json, plan_request, trajectory_body
+from service.problems import problem_responses
 from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
 
 router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
 
-_ERRORS = problem_responses(404, 422, 504)
+_ERRORS = problem_responses(404, 413, 422, 503, 504)
 
 
 @router.post(
@@ -19,18 +20,25 @@ _ERRORS = problem_responses(404, 422, 504)
     response_model=TrajectoryResponse,
     responses=_ERRORS,
 )
-async def create_trajectory(body: TrajectoryRequest, request: Request) -> FiniteJSONResponse:
+async def create_trajectory(body: TrajectoryRequest, request: Request) -> Response:
     """Time the path of ``body`` for its robot under the requested limits and return the
-    samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit."""
+    samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit.
+    The body is built and encoded in the planning thread, within the time budget."""
     settings = request.app.state.settings
-    result = await run_with_budget(lambda deadline: plan_request(body, deadline), settings.plan_budget_s)
-    return FiniteJSONResponse(trajectory_body(result))
+
+    def planned(deadline) -> bytes:
+        return encode_json(trajectory_body(plan_request(body, deadline, settings.max_response_bytes)))
+
+    content = await request.app.state.planning.run(planned, settings.plan_budget_s)
+    return Response(content, media_type="application/json")
 
 
 @router.post("/compare", summary="Compare timing methods on one path", response_model=CompareResponse, responses=_ERRORS)
-async def compare_trajectories(body: CompareRequest, request: Request) -> FiniteJSONResponse:
+async def compare_trajectories(body: CompareRequest, request: Request) -> Response:
     """Time one path under several methods (e.g. ``phase_plane`` against ``quintic``) and return
     each one's duration, peak utilization and solve time: what time-optimality buys."""
     settings = request.app.state.settings
-    result = await run_with_budget(lambda deadline: compare_request(body, deadline), settings.plan_budget_s)
-    return FiniteJSONResponse(result)
+    content = await request.app.state.planning.run(
+        lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s
+    )
+    return Response(content, media_type="application/json")

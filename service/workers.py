@@ -1,0 +1,96 @@
+"""The planning workers: at most ``workers`` plannings run at once, each in a thread of its own
+pool under a time budget; up to ``queue`` more wait for a thread within their budget; beyond
+that a request is refused at once with 503 and ``Retry-After``.
+
+Memory is bounded the same way: each planning is capped (grid, samples, body size) and at most
+``workers`` run. A worker slot is freed when its thread really ends, not when its caller stops
+waiting: after a 504 the deadline is cancelled, the thread stops at its next check (and kills any
+worker process it waits on, ``planners.isolated``), and only then may the next planning start.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from concurrent.futures import ThreadPoolExecutor
+
+from planners import Deadline
+from planners.errors import BudgetExceeded
+from robots.errors import ToptrajError
+
+
+class ServiceBusy(ToptrajError):
+    """Every planning worker is busy and the queue is full.
+
+    Attributes:
+        retry_after: Seconds after which a retry may find a free worker (``Retry-After``).
+    """
+
+    status = 503
+    title = "Service busy"
+
+    def __init__(self, detail: str, retry_after: int = 1):
+        super().__init__(detail)
+        self.retry_after = retry_after
+
+
+class PlanningWorkers:
+    """Runs ``function(deadline)`` calls in at most ``workers`` threads, with a bounded queue.
+
+    Args:
+        workers: Plannings run at once (default in the settings: the number of cores).
+        queue: Requests that may wait for a free worker; beyond, 503.
+    """
+
+    def __init__(self, workers: int, queue: int):
+        self.workers, self.queue = workers, queue
+        self._executor = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="toptraj-plan")
+        self._slots = asyncio.Semaphore(workers)
+        self._admitted = 0
+
+    async def run(self, function, budget_s: float):
+        """``function(deadline)`` in a worker thread; past ``budget_s`` seconds from now (waiting
+        for a worker included), cancel its deadline and raise ``BudgetExceeded``.
+
+        Raises:
+            ServiceBusy: ``workers`` plannings run and ``queue`` more wait already.
+            BudgetExceeded: the budget was spent, waiting or planning.
+        """
+        if self._admitted >= self.workers + self.queue:
+            raise ServiceBusy(
+                f"all {self.workers} planning workers are busy and {self.queue} requests wait already; retry shortly"
+            )
+        deadline = Deadline(budget_s)
+        self._admitted += 1
+        acquired = False
+        try:
+            try:
+                await asyncio.wait_for(self._slots.acquire(), timeout=budget_s)
+            except asyncio.TimeoutError:
+                raise BudgetExceeded(
+                    f"no planning worker came free within the time budget of {budget_s:g} s"
+                ) from None
+            acquired = True
+            future = asyncio.get_running_loop().run_in_executor(self._executor, function, deadline)
+            future.add_done_callback(self._finished)
+            try:
+                return await asyncio.wait_for(asyncio.shield(future), timeout=deadline.remaining())
+            except asyncio.TimeoutError:
+                deadline.cancel()
+                raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s") from None
+            except asyncio.CancelledError:  # the client went away, or the server stops
+                deadline.cancel()
+                raise
+        finally:
+            if not acquired:
+                self._admitted -= 1
+
+    def _finished(self, future: asyncio.Future) -> None:
+        """The thread has ended: free its slot (and consume an error nobody awaits any more)."""
+        self._admitted -= 1
+        self._slots.release()
+        if not future.cancelled():
+            future.exception()
+
+    def close(self) -> None:
+        """Stop taking work; running threads end at their next deadline check."""
+        self._executor.shutdown(wait=False, cancel_futures=True)

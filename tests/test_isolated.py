@@ -1,0 +1,83 @@
+"""``planners.isolated``: a function run in a worker process returns its result or raises its
+error, and is killed when the deadline passes or is cancelled."""
+
+from __future__ import annotations
+
+import os
+import pickle
+import threading
+import time
+
+import numpy as np
+import psutil
+import pytest
+
+import robots
+from planners import BudgetExceeded, Deadline, InfeasiblePath
+from planners.isolated import run_isolated
+
+
+def _spin(pid_file: str) -> None:
+    with open(pid_file, "w") as handle:
+        handle.write(str(os.getpid()))
+    while True:
+        pass
+
+
+def _fail() -> None:
+    raise InfeasiblePath("no way through", s=0.25, joint="elbow")
+
+
+def _torques(robot: robots.Robot, q: np.ndarray) -> np.ndarray:
+    return robot.inverse_dynamics(q, np.ones_like(q), np.ones_like(q))
+
+
+def test_the_result_comes_back_from_the_worker_process():
+    robot = robots.load("ur5")
+    q = np.linspace(-1.0, 1.0, 12).reshape(2, 6)
+    np.testing.assert_array_equal(run_isolated(_torques, robot, q, deadline=Deadline(60)), _torques(robot, q))
+    assert run_isolated(os.getpid, deadline=Deadline(60)) != os.getpid()
+
+
+def test_an_error_comes_back_with_its_facts():
+    with pytest.raises(InfeasiblePath) as caught:
+        run_isolated(_fail, deadline=Deadline(60))
+    assert (caught.value.detail, caught.value.s, caught.value.joint) == ("no way through", 0.25, "elbow")
+
+
+def _killed(pid_file) -> bool:
+    pid = int(pid_file.read_text())
+    try:
+        return psutil.Process(pid).status() == psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return True
+
+
+def test_the_worker_is_killed_when_the_deadline_passes(tmp_path):
+    pid_file = tmp_path / "pid"
+    with pytest.raises(BudgetExceeded):
+        run_isolated(_spin, str(pid_file), deadline=Deadline(1.0))
+    assert _killed(pid_file)
+
+
+def test_the_worker_is_killed_when_the_deadline_is_cancelled(tmp_path):
+    pid_file = tmp_path / "pid"
+    deadline = Deadline(600)
+
+    def cancel_once_started():
+        while not pid_file.exists() or not pid_file.read_text():
+            time.sleep(0.01)
+        deadline.cancel()
+
+    threading.Thread(target=cancel_once_started, daemon=True).start()
+    with pytest.raises(BudgetExceeded):
+        run_isolated(_spin, str(pid_file), deadline=deadline)
+    assert _killed(pid_file)
+
+
+def test_a_robot_pickles_as_its_model():
+    robot = robots.load("panda")
+    copy = pickle.loads(pickle.dumps(robot))
+    assert copy.model == robot.model and copy.joint_names == robot.joint_names
+    q = np.full((1, robot.dof), 0.3)
+    np.testing.assert_allclose(_torques(copy, q), _torques(robot, q), atol=1e-12)
