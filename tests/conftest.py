@@ -38,3 +38,13 @@ def client(tmp_path_factory):
     settings = Settings(preload_robots=False, data_dir=tmp_path_factory.mktemp("data"))
     with TestClient(create_app(settings)) as test_client:
         yield test_client
+
+
+@pytest.fixture(scope="module")
+def patient_client(tmp_path_factory):
+    """A client whose planning budget fits a free-path collocation, which takes tens of seconds
+    on a loaded machine (the synchronous default is 20 s)."""
+    settings = Settings(preload_robots=False, data_dir=tmp_path_factory.mktemp("data"), plan_budget_s=300.0)
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+

@@ -6,21 +6,13 @@ import json
 from pathlib import Path
 
 import pytest
-from fastapi.testclient import TestClient
-
-from service.app import create_app
-from service.settings import Settings
-
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.json"))
 
 
 @pytest.fixture(scope="module")
-def client(tmp_path_factory):
-    """The examples include a free-path collocation that takes tens of seconds on a loaded
-    machine: a budget that lets it finish (the synchronous default is 20 s)."""
-    settings = Settings(preload_robots=False, data_dir=tmp_path_factory.mktemp("data"), plan_budget_s=300.0)
-    with TestClient(create_app(settings)) as test_client:
-        yield test_client
+def client(patient_client):
+    """The examples include a free-path collocation."""
+    return patient_client
 
 
 @pytest.mark.parametrize("example", EXAMPLES, ids=[path.stem for path in EXAMPLES])

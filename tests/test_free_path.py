@@ -11,6 +11,12 @@ from planners import Timing, plan
 from planners.free_path import FreeMotion
 
 
+@pytest.fixture(scope="module")
+def client(patient_client):
+    """Free-path collocations take tens of seconds on a loaded machine."""
+    return patient_client
+
+
 def _geering(goal, revolutions=True):
     arm = robots.load("geering_2r")
     motion = FreeMotion(np.zeros(2), np.array(goal, dtype=float), revolutions=revolutions)
