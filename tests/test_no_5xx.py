@@ -175,7 +175,7 @@ def live_server(monkeypatch):
     """A uvicorn server in a thread whose trajectory planning raises an unexpected error."""
     import service.routes.trajectories as routes
 
-    def broken(request, deadline=None):
+    def broken(*args, **kwargs):
         raise RuntimeError("a planner bug")
 
     monkeypatch.setattr(routes, "plan_request", broken)
