@@ -11,6 +11,7 @@ worker process it waits on, ``planners.isolated``), and only then may the next p
 from __future__ import annotations
 
 import asyncio
+import threading
 from concurrent.futures import ThreadPoolExecutor
 
 from planners import Deadline
@@ -33,6 +34,10 @@ class ServiceBusy(ToptrajError):
         self.retry_after = retry_after
 
 
+#: How often a request waiting for a worker looks for a free one, in s.
+_POLL_S = 0.005
+
+
 class PlanningWorkers:
     """Runs ``function(deadline)`` calls in at most ``workers`` threads, with a bounded queue.
 
@@ -44,7 +49,10 @@ class PlanningWorkers:
     def __init__(self, workers: int, queue: int):
         self.workers, self.queue = workers, queue
         self._executor = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="toptraj-plan")
-        self._slots = asyncio.Semaphore(workers)
+        # Thread primitives, not asyncio ones: a slot is freed by the planning thread itself when
+        # it ends, whatever became of the event loop that started it.
+        self._slots = threading.BoundedSemaphore(workers)
+        self._lock = threading.Lock()
         self._admitted = 0
 
     async def run(self, function, budget_s: float):
@@ -55,23 +63,29 @@ class PlanningWorkers:
             ServiceBusy: ``workers`` plannings run and ``queue`` more wait already.
             BudgetExceeded: the budget was spent, waiting or planning.
         """
-        if self._admitted >= self.workers + self.queue:
-            raise ServiceBusy(
-                f"all {self.workers} planning workers are busy and {self.queue} requests wait already; retry shortly"
-            )
+        with self._lock:
+            if self._admitted >= self.workers + self.queue:
+                raise ServiceBusy(
+                    f"all {self.workers} planning workers are busy and {self.queue} requests wait already; retry shortly"
+                )
+            self._admitted += 1
         deadline = Deadline(budget_s)
-        self._admitted += 1
-        acquired = False
+        started = False
         try:
-            try:
-                await asyncio.wait_for(self._slots.acquire(), timeout=budget_s)
-            except asyncio.TimeoutError:
-                raise BudgetExceeded(
-                    f"no planning worker came free within the time budget of {budget_s:g} s"
-                ) from None
-            acquired = True
-            future = asyncio.get_running_loop().run_in_executor(self._executor, function, deadline)
-            future.add_done_callback(self._finished)
+            while not self._slots.acquire(blocking=False):
+                if deadline.remaining() <= 0.0:
+                    raise BudgetExceeded(f"no planning worker came free within the time budget of {budget_s:g} s")
+                await asyncio.sleep(_POLL_S)
+
+            def work():
+                try:
+                    return function(deadline)
+                finally:
+                    self._release()
+
+            future = asyncio.get_running_loop().run_in_executor(self._executor, work)
+            started = True
+            future.add_done_callback(_consume)
             try:
                 return await asyncio.wait_for(asyncio.shield(future), timeout=deadline.remaining())
             except asyncio.TimeoutError:
@@ -81,16 +95,22 @@ class PlanningWorkers:
                 deadline.cancel()
                 raise
         finally:
-            if not acquired:
-                self._admitted -= 1
+            if not started:
+                with self._lock:
+                    self._admitted -= 1
 
-    def _finished(self, future: asyncio.Future) -> None:
-        """The thread has ended: free its slot (and consume an error nobody awaits any more)."""
-        self._admitted -= 1
+    def _release(self) -> None:
+        """A planning thread has ended: free its slot."""
+        with self._lock:
+            self._admitted -= 1
         self._slots.release()
-        if not future.cancelled():
-            future.exception()
 
     def close(self) -> None:
         """Stop taking work; running threads end at their next deadline check."""
         self._executor.shutdown(wait=False, cancel_futures=True)
+
+
+def _consume(future: asyncio.Future) -> None:
+    """Retrieve an error nobody awaits any more (a request past its budget)."""
+    if not future.cancelled():
+        future.exception()
