@@ -47,10 +47,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         await run_in_threadpool(start_worker_server)
         if settings.preload_robots:
             await run_in_threadpool(_warm_up)
-        # Each run of the app gets its own planning threads (an app may be started again after a
-        # shutdown, as test clients do).
-        app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue)
         yield
+        # Running plannings end at their next deadline check; an app started again (as test
+        # clients do, even overlapping) gets fresh threads under the same slots.
         app.state.planning.close()
 
     app = FastAPI(

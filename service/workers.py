@@ -48,7 +48,7 @@ class PlanningWorkers:
 
     def __init__(self, workers: int, queue: int):
         self.workers, self.queue = workers, queue
-        self._executor = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="toptraj-plan")
+        self._executor: ThreadPoolExecutor | None = None
         # Thread primitives, not asyncio ones: a slot is freed by the planning thread itself when
         # it ends, whatever became of the event loop that started it.
         self._slots = threading.BoundedSemaphore(workers)
@@ -83,7 +83,11 @@ class PlanningWorkers:
                 finally:
                     self._release()
 
-            future = asyncio.get_running_loop().run_in_executor(self._executor, work)
+            try:
+                future = asyncio.get_running_loop().run_in_executor(self._threads(), work)
+            except BaseException:
+                self._slots.release()
+                raise
             started = True
             future.add_done_callback(_consume)
             try:
@@ -99,6 +103,13 @@ class PlanningWorkers:
                 with self._lock:
                     self._admitted -= 1
 
+    def _threads(self) -> ThreadPoolExecutor:
+        """The pool of planning threads, opened on first use and again after ``close``."""
+        with self._lock:
+            if self._executor is None:
+                self._executor = ThreadPoolExecutor(max_workers=self.workers, thread_name_prefix="toptraj-plan")
+            return self._executor
+
     def _release(self) -> None:
         """A planning thread has ended: free its slot."""
         with self._lock:
@@ -106,8 +117,13 @@ class PlanningWorkers:
         self._slots.release()
 
     def close(self) -> None:
-        """Stop taking work; running threads end at their next deadline check."""
-        self._executor.shutdown(wait=False, cancel_futures=True)
+        """Let the threads go: running plannings end at their next deadline check, and the next
+        planning (an app started again) opens a new pool. The slots stay shared, so threads of a
+        closed pool still count against ``workers`` until they end."""
+        with self._lock:
+            executor, self._executor = self._executor, None
+        if executor is not None:
+            executor.shutdown(wait=False)
 
 
 def _consume(future: asyncio.Future) -> None:

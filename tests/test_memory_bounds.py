@@ -86,3 +86,18 @@ def test_a_request_waits_for_a_worker_within_its_budget():
             return await asyncio.gather(*(client.post("/v1/trajectories", json=short) for _ in range(2)))
 
     assert [response.status_code for response in asyncio.run(scenario())] == [200, 200]
+
+
+def test_an_app_started_again_keeps_planning_and_loses_no_worker():
+    """Test clients start and stop an app's lifespan around each use, sometimes overlapping (a
+    fuzzer beside a module client). Every request after a stop is planned, and the one worker
+    is never lost, however many starts and stops came before."""
+    app = create_app(Settings(preload_robots=False, plan_workers=1, plan_queue=0, plan_budget_s=10.0))
+    short = {**FAST, "timing": {"method": "cubic"}}
+    with TestClient(app) as outer:
+        for _ in range(3):
+            with TestClient(app) as inner:
+                assert inner.post("/v1/trajectories", json=short).status_code == 200
+            assert outer.post("/v1/trajectories", json=short).status_code == 200
+    after_stop = TestClient(app)  # no lifespan at all
+    assert [after_stop.post("/v1/trajectories", json=short).status_code for _ in range(3)] == [200] * 3
