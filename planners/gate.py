@@ -67,7 +67,7 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
     result = solve_well_scaled(method, constraints, boundary, duration, deadline)
     for _ in range(GATE_ROUNDS + 1):
         deadline.check()
-        check = check_limits(path, result, robot, limits, kinds, threshold)
+        check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s)
         if check.worst is None or check.worst.ratio <= threshold:
             return result, constraints, check
         if isinstance(result, LawTiming) and duration is None:
@@ -106,7 +106,7 @@ def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath
 def checked(robot, path, result, method, kinds, limits, threshold, constraints) -> TimedStretch:
     """A timing that cannot be refined, through the limit gate: kept when it holds the limits,
     refused (with where, which joint and which limit) when it does not."""
-    check = check_limits(path, result, robot, limits, kinds, threshold)
+    check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s)
     if check.worst is not None and check.worst.ratio > threshold:
         raise limit_exceeded(method, check.worst, robot, path)
     return TimedStretch(path, result, constraints, check)

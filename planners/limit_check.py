@@ -9,7 +9,8 @@ Along q(s) timed by s(t) (Yamamoto et al. eqs. (8), (9); jerk by one more deriva
     tau  = RNEA(q, qd, qdd) + D qd + F sign(qd)
 
 evaluated at the timing's dense states (``PathTiming.dense_states``): for timings on a grid of s,
-``POINTS_PER_INTERVAL`` states per grid interval, both ends and both sides of every corner. This
+``POINTS_PER_INTERVAL`` states per interval of the grid the constraints were built on (as far
+apart in the intervals a method refined), both ends and both sides of every grid point. This
 check is the gate every answer passes: ``planners.plan`` refines the grid where it finds a limit
 exceeded, and refuses the answer when refinement cannot bring it back.
 """
@@ -21,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.paths.base import GeometricPath
-from planners.timing.base import PathTiming
+from planners.timing.base import PathTiming, TimeScaling
 from robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included.
@@ -59,23 +60,26 @@ class LimitCheck:
 
 def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, ...]:
     """q, qd, qdd and (when the states carry sddd) qddd at ``states``, each (n, n_dof), with the
-    path's one-sided derivatives at corners (``states.left``)."""
-    q = path(states.s)
-    qd, qdd = np.empty_like(q), np.empty_like(q)
-    jerk = np.empty_like(q) if states.sddd is not None else None
-    for side, mask in (("right", ~states.left), ("left", states.left)):
-        if not np.any(mask):
-            continue
-        s, sd, sdd = states.s[mask], states.sd[mask], states.sdd[mask]
-        points = path.evaluate(s, side)
-        qd[mask] = points.dq * sd[:, None]
-        qdd[mask] = points.dq * sdd[:, None] + points.ddq * (sd**2)[:, None]
-        if jerk is not None:
-            jerk[mask] = (
-                path.third_derivative(s, side) * (sd**3)[:, None]
-                + 3.0 * points.ddq * (sd * sdd)[:, None]
-                + points.dq * states.sddd[mask][:, None]
-            )
+    path's one-sided derivatives from the left for ``states.left`` states at a corner (and, for
+    the third derivative, at any knot)."""
+    points = path.evaluate(states.s, "right")
+    q, dq, ddq = points.q, points.dq, points.ddq
+    third = path.third_derivative(states.s, "right") if states.sddd is not None else None
+    at_kink = states.left & np.isin(states.s, path.kinks) if len(path.kinks) else None
+    if at_kink is not None and at_kink.any():
+        dq, ddq = dq.copy(), ddq.copy()
+        left = path.evaluate(states.s[at_kink], "left")
+        dq[at_kink], ddq[at_kink] = left.dq, left.ddq
+    if third is not None:
+        # d3q/ds3 jumps at every knot of a spline, not only at corners.
+        at_knot = states.left & np.isin(states.s, path.knots)
+        if at_knot.any():
+            third = third.copy()
+            third[at_knot] = path.third_derivative(states.s[at_knot], "left")
+    sd, sdd = states.sd[:, None], states.sdd[:, None]
+    qd = dq * sd
+    qdd = dq * sdd + ddq * (sd * sd)
+    jerk = None if third is None else third * sd**3 + 3.0 * ddq * (sd * sdd) + dq * states.sddd[:, None]
     return q, qd, qdd, jerk
 
 
@@ -86,6 +90,7 @@ def check_limits(
     limits: JointLimits,
     kinds: tuple[str, ...] = KINDS,
     threshold: float = np.inf,
+    reference: np.ndarray | None = None,
 ) -> LimitCheck:
     """Every limit of ``limits`` (velocity, acceleration, torque, and jerk when the timing has a
     finite one) over the dense states of ``timing`` along ``path``.
@@ -94,8 +99,14 @@ def check_limits(
         kinds: The limits the timing must hold: ``worst`` and ``intervals_over`` look at these
             only (``utilization`` reports every kind).
         threshold: Ratio above which a state's grid interval is listed in ``intervals_over``.
+        reference: For a timing on a grid of s, the grid the constraints were built on: states
+            keep its resolution (``POINTS_PER_INTERVAL`` per interval) where the timing method
+            refined it, instead of that many per refined interval.
     """
-    states = timing.dense_states(POINTS_PER_INTERVAL)
+    if reference is not None and isinstance(timing, TimeScaling):
+        states = timing.dense_states(POINTS_PER_INTERVAL, reference)
+    else:
+        states = timing.dense_states(POINTS_PER_INTERVAL)
     q, qd, qdd, jerk = joint_motion(path, states)
     values = {"velocity": qd, "acceleration": qdd, "torque": robot.inverse_dynamics(q, qd, qdd)}
     if jerk is not None:
@@ -104,13 +115,17 @@ def check_limits(
     over = np.zeros(len(states.s), dtype=bool)
     for kind, value in values.items():
         with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.nan_to_num(np.abs(value) / getattr(limits, kind), nan=0.0, posinf=np.inf)
+            ratio = np.abs(value)
+            ratio *= 1.0 / getattr(limits, kind)  # 0 where a joint is unlimited
+            if not np.isfinite(ratio).all():
+                ratio = np.nan_to_num(ratio, nan=0.0, posinf=np.inf)
         utilization[kind] = ratio.max(axis=0)
         if kind not in kinds:
             continue
-        index = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-        if worst is None or ratio[index] > worst.ratio:
-            worst = Excess(float(ratio[index]), kind, int(index[1]), float(states.s[index[0]]))
-        over |= ratio.max(axis=1) > threshold
+        per_state = ratio.max(axis=1)
+        state = int(np.argmax(per_state))
+        if worst is None or per_state[state] > worst.ratio:
+            worst = Excess(float(per_state[state]), kind, int(np.argmax(ratio[state])), float(states.s[state]))
+        over |= per_state > threshold
     intervals = np.empty(0, dtype=int) if states.interval is None else np.unique(states.interval[over])
     return LimitCheck(utilization, worst, intervals)

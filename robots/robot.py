@@ -152,7 +152,8 @@ class Robot:
         plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``."""
         qd = np.atleast_2d(qd)
         tau = self.rnea(q, qd, qdd)
-        tau += self.viscous_friction * qd + self.coulomb_friction * np.sign(qd)
+        if np.any(self.viscous_friction) or np.any(self.coulomb_friction):
+            tau += self.viscous_friction * qd + self.coulomb_friction * np.sign(qd)
         return tau
 
     def outside_position_limits(self, q: np.ndarray, slack: float = 1e-9) -> tuple[int, int] | None:

@@ -144,8 +144,8 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         "duration": result.duration,
         "samples": {"t": samples.t, "q": samples.q, "qd": samples.qd, "qdd": samples.qdd, "tau": samples.tau},
         "phase_plane": {
-            "s": result.phase_plane.s.tolist(),
-            "sd": result.phase_plane.sd.tolist(),
+            "s": result.phase_plane.s,
+            "sd": result.phase_plane.sd,
             "sd_max": _finite_or_none(result.phase_plane.sd_max),
             "switch_points": [{"s": s, "kind": kind} for s, kind in result.phase_plane.switch_points],
         },

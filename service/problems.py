@@ -89,6 +89,8 @@ def _first_non_finite(value: Any, where: str) -> tuple[str | None, float | None]
     if isinstance(value, dict):
         items = ((f"{where}.{key}" if where else str(key), item) for key, item in value.items())
     elif isinstance(value, (list, tuple)):
+        if _all_finite_numbers(value):
+            return None, None
         items = ((f"{where}[{index}]", item) for index, item in enumerate(value))
     else:
         return None, None
@@ -97,6 +99,18 @@ def _first_non_finite(value: Any, where: str) -> tuple[str | None, float | None]
         if found[0] is not None:
             return found
     return None, None
+
+
+def _all_finite_numbers(values: list | tuple) -> bool:
+    """Whether ``values`` is a flat sequence of finite numbers, checked in one numpy pass (a
+    sequence holding anything else is walked item by item instead)."""
+    if not values or not isinstance(values[0], (int, float)):
+        return False
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return array.ndim == 1 and bool(np.isfinite(array).all())
 
 
 def problem(status: int, title: str, detail: str, headers: dict[str, str] | None = None, **extra) -> JSONResponse:

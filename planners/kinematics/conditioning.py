@@ -47,16 +47,26 @@ def characteristic_length(robot: Robot) -> float:
 
 
 def task_jacobian(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> np.ndarray:
-    """The end effector's Jacobian at ``q`` as conditioned here: 3 translational rows for arms
-    of up to three joints; else angular rows over translational rows divided by ``length``."""
-    data = robot.data
-    pin.computeJointJacobians(robot.model, data, robot.configuration(q))
-    pin.updateFramePlacements(robot.model, data)
-    # Pinocchio returns a (6,) vector, not a (6, 1) matrix, for a one-joint model.
-    jacobian = np.asarray(pin.getFrameJacobian(robot.model, data, frame_id, pin.LOCAL_WORLD_ALIGNED)).reshape(6, robot.dof)
+    """The end effector's Jacobian at ``q`` (n_dof,) as conditioned here: 3 translational rows
+    for arms of up to three joints; else angular rows over translational rows divided by
+    ``length``."""
+    return task_jacobians(robot, np.atleast_2d(q), frame_id, length)[0]
+
+
+def task_jacobians(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> np.ndarray:
+    """``task_jacobian`` at every row of ``q`` (n_samples, n_dof): shape (n_samples, 3 or 6,
+    n_dof)."""
+    model, data = robot.model, robot.data
+    configurations = robot.configuration(q)
+    jacobians = np.empty((len(q), 6, robot.dof))
+    for row, configuration in enumerate(configurations):
+        # Pinocchio returns a (6,) vector, not a (6, 1) matrix, for a one-joint model.
+        jacobians[row] = np.reshape(
+            pin.computeFrameJacobian(model, data, configuration, frame_id, pin.LOCAL_WORLD_ALIGNED), (6, robot.dof)
+        )
     if robot.dof <= 3:
-        return jacobian[:3]
-    return np.vstack([jacobian[3:], jacobian[:3] / length])
+        return jacobians[:, :3]
+    return np.concatenate([jacobians[:, 3:], jacobians[:, :3] / length], axis=1)
 
 
 def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tuple[float, float, float, float]:
@@ -65,6 +75,6 @@ def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tu
     length = characteristic_length(robot)
     frame_id = robot.frame_id(robot.end_effector)
     rows = np.unique(np.linspace(0, len(q) - 1, min(len(q), max_points)).round().astype(int))
-    kappas = frobenius_condition_number(np.array([task_jacobian(robot, q[k], frame_id, length) for k in rows]))
+    kappas = frobenius_condition_number(task_jacobians(robot, q[rows], frame_id, length))
     worst = int(np.argmax(kappas))
     return float(kappas.min()), float(kappas.max()), length, int(rows[worst])

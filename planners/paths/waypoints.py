@@ -53,17 +53,24 @@ class SplinePath(_ThroughWaypoints):
     def __init__(self, waypoints: np.ndarray):
         super().__init__(waypoints)
         self.kinks = np.empty(0)
-        self._spline = CubicSpline(self.knots, self.waypoints, axis=0, bc_type="natural")
-        self._d1 = self._spline.derivative(1)
-        self._d2 = self._spline.derivative(2)
-        self._d3 = self._spline.derivative(3)
+        # Power-basis coefficients per knot interval, shape (4, n_waypoints - 1, n_dof):
+        # q = c0 h^3 + c1 h^2 + c2 h + c3 with h = s - knot.
+        self._coefficients = CubicSpline(self.knots, self.waypoints, axis=0, bc_type="natural").c
+
+    def _local(self, s: np.ndarray):
+        """The coefficients of the interval holding each s, and h = s - its knot, as (n, 1)."""
+        s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
+        interval = np.clip(np.searchsorted(self.knots, s, side="right") - 1, 0, len(self.knots) - 2)
+        c0, c1, c2, c3 = self._coefficients[:, interval]
+        return c0, c1, c2, c3, (s - self.knots[interval])[:, None]
 
     def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
-        s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
-        return PathPoints(self._spline(s), self._d1(s), self._d2(s))
+        c0, c1, c2, c3, h = self._local(s)
+        return PathPoints(((c0 * h + c1) * h + c2) * h + c3, (3.0 * c0 * h + 2.0 * c1) * h + c2, 6.0 * c0 * h + 2.0 * c1)
 
     def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
-        return self._d3(np.clip(np.asarray(s, dtype=float), 0.0, 1.0))
+        c0, _, _, _, h = self._local(s)
+        return np.broadcast_to(6.0 * c0, (len(h), self.dof)).copy()
 
 
 class StopAndGoPath(_ThroughWaypoints):

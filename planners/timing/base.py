@@ -134,14 +134,32 @@ class TimeScaling(PathTiming):
         s = self.s[interval] + self.sd[interval] * tau + 0.5 * sdd * tau**2
         return np.minimum(s, self.s[interval + 1]), np.maximum(sd, 0.0), sdd
 
-    def dense_states(self, points_per_interval: int = 3) -> DenseStates:
-        """``points_per_interval`` states per grid interval, evenly spaced in s, both ends
-        included: a grid point is reached as the end of one interval (``left``) and the start of
-        the next, each with its own sdd. Within an interval x = sd^2 is linear in s."""
-        fractions = np.linspace(0.0, 1.0, max(points_per_interval, 2))
+    def dense_states(self, points_per_interval: int = 3, reference: np.ndarray | None = None) -> DenseStates:
+        """States evenly spaced in s within each grid interval, both ends included: a grid point
+        is reached as the end of one interval (``left``) and the start of the next, each with
+        its own sdd. Within an interval x = sd^2 is linear in s.
+
+        Args:
+            points_per_interval: States per interval of ``reference`` (both ends included).
+            reference: A coarser grid whose resolution the states keep (the grid the path's
+                constraints were built on, which a method may have refined): an interval of
+                this timing gets states as far apart as ``points_per_interval`` per interval of
+                ``reference`` would be, at least its two ends. ``None``: this timing's grid.
+        """
         n_intervals = len(self.s) - 1
-        interval = np.repeat(np.arange(n_intervals), len(fractions))
-        fraction = np.tile(fractions, n_intervals)
+        widths = np.diff(self.s)
+        if reference is None:
+            parts = np.full(n_intervals, max(points_per_interval, 2) - 1)
+        else:
+            reference = np.asarray(reference, dtype=float)
+            middle = 0.5 * (self.s[:-1] + self.s[1:])
+            holder = np.clip(np.searchsorted(reference, middle) - 1, 0, len(reference) - 2)
+            room = np.diff(reference)[holder]
+            parts = np.clip(np.ceil((max(points_per_interval, 2) - 1) * widths / room - 1e-9), 1, None).astype(int)
+        counts = parts + 1
+        interval = np.repeat(np.arange(n_intervals), counts)
+        step = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+        fraction = step / parts[interval]
         s0, s1 = self.s[interval], self.s[interval + 1]
         x = self.sd[interval] ** 2 + fraction * (self.sd[interval + 1] ** 2 - self.sd[interval] ** 2)
         return DenseStates(
@@ -149,7 +167,7 @@ class TimeScaling(PathTiming):
             sd=np.sqrt(np.maximum(x, 0.0)),
             sdd=self.sdd[interval],
             sddd=None,
-            left=fraction == 1.0,
+            left=step == parts[interval],
             interval=interval,
         )
 

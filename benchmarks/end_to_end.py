@@ -1,0 +1,245 @@
+"""The typical request end to end against its anchors, interleaved in one run.
+
+The typical request: ur5, 4 spline waypoints, velocity + acceleration + torque, ``phase_plane``,
+samples every 10 ms. Each round times, in a shuffled order:
+
+* **bare toppra**: one solve of the same path and limits through toppra's own public API, as a
+  toppra user writes it: ``SplineInterpolator`` over the waypoints (knots evenly spaced in s, as
+  ours), ``JointVelocityConstraint``, ``JointAccelerationConstraint`` and
+  ``JointTorqueConstraint`` with a ``pin.rnea`` callback, ``TOPPRA`` on 100 grid intervals,
+  ``compute_trajectory`` (its constraint evaluation, both passes and the parameterization);
+* **RNEA floor**: 3 RNEA per grid point of the grid our answer was actually timed on, in one
+  batched call (``Robot.rnea``, Pinocchio's ``rneaInParallel``);
+* **library**: ``planners.plan`` for the request (no HTTP, no JSON);
+* **planning thread**: what a server's planning thread does: the request's schema object to
+  JSON bytes (``plan_request``, ``trajectory_body``, ``encode_json``);
+* **HTTP**: ``POST /v1/trajectories`` to ``toptraj serve --workers 1`` over one keep-alive
+  loopback connection, the body read in full.
+
+Prints the medians and the ratios of the goals (HTTP <= 1.0x bare toppra and <= 8x the RNEA
+floor; library <= 0.6x bare toppra), then (``--profile``) the stages of a request as shares
+of its HTTP median, from ``cProfile`` over the planning thread's work.
+
+    python benchmarks/end_to_end.py [--rounds 300] [--profile]
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import http.client
+import json
+import os
+import pstats
+import random
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import robots  # noqa: E402
+from service.planning import encode_json, plan_request, trajectory_body  # noqa: E402
+from service.schemas.trajectories import TrajectoryRequest  # noqa: E402
+
+WAYPOINTS = [
+    [0.0, -1.2, 1.0, 0.0, 0.0, 0.0],
+    [0.8, -1.0, 1.4, -0.5, 0.6, 0.3],
+    [1.5, -0.5, 0.8, -1.0, 1.0, 0.8],
+    [2.0, -1.3, 1.2, 0.2, 0.4, 1.2],
+]
+TYPICAL = {
+    "robot": "ur5",
+    "path": {"kind": "waypoints", "waypoints": WAYPOINTS, "interpolation": "spline"},
+    "timing": {"method": "phase_plane", "constraints": ["velocity", "acceleration", "torque"]},
+    "output": {"dt": 0.01},
+}
+#: Stages of the profile: a label and the functions whose cumulative time it is (the first
+#: that appears in the profile counts; nested stages are subtracted from their parents).
+STAGES = (
+    ("request to library arguments", ("plan_request",), ("plan",)),
+    ("path construction and checks", ("make_path", "_check_path_within_limits"), ()),
+    ("constraint build (grid rows)", ("build_path_constraints",), ()),
+    ("timing solve (incl. refinement)", ("solve_well_scaled",), ()),
+    ("dense limit check (the gate)", ("check_limits",), ()),
+    ("sampling at dt", ("sample_trajectory",), ()),
+    ("dense check of the samples", ("samples_exceed",), ()),
+    ("conditioning", ("conditioning_along",), ()),
+    ("phase-plane picture", ("_phase_plane",), ()),
+    ("response body", ("trajectory_body",), ()),
+    ("JSON encoding", ("encode_json",), ()),
+)
+
+
+def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100) -> float:
+    """One toppra solve through its public API; returns the duration (s)."""
+    import pinocchio as pin
+    import toppra
+
+    model, data, limits = robot.model, robot.model.createData(), robot.limits
+    path = toppra.SplineInterpolator(np.linspace(0.0, 1.0, len(waypoints)), waypoints)
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])),
+        toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits.acceleration, limits.acceleration])),
+        toppra.constraint.JointTorqueConstraint(
+            lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
+            np.column_stack([-limits.torque, limits.torque]),
+            np.zeros(robot.dof),
+        ),
+    ]
+    solver = toppra.algorithm.TOPPRA(
+        constraints, path, gridpoints=np.linspace(0.0, 1.0, intervals + 1), parametrizer="ParametrizeConstAccel"
+    )
+    return float(solver.compute_trajectory().duration)
+
+
+def rnea_floor(robot: robots.Robot, states: np.ndarray) -> None:
+    """3 RNEA per grid point, batched: ``states`` is (3 * points, 3, n_dof) of q, qd, qdd."""
+    robot.rnea(states[:, 0], states[:, 1], states[:, 2])
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def _serve(port: int) -> subprocess.Popen:
+    server = subprocess.Popen(
+        [sys.executable, "-m", "service.cli", "serve", "--port", str(port)],
+        cwd=ROOT,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    give_up = time.monotonic() + 120
+    while time.monotonic() < give_up:
+        try:
+            connection = http.client.HTTPConnection("127.0.0.1", port, timeout=2)
+            connection.request("GET", "/health")
+            if connection.getresponse().status == 200:
+                return server
+        except OSError:
+            time.sleep(0.2)
+    server.kill()
+    raise RuntimeError("the server did not come up")
+
+
+def _timed(function) -> float:
+    started = time.perf_counter()
+    function()
+    return time.perf_counter() - started
+
+
+def _profile(request: TrajectoryRequest, http_median_s: float, calls: int = 100) -> None:
+    """Stage shares of the HTTP median, from cProfile over the planning thread's work."""
+
+    def thread_work():
+        return encode_json(trajectory_body(plan_request(request)))
+
+    profiler = cProfile.Profile()
+    profiler.enable()
+    for _ in range(calls):
+        thread_work()
+    profiler.disable()
+    stats = pstats.Stats(profiler).stats
+    cumulative: dict[str, float] = {}
+    for (_, _, name), (_, _, _, total, _) in stats.items():
+        cumulative[name] = cumulative.get(name, 0.0) + total
+    profiled = cumulative.get("thread_work", 0.0)
+    unprofiled = np.median([_timed(thread_work) for _ in range(30)])
+    scale = unprofiled / (profiled / calls)  # cProfile's own overhead taken out, evenly
+    rows, accounted = [], 0.0
+    for label, names, nested in STAGES:
+        seconds = sum(cumulative.get(name, 0.0) for name in names) - sum(cumulative.get(name, 0.0) for name in nested)
+        seconds = scale * seconds / calls
+        accounted += seconds
+        rows.append((label, seconds))
+    rows.append(("rest of the planning thread", unprofiled - accounted))
+    rows.append(("HTTP stack (HTTP median - planning thread)", http_median_s - unprofiled))
+    print(f"\nstages of the typical request (shares of the HTTP median {1e3 * http_median_s:.2f} ms; cProfile, "
+          f"its overhead scaled out):")
+    for label, seconds in sorted(rows, key=lambda row: -row[1]):
+        print(f"  {label:44s} {1e3 * seconds:7.3f} ms  {100 * seconds / http_median_s:5.1f} %")
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--rounds", type=int, default=300)
+    parser.add_argument("--profile", action="store_true", help="print the stages of a request")
+    args = parser.parse_args()
+
+    import toppra
+
+    toppra.setup_logging("WARNING")
+    robot = robots.load("ur5")
+    waypoints = np.array(WAYPOINTS)
+    request = TrajectoryRequest.model_validate(TYPICAL)
+    payload = json.dumps(TYPICAL).encode()
+    from planners import plan
+    from service.planning import _path, _timing
+
+    timing, path_spec = _timing(request), _path(request.path, robot, request)
+    answer = plan(robot, path_spec, timing, 0.01)
+    grid_points = len(answer.phase_plane.s)
+    rng = np.random.default_rng(0)
+    states = rng.uniform(-1.0, 1.0, (3 * grid_points, 3, robot.dof))
+
+    port = _free_port()
+    server = _serve(port)
+    try:
+        connection = http.client.HTTPConnection("127.0.0.1", port, timeout=60)
+
+        def http_call():
+            connection.request("POST", "/v1/trajectories", payload, {"content-type": "application/json"})
+            response = connection.getresponse()
+            body = response.read()
+            if response.status != 200:
+                raise RuntimeError(f"HTTP {response.status}: {body[:300]!r}")
+
+        probes = {
+            "bare toppra": lambda: bare_toppra(robot, waypoints),
+            "RNEA floor": lambda: rnea_floor(robot, states),
+            "library": lambda: plan(robot, path_spec, timing, 0.01),
+            "planning thread": lambda: encode_json(trajectory_body(plan_request(request))),
+            "HTTP": http_call,
+        }
+        for function in probes.values():  # warm-up
+            for _ in range(5):
+                function()
+        times = {name: [] for name in probes}
+        order = list(probes)
+        shuffle = random.Random(1)
+        for _ in range(args.rounds):
+            shuffle.shuffle(order)
+            for name in order:
+                times[name].append(_timed(probes[name]))
+        median = {name: float(np.median(values)) for name, values in times.items()}
+        print(f"typical request: ur5, 4 spline waypoints, velocity + acceleration + torque, dt 0.01; "
+              f"{args.rounds} interleaved rounds; duration {answer.duration:.4f} s (bare toppra "
+              f"{bare_toppra(robot, waypoints):.4f} s at 100 intervals); our grid {grid_points} points")
+        for name, values in times.items():
+            print(f"  {name:16s} p50 {1e3 * median[name]:8.3f} ms   p95 {1e3 * np.percentile(values, 95):8.3f} ms")
+        goals = (
+            ("HTTP p50 / bare toppra", median["HTTP"] / median["bare toppra"], 1.0),
+            ("HTTP p50 / RNEA floor", median["HTTP"] / median["RNEA floor"], 8.0),
+            ("library / bare toppra", median["library"] / median["bare toppra"], 0.6),
+        )
+        print()
+        for label, ratio, goal in goals:
+            print(f"  {label:24s} {ratio:7.2f}x   goal <= {goal:g}x   {'met' if ratio <= goal else 'MISSED'}")
+        if args.profile:
+            _profile(request, median["HTTP"])
+    finally:
+        server.terminate()
+        server.wait(timeout=10)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
