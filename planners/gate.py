@@ -67,7 +67,7 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
     result = solve_well_scaled(method, constraints, boundary, duration, deadline)
     for _ in range(GATE_ROUNDS + 1):
         deadline.check()
-        check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s)
+        check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s, constraints)
         if check.worst is None or check.worst.ratio <= threshold:
             return result, constraints, check
         if isinstance(result, LawTiming) and duration is None:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planners.constraints import PathConstraints
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from robots import JointLimits, Robot
@@ -83,6 +84,34 @@ def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, ...]:
     return q, qd, qdd, jerk
 
 
+def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | None) -> np.ndarray:
+    """Joint torques (n, n_dof) at ``states``. At a state on the grid of ``constraints`` (when
+    they hold a torque row for every joint) the torque is the row ``a u + b x + c + d sd`` the
+    build computed there with Pinocchio's RNEA (the same number, to rounding), on the side the
+    state belongs to; the RNEA runs, batched, at every other state. States at rest are left to
+    the RNEA: the rows carry Coulomb friction for a moving joint."""
+    column = {} if constraints is None else {joint: k for k, (kind, joint) in enumerate(constraints.rows) if kind == "torque"}
+    if len(column) != robot.dof:
+        return robot.inverse_dynamics(q, qd, qdd)
+    columns = [column[joint] for joint in range(robot.dof)]
+    grid = constraints.s
+    index = np.clip(np.searchsorted(grid, states.s), 0, len(grid) - 1)
+    on_grid = (grid[index] == states.s) & (states.sd > 0.0)
+    tau = np.empty_like(qd)
+    between = ~on_grid
+    tau[between] = robot.inverse_dynamics(q[between], qd[between], qdd[between])
+    for left, rows in ((False, (constraints.a, constraints.b, constraints.c, constraints.d)),
+                       (True, (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left))):
+        mask = on_grid & (states.left == left)
+        if not mask.any():
+            continue
+        point = index[mask]
+        a, b, c, d = (row[point][:, columns] for row in rows)
+        sd, sdd = states.sd[mask, None], states.sdd[mask, None]
+        tau[mask] = a * sdd + b * (sd * sd) + c + d * sd
+    return tau
+
+
 def check_limits(
     path: GeometricPath,
     timing: PathTiming,
@@ -91,6 +120,7 @@ def check_limits(
     kinds: tuple[str, ...] = KINDS,
     threshold: float = np.inf,
     reference: np.ndarray | None = None,
+    constraints: PathConstraints | None = None,
 ) -> LimitCheck:
     """Every limit of ``limits`` (velocity, acceleration, torque, and jerk when the timing has a
     finite one) over the dense states of ``timing`` along ``path``.
@@ -102,13 +132,15 @@ def check_limits(
         reference: For a timing on a grid of s, the grid the constraints were built on: states
             keep its resolution (``POINTS_PER_INTERVAL`` per interval) where the timing method
             refined it, instead of that many per refined interval.
+        constraints: The constraints the timing was computed on: at states on their grid, the
+            torque is read from their rows instead of being computed again.
     """
     if reference is not None and isinstance(timing, TimeScaling):
         states = timing.dense_states(POINTS_PER_INTERVAL, reference)
     else:
         states = timing.dense_states(POINTS_PER_INTERVAL)
     q, qd, qdd, jerk = joint_motion(path, states)
-    values = {"velocity": qd, "acceleration": qdd, "torque": robot.inverse_dynamics(q, qd, qdd)}
+    values = {"velocity": qd, "acceleration": qdd, "torque": _torques(robot, states, q, qd, qdd, constraints)}
     if jerk is not None:
         values["jerk"] = jerk
     utilization, worst = {}, None

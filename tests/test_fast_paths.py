@@ -1,0 +1,61 @@
+"""The shortcuts of the typical request compute the numbers of the long way, to rounding: the
+spline's one-pass evaluation against SciPy's ``CubicSpline``, and the dense check's torques read
+from the grid rows against Pinocchio's RNEA at every state (friction included)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.interpolate import CubicSpline
+
+import robots
+from planners.constraints import build_path_constraints
+from planners.grid import path_grid
+from planners.limit_check import _torques, check_limits, joint_motion
+from planners.paths import SplinePath
+from planners.timing import PhasePlaneMethod, ToppraMethod
+from robots.catalog import robot_from_model
+from robots.urdf_check import check_urdf
+
+KINDS = ("velocity", "acceleration", "torque")
+
+
+@pytest.mark.parametrize("count", [2, 3, 5, 12])
+def test_spline_evaluation_matches_scipy(count):
+    rng = np.random.default_rng(count)
+    path = SplinePath(rng.normal(size=(count, 6)))
+    reference = CubicSpline(path.knots, path.waypoints, axis=0, bc_type="natural")
+    s = np.concatenate([rng.uniform(0.0, 1.0, 500), path.knots])
+    points = path.evaluate(s)
+    for order, values in enumerate([points.q, points.dq, points.ddq, path.third_derivative(s)]):
+        expected = reference(s, order)
+        assert np.abs(values - expected).max() <= 1e-12 * max(1.0, np.abs(expected).max())
+
+
+def _friction_pendulum():
+    text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()
+    return robot_from_model("pendulum_1r", check_urdf(text), "upload", None)
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "yamamoto_2r", "pendulum_1r"])
+@pytest.mark.parametrize("method", [PhasePlaneMethod(), ToppraMethod()], ids=["phase_plane", "toppra"])
+def test_dense_check_torques_from_rows_equal_rnea(name, method):
+    robot = _friction_pendulum() if name == "pendulum_1r" else robots.load(name)
+    assert name != "pendulum_1r" or np.any(robot.coulomb_friction) and np.any(robot.viscous_friction)
+    rng = np.random.default_rng(5)
+    lower = np.maximum(robot.limits.position_lower, -2.0)
+    upper = np.minimum(robot.limits.position_upper, 2.0)
+    path = SplinePath(rng.uniform(0.5 * lower, 0.5 * upper, (4, robot.dof)))
+    constraints = build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path))
+    timing = method.solve(constraints)
+    states = timing.dense_states(7, constraints.s)
+    q, qd, qdd, _ = joint_motion(path, states)
+    from_rows = _torques(robot, states, q, qd, qdd, constraints)
+    everywhere = robot.inverse_dynamics(q, qd, qdd)
+    assert np.abs(from_rows - everywhere).max() <= 1e-12 * np.abs(everywhere).max()
+    fast = check_limits(path, timing, robot, robot.limits, KINDS, 1.003, constraints.s, constraints)
+    slow = check_limits(path, timing, robot, robot.limits, KINDS, 1.003, constraints.s)
+    for kind in KINDS:
+        np.testing.assert_allclose(fast.utilization[kind], slow.utilization[kind], rtol=1e-12)
