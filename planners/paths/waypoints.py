@@ -11,6 +11,7 @@ motion start or end at a velocity tangent to the path. Continuous joints are int
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from scipy.interpolate import CubicSpline
 
 from planners.errors import InvalidRequest
@@ -55,22 +56,38 @@ class SplinePath(_ThroughWaypoints):
         self.kinks = np.empty(0)
         # Power-basis coefficients per knot interval, shape (4, n_waypoints - 1, n_dof):
         # q = c0 h^3 + c1 h^2 + c2 h + c3 with h = s - knot.
-        self._coefficients = CubicSpline(self.knots, self.waypoints, axis=0, bc_type="natural").c
-
-    def _local(self, s: np.ndarray):
-        """The coefficients of the interval holding each s, and h = s - its knot, as (n, 1)."""
-        s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
-        interval = np.clip(np.searchsorted(self.knots, s, side="right") - 1, 0, len(self.knots) - 2)
-        c0, c1, c2, c3 = self._coefficients[:, interval]
-        return c0, c1, c2, c3, (s - self.knots[interval])[:, None]
+        self._coefficients = np.ascontiguousarray(CubicSpline(self.knots, self.waypoints, axis=0, bc_type="natural").c)
 
     def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
-        c0, c1, c2, c3, h = self._local(s)
-        return PathPoints(((c0 * h + c1) * h + c2) * h + c3, (3.0 * c0 * h + 2.0 * c1) * h + c2, 6.0 * c0 * h + 2.0 * c1)
+        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
+        return PathPoints(*cubic_pieces(self.knots, self._coefficients, s))
 
     def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
-        c0, _, _, _, h = self._local(s)
-        return np.broadcast_to(6.0 * c0, (len(h), self.dof)).copy()
+        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
+        interval = np.clip(np.searchsorted(self.knots, s, side="right") - 1, 0, len(self.knots) - 2)
+        return 6.0 * self._coefficients[0, interval]
+
+
+@njit(cache=True, nogil=True)
+def cubic_pieces(knots, coefficients, s):  # pragma: no cover - compiled
+    """q, dq/ds and d2q/ds2 (each (n, n_dof)) at ``s`` (n,) of the piecewise cubic with
+    power-basis ``coefficients`` (4, n_knots - 1, n_dof) on ``knots``, in one pass (Horner);
+    a knot belongs to the piece that starts there."""
+    n, n_dof, last = s.shape[0], coefficients.shape[2], knots.shape[0] - 2
+    q = np.empty((n, n_dof))
+    dq = np.empty((n, n_dof))
+    ddq = np.empty((n, n_dof))
+    for i in range(n):
+        piece = min(max(np.searchsorted(knots, s[i], side="right") - 1, 0), last)
+        h = s[i] - knots[piece]
+        for j in range(n_dof):
+            c0 = coefficients[0, piece, j]
+            c1 = coefficients[1, piece, j]
+            c2 = coefficients[2, piece, j]
+            q[i, j] = ((c0 * h + c1) * h + c2) * h + coefficients[3, piece, j]
+            dq[i, j] = (3.0 * c0 * h + 2.0 * c1) * h + c2
+            ddq[i, j] = 6.0 * c0 * h + 2.0 * c1
+    return q, dq, ddq
 
 
 class StopAndGoPath(_ThroughWaypoints):
