@@ -5,13 +5,16 @@ spline inside the joint limits) on ur5, panda, geering_2r and yamamoto_2r, under
 acceleration and torque limits (each robot's limits as loaded; the two-link arms have torque
 limits only). For each path:
 
-* the converged duration T* is the Richardson extrapolation 2 T(20,000) - T(10,000) of the
-  conservative (interpolation) discretization on 20,000 and 10,000 intervals, checked against
-  the midpoint (second-order) discretization on 20,000 intervals: the two must agree within
-  1e-5, else the path is reported and left out;
+* the converged duration T* is the Richardson extrapolation 2 T(2N) - T(N) of the
+  conservative (interpolation) discretization, N = 10,000 intervals and every interval then
+  halved, checked against the midpoint (second-order) discretization on the 2N intervals: the
+  two must agree within 1e-5 (else the same on 20,000 and 40,000 intervals; else the path is
+  reported and left out);
 * for each method, the smallest grid of LADDER (``path_grid(path, n)``, n intervals) whose
-  duration lies within 0.1 % of T* is found, and the method is timed there, best of
-  ``--repeats``, the methods interleaved in each repetition.
+  duration lies within 0.1 % of T* is found, and so is the smallest from which the method
+  stays within 0.1 % on the next two ladder grids as well (a method whose error changes sign
+  as the grid grows can land within 0.1 % on one coarse grid by chance); each method is timed
+  on those grids, best of ``--repeats``, the methods interleaved in each repetition.
 
 What each time includes (the path object itself, ``SplinePath`` or toppra's
 ``SplineInterpolator``, is built beforehand for every method):
@@ -23,11 +26,14 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
 * ``adapter``: the ``toppra`` method of toptraj: the same constraint build plus
   ``ToppraMethod().solve`` (toppra's Seidel solver on the precomputed rows).
 * ``toppra``: toppra used directly through its public API, as a user of toppra pays for it:
-  ``JointVelocityConstraint``, ``JointAccelerationConstraint``, ``JointTorqueConstraint``
-  (toppra's default discretizations: interpolation for acceleration, collocation for torque)
-  with an inverse-dynamics callback ``pin.rnea(model, data, q, v, a) + damping * v``,
+  ``SplineInterpolator`` through the same waypoints and knots (natural ends: the same spline),
+  ``JointVelocityConstraint``, ``JointAccelerationConstraint``, ``JointTorqueConstraint`` (toppra's
+  default discretizations: interpolation for acceleration, collocation for torque, which holds
+  the torque rows only at the start of each interval and comes out below T*) with an
+  inverse-dynamics callback ``pin.rnea(model, data, q, v, a) + damping * v``,
   ``TOPPRA(..., solver_wrapper="seidel")`` (which evaluates the constraints) and
-  ``compute_parameterization(0, 0)``.
+  ``compute_parameterization(0, 0)``. ``toppra-i``: the same with the interpolation
+  discretization for torque as well, conservative like phase_plane's.
 * ``drake`` (ur5 only, when ``pydrake`` imports: ``pip install toptraj[bench]``): Drake's
   ``Toppra`` on a ``MultibodyPlant`` parsed from the same URDF (visual and collision elements
   stripped), the same spline as a ``PiecewisePolynomial.CubicHermite``, ``AddJointVelocityLimit``,
@@ -86,24 +92,31 @@ def random_path(robot, rng) -> tuple[np.ndarray, SplinePath]:
             return waypoints, path
 
 
+def _halved(grid: np.ndarray) -> np.ndarray:
+    """``grid`` with every interval split in two."""
+    fine = np.empty(2 * len(grid) - 1)
+    fine[0::2] = grid
+    fine[1::2] = 0.5 * (grid[:-1] + grid[1:])
+    return fine
+
+
 def converged_duration(path, robot) -> tuple[float, float]:
-    """T* (Richardson, see the module docstring) and its relative gap to the midpoint estimate."""
+    """T* and its relative gap to the midpoint estimate (see the module docstring): on 10,000
+    and 20,000 intervals, or on 20,000 and 40,000 where those two disagree by more than
+    CONVERGED."""
     unrefined = PhasePlaneMethod(max_refinements=0)
-    fine = build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, 20_000))
-    coarse = build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, 10_000))
-    richardson = 2.0 * unrefined.solve(fine).duration - unrefined.solve(coarse).duration
-    return richardson, abs(midpoint_duration(fine) / richardson - 1.0)
-
-
-@dataclass
-class Timed:
-    """One method's equal-accuracy grid and its times (best of the repetitions), in s."""
-
-    grid: int
-    duration: float
-    total: float = np.inf
-    solve: float = np.inf
-    detail: str = ""
+    coarse_grid = path_grid(path, 10_000)
+    coarse = unrefined.solve(build_path_constraints(path, robot, robot.limits, KINDS, coarse_grid)).duration
+    for _ in range(2):
+        fine_grid = _halved(coarse_grid)
+        constraints = build_path_constraints(path, robot, robot.limits, KINDS, fine_grid)
+        fine = unrefined.solve(constraints).duration
+        richardson = 2.0 * fine - coarse
+        gap = abs(midpoint_duration(constraints) / richardson - 1.0)
+        if gap <= CONVERGED:
+            break
+        coarse_grid, coarse = fine_grid, fine
+    return richardson, gap
 
 
 def toptraj_runner(method, path, robot):
@@ -120,9 +133,11 @@ def toptraj_runner(method, path, robot):
     return run
 
 
-def toppra_runner(robot, waypoints, path):
-    """(total, nan, duration, "") of toppra through its public API at n intervals. Limits that
-    are infinite (the two-link arms have only torque limits) are left out, as a toppra user would."""
+def toppra_runner(robot, waypoints, path, interpolation: bool = False):
+    """(total, nan, duration, "") of toppra through its public API at n intervals, with its
+    default discretizations or (``interpolation``) the interpolation one for torque too. Limits
+    that are infinite (the two-link arms have only torque limits) are left out, as a toppra
+    user would."""
     import toppra
     import toppra.algorithm
     import toppra.constraint
@@ -146,9 +161,10 @@ def toppra_runner(robot, waypoints, path):
             made.append(
                 toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits.acceleration, limits.acceleration]))
             )
+        scheme = toppra.constraint.DiscretizationType.Interpolation if interpolation else toppra.constraint.DiscretizationType.Collocation
         made.append(
             toppra.constraint.JointTorqueConstraint(
-                inverse_dynamics, np.column_stack([-limits.torque, limits.torque]), robot.coulomb_friction
+                inverse_dynamics, np.column_stack([-limits.torque, limits.torque]), robot.coulomb_friction, scheme
             )
         )
         return made
@@ -216,27 +232,47 @@ def drake_runner(plant, robot, waypoints, path, failures: list):
     return run
 
 
-def equal_accuracy(run, reference) -> Timed | None:
-    """The smallest ladder grid whose duration is within ACCURACY of ``reference``."""
+@dataclass
+class Scan:
+    """A method's durations on the ladder and its two equal-accuracy grids: the smallest grid
+    within ACCURACY of T* (``first``), and the smallest from which the method stays within it
+    on the next two ladder grids as well (``settled``); ``None`` where there is none."""
+
+    durations: dict = field(default_factory=dict)
+    first: int | None = None
+    settled: int | None = None
+
+
+def scan(run, reference) -> Scan:
+    """Run the method up the ladder until its settled grid is found (or the ladder ends)."""
+    result = Scan()
+    within = []
     for n in LADDER:
         try:
             _, _, duration, _ = run(n)
         except (InfeasiblePath, TimingFailed):
-            continue
-        if abs(duration / reference - 1.0) <= ACCURACY:
-            return Timed(n, duration)
-    return None
+            duration = np.nan
+        result.durations[n] = duration
+        within.append(bool(abs(duration / reference - 1.0) <= ACCURACY))
+        if within[-1] and result.first is None:
+            result.first = n
+        if len(within) >= 3 and all(within[-3:]):
+            result.settled = LADDER[len(within) - 3]
+            return result
+    return result
 
 
-def time_interleaved(runs: dict, found: dict, repeats: int) -> None:
-    """Best-of-``repeats`` times of every method at its grid, the methods interleaved."""
+def time_interleaved(runs: dict, wanted: dict, repeats: int) -> dict:
+    """Best-of-``repeats`` (total, solve, detail) of every method at each of its grids in
+    ``wanted`` (method -> set of grids), the methods interleaved in each repetition."""
+    best = {(method, n): [np.inf, np.inf, ""] for method, grids in wanted.items() for n in grids}
     for _ in range(repeats):
-        for name, run in runs.items():
-            timed = found[name]
-            total, solve, _, detail = run(timed.grid)
-            timed.total = min(timed.total, total)
-            timed.solve = min(timed.solve, solve) if np.isfinite(solve) else timed.solve
-            timed.detail = detail
+        for (method, n), record in best.items():
+            total, solve, _, detail = runs[method](n)
+            record[0] = min(record[0], total)
+            record[1] = min(record[1], solve) if np.isfinite(solve) else record[1]
+            record[2] = detail
+    return best
 
 
 def summary(label: str, values) -> str:
@@ -249,6 +285,9 @@ def summary(label: str, values) -> str:
     )
 
 
+OTHERS = ("toppra", "toppra-i", "adapter", "drake")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--paths", type=int, default=16, help="paths per robot")
@@ -256,6 +295,7 @@ def main() -> int:
     parser.add_argument("--robots", default=",".join(ROBOTS))
     parser.add_argument("--seed", type=int, default=2024)
     args = parser.parse_args()
+    names = args.robots.split(",")
 
     warm = robots.load("ur5")
     warm_waypoints, warm_path = random_path(warm, np.random.default_rng(0))
@@ -266,22 +306,23 @@ def main() -> int:
     ):
         run(50)
 
-    rows = {"toppra": [], "adapter": [], "adapter solve": [], "drake": []}
+    # ratios[definition][method] and per robot: other method's time / phase_plane's time
+    ratios = {definition: {method: [] for method in (*OTHERS, "adapter solve")} for definition in ("first", "settled")}
     per_robot: dict[str, dict[str, list]] = {}
     slower, missed, unconverged, drake_failures = [], [], [], {}
-    drake_available = True
+    drake_available = None
     print(
-        f"{'robot':11s} {'path':>4s} {'T* s':>8s} | {'pp N':>5s} {'->':>5s} {'ms':>6s} {'solve':>6s} | "
-        f"{'tp N':>5s} {'ms':>7s} | {'ad N':>5s} {'ms':>7s} {'solve':>7s} | {'drake N':>7s} {'ms':>7s} | "
-        f"{'toppra/pp':>9s} {'adapter/pp':>10s} {'solve/solve':>11s} {'drake/pp':>8s}"
+        f"{'robot':11s} {'path':>4s} {'T* s':>7s} | {'pp N':>4s} {'pts':>5s} {'ms':>6s} {'solve':>5s} | "
+        f"{'tp N':>4s} {'ms':>6s} | {'tpi N':>5s} {'ms':>7s} | {'ad N':>4s} {'ms':>6s} {'solve':>6s} | "
+        f"{'dk N':>4s} {'ms':>6s} | ratio toppra toppra-i adapter solve drake | settled: toppra toppra-i adapter drake"
     )
-    for name in args.robots.split(","):
+    for name in names:
         robot = robots.load(name)
         plant = drake_plant(robot) if name == "ur5" else None
-        if name == "ur5" and plant is None:
-            drake_available = False
-        rng = np.random.default_rng(args.seed + ROBOTS.index(name) if name in ROBOTS else args.seed)
-        ratios = per_robot.setdefault(name, {"toppra": [], "adapter": []})
+        if name == "ur5":
+            drake_available = plant is not None
+        rng = np.random.default_rng(args.seed + (ROBOTS.index(name) if name in ROBOTS else 0))
+        robot_ratios = per_robot.setdefault(name, {method: [] for method in OTHERS})
         done = 0
         while done < args.paths:
             waypoints, path = random_path(robot, rng)
@@ -296,79 +337,108 @@ def main() -> int:
             runs = {
                 "pp": toptraj_runner(PhasePlaneMethod(), path, robot),
                 "toppra": toppra_runner(robot, waypoints, path),
+                "toppra-i": toppra_runner(robot, waypoints, path, interpolation=True),
                 "adapter": toptraj_runner(ToppraMethod(), path, robot),
             }
             if plant is not None:
                 failures = drake_failures.setdefault(done, [])
                 runs["drake"] = drake_runner(plant, robot, waypoints, path, failures)
-            found = {method: equal_accuracy(run, reference) for method, run in runs.items()}
-            if any(found[method] is None for method in ("pp", "toppra", "adapter")):
-                missed.append((name, done, {method: timed and timed.grid for method, timed in found.items()}))
+            scans = {method: scan(run, reference) for method, run in runs.items()}
+            if any(scans[method].first is None for method in ("pp", "toppra", "toppra-i", "adapter")):
+                missed.append((name, done, {method: (found.first, found.settled) for method, found in scans.items()}))
                 done += 1
                 continue
-            drake = found.get("drake")
-            if drake is None:
-                runs.pop("drake", None)
-                found.pop("drake", None)
-            time_interleaved(runs, found, args.repeats)
-            pp, tp, ad = found["pp"], found["toppra"], found["adapter"]
-            ratio_toppra, ratio_adapter, ratio_solve = tp.total / pp.total, ad.total / pp.total, ad.solve / pp.solve
-            rows["toppra"].append(ratio_toppra)
-            rows["adapter"].append(ratio_adapter)
-            rows["adapter solve"].append(ratio_solve)
-            ratios["toppra"].append(ratio_toppra)
-            ratios["adapter"].append(ratio_adapter)
-            drake_text = f"{'-':>7s} {'-':>7s}"
-            ratio_drake = ""
-            if drake is not None:
-                rows["drake"].append(drake.total / pp.total)
-                drake_text = f"{drake.grid:7d} {1e3 * drake.total:7.2f}"
-                ratio_drake = f"{drake.total / pp.total:8.2f}"
-            elif plant is not None:
-                drake_text = f"{'missed':>7s} {'':>7s}"
+            wanted = {method: {grid for grid in (found.first, found.settled) if grid is not None} for method, found in scans.items()}
+            times = time_interleaved(runs, wanted, args.repeats)
+
+            def at(method, definition):
+                grid = getattr(scans[method], definition) if method in scans else None
+                return None if grid is None else (grid, *times[(method, grid)])
+
+            line = []
+            for definition in ("first", "settled"):
+                pp = at("pp", definition)
+                row = {}
+                for method in OTHERS:
+                    other = at(method, definition)
+                    if pp is None or other is None:
+                        continue
+                    row[method] = other[1] / pp[1]
+                    ratios[definition][method].append(row[method])
+                    if definition == "first":
+                        robot_ratios[method].append(row[method])
+                if pp is not None and at("adapter", definition) is not None:
+                    row["adapter solve"] = at("adapter", definition)[2] / pp[2]
+                    ratios[definition]["adapter solve"].append(row["adapter solve"])
+                line.append(row)
+                if definition == "first" and min(row.get("toppra", np.inf), row.get("adapter", np.inf)) < 1.0:
+                    slower.append((name, done, {method: at(method, definition) for method in ("pp", *OTHERS)}))
+
+            def cell(method, width):
+                found = at(method, "first")
+                if found is None:
+                    return f"{'-':>{width}s} {'-':>6s}"
+                return f"{found[0]:{width}d} {1e3 * found[1]:6.2f}"
+
+            pp = at("pp", "first")
+            adapter = at("adapter", "first")
+
+            def number(row, method, width):
+                return f"{row[method]:{width}.2f}" if method in row else f"{'-':>{width}s}"
+
             print(
-                f"{name:11s} {done:4d} {reference:8.4f} | {pp.grid:5d} {pp.detail:>5s} {1e3 * pp.total:6.2f} {1e3 * pp.solve:6.2f} | "
-                f"{tp.grid:5d} {1e3 * tp.total:7.2f} | {ad.grid:5d} {1e3 * ad.total:7.2f} {1e3 * ad.solve:7.2f} | {drake_text} | "
-                f"{ratio_toppra:9.2f} {ratio_adapter:10.2f} {ratio_solve:11.2f} {ratio_drake:>8s}",
+                f"{name:11s} {done:4d} {reference:7.4f} | {pp[0]:4d} {pp[3]:>5s} {1e3 * pp[1]:6.2f} {1e3 * pp[2]:5.2f} | "
+                f"{cell('toppra', 4)} | {cell('toppra-i', 5)} | {adapter[0]:4d} {1e3 * adapter[1]:6.2f} {1e3 * adapter[2]:6.2f} | "
+                f"{cell('drake', 4)} | {number(line[0], 'toppra', 12)} {number(line[0], 'toppra-i', 8)} "
+                f"{number(line[0], 'adapter', 7)} {number(line[0], 'adapter solve', 5)} {number(line[0], 'drake', 5)} | "
+                f"{number(line[1], 'toppra', 14)} {number(line[1], 'toppra-i', 8)} {number(line[1], 'adapter', 7)} "
+                f"{number(line[1], 'drake', 5)}",
                 flush=True,
             )
-            if min(ratio_toppra, ratio_adapter) < 1.0:
-                slower.append((name, done, pp, tp, ad))
             done += 1
 
     print()
-    print("Times at equal accuracy (each method on the smallest ladder grid within 0.1 % of T*), best of", args.repeats)
-    print("pp = build_path_constraints + PhasePlaneMethod().solve; toppra = toppra's public API incl. its own")
-    print("constraint evaluation; adapter = build_path_constraints + ToppraMethod().solve; solve/solve = the two")
-    print("solves alone on prebuilt constraints (phase_plane's includes the rows it evaluates while refining).")
-    for robot_name, ratios in per_robot.items():
-        print(summary(f"{robot_name:11s} toppra / pp ", ratios["toppra"]))
-        print(summary(f"{robot_name:11s} adapter / pp", ratios["adapter"]))
-    print(summary("all         toppra / pp          ", rows["toppra"]))
-    print(summary("all         adapter / pp         ", rows["adapter"]))
-    print(summary("all         adapter solve / pp solve", rows["adapter solve"]))
-    if drake_available and "ur5" in args.robots.split(","):
-        print(summary("ur5         drake / pp           ", rows["drake"]))
-        failed = {index: grids for index, grids in drake_failures.items() if grids}
-        if failed:
-            print(
-                "Drake's Toppra failed ('failed to find the maximum path acceleration') on "
-                + "; ".join(f"ur5 path {index} at {', '.join(map(str, grids))} intervals" for index, grids in failed.items())
-            )
-    elif "ur5" in args.robots.split(","):
+    print(f"Times at equal accuracy (within 0.1 % of T*), best of {args.repeats}; ratio = the other method's time / phase_plane's")
+    print("(> 1: phase_plane is faster). pp = build_path_constraints + PhasePlaneMethod().solve; toppra = toppra's")
+    print("public API with its default discretizations (collocation for torque), incl. its own constraint evaluation;")
+    print("toppra-i = the same with the interpolation discretization for torque too (conservative, as phase_plane);")
+    print("adapter = build_path_constraints + ToppraMethod().solve; solve = the two solves alone on prebuilt")
+    print("constraints (phase_plane's includes the rows it evaluates while refining); drake = Drake's Toppra.")
+    print("Each method at the smallest ladder grid within 0.1 %:")
+    for robot_name, robot_ratios in per_robot.items():
+        for method in ("toppra", "toppra-i", "adapter"):
+            print(summary(f"  {robot_name:11s} {method:8s} / pp", robot_ratios[method]))
+    for method in (*OTHERS, "adapter solve"):
+        if method == "drake" and not drake_available:
+            continue
+        label = "ur5 drake" if method == "drake" else f"all {method}"
+        print(summary(f"  {label:20s} / pp", ratios["first"][method]))
+    print("Each method at the smallest ladder grid from which it stays within 0.1 % on the next two ladder grids:")
+    for method in (*OTHERS, "adapter solve"):
+        if method == "drake" and not drake_available:
+            continue
+        label = "ur5 drake" if method == "drake" else f"all {method}"
+        print(summary(f"  {label:20s} / pp", ratios["settled"][method]))
+    if drake_available is False:
         print("drake: pydrake not installed (pip install toptraj[bench]); skipped")
+    failed = {index: grids for index, grids in drake_failures.items() if grids}
+    if failed:
+        print(
+            "Drake's Toppra failed (\"failed to find the maximum path acceleration\") on "
+            + "; ".join(f"ur5 path {index} at {', '.join(map(str, grids))} intervals" for index, grids in failed.items())
+        )
     for name, index, gap in unconverged:
         print(f"not converged: {name} path {index}: the two estimates of T* differ by {gap:.1e}; left out")
     for name, index, grids in missed:
-        print(f"missed: {name} path {index}: a method missed 0.1 % on every ladder grid: {grids}")
+        print(f"missed: {name} path {index}: a method missed 0.1 % on every ladder grid (first, settled): {grids}")
     if slower:
-        for name, index, pp, tp, ad in slower:
-            print(
-                f"slower: {name} path {index}: phase_plane N={pp.grid} {1e3 * pp.total:.2f} ms, "
-                f"toppra N={tp.grid} {1e3 * tp.total:.2f} ms, adapter N={ad.grid} {1e3 * ad.total:.2f} ms"
+        for name, index, found in slower:
+            described = ", ".join(
+                f"{method} N={value[0]} {1e3 * value[1]:.2f} ms" for method, value in found.items() if value is not None
             )
+            print(f"slower: {name} path {index}: {described}")
     else:
-        print("phase_plane is slower on no path (against toppra directly or through the adapter)")
+        print("phase_plane is slower than toppra (directly or through the adapter) on no path")
     return 0
 
 

@@ -483,9 +483,11 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, 
 
     Each interval's error, this discretization's time minus the exact one, is estimated from:
 
-    * first order (signed): its time here minus its time in the midpoint discretization x_mid
-      (second order, so it stands for the exact answer where the profile is resolved; where
-      the two disagree, in either direction, the grid does not resolve the profile);
+    * first order: its time here minus its time in the midpoint discretization x_mid (second
+      order, so it stands for the exact answer where the profile is resolved). The
+      conservative discretization is the slower wherever both resolve the profile; where the
+      midpoint one comes out slower, it does not resolve the interval either: that marks the
+      interval (a second-order part below) but estimates no error of this profile;
     * second order: ``switch`` (N,), the time it would save by switching inside it
       (``switch_excess``, which neither discretization sees), and the chord error where the
       profile rides on the ``ceiling`` of admissible x (N + 1,) at both ends: x linear in s
@@ -493,14 +495,13 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, 
       grid points. With x'' from second differences, the chord's time minus the curve's is
       -x'' ds^3 / (24 x^(3/2)) (faster under a convex ceiling, slower under a concave one).
 
-    The estimated relative error is |sum of all| + guard (sum of magnitudes), the second term a
-    guard against errors of the estimates themselves. Where it exceeds ``tolerance``, intervals
-    are split into equal pieces: k pieces leave e / k^p of a first-order estimate (p = 1 where
-    the discretizations differ smoothly, as along the maximum velocity curve, up to 2 where
-    they differ in scattered places, read off the ratio of their signed to their absolute
-    difference) and e / k^2 of a second-order one; the fewest pieces that bring the estimate to
-    ``aim`` times the tolerance (``_pieces``, the larger of the two kinds, at most
-    ``max_pieces`` per interval and ``room`` new points in all, the worst intervals first).
+    The estimated relative error is |the signed sum| plus ``guard`` times the magnitudes that
+    may cancel in it or estimate nothing (chord errors, unresolved intervals): a guard against
+    errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are split into
+    equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order one;
+    the fewest pieces that bring the estimate to ``aim`` times the tolerance (``_pieces``, the
+    larger of the two kinds, at most ``max_pieces`` per interval and ``room`` new points in
+    all, the worst intervals first).
 
     Returns the new points (sorted, each strictly inside an interval; empty when the estimate
     is within the tolerance) and the estimated relative error.
@@ -518,8 +519,7 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, 
         curvature[n_stages] = curvature[n_stages - 1]
     duration = 0.0
     signed = 0.0
-    magnitude = 0.0
-    signed_first = 0.0
+    uncertain = 0.0
     for i in range(n_stages):
         ds = s[i + 1] - s[i]
         here = _interval_time(ds, x[i], x[i + 1])
@@ -539,24 +539,23 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, 
             chord = -0.5 * (curvature[i] + curvature[i + 1]) * ds**3 / (24.0 * mean**1.5)
             if not np.isfinite(chord):
                 chord = 0.0
-        second[i] = switch[i] + abs(chord)
+        # The conservative discretization is slower than the exact profile wherever both
+        # resolve it; where the midpoint one comes out slower, it is its own error (it does
+        # not resolve the interval either), which marks the interval but is no estimate.
+        unresolved = max(-first[i], 0.0)
+        first[i] = max(first[i], 0.0)
+        second[i] = switch[i] + abs(chord) + unresolved
         signed += first[i] + switch[i] + chord
-        signed_first += first[i]
-        first[i] = abs(first[i])
-        magnitude += first[i] + second[i]
+        uncertain += abs(chord) + unresolved
     exact = duration - signed
     if not exact > 0.0:
         exact = duration
-    error = (abs(signed) + guard * magnitude) / exact
+    error = (abs(signed) + guard * uncertain) / exact
     if not error > tolerance or room <= 0:
         return np.empty(0), error
     shrink = aim * tolerance / error
-    first_total = 0.0
-    for i in range(n_stages):
-        first_total += first[i]
-    order = 2.0 - abs(signed_first) / (first_total if first_total > 1e-300 else 1e-300)
     wanted = np.ones(n_stages)
-    _pieces(first, order, shrink, wanted)
+    _pieces(first, 1.0, shrink, wanted)
     _pieces(second, 2.0, shrink, wanted)
     pieces = np.empty(n_stages, dtype=np.int64)
     added = 0

@@ -24,11 +24,16 @@ collapses to one value and the sweeps take it: no chattering, no special case.
 Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
 row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
 point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
-(``planners.kernels``): no LP is solved anywhere. This constant-u scheme is conservative by a
-first-order amount, so the grid is refined where it costs time: the midpoint discretization on
-the same grid (second-order accurate, but not conservative) estimates the error of each interval,
-and the worst intervals are split, with the constraint rows evaluated anew there, until the
-estimated duration error is below the tolerance.
+(``planners.kernels``): no LP is solved anywhere; one compiled call per sweep pair builds the
+rows of every interval, linearizes viscous friction, finds the admissible intervals and runs
+both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
+amount, so the grid is refined where it costs time: the error of each interval is estimated from
+the midpoint discretization on the same grid (second-order accurate, but not conservative), from
+the time it would save by switching inside the interval (a start from rest, a switch onto or off
+the MVC within one interval, which neither discretization sees) and from the chord error along
+a curved MVC; each interval is split into as many pieces as its share of the error asks for,
+with the constraint rows evaluated anew at the new points (one batched evaluation per round),
+until the estimated duration error is below the tolerance.
 """
 
 from __future__ import annotations
@@ -89,8 +94,8 @@ def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> L
 _MAX_PIECES = 8
 #: Refinement aims at this fraction of the tolerance, so that one round usually suffices.
 _AIM = 0.85
-#: Weight of the summed magnitudes of the error estimates in the estimated error (besides the
-#: magnitude of their signed sum): a guard against errors of the estimates themselves.
+#: Weight, in the estimated error, of the estimates that may cancel in its signed sum or
+#: estimate nothing (``planners.kernels.refinement``): a guard against their own errors.
 _GUARD = 0.15
 #: The refined grid has at most 2^max_refinements times the intervals of the given one (what
 #: halving every interval in each round would give), or this many, whichever is more.
