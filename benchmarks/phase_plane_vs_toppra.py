@@ -1,22 +1,63 @@
-"""Solve time of ``phase_plane`` against ``toppra`` at equal accuracy, in one run.
+"""Time of ``phase_plane`` against TOPP-RA at equal accuracy, in one interleaved run.
 
-For seeded random spline paths on ur5 and panda (velocity + acceleration + torque), the
-reference duration is TOPP-RA's on a 10,000-interval grid. For each method, the smallest grid of
-a ladder whose duration lies within 0.1 % of the reference is found; the method's solve time on
-that grid (best of 3, PathConstraints built beforehand and shared) is recorded, and so is the
-time to build those constraints. Prints the median and p95 of the time ratio toppra / phase_plane
-(> 1: phase_plane is faster), and the paths where phase_plane is slower.
+Seeded random spline paths (2 to 5 waypoints within the middle 70 % of each joint's range, the
+spline inside the joint limits) on ur5, panda, geering_2r and yamamoto_2r, under velocity,
+acceleration and torque limits (each robot's limits as loaded; the two-link arms have torque
+limits only). For each path:
 
-    python benchmarks/phase_plane_vs_toppra.py [--paths 30]
+* the converged duration T* is the Richardson extrapolation 2 T(2N) - T(N) of the
+  conservative (interpolation) discretization, N = 10,000 intervals and every interval then
+  halved, checked against the midpoint (second-order) discretization on the 2N intervals: the
+  two must agree within 1e-5 (else the same on 20,000 and 40,000 intervals; else the path is
+  reported and left out);
+* for each method, the smallest grid of LADDER (``path_grid(path, n)``, n intervals) whose
+  duration lies within 0.1 % of T* is found, and so is the smallest from which the method
+  stays within 0.1 % on the next two ladder grids as well (a method whose error changes sign
+  as the grid grows can land within 0.1 % on one coarse grid by chance); each method is timed
+  on those grids, best of ``--repeats``, the methods interleaved in each repetition.
+
+What each time includes (the path object itself, ``SplinePath`` or toppra's
+``SplineInterpolator``, is built beforehand for every method):
+
+* ``pp``: ``phase_plane`` as a user of toptraj pays for it: the constraint build
+  (``build_path_constraints``: path derivatives and a batched Pinocchio RNEA at each grid point)
+  plus ``PhasePlaneMethod().solve`` (which evaluates the constraints anew at the points its grid
+  refinement adds). ``pp solve``: the solve alone, on constraints built beforehand.
+* ``adapter``: the ``toppra`` method of toptraj: the same constraint build plus
+  ``ToppraMethod().solve`` (toppra's Seidel solver on the precomputed rows).
+* ``toppra``: toppra used directly through its public API, as a user of toppra pays for it:
+  ``SplineInterpolator`` through the same waypoints and knots (natural ends: the same spline),
+  ``JointVelocityConstraint``, ``JointAccelerationConstraint``, ``JointTorqueConstraint`` (toppra's
+  default discretizations: interpolation for acceleration, collocation for torque, which holds
+  the torque rows only at the start of each interval and comes out below T*) with an
+  inverse-dynamics callback ``pin.rnea(model, data, q, v, a) + damping * v``,
+  ``TOPPRA(..., solver_wrapper="seidel")`` (which evaluates the constraints) and
+  ``compute_parameterization(0, 0)``. ``toppra-i``: the same with the interpolation
+  discretization for torque as well, conservative like phase_plane's.
+* ``drake`` (ur5 only, when ``pydrake`` imports: ``pip install toptraj[bench]``): Drake's
+  ``Toppra`` on a ``MultibodyPlant`` parsed from the same URDF (visual and collision elements
+  stripped), the same spline as a ``PiecewisePolynomial.CubicHermite``, ``AddJointVelocityLimit``,
+  ``AddJointAccelerationLimit``, ``AddJointTorqueLimit`` and ``SolvePathParameterization``; the
+  plant is built beforehand.
+
+Ratios are the other method's time over ``pp`` (> 1: phase_plane is faster). Prints one line per
+path, then the median, p5 and min of each ratio, per robot and overall, and every path where
+phase_plane is slower.
+
+    python benchmarks/phase_plane_vs_toppra.py [--paths 16] [--repeats 5] [--robots ur5,panda,...]
 """
 
 from __future__ import annotations
 
 import argparse
+import logging
+import re
 import sys
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
 import robots
 from planners.constraints import build_path_constraints
@@ -24,91 +65,380 @@ from planners.errors import InfeasiblePath, TimingFailed
 from planners.grid import path_grid
 from planners.paths import SplinePath
 from planners.timing import PhasePlaneMethod, ToppraMethod
+from planners.timing.phase_plane import midpoint_duration
 
-LADDER = (25, 50, 75, 100, 150, 200, 300, 450, 600, 900, 1200, 1800, 2400, 3600, 5000)
+LADDER = (25, 50, 75, 100, 150, 200, 300, 450, 600, 900, 1200, 1800, 2400, 3600, 5000, 7200, 10000)
 KINDS = ("velocity", "acceleration", "torque")
+ROBOTS = ("ur5", "panda", "geering_2r", "yamamoto_2r")
 ACCURACY = 1e-3
+#: Largest disagreement of the two estimates of the converged duration.
+CONVERGED = 1e-5
+
+logging.getLogger("toppra").setLevel(logging.ERROR)
+logging.getLogger("drake").setLevel(logging.CRITICAL)
 
 
-def _random_path(robot, rng):
-    lower = np.maximum(robot.limits.position_lower, -3.0)
-    upper = np.minimum(robot.limits.position_upper, 3.0)
-    margin = 0.15 * (upper - lower)
+def random_path(robot, rng) -> tuple[np.ndarray, SplinePath]:
+    """2 to 5 waypoints within the middle 70 % of each joint's range (+-pi for continuous joints),
+    drawn until the spline through them stays within the joint limits."""
+    lower = np.where(np.isfinite(robot.limits.position_lower), robot.limits.position_lower, -np.pi)
+    upper = np.where(np.isfinite(robot.limits.position_upper), robot.limits.position_upper, np.pi)
+    middle, half = 0.5 * (lower + upper), 0.35 * (upper - lower)
     while True:
-        path = SplinePath(rng.uniform(lower + margin, upper - margin, (int(rng.integers(2, 6)), robot.dof)))
-        q = path(np.linspace(0, 1, 500))
-        if np.all(q >= lower) and np.all(q <= upper):
-            return path
+        waypoints = middle + rng.uniform(-1, 1, (int(rng.integers(2, 6)), robot.dof)) * half
+        path = SplinePath(waypoints)
+        q = path(np.linspace(0.0, 1.0, 1000))
+        if np.all(q >= robot.limits.position_lower) and np.all(q <= robot.limits.position_upper):
+            return waypoints, path
 
 
-def _best_of(method, constraints, repeats=3):
-    best, result = np.inf, None
-    for _ in range(repeats):
-        started = time.perf_counter()
-        result = method.solve(constraints)
-        best = min(best, time.perf_counter() - started)
-    return best, result
+def _halved(grid: np.ndarray) -> np.ndarray:
+    """``grid`` with every interval split in two."""
+    fine = np.empty(2 * len(grid) - 1)
+    fine[0::2] = grid
+    fine[1::2] = 0.5 * (grid[:-1] + grid[1:])
+    return fine
 
 
-def _equal_accuracy(method, path, robot, reference):
-    """(grid, solve seconds, build seconds, duration) at the smallest ladder grid within ACCURACY."""
-    for n in LADDER:
+def converged_duration(path, robot) -> tuple[float, float]:
+    """T* and its relative gap to the midpoint estimate (see the module docstring): on 10,000
+    and 20,000 intervals, or on 20,000 and 40,000 where those two disagree by more than
+    CONVERGED."""
+    unrefined = PhasePlaneMethod(max_refinements=0)
+    coarse_grid = path_grid(path, 10_000)
+    coarse = unrefined.solve(build_path_constraints(path, robot, robot.limits, KINDS, coarse_grid)).duration
+    for _ in range(2):
+        fine_grid = _halved(coarse_grid)
+        constraints = build_path_constraints(path, robot, robot.limits, KINDS, fine_grid)
+        fine = unrefined.solve(constraints).duration
+        richardson = 2.0 * fine - coarse
+        gap = abs(midpoint_duration(constraints) / richardson - 1.0)
+        if gap <= CONVERGED:
+            break
+        coarse_grid, coarse = fine_grid, fine
+    return richardson, gap
+
+
+def toptraj_runner(method, path, robot):
+    """(total, solve, duration, detail) of a toptraj method at n intervals."""
+
+    def run(n):
         started = time.perf_counter()
         constraints = build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, n))
-        build = time.perf_counter() - started
-        seconds, result = _best_of(method, constraints)
-        if abs(result.duration / reference - 1) <= ACCURACY:
-            return n, seconds, build, result.duration
-    return None
+        built = time.perf_counter()
+        result = method.solve(constraints)
+        done = time.perf_counter()
+        return done - started, done - built, result.duration, f"{len(result.s) - 1}"
+
+    return run
+
+
+def toppra_runner(robot, waypoints, path, interpolation: bool = False):
+    """(total, nan, duration, "") of toppra through its public API at n intervals, with its
+    default discretizations or (``interpolation``) the interpolation one for torque too. Limits
+    that are infinite (the two-link arms have only torque limits) are left out, as a toppra
+    user would."""
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+
+    model = robot.model
+    data = model.createData()
+    damping = robot.viscous_friction
+    to_configuration = robot.configuration if np.any(robot.continuous) else (lambda q: q)
+
+    def inverse_dynamics(q, v, a):
+        return pin.rnea(model, data, to_configuration(q), v, a) + damping * v
+
+    spline = toppra.SplineInterpolator(path.knots, waypoints, bc_type="natural")
+    limits = robot.limits
+
+    def constraints():
+        made = []
+        if np.all(np.isfinite(limits.velocity)):
+            made.append(toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])))
+        if np.all(np.isfinite(limits.acceleration)):
+            made.append(
+                toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits.acceleration, limits.acceleration]))
+            )
+        scheme = toppra.constraint.DiscretizationType.Interpolation if interpolation else toppra.constraint.DiscretizationType.Collocation
+        made.append(
+            toppra.constraint.JointTorqueConstraint(
+                inverse_dynamics, np.column_stack([-limits.torque, limits.torque]), robot.coulomb_friction, scheme
+            )
+        )
+        return made
+
+    def run(n):
+        grid = path_grid(path, n)
+        started = time.perf_counter()
+        instance = toppra.algorithm.TOPPRA(constraints(), spline, gridpoints=grid, solver_wrapper="seidel")
+        _, sd, _ = instance.compute_parameterization(0.0, 0.0)
+        done = time.perf_counter()
+        if sd is None:
+            raise TimingFailed("toppra found no parameterization")
+        return done - started, np.nan, float(np.sum(2.0 * np.diff(grid) / (sd[1:] + sd[:-1]))), ""
+
+    return run
+
+
+def drake_plant(robot):
+    """Drake's MultibodyPlant of ``robot``'s URDF without visual and collision elements (their
+    meshes are package:// URIs), or ``None`` when pydrake is absent."""
+    try:
+        from pydrake.multibody.parsing import Parser
+        from pydrake.multibody.plant import MultibodyPlant
+    except ImportError:
+        return None
+    from robots.catalog import EXAMPLE_ARMS, example_urdf_path
+
+    with open(example_urdf_path(EXAMPLE_ARMS[robot.name].loader)) as handle:
+        text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
+    plant = MultibodyPlant(0.0)
+    Parser(plant).AddModelsFromString(text, "urdf")
+    if 'name="world"' not in text:
+        plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(plant.GetBodyByName(robot.model.names[1]).name()))
+    plant.Finalize()
+    names = tuple(plant.get_joint(index).name() for index in plant.GetJointIndices() if plant.get_joint(index).num_positions() == 1)
+    if names[: robot.dof] != robot.joint_names:
+        raise RuntimeError(f"Drake's joint order {names} differs from Pinocchio's {robot.joint_names}")
+    return plant
+
+
+def drake_runner(plant, robot, waypoints, path, failures: list):
+    """(total, nan, duration, "") of Drake's Toppra at n intervals; grids where it fails are
+    appended to ``failures``."""
+    from pydrake.multibody.optimization import Toppra
+    from pydrake.trajectories import PiecewisePolynomial
+
+    # Cubic Hermite through the knots with the spline's own slopes: the same cubic per segment.
+    spline = PiecewisePolynomial.CubicHermite(path.knots, waypoints.T, path.evaluate(path.knots).dq.T)
+    limits = robot.limits
+
+    def run(n):
+        grid = path_grid(path, n)
+        started = time.perf_counter()
+        toppra = Toppra(spline, plant, grid)
+        toppra.AddJointVelocityLimit(-limits.velocity, limits.velocity)
+        toppra.AddJointAccelerationLimit(-limits.acceleration, limits.acceleration)
+        toppra.AddJointTorqueLimit(-limits.torque, limits.torque)
+        result = toppra.SolvePathParameterization()
+        done = time.perf_counter()
+        if result is None:
+            failures.append(n)
+            raise TimingFailed("Drake's Toppra failed")
+        return done - started, np.nan, float(result.end_time()), ""
+
+    return run
+
+
+@dataclass
+class Scan:
+    """A method's durations on the ladder and its two equal-accuracy grids: the smallest grid
+    within ACCURACY of T* (``first``), and the smallest from which the method stays within it
+    on the next two ladder grids as well (``settled``); ``None`` where there is none."""
+
+    durations: dict = field(default_factory=dict)
+    first: int | None = None
+    settled: int | None = None
+
+
+def scan(run, reference) -> Scan:
+    """Run the method up the ladder until its settled grid is found (or the ladder ends)."""
+    result = Scan()
+    within = []
+    for n in LADDER:
+        try:
+            _, _, duration, _ = run(n)
+        except (InfeasiblePath, TimingFailed):
+            duration = np.nan
+        result.durations[n] = duration
+        within.append(bool(abs(duration / reference - 1.0) <= ACCURACY))
+        if within[-1] and result.first is None:
+            result.first = n
+        if len(within) >= 3 and all(within[-3:]):
+            result.settled = LADDER[len(within) - 3]
+            return result
+    return result
+
+
+def time_interleaved(runs: dict, wanted: dict, repeats: int) -> dict:
+    """Best-of-``repeats`` (total, solve, detail) of every method at each of its grids in
+    ``wanted`` (method -> set of grids), the methods interleaved in each repetition."""
+    best = {(method, n): [np.inf, np.inf, ""] for method, grids in wanted.items() for n in grids}
+    for _ in range(repeats):
+        for (method, n), record in best.items():
+            total, solve, _, detail = runs[method](n)
+            record[0] = min(record[0], total)
+            record[1] = min(record[1], solve) if np.isfinite(solve) else record[1]
+            record[2] = detail
+    return best
+
+
+def summary(label: str, values) -> str:
+    values = np.asarray(values, dtype=float)
+    if values.size == 0:
+        return f"{label}: no paths"
+    return (
+        f"{label}: median {np.median(values):6.2f}  p5 {np.percentile(values, 5):6.2f}  "
+        f"min {values.min():6.2f}  ({values.size} paths)"
+    )
+
+
+OTHERS = ("toppra", "toppra-i", "adapter", "drake")
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--paths", type=int, default=30, help="paths per robot")
+    parser.add_argument("--paths", type=int, default=16, help="paths per robot")
+    parser.add_argument("--repeats", type=int, default=5, help="timed repetitions per method (best of)")
+    parser.add_argument("--robots", default=",".join(ROBOTS))
+    parser.add_argument("--seed", type=int, default=2024)
     args = parser.parse_args()
-    toppra, phase_plane = ToppraMethod(), PhasePlaneMethod()
+    names = args.robots.split(",")
+
     warm = robots.load("ur5")
-    warm_path = _random_path(warm, np.random.default_rng(0))
-    phase_plane.solve(build_path_constraints(warm_path, warm, warm.limits, KINDS, path_grid(warm_path, 50)))
-    toppra.solve(build_path_constraints(warm_path, warm, warm.limits, KINDS, path_grid(warm_path, 50)))
-    ratios, totals, slower = [], [], []
-    print(f"{'robot':6s} {'path':>4s} {'T ref s':>9s} | {'toppra N':>8s} {'ms':>7s} | {'pp N':>6s} {'ms':>7s} | {'ratio':>6s} {'ratio incl. build':>17s}")
-    for name in ("ur5", "panda"):
+    warm_waypoints, warm_path = random_path(warm, np.random.default_rng(0))
+    for run in (
+        toptraj_runner(PhasePlaneMethod(), warm_path, warm),
+        toptraj_runner(ToppraMethod(), warm_path, warm),
+        toppra_runner(warm, warm_waypoints, warm_path),
+    ):
+        run(50)
+
+    # ratios[definition][method] and per robot: other method's time / phase_plane's time
+    ratios = {definition: {method: [] for method in (*OTHERS, "adapter solve")} for definition in ("first", "settled")}
+    per_robot: dict[str, dict[str, list]] = {}
+    slower, missed, unconverged, drake_failures = [], [], [], {}
+    drake_available = None
+    print(
+        f"{'robot':11s} {'path':>4s} {'T* s':>7s} | {'pp N':>4s} {'pts':>5s} {'ms':>6s} {'solve':>5s} | "
+        f"{'tp N':>4s} {'ms':>6s} | {'tpi N':>5s} {'ms':>7s} | {'ad N':>4s} {'ms':>6s} {'solve':>6s} | "
+        f"{'dk N':>4s} {'ms':>6s} | ratio toppra toppra-i adapter solve drake | settled: toppra toppra-i adapter drake"
+    )
+    for name in names:
         robot = robots.load(name)
-        rng = np.random.default_rng(99 if name == "ur5" else 98)
+        plant = drake_plant(robot) if name == "ur5" else None
+        if name == "ur5":
+            drake_available = plant is not None
+        rng = np.random.default_rng(args.seed + (ROBOTS.index(name) if name in ROBOTS else 0))
+        robot_ratios = per_robot.setdefault(name, {method: [] for method in OTHERS})
         done = 0
         while done < args.paths:
-            path = _random_path(robot, rng)
+            waypoints, path = random_path(robot, rng)
             try:
-                reference = toppra.solve(build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, 10_000))).duration
+                reference, gap = converged_duration(path, robot)
             except (InfeasiblePath, TimingFailed):
-                continue
-            theirs = _equal_accuracy(toppra, path, robot, reference)
-            ours = _equal_accuracy(phase_plane, path, robot, reference)
-            if theirs is None or ours is None:
-                print(f"{name:6s} {done:4d}: a method missed 0.1 % on every grid of the ladder: toppra {theirs}, phase_plane {ours}")
+                continue  # no timing can follow this path within the limits: draw another
+            if gap > CONVERGED:
+                unconverged.append((name, done, gap))
                 done += 1
                 continue
-            ratio = theirs[1] / ours[1]
-            total = (theirs[1] + theirs[2]) / (ours[1] + ours[2])
-            ratios.append(ratio)
-            totals.append(total)
-            if ratio < 1:
-                slower.append((name, done, theirs, ours))
+            runs = {
+                "pp": toptraj_runner(PhasePlaneMethod(), path, robot),
+                "toppra": toppra_runner(robot, waypoints, path),
+                "toppra-i": toppra_runner(robot, waypoints, path, interpolation=True),
+                "adapter": toptraj_runner(ToppraMethod(), path, robot),
+            }
+            if plant is not None:
+                failures = drake_failures.setdefault(done, [])
+                runs["drake"] = drake_runner(plant, robot, waypoints, path, failures)
+            scans = {method: scan(run, reference) for method, run in runs.items()}
+            if any(scans[method].first is None for method in ("pp", "toppra", "toppra-i", "adapter")):
+                missed.append((name, done, {method: (found.first, found.settled) for method, found in scans.items()}))
+                done += 1
+                continue
+            wanted = {method: {grid for grid in (found.first, found.settled) if grid is not None} for method, found in scans.items()}
+            times = time_interleaved(runs, wanted, args.repeats)
+
+            def at(method, definition):
+                grid = getattr(scans[method], definition) if method in scans else None
+                return None if grid is None else (grid, *times[(method, grid)])
+
+            line = []
+            for definition in ("first", "settled"):
+                pp = at("pp", definition)
+                row = {}
+                for method in OTHERS:
+                    other = at(method, definition)
+                    if pp is None or other is None:
+                        continue
+                    row[method] = other[1] / pp[1]
+                    ratios[definition][method].append(row[method])
+                    if definition == "first":
+                        robot_ratios[method].append(row[method])
+                if pp is not None and at("adapter", definition) is not None:
+                    row["adapter solve"] = at("adapter", definition)[2] / pp[2]
+                    ratios[definition]["adapter solve"].append(row["adapter solve"])
+                line.append(row)
+                if definition == "first" and min(row.get("toppra", np.inf), row.get("adapter", np.inf)) < 1.0:
+                    slower.append((name, done, {method: at(method, definition) for method in ("pp", *OTHERS)}))
+
+            def cell(method, width):
+                found = at(method, "first")
+                if found is None:
+                    return f"{'-':>{width}s} {'-':>6s}"
+                return f"{found[0]:{width}d} {1e3 * found[1]:6.2f}"
+
+            pp = at("pp", "first")
+            adapter = at("adapter", "first")
+
+            def number(row, method, width):
+                return f"{row[method]:{width}.2f}" if method in row else f"{'-':>{width}s}"
+
             print(
-                f"{name:6s} {done:4d} {reference:9.4f} | {theirs[0]:8d} {1e3 * theirs[1]:7.2f} | "
-                f"{ours[0]:6d} {1e3 * ours[1]:7.2f} | {ratio:6.2f} {total:17.2f}"
+                f"{name:11s} {done:4d} {reference:7.4f} | {pp[0]:4d} {pp[3]:>5s} {1e3 * pp[1]:6.2f} {1e3 * pp[2]:5.2f} | "
+                f"{cell('toppra', 4)} | {cell('toppra-i', 5)} | {adapter[0]:4d} {1e3 * adapter[1]:6.2f} {1e3 * adapter[2]:6.2f} | "
+                f"{cell('drake', 4)} | {number(line[0], 'toppra', 12)} {number(line[0], 'toppra-i', 8)} "
+                f"{number(line[0], 'adapter', 7)} {number(line[0], 'adapter solve', 5)} {number(line[0], 'drake', 5)} | "
+                f"{number(line[1], 'toppra', 14)} {number(line[1], 'toppra-i', 8)} {number(line[1], 'adapter', 7)} "
+                f"{number(line[1], 'drake', 5)}",
+                flush=True,
             )
             done += 1
-    ratios, totals = np.array(ratios), np.array(totals)
+
     print()
-    print(f"paths compared: {len(ratios)}")
-    print(f"solve-time ratio toppra / phase_plane: median {np.median(ratios):.2f}, p95 {np.percentile(ratios, 95):.2f}, "
-          f"p5 {np.percentile(ratios, 5):.2f}, min {ratios.min():.2f}")
-    print(f"including the constraint build:        median {np.median(totals):.2f}, p95 {np.percentile(totals, 95):.2f}, "
-          f"p5 {np.percentile(totals, 5):.2f}, min {totals.min():.2f}")
-    for name, index, theirs, ours in slower:
-        print(f"slower: {name} path {index}: toppra N={theirs[0]} {1e3 * theirs[1]:.2f} ms, phase_plane N={ours[0]} {1e3 * ours[1]:.2f} ms")
+    print(f"Times at equal accuracy (within 0.1 % of T*), best of {args.repeats}; ratio = the other method's time / phase_plane's")
+    print("(> 1: phase_plane is faster). pp = build_path_constraints + PhasePlaneMethod().solve; toppra = toppra's")
+    print("public API with its default discretizations (collocation for torque), incl. its own constraint evaluation;")
+    print("toppra-i = the same with the interpolation discretization for torque too (conservative, as phase_plane);")
+    print("adapter = build_path_constraints + ToppraMethod().solve; solve = the two solves alone on prebuilt")
+    print("constraints (phase_plane's includes the rows it evaluates while refining); drake = Drake's Toppra.")
+    print("Each method at the smallest ladder grid within 0.1 %:")
+    for robot_name, robot_ratios in per_robot.items():
+        for method in ("toppra", "toppra-i", "adapter"):
+            print(summary(f"  {robot_name:11s} {method:8s} / pp", robot_ratios[method]))
+    for method in (*OTHERS, "adapter solve"):
+        if method == "drake" and not drake_available:
+            continue
+        label = "ur5 drake" if method == "drake" else f"all {method}"
+        print(summary(f"  {label:20s} / pp", ratios["first"][method]))
+    print("Each method at the smallest ladder grid from which it stays within 0.1 % on the next two ladder grids:")
+    for method in (*OTHERS, "adapter solve"):
+        if method == "drake" and not drake_available:
+            continue
+        label = "ur5 drake" if method == "drake" else f"all {method}"
+        print(summary(f"  {label:20s} / pp", ratios["settled"][method]))
+    if drake_available is False:
+        print("drake: pydrake not installed (pip install toptraj[bench]); skipped")
+    failed = {index: grids for index, grids in drake_failures.items() if grids}
+    if failed:
+        print(
+            "Drake's Toppra failed (\"failed to find the maximum path acceleration\") on "
+            + "; ".join(f"ur5 path {index} at {', '.join(map(str, grids))} intervals" for index, grids in failed.items())
+        )
+    for name, index, gap in unconverged:
+        print(f"not converged: {name} path {index}: the two estimates of T* differ by {gap:.1e}; left out")
+    for name, index, grids in missed:
+        print(f"missed: {name} path {index}: a method missed 0.1 % on every ladder grid (first, settled): {grids}")
+    if slower:
+        for name, index, found in slower:
+            described = ", ".join(
+                f"{method} N={value[0]} {1e3 * value[1]:.2f} ms" for method, value in found.items() if value is not None
+            )
+            print(f"slower: {name} path {index}: {described}")
+    else:
+        print("phase_plane is slower than toppra (directly or through the adapter) on no path")
     return 0
 
 

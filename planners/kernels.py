@@ -1,9 +1,11 @@
 """Compiled inner loops of the phase-plane method (numba): the per-point admissible interval of
-x = sd^2 and the two sequential sweeps. Plain loops over small row counts, compiled once and
-cached on disk; they hold no knowledge of paths or robots.
+x = sd^2, the bounds on u of each grid interval in either discretization, and the two sequential
+sweeps. Plain loops over small row counts, compiled once (``nogil``, so threads run them in
+parallel) and cached on disk; they hold no knowledge of paths or robots.
 
-Bounds on the path acceleration u come as lines: ``p + q x <= u <= r + w x`` per row, shape
-(N, m), with an intercept of -inf (p) or +inf (r) where a row gives no such bound.
+Bounds on the path acceleration u come as lines: ``p + q x <= u <= r + q x`` per row, shape
+(N, m), with an intercept of -inf (p) or +inf (r) where a row gives no such bound (the two lines
+of a row share their slope q = -b / a).
 """
 
 from __future__ import annotations
@@ -12,9 +14,11 @@ import numpy as np
 from numba import njit
 
 _INF = np.inf
+#: |a| below this fraction of the row's scale |a| + |b| counts as zero (a zero-inertia point).
+ZERO_INERTIA = 1e-10
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _gap(p, q, r, w, i, x):  # pragma: no cover - compiled
     """phi(x) = min_j (r_j + w_j x) - max_k (p_k + q_k x) at point i, its slope there, and the
     intercept of the active piece (so its root is -intercept / slope without cancellation)."""
@@ -45,7 +49,7 @@ def _gap(p, q, r, w, i, x):  # pragma: no cover - compiled
 _X_FAR = 1e12
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def admissible_intervals(p, q, r, w, x_low, x_high):  # pragma: no cover - compiled
     """Narrow ``[x_low, x_high]`` (each (N,), updated in place and returned) at every point to
     the x for which some u lies between every lower and every upper line.
@@ -94,7 +98,194 @@ def admissible_intervals(p, q, r, w, x_low, x_high):  # pragma: no cover - compi
     return x_low, x_high
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
+def _row_bounds(a, b, c, lo, hi):  # pragma: no cover - compiled
+    """Row ``lo <= a u + b x + c <= hi`` as bounds on u, ``low + slope x <= u <= high + slope x``:
+    (low, slope, high, False), NaN intercepts read as no bound. A zero-inertia row (a = 0)
+    bounds x instead: (x_from, 0, x_to, True), the x it admits, ``-inf, inf`` when b = 0 and the
+    row holds, ``inf, -inf`` (none) when b = 0 and it fails."""
+    scale = abs(a) + abs(b)
+    if scale < 1e-300:
+        scale = 1e-300
+    if abs(a) <= ZERO_INERTIA * scale:
+        if b > 0.0:
+            return (lo - c) / b, 0.0, (hi - c) / b, True
+        if b < 0.0:
+            return (hi - c) / b, 0.0, (lo - c) / b, True
+        if c > hi or c < lo:
+            return _INF, 0.0, -_INF, True
+        return -_INF, 0.0, _INF, True
+    from_upper = (hi - c) / a
+    from_lower = (lo - c) / a
+    if a > 0.0:
+        low, high = from_lower, from_upper
+    else:
+        low, high = from_upper, from_lower
+    if low != low:
+        low = -_INF
+    if high != high:
+        high = _INF
+    return low, -b / a, high, False
+
+
+@njit(cache=True, nogil=True)
+def _store(i, k, low, slope, high, singular, p, q, r, x_low, x_high):  # pragma: no cover - compiled
+    """Put one row's bounds (``_row_bounds``) at point i, row k; a zero-inertia row narrows
+    ``x_low[i], x_high[i]`` and leaves no bound on u. Returns whether the row fails at every x."""
+    if singular:
+        p[i, k] = -_INF
+        q[i, k] = 0.0
+        r[i, k] = _INF
+        if low > high:
+            return True
+        if high < x_high[i]:
+            x_high[i] = high
+        if low > x_low[i]:
+            x_low[i] = low
+        return False
+    p[i, k] = low
+    q[i, k] = slope
+    r[i, k] = high
+    return False
+
+
+@njit(cache=True, nogil=True)
+def point_bounds(a, b, c, lower, upper, x_bound):  # pragma: no cover - compiled
+    """Every row of every point (each (N, m)) as bounds on u, and the admissible x of each point
+    under them and ``x <= x_bound`` (N,).
+
+    Returns p, q, r (N, m; the upper lines share the slope q), x_low, x_high (N,; x_high = -1
+    where no x is admissible), singular (N, m: rows with a = 0) and static_fail (N,: a row with
+    a = b = 0 that fails at every x).
+    """
+    n_points, n_rows = a.shape
+    p = np.empty((n_points, n_rows))
+    q = np.empty((n_points, n_rows))
+    r = np.empty((n_points, n_rows))
+    x_low = np.zeros(n_points)
+    x_high = np.empty(n_points)
+    singular = np.zeros((n_points, n_rows), dtype=np.bool_)
+    static_fail = np.zeros(n_points, dtype=np.bool_)
+    for i in range(n_points):
+        x_high[i] = x_bound[i]
+        for k in range(n_rows):
+            low, slope, high, is_singular = _row_bounds(a[i, k], b[i, k], c[i, k], lower[i, k], upper[i, k])
+            if is_singular:
+                singular[i, k] = True
+                if _store(i, k, low, slope, high, True, p, q, r, x_low, x_high):
+                    static_fail[i] = True
+            else:
+                p[i, k] = low
+                q[i, k] = slope
+                r[i, k] = high
+    admissible_intervals(p, q, r, q, x_low, x_high)
+    for i in range(n_points):
+        if static_fail[i] or x_low[i] > x_high[i]:
+            x_high[i] = -1.0
+    return p, q, r, x_low, x_high, singular, static_fail
+
+
+@njit(cache=True, nogil=True)
+def _friction_share(d, root, half):  # pragma: no cover - compiled
+    """The terms (to b, to c) that replace a viscous term ``d sd`` in one half of a row
+    linearized around sd_ref = ``root``: the tangent d (x + x_ref) / (2 sd_ref) of the concave
+    d sqrt(x) where it can only tighten the row, and 0 elsewhere (``PathConstraints.linearized``:
+    half 0 is the row against its upper bound, which takes d > 0; half 1 against its lower
+    bound, which takes d < 0)."""
+    share = max(d, 0.0) if half == 0 else min(d, 0.0)
+    return share / (2.0 * root), 0.5 * share * root
+
+
+@njit(cache=True, nogil=True)
+def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint):  # pragma: no cover - compiled
+    """The rows of each grid interval i on its start state (u_i, x_i) as bounds on u, and the
+    admissible x_i under them.
+
+    Rows ``lo <= a u + b x + c + d sd <= hi`` are given at the grid points, each (N + 1, m):
+    ``ra, rb, rc, rd`` as seen from the interval that starts at a point, ``la, lb, lc, ld`` from
+    the one that ends there (they differ only at corners of the path). With x linear in s over
+    the interval (x_i+1 = x_i + 2 ds u_i):
+
+    * interpolation (``midpoint`` False): every row at s_i, ``ra_i u + rb_i x_i + rc_i``, and at
+      s_i+1 as seen from the interval, ``la_i+1 u + lb_i+1 (x_i + 2 ds u) + lc_i+1``:
+      conservative, the limits hold at every grid point (``phase_plane.interval_rows``);
+    * midpoint (``midpoint`` True): every row at the interval's midpoint with the coefficients
+      averaged from its ends, ``a_m u + b_m (x_i + ds u) + c_m``: second-order accurate, no
+      bound (``phase_plane.midpoint_stage_rows``).
+
+    With ``friction``, each row is first split into its halves against the upper and the lower
+    bound, the viscous term of each replaced by its tangent at x_ref (N + 1,), exactly as
+    ``PathConstraints.linearized`` does; without, ``rd, ld`` and ``x_ref`` are not read.
+
+    Returns p, q, r (N, k m with k = 1 midpoint, 2 interpolation, times 2 with friction),
+    x_low, x_high (N,; x_high = -1 where none is admissible, capped by ``x_bound[i]``) and
+    singular (N,: the interval has a zero-inertia row).
+    """
+    n_stages = s.shape[0] - 1
+    n_rows = ra.shape[1]
+    halves = 2 if friction else 1
+    per_half = n_rows if midpoint else 2 * n_rows
+    width = halves * per_half
+    p = np.empty((n_stages, width))
+    q = np.empty((n_stages, width))
+    r = np.empty((n_stages, width))
+    x_low = np.zeros(n_stages)
+    x_high = np.empty(n_stages)
+    singular = np.zeros(n_stages, dtype=np.bool_)
+    static_fail = np.zeros(n_stages, dtype=np.bool_)
+    root_here = 1.0
+    root_next = 1.0
+    for i in range(n_stages):
+        ds = s[i + 1] - s[i]
+        x_high[i] = x_bound[i]
+        if friction:
+            root_here = np.sqrt(max(x_ref[i], 1e-6))
+            root_next = np.sqrt(max(x_ref[i + 1], 1e-6))
+        for half in range(halves):
+            for j in range(n_rows):
+                b_here, c_here = rb[i, j], rc[i, j]
+                b_next, c_next = lb[i + 1, j], lc[i + 1, j]
+                lo_here, hi_here = lower[i, j], upper[i, j]
+                lo_next, hi_next = lower[i + 1, j], upper[i + 1, j]
+                if friction:
+                    to_b, to_c = _friction_share(rd[i, j], root_here, half)
+                    b_here += to_b
+                    c_here += to_c
+                    to_b, to_c = _friction_share(ld[i + 1, j], root_next, half)
+                    b_next += to_b
+                    c_next += to_c
+                    if half == 0:
+                        lo_here, lo_next = -_INF, -_INF
+                    else:
+                        hi_here, hi_next = _INF, _INF
+                k = half * per_half + j
+                for end_ in range(1 if midpoint else 2):
+                    if midpoint:
+                        b_mid = 0.5 * (b_here + b_next)
+                        a_mid = 0.5 * (ra[i, j] + la[i + 1, j]) + ds * b_mid
+                        low, slope, high, is_singular = _row_bounds(a_mid, b_mid, 0.5 * (c_here + c_next), lo_here, hi_here)
+                    elif end_ == 0:
+                        low, slope, high, is_singular = _row_bounds(ra[i, j], b_here, c_here, lo_here, hi_here)
+                    else:
+                        a_next = la[i + 1, j] + 2.0 * ds * b_next
+                        low, slope, high, is_singular = _row_bounds(a_next, b_next, c_next, lo_next, hi_next)
+                    column = k + end_ * n_rows
+                    if is_singular:
+                        singular[i] = True
+                        if _store(i, column, low, slope, high, True, p, q, r, x_low, x_high):
+                            static_fail[i] = True
+                    else:
+                        p[i, column] = low
+                        q[i, column] = slope
+                        r[i, column] = high
+    admissible_intervals(p, q, r, q, x_low, x_high)
+    for i in range(n_stages):
+        if static_fail[i] or x_low[i] > x_high[i]:
+            x_high[i] = -1.0
+    return p, q, r, x_low, x_high, singular
+
+
+@njit(cache=True, nogil=True)
 def backward_envelope(ds, p, q, r, w, x_low, x_high, x_end, slack):  # pragma: no cover - compiled
     """The controllable sets, swept backward from the end state: for i = N-1 .. 0 the interval
     [lower_i, upper_i] of admissible x_i from which some u in [alpha_i(x_i), beta_i(x_i)] lands
@@ -149,7 +340,7 @@ def backward_envelope(ds, p, q, r, w, x_low, x_high, x_end, slack):  # pragma: n
     return upper, lower, -1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def forward_profile(ds, r, w, envelope, x_start):  # pragma: no cover - compiled
     """Maximum-acceleration sweep from the start, capped by the envelope: x (N + 1,) and, per
     interval, whether the cap decided it (True) or the acceleration limit did (False)."""
@@ -171,3 +362,221 @@ def forward_profile(ds, r, w, envelope, x_start):  # pragma: no cover - compiled
         else:
             x[i + 1] = reach if reach > 0.0 else 0.0
     return x, capped
+
+
+@njit(cache=True, nogil=True)
+def _time_at_bounds(length, x0, x1, beta, alpha, c0, c1):  # pragma: no cover - compiled
+    """Time over an interval of ``length`` from x0 to x1 (x = sd^2) at the bounds: accelerate
+    at u = ``beta`` > 0 from x0, follow the ceiling c(t) (linear from c0 to c1), decelerate at
+    u = ``alpha`` < 0 into x1. -1 where these bounds cannot join the two ends."""
+    slope = (c1 - c0) / length
+    # Acceleration meets the ceiling at t_a, the deceleration leaves it at t_d.
+    t_a = (c0 - x0) / (2.0 * beta - slope) if 2.0 * beta > slope else length
+    t_d = length - (c1 - x1) / (-2.0 * alpha + slope) if -2.0 * alpha + slope > 0.0 else 0.0
+    if 0.0 <= t_a < t_d <= length:
+        top_a = c0 + slope * t_a
+        top_d = c0 + slope * t_d
+        cruise = 2.0 * (t_d - t_a) / (np.sqrt(top_a) + np.sqrt(top_d))
+        return (np.sqrt(top_a) - np.sqrt(x0)) / beta + cruise + (np.sqrt(top_d) - np.sqrt(x1)) / -alpha
+    # Below the ceiling all the way: the two curves meet at t_m.
+    t_m = (x1 - 2.0 * alpha * length - x0) / (2.0 * (beta - alpha))
+    if not 0.0 <= t_m <= length:
+        return -1.0
+    top = x0 + 2.0 * beta * t_m
+    return (np.sqrt(top) - np.sqrt(x0)) / beta + (np.sqrt(top) - np.sqrt(x1)) / -alpha
+
+
+@njit(cache=True, nogil=True)
+def switch_excess(ds, p, q, r, x, ceiling):  # pragma: no cover - compiled
+    """How much faster than the discrete profile x (N + 1,) each interval could be crossed at
+    its bounds (N,). With u constant per interval in the discrete profile, where the optimal
+    profile switches inside an interval (starts from rest, reaches the maximum velocity curve,
+    leaves it to decelerate), the constant-u interval is slower by an amount that a second
+    discretization on the same grid does not see. The maximum path acceleration at x_i,
+    the maximum deceleration at x_i+1 and the admissible upper x at the grid points
+    (``ceiling``, N + 1, linear in between) stand for the interval's bounds."""
+    n_stages, n_rows = p.shape
+    excess = np.zeros(n_stages)
+    for i in range(n_stages):
+        x0 = x[i]
+        x1 = x[i + 1]
+        beta = _INF
+        alpha = -_INF
+        for k in range(n_rows):
+            fastest = r[i, k] + q[i, k] * x0
+            if fastest < beta:
+                beta = fastest
+            slowest = p[i, k] + q[i, k] * x1
+            if slowest > alpha:
+                alpha = slowest
+        c0 = ceiling[i]
+        c1 = ceiling[i + 1]
+        if not (beta > 0.0 and alpha < 0.0 and beta < _INF and alpha > -_INF and c0 < _INF and c1 < _INF):
+            continue
+        c0 = max(c0, x0)
+        c1 = max(c1, x1)
+        if x0 + x1 <= 0.0:
+            continue
+        fast = _time_at_bounds(ds[i], x0, x1, beta, alpha, c0, c1)
+        if fast >= 0.0:
+            chord = 2.0 * ds[i] / (np.sqrt(x0) + np.sqrt(x1))
+            if chord > fast:
+                excess[i] = chord - fast
+    return excess
+
+
+@njit(cache=True, nogil=True)
+def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, x_start, x_end, midpoint, slack):  # pragma: no cover - compiled
+    """One solve on the grid ``s`` (N + 1,): the interval bounds (``interval_bounds``, whose
+    arguments these are), the backward envelope from ``x_end`` and the forward profile from
+    ``min(x_start, envelope_0)``.
+
+    Returns x (N + 1,; empty when the backward sweep failed), capped (N,), envelope and floor
+    (N + 1,), the index of the interval where the backward sweep failed or -1, the admissible
+    upper x_i of each interval (N,) and the ``switch_excess`` of each interval (N,).
+    """
+    p, q, r, x_low, x_high, _ = interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint)
+    n_stages = s.shape[0] - 1
+    ds = np.empty(n_stages)
+    for i in range(n_stages):
+        ds[i] = s[i + 1] - s[i]
+    envelope, floor, failed = backward_envelope(ds, p, q, r, q, x_low, x_high, x_end, slack)
+    if failed >= 0:
+        return np.empty(0), np.empty(0, dtype=np.bool_), envelope, floor, failed, x_high, np.empty(0)
+    x, capped = forward_profile(ds, r, q, envelope, min(x_start, envelope[0]))
+    ceiling = np.empty(n_stages + 1)
+    ceiling[:n_stages] = x_high
+    ceiling[n_stages] = max(x_bound[n_stages], x_end) if x_bound[n_stages] < _INF else x_high[n_stages - 1]
+    return x, capped, envelope, floor, failed, x_high, switch_excess(ds, p, q, r, x, ceiling)
+
+
+@njit(cache=True, nogil=True)
+def _interval_time(ds, x0, x1):  # pragma: no cover - compiled
+    """Time over an interval of length ds with x = sd^2 linear from x0 to x1."""
+    total = np.sqrt(x0) + np.sqrt(x1)
+    return 2.0 * ds / (total if total > 1e-300 else 1e-300)
+
+
+@njit(cache=True, nogil=True)
+def _pieces(error, order, shrink, pieces):  # pragma: no cover - compiled
+    """Raise ``pieces`` (N,) to the pieces per interval that bring the sum of ``error`` (N,),
+    each part falling as k^-order, to ``shrink`` times itself with the fewest pieces in all
+    (Lagrange multipliers: k_i = e_i^(1 / (order + 1)) (sum_j e_j^(1 / (order + 1)) /
+    (shrink sum_j e_j))^(1 / order))."""
+    total = 0.0
+    weights = 0.0
+    for i in range(error.shape[0]):
+        total += error[i]
+        weights += error[i] ** (1.0 / (order + 1.0))
+    if not total > 0.0:
+        return
+    scale = (weights / (shrink * total)) ** (1.0 / order)
+    for i in range(error.shape[0]):
+        wanted = error[i] ** (1.0 / (order + 1.0)) * scale
+        if wanted > pieces[i]:
+            pieces[i] = wanted
+
+
+@njit(cache=True, nogil=True)
+def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, room):  # pragma: no cover - compiled
+    """Error estimate of the profile x (N + 1,) on the grid s, and where to refine it.
+
+    Each interval's error, this discretization's time minus the exact one, is estimated from:
+
+    * first order: its time here minus its time in the midpoint discretization x_mid (second
+      order, so it stands for the exact answer where the profile is resolved). The
+      conservative discretization is the slower wherever both resolve the profile; where the
+      midpoint one comes out slower, it does not resolve the interval either: that marks the
+      interval (a second-order part below) but estimates no error of this profile;
+    * second order: ``switch`` (N,), the time it would save by switching inside it
+      (``switch_excess``, which neither discretization sees), and the chord error where the
+      profile rides on the ``ceiling`` of admissible x (N + 1,) at both ends: x linear in s
+      runs along the chord of the curved ceiling, which neither discretization checks between
+      grid points. With x'' from second differences, the chord's time minus the curve's is
+      -x'' ds^3 / (24 x^(3/2)) (faster under a convex ceiling, slower under a concave one).
+
+    The estimated relative error is |the signed sum| plus ``guard`` times the magnitudes that
+    may cancel in it or estimate nothing (chord errors, unresolved intervals): a guard against
+    errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are split into
+    equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order one;
+    the fewest pieces that bring the estimate to ``aim`` times the tolerance (``_pieces``, the
+    larger of the two kinds, at most ``max_pieces`` per interval and ``room`` new points in
+    all, the worst intervals first).
+
+    Returns the new points (sorted, each strictly inside an interval; empty when the estimate
+    is within the tolerance) and the estimated relative error.
+    """
+    n_stages = s.shape[0] - 1
+    first = np.empty(n_stages)
+    second = np.empty(n_stages)
+    curvature = np.zeros(n_stages + 1)
+    for i in range(1, n_stages):
+        left = (ceiling[i] - ceiling[i - 1]) / (s[i] - s[i - 1])
+        right = (ceiling[i + 1] - ceiling[i]) / (s[i + 1] - s[i])
+        curvature[i] = 2.0 * (right - left) / (s[i + 1] - s[i - 1])
+    if n_stages >= 2:
+        curvature[0] = curvature[1]
+        curvature[n_stages] = curvature[n_stages - 1]
+    duration = 0.0
+    signed = 0.0
+    uncertain = 0.0
+    for i in range(n_stages):
+        ds = s[i + 1] - s[i]
+        here = _interval_time(ds, x[i], x[i + 1])
+        duration += here
+        first[i] = here - _interval_time(ds, x_mid[i], x_mid[i + 1])
+        chord = 0.0
+        riding = (
+            x[i] > 0.0
+            and x[i + 1] > 0.0
+            and x[i] >= ceiling[i] * (1.0 - 1e-6)
+            and x[i + 1] >= ceiling[i + 1] * (1.0 - 1e-6)
+            and ceiling[i] < _INF
+            and ceiling[i + 1] < _INF
+        )
+        if riding:
+            mean = 0.5 * (x[i] + x[i + 1])
+            chord = -0.5 * (curvature[i] + curvature[i + 1]) * ds**3 / (24.0 * mean**1.5)
+            if not np.isfinite(chord):
+                chord = 0.0
+        # The conservative discretization is slower than the exact profile wherever both
+        # resolve it; where the midpoint one comes out slower, it is its own error (it does
+        # not resolve the interval either), which marks the interval but is no estimate.
+        unresolved = max(-first[i], 0.0)
+        first[i] = max(first[i], 0.0)
+        second[i] = switch[i] + abs(chord) + unresolved
+        signed += first[i] + switch[i] + chord
+        uncertain += abs(chord) + unresolved
+    exact = duration - signed
+    if not exact > 0.0:
+        exact = duration
+    error = (abs(signed) + guard * uncertain) / exact
+    if not error > tolerance or room <= 0:
+        return np.empty(0), error
+    shrink = aim * tolerance / error
+    wanted = np.ones(n_stages)
+    _pieces(first, 1.0, shrink, wanted)
+    _pieces(second, 2.0, shrink, wanted)
+    pieces = np.empty(n_stages, dtype=np.int64)
+    added = 0
+    for i in range(n_stages):
+        k = np.ceil(wanted[i])
+        pieces[i] = max_pieces if k > max_pieces else int(k)
+        added += pieces[i] - 1
+    if added > room:
+        # Too many for the grid's cap: the worst intervals first, each as asked.
+        worst = np.argsort(-(first + second), kind="mergesort")
+        used = 0
+        for index in worst:
+            if used + pieces[index] - 1 <= room:
+                used += pieces[index] - 1
+            else:
+                pieces[index] = 1
+        added = used
+    points = np.empty(added)
+    at = 0
+    for i in range(n_stages):
+        for j in range(1, pieces[i]):
+            points[at] = s[i] + (s[i + 1] - s[i]) * j / pieces[i]
+            at += 1
+    return points, error

@@ -16,10 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.constraints import LinearRows
-from planners.kernels import admissible_intervals
-
-#: |a| below this fraction of the row's scale counts as zero (a zero-inertia point).
-ZERO_INERTIA = 1e-10
+from planners.kernels import ZERO_INERTIA, point_bounds
 
 
 @dataclass(frozen=True)
@@ -73,24 +70,16 @@ def acceleration_bounds(rows: LinearRows) -> AccelerationBounds:
 
 def admissible_set(rows: LinearRows, x_bound: np.ndarray) -> AdmissibleSet:
     """Admissible x at every grid point for ``rows`` and the first-order bound ``x <= x_bound``."""
-    b, c, lower, upper = rows.b, rows.c, rows.lower, rows.upper
-    bounds = acceleration_bounds(rows)
-    singular = bounds.singular
-    # Rows with a = 0 bound x itself: lower <= b x + c <= upper.
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cut_high = np.where(b > 0, (upper - c) / b, np.where(b < 0, (lower - c) / b, np.inf))
-        cut_low = np.where(b > 0, (lower - c) / b, np.where(b < 0, (upper - c) / b, -np.inf))
-    static_fail = (singular & (b == 0) & ((c > upper) | (c < lower))).any(axis=1)
-    x_high = np.minimum(np.asarray(x_bound, dtype=float), np.where(singular & (b != 0), cut_high, np.inf).min(axis=1, initial=np.inf))
-    x_low = np.maximum(0.0, np.where(singular & (b != 0), cut_low, -np.inf).max(axis=1, initial=-np.inf))
-    x_low, x_high = admissible_intervals(
-        bounds.p, bounds.q, bounds.r, bounds.w, np.ascontiguousarray(x_low), np.ascontiguousarray(x_high)
-    )
-    empty = (x_low > x_high) | static_fail
+    arrays = [np.ascontiguousarray(array, dtype=float) for array in (rows.a, rows.b, rows.c, rows.lower, rows.upper)]
+    x_bound = np.ascontiguousarray(np.broadcast_to(np.asarray(x_bound, dtype=float), arrays[0].shape[:1]))
+    p, q, r, x_low, x_high, singular, static_fail = point_bounds(*arrays, x_bound)
+    empty = x_high < 0.0
     blocking = np.full((len(x_low), 2), -1)
-    for point in np.flatnonzero(empty):
-        blocking[point] = _blocking_pair(point, bounds, x_low, static_fail, singular, rows)
-    return AdmissibleSet(x_min=x_low, x_max=np.where(empty, -1.0, x_high), blocking_rows=blocking)
+    if empty.any():
+        bounds = AccelerationBounds(p=p, q=q, r=r, w=q, singular=singular)
+        for point in np.flatnonzero(empty):
+            blocking[point] = _blocking_pair(point, bounds, x_low, static_fail, singular, rows)
+    return AdmissibleSet(x_min=x_low, x_max=x_high, blocking_rows=blocking)
 
 
 def _blocking_pair(point, bounds, x_min, static_fail, singular, rows):

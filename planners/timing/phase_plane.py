@@ -24,11 +24,16 @@ collapses to one value and the sweeps take it: no chattering, no special case.
 Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
 row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
 point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
-(``planners.kernels``): no LP is solved anywhere. This constant-u scheme is conservative by a
-first-order amount, so the grid is refined where it costs time: the midpoint discretization on
-the same grid (second-order accurate, but not conservative) estimates the error of each interval,
-and the worst intervals are split, with the constraint rows evaluated anew there, until the
-estimated duration error is below the tolerance.
+(``planners.kernels``): no LP is solved anywhere; one compiled call per sweep pair builds the
+rows of every interval, linearizes viscous friction, finds the admissible intervals and runs
+both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
+amount, so the grid is refined where it costs time: the error of each interval is estimated from
+the midpoint discretization on the same grid (second-order accurate, but not conservative), from
+the time it would save by switching inside the interval (a start from rest, a switch onto or off
+the MVC within one interval, which neither discretization sees) and from the chord error along
+a curved MVC; each interval is split into as many pieces as its share of the error asks for,
+with the constraint rows evaluated anew at the new points (one batched evaluation per round),
+until the estimated duration error is below the tolerance.
 """
 
 from __future__ import annotations
@@ -41,8 +46,8 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
-from planners.kernels import backward_envelope, forward_profile
-from planners.mvc import acceleration_bounds, admissible_set, friction_reference
+from planners.kernels import point_bounds, refinement, sweeps
+from planners.mvc import admissible_set
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
@@ -85,15 +90,30 @@ def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> L
     )
 
 
+#: Pieces into which one refinement round may split an interval at most.
+_MAX_PIECES = 8
+#: Refinement aims at this fraction of the tolerance, so that one round usually suffices.
+_AIM = 0.85
+#: Weight, in the estimated error, of the estimates that may cancel in its signed sum or
+#: estimate nothing (``planners.kernels.refinement``): a guard against their own errors.
+_GUARD = 0.15
+#: The refined grid has at most 2^max_refinements times the intervals of the given one (what
+#: halving every interval in each round would give), or this many, whichever is more.
+_MIN_REFINED_INTERVALS = 4096
+
+
 class PhasePlaneMethod(TimingMethod):
     """Time-optimal timing by phase-plane integration (see the module docstring).
 
     Args:
         tolerance: Relative duration error at which grid refinement stops. The error is
-            estimated by the midpoint discretization on the same grid (second order, so it
-            stands for the exact answer); intervals where the two disagree most are split, with
-            the constraint rows evaluated anew at the new points, until the estimate falls
-            below ``tolerance`` or ``max_refinements`` rounds are done.
+            estimated from the midpoint discretization on the same grid (second order, so it
+            stands for the exact answer), from the time each interval would save by switching
+            inside it, and from the chord error along the maximum velocity curve
+            (``planners.kernels.refinement``); intervals are split where the estimates lie,
+            each into as many pieces as its share asks for, with the constraint rows evaluated
+            anew at the new points, until the estimate falls below ``tolerance`` or
+            ``max_refinements`` rounds are done.
         max_refinements: Rounds of refinement; 0 keeps the given grid.
     """
 
@@ -111,46 +131,86 @@ class PhasePlaneMethod(TimingMethod):
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:
         boundary = (boundary.sd_start**2, boundary.sd_end**2)
-        for round_ in range(self.max_refinements + 1):
-            profile = _solve_on_grid(constraints, boundary, deadline, interval_rows)
-            if round_ == self.max_refinements or not constraints.can_refine:
+        most_intervals = max(2**self.max_refinements * (len(constraints.s) - 1), _MIN_REFINED_INTERVALS)
+        grid = _Grid.of(constraints)
+        profile = _solve_on_grid(grid, boundary, deadline, midpoint=False)
+        for _ in range(self.max_refinements if constraints.can_refine else 0):
+            try:
+                reference = _solve_on_grid(grid, boundary, deadline, midpoint=True, x_ref=profile.x)
+            except InfeasiblePath:
                 break
-            split = self._intervals_to_split(constraints, profile, boundary, deadline)
-            if split.size == 0:
+            room = most_intervals - (len(grid.s) - 1)
+            ceiling = np.append(profile.x_high, grid.x_bound[-1])
+            extra, _ = refinement(
+                grid.s, profile.x, reference.x, ceiling, profile.switch_excess,
+                self.tolerance, _AIM, _GUARD, _MAX_PIECES, room,
+            )
+            if extra.size == 0:
                 break
             deadline.check()
-            constraints = constraints.with_points(0.5 * (constraints.s[split] + constraints.s[split + 1]))
-        switches = _switch_points(constraints.s, profile)
-        return TimeScaling(constraints.s, np.sqrt(profile.x), switches)
+            previous = grid
+            grid = _Grid.of(grid.constraints.with_points(extra))
+            # The profile on the coarser grid is a close reference for viscous friction.
+            x_ref = np.interp(grid.s, previous.s, profile.x) if grid.friction else None
+            profile = _solve_on_grid(grid, boundary, deadline, midpoint=False, x_ref=x_ref)
+        switches = _switch_points(grid.constraints, profile)
+        return TimeScaling(grid.s, np.sqrt(profile.x), switches)
 
-    def _intervals_to_split(self, constraints, profile, boundary, deadline) -> np.ndarray:
-        """Intervals whose time the midpoint discretization (second order) finds different by
-        more than their share of the tolerance, when the total difference exceeds the tolerance.
-        Halving an interval quarters its (second-order local) excess, so this equidistributes
-        the error over the grid."""
-        try:
-            reference = _solve_on_grid(constraints, boundary, deadline, midpoint_stage_rows, profile.x)
-        except InfeasiblePath:
-            return np.empty(0, dtype=int)
-        # Where the two discretizations disagree, in either direction, the grid does not resolve
-        # the profile: the midpoint scheme is no bound, and on coarse grids of strongly curved
-        # paths it can come out longer than the conservative one.
-        excess = np.abs(_interval_times(constraints.s, profile.x) - _interval_times(constraints.s, reference.x))
-        budget = self.tolerance * _interval_times(constraints.s, reference.x).sum()
-        if excess.sum() <= budget:
-            return np.empty(0, dtype=int)
-        return np.flatnonzero(excess > 0.5 * budget / len(excess))
+
+def midpoint_duration(constraints: PathConstraints, boundary: Boundary = AT_REST) -> float:
+    """The duration (s) in the midpoint discretization on the constraints' own grid, without
+    refinement: second-order accurate, but no bound (the limits may be exceeded between grid
+    points). On a fine grid, an estimate of the converged time-optimal duration."""
+    states = (boundary.sd_start**2, boundary.sd_end**2)
+    grid = _Grid.of(constraints)
+    first = _solve_on_grid(grid, states, NO_DEADLINE, midpoint=False)
+    second = _solve_on_grid(grid, states, NO_DEADLINE, midpoint=True, x_ref=first.x)
+    return float(_interval_times(grid.s, second.x).sum())
+
+
+class _Grid(NamedTuple):
+    """The constraints on one grid as contiguous arrays for the kernels: s (N + 1,), the rows
+    seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
+    first-order bound x_bound = sd_max^2 (N + 1,) and whether any row has viscous friction."""
+
+    constraints: PathConstraints
+    s: np.ndarray
+    rows: tuple[np.ndarray, ...]
+    x_bound: np.ndarray
+    friction: bool
+
+    @classmethod
+    def of(cls, constraints: PathConstraints) -> "_Grid":
+        rows = tuple(
+            np.ascontiguousarray(array, dtype=np.float64)
+            for array in (
+                constraints.a, constraints.b, constraints.c, constraints.d,
+                constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left,
+                constraints.lower, constraints.upper,
+            )
+        )  # fmt: skip
+        s = np.ascontiguousarray(constraints.s, dtype=np.float64)
+        x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
+        return cls(constraints, s, rows, x_bound, bool(np.any(rows[3] != 0.0) or np.any(rows[7] != 0.0)))
+
+    def friction_reference(self) -> np.ndarray:
+        """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
+        capped by the first-order bound (1 where it is not positive and finite)."""
+        a, b, c, _, _, _, _, _, lower, upper = self.rows
+        x_max = point_bounds(a, b, c, lower, upper, self.x_bound)[4]
+        return np.where(np.isfinite(x_max) & (x_max > 0), x_max, 1.0)
 
 
 class _Profile(NamedTuple):
     """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
-    envelope (N + 1,), the interval rows and their admissible upper x (N,)."""
+    envelope (N + 1,), the admissible upper x_i of each interval (N,) and how much faster each
+    interval could be crossed at its bounds (N,, ``planners.kernels.switch_excess``)."""
 
     x: np.ndarray
     capped: np.ndarray
     envelope: np.ndarray
-    stage: LinearRows
     x_high: np.ndarray
+    switch_excess: np.ndarray
 
 
 def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -158,25 +218,24 @@ def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
     return 2.0 * np.diff(s) / np.maximum(root[:-1] + root[1:], 1e-300)
 
 
-def _solve_on_grid(constraints, boundary, deadline, discretize, x_ref=None) -> _Profile:
-    """Integrate on the constraints' own grid. Viscous friction is linearized around ``x_ref``
-    (default: a first pass around ``friction_reference``, then one around its answer)."""
-    x_bound = constraints.sd_max**2
+def _solve_on_grid(grid: _Grid, boundary, deadline, midpoint: bool, x_ref=None) -> _Profile:
+    """Integrate on one grid, in the interpolation (conservative) or the midpoint
+    discretization. Viscous friction is linearized around ``x_ref`` (default: a first pass
+    around the frictionless maximum velocity curve, then one around its answer)."""
     passes = 1
     if x_ref is None:
-        x_ref = friction_reference(constraints)
-        passes = 2 if constraints.has_friction else 1
+        passes = 2 if grid.friction else 1
+        x_ref = grid.friction_reference() if grid.friction else grid.x_bound
     for _ in range(passes):
-        stage = discretize(constraints.s, constraints.linearized(x_ref), constraints.linearized(x_ref, "left"))
-        profile = _integrate(constraints, stage, x_bound, *boundary, deadline)
+        profile = _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), *boundary, deadline, midpoint)
         x_ref = profile.x
     return profile
 
 
-def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline) -> _Profile:
-    ds = np.ascontiguousarray(np.diff(constraints.s))
-    admissible = admissible_set(stage, x_bound[:-1])
-    bounds = acceleration_bounds(stage)
+def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profile:
+    """One sweep pair (``planners.kernels.sweeps``) on ``grid``; a failure is explained from the
+    rows linearized around ``x_ref``."""
+    x_bound, constraints = grid.x_bound, grid.constraints
     if x_end > x_bound[-1] * (1 + _SLACK) + _SLACK:
         raise InfeasiblePath(
             f"the end path speed {np.sqrt(x_end):.6g} 1/s is above the maximum velocity curve "
@@ -184,11 +243,13 @@ def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline
             s=1.0,
         )
     deadline.check()
-    envelope, floor, failed = backward_envelope(
-        ds, bounds.p, bounds.q, bounds.r, bounds.w, admissible.x_min, admissible.x_max, float(x_end), _SLACK
+    x, capped, envelope, floor, failed, x_high, switch_excess = sweeps(
+        grid.s, *grid.rows, x_bound, x_ref, grid.friction, float(x_start), float(x_end), midpoint, _SLACK
     )
     if failed >= 0:
-        raise _stuck(constraints, admissible, stage, int(failed))
+        discretize = midpoint_stage_rows if midpoint else interval_rows
+        stage = discretize(constraints.s, constraints.linearized(x_ref), constraints.linearized(x_ref, "left"))
+        raise _stuck(constraints, admissible_set(stage, x_bound[:-1]), stage, int(failed))
     if x_start < floor[0] * (1 - 1e-7) - 1e-12:
         clause, joint = static_load(constraints, 0)
         raise InfeasiblePath(
@@ -204,32 +265,40 @@ def _integrate(constraints, stage: LinearRows, x_bound, x_start, x_end, deadline
             "speed from which the rest of the path can still be followed)",
             s=0.0,
         )
-    deadline.check()
-    x, capped = forward_profile(ds, bounds.r, bounds.w, envelope, float(min(x_start, envelope[0])))
     x[0], x[-1] = x_start, x_end
-    return _Profile(np.maximum(x, 0.0), capped, envelope, stage, admissible.x_max)
+    return _Profile(np.maximum(x, 0.0), capped, envelope, x_high, switch_excess)
 
 
-def _switch_points(s, profile: _Profile) -> tuple[tuple[float, str], ...]:
+def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tuple[float, str], ...]:
     """Where the profile changes between accelerating (at beta) and following the envelope."""
-    capped, envelope, x_high, stage = profile.capped, profile.envelope, profile.x_high, profile.stage
+    s = constraints.s
+    capped, envelope, x_high = profile.capped, profile.envelope, profile.x_high
     points = []
-    scale = np.maximum(np.abs(stage.a) + np.abs(stage.b), 1e-300)
     for i in np.flatnonzero(np.diff(capped.astype(int)) != 0) + 1:
         if capped[i]:
             points.append((float(s[i]), "deceleration"))
             continue
         # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
-        on_mvc = envelope[i] >= x_high[min(i, len(x_high) - 1)] * (1 - 1e-6)
+        at = min(i, len(x_high) - 1)
+        on_mvc = envelope[i] >= x_high[at] * (1 - 1e-6)
         if not on_mvc:
             points.append((float(s[i]), "acceleration"))
-        elif np.any(np.abs(stage.a[min(i, len(x_high) - 1)]) <= 1e-6 * scale[min(i, len(x_high) - 1)]):
+        elif _has_zero_inertia_row(constraints, at):
             points.append((float(s[i]), "singular"))
         elif i >= 1 and i + 1 < len(x_high) and abs(x_high[i + 1] - x_high[i - 1]) > 0.25 * max(x_high[i], 1e-12):
             points.append((float(s[i]), "discontinuity"))
         else:
             points.append((float(s[i]), "tangent"))
     return tuple(points)
+
+
+def _has_zero_inertia_row(constraints: PathConstraints, i: int) -> bool:
+    """Whether a row of interval ``i`` in the interpolation discretization (``interval_rows``)
+    has a u-coefficient within 1e-6 of its scale of zero (viscous friction left out)."""
+    ds = constraints.s[i + 1] - constraints.s[i]
+    a = np.concatenate([constraints.a[i], constraints.a_left[i + 1] + 2.0 * ds * constraints.b_left[i + 1]])
+    b = np.concatenate([constraints.b[i], constraints.b_left[i + 1]])
+    return bool(np.any(np.abs(a) <= 1e-6 * np.maximum(np.abs(a) + np.abs(b), 1e-300)))
 
 
 def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) -> InfeasiblePath:

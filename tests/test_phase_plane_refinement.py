@@ -1,0 +1,122 @@
+"""The compiled phase-plane kernels against the numpy rows they replace, and the grid
+refinement's error estimate against converged durations: from a coarse grid, the default
+answer lands within its tolerance."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robots
+from benchmarks.accuracy import KINDS, random_waypoints
+from planners.constraints import PathConstraints, build_path_constraints
+from planners.errors import InfeasiblePath
+from planners.grid import path_grid
+from planners.kernels import interval_bounds, switch_excess
+from planners.mvc import acceleration_bounds, admissible_set
+from planners.paths import SplinePath
+from planners.timing import PhasePlaneMethod
+from planners.timing.phase_plane import interval_rows, midpoint_duration, midpoint_stage_rows
+
+
+def _random_constraints(rng, n_points: int, n_rows: int, friction: bool) -> PathConstraints:
+    """Rows of random sign and size, some with a = 0 (zero inertia), a corner in the middle."""
+    def rows():
+        a = rng.normal(0, 1, (n_points, n_rows))
+        a[::7, 1] = 0.0
+        return a, rng.normal(0, 1, (n_points, n_rows)), rng.normal(0, 0.8, (n_points, n_rows))
+
+    a, b, c = rows()
+    a_left, b_left, c_left = a.copy(), b.copy(), c.copy()
+    corner = n_points // 2
+    a_left[corner], b_left[corner], c_left[corner] = (row[corner] for row in rows())
+    d = rng.normal(0, 0.3, (n_points, n_rows)) * (rng.random((1, n_rows)) < 0.5) if friction else np.zeros((n_points, n_rows))
+    d_left = d.copy()
+    upper = np.full((n_points, n_rows), 1.0)
+    upper[:, -1] = np.inf  # a row without limit
+    sd_max = np.where(rng.random(n_points) < 0.4, rng.uniform(0.3, 2.0, n_points), np.inf)
+    return PathConstraints(
+        s=np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, n_points - 2)])),
+        sd_max=sd_max, a=a, b=b, c=c, d=d, a_left=a_left, b_left=b_left, c_left=c_left, d_left=d_left,
+        lower=-upper, upper=upper.copy(), rows=tuple(("torque", j) for j in range(n_rows)), joint_names=("j",) * n_rows,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("friction", [False, True])
+@pytest.mark.parametrize("midpoint", [False, True])
+def test_interval_bounds_match_the_rows_they_stand_for(friction, midpoint):
+    """The kernel builds each interval's bounds on u from the rows, linearizing friction
+    itself; the same admissible x and the same tightest bounds on u at any x as the rows
+    built in numpy (``PathConstraints.linearized``, ``interval_rows`` or
+    ``midpoint_stage_rows``, then ``acceleration_bounds``)."""
+    rng = np.random.default_rng(31)
+    constraints = _random_constraints(rng, 120, 5, friction)
+    x_ref = rng.uniform(0.1, 3.0, len(constraints.s))
+    right, left = constraints.linearized(x_ref), constraints.linearized(x_ref, "left")
+    stage = (midpoint_stage_rows if midpoint else interval_rows)(constraints.s, right, left)
+    expected = admissible_set(stage, constraints.sd_max[:-1] ** 2)
+    arrays = (constraints.a, constraints.b, constraints.c, constraints.d,
+              constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)  # fmt: skip
+    p, q, r, x_low, x_high, _ = interval_bounds(
+        constraints.s, *arrays, constraints.lower, constraints.upper, constraints.sd_max**2, x_ref, friction, midpoint
+    )
+    empty = expected.x_max < expected.x_min
+    assert empty.sum() > 5 and (~empty).sum() > 5, empty.sum()  # both kinds of intervals are exercised
+    assert np.array_equal(x_high < 0, empty)
+    assert np.allclose(x_high[~empty], expected.x_max[~empty], rtol=1e-9, atol=1e-12)
+    assert np.allclose(x_low[~empty], expected.x_min[~empty], rtol=1e-9, atol=1e-12)
+    bounds = acceleration_bounds(stage)
+    for x in (0.0, 0.5, 2.0):
+        for kernel, numpy_ in ((p + q * x, bounds.p + bounds.q * x), (r + q * x, bounds.r + bounds.w * x)):
+            largest = np.max(np.where(np.isfinite(kernel), kernel, -np.inf), axis=1)
+            smallest = np.min(np.where(np.isfinite(kernel), kernel, np.inf), axis=1)
+            theirs_largest = np.max(np.where(np.isfinite(numpy_), numpy_, -np.inf), axis=1)
+            theirs_smallest = np.min(np.where(np.isfinite(numpy_), numpy_, np.inf), axis=1)
+            assert np.allclose(largest, theirs_largest, rtol=1e-9) and np.allclose(smallest, theirs_smallest, rtol=1e-9)
+
+
+def test_switch_excess_of_a_start_from_rest_is_the_closed_form():
+    """One interval of length L from rest to x1 = sd_1^2 under u <= beta and x <= x1: the
+    constant-u interval takes 2 L / sd_1; at the bounds, accelerating to x1 in x1 / (2 beta)
+    and then cruising takes sd_1 / beta + (L - x1 / (2 beta)) / sd_1."""
+    length, beta, x1 = 0.1, 3.0, 0.25
+    r = np.array([[beta]])
+    q = np.zeros((1, 1))
+    p = np.array([[-10.0]])
+    excess = switch_excess(np.array([length]), p, q, r, np.array([0.0, x1]), np.array([x1, x1]))
+    sd_1 = np.sqrt(x1)
+    exact = 2 * length / sd_1 - (sd_1 / beta + (length - x1 / (2 * beta)) / sd_1)
+    assert excess[0] == pytest.approx(exact, rel=1e-12)
+
+
+def _converged(path, robot) -> float:
+    """Richardson extrapolation of the conservative discretization on 4,000 and 8,000
+    intervals, checked against the midpoint discretization on 8,000."""
+    unrefined = PhasePlaneMethod(max_refinements=0)
+    coarse = path_grid(path, 4000)
+    fine = np.sort(np.concatenate([coarse, 0.5 * (coarse[:-1] + coarse[1:])]))
+    durations = [unrefined.solve(build_path_constraints(path, robot, robot.limits, KINDS, grid)).duration for grid in (coarse, fine)]
+    converged = 2 * durations[1] - durations[0]
+    check = midpoint_duration(build_path_constraints(path, robot, robot.limits, KINDS, fine))
+    assert check == pytest.approx(converged, rel=3e-5)
+    return converged
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "geering_2r", "yamamoto_2r"])
+def test_a_coarse_grid_is_refined_to_the_tolerance(name):
+    """From 25 intervals, where a start from rest, a switch onto the maximum velocity curve or
+    a stretch along its curved part lies inside one interval, the estimate sees the error and
+    the default answer ends within 0.1 % of the converged duration (estimated within its
+    tolerance of 0.06 %)."""
+    robot = robots.load(name)
+    rng = np.random.default_rng(5)
+    compared = 0
+    while compared < 3:
+        path = SplinePath(random_waypoints(robot, rng))
+        try:
+            converged = _converged(path, robot)
+        except InfeasiblePath:
+            continue
+        result = PhasePlaneMethod().solve(build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, 25)))
+        assert abs(result.duration / converged - 1) <= 1e-3, (name, compared, result.duration, converged, len(result.s))
+        compared += 1
