@@ -45,6 +45,9 @@ def _timing(request: TrajectoryRequest) -> Timing:
         trapezoid_fractions=(timing.trapezoid.tau1, timing.trapezoid.tau2),
         torque_weight=timing.cost.torque_weight,
         limit_margin=timing.limit_margin,
+        tool_speed=limits.tool_speed,
+        tool_angular_speed=limits.tool_angular_speed,
+        tool_frame=limits.tool_frame,
     )
 
 

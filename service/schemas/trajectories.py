@@ -85,7 +85,8 @@ PathRequest = Annotated[
 
 
 class LimitsRequest(Schema):
-    """Per-joint overrides and scale factors of the robot's limits (SI units)."""
+    """Per-joint overrides and scale factors of the robot's limits, and limits on the speed of a
+    tool frame (SI units)."""
 
     velocity: _joint_vector(bounded(ranges.VELOCITY)) | None = None
     acceleration: _joint_vector(bounded(ranges.ACCELERATION)) | None = None
@@ -95,6 +96,15 @@ class LimitsRequest(Schema):
     acceleration_scale: bounded(ranges.SCALE) | None = None
     jerk_scale: bounded(ranges.SCALE) | None = None
     torque_scale: bounded(ranges.SCALE) | None = None
+    tool_speed: bounded(ranges.TOOL_SPEED) | None = Field(
+        default=None, description="Largest linear speed of the tool frame's origin (m/s)."
+    )
+    tool_angular_speed: bounded(ranges.TOOL_ANGULAR_SPEED) | None = Field(
+        default=None, description="Largest angular speed of the tool frame (rad/s)."
+    )
+    tool_frame: Name | None = Field(
+        default=None, description="Frame whose speed tool_speed and tool_angular_speed limit; default the robot's end effector."
+    )
 
 
 class Boundary(Schema):
@@ -201,6 +211,10 @@ class UtilizationPublic(BaseModel):
     acceleration: list[float]
     torque: list[float]
     jerk: list[float] | None = None
+    tool_speed: float | None = Field(default=None, description="Peak tool speed / timing.limits.tool_speed, when limited.")
+    tool_angular_speed: float | None = Field(
+        default=None, description="Peak angular tool speed / timing.limits.tool_angular_speed, when limited."
+    )
 
 
 class BindingPublic(BaseModel):
