@@ -12,7 +12,7 @@ bounds sd <= sd_max(s); acceleration and torque limits give second-order rows
 ``a u + b x + c + d sd in [lower, upper]`` (d: viscous friction, zero for acceleration rows).
 At a corner of the path (a kink, where q' jumps) the motion must stop, so sd_max = 0 there, and
 the rows seen from the interval that ends there (``*_left``) differ from those of the interval
-that starts there.
+that starts there; so do they at a break (where q'' jumps: a line meeting a circular blend).
 The torque coefficients come from Pinocchio's RNEA: a = rnea(q, 0, q') - g,
 b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never see a robot.
 """
@@ -44,7 +44,7 @@ class PathConstraints:
             shape (N + 1, m); units of the limited quantity (rad/s^2 or N m). At a kink these
             hold the side of the interval that starts there.
         a_left, b_left, c_left, d_left: The same rows as seen from the interval that ends at each
-            grid point; the very arrays ``a, b, c, d`` when the path has no kink.
+            grid point; the very arrays ``a, b, c, d`` when the path has no kink or break.
         lower, upper: Bounds of the rows, shape (N + 1, m); ``-inf``/``inf`` where none.
         rows: (kind, joint index) of each of the m rows, kind "acceleration" or "torque".
         joint_names: Joint names, for messages.
@@ -273,8 +273,10 @@ def build_path_constraints(
         sd_max = np.minimum(sd_max, tool_sd_max)
     a_left, b_left, c_left, d_left = a, b, c, d
     kink_index = np.flatnonzero(np.isin(s, path.kinks))
+    sd_max[kink_index] = 0.0
+    # The rows seen from the interval that ends at a corner or a break of the curvature.
+    kink_index = np.flatnonzero(np.isin(s, path.kinks) | np.isin(s, path.breaks))
     if kink_index.size:
-        sd_max[kink_index] = 0.0
         _, (a_k, b_k, c_k, d_k, _), _ = _second_order_rows(
             path, robot, limits, kinds, s[kink_index], "left", deadline
         )

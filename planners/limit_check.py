@@ -67,12 +67,13 @@ class LimitCheck:
 
 def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, ...]:
     """q, qd, qdd and (when the states carry sddd) qddd at ``states``, each (n, n_dof), with the
-    path's one-sided derivatives from the left for ``states.left`` states at a corner (and, for
-    the third derivative, at any knot)."""
+    path's one-sided derivatives from the left for ``states.left`` states at a corner or a break
+    (and, for the third derivative, at any knot)."""
     points = path.evaluate(states.s, "right")
     q, dq, ddq = points.q, points.dq, points.ddq
     third = path.third_derivative(states.s, "right") if states.sddd is not None else None
-    at_kink = states.left & np.isin(states.s, path.kinks) if len(path.kinks) else None
+    sides = np.concatenate([path.kinks, path.breaks])
+    at_kink = states.left & np.isin(states.s, sides) if len(sides) else None
     if at_kink is not None and at_kink.any():
         dq, ddq = dq.copy(), ddq.copy()
         left = path.evaluate(states.s[at_kink], "left")

@@ -55,6 +55,8 @@ TORQUE = Range(1e-6, 1e5, "N m")
 #: Tool-speed limits (m/s, rad/s).
 TOOL_SPEED = Range(1e-6, 1e3, "m/s")
 TOOL_ANGULAR_SPEED = Range(1e-6, 1e3, "rad/s")
+#: Largest distance of a blended corner from its waypoint (joint-space norm, rad or m).
+MAX_DEVIATION = Range(1e-9, 1e4, "rad or m")
 LIMITS = {"velocity": VELOCITY, "acceleration": ACCELERATION, "jerk": JERK, "torque": TORQUE}
 #: Factors on a robot's limits.
 SCALE = Range(1e-3, 1e3, "")

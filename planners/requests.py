@@ -17,15 +17,23 @@ from planners.timing.laws import TrapezoidalProfile
 from planners.timing.min_cost import MinCostMethod
 
 
+#: Largest distance of a blend from its waypoint when a request names none (joint units): the
+#: default path tolerance of MoveIt's time-optimal trajectory generation.
+DEFAULT_MAX_DEVIATION = 0.1
+
+
 @dataclass(frozen=True)
 class WaypointPath:
     """A joint path through ``waypoints`` (shape (n_waypoints, n_dof), joint units), interpolated
-    by ``"spline"`` (C2 cubic), ``"linear"`` (straight segments, stopping at each waypoint), or
-    ``"via"`` (per-joint cubic or quintic segments in time through the via points, the law named
-    by the timing method)."""
+    by ``"spline"`` (C2 cubic), ``"linear"`` (straight segments, stopping at each waypoint),
+    ``"blend"`` (straight segments joined by circular blends within ``max_deviation`` of each
+    waypoint, joint-space norm in joint units; default ``DEFAULT_MAX_DEVIATION``) or ``"via"``
+    (per-joint cubic or quintic segments in time through the via points, the law named by the
+    timing method)."""
 
     waypoints: np.ndarray
     interpolation: str = "spline"
+    max_deviation: float | None = None
 
 
 @dataclass(frozen=True)

@@ -25,17 +25,24 @@ Name = Annotated[str, Field(max_length=MAX_NAME_CHARS)]
 
 
 class WaypointsPath(Schema):
-    """Joint waypoints, interpolated by a C2 cubic spline or by straight segments that stop at
-    each waypoint."""
+    """Joint waypoints, interpolated by a C2 cubic spline, by straight segments that stop at
+    each waypoint, or by straight segments joined by circular blends."""
 
     kind: Literal["waypoints"] = "waypoints"
     waypoints: list[JointVector] = Field(
         min_length=2, max_length=MAX_WAYPOINTS, description="Joint configurations (rad, m), one row each."
     )
-    interpolation: Literal["spline", "linear", "via"] = Field(
+    interpolation: Literal["spline", "linear", "blend", "via"] = Field(
         default="spline",
-        description="`spline` (C2 cubic), `linear` (straight, stopping at each waypoint) or `via` "
-        "(per-joint cubic/quintic segments through via points; with timing.method cubic or quintic).",
+        description="`spline` (C2 cubic), `linear` (straight, stopping at each waypoint), `blend` "
+        "(straight segments joined by circular blends within path.max_deviation of each waypoint, as "
+        "MoveIt's TOTG) or `via` (per-joint cubic/quintic segments through via points; with "
+        "timing.method cubic or quintic).",
+    )
+    max_deviation: bounded(ranges.MAX_DEVIATION) | None = Field(
+        default=None,
+        description="`blend` only: largest joint-space distance (Euclidean norm, rad or m) of a blend from "
+        "its waypoint; default 0.1.",
     )
 
 
