@@ -12,7 +12,7 @@ bounds sd <= sd_max(s); acceleration and torque limits give second-order rows
 ``a u + b x + c + d sd in [lower, upper]`` (d: viscous friction, zero for acceleration rows).
 At a corner of the path (a kink, where q' jumps) the motion must stop, so sd_max = 0 there, and
 the rows seen from the interval that ends there (``*_left``) differ from those of the interval
-that starts there.
+that starts there; so do they at a break (where q'' jumps: a line meeting a circular blend).
 The torque coefficients come from Pinocchio's RNEA: a = rnea(q, 0, q') - g,
 b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never see a robot.
 """
@@ -27,6 +27,7 @@ import numpy as np
 
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
+from planners.tool_speed import tool_speed_bound
 from robots import JointLimits, Robot
 
 CONSTRAINT_KINDS = ("velocity", "acceleration", "torque", "jerk")
@@ -43,7 +44,7 @@ class PathConstraints:
             shape (N + 1, m); units of the limited quantity (rad/s^2 or N m). At a kink these
             hold the side of the interval that starts there.
         a_left, b_left, c_left, d_left: The same rows as seen from the interval that ends at each
-            grid point; the very arrays ``a, b, c, d`` when the path has no kink.
+            grid point; the very arrays ``a, b, c, d`` when the path has no kink or break.
         lower, upper: Bounds of the rows, shape (N + 1, m); ``-inf``/``inf`` where none.
         rows: (kind, joint index) of each of the m rows, kind "acceleration" or "torque".
         joint_names: Joint names, for messages.
@@ -53,6 +54,8 @@ class PathConstraints:
             ruckig read it.
         velocity_joint: Index of the joint whose velocity limit sets sd_max at each point
             (N + 1,), -1 where no velocity limit applies.
+        tool_bound: Where a tool-speed limit (``planners.tool_speed``) sets sd_max instead, the
+            index of that limit in ``TOOL_KINDS`` (N + 1,), -1 elsewhere; ``None`` without one.
         evaluate: Builds the same constraints at other values of s (for methods that refine).
     """
 
@@ -72,6 +75,7 @@ class PathConstraints:
     joint_names: tuple[str, ...]
     jerk: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
     velocity_joint: np.ndarray | None = None
+    tool_bound: np.ndarray | None = None
     evaluate: Callable[[np.ndarray], "PathConstraints"] | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -104,6 +108,7 @@ class PathConstraints:
             rows=self.rows,
             joint_names=self.joint_names,
             velocity_joint=None if self.velocity_joint is None else merge(self.velocity_joint, extra.velocity_joint),
+            tool_bound=None if self.tool_bound is None else merge(self.tool_bound, extra.tool_bound),
             jerk=None if self.jerk is None else (
                 *(merge(mine, theirs) for mine, theirs in zip(self.jerk[:3], extra.jerk[:3])),
                 self.jerk[3],
@@ -249,7 +254,8 @@ def build_path_constraints(
     deadline: Deadline = NO_DEADLINE,
 ) -> PathConstraints:
     """Evaluate the requested ``kinds`` of limits (subset of velocity, acceleration, torque)
-    along ``path`` at the grid ``s`` (which must hold the path's kinks)."""
+    along ``path`` at the grid ``s`` (which must hold the path's kinks); a tool-speed limit
+    (``limits.tool``) joins the first-order bound sd_max."""
     points, (a, b, c, d, bound), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
     deadline.check()
     sd_max = np.full(len(s), np.inf)
@@ -259,10 +265,18 @@ def build_path_constraints(
             per_joint = limits.velocity / np.abs(points.dq)
         sd_max = np.min(per_joint, axis=1)
         velocity_joint = np.where(np.isfinite(sd_max), np.argmin(per_joint, axis=1), -1)
+    tool_bound = None
+    if limits.tool is not None:
+        deadline.check()
+        tool_sd_max, tool_kind = tool_speed_bound(robot, limits.tool, points.q, points.dq)
+        tool_bound = np.where(tool_sd_max < sd_max, tool_kind, -1)
+        sd_max = np.minimum(sd_max, tool_sd_max)
     a_left, b_left, c_left, d_left = a, b, c, d
     kink_index = np.flatnonzero(np.isin(s, path.kinks))
+    sd_max[kink_index] = 0.0
+    # The rows seen from the interval that ends at a corner or a break of the curvature.
+    kink_index = np.flatnonzero(np.isin(s, path.kinks) | np.isin(s, path.breaks))
     if kink_index.size:
-        sd_max[kink_index] = 0.0
         _, (a_k, b_k, c_k, d_k, _), _ = _second_order_rows(
             path, robot, limits, kinds, s[kink_index], "left", deadline
         )
@@ -286,5 +300,6 @@ def build_path_constraints(
         joint_names=robot.joint_names,
         jerk=(points.dq, points.ddq, path.third_derivative(s), limits.jerk) if "jerk" in kinds else None,
         velocity_joint=velocity_joint,
+        tool_bound=tool_bound,
         evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),
     )

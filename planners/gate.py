@@ -17,6 +17,7 @@ from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.timing.law_timing import LawTiming
 from planners.timing.scaled import solve_well_scaled
+from planners.tool_speed import TOOL_KINDS, tool_speeds
 from robots import JointLimits, Robot
 
 #: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is
@@ -74,7 +75,7 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
             # The shortest time law was found on samples of its profile; the dense check sees
             # between them. Slowing a law down by a factor f divides velocities by f,
             # accelerations (and the inertial part of torques) by f^2, jerks by f^3.
-            power = {"velocity": 1.0, "jerk": 3.0}.get(check.worst.kind, 2.0)
+            power = {"velocity": 1.0, "jerk": 3.0, **dict.fromkeys(TOOL_KINDS, 1.0)}.get(check.worst.kind, 2.0)
             result = result.slowed(check.worst.ratio ** (1.0 / power) * (1 + 1e-6))
             if result is None:
                 break
@@ -92,9 +93,10 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
 
 def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> InfeasiblePath:
     s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
-    joint = robot.joint_names[worst.joint]
+    joint = None if worst.joint < 0 else robot.joint_names[worst.joint]
+    what = f"{worst.kind} limit of joint {joint!r}" if joint is not None else f"{worst.kind.replace('_', ' ')} limit"
     return InfeasiblePath(
-        f"the {method} timing exceeds the {worst.kind} limit of joint {joint!r} by "
+        f"the {method} timing exceeds the {what} by "
         f"{100 * (worst.ratio - 1):.2f} % at s = {s:.4f}, and refining the grid there did not bring "
         "it back within the limits; use another timing method, a lower limit scale or more grid points",
         s=s,
@@ -112,14 +114,20 @@ def checked(robot, path, result, method, kinds, limits, threshold, constraints) 
     return TimedStretch(path, result, constraints, check)
 
 
-def samples_exceed(samples, limits: JointLimits, threshold: float, kinds) -> tuple[str, int, int] | None:
-    """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit."""
-    for kind, values in (("velocity", samples.qd), ("acceleration", samples.qdd), ("torque", samples.tau)):
-        if kind not in kinds:
-            continue
+def samples_exceed(samples, limits: JointLimits, threshold: float, kinds, robot: Robot | None = None) -> tuple[str, int, int] | None:
+    """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit (joint
+    -1 for a tool limit, checked when ``robot`` is given)."""
+    checks = [(kind, values, getattr(limits, kind)) for kind, values in
+              (("velocity", samples.qd), ("acceleration", samples.qdd), ("torque", samples.tau)) if kind in kinds]
+    if limits.tool is not None and robot is not None:
+        speeds = tool_speeds(robot, limits.tool, samples.q, samples.qd)
+        checks.append(("tool", speeds, limits.tool.bounds))  # columns in the order of TOOL_KINDS
+    for kind, values, limit in checks:
         with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.nan_to_num(np.abs(values) / getattr(limits, kind), nan=0.0)
+            ratio = np.nan_to_num(np.abs(values) / limit, nan=0.0)
         if ratio.size and ratio.max() > threshold:
             sample, joint = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            if kind == "tool":
+                return TOOL_KINDS[int(joint)], int(sample), -1
             return kind, int(sample), int(joint)
     return None

@@ -8,6 +8,9 @@ Along q(s) timed by s(t) (Yamamoto et al. eqs. (8), (9); jerk by one more deriva
     qddd = q' sddd + 3 q'' sd sdd + q''' sd^3
     tau  = RNEA(q, qd, qdd) + D qd + F sign(qd)
 
+and, when a request limits a tool's speed, |v| and |w| of the frame's twist J(q) qd
+(``planners.tool_speed``; the frame velocities are computed only then).
+
 evaluated at the timing's dense states (``PathTiming.dense_states``): for timings on a grid of s,
 ``POINTS_PER_INTERVAL`` states per interval of the grid the constraints were built on (as far
 apart in the intervals a method refined), both ends and both sides of every grid point. This
@@ -24,6 +27,7 @@ import numpy as np
 from planners.constraints import PathConstraints
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
+from planners.tool_speed import TOOL_KINDS, tool_speeds
 from robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included.
@@ -37,8 +41,9 @@ class Excess:
 
     Attributes:
         ratio: |value| / limit (1.0: the limit binds).
-        kind: "velocity", "acceleration", "torque" or "jerk".
-        joint: Joint index.
+        kind: "velocity", "acceleration", "torque", "jerk", "tool_speed" or
+            "tool_angular_speed".
+        joint: Joint index (-1 for a tool limit).
         s: Path parameter where it occurs.
     """
 
@@ -50,8 +55,9 @@ class Excess:
 
 @dataclass(frozen=True)
 class LimitCheck:
-    """Peak utilization per limit kind and joint (shape (n_dof,) each; 0 where unlimited), the
-    worst state, and the grid intervals holding a state above the threshold (empty when none,
+    """Peak utilization per limit kind and joint (shape (n_dof,) each; 0 where unlimited; a
+    tool limit's, when one is requested, of shape () under its ``TOOL_KINDS`` name), the worst
+    state, and the grid intervals holding a state above the threshold (empty when none,
     or when the timing has no grid)."""
 
     utilization: dict[str, np.ndarray]
@@ -61,12 +67,13 @@ class LimitCheck:
 
 def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, ...]:
     """q, qd, qdd and (when the states carry sddd) qddd at ``states``, each (n, n_dof), with the
-    path's one-sided derivatives from the left for ``states.left`` states at a corner (and, for
-    the third derivative, at any knot)."""
+    path's one-sided derivatives from the left for ``states.left`` states at a corner or a break
+    (and, for the third derivative, at any knot)."""
     points = path.evaluate(states.s, "right")
     q, dq, ddq = points.q, points.dq, points.ddq
     third = path.third_derivative(states.s, "right") if states.sddd is not None else None
-    at_kink = states.left & np.isin(states.s, path.kinks) if len(path.kinks) else None
+    sides = np.concatenate([path.kinks, path.breaks])
+    at_kink = states.left & np.isin(states.s, sides) if len(sides) else None
     if at_kink is not None and at_kink.any():
         dq, ddq = dq.copy(), ddq.copy()
         left = path.evaluate(states.s[at_kink], "left")
@@ -122,12 +129,14 @@ def check_limits(
     reference: np.ndarray | None = None,
     constraints: PathConstraints | None = None,
 ) -> LimitCheck:
-    """Every limit of ``limits`` (velocity, acceleration, torque, and jerk when the timing has a
-    finite one) over the dense states of ``timing`` along ``path``.
+    """Every limit of ``limits`` (velocity, acceleration, torque, jerk when the timing has a
+    finite one, and the tool speeds of ``limits.tool``) over the dense states of ``timing``
+    along ``path``.
 
     Args:
-        kinds: The limits the timing must hold: ``worst`` and ``intervals_over`` look at these
-            only (``utilization`` reports every kind).
+        kinds: The joint limits the timing must hold: ``worst`` and ``intervals_over`` look at
+            these (and at the tool limits, always held when requested) only (``utilization``
+            reports every kind).
         threshold: Ratio above which a state's grid interval is listed in ``intervals_over``.
         reference: For a timing on a grid of s, the grid the constraints were built on: states
             keep its resolution (``POINTS_PER_INTERVAL`` per interval) where the timing method
@@ -143,21 +152,28 @@ def check_limits(
     values = {"velocity": qd, "acceleration": qdd, "torque": _torques(robot, states, q, qd, qdd, constraints)}
     if jerk is not None:
         values["jerk"] = jerk
+    limit_of = {kind: getattr(limits, kind) for kind in values}
+    if limits.tool is not None:
+        speeds = tool_speeds(robot, limits.tool, q, qd)
+        for column, kind in enumerate(TOOL_KINDS):
+            if np.isfinite(limits.tool.bounds[column]):
+                values[kind], limit_of[kind] = speeds[:, column : column + 1], limits.tool.bounds[column : column + 1]
     utilization, worst = {}, None
     over = np.zeros(len(states.s), dtype=bool)
     for kind, value in values.items():
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.abs(value)
-            ratio *= 1.0 / getattr(limits, kind)  # 0 where a joint is unlimited
+            ratio *= 1.0 / limit_of[kind]  # 0 where a joint is unlimited
             if not np.isfinite(ratio).all():
                 ratio = np.nan_to_num(ratio, nan=0.0, posinf=np.inf)
-        utilization[kind] = ratio.max(axis=0)
-        if kind not in kinds:
+        utilization[kind] = ratio.max(axis=0) if kind not in TOOL_KINDS else ratio.max()
+        if kind not in kinds and kind not in TOOL_KINDS:
             continue
         per_state = ratio.max(axis=1)
         state = int(np.argmax(per_state))
         if worst is None or per_state[state] > worst.ratio:
-            worst = Excess(float(per_state[state]), kind, int(np.argmax(ratio[state])), float(states.s[state]))
+            joint = -1 if kind in TOOL_KINDS else int(np.argmax(ratio[state]))
+            worst = Excess(float(per_state[state]), kind, joint, float(states.s[state]))
         over |= per_state > threshold
     intervals = np.empty(0, dtype=int) if states.interval is None else np.unique(states.interval[over])
     return LimitCheck(utilization, worst, intervals)

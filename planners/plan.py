@@ -33,6 +33,7 @@ from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.segmented import SegmentedTiming
+from planners.tool_speed import tool_speed_limit
 from planners.trajectory import sample_trajectory
 from planners.via_points import via_point_trajectory
 from robots import JointLimits, Robot
@@ -93,6 +94,21 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
         "solve_s": result.solve_s,
     }
     return path, solver, timed
+
+
+def _check_tool_limit_served(path_spec, method: TimingMethod) -> None:
+    """Tool-speed limits bound the path speed of a given path: refuse them where the path is
+    shaped by the timing (free motions, via points)."""
+    if isinstance(path_spec, FreeMotion) or method.name == "collocation":
+        raise InvalidRequest(
+            "timing.limits.tool_speed and tool_angular_speed are not served by collocation on a free path; "
+            "give the path (waypoints or a cartesian line) and a method such as phase_plane"
+        )
+    if isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
+        raise InvalidRequest(
+            "timing.limits.tool_speed and tool_angular_speed are not served with interpolation 'via' "
+            "(its segments are shaped by their time laws); use 'spline' or 'linear'"
+        )
 
 
 def _boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
@@ -294,6 +310,10 @@ def plan(
     if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
         raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
     requested: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
+    tool = tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
+    if tool is not None:
+        _check_tool_limit_served(path_spec, method)
+        requested = dataclasses.replace(requested, tool=tool)
     limits = requested.tightened(margin) if margin else requested
     threshold = gate_threshold(margin)
     dropped: tuple[str, ...] = ()
@@ -325,12 +345,13 @@ def plan(
         )
     samples = sample_trajectory(path, result, robot, dt)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
-    beyond = samples_exceed(samples, limits, threshold, kinds)
+    beyond = samples_exceed(samples, limits, threshold, kinds, robot)
     if beyond is not None:
         kind, sample, joint = beyond
+        what = f"{kind} limit of joint {robot.joint_names[joint]!r}" if joint >= 0 else f"{kind.replace('_', ' ')} limit"
         raise TimingFailed(
-            f"the {timed.method} timing's sample at t = {samples.t[sample]:.6g} s exceeds the {kind} limit "
-            f"of joint {robot.joint_names[joint]!r} although its dense check holds; use more grid points"
+            f"the {timed.method} timing's sample at t = {samples.t[sample]:.6g} s exceeds the {what} "
+            "although its dense check holds; use more grid points"
         )
     utilization = _utilization(timed.stretches, margin)
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)

@@ -52,6 +52,11 @@ VELOCITY = Range(1e-6, 1e3, "rad/s")
 ACCELERATION = Range(1e-6, 1e5, "rad/s^2")
 JERK = Range(1e-6, 1e8, "rad/s^3")
 TORQUE = Range(1e-6, 1e5, "N m")
+#: Tool-speed limits (m/s, rad/s).
+TOOL_SPEED = Range(1e-6, 1e3, "m/s")
+TOOL_ANGULAR_SPEED = Range(1e-6, 1e3, "rad/s")
+#: Largest distance of a blended corner from its waypoint (joint-space norm, rad or m).
+MAX_DEVIATION = Range(1e-9, 1e4, "rad or m")
 LIMITS = {"velocity": VELOCITY, "acceleration": ACCELERATION, "jerk": JERK, "torque": TORQUE}
 #: Factors on a robot's limits.
 SCALE = Range(1e-3, 1e3, "")
@@ -91,6 +96,10 @@ def check_timing(timing, dt: float) -> None:
     for kind, values in (timing.limit_overrides or {}).items():
         if values is not None and kind in LIMITS:
             check_vector(values, f"timing.limits.{kind}", LIMITS[kind])
+    for name, accepted in (("tool_speed", TOOL_SPEED), ("tool_angular_speed", TOOL_ANGULAR_SPEED)):
+        value = getattr(timing, name, None)
+        if value is not None:
+            check(value, f"timing.limits.{name}", accepted)
     for kind, factor in (timing.limit_scales or {}).items():
         if factor is not None:
             check(factor, f"timing.limits.{kind}_scale", SCALE)

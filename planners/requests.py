@@ -17,15 +17,23 @@ from planners.timing.laws import TrapezoidalProfile
 from planners.timing.min_cost import MinCostMethod
 
 
+#: Largest distance of a blend from its waypoint when a request names none (joint units): the
+#: default path tolerance of MoveIt's time-optimal trajectory generation.
+DEFAULT_MAX_DEVIATION = 0.1
+
+
 @dataclass(frozen=True)
 class WaypointPath:
     """A joint path through ``waypoints`` (shape (n_waypoints, n_dof), joint units), interpolated
-    by ``"spline"`` (C2 cubic), ``"linear"`` (straight segments, stopping at each waypoint), or
-    ``"via"`` (per-joint cubic or quintic segments in time through the via points, the law named
-    by the timing method)."""
+    by ``"spline"`` (C2 cubic), ``"linear"`` (straight segments, stopping at each waypoint),
+    ``"blend"`` (straight segments joined by circular blends within ``max_deviation`` of each
+    waypoint, joint-space norm in joint units; default ``DEFAULT_MAX_DEVIATION``) or ``"via"``
+    (per-joint cubic or quintic segments in time through the via points, the law named by the
+    timing method)."""
 
     waypoints: np.ndarray
     interpolation: str = "spline"
+    max_deviation: float | None = None
 
 
 @dataclass(frozen=True)
@@ -48,9 +56,13 @@ class Timing:
             cruise as fractions of the duration.
         torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
             ``min_cost``.
-        limit_margin: Fraction of every velocity, acceleration, jerk and torque limit kept in
-            reserve (0 to 0.5): the timing is planned under the limits times (1 - margin), and
-            with a positive margin no returned state exceeds the limits themselves.
+        limit_margin: Fraction of every velocity, acceleration, jerk, torque and tool-speed
+            limit kept in reserve (0 to 0.5): the timing is planned under the limits times
+            (1 - margin), and with a positive margin no returned state exceeds the limits
+            themselves.
+        tool_speed: Largest linear speed of the tool frame's origin, m/s; ``None``: none.
+        tool_angular_speed: Largest angular speed of the tool frame, rad/s; ``None``: none.
+        tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
     """
 
     method: str = "phase_plane"
@@ -66,6 +78,9 @@ class Timing:
     trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
     torque_weight: float = 0.0
     limit_margin: float = 0.0
+    tool_speed: float | None = None
+    tool_angular_speed: float | None = None
+    tool_frame: str | None = None
 
 
 def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:

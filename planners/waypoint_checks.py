@@ -1,20 +1,23 @@
 """Joint waypoints as a request gives them: checked against the robot, repeats dropped, and
-turned into a geometric path (spline or stop-and-go; via points are timed and shaped together
+turned into a geometric path (spline, stop-and-go or blended; via points are timed and shaped together
 in ``planners.via_points``, Cartesian lines in ``planners.paths.cartesian``)."""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
+from planners.paths.blended import BlendedPath
 from planners.paths.cartesian import CartesianLine, cartesian_path
-from planners.ranges import COORDINATE
-from planners.requests import WaypointPath
+from planners.ranges import COORDINATE, MAX_DEVIATION, check
+from planners.requests import DEFAULT_MAX_DEVIATION, WaypointPath
 from robots import Robot
 
-INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath}
+INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath, "blend": BlendedPath}
 MAX_WAYPOINTS = 1_000
 #: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
 MAX_COORDINATE = COORDINATE.high
@@ -27,6 +30,10 @@ def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
     if spec.interpolation not in (*INTERPOLATIONS, "via"):
         raise InvalidRequest(
             f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted([*INTERPOLATIONS, 'via'])}"
+        )
+    if spec.max_deviation is not None and spec.interpolation != "blend":
+        raise InvalidRequest(
+            f"path.max_deviation applies to interpolation 'blend', not {spec.interpolation!r}: leave it out or use 'blend'"
         )
     waypoints = np.asarray(spec.waypoints, dtype=float) if np.ndim(spec.waypoints) == 2 else None
     if waypoints is None:
@@ -78,7 +85,7 @@ def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
         )
     shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
     note = f"path.waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)"
-    return WaypointPath(np.delete(waypoints, repeats, axis=0), spec.interpolation), (note,)
+    return dataclasses.replace(spec, waypoints=np.delete(waypoints, repeats, axis=0)), (note,)
 
 
 def make_path(robot: Robot, spec: "WaypointPath | CartesianLine", deadline: Deadline = NO_DEADLINE) -> GeometricPath:
@@ -86,4 +93,9 @@ def make_path(robot: Robot, spec: "WaypointPath | CartesianLine", deadline: Dead
     linear segments (via points are timed and shaped together, in ``via_points``)."""
     if isinstance(spec, CartesianLine):
         return cartesian_path(robot, spec, deadline)
-    return INTERPOLATIONS[spec.interpolation](checked_waypoints(robot, spec))
+    waypoints = checked_waypoints(robot, spec)
+    if spec.interpolation == "blend":
+        deviation = DEFAULT_MAX_DEVIATION if spec.max_deviation is None else spec.max_deviation
+        check(deviation, "path.max_deviation", MAX_DEVIATION)
+        return BlendedPath(waypoints, deviation)
+    return INTERPOLATIONS[spec.interpolation](waypoints)

@@ -12,7 +12,7 @@ from robots.errors import (
     UploadStoreFull,
     UploadStoreUnavailable,
 )
-from robots.limits import LIMIT_KINDS, JointLimits
+from robots.limits import LIMIT_KINDS, JointLimits, ToolSpeedLimit
 from robots.registry import load
 from robots.robot import Robot
 from robots.store import StoredUpload, UploadStore, default_data_dir
@@ -25,6 +25,7 @@ __all__ = [
     "InvalidRobotName",
     "InvalidURDF",
     "JointLimits",
+    "ToolSpeedLimit",
     "Robot",
     "RobotConflict",
     "StoredUpload",

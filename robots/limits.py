@@ -22,11 +22,39 @@ LIMIT_KINDS = ("position_lower", "position_upper", "velocity", "acceleration", "
 
 
 @dataclass(frozen=True)
+class ToolSpeedLimit:
+    """Bounds on the speed of one frame of a robot (``planners.tool_speed``).
+
+    Attributes:
+        frame: The frame's name.
+        frame_id: Its index in the robot's model.
+        speed: Largest linear speed of the frame's origin, in m/s (``inf``: none).
+        angular_speed: Largest angular speed of the frame, in rad/s (``inf``: none).
+    """
+
+    frame: str
+    frame_id: int
+    speed: float = math.inf
+    angular_speed: float = math.inf
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(speed, angular_speed), shape (2,)."""
+        return np.array([self.speed, self.angular_speed])
+
+    def tightened(self, margin: float) -> "ToolSpeedLimit":
+        """These bounds reduced by the fraction ``margin``."""
+        factor = 1.0 - margin
+        return dataclasses.replace(self, speed=self.speed * factor, angular_speed=self.angular_speed * factor)
+
+
+@dataclass(frozen=True)
 class JointLimits:
     """Per-joint limits, each an array of shape (n_dof,), in the Pinocchio model's joint order.
 
     Units: rad, rad/s, rad/s^2, rad/s^3 and N m for revolute joints (m, m/s, m/s^2, m/s^3 and N for
     prismatic ones). ``inf`` means unlimited; symmetric limits are given by their magnitude.
+    ``tool``, when a request limits the speed of a frame, holds those bounds.
     """
 
     position_lower: np.ndarray
@@ -35,6 +63,7 @@ class JointLimits:
     acceleration: np.ndarray
     jerk: np.ndarray
     torque: np.ndarray
+    tool: ToolSpeedLimit | None = None
 
     def as_lists(self) -> dict[str, list[float | None]]:
         """The limits as JSON-friendly lists, ``None`` standing for unlimited."""
@@ -74,7 +103,7 @@ class JointLimits:
             if not (math.isfinite(factor) and factor > 0.0):
                 raise InvalidLimits(f"timing.limits.{kind}_scale must be positive and finite, got {factor}")
             values[kind] = values[kind] * factor
-        return JointLimits(**values)
+        return JointLimits(**values, tool=self.tool)
 
     def tightened(self, margin: float) -> "JointLimits":
         """These limits with the velocity, acceleration, jerk and torque limits reduced by the
@@ -86,6 +115,7 @@ class JointLimits:
             acceleration=self.acceleration * factor,
             jerk=self.jerk * factor,
             torque=self.torque * factor,
+            tool=None if self.tool is None else self.tool.tightened(margin),
         )
 
 

@@ -45,6 +45,9 @@ def _timing(request: TrajectoryRequest) -> Timing:
         trapezoid_fractions=(timing.trapezoid.tau1, timing.trapezoid.tau2),
         torque_weight=timing.cost.torque_weight,
         limit_margin=timing.limit_margin,
+        tool_speed=limits.tool_speed,
+        tool_angular_speed=limits.tool_angular_speed,
+        tool_frame=limits.tool_frame,
     )
 
 
@@ -103,7 +106,7 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
                 f"path.waypoints[{index}] has {len(row)} values; {robot.name} has {robot.dof} joints "
                 f"({', '.join(robot.joint_names)})"
             )
-    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation)
+    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation)
 
 
 def compare_request(request: CompareRequest, deadline: Deadline) -> dict:

@@ -30,16 +30,20 @@ class GeometricPath(abc.ABC):
             waypoints and the breaks of the piecewise definition.
         kinks: Interior s values where dq/ds jumps (corners): the motion must stop there, and
             the two sides have different derivatives.
+        breaks: Interior s values where dq/ds is continuous but d2q/ds2 jumps (a straight
+            segment meeting a circular blend): the motion goes on, but the limits seen from the
+            two sides differ. ``evaluate`` honours ``side`` there too.
     """
 
     dof: int
     knots: np.ndarray
     kinks: np.ndarray
+    breaks: np.ndarray = np.empty(0)
 
     @abc.abstractmethod
     def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
-        """q, dq/ds and d2q/ds2 at ``s`` (shape (n_samples,)); at a kink, the one-sided derivatives
-        of ``side`` ("left" or "right")."""
+        """q, dq/ds and d2q/ds2 at ``s`` (shape (n_samples,)); at a kink or a break, the one-sided
+        derivatives of ``side`` ("left" or "right")."""
 
     @abc.abstractmethod
     def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:

@@ -29,6 +29,7 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
 from planners.timing.law_timing import LawSegment, LawTiming
+from planners.tool_speed import TOOL_KINDS
 from planners.timing.laws import (
     CubicProfile,
     CycloidalProfile,
@@ -252,6 +253,8 @@ def _utilization(rows: PathConstraints, sd, sdd, sddd):
 def _binding(rows: PathConstraints, kind: str, index: int, sample: int) -> Binding:
     if kind == "row":
         kind, joint = rows.rows[index]
+    elif kind == "velocity" and rows.tool_bound is not None and rows.tool_bound[sample] >= 0:
+        kind, joint = TOOL_KINDS[int(rows.tool_bound[sample])], None
     elif kind == "velocity":
         joint = int(rows.velocity_joint[sample]) if rows.velocity_joint is not None else -1
         joint = None if joint < 0 else joint

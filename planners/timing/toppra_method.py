@@ -19,7 +19,7 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.mvc import admissible_set, friction_reference
+from planners.mvc import acceleration_bounds, admissible_set, friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 logging.getLogger("toppra").setLevel(logging.ERROR)
@@ -59,7 +59,7 @@ def _toppra_classes():
         """Rows ``lower <= a u + b x + c <= upper`` and bounds ``x <= x_bound`` given as arrays,
         already in the interpolation discretization."""
 
-        def __init__(self, right: LinearRows, left: LinearRows, x_bound: np.ndarray):
+        def __init__(self, right: LinearRows, x_bound: np.ndarray, left: LinearRows):
             super().__init__()
             self._right, self._left = right, left
             self._x_bound = x_bound
@@ -109,7 +109,7 @@ class ToppraMethod(TimingMethod):
             left_rows = constraints.linearized(x_ref, side="left")
             deadline.check()
             instance = TOPPRA(
-                [PrecomputedRows(rows, left_rows, x_bound)],
+                [PrecomputedRows(*_singular_rows_as_bounds(rows, x_bound), left_rows)],
                 GridPath(constraints.s),
                 gridpoints=constraints.s,
                 solver_wrapper="seidel",
@@ -120,6 +120,27 @@ class ToppraMethod(TimingMethod):
             scaling = TimeScaling(constraints.s, np.asarray(sd, dtype=float))
             x_ref = scaling.sd**2
         return scaling
+
+
+def _singular_rows_as_bounds(rows: LinearRows, x_bound: np.ndarray) -> tuple[LinearRows, np.ndarray]:
+    """Rows whose u-coefficient vanishes at a grid point (a zero-inertia point, e.g. where a
+    circular blend meets a straight segment) bound x = sd^2 alone there: folded into the
+    first-order bound and dropped from the rows at that point. Kept as rows, such a bound is
+    parallel to toppra's objective (the largest x), and its LP solver returns NaN on that tie.
+    Rows that bound x from below are kept."""
+    bounds = acceleration_bounds(rows)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cut_high = np.where(rows.b > 0, (rows.upper - rows.c) / rows.b, (rows.lower - rows.c) / rows.b)
+        cut_low = np.where(rows.b > 0, (rows.lower - rows.c) / rows.b, (rows.upper - rows.c) / rows.b)
+    fold = bounds.singular & (rows.b != 0.0) & ~(cut_low > 0.0)
+    if not fold.any():
+        return rows, x_bound
+    x_bound = np.minimum(x_bound, np.where(fold, cut_high, np.inf).min(axis=1))
+
+    def kept(array):
+        return np.where(fold, 0.0, array)
+
+    return LinearRows(kept(rows.a), kept(rows.b), kept(rows.c), rows.lower, rows.upper), x_bound
 
 
 def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Exception:

@@ -25,17 +25,24 @@ Name = Annotated[str, Field(max_length=MAX_NAME_CHARS)]
 
 
 class WaypointsPath(Schema):
-    """Joint waypoints, interpolated by a C2 cubic spline or by straight segments that stop at
-    each waypoint."""
+    """Joint waypoints, interpolated by a C2 cubic spline, by straight segments that stop at
+    each waypoint, or by straight segments joined by circular blends."""
 
     kind: Literal["waypoints"] = "waypoints"
     waypoints: list[JointVector] = Field(
         min_length=2, max_length=MAX_WAYPOINTS, description="Joint configurations (rad, m), one row each."
     )
-    interpolation: Literal["spline", "linear", "via"] = Field(
+    interpolation: Literal["spline", "linear", "blend", "via"] = Field(
         default="spline",
-        description="`spline` (C2 cubic), `linear` (straight, stopping at each waypoint) or `via` "
-        "(per-joint cubic/quintic segments through via points; with timing.method cubic or quintic).",
+        description="`spline` (C2 cubic), `linear` (straight, stopping at each waypoint), `blend` "
+        "(straight segments joined by circular blends within path.max_deviation of each waypoint, as "
+        "MoveIt's TOTG) or `via` (per-joint cubic/quintic segments through via points; with "
+        "timing.method cubic or quintic).",
+    )
+    max_deviation: bounded(ranges.MAX_DEVIATION) | None = Field(
+        default=None,
+        description="`blend` only: largest joint-space distance (Euclidean norm, rad or m) of a blend from "
+        "its waypoint; default 0.1.",
     )
 
 
@@ -85,7 +92,8 @@ PathRequest = Annotated[
 
 
 class LimitsRequest(Schema):
-    """Per-joint overrides and scale factors of the robot's limits (SI units)."""
+    """Per-joint overrides and scale factors of the robot's limits, and limits on the speed of a
+    tool frame (SI units)."""
 
     velocity: _joint_vector(bounded(ranges.VELOCITY)) | None = None
     acceleration: _joint_vector(bounded(ranges.ACCELERATION)) | None = None
@@ -95,6 +103,15 @@ class LimitsRequest(Schema):
     acceleration_scale: bounded(ranges.SCALE) | None = None
     jerk_scale: bounded(ranges.SCALE) | None = None
     torque_scale: bounded(ranges.SCALE) | None = None
+    tool_speed: bounded(ranges.TOOL_SPEED) | None = Field(
+        default=None, description="Largest linear speed of the tool frame's origin (m/s)."
+    )
+    tool_angular_speed: bounded(ranges.TOOL_ANGULAR_SPEED) | None = Field(
+        default=None, description="Largest angular speed of the tool frame (rad/s)."
+    )
+    tool_frame: Name | None = Field(
+        default=None, description="Frame whose speed tool_speed and tool_angular_speed limit; default the robot's end effector."
+    )
 
 
 class Boundary(Schema):
@@ -201,6 +218,10 @@ class UtilizationPublic(BaseModel):
     acceleration: list[float]
     torque: list[float]
     jerk: list[float] | None = None
+    tool_speed: float | None = Field(default=None, description="Peak tool speed / timing.limits.tool_speed, when limited.")
+    tool_angular_speed: float | None = Field(
+        default=None, description="Peak angular tool speed / timing.limits.tool_angular_speed, when limited."
+    )
 
 
 class BindingPublic(BaseModel):

@@ -1,0 +1,168 @@
+"""Straight joint segments joined by circular blends (Kunz & Stilman, "Time-Optimal Trajectory
+Generation for Path Following with Bounded Acceleration and Velocity", RSS 2012, section IV),
+the path MoveIt's time-optimal trajectory generation (TOTG) follows.
+
+At an interior waypoint q_i, with unit directions y_i = (q_i - q_i-1) / |q_i - q_i-1| and
+y_i+1 of the segments that meet there and the angle alpha_i = arccos(y_i . y_i+1) between them,
+a circle tangent to both segments replaces the corner. It touches each segment at the distance
+
+    l_i = min(|q_i - q_i-1| / 2, |q_i+1 - q_i| / 2, delta sin(alpha_i / 2) / (1 - cos(alpha_i / 2)))
+
+from the waypoint (eq. (3); the last term keeps the circle within ``delta`` of the waypoint:
+the deviation of the circle is l_i (1 - cos(alpha_i / 2)) / sin(alpha_i / 2)), has the radius
+r_i = l_i / tan(alpha_i / 2) (eq. (4)) and the center
+c_i = q_i + (y_i+1 - y_i) / |y_i+1 - y_i| r_i / cos(alpha_i / 2) (eq. (5)). Half a segment at
+most goes to each of its two blends, so the blends never overlap.
+
+The path is parameterized by arc length sigma (|dq/dsigma| = 1), and s = sigma / L for the total
+length L. On a circle of radius r, with x and y the unit vectors from its center to its start
+and along its start tangent and theta = sigma_local / r,
+
+    q = c + r (x cos theta + y sin theta),          dq/dsigma = -x sin theta + y cos theta,
+    d2q/dsigma2 = -(x cos theta + y sin theta) / r,  d3q/dsigma3 = (x sin theta - y cos theta) / r^2,
+
+so dq/ds is continuous everywhere and d2q/ds2 jumps where a line meets a circle (``breaks``: the
+motion does not stop there, but the limits seen from either side differ). A corner that turns
+back on itself (alpha = pi) cannot be blended and is a corner where the motion stops
+(``kinks``), as is one whose blend would be shorter than ``MIN_BLEND`` of the path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from planners.paths.base import GeometricPath, PathPoints
+
+#: 1 - cos(alpha) below this: the segments continue straight on (no blend needed, the direction
+#: changes by less than 1.5e-6 rad).
+STRAIGHT = 1e-12
+#: A blend shorter than this fraction of the path is a corner where the motion stops.
+MIN_BLEND = 1e-12
+
+
+class BlendedPath(GeometricPath):
+    """Straight segments between the waypoints, each corner replaced by a circular arc that
+    stays within ``max_deviation`` of it (joint-space norm, joint units).
+
+    Args:
+        waypoints: Shape (n_waypoints, n_dof), no two consecutive ones equal, in joint units.
+        max_deviation: Largest distance of a blend from its waypoint (delta), > 0.
+
+    Attributes:
+        length: Total arc length L in joint space (joint units).
+        deviations: Distance of each interior waypoint from its blend, shape (n_waypoints - 2,)
+            (0 where the path passes the waypoint: a straight continuation or a stop).
+    """
+
+    def __init__(self, waypoints: np.ndarray, max_deviation: float):
+        waypoints = np.asarray(waypoints, dtype=float)
+        self.waypoints = waypoints
+        self.dof = waypoints.shape[1]
+        self.max_deviation = float(max_deviation)
+        segments = np.diff(waypoints, axis=0)
+        lengths = np.linalg.norm(segments, axis=1)
+        directions = segments / lengths[:, None]
+        scale = lengths.sum()
+        # Pieces: (kind, start point, direction or x, y, center, radius, length); kind 0 line, 1 arc.
+        pieces, corners, deviations = [], [], []
+        position = waypoints[0]
+        for i in range(1, len(waypoints) - 1):
+            blend = _blend(waypoints[i], directions[i - 1], directions[i], lengths[i - 1], lengths[i], self.max_deviation)
+            if blend is None or blend[4] * blend[5] <= MIN_BLEND * scale:
+                # Straight on (the segments are one line), or a corner that cannot be blended.
+                reverse = directions[i - 1] @ directions[i] < 1.0 - STRAIGHT
+                pieces.append(_line(position, waypoints[i]))
+                corners.append(reverse)
+                position = waypoints[i]
+                deviations.append(0.0)
+                continue
+            center, x, y, radius, angle, distance = blend
+            start = waypoints[i] - distance * directions[i - 1]
+            if np.linalg.norm(start - position) > MIN_BLEND * scale:
+                pieces.append(_line(position, start))
+                corners.append(False)
+            pieces.append(("arc", center, x, y, radius, angle * radius))
+            corners.append(False)
+            position = center + radius * (x * np.cos(angle) + y * np.sin(angle))
+            deviations.append(float(np.linalg.norm(center - waypoints[i]) - radius))
+        pieces.append(_line(position, waypoints[-1]))
+        self._pieces = pieces
+        piece_lengths = np.array([piece[-1] for piece in pieces])
+        self.length = float(piece_lengths.sum())
+        self.knots = np.concatenate(([0.0], np.cumsum(piece_lengths) / self.length))
+        self.knots[-1] = 1.0
+        # corners[k]: whether the junction after piece k is a stop.
+        junctions = self.knots[1:-1]
+        stop = np.array(corners[: len(junctions)], dtype=bool)
+        self.kinks = junctions[stop]
+        self.breaks = junctions[~stop]
+        self.deviations = np.array(deviations)
+        self._is_arc = np.array([piece[0] == "arc" for piece in pieces])
+        n_pieces = len(pieces)
+        # Per piece: origin and direction (lines) or center, x, y (arcs), and the radius.
+        self._a = np.zeros((n_pieces, self.dof))
+        self._b = np.zeros((n_pieces, self.dof))
+        self._c = np.zeros((n_pieces, self.dof))
+        self._radius = np.ones(n_pieces)
+        for k, piece in enumerate(pieces):
+            if piece[0] == "line":
+                self._a[k], self._b[k] = piece[1], piece[2]
+            else:
+                self._a[k], self._b[k], self._c[k], self._radius[k] = piece[1], piece[2], piece[3], piece[4]
+
+    def _locate(self, s, side):
+        s = np.clip(np.atleast_1d(np.asarray(s, dtype=float)), 0.0, 1.0)
+        piece = np.searchsorted(self.knots, s, side="left" if side == "left" else "right") - 1
+        piece = np.clip(piece, 0, len(self._pieces) - 1)
+        local = np.clip((s - self.knots[piece]) * self.length, 0.0, (self.knots[piece + 1] - self.knots[piece]) * self.length)
+        return piece, local
+
+    def _derivatives(self, s, side, orders):
+        """q and its sigma-derivatives up to ``orders`` - 1 (arc-length parameter), each (n, n_dof)."""
+        piece, local = self._locate(s, side)
+        arc = self._is_arc[piece][:, None]
+        radius = self._radius[piece][:, None]
+        theta = local[:, None] / radius
+        cos, sin = np.cos(theta), np.sin(theta)
+        a, b, c = self._a[piece], self._b[piece], self._c[piece]
+        # Lines: q = a + b sigma. Arcs: a = center, b = x, c = y.
+        radial = b * cos + c * sin
+        tangent = -b * sin + c * cos
+        values = [
+            np.where(arc, a + radius * radial, a + b * local[:, None]),
+            np.where(arc, tangent, b),
+            np.where(arc, -radial / radius, 0.0),
+            np.where(arc, -tangent / radius**2, 0.0),
+        ]
+        return values[:orders]
+
+    def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
+        q, dq, ddq = self._derivatives(s, side, 3)
+        return PathPoints(q, dq * self.length, ddq * self.length**2)
+
+    def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
+        return self._derivatives(s, side, 4)[3] * self.length**3
+
+
+def _line(start: np.ndarray, end: np.ndarray):
+    span = end - start
+    length = float(np.linalg.norm(span))
+    return ("line", start, span / length if length > 0 else np.zeros_like(span), length)
+
+
+def _blend(corner, incoming, outgoing, before, after, max_deviation):
+    """(center, x, y, radius, angle, distance) of the circle that replaces the corner at
+    ``corner`` between unit directions ``incoming`` and ``outgoing`` (segments of lengths
+    ``before`` and ``after``), or ``None`` when the segments continue straight on or turn back."""
+    cosine = float(np.clip(incoming @ outgoing, -1.0, 1.0))
+    if cosine > 1.0 - STRAIGHT or cosine < -1.0 + STRAIGHT:
+        return None
+    angle = np.arccos(cosine)
+    half = 0.5 * angle
+    distance = min(0.5 * before, 0.5 * after, max_deviation * np.sin(half) / (2.0 * np.sin(0.5 * half) ** 2))
+    radius = distance / np.tan(half)
+    bisector = outgoing - incoming
+    center = corner + bisector / np.linalg.norm(bisector) * radius / np.cos(half)
+    start = corner - distance * incoming
+    x = (start - center) / np.linalg.norm(start - center)
+    return center, x, incoming, radius, angle, distance

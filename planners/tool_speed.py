@@ -1,0 +1,90 @@
+"""Tool-speed limits: the linear speed (m/s) and the angular speed (rad/s) of a frame of the
+robot, the end effector unless the request names another (welding, gluing, painting).
+
+The frame's twist along a timed path, in the frame's origin with world-aligned axes (Pinocchio's
+``LOCAL_WORLD_ALIGNED``), is J(q) qd with qd = q' sd:
+
+    v = J_v(q) q' sd,    w = J_w(q) q' sd,
+
+linear in the path speed sd. A bound |v| <= v_max is therefore a first-order bound on sd,
+
+    sd <= v_max / |J_v(q) q'|,
+
+of the same form as a joint velocity limit (``PathConstraints.sd_max``), and every timing method
+that reads ``sd_max`` holds it. The dense limit check computes |v| and |w| at its states from
+the frame's velocity (forward kinematics with the joint velocities).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from planners.errors import InvalidRequest
+from robots import Robot, ToolSpeedLimit
+
+#: Names of the tool limits, as ``peak_utilization`` and error messages show them.
+TOOL_KINDS = ("tool_speed", "tool_angular_speed")
+
+
+def tool_speed_limit(robot: Robot, frame: str | None, speed: float | None, angular_speed: float | None) -> ToolSpeedLimit | None:
+    """The tool limit a request asks for, ``None`` when it names no speed.
+
+    Raises:
+        InvalidRequest: ``frame`` is not a frame of the robot (the message lists its frames), or
+            a frame is named without a speed.
+    """
+    if speed is None and angular_speed is None:
+        if frame is not None:
+            raise InvalidRequest(
+                "timing.limits.tool_frame is given without timing.limits.tool_speed or tool_angular_speed"
+            )
+        return None
+    name = frame or robot.end_effector
+    if not robot.model.existFrame(name):
+        frames = [item.name for item in robot.model.frames if item.name != "universe"]
+        shown = ", ".join(repr(item) for item in frames[:60]) + (", ..." if len(frames) > 60 else "")
+        raise InvalidRequest(f"timing.limits.tool_frame {name[:100]!r} is not a frame of {robot.name}; its frames are {shown}")
+    return ToolSpeedLimit(
+        frame=name,
+        frame_id=robot.frame_id(name),
+        speed=np.inf if speed is None else float(speed),
+        angular_speed=np.inf if angular_speed is None else float(angular_speed),
+    )
+
+
+def frame_twists(robot: Robot, frame_id: int, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """The frame's twist J(q) qd at each row of ``q``, ``qd`` (n, n_dof): shape (n, 6), linear
+    velocity of its origin (m/s) then angular velocity (rad/s), in world-aligned axes."""
+    model, data = robot.model, robot.data
+    configurations = robot.configuration(np.atleast_2d(q))
+    qd = np.atleast_2d(qd)
+    twists = np.empty((len(configurations), 6))
+    frame = pin.LOCAL_WORLD_ALIGNED
+    for row, (configuration, velocity) in enumerate(zip(configurations, qd)):
+        pin.forwardKinematics(model, data, configuration, velocity)
+        twists[row] = pin.getFrameVelocity(model, data, frame_id, frame).vector
+    return twists
+
+
+def tool_speeds(robot: Robot, tool: ToolSpeedLimit, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """|v| (m/s) and |w| (rad/s) of the tool frame at each row of ``q``, ``qd``: shape (n, 2)."""
+    twists = frame_twists(robot, tool.frame_id, q, qd)
+    return np.column_stack([np.linalg.norm(twists[:, :3], axis=1), np.linalg.norm(twists[:, 3:], axis=1)])
+
+
+def tool_speed_bound(robot: Robot, tool: ToolSpeedLimit, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The first-order bound the tool limit puts on sd along a path.
+
+    Args:
+        q, dq: The path and its s-derivative at n values of s, each (n, n_dof).
+
+    Returns:
+        sd_max: Shape (n,), in 1/s (``inf`` where the frame does not move with s).
+        kind: Shape (n,), the index in ``TOOL_KINDS`` of the bound that sets ``sd_max``.
+    """
+    per_unit = tool_speeds(robot, tool, q, dq)  # speeds per unit of sd
+    with np.errstate(divide="ignore"):
+        bounds = tool.bounds / per_unit
+    kind = np.argmin(bounds, axis=1)
+    return bounds[np.arange(len(bounds)), kind], kind
