@@ -44,12 +44,18 @@ Ratios are the other method's time over ``pp`` (> 1: phase_plane is faster). Pri
 path, then the median, p5 and min of each ratio, per robot and overall, and every path where
 phase_plane is slower.
 
-    python benchmarks/phase_plane_vs_toppra.py [--paths 16] [--repeats 5] [--robots ur5,panda,...]
+Times are the CPU time of the process (``time.process_time``) by default: every method runs in
+this one thread (Pinocchio's batched RNEA with one thread, toppra's Cython solver, Drake), and on
+a shared machine a run's wall time also holds the waits for other processes, which grow with
+the run's length. ``--clock wall`` times with ``time.perf_counter`` instead.
+
+    python benchmarks/phase_plane_vs_toppra.py [--paths 16] [--repeats 7] [--robots ur5,panda,...] [--clock cpu]
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import logging
 import re
 import sys
@@ -73,6 +79,15 @@ ROBOTS = ("ur5", "panda", "geering_2r", "yamamoto_2r")
 ACCURACY = 1e-3
 #: Largest disagreement of the two estimates of the converged duration.
 CONVERGED = 1e-5
+
+#: The clock the runs are timed with (``--clock``): the process's CPU time by default.
+CLOCKS = {"cpu": time.process_time, "wall": time.perf_counter}
+_clock = [CLOCKS["cpu"]]
+
+
+def _now() -> float:
+    return _clock[0]()
+
 
 logging.getLogger("toppra").setLevel(logging.ERROR)
 logging.getLogger("drake").setLevel(logging.CRITICAL)
@@ -120,15 +135,33 @@ def converged_duration(path, robot) -> tuple[float, float]:
 
 
 def toptraj_runner(method, path, robot):
-    """(total, solve, duration, detail) of a toptraj method at n intervals."""
+    """A run of a toptraj method at n intervals: (total, solve, duration, detail, evaluation),
+    times in s; detail: the number of intervals it ended on; evaluation: the time spent
+    evaluating constraint rows (the build, and the rows at the points refinement adds)."""
 
     def run(n):
-        started = time.perf_counter()
+        spent = [0.0]
+
+        def timed(evaluate):
+            # Refined constraints keep the evaluate of the ones they refine (with_points).
+            def evaluate_timed(extra_s):
+                started = _now()
+                try:
+                    return evaluate(extra_s)
+                finally:
+                    spent[0] += _now() - started
+
+            return evaluate_timed
+
+        started = _now()
         constraints = build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, n))
-        built = time.perf_counter()
+        built = _now()
+        constraints = dataclasses.replace(constraints, evaluate=timed(constraints.evaluate))
+        replaced = _now()
         result = method.solve(constraints)
-        done = time.perf_counter()
-        return done - started, done - built, result.duration, f"{len(result.s) - 1}"
+        done = _now()
+        spent[0] += built - started
+        return done - started - (replaced - built), done - replaced, result.duration, f"{len(result.s) - 1}", spent[0]
 
     return run
 
@@ -171,13 +204,13 @@ def toppra_runner(robot, waypoints, path, interpolation: bool = False):
 
     def run(n):
         grid = path_grid(path, n)
-        started = time.perf_counter()
+        started = _now()
         instance = toppra.algorithm.TOPPRA(constraints(), spline, gridpoints=grid, solver_wrapper="seidel")
         _, sd, _ = instance.compute_parameterization(0.0, 0.0)
-        done = time.perf_counter()
+        done = _now()
         if sd is None:
             raise TimingFailed("toppra found no parameterization")
-        return done - started, np.nan, float(np.sum(2.0 * np.diff(grid) / (sd[1:] + sd[:-1]))), ""
+        return done - started, np.nan, float(np.sum(2.0 * np.diff(grid) / (sd[1:] + sd[:-1]))), "", np.nan
 
     return run
 
@@ -217,17 +250,17 @@ def drake_runner(plant, robot, waypoints, path, failures: list):
 
     def run(n):
         grid = path_grid(path, n)
-        started = time.perf_counter()
+        started = _now()
         toppra = Toppra(spline, plant, grid)
         toppra.AddJointVelocityLimit(-limits.velocity, limits.velocity)
         toppra.AddJointAccelerationLimit(-limits.acceleration, limits.acceleration)
         toppra.AddJointTorqueLimit(-limits.torque, limits.torque)
         result = toppra.SolvePathParameterization()
-        done = time.perf_counter()
+        done = _now()
         if result is None:
             failures.append(n)
             raise TimingFailed("Drake's Toppra failed")
-        return done - started, np.nan, float(result.end_time()), ""
+        return done - started, np.nan, float(result.end_time()), "", np.nan
 
     return run
 
@@ -249,7 +282,7 @@ def scan(run, reference) -> Scan:
     within = []
     for n in LADDER:
         try:
-            _, _, duration, _ = run(n)
+            duration = run(n)[2]
         except (InfeasiblePath, TimingFailed):
             duration = np.nan
         result.durations[n] = duration
@@ -263,15 +296,16 @@ def scan(run, reference) -> Scan:
 
 
 def time_interleaved(runs: dict, wanted: dict, repeats: int) -> dict:
-    """Best-of-``repeats`` (total, solve, detail) of every method at each of its grids in
-    ``wanted`` (method -> set of grids), the methods interleaved in each repetition."""
-    best = {(method, n): [np.inf, np.inf, ""] for method, grids in wanted.items() for n in grids}
+    """Best-of-``repeats`` [total, solve, detail, evaluation, duration] of every method at each
+    of its grids in ``wanted`` (method -> set of grids), the methods interleaved in each
+    repetition; solve and evaluation from the repetition with the best total."""
+    best = {(method, n): [np.inf, np.inf, "", np.nan, np.nan] for method, grids in wanted.items() for n in grids}
     for _ in range(repeats):
         for (method, n), record in best.items():
-            total, solve, _, detail = runs[method](n)
-            record[0] = min(record[0], total)
+            total, solve, duration, detail, evaluation = runs[method](n)
+            if total < record[0]:
+                record[0], record[2], record[3], record[4] = total, detail, evaluation, duration
             record[1] = min(record[1], solve) if np.isfinite(solve) else record[1]
-            record[2] = detail
     return best
 
 
@@ -286,16 +320,29 @@ def summary(label: str, values) -> str:
 
 
 OTHERS = ("toppra", "toppra-i", "adapter", "drake")
+#: How the two grids of a comparison are chosen: each method's smallest ladder grid within 0.1 %
+#: (the primary comparison), each one's settled grid, or phase_plane on the other's grid.
+DEFINITIONS = {
+    "first": "each method at the smallest ladder grid within 0.1 % of T*",
+    "settled": "each method at the smallest ladder grid from which it stays within 0.1 % on the next two",
+    "same": "phase_plane given the other method's grid (the smallest within 0.1 % for the other)",
+}
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--paths", type=int, default=16, help="paths per robot")
-    parser.add_argument("--repeats", type=int, default=5, help="timed repetitions per method (best of)")
+    parser.add_argument("--repeats", type=int, default=7, help="timed repetitions per method (best of)")
     parser.add_argument("--robots", default=",".join(ROBOTS))
     parser.add_argument("--seed", type=int, default=2024)
+    parser.add_argument(
+        "--clock", choices=sorted(CLOCKS), default="cpu",
+        help="cpu: the process's CPU time (time.process_time; a run's time does not grow with the waits "
+        "for other processes on a shared machine); wall: time.perf_counter",
+    )
     args = parser.parse_args()
     names = args.robots.split(",")
+    _clock[0] = CLOCKS[args.clock]
 
     warm = robots.load("ur5")
     warm_waypoints, warm_path = random_path(warm, np.random.default_rng(0))
@@ -306,15 +353,14 @@ def main() -> int:
     ):
         run(50)
 
-    # ratios[definition][method] and per robot: other method's time / phase_plane's time
-    ratios = {definition: {method: [] for method in (*OTHERS, "adapter solve")} for definition in ("first", "settled")}
-    per_robot: dict[str, dict[str, list]] = {}
-    slower, missed, unconverged, drake_failures = [], [], [], {}
+    # ratios[definition][robot][method]: the other method's time / phase_plane's time
+    ratios = {definition: {} for definition in DEFINITIONS}
+    evaluation_share, slower, missed, unconverged, drake_failures, off = [], [], [], [], {}, []
     drake_available = None
     print(
-        f"{'robot':11s} {'path':>4s} {'T* s':>7s} | {'pp N':>4s} {'pts':>5s} {'ms':>6s} {'solve':>5s} | "
+        f"{'robot':11s} {'path':>4s} {'T* s':>7s} | {'pp N':>4s} {'pts':>5s} {'ms':>6s} {'solve':>5s} {'eval':>4s} | "
         f"{'tp N':>4s} {'ms':>6s} | {'tpi N':>5s} {'ms':>7s} | {'ad N':>4s} {'ms':>6s} {'solve':>6s} | "
-        f"{'dk N':>4s} {'ms':>6s} | ratio toppra toppra-i adapter solve drake | settled: toppra toppra-i adapter drake"
+        f"{'dk N':>4s} {'ms':>6s} | ratio toppra toppra-i adapter solve drake | settled: toppra adapter | same grid: toppra adapter"
     )
     for name in names:
         robot = robots.load(name)
@@ -322,7 +368,8 @@ def main() -> int:
         if name == "ur5":
             drake_available = plant is not None
         rng = np.random.default_rng(args.seed + (ROBOTS.index(name) if name in ROBOTS else 0))
-        robot_ratios = per_robot.setdefault(name, {method: [] for method in OTHERS})
+        for definition in DEFINITIONS:
+            ratios[definition][name] = {method: [] for method in (*OTHERS, "adapter solve")}
         done = 0
         while done < args.paths:
             waypoints, path = random_path(robot, rng)
@@ -349,76 +396,86 @@ def main() -> int:
                 done += 1
                 continue
             wanted = {method: {grid for grid in (found.first, found.settled) if grid is not None} for method, found in scans.items()}
+            wanted["pp"] |= {found.first for method, found in scans.items() if method != "pp" and found.first is not None}
             times = time_interleaved(runs, wanted, args.repeats)
 
-            def at(method, definition):
-                grid = getattr(scans[method], definition) if method in scans else None
+            def at(method, grid):
+                """(grid, total, solve, detail, evaluation, duration) of ``method`` at ``grid``."""
                 return None if grid is None else (grid, *times[(method, grid)])
 
-            line = []
-            for definition in ("first", "settled"):
-                pp = at("pp", definition)
-                row = {}
+            rows = {}
+            for definition in DEFINITIONS:
+                row = rows[definition] = {}
                 for method in OTHERS:
-                    other = at(method, definition)
+                    if method not in scans:
+                        continue
+                    other = at(method, getattr(scans[method], "first" if definition == "same" else definition))
+                    pp = at("pp", other[0] if definition == "same" and other else getattr(scans["pp"], "first" if definition == "same" else definition))
                     if pp is None or other is None:
                         continue
+                    if definition == "same" and abs(pp[5] / reference - 1.0) > ACCURACY:
+                        off.append((name, done, other[0], pp[5] / reference - 1.0))
+                        continue
                     row[method] = other[1] / pp[1]
-                    ratios[definition][method].append(row[method])
-                    if definition == "first":
-                        robot_ratios[method].append(row[method])
-                if pp is not None and at("adapter", definition) is not None:
-                    row["adapter solve"] = at("adapter", definition)[2] / pp[2]
-                    ratios[definition]["adapter solve"].append(row["adapter solve"])
-                line.append(row)
-                if definition == "first" and min(row.get("toppra", np.inf), row.get("adapter", np.inf)) < 1.0:
-                    slower.append((name, done, {method: at(method, definition) for method in ("pp", *OTHERS)}))
+                    ratios[definition][name][method].append(row[method])
+                    if method == "adapter":
+                        row["adapter solve"] = other[2] / pp[2]
+                        ratios[definition][name]["adapter solve"].append(row["adapter solve"])
+            if min(rows["first"].get("toppra", np.inf), rows["first"].get("adapter", np.inf)) < 1.0:
+                slower.append((name, done, {method: at(method, scans[method].first) for method in scans}))
+
+            pp = at("pp", scans["pp"].first)
+            adapter = at("adapter", scans["adapter"].first)
+            evaluation_share.append(pp[4] / pp[1])
 
             def cell(method, width):
-                found = at(method, "first")
+                found = at(method, scans[method].first) if method in scans else None
                 if found is None:
                     return f"{'-':>{width}s} {'-':>6s}"
                 return f"{found[0]:{width}d} {1e3 * found[1]:6.2f}"
-
-            pp = at("pp", "first")
-            adapter = at("adapter", "first")
 
             def number(row, method, width):
                 return f"{row[method]:{width}.2f}" if method in row else f"{'-':>{width}s}"
 
             print(
-                f"{name:11s} {done:4d} {reference:7.4f} | {pp[0]:4d} {pp[3]:>5s} {1e3 * pp[1]:6.2f} {1e3 * pp[2]:5.2f} | "
-                f"{cell('toppra', 4)} | {cell('toppra-i', 5)} | {adapter[0]:4d} {1e3 * adapter[1]:6.2f} {1e3 * adapter[2]:6.2f} | "
-                f"{cell('drake', 4)} | {number(line[0], 'toppra', 12)} {number(line[0], 'toppra-i', 8)} "
-                f"{number(line[0], 'adapter', 7)} {number(line[0], 'adapter solve', 5)} {number(line[0], 'drake', 5)} | "
-                f"{number(line[1], 'toppra', 14)} {number(line[1], 'toppra-i', 8)} {number(line[1], 'adapter', 7)} "
-                f"{number(line[1], 'drake', 5)}",
+                f"{name:11s} {done:4d} {reference:7.4f} | {pp[0]:4d} {pp[3]:>5s} {1e3 * pp[1]:6.2f} {1e3 * pp[2]:5.2f} "
+                f"{100 * pp[4] / pp[1]:3.0f}% | {cell('toppra', 4)} | {cell('toppra-i', 5)} | "
+                f"{adapter[0]:4d} {1e3 * adapter[1]:6.2f} {1e3 * adapter[2]:6.2f} | {cell('drake', 4)} | "
+                f"{number(rows['first'], 'toppra', 12)} {number(rows['first'], 'toppra-i', 8)} "
+                f"{number(rows['first'], 'adapter', 7)} {number(rows['first'], 'adapter solve', 5)} "
+                f"{number(rows['first'], 'drake', 5)} | {number(rows['settled'], 'toppra', 14)} "
+                f"{number(rows['settled'], 'adapter', 7)} | {number(rows['same'], 'toppra', 16)} {number(rows['same'], 'adapter', 7)}",
                 flush=True,
             )
             done += 1
 
+    clock = "CPU time of the process" if args.clock == "cpu" else "wall time"
     print()
-    print(f"Times at equal accuracy (within 0.1 % of T*), best of {args.repeats}; ratio = the other method's time / phase_plane's")
-    print("(> 1: phase_plane is faster). pp = build_path_constraints + PhasePlaneMethod().solve; toppra = toppra's")
-    print("public API with its default discretizations (collocation for torque), incl. its own constraint evaluation;")
-    print("toppra-i = the same with the interpolation discretization for torque too (conservative, as phase_plane);")
-    print("adapter = build_path_constraints + ToppraMethod().solve; solve = the two solves alone on prebuilt")
-    print("constraints (phase_plane's includes the rows it evaluates while refining); drake = Drake's Toppra.")
-    print("Each method at the smallest ladder grid within 0.1 %:")
-    for robot_name, robot_ratios in per_robot.items():
-        for method in ("toppra", "toppra-i", "adapter"):
-            print(summary(f"  {robot_name:11s} {method:8s} / pp", robot_ratios[method]))
-    for method in (*OTHERS, "adapter solve"):
-        if method == "drake" and not drake_available:
-            continue
-        label = "ur5 drake" if method == "drake" else f"all {method}"
-        print(summary(f"  {label:20s} / pp", ratios["first"][method]))
-    print("Each method at the smallest ladder grid from which it stays within 0.1 % on the next two ladder grids:")
-    for method in (*OTHERS, "adapter solve"):
-        if method == "drake" and not drake_available:
-            continue
-        label = "ur5 drake" if method == "drake" else f"all {method}"
-        print(summary(f"  {label:20s} / pp", ratios["settled"][method]))
+    print(f"Times: {clock}, best of {args.repeats}, the methods interleaved. Ratio = the other method's time /")
+    print("phase_plane's (> 1: phase_plane is faster). pp = build_path_constraints + PhasePlaneMethod().solve")
+    print("(eval: its share spent evaluating constraint rows, the build and the rows at refinement points);")
+    print("toppra = toppra's public API with its default discretizations (collocation for torque), its own")
+    print("constraint evaluation included; toppra-i = the same with the interpolation discretization for torque")
+    print("too (conservative, as phase_plane); adapter = build_path_constraints + ToppraMethod().solve;")
+    print("adapter solve = the two solves alone on prebuilt constraints (phase_plane's includes the rows it")
+    print("evaluates while refining); drake = Drake's Toppra (ur5).")
+    for definition, described in DEFINITIONS.items():
+        print(f"{described}:")
+        if definition == "first":
+            for robot_name, robot_ratios in ratios[definition].items():
+                for method in ("toppra", "toppra-i", "adapter"):
+                    print(summary(f"  {robot_name:11s} {method:13s} / pp", robot_ratios[method]))
+        for method in (*OTHERS, "adapter solve"):
+            if method == "drake" and not drake_available:
+                continue
+            pooled = [value for robot_ratios in ratios[definition].values() for value in robot_ratios[method]]
+            label = "ur5 drake" if method == "drake" else f"all {method}"
+            print(summary(f"  {label:25s} / pp", pooled))
+    share = np.array(evaluation_share)
+    print(
+        f"phase_plane's time spent evaluating constraint rows: median {100 * np.median(share):.0f} %, "
+        f"p5 {100 * np.percentile(share, 5):.0f} %, p95 {100 * np.percentile(share, 95):.0f} %"
+    )
     if drake_available is False:
         print("drake: pydrake not installed (pip install toptraj[bench]); skipped")
     failed = {index: grids for index, grids in drake_failures.items() if grids}
@@ -431,6 +488,8 @@ def main() -> int:
         print(f"not converged: {name} path {index}: the two estimates of T* differ by {gap:.1e}; left out")
     for name, index, grids in missed:
         print(f"missed: {name} path {index}: a method missed 0.1 % on every ladder grid (first, settled): {grids}")
+    for name, index, grid, error in off:
+        print(f"off: {name} path {index}: phase_plane given {grid} intervals is {error:+.2e} off T*; left out of 'same grid'")
     if slower:
         for name, index, found in slower:
             described = ", ".join(

@@ -562,6 +562,8 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, 
     for i in range(n_stages):
         k = np.ceil(wanted[i])
         pieces[i] = max_pieces if k > max_pieces else int(k)
+        if (s[i + 1] - s[i]) / pieces[i] < 1e-12:
+            pieces[i] = 1  # no pieces shorter than rounding resolves
         added += pieces[i] - 1
     if added > room:
         # Too many for the grid's cap: the worst intervals first, each as asked.
