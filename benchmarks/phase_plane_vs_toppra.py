@@ -22,14 +22,15 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
 * ``pp``: ``phase_plane`` as a user of toptraj pays for it: the constraint build
   (``build_path_constraints``: path derivatives and a batched Pinocchio RNEA at each grid point)
   plus ``PhasePlaneMethod().solve`` (which evaluates the constraints anew at the points its grid
-  refinement adds). ``pp solve``: the solve alone, on constraints built beforehand.
+  refinement adds; the share of the time spent evaluating rows is printed too). ``solve``: the
+  solve alone, on constraints built beforehand.
 * ``adapter``: the ``toppra`` method of toptraj: the same constraint build plus
   ``ToppraMethod().solve`` (toppra's Seidel solver on the precomputed rows).
 * ``toppra``: toppra used directly through its public API, as a user of toppra pays for it:
   ``SplineInterpolator`` through the same waypoints and knots (natural ends: the same spline),
   ``JointVelocityConstraint``, ``JointAccelerationConstraint``, ``JointTorqueConstraint`` (toppra's
   default discretizations: interpolation for acceleration, collocation for torque, which holds
-  the torque rows only at the start of each interval and comes out below T*) with an
+  the torque rows only at the start of each interval and typically comes out below T*) with an
   inverse-dynamics callback ``pin.rnea(model, data, q, v, a) + damping * v``,
   ``TOPPRA(..., solver_wrapper="seidel")`` (which evaluates the constraints) and
   ``compute_parameterization(0, 0)``. ``toppra-i``: the same with the interpolation
@@ -41,9 +42,9 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
   plant is built beforehand. Drake also runs (untimed) on 2,400 and 4,096 intervals of each
   path, and the grids where it fails are reported.
 
-Ratios are the other method's time over ``pp`` (> 1: phase_plane is faster). Prints one line per
-path, then the median, p5 and min of each ratio, per robot and overall, and every path where
-phase_plane is slower.
+Ratios are the other method's time over ``pp`` (> 1: phase_plane is faster), also with
+phase_plane given the other method's grid. Prints one line per path, then the median, p5 and min
+of each ratio, per robot and overall, and every path where phase_plane is slower.
 
 Times are the CPU time of the process (``time.process_time``) by default: every method runs in
 this one thread (Pinocchio's batched RNEA with one thread, toppra's Cython solver, Drake), and on
