@@ -22,14 +22,15 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
 * ``pp``: ``phase_plane`` as a user of toptraj pays for it: the constraint build
   (``build_path_constraints``: path derivatives and a batched Pinocchio RNEA at each grid point)
   plus ``PhasePlaneMethod().solve`` (which evaluates the constraints anew at the points its grid
-  refinement adds). ``pp solve``: the solve alone, on constraints built beforehand.
+  refinement adds; the share of the time spent evaluating rows is printed too). ``solve``: the
+  solve alone, on constraints built beforehand.
 * ``adapter``: the ``toppra`` method of toptraj: the same constraint build plus
   ``ToppraMethod().solve`` (toppra's Seidel solver on the precomputed rows).
 * ``toppra``: toppra used directly through its public API, as a user of toppra pays for it:
   ``SplineInterpolator`` through the same waypoints and knots (natural ends: the same spline),
   ``JointVelocityConstraint``, ``JointAccelerationConstraint``, ``JointTorqueConstraint`` (toppra's
   default discretizations: interpolation for acceleration, collocation for torque, which holds
-  the torque rows only at the start of each interval and comes out below T*) with an
+  the torque rows only at the start of each interval and typically comes out below T*) with an
   inverse-dynamics callback ``pin.rnea(model, data, q, v, a) + damping * v``,
   ``TOPPRA(..., solver_wrapper="seidel")`` (which evaluates the constraints) and
   ``compute_parameterization(0, 0)``. ``toppra-i``: the same with the interpolation
@@ -38,11 +39,12 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
   ``Toppra`` on a ``MultibodyPlant`` parsed from the same URDF (visual and collision elements
   stripped), the same spline as a ``PiecewisePolynomial.CubicHermite``, ``AddJointVelocityLimit``,
   ``AddJointAccelerationLimit``, ``AddJointTorqueLimit`` and ``SolvePathParameterization``; the
-  plant is built beforehand.
+  plant is built beforehand. Drake also runs (untimed) on 2,400 and 4,096 intervals of each
+  path, and the grids where it fails are reported.
 
-Ratios are the other method's time over ``pp`` (> 1: phase_plane is faster). Prints one line per
-path, then the median, p5 and min of each ratio, per robot and overall, and every path where
-phase_plane is slower.
+Ratios are the other method's time over ``pp`` (> 1: phase_plane is faster), also with
+phase_plane given the other method's grid. Prints one line per path, then the median, p5 and min
+of each ratio, per robot and overall, and every path where phase_plane is slower.
 
 Times are the CPU time of the process (``time.process_time``) by default: every method runs in
 this one thread (Pinocchio's batched RNEA with one thread, toppra's Cython solver, Drake), and on
@@ -77,6 +79,8 @@ LADDER = (25, 50, 75, 100, 150, 200, 300, 450, 600, 900, 1200, 1800, 2400, 3600,
 KINDS = ("velocity", "acceleration", "torque")
 ROBOTS = ("ur5", "panda", "geering_2r", "yamamoto_2r")
 ACCURACY = 1e-3
+#: Fine grids on which Drake's Toppra is also run (untimed), to report where it fails.
+DRAKE_FINE = (2400, 4096)
 #: Largest disagreement of the two estimates of the converged duration.
 CONVERGED = 1e-5
 
@@ -391,6 +395,12 @@ def main() -> int:
                 failures = drake_failures.setdefault(done, [])
                 runs["drake"] = drake_runner(plant, robot, waypoints, path, failures)
             scans = {method: scan(run, reference) for method, run in runs.items()}
+            if "drake" in runs:
+                for n in DRAKE_FINE:  # not timed: does it solve on fine grids at all?
+                    try:
+                        runs["drake"](n)
+                    except TimingFailed:
+                        pass
             if any(scans[method].first is None for method in ("pp", "toppra", "toppra-i", "adapter")):
                 missed.append((name, done, {method: (found.first, found.settled) for method, found in scans.items()}))
                 done += 1
@@ -479,10 +489,11 @@ def main() -> int:
     if drake_available is False:
         print("drake: pydrake not installed (pip install toptraj[bench]); skipped")
     failed = {index: grids for index, grids in drake_failures.items() if grids}
-    if failed:
+    if drake_available:
         print(
-            "Drake's Toppra failed (\"failed to find the maximum path acceleration\") on "
-            + "; ".join(f"ur5 path {index} at {', '.join(map(str, grids))} intervals" for index, grids in failed.items())
+            f"Drake's Toppra (also run on {' and '.join(map(str, DRAKE_FINE))} intervals, untimed) failed "
+            f"(\"failed to find the maximum path acceleration\") on {len(failed)} of {len(drake_failures)} ur5 paths"
+            + (": " + "; ".join(f"path {index} at {', '.join(map(str, grids))}" for index, grids in failed.items()) if failed else "")
         )
     for name, index, gap in unconverged:
         print(f"not converged: {name} path {index}: the two estimates of T* differ by {gap:.1e}; left out")
