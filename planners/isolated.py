@@ -13,7 +13,8 @@ nothing to stop it for.
 Children are forked from a fork server (``multiprocessing``'s ``forkserver`` context): a clean,
 single-threaded process started once, which has imported the solver stacks (``PRELOAD``), so a
 child starts in milliseconds without copying the threads of the server. Where ``forkserver`` is
-not available, children are spawned (a fresh interpreter each). As with any ``multiprocessing``
+not available, children are spawned (a fresh interpreter each). A child keeps to one BLAS
+thread (``planners.threads``). As with any ``multiprocessing``
 code, a script that plans with a deadline must guard its entry point with
 ``if __name__ == "__main__":`` (a child imports the main script as ``__mp_main__``).
 """
@@ -25,6 +26,7 @@ import threading
 
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import TimingFailed
+from planners.threads import single_blas_thread
 
 #: Seconds between two deadline checks while waiting for the child.
 POLL_S = 0.02
@@ -59,6 +61,7 @@ def start_worker_server() -> None:
 
 
 def _child(connection, function, args) -> None:
+    single_blas_thread()
     try:
         outcome = ("result", function(*args))
     except Exception as error:  # returned to the parent, which raises it

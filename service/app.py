@@ -12,6 +12,7 @@ import numpy as np
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.isolated import start_worker_server
+from planners.threads import single_blas_thread
 from service.body_limit import BodySizeLimit
 from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.routes import health, robots as robot_routes, trajectories
@@ -35,6 +36,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
     settings = settings or Settings()
+    single_blas_thread()  # plannings run side by side; see planners.threads
     robots.configure_uploads(
         settings.data_dir,
         max_uploads=settings.max_uploads,

@@ -81,3 +81,26 @@ def test_a_robot_pickles_as_its_model():
     assert copy.model == robot.model and copy.joint_names == robot.joint_names
     q = np.full((1, robot.dof), 0.3)
     np.testing.assert_allclose(_torques(copy, q), _torques(robot, q), atol=1e-12)
+
+
+def _blas_threads() -> int:
+    import numpy  # noqa: F401  (its BLAS loaded)
+    from threadpoolctl import threadpool_info
+
+    return max(pool["num_threads"] for pool in threadpool_info() if pool["user_api"] == "blas")
+
+
+@pytest.mark.skipif(os.cpu_count() < 2, reason="a one-core machine gives BLAS one thread anyway")
+def test_the_worker_process_keeps_to_one_blas_thread():
+    """A multi-threaded BLAS spins its threads: with the other core busy, the Geering
+    collocation ran more than ten times slower than alone and over its budget."""
+    assert run_isolated(_blas_threads, deadline=Deadline(60)) == 1
+
+
+@pytest.mark.skipif(os.cpu_count() < 2, reason="a one-core machine gives BLAS one thread anyway")
+def test_the_service_process_keeps_to_one_blas_thread():
+    from service.app import create_app
+    from service.settings import Settings
+
+    create_app(Settings(preload_robots=False))
+    assert _blas_threads() == 1
