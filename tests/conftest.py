@@ -18,6 +18,7 @@ os.environ["TOPTRAJ_DATA_DIR"] = _SESSION_DATA_DIR
 
 from fastapi.testclient import TestClient  # noqa: E402
 
+from planners.threads import single_blas_thread  # noqa: E402
 from service.app import create_app  # noqa: E402
 from service.settings import Settings  # noqa: E402
 
@@ -27,6 +28,11 @@ UR5_WAYPOINTS = [
     [1.5, -0.5, 0.8, -1.0, 1.0, 0.8],
     [2.0, -1.3, 1.2, 0.2, 0.4, 1.2],
 ]
+
+
+# Library-level tests plan in this process as the service does, with one BLAS thread; two test
+# workers on two cores would otherwise spin each other's BLAS threads.
+single_blas_thread()
 
 
 def pytest_sessionfinish(session, exitstatus):
