@@ -1,21 +1,42 @@
-"""The ``toptraj`` command: ``toptraj serve [--host H] [--port P]`` and
+"""The ``toptraj`` command: ``toptraj serve [--host H] [--port P] [--workers N]`` and
 ``toptraj plan request.json`` (prints the response JSON)."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 
 from pydantic import ValidationError
+
+from service.serving import LOOP
+
+#: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
+APP_FACTORY = "service.app:create_app"
+
+
+def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
+    """Planning threads of each of ``workers`` server processes sharing ``cores`` cores: the
+    cores divided among the processes, at least 1. A process's planning threads share one
+    interpreter lock, so they use one core at a time however many there are; the processes
+    are what uses the cores."""
+    cores = cores or os.cpu_count() or 1
+    return max(1, cores // workers)
 
 
 def _serve(args) -> int:
     import uvicorn
 
-    from service.app import create_app
-
-    uvicorn.run(create_app(), host=args.host, port=args.port)
+    if args.workers < 1:
+        print(f"toptraj serve: --workers must be at least 1, not {args.workers}", file=sys.stderr)
+        return 2
+    # Each server process reads its settings from the environment, which it inherits from here.
+    os.environ.setdefault("TOPTRAJ_PLAN_WORKERS", str(plan_threads_per_process(args.workers)))
+    # One process (workers=1) serves in this process; more are spawned processes sharing this
+    # process's listening socket, each with its own app, planning threads and model caches,
+    # restarted by uvicorn's supervisor if one dies, taking connections in turns (service.serving).
+    uvicorn.run(APP_FACTORY, factory=True, host=args.host, port=args.port, workers=args.workers, loop=LOOP)
     return 0
 
 
@@ -49,6 +70,12 @@ def main(argv: list[str] | None = None) -> int:
     serve = commands.add_parser("serve", help="run the HTTP service")
     serve.add_argument("--host", default="127.0.0.1")
     serve.add_argument("--port", type=int, default=8000)
+    serve.add_argument(
+        "--workers",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="server processes on the port, each planning on its own core (default: the number of cores)",
+    )
     serve.set_defaults(run=_serve)
     plan = commands.add_parser("plan", help="plan one request from a JSON file and print the response")
     plan.add_argument("request", help="path of a JSON file shaped like POST /v1/trajectories' body")

@@ -27,9 +27,12 @@ class Settings(BaseSettings):
             used dropped first).
         max_response_bytes: Largest trajectory body served; an ``output.dt`` whose samples
             would not fit gets 422 naming the smallest ``dt`` that does.
-        plan_workers: Plannings run at once (default: the number of cores).
-        plan_queue: Requests that may wait for a planning worker (within their budget); beyond,
-            503 with ``Retry-After``.
+        plan_workers: Plannings run at once in this process, each in a thread (default: the
+            number of cores; under ``toptraj serve --workers N``, the cores divided by N, at
+            least 1: a process's planning threads share one interpreter lock, so more threads
+            add no throughput, and N processes then run as many plannings as there are cores).
+        plan_queue: Requests that may wait for a planning worker of this process (within
+            their budget); beyond, 503 with ``Retry-After``.
     """
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")

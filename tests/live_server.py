@@ -1,5 +1,6 @@
 """A real ``toptraj serve`` in a subprocess, for tests that need a server process of their own:
-the CPU time it spends after a 504, or ``/health`` answering while another request runs."""
+the CPU time it spends after a 504, ``/health`` answering while another request runs, or
+uploads seen by every one of several server processes."""
 
 from __future__ import annotations
 
@@ -24,16 +25,18 @@ def _free_port() -> int:
 
 
 class LiveServer:
-    """``python -m service.cli serve`` on a free port with ``TOPTRAJ_*`` settings ``env``."""
+    """``python -m service.cli serve --workers W`` on a free port with ``TOPTRAJ_*`` settings
+    ``env``; one server process unless ``workers`` asks for more."""
 
-    def __init__(self, **env: str):
+    def __init__(self, workers: int = 1, **env: str):
         self.port = _free_port()
+        self.workers = workers
         self.env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])), **env}
         self.process: subprocess.Popen | None = None
 
     def __enter__(self) -> "LiveServer":
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port)],
+            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--workers", str(self.workers)],
             cwd=ROOT,
             env=self.env,
             stdout=subprocess.DEVNULL,
@@ -44,10 +47,11 @@ class LiveServer:
             if self.process.poll() is not None:
                 raise RuntimeError(f"the server exited with code {self.process.returncode}")
             try:
-                if self.request("GET", "/health", timeout=2)[0] == 200:
+                if self.request("GET", "/health", timeout=2)[0] == 200 and len(self.serving_pids()) == self.workers:
                     return self
             except OSError:
-                time.sleep(0.1)
+                pass
+            time.sleep(0.1)
         raise RuntimeError("the server did not answer /health within 120 s")
 
     def __exit__(self, *exc) -> None:
@@ -68,6 +72,14 @@ class LiveServer:
             return response.status, dict(response.getheaders()), response.read()
         finally:
             connection.close()
+
+    def serving_pids(self) -> list[int]:
+        """Process ids of the processes answering requests: the server itself when it runs one
+        worker, else the worker processes uvicorn spawned."""
+        root = psutil.Process(self.process.pid)
+        if self.workers == 1:
+            return [root.pid]
+        return [child.pid for child in root.children() if "spawn_main" in " ".join(child.cmdline())]
 
     def cpu_seconds(self) -> float:
         """CPU time (user + system) used so far by the server and every process under it,
