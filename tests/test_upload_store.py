@@ -187,7 +187,7 @@ def _start_server(data_dir: Path, port: int, log: Path) -> subprocess.Popen:
     env = {**os.environ, "TOPTRAJ_DATA_DIR": str(data_dir), "TOPTRAJ_PRELOAD_ROBOTS": "false", "PYTHONPATH": str(REPO)}
     with open(log, "wb") as output:
         process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(port)],
+            [sys.executable, "-m", "service.cli", "serve", "--port", str(port), "--workers", "1"],
             env=env,
             stdout=output,
             stderr=subprocess.STDOUT,
