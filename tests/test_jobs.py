@@ -288,16 +288,21 @@ def test_a_finished_job_is_read_after_a_restart_and_running_ones_are_interrupted
         assert _wait(after, queued)["status"] == "done"
 
 
-def _job_workers() -> list[psutil.Process]:
-    """The worker processes of this process's fork server (the jobs' and isolated calls')."""
-    servers = [child for child in psutil.Process().children() if "forkserver" in " ".join(child.cmdline())]
-    return [worker for server in servers for worker in server.children()]
+def _job_workers(pid: int | None = None, timeout_s: float = 60.0) -> list[psutil.Process]:
+    """The worker processes of the fork server of process ``pid`` (default this one), once
+    there is one: a job counts as running from its claim, a moment before its worker forks."""
+    give_up = time.monotonic() + timeout_s
+    while True:
+        root = psutil.Process(pid)
+        servers = [child for child in root.children() if "forkserver" in " ".join(child.cmdline())]
+        workers = [worker for server in servers for worker in server.children()]
+        if workers or time.monotonic() > give_up:
+            return workers
+        time.sleep(0.02)
 
 
 def _workers_of(server: LiveServer) -> list[psutil.Process]:
-    root = psutil.Process(server.process.pid)
-    servers = [child for child in root.children() if "forkserver" in " ".join(child.cmdline())]
-    return [worker for fork_server in servers for worker in fork_server.children()]
+    return _job_workers(server.process.pid)
 
 
 def _still_computing(processes: list[psutil.Process], timeout_s: float) -> list[psutil.Process]:
