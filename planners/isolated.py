@@ -28,9 +28,11 @@ code, a script that plans with a deadline must guard its entry point with
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import os
 import select
+import signal
 import threading
 import time
 from collections.abc import Sequence
@@ -93,8 +95,26 @@ class _PipeProgress:
 
 def _end_with_caller(connection) -> None:
     """End this worker as soon as the process waiting for its answer is gone, even one killed
-    outright: a worker must not compute on for nobody. A thread waits (without polling) for
-    the read end of the answer's pipe to close, which the kernel reports on the write end."""
+    outright: a worker must not compute on for nobody.
+
+    * The kernel kills it when its parent ends (Linux ``PR_SET_PDEATHSIG``): the service itself
+      when spawned, else the fork server, which ends with the service once no worker holds its
+      "alive" pipe open (multiprocessing gives every child a copy, for forking further; a
+      worker never does, so it closes it). This needs no Python code to run, so it works
+      even while a solver holds the interpreter lock for seconds.
+    * Elsewhere, a thread waits (without polling) for the read end of the answer's pipe to
+      close, which the kernel reports on the write end, and ends the process.
+    """
+    from multiprocessing import forkserver
+
+    alive = getattr(forkserver._forkserver, "_forkserver_alive_fd", None)
+    if alive is not None:
+        os.close(alive)
+        forkserver._forkserver._forkserver_alive_fd = None
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux
+        pass
     if not hasattr(select, "poll"):
         return
     poller = select.poll()
