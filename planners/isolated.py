@@ -11,8 +11,7 @@ closures. The memory the child used goes back to the system when it exits. Witho
 nothing to stop it for. A call made inside a worker process (a job's) runs inline too: the
 worker is killed as a whole.
 
-A child ends by itself as soon as its caller is gone (even one killed outright): a thread
-watches the pipe its answer would go through.
+A child ends as soon as its caller is gone, even one killed outright (``_end_with_caller``).
 
 With ``progress=True`` the function is called with a keyword ``progress``, a callable
 ``progress(fraction, stage)`` whose reports reach ``deadline.progress`` in the caller (over the
