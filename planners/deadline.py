@@ -1,21 +1,38 @@
-"""A cooperative time budget: long computations call ``check()`` between steps."""
+"""A cooperative time budget: long computations call ``check()`` between steps, and may say
+how far they are with ``progress(fraction, stage)``."""
 
 from __future__ import annotations
 
+import copy
 import threading
 import time
+from collections.abc import Callable
 
 from planners.errors import BudgetExceeded
+
+#: ``progress(fraction, stage)``: fraction of the work done, in [0, 1], and what is under way.
+Progress = Callable[[float, str], None]
+
+
+def _ignore(fraction: float, stage: str) -> None:
+    """The default progress report: nobody listens."""
 
 
 class Deadline:
     """Raises ``BudgetExceeded`` from ``check()`` once ``budget_s`` seconds have passed since
-    construction, or as soon as ``cancel()`` was called (by a caller that stopped waiting)."""
+    construction, or as soon as ``cancel()`` was called (by a caller that stopped waiting).
 
-    def __init__(self, budget_s: float | None = None):
+    Attributes:
+        progress: ``progress(fraction, stage)`` reports how far the computation is (fraction in
+            [0, 1], a short stage text such as ``"collocation: guess 3 of 15"``); a no-op
+            unless a listener was given. Computations report without knowing who listens.
+    """
+
+    def __init__(self, budget_s: float | None = None, progress: Progress | None = None):
         self.budget_s = budget_s
         self._end = None if budget_s is None else time.monotonic() + budget_s
         self._cancelled = threading.Event()
+        self.progress: Progress = progress or _ignore
 
     def cancel(self) -> None:
         """Make the next ``check()`` raise."""
@@ -29,6 +46,22 @@ class Deadline:
         """Raise ``BudgetExceeded`` when the budget is spent or the caller cancelled."""
         if self._cancelled.is_set() or (self._end is not None and time.monotonic() > self._end):
             raise BudgetExceeded(f"planning exceeded its time budget of {self.budget_s} s")
+
+    def within(self, start: float, end: float, label: str = "") -> Deadline:
+        """This deadline (the same end, the same cancellation) for a part of the work spanning
+        the fractions [start, end] of the whole: its ``progress(f, stage)`` reports
+        ``start + f (end - start)``, and ``"label: stage"`` when a label is given. Without a
+        listener, the deadline itself."""
+        if self.progress is _ignore:
+            return self
+        part = copy.copy(self)
+        outer = self.progress
+
+        def progress(fraction: float, stage: str) -> None:
+            outer(start + (end - start) * min(max(fraction, 0.0), 1.0), f"{label}: {stage}" if label else stage)
+
+        part.progress = progress
+        return part
 
 
 NO_DEADLINE = Deadline()

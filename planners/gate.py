@@ -65,9 +65,11 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
         InfeasiblePath: the limits still do not hold after ``GATE_ROUNDS`` refinements, or the
             method's timing cannot be refined; says where, which joint and which limit.
     """
+    deadline.progress(0.0, "timing")
     result = solve_well_scaled(method, constraints, boundary, duration, deadline)
-    for _ in range(GATE_ROUNDS + 1):
+    for round_ in range(GATE_ROUNDS + 1):
         deadline.check()
+        deadline.progress(0.5 + 0.5 * round_ / (GATE_ROUNDS + 1), f"limit check, round {round_ + 1}")
         check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s, constraints)
         if check.worst is None or check.worst.ratio <= threshold:
             return result, constraints, check

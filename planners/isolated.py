@@ -8,7 +8,14 @@ killed and ``BudgetExceeded`` raised. The function must be a module-level functi
 arguments and result plain picklable data (numpy arrays, dataclasses of them, a ``Robot``), never
 closures. The memory the child used goes back to the system when it exits. Without a deadline
 (``NO_DEADLINE``, the library's default) the function runs in the calling thread: there is
-nothing to stop it for.
+nothing to stop it for. A call made inside a worker process (a job's) runs inline too: the
+worker is killed as a whole.
+
+A child ends as soon as its caller is gone, even one killed outright (``_end_with_caller``).
+
+With ``progress=True`` the function is called with a keyword ``progress``, a callable
+``progress(fraction, stage)`` whose reports reach ``deadline.progress`` in the caller (over the
+pipe, at most every ``PROGRESS_S`` seconds unless the stage changes).
 
 Children are forked from a fork server (``multiprocessing``'s ``forkserver`` context): a clean,
 single-threaded process started once, which has imported the solver stacks (``PRELOAD``), so a
@@ -21,8 +28,14 @@ code, a script that plans with a deadline must guard its entry point with
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
+import os
+import select
+import signal
 import threading
+import time
+from collections.abc import Sequence
 
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import TimingFailed
@@ -30,11 +43,15 @@ from planners.threads import single_blas_thread
 
 #: Seconds between two deadline checks while waiting for the child.
 POLL_S = 0.02
+#: Shortest interval between two progress reports of one stage sent by a child, in s.
+PROGRESS_S = 0.1
 #: Modules the fork server imports once, so that children start with them loaded.
 PRELOAD = ["numpy", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.free_path.collocation"]
 
 _context = None
 _lock = threading.Lock()
+#: True in a worker process: calls nested in it run inline (the whole process is killed).
+_in_worker = False
 
 
 def _get_context():
@@ -50,20 +67,79 @@ def _get_context():
         return _context
 
 
-def start_worker_server() -> None:
-    """Start the fork server now, so that it imports ``PRELOAD`` (a second or two, in its own
-    process) while the service starts, rather than during the first isolated call."""
+def start_worker_server(preload: Sequence[str] = ()) -> None:
+    """Start the fork server now, so that it imports ``PRELOAD`` and ``preload`` (a second or
+    two, in its own process) while the service starts, rather than during the first isolated
+    call. A fork server already running keeps what it imported."""
     context = _get_context()
     if context.get_start_method() == "forkserver":
         from multiprocessing import forkserver
 
+        context.set_forkserver_preload([*PRELOAD, *preload])
         forkserver.ensure_running()
 
 
-def _child(connection, function, args) -> None:
+class _PipeProgress:
+    """``progress(fraction, stage)`` in a child: sent to the parent, throttled per stage."""
+
+    def __init__(self, connection):
+        self._connection = connection
+        self._stage, self._sent = None, 0.0
+
+    def __call__(self, fraction: float, stage: str) -> None:
+        now = time.monotonic()
+        if stage == self._stage and now - self._sent < PROGRESS_S:
+            return
+        self._stage, self._sent = stage, now
+        self._connection.send(("progress", (float(fraction), str(stage))))
+
+
+def _end_with_caller(connection) -> None:
+    """End this worker as soon as the process waiting for its answer is gone, even one killed
+    outright: a worker must not compute on for nobody.
+
+    * The kernel kills it when its parent ends (Linux ``PR_SET_PDEATHSIG``): the service itself
+      when spawned, else the fork server, which ends with the service once no worker holds its
+      "alive" pipe open (multiprocessing gives every child a copy, for forking further; a
+      worker never does, so it closes it). This needs no Python code to run, so it works
+      even while a solver holds the interpreter lock for seconds.
+    * Elsewhere, a thread waits (without polling) for the read end of the answer's pipe to
+      close, which the kernel reports on the write end, and ends the process.
+    """
+    from multiprocessing import forkserver
+
+    alive = getattr(forkserver._forkserver, "_forkserver_alive_fd", None)
+    if alive is not None:
+        os.close(alive)
+        forkserver._forkserver._forkserver_alive_fd = None
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux
+        pass
+    if not hasattr(select, "poll"):
+        return
+    poller = select.poll()
+    poller.register(connection.fileno(), select.POLLERR)
+
+    def watch() -> None:
+        while True:
+            for _, event in poller.poll():
+                if event & select.POLLNVAL:  # this worker closed the pipe itself: done
+                    return
+                if event & (select.POLLERR | select.POLLHUP):
+                    os._exit(1)
+
+    threading.Thread(target=watch, name="toptraj-caller-watch", daemon=True).start()
+
+
+def _child(connection, function, args, progress: bool) -> None:
+    global _in_worker
+    _in_worker = True
+    _end_with_caller(connection)
     single_blas_thread()
     try:
-        outcome = ("result", function(*args))
+        kwargs = {"progress": _PipeProgress(connection)} if progress else {}
+        outcome = ("result", function(*args, **kwargs))
     except Exception as error:  # returned to the parent, which raises it
         outcome = ("error", error)
     try:
@@ -74,29 +150,37 @@ def _child(connection, function, args) -> None:
         connection.close()
 
 
-def run_isolated(function, *args, deadline: Deadline = NO_DEADLINE):
-    """``function(*args)`` computed in a child process, killed once ``deadline`` passes.
+def run_isolated(function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False):
+    """``function(*args)`` computed in a child process, killed once ``deadline`` passes; with
+    ``progress``, ``function(*args, progress=report)``, its reports relayed to
+    ``deadline.progress``.
 
     Raises:
         BudgetExceeded: the deadline passed or was cancelled (the child is killed first).
         TimingFailed: the child died without an answer (e.g. killed by the system for memory).
         Whatever ``function`` raised, re-raised here.
     """
-    if deadline is NO_DEADLINE:
-        return function(*args)
+    if deadline is NO_DEADLINE or _in_worker:
+        return function(*args, **({"progress": deadline.progress} if progress else {}))
     context = _get_context()
     reader, writer = context.Pipe(duplex=False)
-    process = context.Process(target=_child, args=(writer, function, args), daemon=True)
+    process = context.Process(target=_child, args=(writer, function, args, progress), daemon=True)
     try:
         process.start()
         writer.close()
-        while not reader.poll(POLL_S):  # true once the answer is there, or the child is gone
+        while True:
+            if not reader.poll(POLL_S):  # true once a message is there, or the child is gone
+                deadline.check()
+                continue
+            try:
+                kind, value = reader.recv()
+            except EOFError:
+                process.join()
+                raise TimingFailed(f"the worker process stopped without an answer (exit code {process.exitcode})") from None
+            if kind != "progress":
+                break
+            deadline.progress(*value)
             deadline.check()
-        try:
-            kind, value = reader.recv()
-        except EOFError:
-            process.join()
-            raise TimingFailed(f"the worker process stopped without an answer (exit code {process.exitcode})") from None
     finally:
         if process.is_alive():
             process.kill()

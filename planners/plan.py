@@ -168,10 +168,11 @@ def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool)
 
 def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, duration, threshold, deadline):
     s = _grid(stretch, grid_points, method, robot)
+    deadline.progress(0.0, "constraints")
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
     deadline.check()
     timing, constraints, check = gated(
-        robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline
+        robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline.within(0.3, 1.0)
     )
     return TimedStretch(stretch, timing, constraints, check)
 
@@ -197,9 +198,10 @@ def _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold)
         durations = [timing.duration * T / sum(shortest) for T in shortest]
     elif timing.duration is not None:
         durations = [timing.duration]
+    shares = [deadline.within(k / len(parts), (k + 1) / len(parts)) for k in range(len(parts))]
     timed = [
-        _time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, deadline)
-        for part, n, b, T in zip(parts, grid, boundaries, durations)
+        _time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, share)
+        for part, n, b, T, share in zip(parts, grid, boundaries, durations, shares)
     ]
     if len(timed) == 1:
         result = timed[0].timing
@@ -224,7 +226,8 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, thre
 def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, threshold) -> _Timed:
     """A free motion: the collocation's path, re-timed exactly along itself (phase_plane, or
     min_cost for beta > 0) so that every limit holds between the collocation instants too."""
-    path, solver, collocation_timing = _free_motion(robot, spec, method, timing, limits, deadline)
+    path, solver, collocation_timing = _free_motion(robot, spec, method, timing, limits, deadline.within(0.0, 0.9))
+    deadline.progress(0.9, "re-timing along the collocation's path")
     retimer = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
     constraints = build_path_constraints(path, robot, limits, kinds, _grid(path, None, retimer, robot), deadline)
     moving = dataclasses.replace(
@@ -233,7 +236,8 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
     notes = ()
     try:
         result, constraints, check = gated(
-            robot, path, retimer, constraints, _boundary(path, moving, retimer), None, kinds, limits, threshold, deadline
+            robot, path, retimer, constraints, _boundary(path, moving, retimer), None, kinds, limits, threshold,
+            deadline.within(0.9, 1.0),
         )
         stretch = TimedStretch(path, result, constraints, check)
     except InfeasiblePath as error:
@@ -326,16 +330,20 @@ def plan(
             f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
             "law through several waypoints"
         )
+    timing_part = deadline.within(0.0, 0.9)
     with numerical_breakdown_is_failure(method.name):
         if isinstance(path_spec, FreeMotion) or method.name == "collocation":
-            timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
+            timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, timing_part, threshold)
         elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
-            timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, deadline, threshold)
+            timing_part.progress(0.0, "via points")
+            timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, timing_part, threshold)
         else:
+            timing_part.progress(0.0, "path")
             path = make_path(robot, path_spec, deadline)
-            timed = _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold)
+            timed = _timed_path(robot, path, method, timing, kinds, limits, timing_part.within(0.1, 1.0), threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
     deadline.check()
+    deadline.progress(0.9, "sampling")
     require_finite(timed.method, duration=result.duration)
     if result.duration / dt > max_samples - 2:
         raise InvalidRequest(

@@ -15,7 +15,8 @@ from planners.isolated import start_worker_server
 from planners.threads import single_blas_thread
 from service.body_limit import BodySizeLimit
 from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
-from service.routes import health, robots as robot_routes, trajectories
+from service.jobs import JOB_MODULES, job_runner
+from service.routes import health, jobs, robots as robot_routes, trajectories
 from service.settings import Settings
 from service.workers import PlanningWorkers
 
@@ -46,13 +47,15 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        await run_in_threadpool(start_worker_server)
+        await run_in_threadpool(start_worker_server, JOB_MODULES)
         if settings.preload_robots:
             await run_in_threadpool(_warm_up)
+        await run_in_threadpool(app.state.jobs.start)
         yield
         # Running plannings end at their next deadline check; an app started again (as test
         # clients do, even overlapping) gets fresh threads under the same slots.
         app.state.planning.close()
+        await run_in_threadpool(app.state.jobs.close)
 
     app = FastAPI(
         title="toptraj",
@@ -63,10 +66,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue)
+    app.state.jobs = job_runner(settings)
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)
     app.add_middleware(UnexpectedErrors)  # last added, so outermost
     app.include_router(health.router)
     app.include_router(robot_routes.router)
     app.include_router(trajectories.router)
+    app.include_router(jobs.router)
     return app

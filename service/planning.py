@@ -113,15 +113,17 @@ def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
     """Run every method of ``request`` on the same path and limits; a method's own failure is
     reported in its entry instead of failing the comparison."""
     results = []
-    for method in request.methods:
+    for index, method in enumerate(request.methods):
         single = TrajectoryRequest(
             robot=request.robot,
             path=request.path,
             timing=request.timing.model_copy(update={"method": method}),
             output=OutputRequest(dt=1.0),
         )
+        count = len(request.methods)
+        part = deadline.within(index / count, (index + 1) / count, f"{method} ({index + 1} of {count})")
         try:
-            result = plan_request(single, deadline)
+            result = plan_request(single, part)
         except UnknownRobot:
             raise
         except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:

@@ -126,8 +126,10 @@ _PATH_TAGS = ("waypoints", "cartesian", "free")
 
 def _location(loc) -> str:
     parts = [str(part) for part in loc if part not in ("body",)]
-    if len(parts) > 2 and parts[0] == "path" and parts[1] in _PATH_TAGS:
-        del parts[1]
+    for index in range(len(parts) - 2):  # path.<tag>.<field>, at the top or in a job
+        if parts[index] == "path" and parts[index + 1] in _PATH_TAGS:
+            del parts[index + 1]
+            break
     text = ""
     for part in parts:
         text += f"[{part}]" if part.isdigit() else (f".{part}" if text else part)

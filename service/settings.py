@@ -33,6 +33,14 @@ class Settings(BaseSettings):
             add no throughput, and N processes then run as many plannings as there are cores).
         plan_queue: Requests that may wait for a planning worker of this process (within
             their budget); beyond, 503 with ``Retry-After``.
+        job_workers: Jobs (``/v1/jobs``) running at once, each in a worker process, over every
+            server process on the data directory (default: half the cores, at least 1).
+        job_budget_s: Default computing time of a job once running, in s.
+        job_max_budget_s: Largest ``budget_s`` a job may ask for, in s (422 beyond).
+        job_queue: Jobs that may wait for a job worker; beyond, 503 with ``Retry-After``.
+        max_jobs: Most jobs the job store keeps (``jobs.sqlite3``); the oldest ended go first.
+        job_max_age_s: Seconds an ended job is kept, at most.
+        max_job_store_bytes: Most bytes of requests, answers and errors the job store keeps.
     """
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")
@@ -47,3 +55,10 @@ class Settings(BaseSettings):
     max_response_bytes: int = Field(default=20_000_000, ge=1_000_000)
     plan_workers: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
     plan_queue: int = Field(default=8, ge=0)
+    job_workers: int = Field(default_factory=lambda: max(1, (os.cpu_count() or 1) // 2), ge=1)
+    job_budget_s: float = Field(default=300.0, gt=0)
+    job_max_budget_s: float = Field(default=3_600.0, gt=0)
+    job_queue: int = Field(default=100, ge=0)
+    max_jobs: int = Field(default=1_000, ge=1)
+    job_max_age_s: float = Field(default=7 * 86_400.0, gt=0)
+    max_job_store_bytes: int = Field(default=1_000_000_000, ge=1_000_000)

@@ -31,7 +31,7 @@ import pinocchio as pin
 from scipy.optimize import minimize
 
 from planners.constraints import build_path_constraints
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.deadline import NO_DEADLINE, Deadline, Progress
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.grid import path_grid
 from planners.isolated import run_isolated
@@ -306,18 +306,26 @@ def optimize_motion(
 
     SLSQP holds the interpreter for seconds at a time and cannot check a deadline, so under a
     ``deadline`` the optimization runs in a worker process that is killed when it passes
-    (``planners.isolated``).
+    (``planners.isolated``). It reports its progress to ``deadline.progress``: each initial
+    guess ("collocation: guess 3 of 15"), then the refinement.
 
     Raises:
         InvalidRequest: a start or goal outside the joint limits.
         InfeasiblePath: no initial guess leads to a feasible motion.
         BudgetExceeded: ``deadline`` passed.
     """
-    return run_isolated(_optimize_motion, robot, limits, motion, torque_weight, max_iterations, deadline=deadline)
+    return run_isolated(
+        _optimize_motion, robot, limits, motion, torque_weight, max_iterations, deadline=deadline, progress=True
+    )
 
 
 def _optimize_motion(
-    robot: Robot, limits: JointLimits, motion: FreeMotion, torque_weight: float, max_iterations: int
+    robot: Robot,
+    limits: JointLimits,
+    motion: FreeMotion,
+    torque_weight: float,
+    max_iterations: int,
+    progress: Progress = NO_DEADLINE.progress,
 ) -> CollocationResult:
     if robot.outside_position_limits(motion.start) is not None:
         raise InvalidRequest("path.start is outside the joint limits")
@@ -328,7 +336,12 @@ def _optimize_motion(
     coarse_motion = FreeMotion(
         motion.start, motion.goal, motion.start_velocity, motion.end_velocity, min(COARSE_INTERVALS, motion.intervals)
     )
-    for (goal_label, goal), (bend_label, bend) in itertools.product(_goals(robot, motion), _bends(robot.dof)):
+    guesses = list(itertools.product(_goals(robot, motion), _bends(robot.dof)))
+    # Progress: a dense SQP step costs about the cube of the variables, so the refinement
+    # weighs (fine / coarse intervals)^3 coarse guesses.
+    share = 1.0 / (len(guesses) + (motion.intervals / coarse_motion.intervals) ** 3)
+    for index, ((goal_label, goal), (bend_label, bend)) in enumerate(guesses):
+        progress(index * share, f"collocation: guess {index + 1} of {len(guesses)}")
         label = goal_label + bend_label
         coarse = _Problem(robot, limits, coarse_motion, goal, torque_weight)
         try:
@@ -343,6 +356,7 @@ def _optimize_motion(
     if best is None:
         raise InfeasiblePath("the collocation found no feasible motion from any initial guess: " + "; ".join(tried))
     coarse_result, coarse, label, goal = best
+    progress(len(guesses) * share, "collocation: refining the best guess")
     problem = _Problem(robot, limits, motion, goal, torque_weight)
     result, feasible = _solve(problem, _refined(coarse, coarse_result.x, problem), max_iterations)
     if not feasible:

@@ -74,3 +74,4 @@ class Problem(BaseModel):
     errors: list[ValidationIssue] | None = None
     s: float | None = Field(default=None, description="Path parameter in [0, 1] where planning fails.")
     joint: str | None = Field(default=None, description="Joint whose limit cannot be met.")
+    limit: str | None = Field(default=None, description="Kind of limit that cannot be met (velocity, acceleration, torque, jerk).")

@@ -1,0 +1,29 @@
+"""Background jobs: the SQLite job store (``store``), what a job computes in its worker process
+(``work``) and the runner that claims, runs, cancels and records them (``runner``)."""
+
+from __future__ import annotations
+
+from service.jobs.runner import JobRunner
+from service.jobs.store import JobStore
+from service.jobs.work import WorkerSetup
+
+#: Modules the fork server imports for the job workers (``planners.isolated.PRELOAD`` has the
+#: solver stacks), so that a job's process neither imports the web stack (1 to 2 s) nor loads
+#: the compiled kernels (0.5 s) again.
+JOB_MODULES = ("service.jobs.preload",)
+
+__all__ = ["JOB_MODULES", "JobRunner", "JobStore", "WorkerSetup", "job_runner"]
+
+
+def job_runner(settings) -> JobRunner:
+    """The job runner of a service with ``settings`` (``service.settings.Settings``), on the
+    job store in its data directory."""
+    store = JobStore(settings.data_dir, settings.max_jobs, settings.job_max_age_s, settings.max_job_store_bytes)
+    setup = WorkerSetup(
+        data_dir=str(settings.data_dir),
+        max_uploads=settings.max_uploads,
+        max_upload_bytes=settings.max_upload_bytes,
+        upload_cache_size=settings.upload_cache_size,
+        max_response_bytes=settings.max_response_bytes,
+    )
+    return JobRunner(store, settings.job_workers, setup)

@@ -1,0 +1,248 @@
+"""``/v1/jobs``: trajectories and comparisons computed in the background, under a budget of
+their own, with progress; the answer (or the error) is kept in the job store."""
+
+from __future__ import annotations
+
+from datetime import datetime, timezone
+from typing import Annotated
+
+import orjson
+from pydantic import ValidationError
+from fastapi import APIRouter, Body, Query, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import Response
+from starlette.concurrency import run_in_threadpool
+
+import robots
+from planners.errors import InvalidRequest
+from robots.errors import ToptrajError, excerpt
+from service.jobs.store import Job, JobStore
+from service.problems import PROBLEM_JSON, problem_responses
+from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
+
+router = APIRouter(prefix="/v1/jobs", tags=["jobs"])
+
+#: Most jobs on one page of ``GET /v1/jobs``.
+MAX_PAGE = 100
+
+
+class UnknownJob(ToptrajError):
+    """No job has that id (it never existed, or it ended long enough ago to be deleted)."""
+
+    status = 404
+    title = "Unknown job"
+
+
+class JobNotDone(ToptrajError):
+    """The job has no answer: it has not ended, or it ended without one."""
+
+    status = 409
+    title = "Job has no answer"
+
+
+def _problem(status: int, description: str) -> dict:
+    return {**problem_responses(status)[status], "description": description}
+
+
+_UR5 = [[0, -1.2, 1, 0, 0, 0], [0.8, -1, 1.4, -0.5, 0.6, 0.3], [2, -1.3, 1.2, 0.2, 0.4, 1.2]]
+EXAMPLES = {
+    "free_path": {
+        "summary": "A free-path collocation (tens of seconds)",
+        "value": {
+            "trajectory": {
+                "robot": "geering_2r",
+                "path": {"kind": "free", "start": [0.0, 0.0], "goal": [0.76, 0.0]},
+                "timing": {"method": "collocation", "constraints": ["torque"]},
+                "output": {"dt": 0.01},
+            },
+            "budget_s": 600,
+        },
+    },
+    "trajectory": {
+        "summary": "A trajectory, as POST /v1/trajectories",
+        "value": {
+            "trajectory": {
+                "robot": "ur5",
+                "path": {"kind": "waypoints", "waypoints": _UR5},
+                "timing": {"method": "phase_plane", "constraints": ["velocity", "acceleration", "torque"]},
+            }
+        },
+    },
+    "compare": {
+        "summary": "A comparison, as POST /v1/trajectories/compare",
+        "value": {
+            "compare": {
+                "robot": "ur5",
+                "path": {"kind": "waypoints", "waypoints": _UR5},
+                "methods": ["phase_plane", "min_cost", "quintic"],
+            }
+        },
+    },
+}
+
+
+def _time(value: float | None) -> str | None:
+    return None if value is None else datetime.fromtimestamp(value, timezone.utc).isoformat()
+
+
+def job_fields(job: Job) -> dict:
+    """The public fields of ``job`` but its answer (``JobSummary``)."""
+    return {
+        "id": job.id,
+        "kind": job.kind,
+        "status": job.status,
+        "progress": {"fraction": job.fraction, "stage": job.stage},
+        "budget_s": job.budget_s,
+        "created_at": _time(job.created),
+        "started_at": _time(job.started),
+        "finished_at": _time(job.finished),
+        "error": job.error,
+    }
+
+
+def _job_response(job: Job, result: bytes | None = None, status_code: int = 200, headers: dict | None = None) -> Response:
+    """``JobPublic`` as JSON; the stored answer is inserted as it is (no decoding)."""
+    body = {**job_fields(job), "result": None if result is None else orjson.Fragment(result)}
+    return Response(orjson.dumps(body), status_code=status_code, media_type="application/json", headers=headers)
+
+
+def _store(request: Request) -> JobStore:
+    return request.app.state.jobs.store
+
+
+def _job(store: JobStore, job_id: str) -> Job:
+    job = store.get(job_id)
+    if job is None:
+        raise UnknownJob(
+            f"no job has id {excerpt(job_id)}; ids are 32 hex digits from POST /v1/jobs (jobs that "
+            "ended are kept for a while, then deleted)"
+        )
+    return job
+
+
+async def _strictly(request: Request) -> None:
+    """Validate the body again without type coercion, as the OpenAPI declares it: a JSON
+    ``true`` or ``"0.1"`` is not a number. (A job's request is stored and computed later; what
+    is stored is what the schema allows.)
+
+    Raises:
+        RequestValidationError: a 422 naming each field, as for any malformed body.
+    """
+    try:
+        JobCreate.model_validate(await request.json(), strict=True)
+    except ValidationError as error:
+        raise RequestValidationError(
+            [{**item, "loc": ("body", *item["loc"])} for item in error.errors(include_url=False, include_context=False)]
+        ) from None
+
+
+@router.post(
+    "",
+    status_code=202,
+    summary="Start a background job",
+    response_model=JobPublic,
+    responses={
+        202: {
+            "description": "Queued; `GET` the `Location` for its progress and answer.",
+            "headers": {"Location": {"description": "`/v1/jobs/{id}`", "schema": {"type": "string"}}},
+        },
+        404: _problem(404, "No robot has that name."),
+        422: _problem(422, "Malformed request, or a budget_s over the server's maximum."),
+        503: _problem(503, "The job queue is full (`Retry-After`), or the job store cannot be written."),
+    },
+)
+async def create_job(body: Annotated[JobCreate, Body(openapi_examples=EXAMPLES)], request: Request) -> Response:
+    """Compute a trajectory (the body of `POST /v1/trajectories` under `trajectory`) or a
+    comparison (the body of `POST /v1/trajectories/compare` under `compare`) in the background,
+    under a budget of its own (`budget_s`). Answers 202 at once with the job and its `Location`.
+    The answer, once `done`, is the very body the synchronous endpoint would give."""
+    await _strictly(request)
+    settings = request.app.state.settings
+    budget_s = min(settings.job_budget_s, settings.job_max_budget_s) if body.budget_s is None else body.budget_s
+    if budget_s > settings.job_max_budget_s:
+        raise InvalidRequest(
+            f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= "
+            f"{settings.job_max_budget_s:g} (setting TOPTRAJ_JOB_MAX_BUDGET_S)"
+        )
+    runner = request.app.state.jobs
+    await run_in_threadpool(robots.load, body.request.robot)  # an unknown robot is a 404 now, not a failed job
+    request_json = body.request.model_dump_json()
+    job = await run_in_threadpool(runner.store.submit, body.kind, request_json, budget_s, settings.job_queue)
+    runner.wake()
+    return _job_response(job, status_code=202, headers={"Location": f"/v1/jobs/{job.id}"})
+
+
+@router.get("", summary="List recent jobs", response_model=JobList, responses={422: _problem(422, "A bad cursor or limit.")})
+def list_jobs(
+    request: Request,
+    limit: Annotated[int, Query(ge=1, le=MAX_PAGE, description="Jobs per page.")] = 20,
+    cursor: Annotated[str | None, Query(max_length=20, description="`next_cursor` of the previous page.")] = None,
+    status: Annotated[JobStatus | None, Query(description="Only jobs with this status.")] = None,
+) -> Response:
+    """The jobs the store keeps, newest first, without their answers, a page at a time."""
+    before = None
+    if cursor is not None:
+        if not cursor.isdigit():
+            raise InvalidRequest(f"cursor {excerpt(cursor)} is not a next_cursor of GET /v1/jobs")
+        before = int(cursor)
+    jobs = _store(request).jobs(limit + 1, before, status)
+    page = jobs[:limit]
+    body = {"jobs": [job_fields(job) for job in page], "next_cursor": str(page[-1].seq) if len(jobs) > limit else None}
+    return Response(orjson.dumps(body), media_type="application/json")
+
+
+@router.get(
+    "/{job_id}",
+    summary="A job's status, progress and answer",
+    response_model=JobPublic,
+    responses={404: _problem(404, "No job has that id.")},
+)
+def get_job(job_id: str, request: Request) -> Response:
+    """Status, progress and timestamps; once `done`, the `result` (the synchronous endpoint's
+    body); once `failed`, the `error` (its problem+json object)."""
+    store = _store(request)
+    job = _job(store, job_id)
+    return _job_response(job, store.result(job_id) if job.status == "done" else None)
+
+
+@router.get(
+    "/{job_id}/result",
+    summary="A job's answer alone",
+    response_model=None,
+    responses={
+        200: {"description": "The body of the synchronous endpoint (`TrajectoryResponse` or `CompareResponse`).",
+              "content": {"application/json": {"schema": {"type": "object"}}}},
+        404: _problem(404, "No job has that id."),
+        409: _problem(409, "The job has not ended, or ended without an answer (cancelled, interrupted)."),
+        422: _problem(422, "The job failed: its own error, with the status it carries (e.g. 422)."),
+        504: _problem(504, "The job failed past its budget."),
+    },
+)
+def get_job_result(job_id: str, request: Request) -> Response:
+    """Exactly what the synchronous endpoint would have answered: the body once `done`, the
+    job's problem+json (with its own status) once `failed`."""
+    store = _store(request)
+    job = _job(store, job_id)
+    if job.status == "done":
+        result = store.result(job_id)
+        if result is not None:
+            return Response(result, media_type="application/json")
+    if job.status == "failed" and job.error is not None:
+        return Response(orjson.dumps(job.error), status_code=int(job.error.get("status", 500)), media_type=PROBLEM_JSON)
+    raise JobNotDone(f"job {job_id} is {job.status}; GET /v1/jobs/{job_id} shows its progress")
+
+
+@router.delete(
+    "/{job_id}",
+    summary="Cancel a job",
+    response_model=JobPublic,
+    responses={404: _problem(404, "No job has that id."), 409: _problem(409, "The job has ended already.")},
+)
+def cancel_job(job_id: str, request: Request) -> Response:
+    """Cancel a queued or running job: a queued one never runs; a running one's worker process
+    is killed. Cancelling a cancelled job again is harmless; one that has ended otherwise is a 409."""
+    job = request.app.state.jobs.cancel(job_id)
+    if job is None:
+        _job(_store(request), job_id)
+    return _job_response(job)
+

@@ -1,0 +1,97 @@
+"""Schemas of the job resource (``/v1/jobs``): a trajectory or a comparison computed in the
+background, with its progress, then its answer or its error."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from typing import Literal
+
+from pydantic import BaseModel, Field, model_validator
+
+from service.schemas.common import Problem, Schema
+from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
+
+JobKind = Literal["trajectory", "compare"]
+JobStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
+
+
+class JobCreate(Schema):
+    """A job: exactly one of ``trajectory`` (the body of ``POST /v1/trajectories``) or
+    ``compare`` (the body of ``POST /v1/trajectories/compare``); the key names the kind."""
+
+    model_config = {
+        "json_schema_extra": {"oneOf": [{"required": ["trajectory"]}, {"required": ["compare"]}]},
+    }
+
+    # Typed without None: a key given must hold a request (null is refused); absent, it is None.
+    trajectory: TrajectoryRequest = Field(default=None, description="The body of `POST /v1/trajectories`.")
+    compare: CompareRequest = Field(default=None, description="The body of `POST /v1/trajectories/compare`.")
+    budget_s: float | None = Field(
+        default=None,
+        ge=0.1,
+        description="Computing time allowed once the job runs, in s (waiting in the queue does not count). "
+        "Default 300 s (`TOPTRAJ_JOB_BUDGET_S`); at most the server's maximum, 3,600 s by default "
+        "(`TOPTRAJ_JOB_MAX_BUDGET_S`; more gets 422 naming it).",
+    )
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> JobCreate:
+        given = [name for name in ("trajectory", "compare") if name in self.model_fields_set]
+        if len(given) != 1:
+            raise ValueError(
+                "give exactly one of `trajectory` (a POST /v1/trajectories body) or `compare` "
+                f"(a POST /v1/trajectories/compare body); got {' and '.join(given) or 'neither'}"
+            )
+        return self
+
+    @property
+    def kind(self) -> JobKind:
+        return "trajectory" if self.trajectory is not None else "compare"
+
+    @property
+    def request(self) -> TrajectoryRequest | CompareRequest:
+        return self.trajectory if self.trajectory is not None else self.compare
+
+
+class JobProgress(BaseModel):
+    """How far the job is: a fraction of the work and what is under way."""
+
+    fraction: float = Field(ge=0.0, le=1.0, description="0 when queued, 1 when done.")
+    stage: str = Field(description='e.g. "collocation: guess 3 of 15", "limit check, round 1", "sampling".')
+
+
+class JobSummary(BaseModel):
+    """A job without its answer (``GET /v1/jobs/{id}`` carries the answer)."""
+
+    id: str = Field(description="32 hex digits.")
+    kind: JobKind
+    status: JobStatus = Field(
+        description="`queued` (waits for a job worker), `running`, `done` (see `result`), `failed` (see "
+        "`error`), `cancelled` (DELETE), `interrupted` (the server stopped while it ran; submit it again)."
+    )
+    progress: JobProgress
+    budget_s: float = Field(description="Computing time allowed once running, s.")
+    created_at: datetime
+    started_at: datetime | None = None
+    finished_at: datetime | None = None
+    error: Problem | None = Field(
+        default=None,
+        description="When failed or interrupted: the problem+json object the synchronous endpoint would "
+        "answer (status, title, detail, and `s`, `joint`, `limit` where a limit cannot be met; 504 "
+        "past the budget).",
+    )
+
+
+class JobPublic(JobSummary):
+    """A job, with its answer once done."""
+
+    result: TrajectoryResponse | CompareResponse | None = Field(
+        default=None, description="When done: the very body the synchronous endpoint answers."
+    )
+
+
+class JobList(BaseModel):
+    """A page of jobs, newest first."""
+
+    jobs: list[JobSummary]
+    next_cursor: str | None = Field(description="Pass as `cursor` for the next (older) page; null on the last page.")
