@@ -282,9 +282,13 @@ def plan(
     dt: float = 0.01,
     deadline: Deadline = NO_DEADLINE,
     max_samples: int = MAX_SAMPLES,
+    exact_period: bool = False,
 ) -> PlannedTrajectory:
     """Plan the timed trajectory of ``robot`` along ``path_spec``, sampled every ``dt`` seconds
-    into at most ``max_samples`` samples.
+    into at most ``max_samples`` samples. With ``exact_period`` the samples lie on whole periods
+    ``dt``, the final state included: the motion is slowed uniformly to end on one
+    (``planners.trajectory.sample_trajectory``); ``duration`` stays the planned (optimal) one
+    and ``sampled_duration`` is the samples' last instant.
 
     Every answer holds the requested limits on a dense resampling within ``LIMIT_TOLERANCE``
     (with ``timing.limit_margin`` > 0, strictly within the limits): the gate refines the grid
@@ -302,6 +306,14 @@ def plan(
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)
     check_timing(timing, dt)
+    if exact_period and any(
+        v is not None and np.any(np.asarray(v) != 0.0) for v in (timing.start_velocity, timing.end_velocity)
+    ):
+        raise InvalidRequest(
+            "output.exact_period slows the motion uniformly, which would change the nonzero "
+            "timing.boundary velocities: set output.exact_period to false (samples every dt "
+            "plus the final instant) or plan from and to rest"
+        )
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
         raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
     if timing.grid_points is not None and timing.grid_points > method.max_grid_intervals(robot.dof):
@@ -351,7 +363,7 @@ def plan(
             f"{result.duration:.4g} s motion; at most {max_samples} are served: use output.dt >= "
             f"{_round_up(result.duration / (max_samples - 2)):g} s"
         )
-    samples = sample_trajectory(path, result, robot, dt)
+    samples = sample_trajectory(path, result, robot, dt, exact_period)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
     beyond = samples_exceed(samples, limits, threshold, kinds, robot)
     if beyond is not None:

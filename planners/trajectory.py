@@ -6,6 +6,7 @@ al. eqs. (8), (9)), and tau from the robot's inverse dynamics (RNEA plus joint f
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,12 +34,36 @@ def _joint_motion(path: GeometricPath, s, sd, sdd, side: str = "right"):
     return points.q, qd, qdd
 
 
-def sample_trajectory(path: GeometricPath, scaling: PathTiming, robot: Robot, dt: float) -> Samples:
-    """Samples every ``dt`` seconds from 0, plus the final instant."""
+def exact_period_scale(duration: float, dt: float) -> float:
+    """The factor k >= 1 that stretches a motion of ``duration`` s to a whole number of periods
+    ``dt``: k = N dt / duration with N = ceil(duration / dt), at least 1 (a float rounding of
+    duration / dt to an integer counts as that integer)."""
+    periods = max(1, math.ceil(duration / dt - 1e-9))
+    return periods * dt / duration if duration > 0 else 1.0
+
+
+def sample_trajectory(
+    path: GeometricPath, scaling: PathTiming, robot: Robot, dt: float, exact_period: bool = False
+) -> Samples:
+    """Samples every ``dt`` seconds from 0, plus the final instant.
+
+    With ``exact_period`` the motion is slowed uniformly by ``k = exact_period_scale(T, dt)``
+    (less than 1 + dt / T) so that it ends on a sample: t_j = j dt for j = 0 .. N with N dt = k T,
+    as a controller running at period ``dt`` consumes them, the final state included. Along the
+    same path, s(t) becomes s(t / k): velocities scale by 1 / k, accelerations by 1 / k^2, jerks by
+    1 / k^3, and a torque M q'' + C q' + g moves from its optimal value towards the gravity
+    torque g of the same configuration, so every limit the optimal timing held stays held (the
+    samples' own check confirms it, joint friction included)."""
     duration = scaling.duration
-    t = np.arange(0.0, duration, dt)
-    if t.size == 0 or duration - t[-1] > 1e-9 * max(1.0, duration):
-        t = np.append(t, duration)
-    s, sd, sdd = scaling.at_times(t)
+    if exact_period:
+        k = exact_period_scale(duration, dt)
+        t = dt * np.arange(round(k * duration / dt) + 1)
+        s, sd, sdd = scaling.at_times(np.minimum(t / k, duration))
+        sd, sdd = sd / k, sdd / k**2
+    else:
+        t = np.arange(0.0, duration, dt)
+        if t.size == 0 or duration - t[-1] > 1e-9 * max(1.0, duration):
+            t = np.append(t, duration)
+        s, sd, sdd = scaling.at_times(t)
     q, qd, qdd = _joint_motion(path, s, sd, sdd)
     return Samples(t=t, q=q, qd=qd, qdd=qdd, tau=robot.inverse_dynamics(q, qd, qdd))

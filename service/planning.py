@@ -18,10 +18,14 @@ from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.plan import MAX_SAMPLES
 from robots import InvalidLimits, UnknownRobot
 from service.problems import non_finite_answer
+from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.
 NUMBER_BYTES = 25
+#: Bytes a ``joint_trajectory`` point adds to its numbers: its keys, braces and the two
+#: integers of ``time_from_start``.
+POINT_KEYS_BYTES = 160
 #: Bytes of a trajectory body set aside for everything but the samples (phase plane of at
 #: most 2,000 points, utilization, conditioning, warnings).
 RESERVED_BYTES = 256_000
@@ -51,26 +55,54 @@ def _timing(request: TrajectoryRequest) -> Timing:
     )
 
 
-def samples_within(body_bytes: int, n_dof: int) -> int:
+def samples_within(body_bytes: int, n_dof: int, format_: str = "samples") -> int:
     """The most time samples a trajectory body of at most ``body_bytes`` bytes can hold for a
     robot with ``n_dof`` joints: each sample is t and a row of q, qd, qdd and tau, every number
     counted at its longest (``NUMBER_BYTES``), after ``RESERVED_BYTES`` for the rest."""
     per_sample = NUMBER_BYTES * (1 + 4 * n_dof) + 4 * 3  # and each row's brackets and comma
+    if format_ == "joint_trajectory":  # a point's keys and its time_from_start
+        per_sample += POINT_KEYS_BYTES
     return max(2, (body_bytes - RESERVED_BYTES) // per_sample)
 
 
 def plan_request(
-    request: TrajectoryRequest, deadline: Deadline | None = None, max_body_bytes: int | None = None
+    request: TrajectoryRequest,
+    deadline: Deadline | None = None,
+    max_body_bytes: int | None = None,
+    accept: str | None = None,
 ) -> PlannedTrajectory:
     """Plan ``request`` with the library (no HTTP involved); with ``max_body_bytes``, refuse an
     ``output.dt`` whose samples would not fit in a body of that size (422 naming the smallest
-    ``dt`` that fits)."""
+    ``dt`` that fits). ``accept`` (the HTTP Accept header) may choose CSV, which puts the samples
+    on whole periods."""
     robot = robots.load(request.robot)
     timing = _timing(request)
     if request.path.kind == "free":
         timing = dataclasses.replace(timing, start_velocity=None, end_velocity=None)
-    max_samples = MAX_SAMPLES if max_body_bytes is None else min(MAX_SAMPLES, samples_within(max_body_bytes, robot.dof))
-    return plan(robot, _path(request.path, robot, request), timing, request.output.dt, deadline or NO_DEADLINE, max_samples)
+    output = request.output
+    format_ = chosen_format(output.format, accept)
+    max_samples = MAX_SAMPLES if max_body_bytes is None else min(MAX_SAMPLES, samples_within(max_body_bytes, robot.dof, format_))
+    return plan(
+        robot,
+        _path(request.path, robot, request),
+        timing,
+        output.dt,
+        deadline or NO_DEADLINE,
+        max_samples,
+        exact_period=exact_period_for(format_, output.exact_period),
+    )
+
+
+def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
+    """The answer's bytes and media type in the format asked (``service.formats``)."""
+    format_ = chosen_format(request.output.format, accept)
+    if format_ == "csv":
+        return csv_bytes(result), CSV_MEDIA_TYPE
+    body = trajectory_body(result)
+    if format_ == "joint_trajectory":
+        del body["samples"]
+        body["joint_trajectory"] = joint_trajectory(result)
+    return encode_json(body), "application/json"
 
 
 def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath | CartesianLine | FreeMotion:
@@ -147,6 +179,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         "method": result.method,
         "joint_names": list(result.joint_names),
         "duration": result.duration,
+        "sampled_duration": float(samples.t[-1]),
         "samples": {"t": samples.t, "q": samples.q, "qd": samples.qd, "qdd": samples.qdd, "tau": samples.tau},
         "phase_plane": {
             "s": result.phase_plane.s,

@@ -18,7 +18,7 @@ import robots
 from planners import Deadline
 from planners.deadline import Progress
 from planners.errors import InvalidRequest
-from service.planning import compare_request, encode_json, plan_request, trajectory_body
+from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 
@@ -36,7 +36,7 @@ class WorkerSetup:
 
 def _trajectory(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
     body = TrajectoryRequest.model_validate_json(request)
-    return encode_json(trajectory_body(plan_request(body, deadline, setup.max_response_bytes)))
+    return render(plan_request(body, deadline, setup.max_response_bytes), body)[0]
 
 
 def _compare(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:

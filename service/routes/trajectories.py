@@ -5,7 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
-from service.planning import compare_request, encode_json, plan_request, trajectory_body
+from service.planning import compare_request, encode_json, plan_request, render
 from service.problems import problem_responses
 from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
 
@@ -18,7 +18,10 @@ _ERRORS = problem_responses(404, 413, 422, 503, 504)
     "",
     summary="Plan a timed trajectory",
     response_model=TrajectoryResponse,
-    responses=_ERRORS,
+    responses={
+        200: {"content": {"text/csv": {"schema": {"type": "string"}, "example": "t,q.shoulder,…\n0.0,0.0,…\n"}}},
+        **_ERRORS,
+    },
 )
 async def create_trajectory(body: TrajectoryRequest, request: Request) -> Response:
     """Time the path of ``body`` for its robot under the requested limits and return the
@@ -26,11 +29,13 @@ async def create_trajectory(body: TrajectoryRequest, request: Request) -> Respon
     The body is built and encoded in the planning thread, within the time budget."""
     settings = request.app.state.settings
 
-    def planned(deadline) -> bytes:
-        return encode_json(trajectory_body(plan_request(body, deadline, settings.max_response_bytes)))
+    accept = request.headers.get("accept")
 
-    content = await request.app.state.planning.run(planned, settings.plan_budget_s)
-    return Response(content, media_type="application/json")
+    def planned(deadline) -> tuple[bytes, str]:
+        return render(plan_request(body, deadline, settings.max_response_bytes, accept), body, accept)
+
+    content, media_type = await request.app.state.planning.run(planned, settings.plan_budget_s)
+    return Response(content, media_type=media_type)
 
 
 @router.post("/compare", summary="Compare timing methods on one path", response_model=CompareResponse, responses=_ERRORS)

@@ -42,6 +42,13 @@ class JobCreate(Schema):
                 "give exactly one of `trajectory` (a POST /v1/trajectories body) or `compare` "
                 f"(a POST /v1/trajectories/compare body); got {' and '.join(given) or 'neither'}"
             )
+        if self.trajectory is not None and self.trajectory.output.format == "csv":
+            raise ValueError(
+                "a job's answer is JSON (it is part of GET /v1/jobs/{id}): set "
+                "trajectory.output.format to \"samples\" or \"joint_trajectory\" (with "
+                "output.exact_period true for samples on whole periods), or ask POST "
+                "/v1/trajectories for CSV"
+            )
         return self
 
     @property

@@ -171,9 +171,28 @@ class TimingRequest(Schema):
 
 
 class OutputRequest(Schema):
-    """Sampling of the returned trajectory."""
+    """Sampling and shape of the returned trajectory."""
 
     dt: bounded(ranges.DT) = Field(default=0.01, description="Sample period (s).")
+    format: Literal["samples", "joint_trajectory", "csv"] = Field(
+        default="samples",
+        description=(
+            "`samples`: arrays t, q, qd, qdd, tau; `joint_trajectory`: ROS's "
+            "trajectory_msgs/JointTrajectory as JSON (joint_names, points with positions, "
+            "velocities, accelerations, effort, time_from_start {sec, nanosec}); `csv`: text/csv, "
+            "a header and a row per sample (also chosen by `Accept: text/csv`)."
+        ),
+    )
+    exact_period: bool | None = Field(
+        default=None,
+        description=(
+            "Samples on whole periods `dt`, the final state included: the motion is slowed "
+            "uniformly (by less than one period) to end on a sample; `duration` stays the planned "
+            "one, `sampled_duration` is the last sample's time. Default: true for "
+            "`joint_trajectory` and `csv`, false for `samples` (samples every dt plus the final "
+            "instant). Needs a motion from and to rest."
+        ),
+    )
 
 
 class TrajectoryRequest(Schema):
@@ -241,14 +260,44 @@ class ConditioningPublic(BaseModel):
     characteristic_length: float
 
 
+class TimeFromStart(BaseModel):
+    """``builtin_interfaces/Duration``: whole seconds and the nanoseconds within the second."""
+
+    sec: int
+    nanosec: int
+
+
+class JointTrajectoryPoint(BaseModel):
+    """``trajectory_msgs/JointTrajectoryPoint``: one value per joint, SI units (rad, rad/s,
+    rad/s^2, N m; m and N for prismatic joints)."""
+
+    positions: list[float]
+    velocities: list[float]
+    accelerations: list[float]
+    effort: list[float]
+    time_from_start: TimeFromStart
+
+
+class JointTrajectoryPublic(BaseModel):
+    """``trajectory_msgs/JointTrajectory`` without its header (``output.format =
+    "joint_trajectory"``)."""
+
+    joint_names: list[str]
+    points: list[JointTrajectoryPoint]
+
+
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
     robot: str
     method: str
     joint_names: list[str]
-    duration: float
-    samples: SamplesPublic
+    duration: float = Field(description="Planned duration (s).")
+    sampled_duration: float = Field(
+        description="Time of the last sample (s): `duration`, or with `output.exact_period` the whole periods it was stretched to."
+    )
+    samples: SamplesPublic | None = Field(default=None, description="`output.format = \"samples\"`: t (s), q, qd, qdd, tau per sample.")
+    joint_trajectory: JointTrajectoryPublic | None = None
     phase_plane: PhasePlanePublic
     peak_utilization: UtilizationPublic
     binding: BindingPublic | None = None
