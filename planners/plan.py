@@ -19,7 +19,7 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.grid import MAX_POINTS, path_grid
-from planners.waypoint_checks import checked_waypoints, make_path, without_repeats
+from planners.waypoint_checks import checked_waypoints, continuous_turns, make_path, without_repeats
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.gate import TimedStretch, checked, gate_threshold, gated, samples_exceed
 from planners.mvc import admissible_set
@@ -334,7 +334,9 @@ def plan(
     threshold = gate_threshold(margin)
     dropped: tuple[str, ...] = ()
     if isinstance(path_spec, WaypointPath):
+        path_spec, turns = continuous_turns(robot, path_spec)
         path_spec, dropped = without_repeats(path_spec)
+        dropped = (*turns, *dropped)
     if method.two_waypoints_only and (not isinstance(path_spec, WaypointPath) or len(path_spec.waypoints) != 2):
         given = f"{len(path_spec.waypoints)} waypoints" if isinstance(path_spec, WaypointPath) else "a cartesian path"
         raise InvalidRequest(

@@ -29,11 +29,13 @@ class WaypointPath:
     ``"blend"`` (straight segments joined by circular blends within ``max_deviation`` of each
     waypoint, joint-space norm in joint units; default ``DEFAULT_MAX_DEVIATION``) or ``"via"``
     (per-joint cubic or quintic segments in time through the via points, the law named by the
-    timing method)."""
+    timing method). Continuous joints (no position limits) follow the numbers given
+    (``continuous = "as_given"``) or turn the short way between waypoints (``"shortest"``)."""
 
     waypoints: np.ndarray
     interpolation: str = "spline"
     max_deviation: float | None = None
+    continuous: str = "as_given"
 
 
 @dataclass(frozen=True)

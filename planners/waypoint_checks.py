@@ -88,6 +88,54 @@ def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
     return dataclasses.replace(spec, waypoints=np.delete(waypoints, repeats, axis=0)), (note,)
 
 
+CONTINUOUS = ("as_given", "shortest")
+
+
+def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
+    """The waypoints of ``spec`` with the turns of its continuous joints as ``spec.continuous``
+    asks, and notes for the caller.
+
+    * ``"shortest"``: each waypoint of a continuous joint is moved by whole turns (2 pi) to lie
+      within pi of the one before it, so the joint turns the short way (the first waypoint
+      stays as given; the others may then read as equivalent angles, e.g. 6.0 as -0.283).
+    * ``"as_given"``: the numbers are followed as they are; a note names each continuous joint
+      that turns more than pi between two waypoints (the short way is shorter).
+    """
+    if spec.continuous not in CONTINUOUS:
+        raise InvalidRequest(f"path.continuous {spec.continuous!r} is unknown; use one of {list(CONTINUOUS)}")
+    waypoints = np.asarray(spec.waypoints, dtype=float)
+    mask = np.asarray(robot.continuous, dtype=bool)
+    if waypoints.ndim != 2 or waypoints.shape[1] != mask.size or not mask.any() or not np.all(np.isfinite(waypoints)):
+        return spec, ()
+    steps = np.diff(waypoints[:, mask], axis=0)
+    if spec.continuous == "shortest":
+        wrapped = steps - 2.0 * np.pi * np.round(steps / (2.0 * np.pi))
+        if np.array_equal(wrapped, steps):
+            return spec, ()
+        shifted = waypoints.copy()
+        shifted[:, mask] = waypoints[0, mask] + np.vstack([np.zeros(mask.sum()), np.cumsum(wrapped, axis=0)])
+        moved = [robot.joint_names[j] for j, m in zip(np.flatnonzero(mask), (wrapped != steps).any(axis=0)) if m]
+        note = (
+            f"path.continuous 'shortest': continuous joint(s) {', '.join(map(repr, moved))} turn the short "
+            "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"
+        )
+        return dataclasses.replace(spec, waypoints=shifted), (note,)
+    index, column = np.nonzero(np.abs(steps) > np.pi)
+    if index.size == 0:
+        return spec, ()
+    joints = np.flatnonzero(mask)
+    seen: dict[int, int] = {}
+    for i, c in zip(index, column):
+        seen.setdefault(int(joints[c]), int(i))
+    notes = tuple(
+        f"continuous joint {robot.joint_names[j]!r} turns {steps[i, list(joints).index(j)]:+.4g} rad from "
+        f"path.waypoints[{i}] to [{i + 1}], more than pi: the other way round is shorter; "
+        "path.continuous = 'shortest' takes it"
+        for j, i in seen.items()
+    )
+    return spec, notes
+
+
 def make_path(robot: Robot, spec: "WaypointPath | CartesianLine", deadline: Deadline = NO_DEADLINE) -> GeometricPath:
     """The geometric path of a Cartesian line, or of joint waypoints interpolated by spline or
     linear segments (via points are timed and shaped together, in ``via_points``)."""

@@ -138,7 +138,7 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
                 f"path.waypoints[{index}] has {len(row)} values; {robot.name} has {robot.dof} joints "
                 f"({', '.join(robot.joint_names)})"
             )
-    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation)
+    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous)
 
 
 def compare_request(request: CompareRequest, deadline: Deadline) -> dict:

@@ -44,6 +44,12 @@ class WaypointsPath(Schema):
         description="`blend` only: largest joint-space distance (Euclidean norm, rad or m) of a blend from "
         "its waypoint; default 0.1.",
     )
+    continuous: Literal["as_given", "shortest"] = Field(
+        default="as_given",
+        description="Continuous joints (no position limits): `as_given` follows the numbers (a warning "
+        "when one turns more than pi between waypoints), `shortest` turns the short way, waypoints "
+        "after the first reached as equivalent angles.",
+    )
 
 
 class CartesianPathRequest(Schema):
