@@ -5,6 +5,7 @@ from __future__ import annotations
 from contextlib import asynccontextmanager
 
 from fastapi import FastAPI
+from fastapi_offline import FastAPIOffline
 from starlette.concurrency import run_in_threadpool
 
 import numpy as np
@@ -57,7 +58,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.state.planning.close()
         await run_in_threadpool(app.state.jobs.close)
 
-    app = FastAPI(
+    # /docs and /redoc with Swagger UI's and ReDoc's scripts from the installed fastapi-offline
+    # wheel, not a CDN: robot cells are often offline.
+    app = FastAPIOffline(
         title="toptraj",
         summary="Time-optimal trajectories with torques for URDF robot arms.",
         version="0.1.0",
