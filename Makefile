@@ -1,10 +1,12 @@
 # The two commands of the README: `make serve` and `make test`. Both set up .venv on first use.
 PYTHON ?= python3
+HOST ?= 127.0.0.1
+PORT ?= 8000
 VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: serve test install clean
+.PHONY: serve test install browser clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -15,9 +17,17 @@ $(STAMP): pyproject.toml
 install: $(STAMP)
 
 serve: $(STAMP)
-	$(BIN)/toptraj serve --host 127.0.0.1 --port 8000
+	$(BIN)/toptraj serve --host $(HOST) --port $(PORT)
 
-test: $(STAMP)
+# The web page's tests drive a real browser: Debian's chromium, installed with apt when missing
+# (as root; otherwise install it yourself).
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
+	  { [ "$$(id -u)" = 0 ] && { apt-get install -y -qq chromium >/dev/null 2>&1 || \
+	    { apt-get update -qq && apt-get install -y -qq chromium >/dev/null; }; }; } || \
+	  echo "chromium is missing and cannot be installed here: apt-get install chromium"
+
+test: $(STAMP) browser
 	$(BIN)/python -m pytest
 
 clean:

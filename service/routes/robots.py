@@ -1,13 +1,17 @@
-"""``/v1/robots``: the catalog and the uploads, one robot, URDF uploads and their deletion."""
+"""``/v1/robots``: the catalog and the uploads, one robot, URDF uploads and their deletion, and
+the arm as a stick figure for drawing."""
 
 from __future__ import annotations
 
+import numpy as np
 from fastapi import APIRouter, Response
 from starlette.concurrency import run_in_threadpool
 
 import robots
+from planners.errors import InvalidRequest
+from planners.kinematics.skeleton import skeleton
 from service.problems import problem_responses
-from service.schemas.robots import RobotCreate, RobotPublic, RobotSummary
+from service.schemas.robots import RobotCreate, RobotPublic, RobotSummary, SkeletonPublic, SkeletonRequest
 
 router = APIRouter(prefix="/v1/robots", tags=["robots"])
 
@@ -82,3 +86,22 @@ def delete_robot(name: str) -> Response:
     robots cannot be deleted (409)."""
     robots.delete_upload(name)
     return Response(status_code=204)
+
+
+@router.post(
+    "/{name}/skeleton",
+    summary="Joint positions for drawing",
+    responses={404: _problem(404, "No robot has that name."), 422: _problem(422, "Rows of the wrong length, or not finite.")},
+)
+def robot_skeleton(name: str, body: SkeletonRequest) -> SkeletonPublic:
+    """The world positions (m) of the joint origins and the end effector of robot ``name`` in
+    each configuration of ``q``: the arm as a stick figure, for stroboscopic pictures."""
+    robot = robots.load(name)
+    q = np.array(body.q, dtype=float) if len({len(row) for row in body.q}) == 1 else None
+    if q is None or q.shape[1] != robot.dof:
+        raise InvalidRequest(f"each row of q must hold {robot.dof} values, one per joint of {name} ({', '.join(robot.joint_names)})")
+    if not np.all(np.isfinite(q)):
+        row, joint = np.argwhere(~np.isfinite(q))[0]
+        raise InvalidRequest(f"q[{row}][{joint}] is not a finite number")
+    points, positions = skeleton(robot, q)
+    return SkeletonPublic(points=points, positions=positions.tolist())

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, Field
 
@@ -53,3 +53,22 @@ class RobotCreate(Schema):
         "default `urdf-` plus a content hash.",
     )
     urdf: str = Field(max_length=MAX_URDF_CHARS, description="The URDF text (fixed-base arm).")
+
+
+MAX_CONFIGURATIONS = 1_000
+
+
+class SkeletonRequest(Schema):
+    """Joint configurations to draw (rad, m), one row each."""
+
+    q: list[Annotated[list[float], Field(min_length=1, max_length=64)]] = Field(
+        min_length=1, max_length=MAX_CONFIGURATIONS, description="Joint configurations (rad, m), one row each."
+    )
+
+
+class SkeletonPublic(BaseModel):
+    """World positions (m) of each joint origin and of the end effector, per configuration:
+    ``positions[k][i]`` is point ``points[i]`` in configuration k."""
+
+    points: list[str]
+    positions: list[list[list[float]]]

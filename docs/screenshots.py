@@ -1,0 +1,41 @@
+"""The README's screenshots of the web page: the ur5 example and the Geering free-path example,
+planned in a real browser (Playwright driving chromium) against a server started here.
+
+    python docs/screenshots.py        # writes docs/page_ur5.png and docs/page_geering_free.png
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+
+from tests.live_server import LiveServer  # noqa: E402
+
+SHOTS = {"page_ur5.png": 0, "page_geering_free.png": 1}  # file: index of the page's example
+
+
+def main() -> None:
+    from playwright.sync_api import sync_playwright
+
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false") as server, sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
+        page = browser.new_page(viewport={"width": 1400, "height": 1300})
+        for name, preset in SHOTS.items():
+            page.goto(f"http://127.0.0.1:{server.port}/")
+            page.wait_for_selector("body[data-ready=true]")
+            page.select_option("#preset", index=preset)
+            page.click("#plan")
+            page.wait_for_selector("body[data-planned=true]", timeout=300_000)
+            page.wait_for_timeout(500)  # let the plots settle
+            page.screenshot(path=str(HERE / name), full_page=True)
+            print(name, page.inner_text("#summary"))
+        browser.close()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,94 @@
+"""The web page in a real browser (Playwright driving Debian's chromium): it loads with no
+internet, plans the ur5 example, draws its plots, and shows the duration the API gives; ``/docs``
+renders its operations offline too."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from tests.live_server import LiveServer
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.fixture(scope="module")
+def browser_page():
+    """A chromium page that can reach nothing but the service (every other host is refused)."""
+    from playwright.sync_api import sync_playwright
+
+    assert CHROMIUM, "a real browser is needed: apt-get install chromium (make test does it)"
+    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false") as server, sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        page = browser.new_page(viewport={"width": 1400, "height": 1300})
+        base = f"http://127.0.0.1:{server.port}"
+        outside: list[str] = []
+
+        def offline(route):
+            if route.request.url.startswith(base):
+                return route.continue_()
+            outside.append(route.request.url)
+            return route.abort()
+
+        page.route("**/*", offline)
+        yield page, base, server, outside
+        browser.close()
+
+
+def _plotted(page, element: str) -> int:
+    """Traces Plotly drew in ``element`` (0 when nothing was drawn)."""
+    return page.evaluate(
+        f"() => {{ const d = document.getElementById('{element}'); "
+        "return d && d.data && d.querySelector('.main-svg') ? d.data.length : 0; }"
+    )
+
+
+def test_the_page_plans_the_ur5_example_and_draws_it(browser_page):
+    page, base, server, outside = browser_page
+    page.goto(base + "/")
+    page.wait_for_selector("body[data-ready=true]", timeout=30_000)
+    assert page.input_value("#robot") == "ur5"
+    page.click("#plan")
+    page.wait_for_selector("body[data-planned=true], #error:not([hidden])", timeout=60_000)
+    assert not page.is_visible("#error"), page.inner_text("#error")
+    shown = float(page.get_attribute("#duration", "data-duration"))
+    request = page.evaluate(
+        "() => ({robot: document.getElementById('robot').value, path: JSON.parse(document.getElementById('path').value),"
+        " timing: {method: 'phase_plane', constraints: ['velocity', 'acceleration', 'torque']}, output: {dt: 0.01}})"
+    )
+    status, _, raw = server.request("POST", "/v1/trajectories", request)
+    assert status == 200
+    answer = json.loads(raw)
+    assert shown == answer["duration"]
+    assert page.inner_text("#duration").startswith(f"phase_plane: {answer['duration']:.4f} s")
+    assert _plotted(page, "phase-plane") >= 3  # speed, maximum velocity curve, switch points
+    assert _plotted(page, "joints") >= 4 * 6  # q, qd, qdd, tau of six joints
+    assert _plotted(page, "arm") == 12  # the arm at 12 instants
+    rows = page.locator("#durations tbody tr")
+    assert rows.count() == 3 and rows.nth(0).inner_text().startswith("phase_plane")
+    assert outside == []
+
+
+def test_an_error_shows_the_problem_detail(browser_page):
+    page, base, _, _ = browser_page
+    page.goto(base + "/")
+    page.wait_for_selector("body[data-ready=true]")
+    page.fill("#path", '{"kind": "waypoints", "waypoints": [[0, 0, 0, 0, 0, 0], [9, 0, 0, 0, 0, 0]]}')
+    page.click("#plan")
+    page.wait_for_selector("#error:not([hidden])", timeout=30_000)
+    assert "outside the limits" in page.inner_text("#error") and "422" in page.inner_text("#error")
+
+
+@pytest.mark.parametrize("docs", ["/docs", "/redoc"])
+def test_the_api_docs_render_offline(browser_page, docs):
+    page, base, _, outside = browser_page
+    page.goto(base + docs)
+    for operation in ("Plan a timed trajectory", "Compare timing methods on one path", "Start a background job"):
+        page.get_by_text(operation).first.wait_for(state="attached", timeout=30_000)
+    assert page.get_by_text("/v1/trajectories").count() > 0
+    # ReDoc's "powered by" footer links a logo on its vendor's CDN: an image, refused here, that
+    # the page does without. Nothing else may come from elsewhere.
+    assert [url for url in outside if not url.endswith(".svg")] == []
+    outside.clear()
