@@ -1,15 +1,13 @@
-"""The ``toptraj`` command: ``toptraj serve [--host H] [--port P] [--workers N]`` and
-``toptraj plan request.json`` (prints the response JSON)."""
+"""The ``toptraj`` command: ``toptraj serve [--host H] [--port P] [--workers N]``, and
+``toptraj plan|compare FILE|-`` and ``toptraj plot FILE|- -o OUT.html`` (``service.commands``)."""
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 
-from pydantic import ValidationError
-
+from service import commands as commands_
 from service.serving import LOOP
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
@@ -40,29 +38,6 @@ def _serve(args) -> int:
     return 0
 
 
-def _plan(args) -> int:
-    from robots import ToptrajError
-    from service.planning import encode_json, plan_request, trajectory_body
-    from service.schemas.trajectories import TrajectoryRequest
-
-    try:
-        with open(args.request) as handle:
-            request = TrajectoryRequest.model_validate_json(handle.read())
-        body = trajectory_body(plan_request(request))
-    except OSError as error:
-        print(json.dumps({"title": "Cannot read request", "status": 400, "detail": str(error)}))
-        return 2
-    except ValidationError as error:
-        detail = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in error.errors())
-        print(json.dumps({"title": "Invalid request", "status": 422, "detail": detail}))
-        return 1
-    except ToptrajError as error:
-        print(json.dumps({"title": error.title, "status": error.status, "detail": error.detail}))
-        return 1
-    sys.stdout.write(encode_json(body).decode() + "\n")
-    return 0
-
-
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the console script."""
     parser = argparse.ArgumentParser(prog="toptraj", description=__doc__)
@@ -77,9 +52,16 @@ def main(argv: list[str] | None = None) -> int:
         help="server processes on the port, each planning on its own core (default: the number of cores)",
     )
     serve.set_defaults(run=_serve)
-    plan = commands.add_parser("plan", help="plan one request from a JSON file and print the response")
-    plan.add_argument("request", help="path of a JSON file shaped like POST /v1/trajectories' body")
-    plan.set_defaults(run=_plan)
+    plan = commands.add_parser("plan", help="plan one request and print the answer (errors on stderr)")
+    plan.add_argument("request", help="a JSON file shaped like POST /v1/trajectories' body (or a compare body), - for stdin")
+    plan.set_defaults(run=lambda args: commands_.plan(args.request))
+    compare = commands.add_parser("compare", help="time one path under several methods and print the comparison")
+    compare.add_argument("request", help="a JSON file shaped like POST /v1/trajectories/compare's body, - for stdin")
+    compare.set_defaults(run=lambda args: commands_.compare(args.request))
+    plot = commands.add_parser("plot", help="write the web page's plots of one request to a self-contained HTML file")
+    plot.add_argument("request", help="a JSON file shaped like POST /v1/trajectories' body, - for stdin")
+    plot.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    plot.set_defaults(run=lambda args: commands_.plot(args.request, args.output))
     args = parser.parse_args(argv)
     return args.run(args)
 

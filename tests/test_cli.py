@@ -1,25 +1,93 @@
-"""The console script: ``toptraj plan request.json``."""
+"""The console script: ``toptraj plan|compare FILE|-`` and ``toptraj plot``; answers on stdout,
+errors as problem+json on stderr with a non-zero exit, quiet on a closed pipe."""
 
 from __future__ import annotations
 
+import io
 import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
 
 from service.cli import main
 from tests.conftest import UR5_WAYPOINTS
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_plan_prints_the_response(tmp_path, capsys):
     request = tmp_path / "request.json"
     request.write_text(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}}))
     assert main(["plan", str(request)]) == 0
-    body = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    body = json.loads(captured.out)
     assert body["robot"] == "ur5" and body["method"] == "phase_plane" and body["duration"] > 0
-    assert len(body["samples"]["q"][0]) == 6
+    assert len(body["samples"]["q"][0]) == 6 and captured.err == ""
 
 
-def test_plan_reports_bad_input(tmp_path, capsys):
+def test_plan_reports_bad_input_on_stderr(tmp_path, capsys):
     request = tmp_path / "request.json"
     request.write_text(json.dumps({"robot": "nope", "path": {"waypoints": UR5_WAYPOINTS}}))
     assert main(["plan", str(request)]) == 1
-    assert json.loads(capsys.readouterr().out)["status"] == 404
+    captured = capsys.readouterr()
+    assert captured.out == "" and json.loads(captured.err)["status"] == 404
     assert main(["plan", str(tmp_path / "missing.json")]) == 2
+    assert "missing.json" in json.loads(capsys.readouterr().err)["detail"]
+    request.write_text('{"robot": "ur5", "path": {"waypoints": [[0, 0]]}}')
+    assert main(["plan", str(request)]) == 1
+    assert json.loads(capsys.readouterr().err)["status"] == 422
+
+
+def test_plan_reads_stdin(monkeypatch, capsys):
+    monkeypatch.setattr("sys.stdin", io.StringIO(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}})))
+    assert main(["plan", "-"]) == 0
+    assert json.loads(capsys.readouterr().out)["robot"] == "ur5"
+
+
+@pytest.mark.parametrize("command", ["plan", "compare"])
+def test_the_compare_example_runs(command, capsys):
+    assert main([command, str(ROOT / "examples" / "compare_methods.json")]) == 0
+    results = json.loads(capsys.readouterr().out)["results"]
+    expected = json.loads((ROOT / "examples" / "compare_methods.json").read_text())["methods"]
+    assert [r["method"] for r in results] == expected and all(r["duration"] > 0 for r in results)
+
+
+def test_csv_format_prints_csv(tmp_path, capsys):
+    request = tmp_path / "request.json"
+    request.write_text(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}, "output": {"format": "csv"}}))
+    assert main(["plan", str(request)]) == 0
+    assert capsys.readouterr().out.startswith("t,q.shoulder_pan_joint,")
+
+
+def test_a_closed_pipe_ends_quietly(tmp_path):
+    request = tmp_path / "request.json"  # an answer of about 1 MB, far more than a pipe holds
+    request.write_text(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}, "output": {"dt": 0.001}}))
+    command = f"{sys.executable} -m service.cli plan - < {request} | head -c 20"
+    done = subprocess.run(["bash", "-c", command], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.stdout == '{"robot":"ur5","meth'
+    assert done.stderr == ""
+
+
+def test_a_reader_gone_is_no_error(tmp_path, monkeypatch, capsys):
+    class ClosedPipe(io.BytesIO):
+        def write(self, data):
+            raise BrokenPipeError(32, "Broken pipe")
+
+    from service import commands
+
+    request = tmp_path / "request.json"
+    request.write_text(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}}))
+    assert commands._run(str(request), commands._trajectory, out=ClosedPipe()) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_plot_writes_a_page_with_the_three_figures(tmp_path, capsys):
+    out = tmp_path / "page.html"
+    assert main(["plot", str(ROOT / "examples" / "ur5_spline.json"), "-o", str(out)]) == 0
+    page = out.read_text()
+    assert page.count("Plotly.newPlot") == 3 and "Phase plane" in page and "stroboscopically" in page
+    assert "https://cdn" not in page.split("</script>")[0][:2000]  # the library is inlined, not fetched
+    missing = tmp_path / "none.html"
+    assert main(["plot", str(tmp_path / "nope.json"), "-o", str(missing)]) == 2 and not missing.exists()

@@ -1,0 +1,137 @@
+"""What ``toptraj plan``, ``toptraj compare`` and ``toptraj plot`` do: one request read from a
+file or standard input (``-``), planned in this process by the service's own code path
+(``service.planning``), its answer on standard output (or a page of plots in a file), its error
+as problem+json on standard error with a non-zero exit status:
+
+* 0: answered;
+* 1: the request was answered with an error (422 malformed or impossible, 404 unknown robot, …);
+* 2: the request could not be read (no such file, not JSON).
+
+Writing into a closed pipe (``toptraj plan r.json | head``) ends quietly.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import sys
+from typing import Callable
+
+from pydantic import ValidationError
+
+
+class _Unreadable(Exception):
+    """The request cannot be read: exit status 2."""
+
+
+def _problem(title: str, status: int, detail: str) -> dict:
+    return {"type": "about:blank", "title": title, "status": status, "detail": detail}
+
+
+def _read(source: str) -> str:
+    try:
+        if source == "-":
+            return sys.stdin.read()
+        with open(source, encoding="utf-8") as handle:
+            return handle.read()
+    except (OSError, UnicodeDecodeError) as error:
+        raise _Unreadable(f"cannot read the request {source!r}: {error}") from None
+
+
+def _is_compare(text: str) -> bool:
+    """A compare body names its ``methods``."""
+    try:
+        body = json.loads(text)
+    except ValueError:
+        raise _Unreadable("the request is not JSON") from None
+    return isinstance(body, dict) and "methods" in body
+
+
+def _validation_detail(error: ValidationError) -> str:
+    return "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in error.errors())
+
+
+def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
+    """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
+    (standard output); errors to standard error as problem+json."""
+    from robots import ToptrajError
+
+    try:
+        content = answer(_read(source))
+    except _Unreadable as error:
+        print(json.dumps(_problem("Cannot read request", 400, str(error))), file=sys.stderr)
+        return 2
+    except ValidationError as error:
+        print(json.dumps(_problem("Invalid request", 422, _validation_detail(error))), file=sys.stderr)
+        return 1
+    except ToptrajError as error:
+        print(json.dumps(_problem(error.title, error.status, error.detail)), file=sys.stderr)
+        return 1
+    return _write(content, out)
+
+
+def _write(content: bytes, out=None) -> int:
+    stream = out or sys.stdout.buffer
+    try:
+        stream.write(content if content.endswith(b"\n") else content + b"\n")
+        stream.flush()
+    except BrokenPipeError:
+        # The reader has gone (``| head``): say nothing more; stdout points at /dev/null so that
+        # the interpreter's own flush at exit stays quiet too.
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, io.UnsupportedOperation):  # stdout is no file (a test's capture)
+            pass
+    return 0
+
+
+def _trajectory(text: str) -> bytes:
+    from service.planning import plan_request, render
+    from service.schemas.trajectories import TrajectoryRequest
+
+    request = TrajectoryRequest.model_validate_json(text)
+    return render(plan_request(request), request)[0]
+
+
+def _compare(text: str) -> bytes:
+    from planners.deadline import NO_DEADLINE
+    from service.planning import compare_request, encode_json
+    from service.schemas.trajectories import CompareRequest
+
+    return encode_json(compare_request(CompareRequest.model_validate_json(text), NO_DEADLINE))
+
+
+def plan(source: str) -> int:
+    """``toptraj plan FILE|-``: a trajectory body, or a compare body (it names ``methods``)."""
+    return _run(source, lambda text: _compare(text) if _is_compare(text) else _trajectory(text))
+
+
+def compare(source: str) -> int:
+    """``toptraj compare FILE|-``: a compare body."""
+    return _run(source, _compare)
+
+
+def plot(source: str, output: str) -> int:
+    """``toptraj plot FILE|- -o OUT.html``: the page's plots of one trajectory request, in a
+    self-contained HTML file (Plotly's JavaScript inlined: it opens offline)."""
+    from service.plots import figures_html
+    from service.planning import plan_request
+    from service.schemas.trajectories import TrajectoryRequest
+
+    def page(text: str) -> bytes:
+        if _is_compare(text):
+            raise _Unreadable("toptraj plot draws one trajectory request, not a compare body (it names methods)")
+        return figures_html(plan_request(TrajectoryRequest.model_validate_json(text))).encode()
+
+    buffer = io.BytesIO()
+    status = _run(source, page, out=buffer)
+    if status != 0:
+        return status
+    try:
+        with open(output, "wb") as handle:
+            handle.write(buffer.getvalue())
+        return 0
+    except OSError as error:
+        print(json.dumps(_problem("Cannot write the page", 400, f"{output!r}: {error}")), file=sys.stderr)
+        return 2
