@@ -143,9 +143,19 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     return problem(error.status, error.title, error.detail, headers, **extra)
 
 
+def _message(item: dict) -> str:
+    """pydantic's message, with the value given where the choice was among names (an enum):
+    short values only, so that no error echoes a large input."""
+    message = item["msg"]
+    value = item.get("input")
+    if item.get("type") == "literal_error" and isinstance(value, str) and len(value) <= 60:
+        message += f", not {value!r}"
+    return message
+
+
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:
     errors = [
-        {"field": _location(item["loc"]), "message": item["msg"]} for item in error.errors()
+        {"field": _location(item["loc"]), "message": _message(item)} for item in error.errors()
     ]
     detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:5])
     if len(errors) > 5:

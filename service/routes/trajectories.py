@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Request
+from typing import Annotated
+
+from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
 from service.planning import compare_request, encode_json, plan_request, render
 from service.problems import problem_responses
+from service.schemas.examples import openapi_examples
 from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
 
 router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
@@ -23,7 +26,9 @@ _ERRORS = problem_responses(404, 413, 422, 503, 504)
         **_ERRORS,
     },
 )
-async def create_trajectory(body: TrajectoryRequest, request: Request) -> Response:
+async def create_trajectory(
+    body: Annotated[TrajectoryRequest, Body(openapi_examples=openapi_examples(compare=False))], request: Request
+) -> Response:
     """Time the path of ``body`` for its robot under the requested limits and return the
     samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit.
     The body is built and encoded in the planning thread, within the time budget."""
@@ -39,7 +44,9 @@ async def create_trajectory(body: TrajectoryRequest, request: Request) -> Respon
 
 
 @router.post("/compare", summary="Compare timing methods on one path", response_model=CompareResponse, responses=_ERRORS)
-async def compare_trajectories(body: CompareRequest, request: Request) -> Response:
+async def compare_trajectories(
+    body: Annotated[CompareRequest, Body(openapi_examples=openapi_examples(compare=True))], request: Request
+) -> Response:
     """Time one path under several methods (e.g. ``phase_plane`` against ``quintic``) and return
     each one's duration, peak utilization and solve time: what time-optimality buys."""
     settings = request.app.state.settings

@@ -12,9 +12,10 @@ from planners.ranges import Range
 
 
 class Schema(BaseModel):
-    """Base of every request schema: extra fields and non-finite numbers are errors."""
+    """Base of every request schema: extra fields, non-finite numbers and values of another JSON
+    type (`true` or `"0.1"` for a number) are errors, as the OpenAPI declares."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
 
 
 def _range_error(value: float, shown: str) -> PydanticCustomError:
@@ -59,7 +60,7 @@ class ValidationIssue(BaseModel):
     """One field of a request that failed validation."""
 
     field: str = Field(description="Where, e.g. `path.waypoints[1][2]`.")
-    message: str
+    message: str = Field(description="What is wrong with the field.")
 
 
 class Problem(BaseModel):
@@ -67,11 +68,11 @@ class Problem(BaseModel):
     Extension members: ``errors`` (validation failures, one per field), ``s`` and ``joint``
     (where along the path, and which joint, a limit cannot be met)."""
 
-    type: str = "about:blank"
-    title: str
-    status: int
-    detail: str
-    errors: list[ValidationIssue] | None = None
+    type: str = Field(default="about:blank", description="A URI naming the kind of problem (about:blank: the status says it).")
+    title: str = Field(description="A short summary of the kind of problem.")
+    status: int = Field(description="The HTTP status code.")
+    detail: str = Field(description="What went wrong, where, and how to fix it.")
+    errors: list[ValidationIssue] | None = Field(default=None, description="For a malformed request: each field and what is wrong with it.")
     s: float | None = Field(default=None, description="Path parameter in [0, 1] where planning fails.")
     joint: str | None = Field(default=None, description="Joint whose limit cannot be met.")
     limit: str | None = Field(default=None, description="Kind of limit that cannot be met (velocity, acceleration, torque, jerk).")

@@ -71,16 +71,16 @@ class JobSummary(BaseModel):
     """A job without its answer (``GET /v1/jobs/{id}`` carries the answer)."""
 
     id: str = Field(description="32 hex digits.")
-    kind: JobKind
+    kind: JobKind = Field(description="`trajectory` or `compare`: what the job computes.")
     status: JobStatus = Field(
         description="`queued` (waits for a job worker), `running`, `done` (see `result`), `failed` (see "
         "`error`), `cancelled` (DELETE), `interrupted` (the server stopped while it ran; submit it again)."
     )
-    progress: JobProgress
+    progress: JobProgress = Field(description="How far the job is.")
     budget_s: float = Field(description="Computing time allowed once running, s.")
-    created_at: datetime
-    started_at: datetime | None = None
-    finished_at: datetime | None = None
+    created_at: datetime = Field(description="When the job was submitted (UTC).")
+    started_at: datetime | None = Field(default=None, description="When it started running (UTC); null while queued.")
+    finished_at: datetime | None = Field(default=None, description="When it ended (UTC); null until then.")
     error: Problem | None = Field(
         default=None,
         description="When failed or interrupted: the problem+json object the synchronous endpoint would "
@@ -100,5 +100,5 @@ class JobPublic(JobSummary):
 class JobList(BaseModel):
     """A page of jobs, newest first."""
 
-    jobs: list[JobSummary]
+    jobs: list[JobSummary] = Field(description="The page's jobs, newest first, without their answers.")
     next_cursor: str | None = Field(description="Pass as `cursor` for the next (older) page; null on the last page.")

@@ -15,31 +15,31 @@ MAX_URDF_CHARS = 1_000_000
 class RobotSummary(BaseModel):
     """One line of the catalog."""
 
-    name: str
-    dof: int
-    source: Literal["bundled", "example-robot-data", "upload"]
+    name: str = Field(description="The robot's name, as requests give it.")
+    dof: int = Field(description="Degrees of freedom (actuated joints).")
+    source: Literal["bundled", "example-robot-data", "upload"] = Field(description="`bundled` (the papers' arms), `example-robot-data` or `upload`.")
 
 
 class RobotLimits(BaseModel):
     """Per-joint limits in SI units (rad, rad/s, rad/s^2, rad/s^3, N m); ``null`` is unlimited."""
 
-    position_lower: list[float | None]
-    position_upper: list[float | None]
-    velocity: list[float | None]
-    acceleration: list[float | None]
-    jerk: list[float | None]
-    torque: list[float | None]
+    position_lower: list[float | None] = Field(description="Lower position limits (rad, m); null for a continuous joint.")
+    position_upper: list[float | None] = Field(description="Upper position limits (rad, m); null for a continuous joint.")
+    velocity: list[float | None] = Field(description="Velocity limits (rad/s, m/s).")
+    acceleration: list[float | None] = Field(description="Acceleration limits (rad/s^2, m/s^2).")
+    jerk: list[float | None] = Field(description="Jerk limits (rad/s^3, m/s^3).")
+    torque: list[float | None] = Field(description="Torque (N m) or force (N) limits.")
 
 
 class RobotPublic(BaseModel):
     """A robot as the service sees it."""
 
-    name: str
-    dof: int
-    source: str
-    joint_names: list[str]
-    end_effector: str
-    limits: RobotLimits
+    name: str = Field(description="The robot's name, as requests give it.")
+    dof: int = Field(description="Degrees of freedom (actuated joints).")
+    source: str = Field(description="`bundled` (the papers' arms), `example-robot-data` or `upload`.")
+    joint_names: list[str] = Field(description="Joint names, in the order of every per-joint list.")
+    end_effector: str = Field(description="The frame Cartesian paths and tool speeds refer to by default.")
+    limits: RobotLimits = Field(description="Per-joint limits, SI units.")
 
 
 class RobotCreate(Schema):
@@ -70,5 +70,5 @@ class SkeletonPublic(BaseModel):
     """World positions (m) of each joint origin and of the end effector, per configuration:
     ``positions[k][i]`` is point ``points[i]`` in configuration k."""
 
-    points: list[str]
-    positions: list[list[list[float]]]
+    points: list[str] = Field(description="Names of the points: the joints, then the end effector.")
+    positions: list[list[list[float]]] = Field(description="World positions (m): positions[k][i] = [x, y, z] of point i in configuration k.")

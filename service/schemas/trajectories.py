@@ -7,6 +7,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, Discriminator, Field, Tag
 
 from planners import ranges
+from planners.timing import METHODS
 from service.schemas.common import Schema, bounded, signed
 
 MAX_WAYPOINTS = 1_000
@@ -28,7 +29,7 @@ class WaypointsPath(Schema):
     """Joint waypoints, interpolated by a C2 cubic spline, by straight segments that stop at
     each waypoint, or by straight segments joined by circular blends."""
 
-    kind: Literal["waypoints"] = "waypoints"
+    kind: Literal["waypoints"] = Field(default="waypoints", description="`waypoints` (the default when left out).")
     waypoints: list[JointVector] = Field(
         min_length=2, max_length=MAX_WAYPOINTS, description="Joint configurations (rad, m), one row each."
     )
@@ -56,7 +57,7 @@ class CartesianPathRequest(Schema):
     """Straight lines of a frame through positions (orientation free) or poses (orientation by
     slerp), from the pose of the start configuration; joint path by inverse kinematics."""
 
-    kind: Literal["cartesian"]
+    kind: Literal["cartesian"] = Field(description="`cartesian`: straight lines of a frame, joints by inverse kinematics.")
     frame: Name | None = Field(default=None, description="Frame to move; default the robot's end effector.")
     start: JointVector = Field(description="Start joint configuration (rad, m).")
     positions: list[Annotated[list[float], Field(min_length=3, max_length=3)]] | None = Field(
@@ -71,7 +72,7 @@ class FreePathRequest(Schema):
     """Start and goal only: the path and its timing are optimized together (timing.method
     `collocation`)."""
 
-    kind: Literal["free"]
+    kind: Literal["free"] = Field(description="`free`: start and goal only (timing.method `collocation`).")
     start: JointVector = Field(description="Start configuration (rad, m), at rest unless timing.boundary says otherwise.")
     goal: JointVector = Field(description="Goal configuration (rad, m).")
     revolutions: bool = Field(
@@ -95,20 +96,30 @@ PathRequest = Annotated[
         _path_kind, custom_error_type="path_kind", custom_error_message="path.kind must be 'waypoints', 'cartesian' or 'free'"
     ),
 ]
+#: The OpenAPI discriminator of ``path``: ``kind`` chooses the schema (left out, it is
+#: ``waypoints``, which the validator above applies).
+PATH_DISCRIMINATOR = {
+    "propertyName": "kind",
+    "mapping": {
+        "waypoints": "#/components/schemas/WaypointsPath",
+        "cartesian": "#/components/schemas/CartesianPathRequest",
+        "free": "#/components/schemas/FreePathRequest",
+    },
+}
 
 
 class LimitsRequest(Schema):
     """Per-joint overrides and scale factors of the robot's limits, and limits on the speed of a
     tool frame (SI units)."""
 
-    velocity: _joint_vector(bounded(ranges.VELOCITY)) | None = None
-    acceleration: _joint_vector(bounded(ranges.ACCELERATION)) | None = None
-    jerk: _joint_vector(bounded(ranges.JERK)) | None = None
-    torque: _joint_vector(bounded(ranges.TORQUE)) | None = None
-    velocity_scale: bounded(ranges.SCALE) | None = None
-    acceleration_scale: bounded(ranges.SCALE) | None = None
-    jerk_scale: bounded(ranges.SCALE) | None = None
-    torque_scale: bounded(ranges.SCALE) | None = None
+    velocity: _joint_vector(bounded(ranges.VELOCITY)) | None = Field(default=None, description="Per-joint velocity limits replacing the robot's (rad/s, m/s).")
+    acceleration: _joint_vector(bounded(ranges.ACCELERATION)) | None = Field(default=None, description="Per-joint acceleration limits replacing the robot's (rad/s^2, m/s^2).")
+    jerk: _joint_vector(bounded(ranges.JERK)) | None = Field(default=None, description="Per-joint jerk limits replacing the robot's (rad/s^3, m/s^3).")
+    torque: _joint_vector(bounded(ranges.TORQUE)) | None = Field(default=None, description="Per-joint torque limits replacing the robot's (N m, N).")
+    velocity_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every velocity limit (after overrides).")
+    acceleration_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every acceleration limit.")
+    jerk_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every jerk limit.")
+    torque_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every torque limit.")
     tool_speed: bounded(ranges.TOOL_SPEED) | None = Field(
         default=None, description="Largest linear speed of the tool frame's origin (m/s)."
     )
@@ -124,30 +135,34 @@ class Boundary(Schema):
     """Joint velocities (rad/s) and accelerations (rad/s^2) at the ends, tangent to the path;
     absent means rest."""
 
-    start_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = None
-    end_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = None
-    start_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = None
-    end_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = None
+    start_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = Field(default=None, description="Joint velocities at the start (rad/s, m/s), tangent to the path.")
+    end_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = Field(default=None, description="Joint velocities at the end (rad/s, m/s), tangent to the path.")
+    start_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = Field(default=None, description="Joint accelerations at the start (rad/s^2, m/s^2).")
+    end_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = Field(default=None, description="Joint accelerations at the end (rad/s^2, m/s^2).")
 
 
 class CostRequest(Schema):
     """Weights of the cost integral of (1 + beta |tau|^2) dt (min_cost): beta in 1/(N m)^2."""
 
-    torque_weight: Annotated[float, Field(ge=0.0, le=1e3)] = 0.0
+    torque_weight: Annotated[float, Field(description="beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2 (min_cost, collocation).", ge=0.0, le=1e3)] = 0.0
 
 
 class TrapezoidRequest(Schema):
     """Switching fractions of the trapezoidal law (Angeles 6.1): acceleration ends at tau1 and
     deceleration starts at tau2, as fractions of the duration."""
 
-    tau1: bounded(ranges.TRAPEZOID_FRACTION) = 1.0 / 3.0
-    tau2: bounded(ranges.TRAPEZOID_FRACTION) = 2.0 / 3.0
+    tau1: bounded(ranges.TRAPEZOID_FRACTION) = Field(default=1.0 / 3.0, description="End of the acceleration phase, as a fraction of the duration.")
+    tau2: bounded(ranges.TRAPEZOID_FRACTION) = Field(default=2.0 / 3.0, description="Start of the deceleration phase, as a fraction of the duration.")
+
+
+#: Every timing method, as the OpenAPI enum of ``timing.method`` and the compare's ``methods``.
+MethodName = Literal[(*METHODS, "collocation")]
 
 
 class TimingRequest(Schema):
     """How to time the path."""
 
-    method: Name = Field(
+    method: MethodName = Field(
         default="phase_plane",
         description="`phase_plane` (time-optimal, default), `toppra`, `min_cost` (minimum of the "
         "integral of 1 + beta |tau|^2), `ruckig` (jerk-limited, two waypoints), a time law "
@@ -158,13 +173,13 @@ class TimingRequest(Schema):
         max_length=4,
         description="Limits to respect; jerk only with the time laws and ruckig.",
     )
-    limits: LimitsRequest = LimitsRequest()
+    limits: LimitsRequest = Field(default=LimitsRequest(), description="Limit overrides and scale factors, and tool-speed limits.")
     duration: bounded(ranges.DURATION) | None = Field(
         default=None, description="Seconds, for the classical time laws and via points."
     )
-    boundary: Boundary = Boundary()
-    cost: CostRequest = CostRequest()
-    trapezoid: TrapezoidRequest = TrapezoidRequest()
+    boundary: Boundary = Field(default=Boundary(), description="Joint velocities and accelerations at the ends; rest by default.")
+    cost: CostRequest = Field(default=CostRequest(), description="Weights of the cost integral (min_cost, collocation).")
+    trapezoid: TrapezoidRequest = Field(default=TrapezoidRequest(), description="Switching fractions of the trapezoidal law.")
     grid_points: Annotated[int, Field(ge=2, le=20_000)] | None = Field(
         default=None, description="Number of grid intervals over the path; default chosen from it."
     )
@@ -205,44 +220,47 @@ class TrajectoryRequest(Schema):
     """A motion to plan."""
 
     robot: Name = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
-    path: PathRequest
-    timing: TimingRequest = TimingRequest()
-    output: OutputRequest = OutputRequest()
+    path: PathRequest = Field(
+        description="The geometric path: waypoints, a Cartesian line, or a free start and goal; `kind` says which.",
+        json_schema_extra={"discriminator": PATH_DISCRIMINATOR},
+    )
+    timing: TimingRequest = Field(default=TimingRequest(), description="How to time the path: method, constraints, limits.")
+    output: OutputRequest = Field(default=OutputRequest(), description="Sampling and shape of the answer.")
 
 
 class SamplesPublic(BaseModel):
     """Time samples; ``q[k]`` holds one value per joint at ``t[k]``."""
 
-    t: list[float]
-    q: list[list[float]]
-    qd: list[list[float]]
-    qdd: list[list[float]]
-    tau: list[list[float]]
+    t: list[float] = Field(description="Sample times (s).")
+    q: list[list[float]] = Field(description="Joint positions (rad, m), a row per sample.")
+    qd: list[list[float]] = Field(description="Joint velocities (rad/s, m/s), a row per sample.")
+    qdd: list[list[float]] = Field(description="Joint accelerations (rad/s^2, m/s^2), a row per sample.")
+    tau: list[list[float]] = Field(description="Joint torques (N m) or forces (N) from inverse dynamics with friction, a row per sample.")
 
 
 class SwitchPoint(BaseModel):
-    s: float
-    kind: str
+    s: float = Field(description="Path parameter of the switch (0 to 1).")
+    kind: str = Field(description="How the switch arises: acceleration, deceleration, tangent, singular, discontinuity.")
 
 
 class PhasePlanePublic(BaseModel):
     """The timing in the phase plane: path speed ``sd`` and maximum velocity curve ``sd_max``
     (1/s) over s in [0, 1]."""
 
-    s: list[float]
-    sd: list[float]
-    sd_max: list[float | None]
-    switch_points: list[SwitchPoint] = []
+    s: list[float] = Field(description="Path parameter of each point (0 to 1).")
+    sd: list[float] = Field(description="Path speed ds/dt at each point (1/s).")
+    sd_max: list[float | None] = Field(description="Maximum velocity curve at each point (1/s); null where unbounded.")
+    switch_points: list[SwitchPoint] = Field(default=[], description="Where the path acceleration switches, and the kind of switch.")
 
 
 class UtilizationPublic(BaseModel):
     """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds); jerk
     for timings with a finite jerk (time laws, ruckig)."""
 
-    velocity: list[float]
-    acceleration: list[float]
-    torque: list[float]
-    jerk: list[float] | None = None
+    velocity: list[float] = Field(description="Peak |qd| / velocity limit per joint.")
+    acceleration: list[float] = Field(description="Peak |qdd| / acceleration limit per joint.")
+    torque: list[float] = Field(description="Peak |tau| / torque limit per joint.")
+    jerk: list[float] | None = Field(default=None, description="Peak |qddd| / jerk limit per joint, for timings with a finite jerk.")
     tool_speed: float | None = Field(default=None, description="Peak tool speed / timing.limits.tool_speed, when limited.")
     tool_angular_speed: float | None = Field(
         default=None, description="Peak angular tool speed / timing.limits.tool_angular_speed, when limited."
@@ -252,89 +270,91 @@ class UtilizationPublic(BaseModel):
 class BindingPublic(BaseModel):
     """The limit that set a minimal duration (time laws): its kind, joint and place."""
 
-    kind: str
-    joint: str | None
-    s: float
+    kind: str = Field(description="The binding limit: velocity, acceleration, jerk or torque.")
+    joint: str | None = Field(description="The joint whose limit binds; null for a limit of the whole path.")
+    s: float = Field(description="Where along the path it binds (path parameter, 0 to 1).")
 
 
 class ConditioningPublic(BaseModel):
     """Frobenius condition number of the end effector's Jacobian along the trajectory (1:
     isotropic; null: singular), translations over the characteristic length L (m)."""
 
-    kappa_min: float | None
-    kappa_max: float | None
-    characteristic_length: float
+    kappa_min: float | None = Field(description="Smallest condition number along the trajectory (1: isotropic); null where singular.")
+    kappa_max: float | None = Field(description="Largest condition number along the trajectory; null where singular.")
+    characteristic_length: float = Field(description="Length (m) that makes translations and rotations commensurate in the Jacobian.")
 
 
 class TimeFromStart(BaseModel):
     """``builtin_interfaces/Duration``: whole seconds and the nanoseconds within the second."""
 
-    sec: int
-    nanosec: int
+    sec: int = Field(description="Whole seconds.")
+    nanosec: int = Field(description="Nanoseconds within the second, 0 to 999,999,999.")
 
 
 class JointTrajectoryPoint(BaseModel):
     """``trajectory_msgs/JointTrajectoryPoint``: one value per joint, SI units (rad, rad/s,
     rad/s^2, N m; m and N for prismatic joints)."""
 
-    positions: list[float]
-    velocities: list[float]
-    accelerations: list[float]
-    effort: list[float]
-    time_from_start: TimeFromStart
+    positions: list[float] = Field(description="Joint positions (rad, m).")
+    velocities: list[float] = Field(description="Joint velocities (rad/s, m/s).")
+    accelerations: list[float] = Field(description="Joint accelerations (rad/s^2, m/s^2).")
+    effort: list[float] = Field(description="Joint torques (N m) or forces (N).")
+    time_from_start: TimeFromStart = Field(description="Time of the point from the start.")
 
 
 class JointTrajectoryPublic(BaseModel):
     """``trajectory_msgs/JointTrajectory`` without its header (``output.format =
     "joint_trajectory"``)."""
 
-    joint_names: list[str]
-    points: list[JointTrajectoryPoint]
+    joint_names: list[str] = Field(description="Joint names, in the order of every point's values.")
+    points: list[JointTrajectoryPoint] = Field(description="The samples, one point each, on whole periods of output.dt.")
 
 
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
-    robot: str
-    method: str
-    joint_names: list[str]
+    robot: str = Field(description="The robot planned for.")
+    method: str = Field(description="The timing method used.")
+    joint_names: list[str] = Field(description="Joint names, in the order of every per-joint list.")
     duration: float = Field(description="Planned duration (s).")
     sampled_duration: float = Field(
         description="Time of the last sample (s): `duration`, or with `output.exact_period` the whole periods it was stretched to."
     )
     samples: SamplesPublic | None = Field(default=None, description="`output.format = \"samples\"`: t (s), q, qd, qdd, tau per sample.")
-    joint_trajectory: JointTrajectoryPublic | None = None
-    phase_plane: PhasePlanePublic
-    peak_utilization: UtilizationPublic
-    binding: BindingPublic | None = None
-    conditioning: ConditioningPublic
+    joint_trajectory: JointTrajectoryPublic | None = Field(default=None, description="`output.format = \"joint_trajectory\"`: the samples as ROS's trajectory_msgs/JointTrajectory.")
+    phase_plane: PhasePlanePublic = Field(description="The timing in the phase plane (s, path speed, maximum velocity curve).")
+    peak_utilization: UtilizationPublic = Field(description="Peak |value| / limit per joint on a dense resampling (1.0: the limit binds).")
+    binding: BindingPublic | None = Field(default=None, description="The limit that set a minimal duration (time laws).")
+    conditioning: ConditioningPublic = Field(description="Condition number of the end effector's Jacobian along the trajectory.")
     cost: float | None = Field(default=None, description="min_cost, collocation: the integral of (1 + beta |tau|^2) dt, in s.")
     solver: dict | None = Field(default=None, description="collocation: status, iterations, the winning initial guess.")
-    solve_ms: float
-    warnings: list[str]
+    solve_ms: float = Field(description="Planning time in the library (ms).")
+    warnings: list[str] = Field(description="What the answer should be read with: dropped waypoints, singularities, turns of continuous joints.")
 
 
 class CompareRequest(Schema):
     """One path under several timing methods."""
 
     robot: Name = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
-    path: PathRequest
-    methods: list[Name] = Field(
+    path: PathRequest = Field(
+        description="The path, as in POST /v1/trajectories.", json_schema_extra={"discriminator": PATH_DISCRIMINATOR}
+    )
+    methods: list[MethodName] = Field(
         min_length=1, max_length=10, description="Timing methods to run, e.g. [\"phase_plane\", \"quintic\"]."
     )
-    timing: TimingRequest = TimingRequest()
+    timing: TimingRequest = Field(default=TimingRequest(), description="Constraints and limits shared by every method (its `method` is ignored).")
 
 
 class CompareResult(BaseModel):
     """One method's answer: its duration, peak utilization and solve time, or its error."""
 
-    method: str
-    duration: float | None = None
-    peak_utilization: UtilizationPublic | None = None
-    binding: BindingPublic | None = None
-    solve_ms: float | None = None
-    error: dict | None = None
+    method: str = Field(description="The timing method.")
+    duration: float | None = Field(default=None, description="Duration (s); null when the method failed.")
+    peak_utilization: UtilizationPublic | None = Field(default=None, description="Peak |value| / limit per joint on a dense resampling.")
+    binding: BindingPublic | None = Field(default=None, description="The limit that set a minimal duration (time laws).")
+    solve_ms: float | None = Field(default=None, description="Planning time (ms).")
+    error: dict | None = Field(default=None, description="The method's problem (status, title, detail) when it failed.")
 
 
 class CompareResponse(BaseModel):
-    results: list[CompareResult]
+    results: list[CompareResult] = Field(description="One result per requested method, in the order asked.")

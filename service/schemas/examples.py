@@ -1,0 +1,32 @@
+"""The request examples of ``examples/`` (kept in ``service/examples`` so that they ship with
+the package), as OpenAPI examples of the endpoints they are bodies of: each is answered by the
+tests (``tests/test_examples.py``), so every example in ``/docs`` works."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+DIRECTORY = Path(__file__).resolve().parents[1] / "examples"
+
+#: A line of ``/docs`` per example file (file stem: summary).
+SUMMARIES = {
+    "ur5_spline": "ur5: spline through 4 waypoints, time-optimal under velocity, acceleration and torque limits",
+    "lecture_cartesian_line": "lecture arm: a Cartesian straight line through inverse kinematics",
+    "yamamoto_min_cost": "Yamamoto's arm: minimum time plus energy (beta = 0.03) along a straight line",
+    "geering_free_motion": "Geering's arm: free path, path and timing optimized together (tens of seconds; see /v1/jobs)",
+    "compare_methods": "several methods on one path",
+}
+
+
+def _load() -> dict[str, dict]:
+    return {path.stem: json.loads(path.read_text()) for path in sorted(DIRECTORY.glob("*.json"))}
+
+
+def openapi_examples(compare: bool) -> dict[str, dict]:
+    """The examples that are compare bodies (they name ``methods``), or the others."""
+    return {
+        stem: {"summary": SUMMARIES.get(stem, stem.replace("_", " ")), "value": body}
+        for stem, body in _load().items()
+        if ("methods" in body) == compare
+    }
