@@ -34,6 +34,7 @@ from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.segmented import SegmentedTiming
 from planners.tool_speed import tool_speed_limit
+from planners.collision import Obstacle, check_clearance
 from planners.trajectory import sample_trajectory
 from planners.via_points import via_point_trajectory
 from robots import JointLimits, Robot
@@ -275,6 +276,10 @@ def _utilization(stretches_, margin: float) -> dict[str, np.ndarray]:
     }
 
 
+#: Distance (m) every link keeps from the obstacles unless a request says otherwise.
+DEFAULT_CLEARANCE = 0.01
+
+
 def plan(
     robot: Robot,
     path_spec: "WaypointPath | CartesianLine",
@@ -283,12 +288,16 @@ def plan(
     deadline: Deadline = NO_DEADLINE,
     max_samples: int = MAX_SAMPLES,
     exact_period: bool = False,
+    obstacles: tuple[Obstacle, ...] = (),
+    clearance: float = DEFAULT_CLEARANCE,
 ) -> PlannedTrajectory:
     """Plan the timed trajectory of ``robot`` along ``path_spec``, sampled every ``dt`` seconds
     into at most ``max_samples`` samples. With ``exact_period`` the samples lie on whole periods
     ``dt``, the final state included: the motion is slowed uniformly to end on one
     (``planners.trajectory.sample_trajectory``); ``duration`` stays the planned (optimal) one
-    and ``sampled_duration`` is the samples' last instant.
+    and ``sampled_duration`` is the samples' last instant. With ``obstacles`` (world frame),
+    every link keeps ``clearance`` (m) from them along the path (``planners.collision``), and
+    the answer carries the smallest distance found.
 
     Every answer holds the requested limits on a dense resampling within ``LIMIT_TOLERANCE``
     (with ``timing.limit_margin`` > 0, strictly within the limits): the gate refines the grid
@@ -345,6 +354,9 @@ def plan(
             "law through several waypoints"
         )
     timing_part = deadline.within(0.0, 0.9)
+    checked_first = None
+    if obstacles and isinstance(path_spec, FreeMotion):
+        raise InvalidRequest("path.obstacles are not served on free paths yet: give waypoints that clear them")
     with numerical_breakdown_is_failure(method.name):
         if isinstance(path_spec, FreeMotion) or method.name == "collocation":
             timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, timing_part, threshold)
@@ -354,9 +366,16 @@ def plan(
         else:
             timing_part.progress(0.0, "path")
             path = make_path(robot, path_spec, deadline)
+            if obstacles:
+                timing_part.progress(0.05, "clearance")
+                checked_first = check_clearance(path, robot, list(obstacles), clearance, deadline)
             timed = _timed_path(robot, path, method, timing, kinds, limits, timing_part.within(0.1, 1.0), threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
     deadline.check()
+    found_clearance = None
+    if obstacles:
+        # a given path was checked before its timing; a path shaped with its timing (via points) now
+        found_clearance = checked_first or check_clearance(path, robot, list(obstacles), clearance, deadline)
     deadline.progress(0.9, "sampling")
     require_finite(timed.method, duration=result.duration)
     if result.duration / dt > max_samples - 2:
@@ -398,6 +417,7 @@ def plan(
         conditioning=Conditioning(kappa_min, kappa_max, length),
         cost=timed.cost,
         solver=timed.solver,
+        clearance=found_clearance,
     )
 
 

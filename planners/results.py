@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from planners.errors import TimingFailed
 from planners.timing.base import Binding
 from planners.trajectory import Samples
+
+if TYPE_CHECKING:
+    from planners.collision import Clearance
 
 
 @dataclass(frozen=True)
@@ -48,6 +52,7 @@ class PlannedTrajectory:
     conditioning: Conditioning | None = None
     cost: float | None = None
     solver: dict | None = None
+    clearance: "Clearance | None" = None
 
 
 def require_finite(method: str, **quantities) -> None:

@@ -15,7 +15,8 @@ from planners.boundary import finite_vector
 from planners.deadline import NO_DEADLINE
 from planners.free_path import FreeMotion
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
-from planners.plan import MAX_SAMPLES
+from planners.collision import BoxObstacle, CapsuleObstacle, SphereObstacle
+from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from robots import InvalidLimits, UnknownRobot
 from service.problems import non_finite_answer
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
@@ -90,7 +91,22 @@ def plan_request(
         deadline or NO_DEADLINE,
         max_samples,
         exact_period=exact_period_for(format_, output.exact_period),
+        obstacles=_obstacles(getattr(request.path, "obstacles", [])),
+        clearance=getattr(request.path, "clearance", DEFAULT_CLEARANCE),
     )
+
+
+def _obstacles(specs) -> tuple:
+    """The request's obstacles as the library's domain objects."""
+    made = []
+    for spec in specs:
+        if spec.kind == "sphere":
+            made.append(SphereObstacle(np.array(spec.center, dtype=float), spec.radius))
+        elif spec.kind == "box":
+            made.append(BoxObstacle(np.array(spec.center, dtype=float), np.array(spec.size, dtype=float), np.array(spec.orientation, dtype=float)))
+        else:
+            made.append(CapsuleObstacle(np.array(spec.a, dtype=float), np.array(spec.b, dtype=float), spec.radius))
+    return tuple(made)
 
 
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
@@ -200,6 +216,12 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         "solver": result.solver,
         "solve_ms": result.solve_ms,
         "warnings": list(result.warnings),
+        "min_clearance": None if result.clearance is None else {
+            "distance": result.clearance.distance,
+            "link": result.clearance.link,
+            "obstacle": result.clearance.obstacle,
+            "s": result.clearance.s,
+        },
     }
 
 

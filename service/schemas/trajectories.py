@@ -25,6 +25,52 @@ JointVector = _joint_vector(signed(ranges.COORDINATE))
 Name = Annotated[str, Field(max_length=MAX_NAME_CHARS)]
 
 
+Point = Annotated[list[signed(ranges.COORDINATE)], Field(min_length=3, max_length=3)]
+MAX_OBSTACLES = 100
+
+
+class SphereObstacleRequest(Schema):
+    """A ball in the world frame."""
+
+    kind: Literal["sphere"] = Field(description="`sphere`.")
+    center: Point = Field(description="Center [x, y, z] (m), world frame.")
+    radius: Annotated[float, Field(gt=0.0, le=100.0)] = Field(description="Radius (m).")
+
+
+class BoxObstacleRequest(Schema):
+    """An oriented box in the world frame."""
+
+    kind: Literal["box"] = Field(description="`box`.")
+    center: Point = Field(description="Center [x, y, z] (m), world frame.")
+    size: Annotated[list[Annotated[float, Field(gt=0.0, le=100.0)]], Field(min_length=3, max_length=3)] = Field(
+        description="Edge lengths [sx, sy, sz] (m) along the box's own axes."
+    )
+    orientation: Annotated[list[Annotated[float, Field(ge=-1.0, le=1.0)]], Field(min_length=4, max_length=4)] = Field(
+        default=[0.0, 0.0, 0.0, 1.0], description="Unit quaternion [qx, qy, qz, qw] from the box's axes to the world's."
+    )
+
+
+class CapsuleObstacleRequest(Schema):
+    """The points within `radius` of the segment from `a` to `b`, world frame."""
+
+    kind: Literal["capsule"] = Field(description="`capsule`.")
+    a: Point = Field(description="One end of the axis [x, y, z] (m).")
+    b: Point = Field(description="The other end of the axis [x, y, z] (m).")
+    radius: Annotated[float, Field(gt=0.0, le=100.0)] = Field(description="Radius (m).")
+
+
+ObstacleRequest = Annotated[
+    SphereObstacleRequest | BoxObstacleRequest | CapsuleObstacleRequest, Field(discriminator="kind")
+]
+OBSTACLES = Field(
+    default=[],
+    max_length=MAX_OBSTACLES,
+    description="Obstacles in the world frame (spheres, boxes, capsules): every link keeps path.clearance "
+    "from them along the path, else 422 naming the link, the obstacle and s; the answer reports min_clearance.",
+)
+CLEARANCE = Field(default=0.01, ge=0.0, le=1.0, description="Distance (m) every link keeps from every obstacle.")
+
+
 class WaypointsPath(Schema):
     """Joint waypoints, interpolated by a C2 cubic spline, by straight segments that stop at
     each waypoint, or by straight segments joined by circular blends."""
@@ -51,6 +97,8 @@ class WaypointsPath(Schema):
         "when one turns more than pi between waypoints), `shortest` turns the short way, waypoints "
         "after the first reached as equivalent angles.",
     )
+    obstacles: list[ObstacleRequest] = OBSTACLES
+    clearance: float = CLEARANCE
 
 
 class CartesianPathRequest(Schema):
@@ -66,6 +114,8 @@ class CartesianPathRequest(Schema):
     poses: list[Annotated[list[float], Field(min_length=7, max_length=7)]] | None = Field(
         default=None, min_length=1, max_length=MAX_WAYPOINTS, description="[x, y, z, qx, qy, qz, qw]."
     )
+    obstacles: list[ObstacleRequest] = OBSTACLES
+    clearance: float = CLEARANCE
 
 
 class FreePathRequest(Schema):
@@ -78,7 +128,12 @@ class FreePathRequest(Schema):
     revolutions: bool = Field(
         default=True, description="Whether continuous joints may reach their goal one revolution either way."
     )
-    obstacles: list[dict] = Field(default=[], max_length=0, description="Not supported yet: must be empty.")
+    obstacles: list[ObstacleRequest] = Field(
+        default=[],
+        max_length=0,
+        description="Not served on free paths yet (the global search among obstacles is to come): must be "
+        "empty; give waypoints that clear the obstacles instead.",
+    )
 
 
 def _path_kind(value) -> str:
@@ -310,6 +365,15 @@ class JointTrajectoryPublic(BaseModel):
     points: list[JointTrajectoryPoint] = Field(description="The samples, one point each, on whole periods of output.dt.")
 
 
+class ClearancePublic(BaseModel):
+    """The closest approach of the robot to the obstacles along the path."""
+
+    distance: float = Field(description="Smallest distance (m) between a link and an obstacle; at least path.clearance.")
+    link: str = Field(description="The link (its collision capsule) where it occurs.")
+    obstacle: int = Field(description="The obstacle, as its index in path.obstacles.")
+    s: float = Field(description="Where along the path (path parameter, 0 to 1).")
+
+
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
@@ -329,6 +393,9 @@ class TrajectoryResponse(BaseModel):
     cost: float | None = Field(default=None, description="min_cost, collocation: the integral of (1 + beta |tau|^2) dt, in s.")
     solver: dict | None = Field(default=None, description="collocation: status, iterations, the winning initial guess.")
     solve_ms: float = Field(description="Planning time in the library (ms).")
+    min_clearance: ClearancePublic | None = Field(
+        default=None, description="With path.obstacles: the closest approach of any link to any obstacle."
+    )
     warnings: list[str] = Field(description="What the answer should be read with: dropped waypoints, singularities, turns of continuous joints.")
 
 
