@@ -2,8 +2,9 @@
 one interleaved run.
 
 For each of ``--paths`` seeded random spline paths (half ur5, half panda; 2 to 5 waypoints,
-within the joint ranges), with velocity, acceleration and torque limits, and jerk limits for
-``jerk_limited``: both methods time the path through ``planners.plan`` (the library call the
+within the joint ranges), with velocity, acceleration and torque limits (the torque scaled down
+until holding the arm still along the path takes 1 / 1.3 of it somewhere, so that it shapes the
+motion), and jerk limits for ``jerk_limited``: both methods time the path through ``planners.plan`` (the library call the
 service makes, limit gate included), alternately, ``--repeats`` times each; the median solve
 time of each is kept. Every answer's limits are recomputed from 1 ms samples (velocity and
 acceleration as returned, torque by RNEA, jerk by finite differences of the accelerations).
@@ -24,6 +25,7 @@ import numpy as np
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import InfeasiblePath, TimingFailed
+from planners.waypoint_checks import make_path
 
 JERK_FREE = ("velocity", "acceleration", "torque")
 JERK = (*JERK_FREE, "jerk")
@@ -36,17 +38,25 @@ def _random_waypoints(robot, rng) -> np.ndarray:
     return rng.uniform(lower + margin, upper - margin, (int(rng.integers(2, 6)), robot.dof))
 
 
-def _utilization(robot, samples) -> dict[str, float]:
+def _torque_scale(robot, waypoints) -> float:
+    """The torque scale at which holding still along the path takes 1 / 1.3 of the limit."""
+    q = make_path(robot, WaypointPath(waypoints))(np.linspace(0.0, 1.0, 400))
+    gravity = np.abs(robot.inverse_dynamics(q, np.zeros_like(q), np.zeros_like(q))) / robot.limits.torque
+    return min(1.0, 1.3 * float(gravity.max()))
+
+
+def _utilization(robot, samples, scales) -> dict[str, float]:
     """Worst |value| / limit over the samples, per kind."""
+    limits = robot.limits.with_request(scales=scales)
     jerk = np.diff(samples.qdd, axis=0) / np.diff(samples.t)[:, None]
     torque = robot.inverse_dynamics(samples.q, samples.qd, samples.qdd)
     values = {"velocity": samples.qd, "acceleration": samples.qdd, "torque": torque, "jerk": jerk}
-    return {kind: float(np.max(np.abs(value) / getattr(robot.limits, kind))) for kind, value in values.items()}
+    return {kind: float(np.max(np.abs(value) / getattr(limits, kind))) for kind, value in values.items()}
 
 
-def _timed(robot, waypoints, method, kinds):
+def _timed(robot, waypoints, method, kinds, scales):
     started = time.perf_counter()
-    result = plan(robot, WaypointPath(waypoints), Timing(method=method, constraints=kinds), dt=1e-3)
+    result = plan(robot, WaypointPath(waypoints), Timing(method=method, constraints=kinds, limit_scales=scales), dt=1e-3)
     return time.perf_counter() - started, result
 
 
@@ -64,9 +74,10 @@ def main() -> None:
         times = {"phase_plane": [], "jerk_limited": []}
         results = {}
         try:
+            scales = {"torque": _torque_scale(robot, waypoints)}
             for _ in range(arguments.repeats):
                 for method, kinds in (("phase_plane", JERK_FREE), ("jerk_limited", JERK)):
-                    seconds, results[method] = _timed(robot, waypoints, method, kinds)
+                    seconds, results[method] = _timed(robot, waypoints, method, kinds, scales)
                     times[method].append(seconds)
         except (InfeasiblePath, TimingFailed) as error:
             failures.append((name, index, f"{type(error).__name__}: {error.detail[:120]}"))
@@ -78,7 +89,7 @@ def main() -> None:
             "duration_ratio": jerk_limited.duration / jerk_free.duration,
             "time_ratio": float(np.median(times["jerk_limited"]) / np.median(times["phase_plane"])),
             "solve_ms": 1e3 * float(np.median(times["jerk_limited"])),
-            "utilization": _utilization(robot, jerk_limited.samples),
+            "utilization": _utilization(robot, jerk_limited.samples, scales),
             "reported_jerk": float(jerk_limited.peak_utilization["jerk"].max()),
         })
         print(

@@ -50,10 +50,10 @@ restriction, so the duration decreases monotonically. The first restriction is t
 the jerk-free time-optimal profile (``phase_plane``).
 
 The grid solution follows a phase of constant jerk only approximately (within about 0.2 % of
-the duration on the default grid). Where the solution has at most nine phases (a straight
-joint line, limits that do not change along the path), ``planners.timing.jerk_polish`` refines
-it in time, as segments of constant jerk with free switching times; for limits that do not
-change along the path that is the exact optimum (Berscheid & Kroeger's profile, the same as
+the duration on the default grid). Where every limit is the same along the whole path (a
+straight joint line under velocity, acceleration and jerk limits) and the solution has at most
+nine phases, ``planners.timing.jerk_polish`` refines it in time, as segments of constant jerk
+with free switching times: the exact optimum there (Berscheid & Kroeger's profile, the same as
 ruckig's along the line).
 """
 
@@ -133,11 +133,34 @@ class JerkLimitedMethod(TimingMethod):
             x, u, best = x_step, u_step, candidate
             if gain <= self.tolerance * best.duration:
                 break
-        if self.polish:
+        if self.polish and _uniform(constraints):
             polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
             if polished is not None:
                 return polished
         return best
+
+
+def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:
+    """Whether every limit is the same along the whole path (a straight joint line under
+    velocity, acceleration and jerk limits): the polish's segments of constant path jerk are the
+    exact optimum there, and seldom beat the grid solution elsewhere (so it is not tried)."""
+    dq, ddq, dddq, _ = constraints.jerk
+    # Spreads are measured against the larger of each array's own magnitude and the path's
+    # (|q'|): d2q/ds2 of a straight line is rounding noise of that size, not a change.
+    reference = float(np.abs(dq).max(initial=0.0))
+    arrays = [constraints.sd_max, dq, ddq, dddq, constraints.a, constraints.b, constraints.c, constraints.d,
+              constraints.lower, constraints.upper]
+    for values in arrays:
+        values = np.asarray(values, dtype=float)
+        if values.size == 0:
+            continue
+        finite = np.isfinite(values)
+        if not np.array_equal(finite, np.broadcast_to(finite[:1], finite.shape)):
+            return False
+        spread = np.ptp(np.where(finite, values, 0.0), axis=0)
+        if np.any(spread > tolerance * max(float(np.abs(values[finite]).max(initial=0.0)), reference, 1e-300)):
+            return False
+    return True
 
 
 def _start_phase(constraints: PathConstraints, point: int) -> float:
