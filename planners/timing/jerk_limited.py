@@ -440,6 +440,9 @@ class _Problem:
         self.deadline.check()
         solver = highspy.Highs()
         solver.setOptionValue("output_flag", False)
+        # Near an end at rest the jerk rows' right-hand sides are as small as x there (1e-8 of
+        # the typical x): HiGHS's default tolerance of 1e-7 would let them be exceeded twofold.
+        solver.setOptionValue("primal_feasibility_tolerance", 1e-10)
         remaining = self.deadline.remaining()
         if remaining is not None:
             solver.setOptionValue("time_limit", max(remaining, 1e-3))
@@ -457,10 +460,14 @@ class _Problem:
         if status == highspy.HighsModelStatus.kTimeLimit:
             self.deadline.check()
             raise BudgetExceeded(f"planning exceeded its time budget of {self.deadline.budget_s} s")
-        if status != highspy.HighsModelStatus.kOptimal:
+        if status == highspy.HighsModelStatus.kInfeasible:
             raise InfeasiblePath(
-                f"no jerk-limited motion follows the path within the limits (the linear program is "
-                f"{solver.modelStatusToString(status).lower()})"
+                "no jerk-limited motion follows the path within the limits (the linear program is infeasible)"
+            )
+        if status != highspy.HighsModelStatus.kOptimal:
+            raise TimingFailed(
+                f"the jerk-limited timing's linear program ended without a solution (HiGHS: "
+                f"{solver.modelStatusToString(status).lower()}); try other timing.grid_points"
             )
         self._basis, self._basis_shape = solver.getBasis(), matrix.shape
         values = np.asarray(solver.getSolution().col_value)
