@@ -50,8 +50,10 @@ class PathConstraints:
         joint_names: Joint names, for messages.
         jerk: When jerk is limited, (dq, ddq, dddq, limit): the path's first three
             s-derivatives, each (N + 1, n_dof), and the jerk limit (n_dof,) in rad/s^3. The
-            jerk dq sddd + 3 ddq sd sdd + dddq sd^3 involves sddd, so only the time laws and
-            ruckig read it.
+            jerk dq sddd + 3 ddq sd sdd + dddq sd^3 involves sddd, so only the time laws,
+            ruckig and jerk_limited read it.
+        jerk_left: With ``jerk``, (dq, ddq, dddq) as seen from the interval that ends at each
+            grid point (they differ from ``jerk``'s at the path's knots, where d3q/ds3 jumps).
         velocity_joint: Index of the joint whose velocity limit sets sd_max at each point
             (N + 1,), -1 where no velocity limit applies.
         tool_bound: Where a tool-speed limit (``planners.tool_speed``) sets sd_max instead, the
@@ -74,6 +76,7 @@ class PathConstraints:
     rows: tuple[tuple[str, int], ...]
     joint_names: tuple[str, ...]
     jerk: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+    jerk_left: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     velocity_joint: np.ndarray | None = None
     tool_bound: np.ndarray | None = None
     evaluate: Callable[[np.ndarray], "PathConstraints"] | None = field(default=None, repr=False, compare=False)
@@ -113,6 +116,9 @@ class PathConstraints:
                 *(merge(mine, theirs) for mine, theirs in zip(self.jerk[:3], extra.jerk[:3])),
                 self.jerk[3],
             ),
+            jerk_left=None if self.jerk_left is None else tuple(
+                merge(mine, theirs) for mine, theirs in zip(self.jerk_left, extra.jerk[:3])
+            ),
             evaluate=self.evaluate,
         )
 
@@ -132,6 +138,7 @@ class PathConstraints:
             b_left=self.b_left * kappa,
             d_left=self.d_left * root,
             jerk=None,
+            jerk_left=None,
             evaluate=None,
         )
 
@@ -245,6 +252,18 @@ def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.nda
     return points, stacked, tuple(row for row, keep in zip(rows, finite) if keep)
 
 
+def _left_derivatives(path: GeometricPath, s: np.ndarray, points, third: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """dq, ddq and dddq at ``s`` from the left: the right-hand values (``points``, ``third``)
+    except at the path's knots, where the path is evaluated from the left."""
+    dq, ddq, dddq = points.dq.copy(), points.ddq.copy(), third.copy()
+    at_knot = np.flatnonzero(np.isin(s, path.knots) & (s > 0.0))
+    if at_knot.size:
+        left = path.evaluate(s[at_knot], "left")
+        dq[at_knot], ddq[at_knot] = left.dq, left.ddq
+        dddq[at_knot] = path.third_derivative(s[at_knot], "left")
+    return dq, ddq, dddq
+
+
 def build_path_constraints(
     path: GeometricPath,
     robot: Robot,
@@ -283,6 +302,7 @@ def build_path_constraints(
         a_left, b_left, c_left, d_left = a.copy(), b.copy(), c.copy(), d.copy()
         a_left[kink_index], b_left[kink_index] = a_k, b_k
         c_left[kink_index], d_left[kink_index] = c_k, d_k
+    third = path.third_derivative(s) if "jerk" in kinds else None
     return PathConstraints(
         s=s,
         sd_max=sd_max,
@@ -298,7 +318,8 @@ def build_path_constraints(
         upper=bound.copy(),
         rows=rows,
         joint_names=robot.joint_names,
-        jerk=(points.dq, points.ddq, path.third_derivative(s), limits.jerk) if "jerk" in kinds else None,
+        jerk=None if third is None else (points.dq, points.ddq, third, limits.jerk),
+        jerk_left=None if third is None else _left_derivatives(path, s, points, third),
         velocity_joint=velocity_joint,
         tool_bound=tool_bound,
         evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),

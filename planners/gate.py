@@ -116,11 +116,22 @@ def checked(robot, path, result, method, kinds, limits, threshold, constraints) 
     return TimedStretch(path, result, constraints, check)
 
 
-def samples_exceed(samples, limits: JointLimits, threshold: float, kinds, robot: Robot | None = None) -> tuple[str, int, int] | None:
+def samples_exceed(
+    samples, limits: JointLimits, threshold: float, kinds, robot: Robot | None = None, jerk: bool = False
+) -> tuple[str, int, int] | None:
     """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit (joint
-    -1 for a tool limit, checked when ``robot`` is given)."""
+    -1 for a tool limit, checked when ``robot`` is given). With ``jerk`` (for timings whose
+    acceleration is continuous) and the jerk among ``kinds``, the jerk between consecutive
+    samples, by finite differences of their accelerations, is checked too: it is the mean of
+    the jerk over the step, never above its peak, so it exceeds the limit only where the
+    accelerations jump (sample index: the step's first)."""
     checks = [(kind, values, getattr(limits, kind)) for kind, values in
               (("velocity", samples.qd), ("acceleration", samples.qdd), ("torque", samples.tau)) if kind in kinds]
+    if jerk and "jerk" in kinds and len(samples.t) > 1:
+        steps = np.diff(samples.t)[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            between = np.where(steps > 0.0, np.diff(samples.qdd, axis=0) / steps, 0.0)
+        checks.append(("jerk", between, limits.jerk))
     if limits.tool is not None and robot is not None:
         speeds = tool_speeds(robot, limits.tool, samples.q, samples.qd)
         checks.append(("tool", speeds, limits.tool.bounds))  # columns in the order of TOOL_KINDS

@@ -63,6 +63,22 @@ def _check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) 
         )
 
 
+def _check_jerk_finite(path: GeometricPath, kinds) -> None:
+    """A jerk limit needs a path whose d2q/ds2 is continuous where the motion goes on: at a
+    break (a straight segment meeting a circular blend) the joint acceleration q'' sd^2 jumps
+    unless the motion stops there, an infinite jerk."""
+    if "jerk" not in kinds or not len(path.breaks):
+        return
+    s = float(path.breaks[0])
+    raise InfeasiblePath(
+        f"the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend), "
+        "so the joint accelerations jump there and no motion that passes it has a finite jerk: use "
+        "interpolation 'spline' with a jerk limit, or leave 'jerk' out of timing.constraints",
+        s=s,
+        limit="jerk",
+    )
+
+
 def _moving(velocity):
     """A boundary velocity, or ``None`` for rest (a zero vector included)."""
     if velocity is None or not np.any(np.asarray(velocity) != 0.0):
@@ -182,6 +198,7 @@ def _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold)
     """A given path timed by ``method``; each stretch between corners (where the motion stops)
     on its own, as its own rest-to-rest problem, and every one through the limit gate."""
     _check_path_within_limits(robot, path, path_grid(path, timing.grid_points))
+    _check_jerk_finite(path, kinds)
     boundary = _boundary(path, timing, method)
     parts = stretches(path)
     widths = [getattr(part, "width", 1.0) for part in parts]
@@ -386,10 +403,16 @@ def plan(
         )
     samples = sample_trajectory(path, result, robot, dt, exact_period)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
-    beyond = samples_exceed(samples, limits, threshold, kinds, robot)
+    beyond = samples_exceed(samples, limits, threshold, kinds, robot, jerk=method.continuous_acceleration)
     if beyond is not None:
         kind, sample, joint = beyond
         what = f"{kind} limit of joint {robot.joint_names[joint]!r}" if joint >= 0 else f"{kind.replace('_', ' ')} limit"
+        if kind == "jerk":
+            raise TimingFailed(
+                f"the {timed.method} timing's accelerations jump between the samples at t = "
+                f"{samples.t[sample]:.6g} s and {samples.t[sample + 1]:.6g} s: the jerk from the samples "
+                f"exceeds the {what}"
+            )
         raise TimingFailed(
             f"the {timed.method} timing's sample at t = {samples.t[sample]:.6g} s exceeds the {what} "
             "although its dense check holds; use more grid points"

@@ -91,7 +91,7 @@ def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
         raise InvalidRequest(f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}")
     unsupported = [kind for kind in kinds if kind not in method.kinds]
     if unsupported:
-        hint = " (for jerk, use a time law or ruckig)" if unsupported[0] == "jerk" else ""
+        hint = " (for jerk, use jerk_limited, a time law or ruckig)" if unsupported[0] == "jerk" else ""
         raise InvalidRequest(
             f"timing.method {method.name!r} cannot limit {unsupported[0]}; it handles "
             f"{sorted(method.kinds)}{hint}"

@@ -25,7 +25,8 @@ def _via_points() -> list[list[float]]:
 
 
 #: One request per family that used to run on after its 504: via points, min_cost at its
-#: largest grid, the IK of a long Cartesian polyline (24 m), and the collocation of a free motion.
+#: largest grid, the IK of a long Cartesian polyline (24 m), the collocation of a free motion, and
+#: jerk_limited's linear programs at its largest grid (each stopped by HiGHS's own time limit).
 SLOW = {
     "via_points": {
         "robot": "ur5",
@@ -46,6 +47,11 @@ SLOW = {
         "robot": "ur5",
         "path": {"kind": "free", "start": [0.0] * 6, "goal": [0.5] * 6},
         "timing": {"method": "collocation"},
+    },
+    "jerk_limited": {
+        "robot": "ur5",
+        "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS},
+        "timing": {"method": "jerk_limited", "grid_points": 2000},
     },
 }
 

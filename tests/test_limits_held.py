@@ -16,7 +16,7 @@ import pytest
 
 DATA = Path(__file__).parent / "data"
 KINDS = ("velocity", "acceleration", "torque")
-METHODS = ("phase_plane", "toppra", "min_cost", "quintic", "trapezoidal")
+METHODS = ("phase_plane", "toppra", "min_cost", "quintic", "trapezoidal", "jerk_limited")
 
 
 @pytest.fixture(scope="module")
@@ -62,6 +62,10 @@ def worst_ratio(body: dict, limits: dict[str, np.ndarray]) -> tuple[float, str]:
     even = steps > 0.5 * np.median(steps)
     differences = np.diff(samples["qd"], axis=0)[even] / steps[even][:, None]
     ratios["acceleration (differences)"] = np.max(np.abs(differences) / limits["acceleration"])
+    if body["method"] == "jerk_limited":
+        # Its accelerations are continuous: their differences average the jerk over each step.
+        jerk = np.diff(samples["qdd"], axis=0)[even] / steps[even][:, None]
+        ratios["jerk (differences)"] = np.max(np.abs(jerk) / limits["jerk"])
     kind = max(ratios, key=ratios.get)
     return float(ratios[kind]), kind
 
@@ -108,7 +112,7 @@ def test_a_positive_margin_keeps_every_sample_within_the_limits(client, uploaded
     name = uploaded.get(robot, robot)
     limits = robot_limits(client, name)
     rng = np.random.default_rng(seed)
-    for method in ("phase_plane", "toppra", "min_cost", "cycloidal"):
+    for method in ("phase_plane", "toppra", "min_cost", "cycloidal", "jerk_limited"):
         waypoints = random_waypoints(limits, rng, 4, tiny_first=True)
         response = plan(client, name, waypoints, method, limit_margin=0.002)
         assert response.status_code == 200, response.text
@@ -137,7 +141,7 @@ def test_stop_and_go_paths_with_a_short_segment_are_timed(client, length):
     short = middle + length * np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     end = short + np.array([0.5, -0.4, 0.3, -0.2, 0.3, 0.1])
     waypoints = [start.tolist(), middle.tolist(), short.tolist(), end.tolist()]
-    for method in ("phase_plane", "toppra", "min_cost", "trapezoidal"):
+    for method in ("phase_plane", "toppra", "min_cost", "trapezoidal", "jerk_limited"):
         response = plan(client, "ur5", waypoints, method, interpolation="linear")
         assert response.status_code == 200, (method, response.text)
         body = response.json()
@@ -150,7 +154,7 @@ def test_stop_and_go_paths_with_a_short_segment_are_timed(client, length):
 
 
 @pytest.mark.parametrize(
-    "method", ["phase_plane", "toppra", "min_cost", "cubic", "quintic", "trapezoidal", "cycloidal", "ruckig"]
+    "method", ["phase_plane", "toppra", "min_cost", "cubic", "quintic", "trapezoidal", "cycloidal", "ruckig", "jerk_limited"]
 )
 def test_a_one_joint_arm_is_planned_by_every_method(client, uploaded, method):
     constraints = ["velocity", "acceleration"] if method == "ruckig" else list(KINDS)

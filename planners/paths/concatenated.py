@@ -50,5 +50,5 @@ class ConcatenatedPath(GeometricPath):
         for k, path in enumerate(self.pieces):
             mine = piece == k
             if np.any(mine):
-                out[mine] = path.third_derivative(np.clip(local[mine], 0.0, 1.0)) / (width[mine] ** 3)[:, None]
+                out[mine] = path.third_derivative(np.clip(local[mine], 0.0, 1.0), side) / (width[mine] ** 3)[:, None]
         return out

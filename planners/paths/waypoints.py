@@ -63,8 +63,9 @@ class SplinePath(_ThroughWaypoints):
         return PathPoints(*cubic_pieces(self.knots, self._coefficients, s))
 
     def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
+        """d3q/ds3 (constant per piece; at a knot, the piece on ``side``)."""
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
-        interval = np.clip(np.searchsorted(self.knots, s, side="right") - 1, 0, len(self.knots) - 2)
+        interval = np.clip(np.searchsorted(self.knots, s, side="left" if side == "left" else "right") - 1, 0, len(self.knots) - 2)
         return 6.0 * self._coefficients[0, interval]
 
 

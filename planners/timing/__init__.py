@@ -2,6 +2,7 @@
 
 from planners.timing.base import TimeScaling, TimingMethod
 from planners.timing.classical import ClassicalMethod, classical_methods
+from planners.timing.jerk_limited import JerkLimitedMethod
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.ruckig_method import RuckigMethod
@@ -9,7 +10,7 @@ from planners.timing.toppra_method import ToppraMethod
 
 #: ``timing.method`` name -> method.
 METHODS: dict[str, TimingMethod] = {
-    method.name: method for method in (PhasePlaneMethod(), ToppraMethod(), *classical_methods(), RuckigMethod(), MinCostMethod())
+    method.name: method for method in (PhasePlaneMethod(), ToppraMethod(), *classical_methods(), RuckigMethod(), MinCostMethod(), JerkLimitedMethod())
 }
 
 __all__ = ["METHODS", "ClassicalMethod", "PhasePlaneMethod", "TimeScaling", "TimingMethod", "ToppraMethod"]

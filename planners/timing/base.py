@@ -186,6 +186,8 @@ class TimingMethod(abc.ABC):
         takes_acceleration_boundary: Whether boundary path accelerations are honoured.
         required_kinds: Limit kinds the method always applies, requested or not.
         two_waypoints_only: Whether the method times only a straight move between two states.
+        continuous_acceleration: Whether the method's path acceleration is continuous, so that
+            the jerk of its samples (by finite differences) is checked against a jerk limit too.
         absolute_tolerances: Whether the method's solver works with absolute tolerances, so
             that it needs path speeds of order one (``planners.timing.scaled``).
         grid_budget: The largest grid the method serves, in grid intervals times joints: its
@@ -200,6 +202,7 @@ class TimingMethod(abc.ABC):
     takes_duration: bool = False
     takes_acceleration_boundary: bool = False
     two_waypoints_only: bool = False
+    continuous_acceleration: bool = False
     absolute_tolerances: bool = False
     grid_budget: int = 140_000
 

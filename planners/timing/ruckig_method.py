@@ -72,6 +72,7 @@ class RuckigMethod(TimingMethod):
     required_kinds = frozenset({"jerk"})
     takes_acceleration_boundary = True
     two_waypoints_only = True
+    continuous_acceleration = True
 
     def solve(
         self,

@@ -220,13 +220,14 @@ class TimingRequest(Schema):
     method: MethodName = Field(
         default="phase_plane",
         description="`phase_plane` (time-optimal, default), `toppra`, `min_cost` (minimum of the "
-        "integral of 1 + beta |tau|^2), `ruckig` (jerk-limited, two waypoints), a time law "
+        "integral of 1 + beta |tau|^2), `jerk_limited` (time-optimal with jerk limits too), `ruckig` "
+        "(jerk-limited, two waypoints), a time law "
         "(`cubic`, `quintic`, `trapezoidal`, `cycloidal`), or `collocation` (free path).",
     )
     constraints: list[Literal["velocity", "acceleration", "torque", "jerk"]] = Field(
         default=["velocity", "acceleration", "torque"],
         max_length=4,
-        description="Limits to respect; jerk only with the time laws and ruckig.",
+        description="Limits to respect; jerk only with jerk_limited, the time laws and ruckig.",
     )
     limits: LimitsRequest = Field(default=LimitsRequest(), description="Limit overrides and scale factors, and tool-speed limits.")
     duration: bounded(ranges.DURATION) | None = Field(
@@ -310,7 +311,7 @@ class PhasePlanePublic(BaseModel):
 
 class UtilizationPublic(BaseModel):
     """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds); jerk
-    for timings with a finite jerk (time laws, ruckig)."""
+    for timings with a finite jerk (jerk_limited, time laws, ruckig)."""
 
     velocity: list[float] = Field(description="Peak |qd| / velocity limit per joint.")
     acceleration: list[float] = Field(description="Peak |qdd| / acceleration limit per joint.")
