@@ -17,7 +17,7 @@ from planners.threads import single_blas_thread
 from service.body_limit import BodySizeLimit
 from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.jobs import JOB_MODULES, job_runner
-from service.routes import health, jobs, robots as robot_routes, trajectories, web
+from service.routes import batches, health, jobs, robots as robot_routes, trajectories, web
 from service.settings import Settings
 from service.workers import PlanningWorkers
 
@@ -77,5 +77,6 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(robot_routes.router)
     app.include_router(trajectories.router)
     app.include_router(jobs.router)
+    app.include_router(batches.router)
     app.include_router(web.router)
     return app

@@ -62,6 +62,12 @@ def main(argv: list[str] | None = None) -> int:
     plot.add_argument("request", help="a JSON file shaped like POST /v1/trajectories' body, - for stdin")
     plot.add_argument("-o", "--output", required=True, help="the HTML file to write")
     plot.set_defaults(run=lambda args: commands_.plot(args.request, args.output))
+    batch = commands.add_parser("batch", help="plan a file of requests (JSON Lines) on Ray, resumably")
+    batch.add_argument("requests", help="a JSON Lines file: a POST /v1/trajectories (or compare) body per line")
+    batch.add_argument("-o", "--output", required=True, help="the JSON Lines file of results (appended; resumed)")
+    batch.add_argument("--workers", type=int, default=None, help="Ray workers (CPUs) of a local Ray (default: the cores)")
+    batch.add_argument("--ray-address", default=None, help="an existing Ray cluster: auto or ray://host:port (default: a local Ray)")
+    batch.set_defaults(run=lambda args: commands_.batch(args.requests, args.output, args.workers, args.ray_address))
     args = parser.parse_args(argv)
     return args.run(args)
 

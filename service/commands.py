@@ -52,6 +52,11 @@ def _validation_detail(error: ValidationError) -> str:
     return "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in error.errors())
 
 
+def validation_problem(error: ValidationError) -> dict:
+    """The problem+json of a request that does not fit its schema (as the HTTP API's 422)."""
+    return _problem("Invalid request", 422, _validation_detail(error))
+
+
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
@@ -63,7 +68,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
         print(json.dumps(_problem("Cannot read request", 400, str(error))), file=sys.stderr)
         return 2
     except ValidationError as error:
-        print(json.dumps(_problem("Invalid request", 422, _validation_detail(error))), file=sys.stderr)
+        print(json.dumps(validation_problem(error)), file=sys.stderr)
         return 1
     except ToptrajError as error:
         print(json.dumps(_problem(error.title, error.status, error.detail)), file=sys.stderr)
@@ -135,3 +140,25 @@ def plot(source: str, output: str) -> int:
     except OSError as error:
         print(json.dumps(_problem("Cannot write the page", 400, f"{output!r}: {error}")), file=sys.stderr)
         return 2
+
+
+def batch(requests: str, output: str, workers: int | None, ray_address: str | None) -> int:
+    """``toptraj batch FILE -o OUT``: every request line planned (on Ray), a result line each,
+    resumable (``service.batches``)."""
+    from service.batches import run_batch
+    from service.batches.runner import progress_bar
+
+    if workers is not None and workers < 1:
+        print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)
+        return 2
+    try:
+        report = run_batch(requests, output, workers, ray_address, progress_bar())
+    except OSError as error:
+        print(json.dumps(_problem("Cannot read or write", 400, str(error))), file=sys.stderr)
+        return 2
+    print(
+        f"{report.planned} planned, {report.skipped} already in {output}, {report.total} in all, "
+        f"{report.seconds:.1f} s ({report.rate:.1f} requests/s)",
+        file=sys.stderr,
+    )
+    return 0

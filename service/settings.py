@@ -41,6 +41,9 @@ class Settings(BaseSettings):
         max_jobs: Most jobs the job store keeps (``jobs.sqlite3``); the oldest ended go first.
         job_max_age_s: Seconds an ended job is kept, at most.
         max_job_store_bytes: Most bytes of requests, answers and errors the job store keeps.
+        ray_address: A Ray cluster for batches (``POST /v1/batches``): ``auto``,
+            ``ray://host:port`` or ``local`` (a Ray started in the job's process); none: a batch
+            runs in the server's own job worker process.
     """
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")
@@ -62,3 +65,4 @@ class Settings(BaseSettings):
     max_jobs: int = Field(default=1_000, ge=1)
     job_max_age_s: float = Field(default=7 * 86_400.0, gt=0)
     max_job_store_bytes: int = Field(default=1_000_000_000, ge=1_000_000)
+    ray_address: str | None = None

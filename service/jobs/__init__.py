@@ -25,5 +25,6 @@ def job_runner(settings) -> JobRunner:
         max_upload_bytes=settings.max_upload_bytes,
         upload_cache_size=settings.upload_cache_size,
         max_response_bytes=settings.max_response_bytes,
+        ray_address=settings.ray_address,
     )
     return JobRunner(store, settings.job_workers, setup)

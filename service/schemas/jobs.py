@@ -11,7 +11,7 @@ from pydantic import BaseModel, Field, model_validator
 from service.schemas.common import Problem, Schema
 from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
 
-JobKind = Literal["trajectory", "compare"]
+JobKind = Literal["trajectory", "compare", "batch"]
 JobStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
 
 
@@ -71,7 +71,7 @@ class JobSummary(BaseModel):
     """A job without its answer (``GET /v1/jobs/{id}`` carries the answer)."""
 
     id: str = Field(description="32 hex digits.")
-    kind: JobKind = Field(description="`trajectory` or `compare`: what the job computes.")
+    kind: JobKind = Field(description="`trajectory`, `compare` or `batch`: what the job computes.")
     status: JobStatus = Field(
         description="`queued` (waits for a job worker), `running`, `done` (see `result`), `failed` (see "
         "`error`), `cancelled` (DELETE), `interrupted` (the server stopped while it ran; submit it again)."
@@ -89,11 +89,44 @@ class JobSummary(BaseModel):
     )
 
 
+#: Most requests of one batch (each answer may be large: a trajectory body of a 6-joint arm
+#: at dt = 0.01 s is about 100 kB, and a job's answer is held by the job store).
+MAX_BATCH_REQUESTS = 200
+
+
+class BatchCreate(Schema):
+    """Many requests in one job: each the body of `POST /v1/trajectories` or, naming `methods`,
+    of `POST /v1/trajectories/compare`."""
+
+    requests: list[dict] = Field(
+        min_length=1,
+        max_length=MAX_BATCH_REQUESTS,
+        description="The requests, each checked now against its schema (a 422 names the first bad one).",
+    )
+    budget_s: float | None = Field(
+        default=None, ge=0.1, description="Computing time of the whole batch once it runs, in s (as a job's)."
+    )
+
+
+class BatchResult(BaseModel):
+    """One request's answer in a batch."""
+
+    line: int = Field(description="The request's position in `requests`, from 1.")
+    status: int = Field(description="The HTTP status its own endpoint would answer.")
+    body: dict = Field(description="Its answer, or its problem+json.")
+
+
+class BatchResponse(BaseModel):
+    """A batch's answers, in the order of its requests."""
+
+    results: list[BatchResult] = Field(description="One per request, errors included.")
+
+
 class JobPublic(JobSummary):
     """A job, with its answer once done."""
 
-    result: TrajectoryResponse | CompareResponse | None = Field(
-        default=None, description="When done: the very body the synchronous endpoint answers."
+    result: TrajectoryResponse | CompareResponse | BatchResponse | None = Field(
+        default=None, description="When done: the very body the synchronous endpoint answers (a batch: every answer)."
     )
 
 

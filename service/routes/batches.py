@@ -1,0 +1,61 @@
+"""``POST /v1/batches``: many requests as one job (``service.jobs``, kind ``batch``), answered
+by ``GET /v1/jobs/{id}`` like any job: in the server's own job worker process, or on the Ray
+cluster the server is configured with (``TOPTRAJ_RAY_ADDRESS``). For thousands of requests,
+``toptraj batch`` on a file is the tool."""
+
+from __future__ import annotations
+
+import orjson
+from fastapi import APIRouter, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import Response
+from pydantic import ValidationError
+
+from planners.errors import InvalidRequest
+from service.routes.jobs import _job_response, _problem
+from service.schemas.jobs import BatchCreate, JobPublic
+from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+
+router = APIRouter(prefix="/v1/batches", tags=["jobs"])
+
+
+def _checked(requests: list[dict]) -> None:
+    """Each request against its schema (strictly, as the endpoints take them): a 422 naming
+    the first bad one and its field."""
+    for index, item in enumerate(requests):
+        schema = CompareRequest if "methods" in item else TrajectoryRequest
+        try:
+            schema.model_validate(item, strict=True)
+        except ValidationError as error:
+            raise RequestValidationError(
+                [{**e, "loc": ("body", "requests", index, *e["loc"])} for e in error.errors(include_url=False, include_context=False)]
+            ) from None
+
+
+@router.post(
+    "",
+    status_code=202,
+    summary="Start a batch of requests",
+    response_model=JobPublic,
+    responses={
+        202: {"description": "Queued as a job; `GET` the `Location` for its progress and answers."},
+        422: _problem(422, "A request of the batch does not fit its schema, or a budget over the maximum."),
+        503: _problem(503, "The job queue is full (`Retry-After`)."),
+    },
+)
+async def create_batch(body: BatchCreate, request: Request) -> Response:
+    """Plan every request (trajectory or compare bodies) in the background as one job; the
+    job's answer lists each request's status and body (its answer or its problem), in order."""
+    _checked(body.requests)
+    settings = request.app.state.settings
+    budget_s = settings.job_budget_s if body.budget_s is None else body.budget_s
+    if budget_s > settings.job_max_budget_s:
+        raise InvalidRequest(f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= {settings.job_max_budget_s:g}")
+    runner = request.app.state.jobs
+    from starlette.concurrency import run_in_threadpool
+
+    job = await run_in_threadpool(
+        runner.store.submit, "batch", orjson.dumps({"requests": body.requests}).decode(), budget_s, settings.job_queue
+    )
+    runner.wake()
+    return _job_response(job, status_code=202, headers={"Location": f"/v1/jobs/{job.id}"})
