@@ -136,3 +136,29 @@ def test_a_batch_over_http_answers_each_request_in_order(client):
 def test_a_bad_request_in_a_batch_is_refused_at_once(client):
     response = client.post("/v1/batches", json={"requests": [{"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.1] * 6]}}, {"robot": "ur5", "path": {"waypoints": "no"}}]})
     assert response.status_code == 422 and "requests[1]" in response.text
+
+
+def test_a_batch_over_http_runs_on_ray_when_the_server_has_an_address(tmp_path):
+    """``TOPTRAJ_RAY_ADDRESS=local``: the job hands its requests to a Ray it starts."""
+    from fastapi.testclient import TestClient
+
+    from service.app import create_app
+    from service.settings import Settings
+
+    import os
+    import time
+
+    good = json.loads(_requests(2)[1])
+    started = time.time()
+    settings = Settings(preload_robots=False, data_dir=tmp_path, ray_address="local")
+    with TestClient(create_app(settings)) as client:
+        location = client.post("/v1/batches", json={"requests": [good, {"robot": "nope", **PLAN}]}).headers["location"]
+        for _ in range(1200):
+            job = client.get(location).json()
+            if job["status"] in ("done", "failed"):
+                break
+            time.sleep(0.1)
+    assert job["status"] == "done", job
+    assert [(r["line"], r["status"]) for r in job["result"]["results"]] == [(1, 200), (2, 404)]
+    # the job started a Ray session of its own (Ray keeps its newest session's files here)
+    assert os.path.getmtime(os.path.realpath("/tmp/ray/session_latest")) >= started
