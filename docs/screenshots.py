@@ -23,7 +23,7 @@ def main() -> None:
 
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false") as server, sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
+        browser = playwright.chromium.launch(executable_path=chromium, args=["--no-sandbox", "--disable-dev-shm-usage"])
         page = browser.new_page(viewport={"width": 1400, "height": 1300})
         for name, preset in SHOTS.items():
             page.goto(f"http://127.0.0.1:{server.port}/")

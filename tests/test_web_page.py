@@ -21,7 +21,7 @@ def browser_page():
 
     assert CHROMIUM, "a real browser is needed: apt-get install chromium (make test does it)"
     with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false") as server, sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
         page = browser.new_page(viewport={"width": 1400, "height": 1300})
         base = f"http://127.0.0.1:{server.port}"
         outside: list[str] = []
