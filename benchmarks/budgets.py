@@ -205,7 +205,7 @@ def health_during_large_body() -> None:
         for dt in filter(None, (1e-5, smallest)):
             answer = {}
             thread = threading.Thread(
-                target=lambda dt=dt: answer.update(
+                target=lambda dt=dt, answer=answer: answer.update(
                     started=time.monotonic(),
                     response=server.request("POST", "/v1/trajectories", {**request, "output": {"dt": dt}}),
                     ended=time.monotonic(),

@@ -16,13 +16,12 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import InfeasiblePath, TimingFailed
 from robots.catalog import robot_from_model
-
-import pinocchio as pin
 
 DATA = Path(__file__).parent.parent / "tests" / "data"
 KINDS = ("velocity", "acceleration", "torque")

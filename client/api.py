@@ -42,7 +42,7 @@ class Trajectory:
     body: dict = field(repr=False)
 
     @classmethod
-    def from_body(cls, body: dict) -> "Trajectory":
+    def from_body(cls, body: dict) -> Trajectory:
         samples = body["samples"]
         return cls(
             robot=body["robot"],
@@ -77,7 +77,7 @@ class Client:
         self._http = http or httpx.Client(base_url=base_url, timeout=timeout)
         self._owned = http is None
 
-    def __enter__(self) -> "Client":
+    def __enter__(self) -> Client:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -20,8 +20,8 @@ b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never se
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -79,14 +79,14 @@ class PathConstraints:
     jerk_left: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     velocity_joint: np.ndarray | None = None
     tool_bound: np.ndarray | None = None
-    evaluate: Callable[[np.ndarray], "PathConstraints"] | None = field(default=None, repr=False, compare=False)
+    evaluate: Callable[[np.ndarray], PathConstraints] | None = field(default=None, repr=False, compare=False)
 
     @property
     def can_refine(self) -> bool:
         """Whether rows can be evaluated at new values of s (``with_points``)."""
         return self.evaluate is not None
 
-    def with_points(self, extra_s: np.ndarray) -> "PathConstraints":
+    def with_points(self, extra_s: np.ndarray) -> PathConstraints:
         """These constraints on the grid refined by ``extra_s`` (values strictly inside grid
         intervals, never at a corner), evaluating the rows only at the new points."""
         extra = self.evaluate(np.asarray(extra_s, dtype=float))
@@ -122,7 +122,7 @@ class PathConstraints:
             evaluate=self.evaluate,
         )
 
-    def time_scaled(self, kappa: float) -> "PathConstraints":
+    def time_scaled(self, kappa: float) -> PathConstraints:
         """The same limits in a scaled time: with x = kappa x' and u = kappa u' (time runs
         sqrt(kappa) times slower), the rows ``(kappa a) u' + (kappa b) x' + c + (sqrt(kappa) d) sd'``
         and the bound sd' <= sd_max / sqrt(kappa). A solver that works with absolute tolerances
@@ -147,7 +147,7 @@ class PathConstraints:
         """Whether any row has a term linear in sd (viscous joint friction)."""
         return bool(np.any(self.d != 0.0))
 
-    def linearized(self, x_ref: np.ndarray, side: str = "right") -> "LinearRows":
+    def linearized(self, x_ref: np.ndarray, side: str = "right") -> LinearRows:
         """Rows linear in (u, x), a conservative inner approximation of these constraints.
 
         A viscous term d sd = d sqrt(x) is replaced by a bound that can only tighten the row:

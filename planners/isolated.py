@@ -46,7 +46,7 @@ POLL_S = 0.02
 #: Shortest interval between two progress reports of one stage sent by a child, in s.
 PROGRESS_S = 0.1
 #: Modules the fork server imports once, so that children start with them loaded.
-PRELOAD = ["numpy", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.free_path.collocation"]
+PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.free_path.collocation"]
 
 _context = None
 _lock = threading.Lock()

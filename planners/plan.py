@@ -14,19 +14,19 @@ from typing import NamedTuple
 import numpy as np
 
 from planners.boundary import path_acceleration, path_speed
+from planners.collision import Obstacle, check_clearance
 from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
-from planners.grid import MAX_POINTS, path_grid
-from planners.waypoint_checks import checked_waypoints, continuous_turns, make_path, without_repeats
-from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.gate import TimedStretch, checked, gate_threshold, gated, samples_exceed
+from planners.grid import MAX_POINTS, path_grid
+from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.mvc import admissible_set
-from planners.ranges import check_timing
 from planners.paths import GeometricPath
 from planners.paths.cartesian import CartesianLine
 from planners.paths.stretch import stretches
+from planners.ranges import check_timing
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
 from planners.timing.base import Boundary, PathTiming, TimingMethod
@@ -34,9 +34,9 @@ from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.segmented import SegmentedTiming
 from planners.tool_speed import tool_speed_limit
-from planners.collision import Obstacle, check_clearance
 from planners.trajectory import sample_trajectory
 from planners.via_points import via_point_trajectory
+from planners.waypoint_checks import checked_waypoints, continuous_turns, make_path, without_repeats
 from robots import JointLimits, Robot
 
 MAX_SAMPLES = 200_000
@@ -154,7 +154,7 @@ class _Timed(NamedTuple):
 
     path: GeometricPath
     timing: PathTiming
-    stretches: tuple["TimedStretch", ...]
+    stretches: tuple[TimedStretch, ...]
     method: str
     notes: tuple[str, ...] = ()
     cost: float | None = None
@@ -299,7 +299,7 @@ DEFAULT_CLEARANCE = 0.01
 
 def plan(
     robot: Robot,
-    path_spec: "WaypointPath | CartesianLine",
+    path_spec: WaypointPath | CartesianLine,
     timing: Timing = Timing(),
     dt: float = 0.01,
     deadline: Deadline = NO_DEADLINE,

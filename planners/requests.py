@@ -16,7 +16,6 @@ from planners.timing.collocation_method import CollocationMethod
 from planners.timing.laws import TrapezoidalProfile
 from planners.timing.min_cost import MinCostMethod
 
-
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
 #: default path tolerance of MoveIt's time-optimal trajectory generation.
 DEFAULT_MAX_DEVIATION = 0.1

@@ -52,7 +52,7 @@ class PlannedTrajectory:
     conditioning: Conditioning | None = None
     cost: float | None = None
     solver: dict | None = None
-    clearance: "Clearance | None" = None
+    clearance: Clearance | None = None
 
 
 def require_finite(method: str, **quantities) -> None:

@@ -136,7 +136,7 @@ def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tu
     return spec, notes
 
 
-def make_path(robot: Robot, spec: "WaypointPath | CartesianLine", deadline: Deadline = NO_DEADLINE) -> GeometricPath:
+def make_path(robot: Robot, spec: WaypointPath | CartesianLine, deadline: Deadline = NO_DEADLINE) -> GeometricPath:
     """The geometric path of a Cartesian line, or of joint waypoints interpolated by spline or
     linear segments (via points are timed and shaped together, in ``via_points``)."""
     if isinstance(spec, CartesianLine):

@@ -42,7 +42,7 @@ class ToolSpeedLimit:
         """(speed, angular_speed), shape (2,)."""
         return np.array([self.speed, self.angular_speed])
 
-    def tightened(self, margin: float) -> "ToolSpeedLimit":
+    def tightened(self, margin: float) -> ToolSpeedLimit:
         """These bounds reduced by the fraction ``margin``."""
         factor = 1.0 - margin
         return dataclasses.replace(self, speed=self.speed * factor, angular_speed=self.angular_speed * factor)
@@ -76,7 +76,7 @@ class JointLimits:
         self,
         overrides: dict[str, list[float] | None] | None = None,
         scales: dict[str, float] | None = None,
-    ) -> "JointLimits":
+    ) -> JointLimits:
         """These limits with a request's per-joint ``overrides`` replacing and ``scales``
         multiplying the velocity, acceleration, jerk and torque limits.
 
@@ -105,7 +105,7 @@ class JointLimits:
             values[kind] = values[kind] * factor
         return JointLimits(**values, tool=self.tool)
 
-    def tightened(self, margin: float) -> "JointLimits":
+    def tightened(self, margin: float) -> JointLimits:
         """These limits with the velocity, acceleration, jerk and torque limits reduced by the
         fraction ``margin`` (0 <= margin < 1); position limits unchanged."""
         factor = 1.0 - margin

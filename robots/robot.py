@@ -73,7 +73,7 @@ class Robot:
         source: str,
         end_effector: str,
         limits: JointLimits,
-    ) -> "Robot":
+    ) -> Robot:
         """Wrap ``model``, precomputing the map from tangent coordinates to Pinocchio's q."""
         cos_index, pair_angle, plain_q, plain_v = [], [], [], []
         continuous = np.zeros(model.nv, dtype=bool)

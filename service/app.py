@@ -4,20 +4,20 @@ from __future__ import annotations
 
 from contextlib import asynccontextmanager
 
+import numpy as np
 from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 from starlette.concurrency import run_in_threadpool
-
-import numpy as np
 
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.isolated import start_worker_server
 from planners.threads import single_blas_thread
 from service.body_limit import BodySizeLimit
-from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.jobs import JOB_MODULES, job_runner
-from service.routes import batches, health, jobs, robots as robot_routes, trajectories, web
+from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
+from service.routes import batches, health, jobs, trajectories, web
+from service.routes import robots as robot_routes
 from service.settings import Settings
 from service.workers import PlanningWorkers
 

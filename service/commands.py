@@ -16,7 +16,7 @@ import io
 import json
 import os
 import sys
-from typing import Callable
+from collections.abc import Callable
 
 from pydantic import ValidationError
 
@@ -120,8 +120,8 @@ def compare(source: str) -> int:
 def plot(source: str, output: str) -> int:
     """``toptraj plot FILE|- -o OUT.html``: the page's plots of one trajectory request, in a
     self-contained HTML file (Plotly's JavaScript inlined: it opens offline)."""
-    from service.plots import figures_html
     from service.planning import plan_request
+    from service.plots import figures_html
     from service.schemas.trajectories import TrajectoryRequest
 
     def page(text: str) -> bytes:

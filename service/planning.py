@@ -12,14 +12,14 @@ import orjson
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
 from planners.boundary import finite_vector
-from planners.deadline import NO_DEADLINE
-from planners.free_path import FreeMotion
-from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.collision import BoxObstacle, CapsuleObstacle, SphereObstacle
+from planners.deadline import NO_DEADLINE
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.free_path import FreeMotion
 from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from robots import InvalidLimits, UnknownRobot
-from service.problems import non_finite_answer
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
+from service.problems import non_finite_answer
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.

@@ -112,7 +112,7 @@ class PlanningWorkers:
             future.add_done_callback(_consume)
             try:
                 return await asyncio.wait_for(asyncio.shield(future), timeout=deadline.remaining())
-            except asyncio.TimeoutError:
+            except TimeoutError:
                 deadline.cancel()
                 raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s") from None
             except asyncio.CancelledError:  # the client went away, or the server stops
@@ -146,7 +146,7 @@ class PlanningWorkers:
                     raise BudgetExceeded(f"no planning worker came free within the time budget of {budget_s:g} s")
                 try:
                     await asyncio.wait_for(waiter.woken.wait(), timeout=min(remaining, _POLL_S))
-                except asyncio.TimeoutError:
+                except TimeoutError:
                     pass
                 waiter.woken.clear()
         finally:

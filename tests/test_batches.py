@@ -140,13 +140,13 @@ def test_a_bad_request_in_a_batch_is_refused_at_once(client):
 
 def test_a_batch_over_http_runs_on_ray_when_the_server_has_an_address(tmp_path):
     """``TOPTRAJ_RAY_ADDRESS=local``: the job hands its requests to a Ray it starts."""
+    import os
+    import time
+
     from fastapi.testclient import TestClient
 
     from service.app import create_app
     from service.settings import Settings
-
-    import os
-    import time
 
     good = json.loads(_requests(2)[1])
     started = time.time()

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
+
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.json"))
 
 

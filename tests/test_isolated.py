@@ -19,7 +19,7 @@ from planners.isolated import run_isolated
 
 def _spin(pid_file: str) -> None:
     with open(pid_file, "w") as handle:
-        handle.write(str(os.getpid()))
+        handle.write(f"{os.getpid()} {psutil.Process().create_time()}")
     while True:
         pass
 
@@ -46,9 +46,12 @@ def test_an_error_comes_back_with_its_facts():
 
 
 def _killed(pid_file) -> bool:
-    pid = int(pid_file.read_text())
+    """Whether the worker that wrote ``pid_file`` is gone (its number may already belong to
+    another process on a busy machine: the start time tells them apart)."""
+    pid, created = pid_file.read_text().split()
     try:
-        return psutil.Process(pid).status() == psutil.STATUS_ZOMBIE
+        process = psutil.Process(int(pid))
+        return process.create_time() != float(created) or process.status() == psutil.STATUS_ZOMBIE
     except psutil.NoSuchProcess:
         return True
 
@@ -56,7 +59,8 @@ def _killed(pid_file) -> bool:
 def test_the_worker_is_killed_when_the_deadline_passes(tmp_path):
     pid_file = tmp_path / "pid"
     with pytest.raises(BudgetExceeded):
-        run_isolated(_spin, str(pid_file), deadline=Deadline(1.0))
+        # long enough for the worker to start spinning even on a busy machine
+        run_isolated(_spin, str(pid_file), deadline=Deadline(3.0))
     assert _killed(pid_file)
 
 

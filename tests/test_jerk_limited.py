@@ -11,7 +11,7 @@ from ruckig import InputParameter, Ruckig, Trajectory
 
 import robots
 from planners import Timing, WaypointPath, plan
-from planners.errors import InfeasiblePath, TimingFailed
+from planners.errors import TimingFailed
 from planners.timing.jerk_limited import JerkLimitedMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.waypoint_checks import make_path

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import uvicorn
 
+import robots
 from planners import Deadline, InvalidRequest, Timing, TimingFailed, WaypointPath, plan
 from planners.grid import path_grid
 from planners.results import require_finite
@@ -21,8 +22,6 @@ from service.app import create_app
 from service.problems import FiniteJSONResponse, NonFiniteAnswer
 from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
-
-import robots
 
 DIRECTION = [0.8, 0.2, 0.4, -0.5, 0.6, 0.3]
 TWO = UR5_WAYPOINTS[:2]

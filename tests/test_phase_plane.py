@@ -12,9 +12,9 @@ from planners import Timing, WaypointPath, plan
 from planners.constraints import build_path_constraints
 from planners.errors import InfeasiblePath
 from planners.grid import path_grid
+from planners.limit_check import check_limits
 from planners.paths import SplinePath
 from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.limit_check import check_limits
 
 UR5 = robots.load("ur5")
 START = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])

@@ -11,9 +11,9 @@ import robots
 from planners.constraints import build_path_constraints
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.grid import path_grid
+from planners.limit_check import check_limits
 from planners.paths import SplinePath, StopAndGoPath
 from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.limit_check import check_limits
 
 CASES = {"ur5": 334, "panda": 333, "yamamoto_2r": 333}
 

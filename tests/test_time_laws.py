@@ -8,9 +8,9 @@ import pytest
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.timing.laws import (
+    CubicProfile,
     CycloidalProfile,
     QuinticProfile,
-    CubicProfile,
     TrapezoidalProfile,
     cubic_coefficients,
     polynomial_derivatives,

@@ -29,7 +29,6 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
 from planners.timing.law_timing import LawSegment, LawTiming
-from planners.tool_speed import TOOL_KINDS
 from planners.timing.laws import (
     CubicProfile,
     CycloidalProfile,
@@ -39,6 +38,7 @@ from planners.timing.laws import (
     cubic_coefficients,
     quintic_coefficients,
 )
+from planners.tool_speed import TOOL_KINDS
 
 #: Keeps samples strictly inside a segment, so that a corner is seen from the segment's side.
 _INSIDE = 1e-9

@@ -104,7 +104,7 @@ class JerkLimitedMethod(TimingMethod):
         boundary: Boundary = AT_REST,
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
-    ) -> "JerkTimeScaling | JerkSegmentsTiming":
+    ) -> JerkTimeScaling | JerkSegmentsTiming:
         if constraints.jerk is None:
             raise InvalidRequest("timing.method 'jerk_limited' needs the jerk constraint")
         if boundary.sdd_start or boundary.sdd_end:

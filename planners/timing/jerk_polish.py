@@ -232,7 +232,7 @@ def _polished(constraints, grid_timing, initial, sd_start: float, sd_end: float,
     for _ in range(ROUNDS + 1):
         checks = (segment, fraction)
 
-        def evaluate(z):
+        def evaluate(z, checks=checks):
             deadline.check()
             tau, sigma = np.maximum(z[:M] * scales[:M], 0.0), z[M:] * scales[M:]
             s, v, a, sig, Dp, starts, D = _points(tau, sigma, start, checks)

@@ -72,7 +72,7 @@ class LawTiming(PathTiming):
     def duration(self) -> float:
         return float(sum(segment.duration for segment in self.segments))
 
-    def slowed(self, factor: float) -> "LawTiming | None":
+    def slowed(self, factor: float) -> LawTiming | None:
         """The same rest-to-rest laws, each ``factor`` times longer (velocities divide by the
         factor, accelerations by its square); ``None`` when a segment is a polynomial fitted to
         boundary speeds, which a longer duration would change."""

@@ -180,7 +180,7 @@ class _Grid(NamedTuple):
     friction: bool
 
     @classmethod
-    def of(cls, constraints: PathConstraints) -> "_Grid":
+    def of(cls, constraints: PathConstraints) -> _Grid:
         rows = tuple(
             np.ascontiguousarray(array, dtype=np.float64)
             for array in (

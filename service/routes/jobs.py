@@ -3,14 +3,14 @@ their own, with progress; the answer (or the error) is kept in the job store."""
 
 from __future__ import annotations
 
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Annotated
 
 import orjson
-from pydantic import ValidationError
 from fastapi import APIRouter, Body, Query, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
+from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 import robots
@@ -82,7 +82,7 @@ EXAMPLES = {
 
 
 def _time(value: float | None) -> str | None:
-    return None if value is None else datetime.fromtimestamp(value, timezone.utc).isoformat()
+    return None if value is None else datetime.fromtimestamp(value, UTC).isoformat()
 
 
 def job_fields(job: Job) -> dict:
