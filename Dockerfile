@@ -25,11 +25,12 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
     PATH=/opt/venv/bin:${PATH}
 
 # libgomp1: OpenMP runtime that the pinocchio wheels link against (not bundled in them).
-# chromium: the real browser the web page's tests drive (Playwright).
+# chromium: the real browser the web page's tests drive (Playwright, whose bundled node driver
+# needs libatomic1).
 # Unprivileged runtime user; /app is its working directory (pytest keeps its cache there).
 # hadolint ignore=DL3008
 RUN apt-get update \
-    && apt-get install -y --no-install-recommends libgomp1 chromium \
+    && apt-get install -y --no-install-recommends libgomp1 chromium libatomic1 \
     && rm -rf /var/lib/apt/lists/* \
     && groupadd --gid 10001 toptraj \
     && useradd --create-home --uid 10001 --gid 10001 --shell /usr/sbin/nologin toptraj \
