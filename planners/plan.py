@@ -216,6 +216,8 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, thre
     """Via points: segments shaped and timed together by the limits."""
     if timing.start_velocity is not None or timing.end_velocity is not None:
         raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
+    if timing.supporting_points is not None:
+        raise InvalidRequest("via-point segments are polynomials: leave timing.supporting_points out, or use 'spline' or 'linear'")
     path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration, deadline)
     s = _grid(path, timing.grid_points, method, robot)
     _check_path_within_limits(robot, path, s)

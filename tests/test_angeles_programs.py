@@ -240,3 +240,9 @@ def test_laws_over_http(client):
     body["timing"]["supporting_points"] = 3
     refused = client.post("/v1/trajectories", json=body)
     assert refused.status_code == 422 and "supporting_points" in refused.text
+
+
+def test_supporting_points_refused_with_via_points():
+    path = WaypointPath(np.array(UR5_WAYPOINTS), "via")
+    with pytest.raises(InvalidRequest, match="supporting_points"):
+        plan(UR5, path, Timing(method="cubic", supporting_points=8))
