@@ -33,6 +33,7 @@ from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.segmented import SegmentedTiming
+from planners.timing.unsynchronized import unsynchronized_trajectory
 from planners.tool_speed import tool_speed_limit
 from planners.trajectory import sample_trajectory
 from planners.via_points import via_point_trajectory
@@ -233,7 +234,33 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, thre
     """Via points: segments shaped and timed together by the limits."""
     if timing.start_velocity is not None or timing.end_velocity is not None:
         raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
+    if timing.supporting_points is not None:
+        raise InvalidRequest("via-point segments are polynomials: leave timing.supporting_points out, or use 'spline' or 'linear'")
     path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration, deadline)
+    s = _grid(path, timing.grid_points, method, robot)
+    _check_path_within_limits(robot, path, s)
+    constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
+    stretch = checked(robot, path, result, method.name, kinds, limits, threshold, constraints)
+    return _Timed(path, result, (stretch,), method.name)
+
+
+def _timed_unsynchronized(robot, spec, method, timing, kinds, limits, deadline, threshold) -> _Timed:
+    """Every joint at its own full speed to its goal (``timing.synchronization = "none"``)."""
+    if not isinstance(spec, WaypointPath) or spec.interpolation == "via" or len(spec.waypoints) != 2:
+        raise InvalidRequest(
+            "timing.synchronization 'none' moves every joint on its own from a start to a goal: give "
+            "exactly 2 waypoints (interpolation 'spline' or 'linear'), or use 'normalized'"
+        )
+    boundary = (timing.start_velocity, timing.end_velocity, timing.start_acceleration, timing.end_acceleration)
+    if any(value is not None for value in boundary) or limits.tool is not None:
+        raise InvalidRequest(
+            "timing.synchronization 'none' moves every joint from rest to rest on its own: leave "
+            "timing.boundary and the tool-speed limits out, or use 'normalized'"
+        )
+    waypoints = checked_waypoints(robot, spec)
+    path, result = unsynchronized_trajectory(
+        robot, waypoints[0], waypoints[1], method.profile, limits, kinds, timing.duration, deadline
+    )
     s = _grid(path, timing.grid_points, method, robot)
     _check_path_within_limits(robot, path, s)
     constraints = build_path_constraints(path, robot, limits, tuple(k for k in kinds if k != "jerk"), s, deadline)
@@ -377,6 +404,9 @@ def plan(
     with numerical_breakdown_is_failure(method.name):
         if isinstance(path_spec, FreeMotion) or method.name == "collocation":
             timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, timing_part, threshold)
+        elif timing.synchronization == "none":
+            timing_part.progress(0.0, "joint moves")
+            timed = _timed_unsynchronized(robot, path_spec, method, timing, kinds, limits, timing_part, threshold)
         elif isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
             timing_part.progress(0.0, "via points")
             timed = _timed_via_points(robot, path_spec, method, timing, kinds, limits, timing_part, threshold)

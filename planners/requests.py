@@ -13,7 +13,8 @@ from planners.timing import METHODS
 from planners.timing.base import TimingMethod
 from planners.timing.classical import ClassicalMethod
 from planners.timing.collocation_method import CollocationMethod
-from planners.timing.laws import TrapezoidalProfile
+from planners.timing.laws import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
+from planners.timing.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
 from planners.timing.min_cost import MinCostMethod
 
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
@@ -55,6 +56,15 @@ class Timing:
         duration: Seconds, for the time laws; ``None`` asks for the shortest within the limits.
         trapezoid_fractions: (tau1, tau2), the trapezoidal law's ends of acceleration and of
             cruise as fractions of the duration.
+        trapezoid_blend: ``"linear"`` (constant acceleration, Angeles 6.1) or ``"cycloidal"``
+            (cycloidal blends, Angeles 6.3) for the trapezoidal law's speed ramps.
+        supporting_points: For a time law, approximate it by the cubic spline through this many
+            equally spaced points of it (Angeles 6.1 (c), ``planners.timing.splines``);
+            ``None``: the law itself.
+        synchronization: For a time law on a straight joint move (two waypoints):
+            ``"normalized"`` times the straight joint line as one, every joint starting and
+            stopping together; ``"none"`` runs every joint at its own full speed to its goal
+            (lecture "Trajectory Planning"; ``planners.timing.unsynchronized``).
         torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
             ``min_cost``.
         limit_margin: Fraction of every velocity, acceleration, jerk, torque and tool-speed
@@ -77,6 +87,9 @@ class Timing:
     end_acceleration: np.ndarray | None = None
     duration: float | None = None
     trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
+    trapezoid_blend: str = "linear"
+    supporting_points: int | None = None
+    synchronization: str = "normalized"
     torque_weight: float = 0.0
     limit_margin: float = 0.0
     tool_speed: float | None = None
@@ -101,13 +114,68 @@ def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
     return kinds
 
 
-def timing_method(timing: Timing) -> TimingMethod:
-    """The method named by ``timing.method`` (with its per-request options)."""
+#: Trapezoid ramps by ``timing.trapezoid.blend``.
+BLENDS = {"linear": TrapezoidalProfile, "cycloidal": CycloidalBlendProfile}
+SYNCHRONIZATIONS = ("normalized", "none")
+
+
+def law_profile(timing: Timing) -> NormalizedProfile:
+    """The normalized profile of a time law request: the law (trapezoid fractions and blend),
+    or its spline through ``timing.supporting_points`` points."""
     if timing.method == "trapezoidal":
         tau1, tau2 = timing.trapezoid_fractions
         if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
             raise InvalidRequest(f"timing.trapezoid needs 0 < tau1 <= tau2 < 1, got {tau1}, {tau2}")
-        return ClassicalMethod(TrapezoidalProfile(tau1, tau2))
+        if timing.trapezoid_blend not in BLENDS:
+            raise InvalidRequest(f"timing.trapezoid.blend {timing.trapezoid_blend!r} is unknown; use one of {list(BLENDS)}")
+        profile = BLENDS[timing.trapezoid_blend](tau1, tau2)
+    else:
+        profile = PROFILES[timing.method]()
+    if timing.supporting_points is None:
+        return profile
+    points = timing.supporting_points
+    if not (isinstance(points, int) and MIN_SUPPORTING_POINTS <= points <= MAX_SUPPORTING_POINTS):
+        raise InvalidRequest(
+            f"timing.supporting_points = {points!r} is outside [{MIN_SUPPORTING_POINTS}, {MAX_SUPPORTING_POINTS}]"
+        )
+    try:
+        return SplineProfile(profile, points)
+    except ValueError as error:
+        raise InvalidRequest(f"timing.supporting_points: {error}") from None
+
+
+def _check_law_options(timing: Timing) -> None:
+    """Refuse the time-law options with a method that does not use them."""
+    law = timing.method in PROFILES
+    if timing.trapezoid_blend != "linear" and timing.method != "trapezoidal":
+        raise InvalidRequest(f"timing.trapezoid.blend is used by timing.method 'trapezoidal', not {timing.method!r}")
+    if timing.supporting_points is not None and not law:
+        raise InvalidRequest(
+            f"timing.supporting_points approximates a time law ({', '.join(PROFILES)}), not timing.method {timing.method!r}"
+        )
+    moving = [value for value in (timing.start_velocity, timing.end_velocity, timing.start_acceleration, timing.end_acceleration)
+              if value is not None and np.any(np.asarray(value) != 0.0)]
+    if timing.supporting_points is not None and moving:
+        raise InvalidRequest(
+            "timing.supporting_points gives a law from rest to rest: leave timing.boundary out, or drop "
+            "supporting_points to use cubic or quintic with boundary states"
+        )
+    if timing.synchronization not in SYNCHRONIZATIONS:
+        raise InvalidRequest(f"timing.synchronization {timing.synchronization!r} is unknown; use one of {list(SYNCHRONIZATIONS)}")
+    if timing.synchronization == "none" and not law:
+        raise InvalidRequest(
+            f"timing.synchronization 'none' runs each joint with a time law ({', '.join(PROFILES)}), not with "
+            f"timing.method {timing.method!r}"
+        )
+
+
+def timing_method(timing: Timing) -> TimingMethod:
+    """The method named by ``timing.method`` (with its per-request options)."""
+    _check_law_options(timing)
+    if timing.method == "trapezoidal" or (timing.method in PROFILES and timing.supporting_points is not None):
+        method = METHODS[timing.method]
+        boundary_law = getattr(method, "boundary_law", None) if timing.supporting_points is None else None
+        return ClassicalMethod(law_profile(timing), boundary_law=boundary_law)
     if timing.torque_weight != 0.0 and timing.method not in ("min_cost", "collocation"):
         raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}; use min_cost")
     if timing.method == "min_cost":

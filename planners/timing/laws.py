@@ -144,6 +144,52 @@ class TrapezoidalProfile(NormalizedProfile):
         return sigma, speed, acceleration, np.zeros_like(tau)
 
 
+class CycloidalBlendProfile(TrapezoidalProfile):
+    """The trapezoidal speed profile with cycloidal blends (Angeles, problem 6.3): the speed rises
+    on [0, tau1] along half a cycloidal-motion speed (eqs. 86, 87 with u = tau / (2 tau1) in the
+    cycloidal motion of eqs. 6.38a, b),
+
+        s(tau) = (A / 2) [tau / tau1 - sin(pi tau / tau1) / pi],
+        s'(tau) = (A / (2 tau1)) [1 - cos(pi tau / tau1)],
+
+    cruises at s'_max on [tau1, tau2], and falls on [tau2, 1] along the mirror image. The text
+    stops at "A is a constant to be determined"; continuity of the speed at tau1 gives
+    s'(tau1) = A / tau1 = s'_max, so A = tau1 s'_max. Each blend covers half its length at
+    s'_max (the mean of 1 - cos is 1), as the trapezoid's straight ramps do, so the area
+    condition of problem 6.1 (a) is unchanged: s'_max = 2 / (1 - tau1 + tau2), eq. (78), and
+    A = 2 tau1 / (1 - tau1 + tau2). The acceleration is continuous (zero where each blend meets
+    the cruise and at rest), its peak pi / 2 times the trapezoid's, pi s'_max / (2 tau1).
+    """
+
+    name = "trapezoidal"
+
+    def knots(self):
+        return np.array([0.0, 0.5 * self.tau1, self.tau1, self.tau2, 0.5 * (1.0 + self.tau2), 1.0])
+
+    def derivatives(self, tau):
+        tau = np.asarray(tau, dtype=float)
+        t1, t2, v = self.tau1, self.tau2, self.peak_speed
+        rising, falling = tau <= t1, tau >= t2
+        # Blend phase angles: pi tau / tau1 on the rise, pi (1 - tau) / (1 - tau2) on the fall.
+        up = np.pi * np.clip(tau / t1, 0.0, 1.0)
+        down = np.pi * np.clip((1.0 - tau) / (1.0 - t2), 0.0, 1.0)
+        A_up, A_down = t1 * v, (1.0 - t2) * v
+        sigma = np.where(
+            rising,
+            0.5 * A_up * (up - np.sin(up)) / np.pi,
+            np.where(falling, 1.0 - 0.5 * A_down * (down - np.sin(down)) / np.pi, 0.5 * A_up + v * (tau - t1)),
+        )
+        speed = np.where(rising, 0.5 * v * (1 - np.cos(up)), np.where(falling, 0.5 * v * (1 - np.cos(down)), v))
+        acceleration = np.where(
+            rising, 0.5 * v * np.pi / t1 * np.sin(up), np.where(falling, -0.5 * v * np.pi / (1 - t2) * np.sin(down), 0.0)
+        )
+        jerk = np.where(
+            rising, 0.5 * v * (np.pi / t1) ** 2 * np.cos(up),
+            np.where(falling, 0.5 * v * (np.pi / (1 - t2)) ** 2 * np.cos(down), 0.0),
+        )
+        return sigma, speed, acceleration, jerk
+
+
 class CycloidalProfile(NormalizedProfile):
     """sigma = tau - sin(2 pi tau) / (2 pi) (Angeles eq. 6.38): zero speed and acceleration at
     both ends, peak acceleration 2 pi."""

@@ -8,6 +8,7 @@ from pydantic import BaseModel, Discriminator, Field, Tag
 
 from planners import ranges
 from planners.timing import METHODS
+from planners.timing.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
 from service.schemas.common import Schema, bounded, signed
 
 MAX_WAYPOINTS = 1_000
@@ -208,6 +209,11 @@ class TrapezoidRequest(Schema):
 
     tau1: bounded(ranges.TRAPEZOID_FRACTION) = Field(default=1.0 / 3.0, description="End of the acceleration phase, as a fraction of the duration.")
     tau2: bounded(ranges.TRAPEZOID_FRACTION) = Field(default=2.0 / 3.0, description="Start of the deceleration phase, as a fraction of the duration.")
+    blend: Literal["linear", "cycloidal"] = Field(
+        default="linear",
+        description="Shape of the speed ramps: `linear` (constant acceleration, Angeles 6.1) or "
+        "`cycloidal` (half cycloidal motions, continuous acceleration, Angeles 6.3).",
+    )
 
 
 #: Every timing method, as the OpenAPI enum of ``timing.method`` and the compare's ``methods``.
@@ -238,6 +244,19 @@ class TimingRequest(Schema):
     trapezoid: TrapezoidRequest = Field(default=TrapezoidRequest(), description="Switching fractions of the trapezoidal law.")
     grid_points: Annotated[int, Field(ge=2, le=20_000)] | None = Field(
         default=None, description="Number of grid intervals over the path; default chosen from it."
+    )
+    supporting_points: Annotated[int, Field(ge=MIN_SUPPORTING_POINTS, le=MAX_SUPPORTING_POINTS)] | None = Field(
+        default=None,
+        description="For a time law: replace it by the cubic spline through this many equally spaced "
+        "points of it (count; Angeles 6.1 (c)), at rest at both ends: continuous acceleration and a "
+        "finite jerk. Default: the law itself.",
+    )
+    synchronization: Literal["normalized", "none"] = Field(
+        default="normalized",
+        description="For a time law on a straight joint move (two waypoints): `normalized` (default) "
+        "times the straight joint line as one, all joints starting and stopping together; `none` runs "
+        "every joint at its own full speed to its goal, so faster joints finish early and the joint "
+        "path is no longer straight (lecture \"Trajectory Planning\").",
     )
     limit_margin: Annotated[float, Field(ge=0.0, le=0.5)] = Field(
         default=0.0,
