@@ -236,6 +236,8 @@ def _timed_via_points(robot, spec, method, timing, kinds, limits, deadline, thre
         raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
     if timing.supporting_points is not None:
         raise InvalidRequest("via-point segments are polynomials: leave timing.supporting_points out, or use 'spline' or 'linear'")
+    if "jerk" in kinds and method.name in ("cubic", "quintic"):
+        method.refuse_jerk_limit()
     path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration, deadline)
     s = _grid(path, timing.grid_points, method, robot)
     _check_path_within_limits(robot, path, s)
@@ -257,6 +259,8 @@ def _timed_unsynchronized(robot, spec, method, timing, kinds, limits, deadline, 
             "timing.synchronization 'none' moves every joint from rest to rest on its own: leave "
             "timing.boundary and the tool-speed limits out, or use 'normalized'"
         )
+    if "jerk" in kinds:
+        method.refuse_jerk_limit()
     waypoints = checked_waypoints(robot, spec)
     path, result = unsynchronized_trajectory(
         robot, waypoints[0], waypoints[1], method.profile, limits, kinds, timing.duration, deadline

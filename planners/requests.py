@@ -14,8 +14,8 @@ from planners.timing.base import TimingMethod
 from planners.timing.classical import ClassicalMethod
 from planners.timing.collocation_method import CollocationMethod
 from planners.timing.laws import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
-from planners.timing.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
 from planners.timing.min_cost import MinCostMethod
+from planners.timing.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
 
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
 #: default path tolerance of MoveIt's time-optimal trajectory generation.

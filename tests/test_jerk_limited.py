@@ -213,16 +213,18 @@ def test_the_gate_refuses_samples_whose_accelerations_jump(monkeypatch):
     assert "t = " in raised.value.detail
 
 
-def test_a_torque_limit_below_gravity_is_refused_with_where_and_which(client):
+@pytest.mark.parametrize("method", ["jerk_limited", "phase_plane", "toppra", "quintic"])
+def test_a_torque_limit_below_gravity_is_refused_with_where_and_which(client, method):
     body = {
         "robot": "ur5",
         "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS[:2]},
-        "timing": {"method": "jerk_limited", "limits": {"torque_scale": 0.05}},
+        "timing": {"method": method, "limits": {"torque_scale": 0.05}},
     }
     response = client.post("/v1/trajectories", json=body)
     assert response.status_code == 422, response.text
     problem = response.json()
     assert "torque" in problem["detail"] and problem["joint"] and 0.0 <= problem["s"] <= 1.0
+    assert problem["limit"] == "torque"
 
 
 @pytest.mark.parametrize(

@@ -7,7 +7,10 @@ import pytest
 
 import robots
 from planners import Timing, WaypointPath, plan
+from planners.errors import InfeasiblePath
+from planners.timing.classical import ClassicalMethod
 from planners.timing.laws import (
+    PROFILES,
     CubicProfile,
     CycloidalProfile,
     QuinticProfile,
@@ -81,19 +84,41 @@ LAWS = ["cubic", "quintic", "trapezoidal", "cycloidal"]
 @pytest.mark.parametrize("interpolation", ["spline", "linear"])
 @pytest.mark.parametrize("law", LAWS)
 def test_shortest_law_respects_every_limit_and_is_not_faster_than_optimal(law, interpolation):
-    kinds = ("velocity", "acceleration", "torque", "jerk")
+    # The cubic and the trapezoid have acceleration steps: no jerk limit for them (see below).
+    smooth = law in ("quintic", "cycloidal")
+    kinds = ("velocity", "acceleration", "torque", "jerk")[: 4 if smooth else 3]
     path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
-    result = plan(UR5, path, Timing(method=law, constraints=kinds))
+    result = plan(UR5, path, Timing(method=law, constraints=kinds), dt=0.001)
     optimal = plan(UR5, path, Timing(method="phase_plane", constraints=kinds[:3]))
     assert result.duration >= optimal.duration
     for kind in kinds:
         assert result.peak_utilization[kind].max() <= 1.005, kind
+    if smooth:  # the jerk of the 1 ms samples, independently of the reported one
+        samples = result.samples
+        jerk = np.diff(samples.qdd, axis=0) / np.diff(samples.t)[:, None]
+        assert np.abs(jerk / UR5.limits.jerk).max() <= 1.005
     # The binding limit is really reached: the law is as short as it can be.
     binding = result.binding
     joint = UR5.joint_names.index(binding.joint)
     assert 0.995 <= result.peak_utilization[binding.kind][joint] <= 1.005
     assert result.samples.qd[0] == pytest.approx(np.zeros(6), abs=1e-12)
     assert result.samples.q[-1] == pytest.approx(UR5_WAYPOINTS[-1], abs=1e-9)
+
+
+@pytest.mark.parametrize("interpolation", ["spline", "linear", "via"])
+@pytest.mark.parametrize("law, steps", [("cubic", [0.0, 1.0]), ("trapezoidal", [0.0, 1 / 3, 2 / 3, 1.0])])
+def test_laws_with_acceleration_steps_refuse_a_jerk_limit(law, steps, interpolation):
+    """The cubic leaves rest with sigma''(0) = 6 and the trapezoid switches between constant
+    accelerations: an infinite jerk at each step, whatever the duration (on 1 ms samples of
+    the unchecked law the jerk reaches 30 to 100 times ur5's limit)."""
+    if interpolation == "via" and law == "trapezoidal":
+        pytest.skip("via points take cubic or quintic segments")
+    path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
+    with pytest.raises(InfeasiblePath) as refused:
+        plan(UR5, path, Timing(method=law, constraints=("velocity", "acceleration", "jerk")))
+    assert refused.value.limit == "jerk"
+    assert "quintic" in str(refused.value)
+    assert ClassicalMethod(PROFILES[law]()).profile.acceleration_steps() == pytest.approx(steps)
 
 
 def test_single_joint_closed_forms():

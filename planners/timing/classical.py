@@ -102,6 +102,30 @@ class ClassicalMethod(TimingMethod):
         self.name = profile.name
         self.boundary_law = boundary_law
         self.takes_acceleration_boundary = boundary_law == "quintic"
+        # The samples' jerk (finite differences) is checked too where the law has no jumps.
+        self.continuous_acceleration = not len(profile.acceleration_steps())
+
+    def refuse_jerk_limit(self) -> None:
+        """Refuse a jerk limit when the law's acceleration jumps (the cubic leaves rest with
+        sigma''(0) = 6, the trapezoid switches between constant accelerations): its jerk is
+        infinite there whatever the duration.
+
+        Raises:
+            InfeasiblePath: with ``limit = "jerk"`` and the first jump's tau as ``s`` (a law on
+                one stretch; per stretch on a path with corners).
+        """
+        steps = self.profile.acceleration_steps()
+        if not len(steps):
+            return
+        where = ", ".join(f"{tau:.4g}" for tau in steps)
+        raise InfeasiblePath(
+            f"the {self.profile.description}'s acceleration jumps at tau = {where} (as a fraction of each stretch's "
+            "duration), so its jerk is infinite there and no duration holds a jerk limit: use quintic, "
+            "cycloidal, trapezoidal with blend 'cycloidal' or jerk_limited, or leave 'jerk' out of "
+            "timing.constraints",
+            s=float(self.profile.derivatives(steps[:1])[0][0]),
+            limit="jerk",
+        )
 
     def solve(
         self,
@@ -110,6 +134,8 @@ class ClassicalMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> LawTiming:
+        if constraints.jerk is not None:
+            self.refuse_jerk_limit()
         moving = boundary.sd_start != 0.0 or boundary.sd_end != 0.0 or bool(boundary.sdd_start) or bool(boundary.sdd_end)
         if moving and self.boundary_law is None:
             raise InvalidRequest(
@@ -166,12 +192,14 @@ class ClassicalMethod(TimingMethod):
             tau = np.linspace(*around, 33)
         y, rows = best, binding_rows
         if y <= 0.0:
-            clause, joint = static_load(rows, sample)
+            clause, joint, _ = static_load(rows, sample)
+            exceeded = kind if kind != "row" else rows.rows[index][0]
             raise InfeasiblePath(
                 f"the {self.name} law cannot meet the limits at any duration: at s = {rows.s[sample]:.4f} "
-                f"the {kind if kind != 'row' else rows.rows[index][0]} limit is exceeded at rest{clause}",
+                f"the {exceeded} limit is exceeded at rest{clause}",
                 s=float(rows.s[sample]),
                 joint=joint,
+                limit=exceeded,
             )
         return LawSegment(start, end, 1.0 / y, profile=self.profile), _binding(rows, kind, index, sample)
 

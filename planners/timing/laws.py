@@ -68,6 +68,23 @@ class NormalizedProfile(abc.ABC):
         sigma' and sigma''."""
         return np.array([0.0, 0.5, 1.0])
 
+    @property
+    def description(self) -> str:
+        """How an answer names the law."""
+        return f"{self.name} law"
+
+    def inner_acceleration_steps(self) -> np.ndarray:
+        """tau in (0, 1) where sigma'' jumps (none for a law with continuous acceleration)."""
+        return np.empty(0)
+
+    def acceleration_steps(self) -> np.ndarray:
+        """tau where the acceleration jumps, the ends included when the law leaves or reaches
+        rest with sigma'' != 0 (the motion is at rest before and after it). At each of them the
+        jerk is infinite, so no duration of the law holds a jerk limit."""
+        ends = self.derivatives(np.array([0.0, 1.0]))[2]
+        outer = np.array([0.0, 1.0])[np.abs(ends) > 1e-9]
+        return np.union1d(outer, self.inner_acceleration_steps())
+
     def tau_at(self, sigma: np.ndarray) -> np.ndarray:
         """The tau with sigma(tau) = ``sigma`` (sigma is increasing): bisection to 1e-13."""
         sigma = np.clip(np.asarray(sigma, dtype=float), 0.0, 1.0)
@@ -128,6 +145,9 @@ class TrapezoidalProfile(NormalizedProfile):
     def knots(self):
         return np.array([0.0, self.tau1, self.tau2, 1.0])
 
+    def inner_acceleration_steps(self):
+        return np.unique([self.tau1, self.tau2])
+
     def derivatives(self, tau):
         tau = np.asarray(tau, dtype=float)
         t1, t2, v = self.tau1, self.tau2, self.peak_speed
@@ -165,6 +185,9 @@ class CycloidalBlendProfile(TrapezoidalProfile):
 
     def knots(self):
         return np.array([0.0, 0.5 * self.tau1, self.tau1, self.tau2, 0.5 * (1.0 + self.tau2), 1.0])
+
+    def inner_acceleration_steps(self):
+        return np.empty(0)
 
     def derivatives(self, tau):
         tau = np.asarray(tau, dtype=float)

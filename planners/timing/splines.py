@@ -166,6 +166,10 @@ class SplineProfile(NormalizedProfile):
                 "use more supporting points"
             )
 
+    @property
+    def description(self) -> str:
+        return f"cubic spline through {self.supporting_points} points of the {self.law.name} law"
+
     def knots(self):
         return np.union1d(self.spline.points, [0.5])
 
