@@ -40,13 +40,11 @@ RUN apt-get update \
 
 WORKDIR /app
 
-# Dependencies first, in their own layer: it is rebuilt only when pyproject.toml changes.
-# They are read from [project.dependencies] and the "test" extra, so the test suite can run
-# in the image.
-COPY pyproject.toml README.md ./
-RUN python -c "import tomllib; p = tomllib.load(open('pyproject.toml', 'rb'))['project']; print('\n'.join(p.get('dependencies', []) + p.get('optional-dependencies', {}).get('test', [])))" > /tmp/requirements.txt \
-    && pip install -r /tmp/requirements.txt \
-    && rm /tmp/requirements.txt
+# Dependencies first, in their own layer: it is rebuilt only when the lock file changes. The
+# exact versions and hashes of requirements.lock (the runtime dependencies and the "test"
+# extra, so the test suite can run in the image; `make lock` re-resolves it).
+COPY requirements.lock ./
+RUN pip install --require-hashes -r requirements.lock
 
 # The code (and tests/), then the package itself without touching the dependencies.
 COPY . .

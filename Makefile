@@ -6,13 +6,23 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: serve test install browser clean
+.PHONY: serve test install browser lock clean
 
-$(STAMP): pyproject.toml
+# Exact versions with their hashes from requirements.lock (the runtime dependencies and the
+# test extra, resolved from the ranges in pyproject.toml), then the project itself on top.
+$(STAMP): pyproject.toml requirements.lock
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[test]"
+	$(BIN)/python -m pip install --quiet --require-hashes -r requirements.lock
+	$(BIN)/python -m pip install --quiet --no-deps -e .
 	touch $(STAMP)
+
+# Re-resolve requirements.lock after a change of the ranges in pyproject.toml (uv's resolver,
+# for Linux x86_64 and Python 3.11, the platform of the image and of CI).
+lock: $(STAMP)
+	$(BIN)/python -m pip install --quiet uv
+	$(BIN)/uv pip compile pyproject.toml --extra test --python-version 3.11 \
+	  --python-platform x86_64-manylinux_2_28 --generate-hashes --quiet -o requirements.lock
 
 install: $(STAMP)
 
