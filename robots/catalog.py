@@ -14,7 +14,7 @@ from os.path import join
 import numpy as np
 import pinocchio as pin
 
-from robots.limits import limits_for
+from robots.limits import limits_with_sources
 from robots.robot import Robot, tangent_position_limits
 
 #: Bundled URDFs: name -> end-effector frame.
@@ -61,12 +61,27 @@ def _last_body_frame(model: pin.Model) -> str:
     return bodies[-1]
 
 
-def robot_from_model(name: str, model: pin.Model, source: str, end_effector: str | None) -> Robot:
-    """``model`` as a ``Robot`` with its limits (URDF values completed by ``data/limits.toml``);
-    ``end_effector`` ``None`` means the last body frame."""
+def robot_from_model(
+    name: str,
+    model: pin.Model,
+    source: str,
+    end_effector: str | None,
+    given_limits: dict[str, np.ndarray] | None = None,
+    locked_joints: dict[str, float] | None = None,
+    notes: tuple[str, ...] = (),
+) -> Robot:
+    """``model`` as a ``Robot`` with its limits (URDF values completed by ``data/limits.toml``,
+    tightened or completed by ``given_limits`` from an upload's joint_limits.yaml) and where
+    each comes from; ``end_effector`` ``None`` means the last body frame."""
     lower, upper = tangent_position_limits(model)
-    limits = limits_for(name, lower, upper, np.array(model.velocityLimit), np.array(model.effortLimit))
-    return Robot.from_model(name, model, source, end_effector or _last_body_frame(model), limits)
+    joint_names = tuple(model.names[1:])
+    limits, sources, limit_notes = limits_with_sources(
+        name, lower, upper, np.array(model.velocityLimit), np.array(model.effortLimit), given_limits, joint_names
+    )
+    return Robot.from_model(
+        name, model, source, end_effector or _last_body_frame(model), limits, sources, locked_joints,
+        (*notes, *limit_notes),
+    )
 
 
 _robot_from_model = robot_from_model  # the former, private name
@@ -96,7 +111,7 @@ def load_catalog_robot(name: str) -> Robot:
             reference[model.joints[model.getJointId(joint_name)].idx_q] = value
         locked_ids = [model.getJointId(joint_name) for joint_name in arm.locked]
         model = pin.buildReducedModel(model, locked_ids, reference)
-    return robot_from_model(name, model, "example-robot-data", arm.end_effector)
+    return robot_from_model(name, model, "example-robot-data", arm.end_effector, locked_joints=arm.locked)
 
 
 def is_catalog_robot(name: str) -> bool:

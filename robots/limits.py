@@ -134,21 +134,75 @@ def limits_for(
 ) -> JointLimits:
     """Complete a robot's URDF limits with the data file's entry for ``robot_name`` (or the
     default rule when it has none)."""
+    return limits_with_sources(robot_name, position_lower, position_upper, velocity, torque)[0]
+
+
+def limits_with_sources(
+    robot_name: str,
+    position_lower: np.ndarray,
+    position_upper: np.ndarray,
+    velocity: np.ndarray,
+    torque: np.ndarray,
+    given: dict[str, np.ndarray] | None = None,
+    joint_names: tuple[str, ...] | list[str] | None = None,
+) -> tuple[JointLimits, dict[str, tuple[str, ...]], list[str]]:
+    """A robot's limits, where each one comes from, and notes on what was not taken.
+
+    In order: the URDF's position, velocity and effort limits; the data file's entry for
+    ``robot_name`` (catalog robots); ``given`` (an upload's joint_limits.yaml: {kind: (n_dof,)},
+    NaN where it gives none), whose velocity and torque limits only tighten the URDF's; the
+    default rule for acceleration (velocity / ``seconds_to_full_speed``) and jerk
+    (acceleration / ``seconds_to_full_acceleration``) where nothing gave them.
+
+    Returns:
+        The limits; {kind: one source per joint}, sources being "urdf", "limits.toml",
+        "joint_limits.yaml" or "default: ..." (the rule); the notes.
+    """
     table = _limit_table()
     entry = table.get(robot_name, {})
     rule = table["default"]
+    n_dof = len(np.atleast_1d(velocity))
+    names = list(joint_names) if joint_names is not None else [str(k) for k in range(n_dof)]
     values = {
         "position_lower": np.asarray(position_lower, dtype=float),
         "position_upper": np.asarray(position_upper, dtype=float),
         "velocity": np.asarray(velocity, dtype=float),
         "torque": np.asarray(torque, dtype=float),
     }
+    sources = {kind: ["urdf"] * n_dof for kind in values}
     for kind in ("position_lower", "position_upper", "velocity", "torque"):
         if kind in entry:
             values[kind] = np.asarray(entry[kind], dtype=float)
-    with np.errstate(invalid="ignore"):
-        default_acceleration = values["velocity"] / rule["seconds_to_full_speed"]
-    values["acceleration"] = np.asarray(entry.get("acceleration", default_acceleration), dtype=float)
-    default_jerk = values["acceleration"] / rule["seconds_to_full_acceleration"]
-    values["jerk"] = np.asarray(entry.get("jerk", default_jerk), dtype=float)
-    return JointLimits(**values)
+            sources[kind] = ["limits.toml"] * n_dof
+    given = given or {}
+    notes = []
+    for kind in ("velocity", "torque"):
+        if kind not in given:
+            continue
+        for k in np.flatnonzero(np.isfinite(given[kind])):
+            if given[kind][k] <= values[kind][k]:
+                values[kind] = values[kind].copy()
+                values[kind][k] = given[kind][k]
+                sources[kind][k] = "joint_limits.yaml"
+            else:
+                unit = "N m" if kind == "torque" else "rad/s"
+                notes.append(
+                    f"joint_limits.yaml allows joint {names[k]!r} a {kind} of {given[kind][k]:g} {unit}, above the "
+                    f"URDF's {values[kind][k]:g}: the URDF's limit is kept"
+                )
+    for kind, default, seconds in (
+        ("acceleration", "velocity", "seconds_to_full_speed"),
+        ("jerk", "acceleration", "seconds_to_full_acceleration"),
+    ):
+        with np.errstate(invalid="ignore"):
+            values[kind] = values[default] / rule[seconds]
+        sources[kind] = [f"default: {default} limit / {rule[seconds]:g} s"] * n_dof
+        if kind in entry:
+            values[kind] = np.asarray(entry[kind], dtype=float)
+            sources[kind] = ["limits.toml"] * n_dof
+        if kind in given:
+            for k in np.flatnonzero(np.isfinite(given[kind])):
+                values[kind] = values[kind].copy()
+                values[kind][k] = given[kind][k]
+                sources[kind][k] = "joint_limits.yaml"
+    return JointLimits(**values), {kind: tuple(sources[kind]) for kind in LIMIT_KINDS}, notes

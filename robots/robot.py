@@ -48,6 +48,10 @@ class Robot:
         continuous: Boolean mask, shape (n_dof,): joints without position limits.
         viscous_friction: Joint damping from the URDF, shape (n_dof,), in N m s/rad.
         coulomb_friction: Joint dry friction from the URDF, shape (n_dof,), in N m.
+        limit_sources: {limit kind: where each joint's limit comes from} ("urdf",
+            "limits.toml", "joint_limits.yaml", "default: ..."); empty when not recorded.
+        locked_joints: Joints of the URDF fixed at a value (rad, m), not among ``joint_names``.
+        notes: What a user of the robot should know (ignored meshes, limits not applied).
     """
 
     name: str
@@ -64,6 +68,9 @@ class Robot:
     _plain_q_index: np.ndarray = field(repr=False)
     _plain_v_index: np.ndarray = field(repr=False)
     _local: threading.local = field(default_factory=threading.local, repr=False, compare=False)
+    limit_sources: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False, compare=False)
+    locked_joints: dict[str, float] = field(default_factory=dict, repr=False, compare=False)
+    notes: tuple[str, ...] = field(default=(), repr=False, compare=False)
 
     @classmethod
     def from_model(
@@ -73,6 +80,9 @@ class Robot:
         source: str,
         end_effector: str,
         limits: JointLimits,
+        limit_sources: dict[str, tuple[str, ...]] | None = None,
+        locked_joints: dict[str, float] | None = None,
+        notes: tuple[str, ...] = (),
     ) -> Robot:
         """Wrap ``model``, precomputing the map from tangent coordinates to Pinocchio's q."""
         cos_index, pair_angle, plain_q, plain_v = [], [], [], []
@@ -99,12 +109,17 @@ class Robot:
             _angle_index_of_pair=np.asarray(pair_angle, dtype=int),
             _plain_q_index=np.asarray(plain_q, dtype=int),
             _plain_v_index=np.asarray(plain_v, dtype=int),
+            limit_sources=dict(limit_sources or {}),
+            locked_joints=dict(locked_joints or {}),
+            notes=tuple(notes),
         )
 
     def __reduce__(self):
         """Pickled as its model and metadata (the per-thread workspaces are rebuilt), so that a
         robot can be sent to a worker process."""
-        return Robot.from_model, (self.name, self.model, self.source, self.end_effector, self.limits)
+        return Robot.from_model, (
+            self.name, self.model, self.source, self.end_effector, self.limits, self.limit_sources, self.locked_joints, self.notes
+        )
 
     @property
     def dof(self) -> int:

@@ -7,7 +7,9 @@ IMMEDIATE``) makes that check-then-write atomic across processes without lock fi
 commit is atomic and durable (write-ahead log), which is what "write a temporary file, then
 ``os.replace``" gives for one file but not for a file plus an index. The text is still content
 addressed: ``urdfs`` holds each distinct text once under its SHA-256, ``robots`` maps names to
-digests, so two names for one text store it once.
+digests, so two names for one text store it once, each with its own options (locked joints,
+joint_limits.yaml: ``robots.upload_options``, as canonical JSON; "" for none). A database
+written before options existed gets the column on first use, its uploads with no options.
 
 Nothing is cached here: every call opens its own connection, so a process sees what another
 process committed, and a forked worker never shares a connection with its parent.
@@ -39,9 +41,17 @@ CREATE TABLE IF NOT EXISTS robots (
     name TEXT PRIMARY KEY,
     digest TEXT NOT NULL REFERENCES urdfs (digest),
     dof INTEGER NOT NULL,
-    created REAL NOT NULL         -- Unix time, s
+    created REAL NOT NULL,        -- Unix time, s
+    options TEXT NOT NULL DEFAULT ''  -- robots.upload_options.UploadOptions.to_json()
 );
 """
+
+
+def _migrate(connection: sqlite3.Connection) -> None:
+    """Add the ``options`` column to a database written before it existed."""
+    columns = [row[1] for row in connection.execute("PRAGMA table_info(robots)")]
+    if columns and "options" not in columns:
+        connection.execute("ALTER TABLE robots ADD COLUMN options TEXT NOT NULL DEFAULT ''")
 
 
 def default_data_dir() -> Path:
@@ -55,13 +65,14 @@ def default_data_dir() -> Path:
 
 @dataclass(frozen=True)
 class StoredUpload:
-    """One stored upload: its name, the SHA-256 of its text, its degrees of freedom and when it
-    was stored (Unix time, s)."""
+    """One stored upload: its name, the SHA-256 of its text, its degrees of freedom, when it
+    was stored (Unix time, s) and its options (canonical JSON, "" for none)."""
 
     name: str
     digest: str
     dof: int
     created: float
+    options: str = ""
 
 
 @dataclass(frozen=True)
@@ -109,6 +120,7 @@ class UploadStore:
                     connection.execute("PRAGMA auto_vacuum = INCREMENTAL")  # takes effect on a new database
                     connection.execute("PRAGMA journal_mode = WAL")
                     connection.executescript(_SCHEMA)
+                _migrate(connection)
                 yield connection
             finally:
                 connection.close()
@@ -120,29 +132,46 @@ class UploadStore:
 
     def digest(self, name: str) -> str | None:
         """SHA-256 of the text stored under ``name``, ``None`` when there is none."""
+        key = self.key(name)
+        return None if key is None else key[0]
+
+    def key(self, name: str) -> tuple[str, str] | None:
+        """``(digest, options)`` stored under ``name`` (what a built model depends on), ``None``
+        when there is none."""
         with self._connect(write=False) as connection:
             if connection is None:
                 return None
-            row = connection.execute("SELECT digest FROM robots WHERE name = ?", (name,)).fetchone()
-        return None if row is None else row[0]
+            row = connection.execute(f"SELECT digest, {self._options(connection)} FROM robots WHERE name = ?", (name,)).fetchone()
+        return None if row is None else (row[0], row[1])
 
-    def read(self, name: str) -> tuple[str, str] | None:
-        """``(digest, text)`` stored under ``name``, ``None`` when there is none."""
+    def read(self, name: str) -> tuple[str, str, str] | None:
+        """``(digest, text, options)`` stored under ``name``, ``None`` when there is none."""
         with self._connect(write=False) as connection:
             if connection is None:
                 return None
             row = connection.execute(
-                "SELECT robots.digest, urdfs.urdf FROM robots JOIN urdfs USING (digest) WHERE name = ?", (name,)
+                f"SELECT robots.digest, urdfs.urdf, {self._options(connection)} FROM robots JOIN urdfs USING (digest) "
+                "WHERE name = ?",
+                (name,),
             ).fetchone()
-        return None if row is None else (row[0], row[1])
+        return None if row is None else (row[0], row[1], row[2])
 
     def uploads(self) -> list[StoredUpload]:
         """Every stored upload, by name."""
         with self._connect(write=False) as connection:
             if connection is None:
                 return []
-            rows = connection.execute("SELECT name, digest, dof, created FROM robots ORDER BY name").fetchall()
+            rows = connection.execute(
+                f"SELECT name, digest, dof, created, {self._options(connection)} FROM robots ORDER BY name"
+            ).fetchall()
         return [StoredUpload(*row) for row in rows]
+
+    @staticmethod
+    def _options(connection: sqlite3.Connection) -> str:
+        """The options column as a SELECT reads it: '' from a database written before options
+        existed (reading never writes; the next write adds the column)."""
+        columns = [row[1] for row in connection.execute("PRAGMA table_info(robots)")]
+        return "options" if "options" in columns else "''"
 
     def usage(self) -> StoreUsage:
         """How many uploads and bytes the store holds, with its caps."""
@@ -156,25 +185,26 @@ class UploadStore:
         size = connection.execute("SELECT COALESCE(SUM(bytes), 0) FROM urdfs").fetchone()[0]
         return count, size
 
-    def put(self, name: str, digest: str, urdf: str, dof: int) -> bool:
-        """Store ``urdf`` (whose SHA-256 is ``digest``) under ``name``, atomically.
+    def put(self, name: str, digest: str, urdf: str, dof: int, options: str = "") -> bool:
+        """Store ``urdf`` (whose SHA-256 is ``digest``) under ``name`` with ``options``, atomically.
 
         Returns:
-            ``True`` when stored, ``False`` when ``name`` already held this very text.
+            ``True`` when stored, ``False`` when ``name`` already held this very text and options.
 
         Raises:
-            RobotConflict: ``name`` holds a different text.
+            RobotConflict: ``name`` holds a different text or different options.
             UploadStoreFull: storing it would pass the count or byte cap.
         """
         size = len(urdf.encode())
         with self._connect(write=True) as connection:
             connection.execute("BEGIN IMMEDIATE")
             try:
-                row = connection.execute("SELECT digest FROM robots WHERE name = ?", (name,)).fetchone()
+                row = connection.execute("SELECT digest, options FROM robots WHERE name = ?", (name,)).fetchone()
                 if row is not None:
-                    if row[0] != digest:
+                    if row[0] != digest or row[1] != options:
+                        what = "URDF" if row[0] != digest else "set of options (locked joints, joint limits)"
                         raise RobotConflict(
-                            f"name {excerpt(name)} already holds a different URDF; choose another name, or "
+                            f"name {excerpt(name)} already holds a different {what}; choose another name, or "
                             "DELETE /v1/robots/{name} first"
                         )
                     connection.execute("ROLLBACK")
@@ -191,7 +221,8 @@ class UploadStore:
                 if not known:
                     connection.execute("INSERT INTO urdfs (digest, urdf, bytes) VALUES (?, ?, ?)", (digest, urdf, size))
                 connection.execute(
-                    "INSERT INTO robots (name, digest, dof, created) VALUES (?, ?, ?, ?)", (name, digest, dof, time.time())
+                    "INSERT INTO robots (name, digest, dof, created, options) VALUES (?, ?, ?, ?, ?)",
+                    (name, digest, dof, time.time(), options),
                 )
                 connection.execute("COMMIT")
             except BaseException:

@@ -23,7 +23,8 @@ from robots.catalog import catalog_names, is_catalog_robot, robot_from_model
 from robots.errors import CatalogRobotReadOnly, InvalidRobotName, InvalidURDF, RobotConflict, UnknownRobot, excerpt
 from robots.robot import Robot
 from robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, StoredUpload, UploadStore, default_data_dir
-from robots.urdf_check import check_urdf
+from robots.upload_options import InvalidUpload, UploadOptions, apply_locks, yaml_limit_arrays
+from robots.urdf_check import check_urdf, mesh_count
 
 DEFAULT_CACHE_SIZE = 32
 MAX_NAME_CHARS = 64
@@ -32,19 +33,19 @@ NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_.-]{0,63}")
 
 
 class _RobotCache:
-    """Least-recently-used ``Robot`` objects keyed by ``(name, digest)``, at most ``size``."""
+    """Least-recently-used ``Robot`` objects keyed by ``(name, (digest, options))``, at most ``size``."""
 
     def __init__(self, size: int):
         self.size = size
-        self._robots: OrderedDict[tuple[str, str], Robot] = OrderedDict()
+        self._robots: OrderedDict[tuple[str, tuple[str, str]], Robot] = OrderedDict()
 
-    def get(self, key: tuple[str, str]) -> Robot | None:
+    def get(self, key: tuple[str, tuple[str, str]]) -> Robot | None:
         robot = self._robots.get(key)
         if robot is not None:
             self._robots.move_to_end(key)
         return robot
 
-    def put(self, key: tuple[str, str], robot: Robot) -> None:
+    def put(self, key: tuple[str, tuple[str, str]], robot: Robot) -> None:
         self.discard(key[0])
         self._robots[key] = robot
         while len(self._robots) > self.size:
@@ -104,10 +105,33 @@ def check_name(name: str) -> None:
         )
 
 
-def _build(name: str, digest: str, urdf: str) -> Robot:
-    robot = robot_from_model(name, check_urdf(urdf), "upload", None)
+def build_upload(name: str, urdf: str, options: UploadOptions) -> Robot:
+    """The robot of an upload: its URDF checked and built, the locked joints fixed, the limits
+    of its joint_limits.yaml applied, and notes on what was not used.
+
+    Raises:
+        InvalidURDF: the text is not a usable fixed-base arm.
+        InvalidUpload: the options do not fit the URDF.
+    """
+    full = check_urdf(urdf)
+    model = apply_locks(full, options.locked_joints)
+    given = yaml_limit_arrays(tuple(model.names[1:]), options) if options.joint_limits else None
+    notes = list(options.notes)
+    meshes = mesh_count(urdf)
+    if meshes:
+        notes.append(
+            f"the URDF's {meshes} mesh files are not loaded: the dynamics come from its <inertial> elements, "
+            "and obstacle checks use a capsule of 0.03 m radius along each link"
+        )
+    if options.locked_joints:
+        notes.append("joints locked: " + ", ".join(f"{joint} = {value:g}" for joint, value in options.locked_joints.items()))
+    return robot_from_model(name, model, "upload", None, given, options.locked_joints, tuple(notes))
+
+
+def _build(name: str, key: tuple[str, str], urdf: str) -> Robot:
+    robot = build_upload(name, urdf, UploadOptions.from_json(key[1]))
     with _lock:
-        _cache.put((name, digest), robot)
+        _cache.put((name, key), robot)
     return robot
 
 
@@ -119,51 +143,61 @@ def load_upload(name: str) -> Robot | None:
         InvalidURDF: the stored text no longer passes the checks (they became stricter).
     """
     store = upload_store()
-    digest = store.digest(name)
-    if digest is None:
+    key = store.key(name)
+    if key is None:
         return None
     with _lock:
-        robot = _cache.get((name, digest))
+        robot = _cache.get((name, key))
     if robot is not None:
         return robot
     stored = store.read(name)
     if stored is None:
         return None
+    digest, urdf, options = stored
     try:
-        return _build(name, *stored)
-    except InvalidURDF as error:
+        return _build(name, (digest, options), urdf)
+    except (InvalidURDF, InvalidUpload) as error:
         raise InvalidURDF(f"the stored upload {excerpt(name)} no longer passes the checks: {error.detail}") from None
 
 
-def register_urdf(urdf: str, name: str | None = None) -> Robot:
-    """Check ``urdf``, build its model and store it under ``name`` (default: ``urdf-`` and the
-    first 12 hex digits of the content's SHA-256). Uploading the same content twice is harmless.
+def register_urdf(urdf: str, name: str | None = None, options: UploadOptions | None = None) -> Robot:
+    """Check ``urdf`` and its ``options``, build its model and store both under ``name``
+    (default: ``urdf-`` and the first 12 hex digits of the SHA-256 of the content and the
+    options). Uploading the same content with the same options twice is harmless.
 
     Raises:
         InvalidRobotName: ``name`` breaks ``NAME_PATTERN``.
         InvalidURDF: the text is not a usable fixed-base arm (see ``robots.urdf_check``).
+        InvalidUpload: the options do not fit the URDF (``robots.upload_options``).
         RobotConflict: ``name`` is a catalog robot or holds a different upload.
         UploadStoreFull: the store is at its cap of uploads or bytes.
     """
+    options = options or UploadOptions()
+    stored_options = options.to_json()
     digest = hashlib.sha256(urdf.encode()).hexdigest()
     if name is None:
-        name = f"urdf-{digest[:12]}"
+        named = digest if not stored_options else hashlib.sha256((urdf + stored_options).encode()).hexdigest()
+        name = f"urdf-{named[:12]}"
     check_name(name)
     if is_catalog_robot(name):
         raise RobotConflict(f"name {name!r} belongs to a catalog robot; choose another")
     store = upload_store()
-    held = store.digest(name)
-    if held is not None and held != digest:
+    held = store.key(name)
+    if held is not None and held[0] != digest:
         raise RobotConflict(f"name {name!r} already holds a different URDF; choose another name or delete it first")
-    if held == digest:
+    if held is not None and held[1] != stored_options:
+        raise RobotConflict(
+            f"name {name!r} already holds this URDF with other options (locked joints, joint limits); choose "
+            "another name or delete it first"
+        )
+    if held is not None:
         robot = load_upload(name)
         if robot is not None:
             return robot
-    model = check_urdf(urdf)
-    robot = robot_from_model(name, model, "upload", None)
-    store.put(name, digest, urdf, robot.dof)
+    robot = build_upload(name, urdf, options)
+    store.put(name, digest, urdf, robot.dof, stored_options)
     with _lock:
-        _cache.put((name, digest), robot)
+        _cache.put((name, (digest, stored_options)), robot)
     return robot
 
 

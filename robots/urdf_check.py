@@ -425,3 +425,10 @@ def check_urdf(urdf: str) -> pin.Model:
         raise InvalidURDF(f"Pinocchio cannot build the model: {excerpt(str(error), 300)}") from None
     _check_joint_space_inertia(model)
     return model
+
+
+def mesh_count(urdf: str) -> int:
+    """How many distinct mesh files the ``<visual>`` and ``<collision>`` elements of ``urdf``
+    (already checked by ``check_urdf``) refer to; none of them is loaded."""
+    root = ElementTree.fromstring(urdf)
+    return len({mesh.get("filename", "") for mesh in root.iter("mesh")})

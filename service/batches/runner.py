@@ -45,8 +45,8 @@ class BatchReport:
         return self.planned / self.seconds if self.seconds > 0 else 0.0
 
 
-def _uploads_named(texts: list[str]) -> dict[str, str]:
-    """URDF texts of the uploaded robots the requests name (catalog robots need none)."""
+def _uploads_named(texts: list[str]) -> dict[str, tuple[str, str]]:
+    """URDF texts and options of the uploaded robots the requests name (catalog robots need none)."""
     names = set()
     for text in texts:
         try:
@@ -60,7 +60,7 @@ def _uploads_named(texts: list[str]) -> dict[str, str]:
     for name in sorted(names):
         stored = store.read(name)
         if stored is not None:
-            found[name] = stored[1]
+            found[name] = (stored[1], stored[2])
     return found
 
 

@@ -13,6 +13,7 @@ from pydantic import ValidationError
 import robots
 from planners.deadline import Deadline
 from robots import ToptrajError
+from robots.upload_options import UploadOptions
 from service.commands import validation_problem
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
@@ -20,18 +21,19 @@ from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 _configured = False
 
 
-def _uploads_here(uploads: dict[str, str]) -> None:
+def _uploads_here(uploads: dict[str, tuple[str, str]]) -> None:
     """Make the uploaded robots a batch uses available in this process: a worker on another
-    machine has no access to the server's data directory, so their URDF texts travel with the
-    tasks and are registered in a store of the worker's own."""
+    machine has no access to the server's data directory, so their URDF texts and options
+    (``UploadOptions.to_json``) travel with the tasks and are registered in a store of the
+    worker's own."""
     global _configured
     if not uploads:
         return
     if not _configured:
         robots.configure_uploads(tempfile.mkdtemp(prefix="toptraj-batch-uploads-"))
         _configured = True
-    for name, urdf in uploads.items():
-        robots.register_urdf(urdf, name)
+    for name, (urdf, options) in uploads.items():
+        robots.register_urdf(urdf, name, UploadOptions.from_json(options))
 
 
 def _problem_bytes(status: int, title: str, detail: str, **extra) -> bytes:
@@ -66,7 +68,7 @@ def result_line(key: str, number: int, status: int, body: bytes) -> bytes:
     return head + b',"body":' + body + b"}\n"
 
 
-def answer_chunk(chunk: list[tuple[str, str, int]], uploads: dict[str, str], budget_s: float) -> list[bytes]:
+def answer_chunk(chunk: list[tuple[str, str, int]], uploads: dict[str, tuple[str, str]], budget_s: float) -> list[bytes]:
     """Result lines (bytes) of a chunk of (key, text, line number) requests."""
     _uploads_here(uploads)
     return [result_line(key, number, *answer(text, budget_s)) for key, text, number in chunk]

@@ -10,6 +10,8 @@ from starlette.concurrency import run_in_threadpool
 import robots
 from planners.errors import InvalidRequest
 from planners.kinematics.skeleton import skeleton
+from robots.limits import LIMIT_KINDS
+from robots.upload_options import upload_options
 from service.problems import problem_responses
 from service.schemas.robots import RobotCreate, RobotPublic, RobotSummary, SkeletonPublic, SkeletonRequest
 
@@ -30,6 +32,9 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
         joint_names=list(robot.joint_names),
         end_effector=robot.end_effector,
         limits=robot.limits.as_lists(),
+        limit_sources={kind: list(robot.limit_sources.get(kind, ())) for kind in LIMIT_KINDS},
+        locked_joints=robot.locked_joints,
+        notes=list(robot.notes),
     )
 
 
@@ -65,8 +70,12 @@ def get_robot(name: str) -> RobotPublic:
 async def upload_robot(body: RobotCreate) -> RobotPublic:
     """Check a fixed-base arm's URDF (tree structure, finite and physically possible masses,
     inertias, origins and limits), build it with Pinocchio and store it durably under ``name``
-    (default: a content hash). Uploading the same URDF under the same name again is harmless."""
-    robot = await run_in_threadpool(robots.register_urdf, body.urdf, body.name)
+    (default: a content hash), with its options: joints locked at a value (``locked_joints``)
+    and limits in MoveIt's ``joint_limits.yaml`` form (``joint_limits``). Uploading the same
+    URDF with the same options under the same name again is harmless. The answer says where
+    each limit comes from and what was not used (``limit_sources``, ``notes``)."""
+    options = upload_options(body.locked_joints, body.joint_limits)
+    robot = await run_in_threadpool(robots.register_urdf, body.urdf, body.name, options)
     return robot_public(robot)
 
 

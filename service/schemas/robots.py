@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field
 
@@ -31,6 +31,18 @@ class RobotLimits(BaseModel):
     torque: list[float | None] = Field(description="Torque (N m) or force (N) limits.")
 
 
+class RobotLimitSources(BaseModel):
+    """Where each joint's limit comes from: `urdf`, `limits.toml` (the service's table for catalog
+    robots), `joint_limits.yaml` (given with the upload) or `default: ...` (the rule applied)."""
+
+    position_lower: list[str] = Field(description="Source of each lower position limit.")
+    position_upper: list[str] = Field(description="Source of each upper position limit.")
+    velocity: list[str] = Field(description="Source of each velocity limit.")
+    acceleration: list[str] = Field(description="Source of each acceleration limit.")
+    jerk: list[str] = Field(description="Source of each jerk limit.")
+    torque: list[str] = Field(description="Source of each torque limit.")
+
+
 class RobotPublic(BaseModel):
     """A robot as the service sees it."""
 
@@ -40,6 +52,11 @@ class RobotPublic(BaseModel):
     joint_names: list[str] = Field(description="Joint names, in the order of every per-joint list.")
     end_effector: str = Field(description="The frame Cartesian paths and tool speeds refer to by default.")
     limits: RobotLimits = Field(description="Per-joint limits, SI units.")
+    limit_sources: RobotLimitSources = Field(description="Where each limit comes from, per joint.")
+    locked_joints: dict[str, float] = Field(
+        description="Joints of the URDF fixed at a value (rad, m) and left out of joint_names (grippers)."
+    )
+    notes: list[str] = Field(description="What was not used or was changed: mesh files, limits not applied.")
 
 
 class RobotCreate(Schema):
@@ -53,6 +70,19 @@ class RobotCreate(Schema):
         "default `urdf-` plus a content hash.",
     )
     urdf: str = Field(max_length=MAX_URDF_CHARS, description="The URDF text (fixed-base arm).")
+    locked_joints: dict[str, float] | None = Field(
+        default=None,
+        max_length=64,
+        description="Joints to fix at a value (rad, m), e.g. a gripper's fingers: "
+        '`{"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}`. The robot plans the other joints.',
+    )
+    joint_limits: str | dict[str, Any] | None = Field(
+        default=None,
+        description="Limits in the form of MoveIt's `joint_limits.yaml`: its text, or the same structure as "
+        "JSON (`{\"joint_limits\": {joint: {\"has_acceleration_limits\": true, \"max_acceleration\": 10.0, ...}}}`). "
+        "Acceleration and jerk limits (rad/s^2, rad/s^3) are taken as given; velocity and effort limits "
+        "(rad/s, N m) only tighten the URDF's. The robot's `limit_sources` and `notes` say what was applied.",
+    )
 
 
 MAX_CONFIGURATIONS = 1_000

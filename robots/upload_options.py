@@ -1,0 +1,229 @@
+"""What an upload may add to its URDF: joints locked at a value, and limits in the form of
+MoveIt's ``joint_limits.yaml``.
+
+* ``locked_joints`` {joint: value (rad or m)}: the robot is the reduced model with those joints
+  fixed (``pinocchio.buildReducedModel``), as the catalog locks Panda's fingers: an uploaded
+  Panda with both finger joints locked plans its 7 arm joints.
+* ``joint_limits``: the text of a ``joint_limits.yaml`` (or the same structure as JSON):
+
+      joint_limits:
+        shoulder_pan_joint:
+          has_velocity_limits: true
+          max_velocity: 3.15
+          has_acceleration_limits: true
+          max_acceleration: 10.0
+          has_jerk_limits: false
+
+  A ``max_*`` applies where its ``has_*_limits`` is true, as in MoveIt. Acceleration and jerk
+  limits (which URDFs do not carry) are taken as given. Velocity and effort limits tighten the
+  URDF's: where the file allows more than the URDF, the URDF's limit is kept and the robot's
+  notes say so. Position limits stay the URDF's (noted when the file gives them), and
+  MoveIt's default scaling factors are not applied (noted): requests scale limits themselves.
+
+Options are checked against the URDF's model before anything is stored; a wrong joint name, a
+value outside the joint's range, a non-positive limit or a malformed file is an ``InvalidUpload``
+(422) naming the joint and the key.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+import yaml
+
+from robots.errors import ToptrajError, excerpt
+
+#: The keys of a joint's entry in joint_limits.yaml, and the limit kind each maximum sets.
+_MAXIMA = {"max_velocity": "velocity", "max_acceleration": "acceleration", "max_jerk": "jerk", "max_effort": "torque"}
+_FLAGS = {"velocity": "has_velocity_limits", "acceleration": "has_acceleration_limits", "jerk": "has_jerk_limits",
+          "torque": "has_effort_limits"}
+_POSITION_KEYS = {"has_position_limits", "min_position", "max_position", "angle_wraparound"}
+_KNOWN_KEYS = set(_MAXIMA) | set(_FLAGS.values()) | _POSITION_KEYS
+_SCALING_KEYS = {"default_velocity_scaling_factor", "default_acceleration_scaling_factor"}
+#: Largest joint_limits text accepted, in characters.
+MAX_LIMITS_CHARS = 200_000
+
+
+class InvalidUpload(ToptrajError):
+    """The options of an upload do not fit its URDF or are malformed."""
+
+    title = "Invalid upload options"
+
+
+@dataclass(frozen=True)
+class UploadOptions:
+    """Checked options of an upload.
+
+    Attributes:
+        locked_joints: {joint name: value (rad, m)}, in the order given.
+        joint_limits: {joint name: {kind: value}}, kinds among velocity, acceleration, jerk,
+            torque (rad/s, rad/s^2, rad/s^3, N m; m/s..., N for prismatic joints).
+        notes: What the file gave that is not applied (position limits, scaling factors).
+    """
+
+    locked_joints: dict[str, float] = field(default_factory=dict)
+    joint_limits: dict[str, dict[str, float]] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    def __bool__(self) -> bool:
+        return bool(self.locked_joints or self.joint_limits or self.notes)
+
+    def to_json(self) -> str:
+        """Canonical JSON for the store ("" for no options, what records stored before options
+        existed hold)."""
+        if not self:
+            return ""
+        return json.dumps(
+            {"locked_joints": self.locked_joints, "joint_limits": self.joint_limits, "notes": list(self.notes)},
+            sort_keys=True,
+            separators=(",", ":"),
+        )
+
+    @classmethod
+    def from_json(cls, text: str | None) -> UploadOptions:
+        """The options ``to_json`` wrote ("" or ``None``: none)."""
+        if not text:
+            return cls()
+        data = json.loads(text)
+        return cls(dict(data.get("locked_joints", {})), dict(data.get("joint_limits", {})), tuple(data.get("notes", ())))
+
+
+def _short(name) -> str:
+    """A name as a dotted path shows it, cut at 40 characters."""
+    name = str(name)
+    return name if len(name) <= 40 else f"{name[:40]}..."
+
+
+def _number(value, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise InvalidUpload(f"{where} must be a finite number, got {excerpt(repr(value), 40)}")
+    return float(value)
+
+
+def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
+    """{joint: {kind: value}} and notes from a joint_limits.yaml text or its parsed structure."""
+    if isinstance(given, str):
+        if len(given) > MAX_LIMITS_CHARS:
+            raise InvalidUpload(f"joint_limits holds {len(given)} characters; at most {MAX_LIMITS_CHARS} are read")
+        try:
+            given = yaml.safe_load(given)
+        except yaml.YAMLError as error:
+            mark = getattr(error, "problem_mark", None)
+            where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+            raise InvalidUpload(
+                f"joint_limits is not valid YAML{where}: {excerpt(str(getattr(error, 'problem', error)), 80)}"
+            ) from None
+    if not isinstance(given, dict) or not isinstance(given.get("joint_limits"), dict):
+        raise InvalidUpload(
+            "joint_limits must hold a 'joint_limits' mapping of joint names to their limits, as MoveIt's "
+            "joint_limits.yaml does (joint_limits: {joint: {has_acceleration_limits: true, max_acceleration: 10.0}})"
+        )
+    notes = []
+    unknown = sorted(set(given) - {"joint_limits"} - _SCALING_KEYS)
+    if unknown:
+        raise InvalidUpload(f"joint_limits: unknown top-level key {excerpt(unknown[0], 40)}; expected 'joint_limits'")
+    scaling = sorted(set(given) & _SCALING_KEYS)
+    if scaling:
+        notes.append(f"joint_limits.yaml's {', '.join(scaling)} not applied: requests scale limits (timing.limits)")
+    limits: dict[str, dict[str, float]] = {}
+    positions = []
+    for joint, entry in given["joint_limits"].items():
+        where = f"joint_limits.{_short(joint)}"
+        if not isinstance(entry, dict):
+            raise InvalidUpload(f"{where} must be a mapping of limit keys (max_velocity, max_acceleration, ...)")
+        unknown = sorted(set(entry) - _KNOWN_KEYS)
+        if unknown:
+            raise InvalidUpload(f"{where}: unknown key {excerpt(str(unknown[0]), 40)}; known: {', '.join(sorted(_KNOWN_KEYS))}")
+        values = {}
+        for key, kind in _MAXIMA.items():
+            flag = entry.get(_FLAGS[kind], False)
+            if not isinstance(flag, bool):
+                raise InvalidUpload(f"{where}.{_FLAGS[kind]} must be true or false")
+            if not flag:
+                continue
+            if key not in entry:
+                raise InvalidUpload(f"{where}: {_FLAGS[kind]} is true but {key} is missing")
+            value = _number(entry[key], f"{where}.{key}")
+            if value <= 0.0:
+                raise InvalidUpload(f"{where}.{key} must be positive, got {value:g}")
+            values[kind] = value
+        if entry.get("has_position_limits"):
+            positions.append(str(joint))
+        limits[str(joint)] = values
+    if positions:
+        notes.append(f"joint_limits.yaml's position limits of {', '.join(positions)} not applied: the URDF's are used")
+    return limits, notes
+
+
+def upload_options(locked_joints: dict | None = None, joint_limits=None) -> UploadOptions:
+    """Options from an upload request, checked for form (names are checked against the model
+    by ``apply_locks`` and ``robots.limits``).
+
+    Raises:
+        InvalidUpload: a non-finite locked value, or a malformed joint_limits.
+    """
+    locked = {}
+    for joint, value in (locked_joints or {}).items():
+        locked[str(joint)] = _number(value, f"locked_joints.{_short(joint)}")
+    limits, notes = ({}, []) if joint_limits is None else _joint_limits(joint_limits)
+    return UploadOptions(locked, limits, tuple(notes))
+
+
+def _moving_joints(model: pin.Model) -> dict[str, int]:
+    return {model.names[j]: j for j in range(1, model.njoints)}
+
+
+def apply_locks(model: pin.Model, locked: dict[str, float]) -> pin.Model:
+    """``model`` with the joints of ``locked`` fixed at their values (rad, m).
+
+    Raises:
+        InvalidUpload: an unknown joint, a value outside the joint's range, or every joint locked.
+    """
+    if not locked:
+        return model
+    joints = _moving_joints(model)
+    reference = pin.neutral(model)
+    for name, value in locked.items():
+        if name not in joints:
+            raise InvalidUpload(
+                f"locked_joints names {excerpt(name, 40)}, which is not a moving joint of the URDF; its joints: "
+                f"{excerpt(', '.join(joints), 300)}"
+            )
+        joint = model.joints[joints[name]]
+        if joint.nq == 2:  # a continuous joint: (cos, sin)
+            reference[joint.idx_q : joint.idx_q + 2] = (math.cos(value), math.sin(value))
+            continue
+        lower, upper = model.lowerPositionLimit[joint.idx_q], model.upperPositionLimit[joint.idx_q]
+        if not lower <= value <= upper:
+            raise InvalidUpload(
+                f"locked_joints.{_short(name)} = {value:g} is outside the joint's range [{lower:g}, {upper:g}]"
+            )
+        reference[joint.idx_q] = value
+    if len(locked) >= len(joints):
+        raise InvalidUpload("locked_joints locks every moving joint; leave at least one free")
+    return pin.buildReducedModel(model, [joints[name] for name in locked], reference)
+
+
+def yaml_limit_arrays(joint_names: tuple[str, ...] | list[str], options: UploadOptions) -> dict[str, np.ndarray]:
+    """The file's limits as arrays over ``joint_names`` (NaN where it gives none): {kind: (n_dof,)}.
+
+    Raises:
+        InvalidUpload: the file names a joint that is neither a joint of the robot nor locked.
+    """
+    index = {name: k for k, name in enumerate(joint_names)}
+    arrays = {kind: np.full(len(joint_names), np.nan) for kind in _FLAGS}
+    for joint, values in options.joint_limits.items():
+        if joint in options.locked_joints:
+            continue
+        if joint not in index:
+            raise InvalidUpload(
+                f"joint_limits names {excerpt(joint, 40)}, which is not a moving joint of the URDF; its joints: "
+                f"{excerpt(', '.join(joint_names), 300)}"
+            )
+        for kind, value in values.items():
+            arrays[kind][index[joint]] = value
+    return arrays
