@@ -52,5 +52,5 @@ def path_grid(path: GeometricPath, n_intervals: int | None = None) -> np.ndarray
         total = min(max(int(n_intervals), segments), MAX_POINTS)
         counts = np.maximum(floor, np.round(total * lengths).astype(int))
     pieces = [np.linspace(start, end, count + 1)[:-1] for start, end, count in zip(knots[:-1], knots[1:], counts)]
-    pieces.append([1.0])
+    pieces.append(np.array([1.0]))
     return np.concatenate(pieces)

@@ -205,4 +205,8 @@ def limits_with_sources(
                 values[kind] = values[kind].copy()
                 values[kind][k] = given[kind][k]
                 sources[kind][k] = "joint_limits.yaml"
-    return JointLimits(**values), {kind: tuple(sources[kind]) for kind in LIMIT_KINDS}, notes
+    limits = JointLimits(
+        values["position_lower"], values["position_upper"], values["velocity"], values["acceleration"], values["jerk"],
+        values["torque"],
+    )
+    return limits, {kind: tuple(sources[kind]) for kind in LIMIT_KINDS}, notes

@@ -102,6 +102,13 @@ class UploadStore:
         return f"UploadStore({str(self.path)!r}, max_uploads={self.max_uploads}, max_bytes={self.max_bytes})"
 
     @contextmanager
+    def _write(self) -> Iterator[sqlite3.Connection]:
+        """A writing connection (``_connect``), which creates the database when it is missing."""
+        with self._connect(write=True) as connection:
+            assert connection is not None
+            yield connection
+
+    @contextmanager
     def _connect(self, write: bool) -> Iterator[sqlite3.Connection | None]:
         """A connection in autocommit mode (``None`` when reading a store that does not exist).
 
@@ -196,7 +203,7 @@ class UploadStore:
             UploadStoreFull: storing it would pass the count or byte cap.
         """
         size = len(urdf.encode())
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute("BEGIN IMMEDIATE")
             try:
                 row = connection.execute("SELECT digest, options FROM robots WHERE name = ?", (name,)).fetchone()
@@ -235,7 +242,7 @@ class UploadStore:
         """Remove ``name`` (and its text when no other name uses it); ``False`` if absent."""
         if not self.path.exists():
             return False
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute("BEGIN IMMEDIATE")
             try:
                 row = connection.execute("SELECT digest FROM robots WHERE name = ?", (name,)).fetchone()

@@ -139,9 +139,10 @@ def _check_geometry(link: ElementTree.Element, where: str) -> None:
                 if shape.tag not in _SHAPES:
                     continue  # Pinocchio reads no other shape
                 shape_where = f"{place} <{shape.tag}>"
+                sizes: list[float]
                 if shape.tag == "box":
-                    sizes = _vector(shape, "size", shape_where)
-                    sizes = [] if sizes is None else list(sizes)
+                    box = _vector(shape, "size", shape_where)
+                    sizes = [] if box is None else list(box)
                 elif shape.tag == "mesh":
                     scale = _vector(shape, "scale", shape_where)
                     if scale is not None and np.abs(scale).max() > MAX_MESH_SCALE:
@@ -238,8 +239,8 @@ def _check_limits(joint: ElementTree.Element, kind: str, where: str) -> None:
         return
     if lower is None or upper is None or not lower < upper:
         raise InvalidURDF(f"{where}: needs position limits lower < upper, got {lower}, {upper}")
-    for name in ("lower", "upper"):
-        _within(values[name], -MAX_POSITION, MAX_POSITION, where, f"{name} position limit", "rad (m for prismatic)")
+    for name, value in (("lower", lower), ("upper", upper)):
+        _within(value, -MAX_POSITION, MAX_POSITION, where, f"{name} position limit", "rad (m for prismatic)")
 
 
 def _check_joint_numbers(joint: ElementTree.Element, kind: str, where: str) -> None:
@@ -262,7 +263,9 @@ def _check_joint_numbers(joint: ElementTree.Element, kind: str, where: str) -> N
         ("mimic", ("multiplier", "offset")),
     ):
         element = joint.find(tag)
-        for name in () if element is None else names:
+        if element is None:
+            continue
+        for name in names:
             value = _scalar(element, name, f"{where} <{tag}>")
             if value is not None:
                 _within(value, -MAX_OTHER, MAX_OTHER, where, f"<{tag}> {name}", "")

@@ -39,6 +39,7 @@ import socket
 import sys
 import weakref
 
+_BaseLoop: type[asyncio.AbstractEventLoop]
 try:
     from uvloop import Loop as _BaseLoop
 except ImportError:  # pragma: no cover - uvloop is a dependency where it builds
@@ -113,7 +114,11 @@ async def _wait_readable(loop: asyncio.AbstractEventLoop, sock: socket.socket) -
     """Return once ``sock`` is readable (for a listening socket: a connection waits)."""
     readable = loop.create_future()
     fd = sock.fileno()
-    loop.add_reader(fd, lambda: readable.done() or readable.set_result(None))
+    def ready() -> None:
+        if not readable.done():
+            readable.set_result(None)
+
+    loop.add_reader(fd, ready)
     try:
         await readable
     finally:

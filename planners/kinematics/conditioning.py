@@ -43,7 +43,7 @@ def characteristic_length(robot: Robot) -> float:
     pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
     tip = data.oMf[robot.frame_id(robot.end_effector)].translation
     base = data.oMi[1].translation
-    return float(max(np.linalg.norm(tip - base), 0.05))
+    return max(float(np.linalg.norm(tip - base)), 0.05)
 
 
 def task_jacobian(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> np.ndarray:
@@ -75,6 +75,6 @@ def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tu
     length = characteristic_length(robot)
     frame_id = robot.frame_id(robot.end_effector)
     rows = np.unique(np.linspace(0, len(q) - 1, min(len(q), max_points)).round().astype(int))
-    kappas = frobenius_condition_number(task_jacobians(robot, q[rows], frame_id, length))
+    kappas = np.atleast_1d(frobenius_condition_number(task_jacobians(robot, q[rows], frame_id, length)))
     worst = int(np.argmax(kappas))
     return float(kappas.min()), float(kappas.max()), length, int(rows[worst])

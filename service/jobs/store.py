@@ -120,8 +120,9 @@ class Job:
 
     @classmethod
     def from_row(cls, row) -> Job:
-        *head, error, seq = row
-        return cls(*head, None if error is None else json.loads(error), seq)
+        job_id, kind, status, fraction, stage, budget_s, created, started, finished, error, seq = row
+        problem = None if error is None else json.loads(error)
+        return cls(job_id, kind, status, fraction, stage, budget_s, created, started, finished, problem, seq)
 
 
 @dataclass(frozen=True)
@@ -180,6 +181,13 @@ class JobStore:
         return f"JobStore({str(self.path)!r}, {bounds})"
 
     @contextmanager
+    def _write(self) -> Iterator[sqlite3.Connection]:
+        """A writing connection (``_connect``), which creates the database when it is missing."""
+        with self._connect(write=True) as connection:
+            assert connection is not None
+            yield connection
+
+    @contextmanager
     def _connect(self, write: bool) -> Iterator[sqlite3.Connection | None]:
         """A connection in autocommit mode (``None`` when reading a store that does not exist).
 
@@ -211,7 +219,7 @@ class JobStore:
     def _transaction(self) -> Iterator[sqlite3.Connection]:
         """A write transaction (``BEGIN IMMEDIATE``): committed at the end of the block, rolled
         back on an error."""
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute("BEGIN IMMEDIATE")
             try:
                 yield connection
@@ -243,7 +251,9 @@ class JobStore:
             pruned = self._prune(connection)
         if pruned:
             self._vacuum()
-        return self.get(job_id)
+        job = self.get(job_id)
+        assert job is not None  # just stored; pruning removes finished jobs only
+        return job
 
     def get(self, job_id: str) -> Job | None:
         """The job ``job_id``, ``None`` when there is none."""
@@ -264,7 +274,8 @@ class JobStore:
     def jobs(self, limit: int, before: int | None = None, status: str | None = None) -> list[Job]:
         """At most ``limit`` jobs, newest first, submitted before the job of sequence number
         ``before`` (when given), with ``status`` (when given)."""
-        clauses, values = [], []
+        clauses: list[str] = []
+        values: list[int | str] = []
         if before is not None:
             clauses.append("seq < ?")
             values.append(before)
@@ -289,7 +300,7 @@ class JobStore:
         """
         if not self.path.exists():
             return None
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute(
                 "UPDATE jobs SET status = 'cancelled', finished = ?, owner = NULL "
                 "WHERE id = ? AND status IN ('queued', 'running')",
@@ -329,7 +340,7 @@ class JobStore:
 
     def report(self, job_id: str, owner: str, fraction: float, stage: str) -> None:
         """Record the progress of a running job of ``owner``."""
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute(
                 "UPDATE jobs SET fraction = ?, stage = ?, heartbeat = ? WHERE id = ? AND owner = ? AND status = 'running'",
                 (fraction, stage[:200], time.time(), job_id, owner),
@@ -338,7 +349,7 @@ class JobStore:
     def heartbeat(self, owner: str, job_ids: list[str]) -> set[str]:
         """Mark the running jobs of ``owner`` alive; returns those of ``job_ids`` that no longer
         run under ``owner`` (cancelled, or taken as interrupted): their work must stop."""
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute("UPDATE jobs SET heartbeat = ? WHERE owner = ? AND status = 'running'", (time.time(), owner))
             marks = ",".join("?" * len(job_ids))
             running = {
@@ -394,7 +405,7 @@ class JobStore:
         if not self.path.exists():
             return
         text = json.dumps(error)
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute(
                 "UPDATE jobs SET status = 'interrupted', finished = ?, error = ?, owner = NULL, bytes = bytes + ? "
                 "WHERE owner = ? AND status = 'running'",
@@ -431,7 +442,7 @@ class JobStore:
 
     def _vacuum(self) -> None:
         """Give pages freed by deletions back to the file system."""
-        with self._connect(write=True) as connection:
+        with self._write() as connection:
             connection.execute("PRAGMA incremental_vacuum")
 
     def usage(self) -> tuple[int, int]:
