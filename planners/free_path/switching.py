@@ -40,7 +40,7 @@ from robots import JointLimits, Robot
 
 #: Longest Runge-Kutta step (s) while the switching times are solved for, and of the final
 #: integration of the refined motion.
-SOLVE_STEP = 4e-3
+SOLVE_STEP = 8e-3
 FINAL_STEP = 1e-3
 #: Largest goal error (rad, rad/s) of an accepted refinement.
 GOAL_TOLERANCE = 1e-8
