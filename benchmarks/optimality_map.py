@@ -1,7 +1,7 @@
 """Jeong & Lee's optimality map (section 4.3) of the Geering arm: which family of time-optimal
 motions wins as the shoulder goal phi_b grows, with the elbow free (back to 0 or a full turn).
 
-    python benchmarks/optimality_map.py --step 0.1 --width 1e-4
+    python benchmarks/optimality_map.py --step 0.1 --width 1e-3
 
 Discovers the families from the free-path answers at a few anchor goals
 (``planners.free_path.optimality_map``), prints one row per phi_b (each family's T in s, "-"
@@ -38,7 +38,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--anchors", default="0.5,0.98,1.25,2.5", help="shoulder goals (rad) of the free-path answers")
     parser.add_argument("--step", type=float, default=0.1, help="sweep step of phi_b (rad)")
-    parser.add_argument("--width", type=float, default=1e-4, help="bisection bracket width (rad)")
+    parser.add_argument("--width", type=float, default=1e-3, help="bisection bracket width (rad)")
     args = parser.parse_args()
     arm = robots.load("geering_2r")
     started = time.perf_counter()

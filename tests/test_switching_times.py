@@ -145,7 +145,7 @@ def test_collocation_alone_places_switches_within_its_step(arm, type_3):
 # tries psi_b = 0 and -2 pi) at phi_b = 0.5 (Type 1), 0.76 (Type 3) and pi (Type 4), each
 # continued in phi_b with its switching structure; the fastest wins, and the boundaries are
 # bisected to 0.01 rad (the paper prints two decimals). benchmarks/optimality_map.py prints the
-# whole sweep and bisects to 1e-4 rad: 0.7613 and 1.7621.
+# whole sweep and bisects further (1e-3 rad: [0.7609, 0.7617] and [1.7617, 1.7625]).
 BOUNDARY_WIDTH = 0.01  # rad
 
 
@@ -184,3 +184,17 @@ def test_type_3_to_type_4_boundary(arm, type_3, type_4):
     assert lower - 0.005 <= 1.76 <= upper + 0.005
     # where Type 3's inner u1 arcs shrink to nothing, Type 4 takes over
     assert three.at(upper) is None and four.at(upper) is not None
+
+
+def test_switching_times_in_the_answer_schema(type_3):
+    """The answer carries switching_times per joint name (s), declared in the OpenAPI."""
+    from service.app import create_app
+    from service.planning import trajectory_body
+    from service.schemas.trajectories import TrajectoryResponse
+    from service.settings import Settings
+
+    body = TrajectoryResponse.model_validate(trajectory_body(type_3)).model_dump()
+    assert set(body["switching_times"]) == {"phi", "psi"}
+    assert body["switching_times"]["psi"] == pytest.approx([type_3.duration / 2], abs=1e-4)
+    field = create_app(Settings(preload_robots=False)).openapi()["components"]["schemas"]["TrajectoryResponse"]["properties"]["switching_times"]
+    assert "(s)" in field["description"]
