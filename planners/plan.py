@@ -19,6 +19,7 @@ from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
+from planners.free_path.switching import collocation_switches, refine_collocation, switched_path, switching_times
 from planners.gate import TimedStretch, checked, gate_threshold, gated, samples_exceed
 from planners.grid import MAX_POINTS, path_grid
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
@@ -43,6 +44,9 @@ from robots import JointLimits, Robot
 MAX_SAMPLES = 200_000
 #: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
 MAX_PHASE_PLANE_POINTS = 2_000
+#: Share of its limit beyond which a sampled torque counts as saturated when switching times
+#: are read off the samples.
+SATURATION_READ = 0.98
 #: Largest timing.limit_margin (a fraction of every limit kept in reserve).
 MAX_LIMIT_MARGIN = 0.5
 
@@ -111,7 +115,7 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
         "initial_guess": result.initial_guess,
         "solve_s": result.solve_s,
     }
-    return path, solver, timed
+    return path, solver, timed, result
 
 
 def _check_tool_limit_served(path_spec, method: TimingMethod) -> None:
@@ -160,6 +164,7 @@ class _Timed(NamedTuple):
     notes: tuple[str, ...] = ()
     cost: float | None = None
     solver: dict | None = None
+    switching_times: dict | None = None
 
 
 def _grid(path: GeometricPath, n_intervals: int | None, method: TimingMethod, robot: Robot) -> np.ndarray:
@@ -275,8 +280,8 @@ def _timed_unsynchronized(robot, spec, method, timing, kinds, limits, deadline, 
 def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, threshold) -> _Timed:
     """A free motion: the collocation's path, re-timed exactly along itself (phase_plane, or
     min_cost for beta > 0) so that every limit holds between the collocation instants too."""
-    path, solver, collocation_timing = _free_motion(robot, spec, method, timing, limits, deadline.within(0.0, 0.9))
-    deadline.progress(0.9, "re-timing along the collocation's path")
+    path, solver, collocation_timing, collocation = _free_motion(robot, spec, method, timing, limits, deadline.within(0.0, 0.8))
+    deadline.progress(0.8, "re-timing along the collocation's path")
     retimer = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
     constraints = build_path_constraints(path, robot, limits, kinds, _grid(path, None, retimer, robot), deadline)
     moving = dataclasses.replace(
@@ -295,8 +300,32 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
         result = collocation_timing
         stretch = checked(robot, path, result, "collocation", kinds, limits, threshold, constraints)
         notes = (f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})",)
+    switching = None
+    if timing.torque_weight == 0.0:
+        deadline.progress(0.9, "refining the switching times")
+        path, result, stretch, switching, notes = _switched(
+            robot, spec, collocation, (path, result, stretch), kinds, limits, threshold, notes, deadline
+        )
+        solver = {**solver, "switching": "refined" if switching is not None else "read off the samples"}
     cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
-    return _Timed(path, result, (stretch,), "collocation", notes, cost, solver)
+    return _Timed(path, result, (stretch,), "collocation", notes, cost, solver, switching)
+
+
+def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, deadline):
+    """The time-optimal free motion with exact bang-bang torques (``planners.free_path.switching``)
+    in place of ``timed`` (path, timing, stretch) when it reaches the goal, is not longer and
+    passes the limit gate; with its switching times (else ``None``)."""
+    path, result, stretch = timed
+    refined = refine_collocation(robot, limits, spec, collocation, deadline)
+    if refined is None or refined.duration > result.duration:
+        return path, result, stretch, None, notes
+    switched, timing = switched_path(refined)
+    constraints = build_path_constraints(switched, robot, limits, kinds, path_grid(switched), deadline)
+    try:
+        stretch = checked(robot, switched, timing, "collocation", kinds, limits, threshold, constraints)
+    except InfeasiblePath as error:
+        return path, result, stretch, None, (*notes, f"the bang-bang refinement is not returned: {error.detail}")
+    return switched, timing, stretch, switching_times(refined.controls, robot.joint_names), notes
 
 
 def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -458,6 +487,10 @@ def plan(
             f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} "
             f"at t = {samples.t[worst]:.4g} s"
         )
+    switching = timed.switching_times
+    if switching is None and timed.method == "collocation" and timing.torque_weight == 0.0:
+        read = collocation_switches(samples.t, samples.tau, limits.torque, level=SATURATION_READ)
+        switching = switching_times(read, robot.joint_names)
     s, sd, mvc = _phase_plane(timed.stretches)
     require_finite(timed.method, path_speed=sd, cost=timed.cost)
     return PlannedTrajectory(
@@ -474,6 +507,7 @@ def plan(
         conditioning=Conditioning(kappa_min, kappa_max, length),
         cost=timed.cost,
         solver=timed.solver,
+        switching_times=switching,
         clearance=found_clearance,
     )
 

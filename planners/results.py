@@ -53,6 +53,9 @@ class PlannedTrajectory:
     cost: float | None = None
     solver: dict | None = None
     clearance: Clearance | None = None
+    #: Free paths with time-optimal (bang-bang) torques: {joint name: [t, ...]} in s, the
+    #: instants where each saturated torque changes sides.
+    switching_times: dict[str, list[float]] | None = None
 
 
 def require_finite(method: str, **quantities) -> None:

@@ -217,6 +217,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         },
         "cost": result.cost,
         "solver": result.solver,
+        "switching_times": result.switching_times,
         "solve_ms": result.solve_ms,
         "warnings": list(result.warnings),
         "min_clearance": None if result.clearance is None else {

@@ -412,6 +412,12 @@ class TrajectoryResponse(BaseModel):
     conditioning: ConditioningPublic = Field(description="Condition number of the end effector's Jacobian along the trajectory.")
     cost: float | None = Field(default=None, description="min_cost, collocation: the integral of (1 + beta |tau|^2) dt, in s.")
     solver: dict | None = Field(default=None, description="collocation: status, iterations, the winning initial guess.")
+    switching_times: dict[str, list[float]] | None = Field(
+        default=None,
+        description="collocation with torque_weight 0 (bang-bang torques): for each joint name, the times (s) "
+        "at which its saturated torque changes sides, in increasing order; solver.switching says whether "
+        "they were refined (exact bang-bang controls) or read off the samples.",
+    )
     solve_ms: float = Field(description="Planning time in the library (ms).")
     min_clearance: ClearancePublic | None = Field(
         default=None, description="With path.obstacles: the closest approach of any link to any obstacle."

@@ -1,0 +1,470 @@
+"""Switching times of a bang-bang free motion, refined by a direct switching-time
+parameterization (Jeong & Lee section 4.3, after Geering et al. 1986: the time-optimal motions
+of the two-link arm are bang-bang, each torque at one bound or the other between its switching
+times, and the paper's figure captions print those times).
+
+A collocation (``planners.free_path.collocation``) places a switch only between two of its
+instants: it changes sides somewhere within one interval h = T / K (36 ms at K = 30 on the
+Geering arm), and reading the instant where the interpolated torque crosses zero leaves errors
+of a good part of h. Here the controls are instead exactly bang-bang,
+
+    u_j(t) = sign_j,i * tau_max,j     for  t_j,i-1 <= t < t_j,i,
+
+with the signs sign_j,i taken from the collocation, and the unknowns are the switching times
+t_j,i of every joint and the duration T. The motion is integrated forward from the start state
+by Pinocchio's forward dynamics (``pinocchio.aba``, a classical Runge-Kutta step on each arc
+between consecutive switches of any joint, so that no step straddles a switch), and the goal
+state q(T) = q_b, v(T) = v_b gives 2 n equations. With as many unknowns as equations (Type 1
+of the paper: 3 switches and T) they are solved by Gauss-Newton (``scipy.optimize.least_squares``);
+with more (Types 2 to 4: 4 switches and T), the least-squares solution seeds a minimization of T
+under those equations (SLSQP), the switching-time optimization.
+
+Near a change of type (the paper's Types 1 and 2 at phi_b = 0.98) two switching structures
+give almost the same T; ``refine_switching`` therefore also tries the neighbouring structures
+(a boundary arc of one joint removed, or a short one added) and keeps the shortest motion that
+meets the goal.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from scipy.optimize import minimize
+
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.free_path.collocation import CollocationResult, FreeMotion
+from planners.via_points import ConstantSpeedTiming, ViaPath
+from robots import JointLimits, Robot
+
+#: Longest Runge-Kutta step (s) while the switching times are solved for, and of the final
+#: integration of the refined motion.
+SOLVE_STEP = 8e-3
+FINAL_STEP = 1e-3
+#: Largest goal error (rad, rad/s) of an accepted refinement.
+GOAL_TOLERANCE = 1e-8
+#: A torque is saturated on one side where it lies beyond this fraction of its limit.
+SATURATED = 0.5
+#: Duration (s) of a boundary arc added when neighbouring structures are tried.
+NEW_ARC = 0.01
+
+
+@dataclass(frozen=True)
+class BangBang:
+    """Bang-bang controls: per joint, the signs of its arcs (n_arcs,), +1 or -1, and the times
+    (n_arcs - 1,) in s where it changes sides, over a duration T (s)."""
+
+    signs: tuple[np.ndarray, ...]
+    switches: tuple[np.ndarray, ...]
+    duration: float
+
+    def unknowns(self) -> np.ndarray:
+        return np.concatenate([*self.switches, [self.duration]])
+
+    def with_unknowns(self, theta: np.ndarray) -> BangBang:
+        cuts = np.cumsum([len(s) for s in self.switches])[:-1]
+        return BangBang(self.signs, tuple(np.array(x) for x in np.split(theta[:-1], cuts)), float(theta[-1]))
+
+    def label(self) -> str:
+        return "; ".join("(" + ", ".join("max" if s > 0 else "min" for s in signs) + ")" for signs in self.signs)
+
+
+@dataclass(frozen=True)
+class SwitchedMotion:
+    """A refined bang-bang motion: its controls, and its states at instants t (n_t,) that include
+    every switch (a switching instant appears twice, before and after): q, v, a (n_t, n_dof) in
+    rad, rad/s, rad/s^2, and tau (n_t, n_dof) in N m; the goal error it leaves (rad, rad/s)."""
+
+    controls: BangBang
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    goal_error: float
+
+    @property
+    def duration(self) -> float:
+        return self.controls.duration
+
+
+def collocation_switches(t: np.ndarray, tau: np.ndarray, torque_limit: np.ndarray, level: float = SATURATED) -> BangBang:
+    """The bang-bang structure read off sampled torques (t (n,) in s, tau (n, n_dof) in N m): per
+    joint, the sides where |tau| exceeds ``level`` of its limit, and between two sides the instant where the linearly interpolated
+    torque crosses zero. Its accuracy is bounded by the sampling step (the collocation's h)."""
+    signs, switches = [], []
+    for j in range(tau.shape[1]):
+        bound = level * torque_limit[j]
+        side = np.where(tau[:, j] > bound, 1, np.where(tau[:, j] < -bound, -1, 0))
+        saturated = np.flatnonzero(side)
+        joint_signs, joint_switches = [], []
+        for k, index in enumerate(saturated):
+            if joint_signs and side[index] == joint_signs[-1]:
+                continue
+            if joint_signs:
+                previous = saturated[k - 1]
+                segment = tau[previous : index + 1, j]
+                crossing = int(np.flatnonzero(np.diff(np.sign(segment)) != 0)[0])
+                a, b = previous + crossing, previous + crossing + 1
+                joint_switches.append(t[a] + (t[b] - t[a]) * tau[a, j] / (tau[a, j] - tau[b, j]))
+            joint_signs.append(int(side[index]))
+        if not joint_signs:
+            joint_signs = [1 if tau[:, j].mean() >= 0 else -1]
+        signs.append(np.array(joint_signs))
+        switches.append(np.array(joint_switches))
+    return BangBang(tuple(signs), tuple(switches), float(t[-1]))
+
+
+class _Shooting:
+    """The forward integration of bang-bang controls from a start state."""
+
+    def __init__(self, robot: Robot, torque_limit, start, start_velocity, deadline: Deadline = NO_DEADLINE):
+        self.robot, self.limit, self.deadline = robot, np.asarray(torque_limit, dtype=float), deadline
+        self.start, self.start_velocity = np.asarray(start, float), np.asarray(start_velocity, float)
+        self.data = robot.model.createData()
+
+    def acceleration(self, q, v, tau):
+        robot = self.robot
+        configuration = np.empty(robot.model.nq)
+        configuration[robot._plain_q_index] = q[robot._plain_v_index]
+        angles = q[robot._angle_index_of_pair]
+        configuration[robot._cos_index] = np.cos(angles)
+        configuration[robot._cos_index + 1] = np.sin(angles)
+        return pin.aba(robot.model, self.data, configuration, v, tau)
+
+    def arcs(self, controls: BangBang):
+        """Instants (n_arcs + 1,) where any joint switches, with the torque (n_dof,) on each arc."""
+        times = np.concatenate([[0.0], *controls.switches, [controls.duration]])
+        edges = np.unique(np.clip(times, 0.0, controls.duration))
+        torques = []
+        for begin, end in zip(edges[:-1], edges[1:]):
+            middle = 0.5 * (begin + end)
+            torques.append(
+                np.array([signs[np.searchsorted(switches, middle)] for signs, switches in zip(controls.signs, controls.switches)])
+                * self.limit
+            )
+        return edges, torques
+
+    def run(self, controls: BangBang, step: float, keep: bool = False):
+        """The end state (q, v) after T; with ``keep``, also every step's (t, q, v, a, tau)."""
+        self.deadline.check()
+        q, v = self.start.copy(), self.start_velocity.copy()
+        edges, torques = self.arcs(controls)
+        record = []
+        for begin, end, tau in zip(edges[:-1], edges[1:], torques):
+            length = end - begin
+            if length <= 0.0:
+                continue
+            n = max(1, int(np.ceil(length / step)))
+            h = length / n
+            for k in range(n):
+                a1 = self.acceleration(q, v, tau)
+                if keep:
+                    record.append((begin + k * h, q, v, a1, tau))
+                q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
+                a2 = self.acceleration(q2, v2, tau)
+                q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
+                a3 = self.acceleration(q3, v3, tau)
+                q4, v4 = q + h * v3, v + h * a3
+                a4 = self.acceleration(q4, v4, tau)
+                q = q + h / 6 * (v + 2 * v2 + 2 * v3 + v4)
+                v = v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            if keep:
+                record.append((end, q, v, self.acceleration(q, v, tau), tau))
+        return q, v, record
+
+
+def _jacobian(function, x: np.ndarray, value: np.ndarray, step: float = 1e-6) -> np.ndarray:
+    """Forward differences of ``function`` at ``x`` (where it is ``value``)."""
+    columns = []
+    for i in range(len(x)):
+        shifted = x.copy()
+        shifted[i] += step
+        columns.append((function(shifted) - value) / step)
+    return np.array(columns).T
+
+
+def _newton(function, x: np.ndarray, tolerance: float, iterations: int = 30) -> np.ndarray:
+    """Gauss-Newton steps of least norm (the pseudo-inverse: square or with more unknowns than
+    equations) towards function(x) = 0, halved while they do not reduce the residual."""
+    value = function(x)
+    for _ in range(iterations):
+        norm = np.abs(value).max()
+        if norm < tolerance:
+            break
+        step = np.linalg.lstsq(_jacobian(function, x, value), -value, rcond=None)[0]
+        for _ in range(20):
+            trial = x + step
+            trial_value = function(trial)
+            if np.abs(trial_value).max() < norm:
+                x, value = trial, trial_value
+                break
+            step = step / 2
+        else:
+            break
+    return x
+
+
+def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> BangBang | None:
+    """Switching times and T that reach the goal, the shortest such when there are more unknowns
+    than goal equations; ``None`` when the goal is not met or the switches leave their order.
+
+    With one unknown more than equations (the paper's Types 2 to 4), one switching time p is
+    held while Newton's method solves for the others and T, and T(p) is minimized by the secant
+    method on dT/dp (from the implicit function theorem on the same Jacobian, dT/dp = -(J_y^-1
+    J_p)_T); with more, by SLSQP under the goal equations."""
+    target = np.concatenate([goal, goal_velocity])
+    counts = [len(s) for s in seed.switches]
+
+    def residual(theta, step=SOLVE_STEP):
+        q, v, _ = shooting.run(seed.with_unknowns(theta), step)
+        return np.concatenate([q, v]) - target
+
+    def ordering(theta):
+        """Each joint's switches in order within (0, T): differences that must stay >= 0."""
+        gaps, offset, T = [], 0, theta[-1]
+        for count in counts:
+            times = np.concatenate([[0.0], theta[offset : offset + count], [T]])
+            gaps.append(np.diff(times))
+            offset += count
+        return np.concatenate(gaps)
+
+    theta = _newton(residual, seed.unknowns(), 1e-9)
+    if np.abs(residual(theta)).max() > 1e-6 or ordering(theta).min() < -1e-9:
+        return None
+    free = len(theta) - len(target)
+    held = None
+    if free == 1:
+        theta, held = _secant_minimum(residual, theta)
+    elif free > 1:
+        theta = minimize(
+            lambda x: x[-1],
+            theta,
+            jac=lambda x: np.eye(len(x))[-1],
+            method="SLSQP",
+            constraints=[
+                {"type": "eq", "fun": residual, "jac": lambda x: _jacobian(residual, x, residual(x))},
+                {"type": "ineq", "fun": ordering},
+            ],
+            options={"maxiter": 100, "ftol": 1e-12},
+        ).x
+        held = np.arange(len(target), len(theta) - 1)
+    # Polished on the final step, the held switching times (if any) where they were chosen.
+    if held is None:
+        theta = _newton(lambda x: residual(x, FINAL_STEP), theta, GOAL_TOLERANCE)
+    else:
+        theta = _held(lambda x, h=held: residual(x, FINAL_STEP), theta, np.atleast_1d(held), GOAL_TOLERANCE)
+    if ordering(theta).min() < -1e-9 or np.abs(residual(theta, FINAL_STEP)).max() > 1e-6:
+        return None
+    return seed.with_unknowns(theta)
+
+
+def _held(function, theta: np.ndarray, held: np.ndarray, tolerance: float) -> np.ndarray:
+    """Newton's method on the unknowns other than ``held`` (indices), which keep their values."""
+    others = np.setdiff1d(np.arange(len(theta)), held)
+
+    def reduced(x):
+        full = theta.copy()
+        full[others] = x
+        return function(full)
+
+    result = theta.copy()
+    result[others] = _newton(reduced, theta[others], tolerance)
+    return result
+
+
+#: First trial step (s) of the held switching time, and the largest step of the secant method.
+SECANT_FIRST, SECANT_LONGEST, SECANT_TOLERANCE = 2e-3, 2e-2, 1e-8
+
+
+def _secant_minimum(residual, theta: np.ndarray, iterations: int = 30) -> tuple[np.ndarray, int]:
+    """The shortest T along the one-dimensional family of solutions through ``theta``: the
+    switching time p that the family's tangent moves most is held, and dT/dp = 0 is solved by
+    the secant method, each trial corrected back onto the family by Newton's method."""
+    J = _jacobian(residual, theta, residual(theta))
+    tangent = np.linalg.svd(J)[2][-1]
+    p = int(np.argmax(np.abs(tangent[:-1])))
+    others = np.setdiff1d(np.arange(len(theta)), [p])
+
+    def slope(x):
+        """dT/dp on the family at the solution x, and d(others)/dp."""
+        value = residual(x)
+        jacobian = _jacobian(residual, x, value)
+        derivative = -np.linalg.solve(jacobian[:, others], jacobian[:, p])
+        return derivative[-1], derivative
+
+    g, direction = slope(theta)
+    previous = None
+    for _ in range(iterations):
+        if previous is None:
+            step = -np.sign(g) * SECANT_FIRST
+        else:
+            curvature = (g - previous[1]) / (theta[p] - previous[0])
+            step = -g / curvature if curvature > 0 else -np.sign(g) * SECANT_LONGEST
+        step = float(np.clip(step, -SECANT_LONGEST, SECANT_LONGEST))
+        trial = theta.copy()
+        trial[p] += step
+        trial[others] += direction * step
+        trial = _held(residual, trial, np.array([p]), 1e-10)
+        if np.abs(residual(trial)).max() > 1e-7:
+            break
+        previous = (theta[p], g)
+        theta = trial
+        g, direction = slope(theta)
+        if abs(step) < SECANT_TOLERANCE:
+            break
+    return theta, p
+
+
+def _neighbours(seed: BangBang) -> list[BangBang]:
+    """The seed, and the structures one boundary arc away: per joint, its first or last arc
+    removed (when it has more than one), or a short arc of the other sign added at either end."""
+    options = [seed]
+    T = seed.duration
+    for j, (signs, switches) in enumerate(zip(seed.signs, seed.switches)):
+        variants = []
+        if len(signs) > 1:
+            variants.append((signs[1:], switches[1:]))
+            variants.append((signs[:-1], switches[:-1]))
+        variants.append((np.concatenate([[-signs[0]], signs]), np.concatenate([[NEW_ARC], switches])))
+        variants.append((np.concatenate([signs, [-signs[-1]]]), np.concatenate([switches, [T - NEW_ARC]])))
+        for new_signs, new_switches in variants:
+            options.append(
+                BangBang(
+                    seed.signs[:j] + (new_signs,) + seed.signs[j + 1 :],
+                    seed.switches[:j] + (np.asarray(new_switches, float),) + seed.switches[j + 1 :],
+                    T,
+                )
+            )
+    return options
+
+
+def refine_switching(
+    robot: Robot,
+    torque_limit: np.ndarray,
+    start: np.ndarray,
+    goal: np.ndarray,
+    seed: BangBang,
+    start_velocity: np.ndarray | None = None,
+    goal_velocity: np.ndarray | None = None,
+    neighbours: bool = False,
+    deadline: Deadline = NO_DEADLINE,
+) -> SwitchedMotion | None:
+    """The bang-bang motion from ``start`` to ``goal`` (rad; rest unless velocities are given,
+    rad/s) with the switching structure of ``seed`` (or, with ``neighbours``, of the structure
+    one boundary arc away that gives the shortest duration), its switching times and duration
+    solved for from ``seed``'s; ``None`` when no structure reaches the goal."""
+    zero = np.zeros(robot.dof)
+    start_velocity = zero if start_velocity is None else np.asarray(start_velocity, float)
+    goal_velocity = zero if goal_velocity is None else np.asarray(goal_velocity, float)
+    shooting = _Shooting(robot, torque_limit, start, start_velocity, deadline)
+    best = None
+    for candidate in _neighbours(seed) if neighbours else [seed]:
+        try:
+            solved = _solve(shooting, candidate, np.asarray(goal, float), goal_velocity)
+        except (ValueError, np.linalg.LinAlgError):
+            solved = None
+        if solved is not None and (best is None or solved.duration < best.duration - 1e-9):
+            best = solved
+    if best is None:
+        return None
+    return _motion(shooting, _pruned(best), np.asarray(goal, float), goal_velocity)
+
+
+def refine_collocation(
+    robot: Robot, limits: JointLimits, motion: FreeMotion, collocation: CollocationResult, deadline: Deadline = NO_DEADLINE
+) -> SwitchedMotion | None:
+    """The time-optimal (beta = 0) collocation's motion refined to exact bang-bang controls,
+    seeded by the switches read off its torques; ``None`` where that does not apply (friction,
+    unlimited torques) or does not reach the goal."""
+    frictionless = not (np.any(robot.viscous_friction) or np.any(robot.coulomb_friction))
+    if not frictionless or not np.all(np.isfinite(limits.torque)):
+        return None
+    seed = collocation_switches(collocation.t, collocation.tau, limits.torque)
+    return refine_switching(
+        robot, limits.torque, motion.start, collocation.q[-1], seed, motion.start_velocity, motion.end_velocity,
+        deadline=deadline,
+    )
+
+
+def _pruned(controls: BangBang) -> BangBang:
+    """Arcs that shrank to nothing removed (two switches at one instant, or one at an end)."""
+    signs, switches = [], []
+    for joint_signs, joint_switches in zip(controls.signs, controls.switches):
+        edges = np.concatenate([[0.0], joint_switches, [controls.duration]])
+        keep = np.diff(edges) > 1e-9
+        kept_signs = joint_signs[keep]
+        kept_edges = np.concatenate([[0.0], edges[1:][keep]])
+        merged_signs, merged_switches = [kept_signs[0]], []
+        for sign, edge in zip(kept_signs[1:], kept_edges[1:-1]):
+            if sign != merged_signs[-1]:
+                merged_signs.append(sign)
+                merged_switches.append(edge)
+        signs.append(np.array(merged_signs))
+        switches.append(np.array(merged_switches))
+    return BangBang(tuple(signs), tuple(switches), controls.duration)
+
+
+def _motion(shooting: _Shooting, controls: BangBang, goal, goal_velocity) -> SwitchedMotion:
+    q, v, record = shooting.run(controls, FINAL_STEP, keep=True)
+    error = float(np.abs(np.concatenate([q - goal, v - goal_velocity])).max())
+    t, qs, vs, accelerations, torques = (np.array(column) for column in zip(*record))
+    return SwitchedMotion(controls, t, qs, vs, accelerations, torques, error)
+
+
+def mirrored(controls: BangBang) -> BangBang:
+    """The time-reversed twin of a rest-to-rest bang-bang motion on an arm whose inertia depends
+    on cos(q) only and without gravity (the Geering arm between stretched poses): u(t) -> -u(T - t),
+    equally fast; its switching times are T - t in reverse order."""
+    T = controls.duration
+    return BangBang(
+        tuple(-signs[::-1] for signs in controls.signs),
+        tuple((T - switches)[::-1] for switches in controls.switches),
+        T,
+    )
+
+
+#: Spacing (s) of the quintic Hermite pieces that carry a refined motion into an answer.
+PIECE = 5e-3
+
+
+def switched_path(motion: SwitchedMotion) -> tuple[ViaPath, ConstantSpeedTiming]:
+    """The refined motion as a path in time with constant-speed timing: quintic Hermite pieces
+    through its integrated states (q, v, a at both ends of each piece, about ``PIECE`` long, with
+    a piece boundary at every switch, where the accelerations jump)."""
+    t = motion.t
+    boundaries = np.flatnonzero(np.diff(t) == 0.0)  # the last record of an arc, before its switch
+    keep, begin = [], 0
+    for end in [*boundaries, len(t) - 1]:
+        arc = np.arange(begin, end + 1)
+        stride = max(1, int(PIECE * (len(arc) - 1) / max(t[end] - t[begin], 1e-12)))
+        chosen = arc[::stride]
+        keep.append(chosen if chosen[-1] == end else np.append(chosen, end))
+        begin = end + 1
+    pieces = []
+    for indices in keep:
+        for i, j in zip(indices[:-1], indices[1:]):
+            pieces.append((i, j))
+    h = np.array([t[j] - t[i] for i, j in pieces])
+    coefficients = np.stack(
+        [_quintic(motion.q[i], motion.v[i], motion.a[i], motion.q[j], motion.v[j], motion.a[j], t[j] - t[i]) for i, j in pieces]
+    )
+    path = ViaPath(coefficients, h)
+    return path, ConstantSpeedTiming(path.total, path.knots)
+
+
+def _quintic(q0, v0, a0, q1, v1, a1, h):
+    """Coefficients (n_dof, 6) in local time of the quintic with these end states."""
+    d = q1 - q0 - v0 * h - a0 * h**2 / 2
+    e = v1 - v0 - a0 * h
+    f = a1 - a0
+    c3 = (10 * d - 4 * e * h + f * h**2 / 2) / h**3
+    c4 = (-15 * d + 7 * e * h - f * h**2) / h**4
+    c5 = (6 * d - 3 * e * h + f * h**2 / 2) / h**5
+    return np.stack([q0, v0, a0 / 2, c3, c4, c5], axis=1)
+
+
+def switching_times(controls: BangBang, joint_names) -> dict[str, list[float]]:
+    """{joint name: [t, ...]} (s): where each joint's saturated torque changes sides."""
+    return {name: [float(t) for t in switches] for name, switches in zip(joint_names, controls.switches)}
