@@ -89,12 +89,22 @@ class PathConstraints:
     def with_points(self, extra_s: np.ndarray) -> PathConstraints:
         """These constraints on the grid refined by ``extra_s`` (values strictly inside grid
         intervals, never at a corner), evaluating the rows only at the new points."""
+        if self.evaluate is None:
+            raise ValueError("these constraints cannot be evaluated at other points (refinable is False)")
         extra = self.evaluate(np.asarray(extra_s, dtype=float))
         order = np.argsort(np.concatenate([self.s, extra.s]), kind="stable")
 
         def merge(mine, theirs):
             return np.concatenate([mine, theirs])[order]
 
+        jerk = jerk_left = None
+        if self.jerk is not None:
+            assert extra.jerk is not None  # evaluated with the same limits
+            dq, ddq, dddq = (merge(mine, theirs) for mine, theirs in zip(self.jerk[:3], extra.jerk[:3]))
+            jerk = (dq, ddq, dddq, self.jerk[3])
+            if self.jerk_left is not None:
+                left_dq, left_ddq, left_dddq = (merge(mine, theirs) for mine, theirs in zip(self.jerk_left, extra.jerk[:3]))
+                jerk_left = (left_dq, left_ddq, left_dddq)
         return PathConstraints(
             s=merge(self.s, extra.s),
             sd_max=merge(self.sd_max, extra.sd_max),
@@ -112,13 +122,8 @@ class PathConstraints:
             joint_names=self.joint_names,
             velocity_joint=None if self.velocity_joint is None else merge(self.velocity_joint, extra.velocity_joint),
             tool_bound=None if self.tool_bound is None else merge(self.tool_bound, extra.tool_bound),
-            jerk=None if self.jerk is None else (
-                *(merge(mine, theirs) for mine, theirs in zip(self.jerk[:3], extra.jerk[:3])),
-                self.jerk[3],
-            ),
-            jerk_left=None if self.jerk_left is None else tuple(
-                merge(mine, theirs) for mine, theirs in zip(self.jerk_left, extra.jerk[:3])
-            ),
+            jerk=jerk,
+            jerk_left=jerk_left,
             evaluate=self.evaluate,
         )
 

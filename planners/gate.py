@@ -46,7 +46,7 @@ def gate_threshold(margin: float) -> float:
     return min(LIMIT_TOLERANCE, (1.0 - 1e-9) / (1.0 - margin))
 
 
-def _refinement(timing: PathTiming, intervals: np.ndarray) -> np.ndarray:
+def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
     """Points that split each listed grid interval of ``timing`` in four."""
     s = timing.s
     quarters = np.array([0.25, 0.5, 0.75])

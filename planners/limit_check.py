@@ -65,7 +65,7 @@ class LimitCheck:
     intervals_over: np.ndarray
 
 
-def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, ...]:
+def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """q, qd, qdd and (when the states carry sddd) qddd at ``states``, each (n, n_dof), with the
     path's one-sided derivatives from the left for ``states.left`` states at a corner or a break
     (and, for the third derivative, at any knot)."""
@@ -98,7 +98,7 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     state belongs to; the RNEA runs, batched, at every other state. States at rest are left to
     the RNEA: the rows carry Coulomb friction for a moving joint."""
     column = {} if constraints is None else {joint: k for k, (kind, joint) in enumerate(constraints.rows) if kind == "torque"}
-    if len(column) != robot.dof:
+    if constraints is None or len(column) != robot.dof:
         return robot.inverse_dynamics(q, qd, qdd)
     columns = [column[joint] for joint in range(robot.dof)]
     grid = constraints.s

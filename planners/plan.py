@@ -26,7 +26,7 @@ from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_a
 from planners.mvc import admissible_set
 from planners.paths import GeometricPath
 from planners.paths.cartesian import CartesianLine
-from planners.paths.stretch import stretches
+from planners.paths.stretch import Stretch, stretches
 from planners.ranges import check_timing
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
@@ -230,7 +230,9 @@ def _timed_path(robot, path, method, timing, kinds, limits, deadline, threshold)
     if len(timed) == 1:
         result = timed[0].timing
     else:
-        edges = np.concatenate(([0.0], [part.end for part in parts]))
+        ends = [part.end for part in parts if isinstance(part, Stretch)]
+        assert len(ends) == len(parts)  # a path with corners comes apart into stretches
+        edges = np.concatenate(([0.0], ends))
         result = SegmentedTiming(edges, tuple(item.timing for item in timed))
     return _Timed(path, result, tuple(timed), method.name, cost=getattr(result, "cost", None))
 
@@ -287,7 +289,7 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
     moving = dataclasses.replace(
         timing, start_velocity=_moving(spec.start_velocity), end_velocity=_moving(spec.end_velocity), duration=None
     )
-    notes = ()
+    notes: tuple[str, ...] = ()
     try:
         result, constraints, check = gated(
             robot, path, retimer, constraints, _boundary(path, moving, retimer), None, kinds, limits, threshold,
@@ -359,7 +361,7 @@ DEFAULT_CLEARANCE = 0.01
 
 def plan(
     robot: Robot,
-    path_spec: WaypointPath | CartesianLine,
+    path_spec: WaypointPath | CartesianLine | FreeMotion,
     timing: Timing = Timing(),
     dt: float = 0.01,
     deadline: Deadline = NO_DEADLINE,

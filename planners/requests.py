@@ -115,13 +115,14 @@ def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
 
 
 #: Trapezoid ramps by ``timing.trapezoid.blend``.
-BLENDS = {"linear": TrapezoidalProfile, "cycloidal": CycloidalBlendProfile}
+BLENDS: dict[str, type[TrapezoidalProfile]] = {"linear": TrapezoidalProfile, "cycloidal": CycloidalBlendProfile}
 SYNCHRONIZATIONS = ("normalized", "none")
 
 
 def law_profile(timing: Timing) -> NormalizedProfile:
     """The normalized profile of a time law request: the law (trapezoid fractions and blend),
     or its spline through ``timing.supporting_points`` points."""
+    profile: NormalizedProfile
     if timing.method == "trapezoidal":
         tau1, tau2 = timing.trapezoid_fractions
         if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
@@ -184,7 +185,7 @@ def timing_method(timing: Timing) -> TimingMethod:
         return MinCostMethod(timing.torque_weight)
     if timing.method == "collocation":
         return CollocationMethod()
-    method = METHODS.get(timing.method)
-    if method is None:
+    named = METHODS.get(timing.method)
+    if named is None:
         raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
-    return method
+    return named

@@ -123,12 +123,12 @@ def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tu
     index, column = np.nonzero(np.abs(steps) > np.pi)
     if index.size == 0:
         return spec, ()
-    joints = np.flatnonzero(mask)
+    joints = [int(j) for j in np.flatnonzero(mask)]
     seen: dict[int, int] = {}
     for i, c in zip(index, column):
-        seen.setdefault(int(joints[c]), int(i))
+        seen.setdefault(joints[int(c)], int(i))
     notes = tuple(
-        f"continuous joint {robot.joint_names[j]!r} turns {steps[i, list(joints).index(j)]:+.4g} rad from "
+        f"continuous joint {robot.joint_names[j]!r} turns {steps[i][joints.index(j)]:+.4g} rad from "
         f"path.waypoints[{i}] to [{i + 1}], more than pi: the other way round is shorter; "
         "path.continuous = 'shortest' takes it"
         for j, i in seen.items()

@@ -75,7 +75,7 @@ class JointLimits:
     def with_request(
         self,
         overrides: dict[str, list[float] | None] | None = None,
-        scales: dict[str, float] | None = None,
+        scales: dict[str, float | None] | None = None,
     ) -> JointLimits:
         """These limits with a request's per-joint ``overrides`` replacing and ``scales``
         multiplying the velocity, acceleration, jerk and torque limits.

@@ -85,7 +85,10 @@ class Robot:
         notes: tuple[str, ...] = (),
     ) -> Robot:
         """Wrap ``model``, precomputing the map from tangent coordinates to Pinocchio's q."""
-        cos_index, pair_angle, plain_q, plain_v = [], [], [], []
+        cos_index: list[int] = []
+        pair_angle: list[int] = []
+        plain_q: list[int] = []
+        plain_v: list[int] = []
         continuous = np.zeros(model.nv, dtype=bool)
         for joint in model.joints[1:]:
             if _is_continuous(joint):

@@ -12,7 +12,7 @@ import orjson
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
 from planners.boundary import finite_vector
-from planners.collision import BoxObstacle, CapsuleObstacle, SphereObstacle
+from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 from planners.deadline import NO_DEADLINE
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.free_path import FreeMotion
@@ -101,7 +101,7 @@ def plan_request(
 
 def _obstacles(specs) -> tuple:
     """The request's obstacles as the library's domain objects."""
-    made = []
+    made: list[Obstacle] = []
     for spec in specs:
         if spec.kind == "sphere":
             made.append(SphereObstacle(np.array(spec.center, dtype=float), spec.radius))
@@ -185,7 +185,8 @@ def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
     return {"results": results}
 
 
-def _finite_or_none(values: np.ndarray) -> list[float | None]:
+def _finite_or_none(values) -> list[float | None]:
+    """Non-finite values (an unbounded MVC, a singular Jacobian) as JSON nulls."""
     return [float(v) if math.isfinite(v) else None for v in values]
 
 
@@ -193,6 +194,8 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
     """The JSON body of a planned trajectory (DESIGN.md contract); the samples stay numpy arrays
     until ``encode_json``."""
     samples = result.samples
+    conditioning = result.conditioning
+    assert conditioning is not None  # plan() measures it on every answer
     return {
         "robot": result.robot,
         "method": result.method,
@@ -211,9 +214,9 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "kind": result.binding.kind, "joint": result.binding.joint, "s": result.binding.s
         },
         "conditioning": {
-            "kappa_min": _finite_or_none([result.conditioning.kappa_min])[0],
-            "kappa_max": _finite_or_none([result.conditioning.kappa_max])[0],
-            "characteristic_length": result.conditioning.characteristic_length,
+            "kappa_min": _finite_or_none([conditioning.kappa_min])[0],
+            "kappa_max": _finite_or_none([conditioning.kappa_max])[0],
+            "characteristic_length": conditioning.characteristic_length,
         },
         "cost": result.cost,
         "solver": result.solver,

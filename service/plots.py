@@ -31,7 +31,7 @@ def phase_plane_figure(result: PlannedTrajectory) -> go.Figure:
         at = np.array([point for point, k in plane.switch_points if k == kind])
         figure.add_scatter(x=at, y=np.interp(at, s, sd), mode="markers", name=f"switch: {kind}", marker={"size": 9})
     top = float(sd.max()) if sd.size else 1.0
-    yaxis = {"title": {"text": "ṡ (1/s)"}, "rangemode": "tozero"}
+    yaxis: dict[str, object] = {"title": {"text": "ṡ (1/s)"}, "rangemode": "tozero"}
     if np.nanmax(np.append(mvc[np.isfinite(mvc)], 0.0)) > 2 * top:
         yaxis["range"] = [0, 1.6 * top]
     figure.update_layout(title={"text": "Phase plane"}, xaxis={"title": {"text": "s"}}, yaxis=yaxis)
@@ -50,7 +50,7 @@ def joints_figure(result: PlannedTrajectory, limits) -> go.Figure:
             color = palette[joint % len(palette)]
             figure.add_scatter(x=samples.t, y=values[:, joint], name=name, legendgroup=name, showlegend=row == 1,
                                line={"color": color}, row=row, col=1)
-            utilization = result.peak_utilization.get(kind)
+            utilization = None if kind is None else result.peak_utilization.get(kind)
             if limit is not None and np.isfinite(limit[joint]) and utilization is not None and utilization[joint] > 0.5:
                 for sign in (1, -1):
                     figure.add_scatter(x=[samples.t[0], samples.t[-1]], y=[sign * limit[joint]] * 2, mode="lines", showlegend=False,

@@ -82,7 +82,7 @@ def _first_non_finite(value: Any, where: str) -> tuple[str | None, float | None]
     if isinstance(value, float) and not math.isfinite(value):
         return where, value
     if isinstance(value, np.ndarray):
-        bad = np.argwhere(~np.isfinite(value)) if value.dtype.kind == "f" else []
+        bad = np.argwhere(~np.isfinite(value)) if value.dtype.kind == "f" else np.empty((0, value.ndim), dtype=int)
         if len(bad) == 0:
             return None, None
         return where + "".join(f"[{i}]" for i in bad[0]), float(value[tuple(bad[0])])
@@ -164,7 +164,7 @@ def _validation_error(request: Request, error: RequestValidationError) -> JSONRe
 
 
 def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
-    headers = error.headers
+    headers = None if error.headers is None else dict(error.headers)
     if error.status_code == 405:
         allowed = _allowed_methods(request)
         headers = {**(headers or {}), "Allow": ", ".join(allowed)}
@@ -222,9 +222,10 @@ class UnexpectedErrors:
 def install_problem_handlers(app: FastAPI) -> None:
     """Route every error family of ``app`` to a problem+json answer and declare them in its
     OpenAPI. Add ``UnexpectedErrors`` as the app's last (outermost) middleware."""
-    app.add_exception_handler(ToptrajError, _toptraj_error)
-    app.add_exception_handler(RequestValidationError, _validation_error)
-    app.add_exception_handler(StarletteHTTPException, _http_error)
+    # Starlette types every handler as taking Exception; each of these takes its own class.
+    app.add_exception_handler(ToptrajError, _toptraj_error)  # type: ignore[arg-type]
+    app.add_exception_handler(RequestValidationError, _validation_error)  # type: ignore[arg-type]
+    app.add_exception_handler(StarletteHTTPException, _http_error)  # type: ignore[arg-type]
     declare_problems(app)
 
 
@@ -250,7 +251,7 @@ def _problem_content() -> dict:
     return {PROBLEM_JSON: {"schema": {"$ref": _REF + "Problem"}}}
 
 
-def problem_responses(*statuses: int) -> dict[int, dict]:
+def problem_responses(*statuses: int) -> dict[int | str, dict[str, Any]]:
     """``responses=`` of a route: each status answered with a problem+json body."""
     return {status: {"description": _DESCRIPTIONS[status], "content": _problem_content()} for status in statuses}
 
@@ -287,4 +288,4 @@ def declare_problems(app: FastAPI) -> None:
     def openapi() -> dict:
         return _declare(FastAPI.openapi(app))
 
-    app.openapi = openapi
+    app.openapi = openapi  # type: ignore[method-assign]  # FastAPI's way to extend its schema

@@ -38,12 +38,15 @@ import logging
 import socket
 import sys
 import weakref
+from typing import TYPE_CHECKING
 
-_BaseLoop: type[asyncio.AbstractEventLoop]
-try:
-    from uvloop import Loop as _BaseLoop
-except ImportError:  # pragma: no cover - uvloop is a dependency where it builds
+if TYPE_CHECKING:
     _BaseLoop = asyncio.SelectorEventLoop
+else:
+    try:
+        from uvloop import Loop as _BaseLoop
+    except ImportError:  # pragma: no cover - uvloop is a dependency where it builds
+        _BaseLoop = asyncio.SelectorEventLoop
 
 #: uvicorn's ``loop`` setting naming the event loop class of each server process.
 LOOP = "service.serving:new_event_loop"

@@ -142,6 +142,7 @@ class PlanningWorkers:
                     if self._waiting[0] is waiter and self._slots.acquire(blocking=False):
                         return
                 remaining = deadline.remaining()
+                assert remaining is not None  # a planning always runs under a budget
                 if remaining <= 0.0:
                     raise BudgetExceeded(f"no planning worker came free within the time budget of {budget_s:g} s")
                 try:

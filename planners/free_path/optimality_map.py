@@ -51,6 +51,7 @@ class Family:
         steps = max(1, int(np.ceil(abs(phi_b - nearest) / self.step - 1e-9)))
         controls = self.solutions[nearest]
         for phi in np.linspace(nearest, phi_b, steps + 1)[1:]:
+            assert controls is not None  # known solutions are not None; a None ends the loop below
             motion = refine_switching(
                 self.robot, self.robot.limits.torque, np.zeros(2), np.array([phi, self.elbow]), controls
             )

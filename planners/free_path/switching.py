@@ -98,7 +98,8 @@ def collocation_switches(t: np.ndarray, tau: np.ndarray, torque_limit: np.ndarra
         bound = level * torque_limit[j]
         side = np.where(tau[:, j] > bound, 1, np.where(tau[:, j] < -bound, -1, 0))
         saturated = np.flatnonzero(side)
-        joint_signs, joint_switches = [], []
+        joint_signs: list = []
+        joint_switches: list = []
         for k, index in enumerate(saturated):
             if joint_signs and side[index] == joint_signs[-1]:
                 continue
@@ -234,7 +235,7 @@ def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> BangBang
     if np.abs(residual(theta)).max() > 1e-6 or ordering(theta).min() < -1e-9:
         return None
     free = len(theta) - len(target)
-    held = None
+    held: int | np.ndarray | None = None
     if free == 1:
         theta, held = _secant_minimum(residual, theta)
     elif free > 1:

@@ -69,7 +69,7 @@ def task_jacobians(robot: Robot, q: np.ndarray, frame_id: int, length: float) ->
     return np.concatenate([jacobians[:, 3:], jacobians[:, :3] / length], axis=1)
 
 
-def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tuple[float, float, float, float]:
+def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tuple[float, float, float, int]:
     """(kappa_min, kappa_max, L, index of kappa_max in ``q``) over at most ``max_points``
     evenly spaced rows of ``q`` (n_samples, n_dof)."""
     length = characteristic_length(robot)

@@ -98,10 +98,11 @@ def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DE
         raise InvalidRequest(f"path.start must hold {robot.dof} finite joint values")
     outside = robot.outside_position_limits(start)
     if outside is not None:
-        joint = outside[1]
-        raise InvalidRequest(f"path.start[{joint}] = {start[joint]:.6g} is outside the limits of joint {robot.joint_names[joint]!r}")
+        column = outside[1]
+        raise InvalidRequest(f"path.start[{column}] = {start[column]:.6g} is outside the limits of joint {robot.joint_names[column]!r}")
     field, offset, positions, rotations = _targets(line, frame_pose(robot, start, frame_id))
-    pieces, lengths = [], []
+    pieces: list[GeometricPath] = []
+    lengths: list[float] = []
     q = start
     for k in range(len(positions) - 1):
         span = np.linalg.norm(positions[k + 1] - positions[k])
@@ -132,7 +133,7 @@ def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DE
         piece = SplinePath(joint_points)
         _check_deviation(robot, frame_id, piece, positions[k], positions[k + 1], field, k + offset, deadline)
         pieces.append(piece)
-        lengths.append(np.sum(np.linalg.norm(np.diff(joint_points, axis=0), axis=1)))
+        lengths.append(float(np.sum(np.linalg.norm(np.diff(joint_points, axis=0), axis=1))))
         q = joint_points[-1]
     return ConcatenatedPath(pieces, np.array(lengths))
 

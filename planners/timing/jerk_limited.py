@@ -144,6 +144,7 @@ def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:
     """Whether every limit is the same along the whole path (a straight joint line under
     velocity, acceleration and jerk limits): the polish's segments of constant path jerk are the
     exact optimum there, and seldom beat the grid solution elsewhere (so it is not tried)."""
+    assert constraints.jerk is not None  # jerk_limited always builds the jerk rows
     dq, ddq, dddq, _ = constraints.jerk
     # Spreads are measured against the larger of each array's own magnitude and the path's
     # (|q'|): d2q/ds2 of a straight line is rounding noise of that size, not a change.
@@ -168,6 +169,7 @@ def _start_phase(constraints: PathConstraints, point: int) -> float:
     point ``point`` (0 or -1), were the path's coefficients constant: at the largest path jerk
     sigma = min_k J_k / |q'_k| until the largest path acceleration u_max allowed at rest,
     s = sigma t^3 / 6 with t = u_max / sigma."""
+    assert constraints.jerk is not None  # jerk_limited always builds the jerk rows
     dq, _, _, limit = constraints.jerk
     with np.errstate(divide="ignore", invalid="ignore"):
         sigma = np.nanmin(np.where(dq[point] != 0.0, limit / np.abs(dq[point]), np.inf))
@@ -193,7 +195,7 @@ def _graded(constraints: PathConstraints, boundary: Boundary) -> PathConstraints
     if not constraints.can_refine:
         return constraints
     s = constraints.s
-    extra = []
+    pieces: list[np.ndarray] = []
     for at_rest, point, sign, room in (
         (boundary.sd_start == 0.0, 0, 1.0, s[1] - s[0]),
         (boundary.sd_end == 0.0, -1, -1.0, s[-1] - s[-2]),
@@ -205,9 +207,9 @@ def _graded(constraints: PathConstraints, boundary: Boundary) -> PathConstraints
             phase = room * FALLBACK_FIRST_INTERVAL / _REST_POINTS[0]
         offsets = phase * _REST_POINTS
         offsets = offsets[offsets < 0.9 * room]
-        extra.append(s[point] + sign * offsets)
-    extra = np.concatenate(extra) if extra else np.empty(0)
-    extra = np.unique(extra[~np.isin(extra, s)])
+        pieces.append(s[point] + sign * offsets)
+    points = np.concatenate(pieces) if pieces else np.empty(0)
+    extra = np.unique(points[~np.isin(points, s)])
     return constraints.with_points(extra) if extra.size else constraints
 
 

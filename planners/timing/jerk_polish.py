@@ -94,6 +94,7 @@ class _Checks:
 
     def __init__(self, constraints: PathConstraints):
         self.constraints = constraints
+        assert constraints.jerk is not None  # polished only where jerk is limited
         dq, _, _, limit = constraints.jerk
         self.jerk_joints = np.flatnonzero(np.isfinite(limit))
         self.jerk_limit = limit[self.jerk_joints]
@@ -206,7 +207,8 @@ def polish(constraints: PathConstraints, grid_timing, sd_start: float, sd_end: f
     ``MERGE_FRACTIONS`` polished in turn, the shortest result kept."""
     if not constraints.can_refine:
         return None
-    best, tried = None, []
+    best = None
+    tried: list[np.ndarray] = []
     for merge_below in MERGE_FRACTIONS:
         initial = phases(grid_timing, merge_below)
         if initial is None or any(len(initial[0]) == len(seen) for seen in tried):
@@ -358,7 +360,7 @@ def _distinct_rows(rows: np.ndarray, tolerance: float = 1e-9) -> np.ndarray:
     """Indices of the rows of ``rows`` (m, k) that repeat no earlier row within ``tolerance``
     (relative to the larger magnitude of the two)."""
     scale = np.maximum(np.abs(rows).max(axis=1), 1e-300)
-    keep = []
+    keep: list[int] = []
     for i in range(len(rows)):
         if keep:
             kept = np.asarray(keep)

@@ -19,7 +19,7 @@ along which u = 2 x / (3 s) and du/ds = 2 / t^2 = 2 x / (9 s^2) (mirrored at an 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,7 +42,8 @@ class JerkTimeScaling(TimeScaling):
             constant path jerk.
     """
 
-    u: np.ndarray = None
+    # Always given; a default only because the base class's fields have defaults.
+    u: np.ndarray = field(default_factory=lambda: np.zeros(0))
     rest_start: bool = False
     rest_end: bool = False
 
@@ -164,6 +165,7 @@ class JerkTimeScaling(TimeScaling):
     def dense_states(self, points_per_interval: int = 3, reference: np.ndarray | None = None) -> DenseStates:
         base = TimeScaling.dense_states(self, points_per_interval, reference)
         interval = base.interval
+        assert interval is not None  # TimeScaling's dense states carry their intervals
         offset = base.s - self.s[interval]
         x, u, sddd = self._state(interval, offset)
         return DenseStates(s=base.s, sd=np.sqrt(x), sdd=u, sddd=sddd, left=base.left, interval=interval)

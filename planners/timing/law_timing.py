@@ -33,7 +33,9 @@ class LawSegment:
             T, span = self.duration, self.s_end - self.s_start
             sigma, d1, d2, d3 = self.profile.derivatives(t / T)
             return self.s_start + span * sigma, span * d1 / T, span * d2 / T**2, span * d3 / T**3
-        return tuple(polynomial_derivatives(self.coefficients, t, 4))
+        assert self.coefficients is not None  # a segment without a profile is a polynomial
+        first, second, third, fourth = polynomial_derivatives(self.coefficients, t, 4)
+        return first, second, third, fourth
 
     def time_at(self, s: np.ndarray) -> np.ndarray:
         """Local time at which the segment passes ``s`` (s(t) increases along a segment)."""

@@ -233,4 +233,4 @@ class CycloidalProfile(NormalizedProfile):
         )
 
 
-PROFILES = {"cubic": CubicProfile, "quintic": QuinticProfile, "trapezoidal": TrapezoidalProfile, "cycloidal": CycloidalProfile}
+PROFILES: dict[str, type[NormalizedProfile]] = {"cubic": CubicProfile, "quintic": QuinticProfile, "trapezoidal": TrapezoidalProfile, "cycloidal": CycloidalProfile}

@@ -130,13 +130,13 @@ class PhasePlaneMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:
-        boundary = (boundary.sd_start**2, boundary.sd_end**2)
+        x_ends = (boundary.sd_start**2, boundary.sd_end**2)
         most_intervals = max(2**self.max_refinements * (len(constraints.s) - 1), _MIN_REFINED_INTERVALS)
         grid = _Grid.of(constraints)
-        profile = _solve_on_grid(grid, boundary, deadline, midpoint=False)
+        profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False)
         for _ in range(self.max_refinements if constraints.can_refine else 0):
             try:
-                reference = _solve_on_grid(grid, boundary, deadline, midpoint=True, x_ref=profile.x)
+                reference = _solve_on_grid(grid, x_ends, deadline, midpoint=True, x_ref=profile.x)
             except InfeasiblePath:
                 break
             room = most_intervals - (len(grid.s) - 1)
@@ -152,7 +152,7 @@ class PhasePlaneMethod(TimingMethod):
             grid = _Grid.of(grid.constraints.with_points(extra))
             # The profile on the coarser grid is a close reference for viscous friction.
             x_ref = np.interp(grid.s, previous.s, profile.x) if grid.friction else None
-            profile = _solve_on_grid(grid, boundary, deadline, midpoint=False, x_ref=x_ref)
+            profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False, x_ref=x_ref)
         switches = _switch_points(grid.constraints, profile)
         return TimeScaling(grid.s, np.sqrt(profile.x), switches)
 
@@ -218,7 +218,7 @@ def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
     return 2.0 * np.diff(s) / np.maximum(root[:-1] + root[1:], 1e-300)
 
 
-def _solve_on_grid(grid: _Grid, boundary, deadline, midpoint: bool, x_ref=None) -> _Profile:
+def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoint: bool, x_ref=None) -> _Profile:
     """Integrate on one grid, in the interpolation (conservative) or the midpoint
     discretization. Viscous friction is linearized around ``x_ref`` (default: a first pass
     around the frictionless maximum velocity curve, then one around its answer)."""
@@ -227,7 +227,8 @@ def _solve_on_grid(grid: _Grid, boundary, deadline, midpoint: bool, x_ref=None) 
         passes = 2 if grid.friction else 1
         x_ref = grid.friction_reference() if grid.friction else grid.x_bound
     for _ in range(passes):
-        profile = _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), *boundary, deadline, midpoint)
+        x_start, x_end = boundary
+        profile = _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), x_start, x_end, deadline, midpoint)
         x_ref = profile.x
     return profile
 
@@ -243,7 +244,7 @@ def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profi
             s=1.0,
         )
     deadline.check()
-    x, capped, envelope, floor, failed, x_high, switch_excess = sweeps(
+    x, capped, envelope, floor, failed, x_high, switch_excess = sweeps(  # type: ignore[call-arg]  # numba
         grid.s, *grid.rows, x_bound, x_ref, grid.friction, float(x_start), float(x_end), midpoint, _SLACK
     )
     if failed >= 0:
@@ -280,7 +281,7 @@ def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tup
             points.append((float(s[i]), "deceleration"))
             continue
         # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
-        at = min(i, len(x_high) - 1)
+        at = min(int(i), len(x_high) - 1)
         on_mvc = envelope[i] >= x_high[at] * (1 - 1e-6)
         if not on_mvc:
             points.append((float(s[i]), "acceleration"))

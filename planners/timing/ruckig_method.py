@@ -81,6 +81,7 @@ class RuckigMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> RuckigTiming:
+        assert constraints.jerk is not None  # ruckig requires the jerk rows (required_kinds)
         dq, ddq, _, jerk_limit = constraints.jerk
         if np.abs(ddq).max() > 1e-9 * max(1.0, np.abs(dq).max()):
             raise InvalidRequest("ruckig times straight joint-space moves only: give exactly two waypoints")

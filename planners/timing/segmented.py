@@ -43,7 +43,7 @@ class SegmentedTiming(PathTiming):
         return float(self.starts[-1])
 
     @property
-    def switch_points(self) -> tuple[tuple[float, str], ...]:
+    def switch_points(self) -> tuple[tuple[float, str], ...]:  # type: ignore[override]  # from the parts
         return tuple(
             (float(a + w * sigma), kind)
             for a, w, part in zip(self.edges, self.widths, self.parts)
@@ -51,7 +51,7 @@ class SegmentedTiming(PathTiming):
         )
 
     @property
-    def binding(self) -> Binding | None:
+    def binding(self) -> Binding | None:  # type: ignore[override]  # from the parts
         """The binding limit of the longest stretch, in the path's s."""
         slowest = int(np.argmax([part.duration for part in self.parts]))
         binding = self.parts[slowest].binding
@@ -64,7 +64,8 @@ class SegmentedTiming(PathTiming):
     def cost(self) -> float | None:
         """The summed cost of the stretches, for methods that report one."""
         costs = [getattr(part, "cost", None) for part in self.parts]
-        return None if any(cost is None for cost in costs) else float(sum(costs))
+        known = [cost for cost in costs if cost is not None]
+        return None if len(known) < len(costs) else float(sum(known))
 
     def at_times(self, t: np.ndarray):
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)

@@ -119,6 +119,7 @@ class ToppraMethod(TimingMethod):
                 raise _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end)
             scaling = TimeScaling(constraints.s, np.asarray(sd, dtype=float))
             x_ref = scaling.sd**2
+        assert scaling is not None  # one pass at least
         return scaling
 
 

@@ -167,7 +167,7 @@ def unsynchronized_trajectory(
 
     orders = {"velocity": 0, "acceleration": 1, "jerk": 2}
     peak_at = float(_peaks(profile)[1][orders[setting[slowest]]])
-    binding = Binding(setting[slowest], robot.joint_names[slowest], peak_at)
+    binding: Binding | None = Binding(setting[slowest], robot.joint_names[slowest], peak_at)
     factor = 1.0
     if duration is not None:
         factor, binding = duration / durations[slowest], None

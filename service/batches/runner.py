@@ -123,7 +123,8 @@ def run_batch(
     uploads = ray.put(_uploads_named([r.text for r in todo]))
     chunks = [[(r.key, r.text, r.number) for r in todo[k : k + CHUNK]] for k in range(0, len(todo), CHUNK)]
     window = 2 * int(ray.available_resources().get("CPU", workers or 1) or 1) + 1
-    pending, next_chunk, finished = [], 0, 0
+    pending: list = []
+    next_chunk, finished = 0, 0
     with open(output_path, "ab") as out:
         while pending or next_chunk < len(chunks):
             while next_chunk < len(chunks) and len(pending) < window:

@@ -177,6 +177,8 @@ class JobRunner:
         for entry in running:
             if entry.thread is not None:
                 entry.thread.join(timeout_s)
+        if self.owner is None:  # never started
+            return
         try:
             self.store.interrupt(self.owner, INTERRUPTED)
         except JobStoreUnavailable as error:
@@ -240,10 +242,16 @@ class JobRunner:
         for entry in entries:
             entry.progress.flush()
         ids = [entry.job.id for entry in entries]
-        gone = self.store.heartbeat(self.owner, ids) if beat else self._not_running(ids)
+        gone = self.store.heartbeat(self._me, ids) if beat else self._not_running(ids)
         for entry in entries:
             if entry.job.id in gone:
                 entry.stop()
+
+    @property
+    def _me(self) -> str:
+        """The owner name of this runner's jobs (``start`` sets it)."""
+        assert self.owner is not None, "the job runner has not started"
+        return self.owner
 
     def _not_running(self, ids: list[str]) -> set[str]:
         jobs = (self.store.get(job_id) for job_id in ids)
@@ -257,10 +265,10 @@ class JobRunner:
 
     def _claim(self) -> None:
         while len(self.running_here()) < self.workers and not self._stopping.is_set() and self.store.has_queued():
-            job = self.store.claim(self.owner, self.workers)
+            job = self.store.claim(self._me, self.workers)
             if job is None:
                 return
-            progress = _Progress(self.store, job.id, self.owner)
+            progress = _Progress(self.store, job.id, self._me)
             entry = _Running(job, Deadline(job.budget_s + GRACE_S, progress=progress.report), progress)
             entry.thread = threading.Thread(target=self._run, args=(entry,), name=f"toptraj-job-{job.id[:8]}", daemon=True)
             with self._lock:
@@ -275,7 +283,7 @@ class JobRunner:
             if outcome is not None:
                 entry.progress.flush()
                 status, result, error = outcome
-                self.store.finish(job.id, self.owner, status, result, error)
+                self.store.finish(job.id, self._me, status, result, error)
         except JobStoreUnavailable as error:
             logger.error("job %s: outcome not written: %s", job.id, error.detail)
         finally:

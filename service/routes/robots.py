@@ -3,6 +3,8 @@ the arm as a stick figure for drawing."""
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 from fastapi import APIRouter, Response
 from starlette.concurrency import run_in_threadpool
@@ -13,7 +15,16 @@ from planners.kinematics.skeleton import skeleton
 from robots.limits import LIMIT_KINDS
 from robots.upload_options import upload_options
 from service.problems import problem_responses
-from service.schemas.robots import RobotCreate, RobotPublic, RobotSummary, SkeletonPublic, SkeletonRequest
+from service.schemas.robots import (
+    RobotCreate,
+    RobotLimits,
+    RobotLimitSources,
+    RobotPublic,
+    RobotSummary,
+    SkeletonPublic,
+    SkeletonRequest,
+    Source,
+)
 
 router = APIRouter(prefix="/v1/robots", tags=["robots"])
 
@@ -31,8 +42,8 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
         source=robot.source,
         joint_names=list(robot.joint_names),
         end_effector=robot.end_effector,
-        limits=robot.limits.as_lists(),
-        limit_sources={kind: list(robot.limit_sources.get(kind, ())) for kind in LIMIT_KINDS},
+        limits=RobotLimits(**robot.limits.as_lists()),
+        limit_sources=RobotLimitSources(**{kind: list(robot.limit_sources.get(kind, ())) for kind in LIMIT_KINDS}),
         locked_joints=robot.locked_joints,
         notes=list(robot.notes),
     )
@@ -43,7 +54,7 @@ def list_robots() -> list[RobotSummary]:
     """Every robot the service can plan for: the bundled paper arms, the fixed-base arms of
     example-robot-data and the uploaded URDFs (from the store, without building their models)."""
     catalog = [
-        RobotSummary(name=robot.name, dof=robot.dof, source=robot.source)
+        RobotSummary(name=robot.name, dof=robot.dof, source=cast(Source, robot.source))
         for robot in map(robots.load, robots.catalog_names())
     ]
     uploads = [RobotSummary(name=upload.name, dof=upload.dof, source="upload") for upload in robots.list_uploads()]

@@ -24,8 +24,8 @@ class JobCreate(Schema):
     }
 
     # Typed without None: a key given must hold a request (null is refused); absent, it is None.
-    trajectory: TrajectoryRequest = Field(default=None, description="The body of `POST /v1/trajectories`.")
-    compare: CompareRequest = Field(default=None, description="The body of `POST /v1/trajectories/compare`.")
+    trajectory: TrajectoryRequest = Field(default=None, description="The body of `POST /v1/trajectories`.")  # type: ignore[assignment]
+    compare: CompareRequest = Field(default=None, description="The body of `POST /v1/trajectories/compare`.")  # type: ignore[assignment]
     budget_s: float | None = Field(
         default=None,
         ge=0.1,

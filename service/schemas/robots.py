@@ -12,12 +12,15 @@ from service.schemas.common import Schema
 MAX_URDF_CHARS = 1_000_000
 
 
+Source = Literal["bundled", "example-robot-data", "upload"]
+
+
 class RobotSummary(BaseModel):
     """One line of the catalog."""
 
     name: str = Field(description="The robot's name, as requests give it.")
     dof: int = Field(description="Degrees of freedom (actuated joints).")
-    source: Literal["bundled", "example-robot-data", "upload"] = Field(description="`bundled` (the papers' arms), `example-robot-data` or `upload`.")
+    source: Source = Field(description="`bundled` (the papers' arms), `example-robot-data` or `upload`.")
 
 
 class RobotLimits(BaseModel):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Discriminator, Field, Tag
 
@@ -17,7 +17,7 @@ MAX_JOINTS = 64
 MAX_NAME_CHARS = 256
 
 
-def _joint_vector(item) -> type:
+def _joint_vector(item) -> Any:
     """A list of one value per joint."""
     return Annotated[list[item], Field(min_length=1, max_length=MAX_JOINTS)]
 
@@ -63,7 +63,7 @@ class CapsuleObstacleRequest(Schema):
 ObstacleRequest = Annotated[
     SphereObstacleRequest | BoxObstacleRequest | CapsuleObstacleRequest, Field(discriminator="kind")
 ]
-OBSTACLES = Field(
+OBSTACLES: Any = Field(
     default=[],
     max_length=MAX_OBSTACLES,
     description="Obstacles in the world frame (spheres, boxes, capsules): every link keeps path.clearance "
@@ -154,7 +154,7 @@ PathRequest = Annotated[
 ]
 #: The OpenAPI discriminator of ``path``: ``kind`` chooses the schema (left out, it is
 #: ``waypoints``, which the validator above applies).
-PATH_DISCRIMINATOR = {
+PATH_DISCRIMINATOR: dict[str, Any] = {
     "propertyName": "kind",
     "mapping": {
         "waypoints": "#/components/schemas/WaypointsPath",
