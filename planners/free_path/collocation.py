@@ -10,9 +10,10 @@ integrated exactly:
 
 with h = T / K, and the torque at each instant is the robot's own inverse dynamics,
 tau_k = RNEA(q_k, v_k, a_k) from its Pinocchio model (URDF), with exact first derivatives from
-Pinocchio's analytical RNEA derivatives. The nonlinear program is solved by SLSQP (scipy), a
-sequential quadratic programming method fed with those exact gradients; for these sizes (a few
-joints, tens of instants) a dense SQP converges in tens of iterations.
+Pinocchio's analytical RNEA derivatives. The initial guesses are solved on a coarse grid by
+SLSQP (scipy), a dense sequential quadratic programming method fed with those gradients; the
+best is refined on the requested grid by IPOPT, whose sparse KKT system keeps fine grids and
+many joints affordable (``planners.free_path.sparse``; SLSQP again should IPOPT fail).
 
 Several initial guesses are tried: the straight joint line to the goal and, for continuous
 joints, to the goal shifted by +-2 pi (the elbow turning a full revolution, as in the Geering
@@ -33,6 +34,7 @@ from scipy.optimize import minimize
 from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline, Progress
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.free_path.sparse import solve_sparse
 from planners.grid import path_grid
 from planners.isolated import run_isolated
 from planners.paths.waypoints import SplinePath
@@ -358,7 +360,11 @@ def _optimize_motion(
     coarse_result, coarse, label, goal = best
     progress(len(guesses) * share, "collocation: refining the best guess")
     problem = _Problem(robot, limits, motion, goal, torque_weight)
-    result, feasible = _solve(problem, _refined(coarse, coarse_result.x, problem), max_iterations)
+    z0 = _refined(coarse, coarse_result.x, problem)
+    result = solve_sparse(problem, z0, max_iterations)
+    feasible = np.abs(problem.defects(result.x)).max() < 1e-6 and problem.torque_margin(result.x).min() > -1e-6
+    if not feasible:  # the dense SQP, from the same start
+        result, feasible = _solve(problem, z0, max_iterations)
     if not feasible:
         raise InfeasiblePath(f"the collocation did not converge on the fine grid from its best guess ({label}): {result.message}")
     T, q, v, a = problem.unpack(result.x)
