@@ -406,8 +406,9 @@ def test_cancelling_a_running_job_stops_its_work(server):
 
 @pytest.mark.slow
 def test_the_geering_free_path_example_runs_as_a_job_while_requests_are_served(client):
-    """The shipped example as it is (a collocation of 13 to 200 s on this machine, past the
-    synchronous budget under load), with the synchronous endpoint answering meanwhile."""
+    """The shipped example as it is (a collocation with its switching-time refinement, some
+    seconds), with the synchronous endpoint answering meanwhile and the job's progress
+    reported by stage."""
     example = json.loads((EXAMPLES / "geering_free_motion.json").read_text())
     job_id = _submit(client, {"trajectory": example}, budget_s=3600)
     served, stages, next_request = 0, set(), time.monotonic()
@@ -421,7 +422,7 @@ def test_the_geering_free_path_example_runs_as_a_job_while_requests_are_served(c
             next_request = time.monotonic() + 2.0
         time.sleep(0.2)
     assert job["status"] == "done", job["error"]
-    assert served >= 1 and len([stage for stage in stages if stage.startswith("collocation")]) >= 3
+    assert served >= 1 and any(stage.startswith("collocation") for stage in stages)
     # Jeong & Lee's type-3 motion: T = 0.9755 s with the elbow turning a full revolution.
     assert job["result"]["duration"] == pytest.approx(0.9755, rel=1e-2)
     assert job["result"]["solver"]["duration"] == pytest.approx(0.9755, rel=1e-2)

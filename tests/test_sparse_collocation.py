@@ -42,9 +42,9 @@ def test_yamamoto_minimum_time_converges_to_0_20599():
     assert result.fun == pytest.approx(0.20599, abs=2e-5)
 
 
-def test_sparse_and_dense_solvers_find_the_same_optimum():
-    """The same NLP (Yamamoto, 12 intervals) solved by IPOPT and by SLSQP from IPOPT's answer:
-    SLSQP stops where it starts, within its tolerance."""
+def test_the_dense_solver_stays_at_the_sparse_solvers_optimum():
+    """IPOPT's answer (Yamamoto, 12 intervals) is a local optimum of the same NLP for the dense
+    solver too: SLSQP started there stays there, within its tolerance."""
     problem, result = _solve("yamamoto_2r", np.radians([45.0, -90.0]), np.radians([-90.0, 0.0]), 12)
     dense, feasible = collocation._solve(problem, result.x, 200)
     assert feasible

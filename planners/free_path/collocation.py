@@ -34,7 +34,7 @@ from scipy.optimize import minimize
 from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline, Progress
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
-from planners.free_path.sparse import solve_sparse
+from planners.free_path.sparse import SparseCollocation, solve_sparse
 from planners.grid import path_grid
 from planners.isolated import run_isolated
 from planners.paths.waypoints import SplinePath
@@ -290,8 +290,12 @@ def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int):
         ],
         options={"maxiter": max_iterations, "ftol": 1e-10},
     )
-    feasible = np.abs(problem.defects(result.x)).max() < 1e-6 and problem.torque_margin(result.x).min() > -1e-6
-    return result, feasible
+    return result, _feasible(problem, result.x)
+
+
+def _feasible(problem: _Problem, z: np.ndarray) -> bool:
+    """Whether ``z`` meets the equalities and the torque limits (Pinocchio's RNEA) within 1e-6."""
+    return bool(np.abs(problem.defects(z)).max() < 1e-6 and problem.torque_margin(z).min() > -1e-6)
 
 
 def optimize_motion(
@@ -335,6 +339,7 @@ def _optimize_motion(
         raise InvalidRequest("path.goal is outside the joint limits")
     started = time.perf_counter()
     best, tried = None, []
+    coarse_solver = None
     coarse_motion = FreeMotion(
         motion.start, motion.goal, motion.start_velocity, motion.end_velocity, min(COARSE_INTERVALS, motion.intervals)
     )
@@ -351,7 +356,10 @@ def _optimize_motion(
         except (InfeasiblePath, TimingFailed) as error:
             tried.append(f"{label}: {error.detail}")
             continue
-        result, feasible = _solve(coarse, z0, max_iterations)
+        if coarse_solver is None:  # one sparse solver for every guess: they differ in bounds only
+            coarse_solver = SparseCollocation(coarse, max_iterations)
+        result = coarse_solver.solve(coarse, z0)
+        feasible = _feasible(coarse, result.x)
         tried.append(f"{label}: {result.message} (cost {result.fun:.6g})")
         if feasible and (best is None or result.fun < best[0].fun):
             best = (result, coarse, label, goal)
@@ -362,7 +370,7 @@ def _optimize_motion(
     problem = _Problem(robot, limits, motion, goal, torque_weight)
     z0 = _refined(coarse, coarse_result.x, problem)
     result = solve_sparse(problem, z0, max_iterations)
-    feasible = np.abs(problem.defects(result.x)).max() < 1e-6 and problem.torque_margin(result.x).min() > -1e-6
+    feasible = _feasible(problem, result.x)
     if not feasible:  # the dense SQP, from the same start
         result, feasible = _solve(problem, z0, max_iterations)
     if not feasible:
