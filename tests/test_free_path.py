@@ -77,8 +77,8 @@ def test_yamamoto_free_path_cost_and_minimum_time():
 
 def test_ur5_smoke():
     """Any fixed-base revolute arm: a 6-joint free motion over HTTP (a generous budget, so that
-    a loaded shared machine does not turn the smoke test into a timing test; 4 intervals, since
-    SciPy's SLSQP takes some 40 iterations there but about 250, over three CPU minutes, at 8)."""
+    a loaded shared machine does not turn the smoke test into a timing test; 4 intervals keep
+    it quick, tests/test_sparse_collocation.py solves 30)."""
     from fastapi.testclient import TestClient
 
     from service.app import create_app
