@@ -151,16 +151,19 @@ class TrapezoidalProfile(NormalizedProfile):
     def derivatives(self, tau):
         tau = np.asarray(tau, dtype=float)
         t1, t2, v = self.tau1, self.tau2, self.peak_speed
-        accel, decel = v / t1, v / (1.0 - t2)
         rising = tau <= t1
         falling = tau >= t2
-        sigma = np.where(
-            rising,
-            0.5 * accel * tau**2,
-            np.where(falling, 1.0 - 0.5 * decel * (1.0 - tau) ** 2, 0.5 * accel * t1**2 + v * (tau - t1)),
-        )
-        speed = np.where(rising, accel * tau, np.where(falling, decel * (1.0 - tau), v))
-        acceleration = np.where(rising, accel, np.where(falling, -decel, 0.0))
+        # A ramp of a few ulps overflows its level to infinity; np.where evaluates every branch,
+        # and the one that overflows is never the one selected.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            accel, decel = v / t1, v / (1.0 - t2)
+            sigma = np.where(
+                rising,
+                0.5 * accel * tau**2,
+                np.where(falling, 1.0 - 0.5 * decel * (1.0 - tau) ** 2, 0.5 * accel * t1**2 + v * (tau - t1)),
+            )
+            speed = np.where(rising, accel * tau, np.where(falling, decel * (1.0 - tau), v))
+            acceleration = np.where(rising, accel, np.where(falling, -decel, 0.0))
         return sigma, speed, acceleration, np.zeros_like(tau)
 
 
