@@ -49,6 +49,7 @@ RUN pip install --require-hashes -r requirements.lock
 # The code (and tests/), then the package itself without touching the dependencies.
 COPY . .
 RUN pip install --no-deps . \
+    && pip check \
     && rm -rf build ./*.egg-info
 
 USER 10001:10001

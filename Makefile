@@ -9,12 +9,14 @@ STAMP := $(VENV)/.installed
 .PHONY: serve test install browser lock clean
 
 # Exact versions with their hashes from requirements.lock (the runtime dependencies and the
-# test extra, resolved from the ranges in pyproject.toml), then the project itself on top.
+# test extra, resolved from the ranges in pyproject.toml), then the project itself on top;
+# pip check fails when the lock no longer holds a dependency pyproject.toml asks for (make lock).
 $(STAMP): pyproject.toml requirements.lock
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet --require-hashes -r requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
+	$(BIN)/python -m pip check
 	touch $(STAMP)
 
 # Re-resolve requirements.lock after a change of the ranges in pyproject.toml (uv's resolver,

@@ -70,9 +70,11 @@ def acceleration_bounds(rows: LinearRows) -> AccelerationBounds:
 
 def admissible_set(rows: LinearRows, x_bound: np.ndarray) -> AdmissibleSet:
     """Admissible x at every grid point for ``rows`` and the first-order bound ``x <= x_bound``."""
-    arrays = [np.ascontiguousarray(array, dtype=float) for array in (rows.a, rows.b, rows.c, rows.lower, rows.upper)]
-    x_bound = np.ascontiguousarray(np.broadcast_to(np.asarray(x_bound, dtype=float), arrays[0].shape[:1]))
-    p, q, r, x_low, x_high, singular, static_fail = point_bounds(*arrays, x_bound)  # type: ignore[call-arg]  # numba
+    a, b, c, lower, upper = (
+        np.ascontiguousarray(array, dtype=float) for array in (rows.a, rows.b, rows.c, rows.lower, rows.upper)
+    )
+    x_bound = np.ascontiguousarray(np.broadcast_to(np.asarray(x_bound, dtype=float), a.shape[:1]))
+    p, q, r, x_low, x_high, singular, static_fail = point_bounds(a, b, c, lower, upper, x_bound)
     empty = x_high < 0.0
     blocking = np.full((len(x_low), 2), -1)
     if empty.any():

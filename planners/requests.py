@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from planners.constraints import CONSTRAINT_KINDS
 from planners.errors import InvalidRequest
@@ -81,10 +82,10 @@ class Timing:
     limit_overrides: dict[str, list[float] | None] = field(default_factory=dict)
     limit_scales: dict[str, float | None] = field(default_factory=dict)
     grid_points: int | None = None
-    start_velocity: np.ndarray | None = None
-    end_velocity: np.ndarray | None = None
-    start_acceleration: np.ndarray | None = None
-    end_acceleration: np.ndarray | None = None
+    start_velocity: ArrayLike | None = None
+    end_velocity: ArrayLike | None = None
+    start_acceleration: ArrayLike | None = None
+    end_acceleration: ArrayLike | None = None
     duration: float | None = None
     trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
     trapezoid_blend: str = "linear"

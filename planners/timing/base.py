@@ -56,8 +56,16 @@ class Binding:
 class PathTiming(abc.ABC):
     """s(t) on [0, duration], from s = 0 to s = 1."""
 
-    switch_points: tuple[tuple[float, str], ...] = ()
-    binding: Binding | None = None
+    # Read-only here: a subclass gives them as dataclass fields with a default, or as properties.
+    @property
+    def switch_points(self) -> tuple[tuple[float, str], ...]:
+        """(s, kind) pairs a method found, for the response; none unless a method says so."""
+        return ()
+
+    @property
+    def binding(self) -> Binding | None:
+        """The limit that sets the duration, when the method knows it."""
+        return None
 
     @property
     @abc.abstractmethod

@@ -168,6 +168,21 @@ def midpoint_duration(constraints: PathConstraints, boundary: Boundary = AT_REST
     return float(_interval_times(grid.s, second.x).sum())
 
 
+class _Rows(NamedTuple):
+    """The kernels' row arrays, each (N + 1, m): seen from the right, from the left, bounds."""
+
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
+    a_left: np.ndarray
+    b_left: np.ndarray
+    c_left: np.ndarray
+    d_left: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+
 class _Grid(NamedTuple):
     """The constraints on one grid as contiguous arrays for the kernels: s (N + 1,), the rows
     seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
@@ -175,20 +190,20 @@ class _Grid(NamedTuple):
 
     constraints: PathConstraints
     s: np.ndarray
-    rows: tuple[np.ndarray, ...]
+    rows: _Rows
     x_bound: np.ndarray
     friction: bool
 
     @classmethod
     def of(cls, constraints: PathConstraints) -> _Grid:
-        rows = tuple(
+        rows = _Rows(*(
             np.ascontiguousarray(array, dtype=np.float64)
             for array in (
                 constraints.a, constraints.b, constraints.c, constraints.d,
                 constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left,
                 constraints.lower, constraints.upper,
             )
-        )  # fmt: skip
+        ))  # fmt: skip
         s = np.ascontiguousarray(constraints.s, dtype=np.float64)
         x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
         return cls(constraints, s, rows, x_bound, bool(np.any(rows[3] != 0.0) or np.any(rows[7] != 0.0)))
@@ -244,7 +259,7 @@ def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profi
             s=1.0,
         )
     deadline.check()
-    x, capped, envelope, floor, failed, x_high, switch_excess = sweeps(  # type: ignore[call-arg]  # numba
+    x, capped, envelope, floor, failed, x_high, switch_excess = sweeps(
         grid.s, *grid.rows, x_bound, x_ref, grid.friction, float(x_start), float(x_end), midpoint, _SLACK
     )
     if failed >= 0:

@@ -43,7 +43,7 @@ class SegmentedTiming(PathTiming):
         return float(self.starts[-1])
 
     @property
-    def switch_points(self) -> tuple[tuple[float, str], ...]:  # type: ignore[override]  # from the parts
+    def switch_points(self) -> tuple[tuple[float, str], ...]:
         return tuple(
             (float(a + w * sigma), kind)
             for a, w, part in zip(self.edges, self.widths, self.parts)
@@ -51,7 +51,7 @@ class SegmentedTiming(PathTiming):
         )
 
     @property
-    def binding(self) -> Binding | None:  # type: ignore[override]  # from the parts
+    def binding(self) -> Binding | None:
         """The binding limit of the longest stretch, in the path's s."""
         slowest = int(np.argmax([part.duration for part in self.parts]))
         binding = self.parts[slowest].binding

@@ -3,8 +3,10 @@ physical range at the edge."""
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from collections.abc import Iterator
+from dataclasses import dataclass
 
+from annotated_types import GroupedMetadata
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, WithJsonSchema
 from pydantic_core import PydanticCustomError
 
@@ -24,24 +26,37 @@ def _range_error(value: float, shown: str) -> PydanticCustomError:
     )
 
 
-def bounded(accepted: Range) -> Any:
-    """A float in [low, high] of ``accepted`` (OpenAPI minimum and maximum; a 422 naming the
-    range otherwise)."""
+@dataclass(frozen=True)
+class RangeCheck(GroupedMetadata):
+    """``Annotated`` metadata of a float checked against a range: its validator (a 422 naming the
+    range) and its OpenAPI minimum and maximum. Made by ``bounded`` and ``signed``."""
+
+    validator: AfterValidator
+    schema: WithJsonSchema
+
+    def __iter__(self) -> Iterator[object]:
+        yield self.validator
+        yield self.schema
+
+
+def bounded(accepted: Range) -> RangeCheck:
+    """A float in [low, high] of ``accepted``: ``Annotated[float, bounded(accepted)]`` (OpenAPI
+    minimum and maximum; a 422 naming the range otherwise)."""
 
     def check(value: float) -> float:
         if not accepted.holds(value):
             raise _range_error(value, accepted.describe())
         return value
 
-    return Annotated[
-        float,
+    return RangeCheck(
         AfterValidator(check),
         WithJsonSchema({"type": "number", "minimum": accepted.low, "maximum": accepted.high}),
-    ]
+    )
 
 
-def signed(accepted: Range) -> Any:
-    """A float in [-high, high] of ``accepted``: a signed quantity of bounded magnitude."""
+def signed(accepted: Range) -> RangeCheck:
+    """A float in [-high, high] of ``accepted``, a signed quantity of bounded magnitude:
+    ``Annotated[float, signed(accepted)]``."""
     shown = f"[-{accepted.high:g}, {accepted.high:g}] {accepted.unit}".rstrip()
 
     def check(value: float) -> float:
@@ -49,11 +64,10 @@ def signed(accepted: Range) -> Any:
             raise _range_error(value, shown)
         return value
 
-    return Annotated[
-        float,
+    return RangeCheck(
         AfterValidator(check),
         WithJsonSchema({"type": "number", "minimum": -accepted.high, "maximum": accepted.high}),
-    ]
+    )
 
 
 class ValidationIssue(BaseModel):

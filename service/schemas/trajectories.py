@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 from pydantic import BaseModel, Discriminator, Field, Tag
 
@@ -17,16 +17,15 @@ MAX_JOINTS = 64
 MAX_NAME_CHARS = 256
 
 
-def _joint_vector(item) -> Any:
-    """A list of one value per joint."""
-    return Annotated[list[item], Field(min_length=1, max_length=MAX_JOINTS)]
-
-
-JointVector = _joint_vector(signed(ranges.COORDINATE))
+_Item = TypeVar("_Item")
+#: A list of one value per joint: ``PerJoint[Annotated[float, bounded(ranges.VELOCITY)]]``.
+PerJoint = Annotated[list[_Item], Field(min_length=1, max_length=MAX_JOINTS)]
+Coordinate = Annotated[float, signed(ranges.COORDINATE)]
+JointVector = PerJoint[Coordinate]
 Name = Annotated[str, Field(max_length=MAX_NAME_CHARS)]
 
 
-Point = Annotated[list[signed(ranges.COORDINATE)], Field(min_length=3, max_length=3)]
+Point = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
 MAX_OBSTACLES = 100
 
 
@@ -87,7 +86,7 @@ class WaypointsPath(Schema):
         "MoveIt's TOTG) or `via` (per-joint cubic/quintic segments through via points; with "
         "timing.method cubic or quintic).",
     )
-    max_deviation: bounded(ranges.MAX_DEVIATION) | None = Field(
+    max_deviation: Annotated[float, bounded(ranges.MAX_DEVIATION)] | None = Field(
         default=None,
         description="`blend` only: largest joint-space distance (Euclidean norm, rad or m) of a blend from "
         "its waypoint; default 0.1.",
@@ -168,18 +167,18 @@ class LimitsRequest(Schema):
     """Per-joint overrides and scale factors of the robot's limits, and limits on the speed of a
     tool frame (SI units)."""
 
-    velocity: _joint_vector(bounded(ranges.VELOCITY)) | None = Field(default=None, description="Per-joint velocity limits replacing the robot's (rad/s, m/s).")
-    acceleration: _joint_vector(bounded(ranges.ACCELERATION)) | None = Field(default=None, description="Per-joint acceleration limits replacing the robot's (rad/s^2, m/s^2).")
-    jerk: _joint_vector(bounded(ranges.JERK)) | None = Field(default=None, description="Per-joint jerk limits replacing the robot's (rad/s^3, m/s^3).")
-    torque: _joint_vector(bounded(ranges.TORQUE)) | None = Field(default=None, description="Per-joint torque limits replacing the robot's (N m, N).")
-    velocity_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every velocity limit (after overrides).")
-    acceleration_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every acceleration limit.")
-    jerk_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every jerk limit.")
-    torque_scale: bounded(ranges.SCALE) | None = Field(default=None, description="Factor on every torque limit.")
-    tool_speed: bounded(ranges.TOOL_SPEED) | None = Field(
+    velocity: PerJoint[Annotated[float, bounded(ranges.VELOCITY)]] | None = Field(default=None, description="Per-joint velocity limits replacing the robot's (rad/s, m/s).")
+    acceleration: PerJoint[Annotated[float, bounded(ranges.ACCELERATION)]] | None = Field(default=None, description="Per-joint acceleration limits replacing the robot's (rad/s^2, m/s^2).")
+    jerk: PerJoint[Annotated[float, bounded(ranges.JERK)]] | None = Field(default=None, description="Per-joint jerk limits replacing the robot's (rad/s^3, m/s^3).")
+    torque: PerJoint[Annotated[float, bounded(ranges.TORQUE)]] | None = Field(default=None, description="Per-joint torque limits replacing the robot's (N m, N).")
+    velocity_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every velocity limit (after overrides).")
+    acceleration_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every acceleration limit.")
+    jerk_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every jerk limit.")
+    torque_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every torque limit.")
+    tool_speed: Annotated[float, bounded(ranges.TOOL_SPEED)] | None = Field(
         default=None, description="Largest linear speed of the tool frame's origin (m/s)."
     )
-    tool_angular_speed: bounded(ranges.TOOL_ANGULAR_SPEED) | None = Field(
+    tool_angular_speed: Annotated[float, bounded(ranges.TOOL_ANGULAR_SPEED)] | None = Field(
         default=None, description="Largest angular speed of the tool frame (rad/s)."
     )
     tool_frame: Name | None = Field(
@@ -191,10 +190,10 @@ class Boundary(Schema):
     """Joint velocities (rad/s) and accelerations (rad/s^2) at the ends, tangent to the path;
     absent means rest."""
 
-    start_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = Field(default=None, description="Joint velocities at the start (rad/s, m/s), tangent to the path.")
-    end_velocity: _joint_vector(signed(ranges.VELOCITY)) | None = Field(default=None, description="Joint velocities at the end (rad/s, m/s), tangent to the path.")
-    start_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = Field(default=None, description="Joint accelerations at the start (rad/s^2, m/s^2).")
-    end_acceleration: _joint_vector(signed(ranges.ACCELERATION)) | None = Field(default=None, description="Joint accelerations at the end (rad/s^2, m/s^2).")
+    start_velocity: PerJoint[Annotated[float, signed(ranges.VELOCITY)]] | None = Field(default=None, description="Joint velocities at the start (rad/s, m/s), tangent to the path.")
+    end_velocity: PerJoint[Annotated[float, signed(ranges.VELOCITY)]] | None = Field(default=None, description="Joint velocities at the end (rad/s, m/s), tangent to the path.")
+    start_acceleration: PerJoint[Annotated[float, signed(ranges.ACCELERATION)]] | None = Field(default=None, description="Joint accelerations at the start (rad/s^2, m/s^2).")
+    end_acceleration: PerJoint[Annotated[float, signed(ranges.ACCELERATION)]] | None = Field(default=None, description="Joint accelerations at the end (rad/s^2, m/s^2).")
 
 
 class CostRequest(Schema):
@@ -207,8 +206,8 @@ class TrapezoidRequest(Schema):
     """Switching fractions of the trapezoidal law (Angeles 6.1): acceleration ends at tau1 and
     deceleration starts at tau2, as fractions of the duration."""
 
-    tau1: bounded(ranges.TRAPEZOID_FRACTION) = Field(default=1.0 / 3.0, description="End of the acceleration phase, as a fraction of the duration.")
-    tau2: bounded(ranges.TRAPEZOID_FRACTION) = Field(default=2.0 / 3.0, description="Start of the deceleration phase, as a fraction of the duration.")
+    tau1: Annotated[float, bounded(ranges.TRAPEZOID_FRACTION)] = Field(default=1.0 / 3.0, description="End of the acceleration phase, as a fraction of the duration.")
+    tau2: Annotated[float, bounded(ranges.TRAPEZOID_FRACTION)] = Field(default=2.0 / 3.0, description="Start of the deceleration phase, as a fraction of the duration.")
     blend: Literal["linear", "cycloidal"] = Field(
         default="linear",
         description="Shape of the speed ramps: `linear` (constant acceleration, Angeles 6.1) or "
@@ -217,7 +216,10 @@ class TrapezoidRequest(Schema):
 
 
 #: Every timing method, as the OpenAPI enum of ``timing.method`` and the compare's ``methods``.
-MethodName = Literal[(*METHODS, "collocation")]
+if TYPE_CHECKING:  # the names are known when the methods are imported
+    MethodName = str
+else:
+    MethodName = Literal[(*METHODS, "collocation")]
 
 
 class TimingRequest(Schema):
@@ -236,7 +238,7 @@ class TimingRequest(Schema):
         description="Limits to respect; jerk only with jerk_limited, the time laws and ruckig.",
     )
     limits: LimitsRequest = Field(default=LimitsRequest(), description="Limit overrides and scale factors, and tool-speed limits.")
-    duration: bounded(ranges.DURATION) | None = Field(
+    duration: Annotated[float, bounded(ranges.DURATION)] | None = Field(
         default=None, description="Seconds, for the classical time laws and via points."
     )
     boundary: Boundary = Field(default=Boundary(), description="Joint velocities and accelerations at the ends; rest by default.")
@@ -269,7 +271,7 @@ class TimingRequest(Schema):
 class OutputRequest(Schema):
     """Sampling and shape of the returned trajectory."""
 
-    dt: bounded(ranges.DT) = Field(default=0.01, description="Sample period (s).")
+    dt: Annotated[float, bounded(ranges.DT)] = Field(default=0.01, description="Sample period (s).")
     format: Literal["samples", "joint_trajectory", "csv"] = Field(
         default="samples",
         description=(
