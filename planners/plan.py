@@ -30,6 +30,9 @@ from planners.paths.stretch import Stretch, stretches
 from planners.ranges import check_timing
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
+from planners.search.curve import GridSplinePath
+from planners.search.local import LocalOptimum, optimize_locally
+from planners.search.method import global_search
 from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
@@ -94,7 +97,9 @@ def _moving(velocity):
 def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
     """Path and timing optimized together (``path.kind = "free"`` with ``collocation``)."""
     if not isinstance(path_spec, FreeMotion) or method.name != "collocation":
-        raise InvalidRequest("a free path (start and goal only) needs timing.method 'collocation', and collocation a free path")
+        raise InvalidRequest(
+            "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
+        )
     if timing.grid_points is not None and not 4 <= timing.grid_points <= 100:
         raise InvalidRequest(f"timing.grid_points sets the collocation intervals, 4 to 100; got {timing.grid_points}")
     if timing.grid_points is not None:
@@ -164,6 +169,7 @@ class _Timed(NamedTuple):
     notes: tuple[str, ...] = ()
     cost: float | None = None
     solver: dict | None = None
+    search: dict | None = None
     switching_times: dict | None = None
 
 
@@ -310,7 +316,7 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
         )
         solver = {**solver, "switching": "refined" if switching is not None else "read off the samples"}
     cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
-    return _Timed(path, result, (stretch,), "collocation", notes, cost, solver, switching)
+    return _Timed(path, result, (stretch,), "collocation", notes, cost, solver, switching_times=switching)
 
 
 def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, deadline):
@@ -328,6 +334,81 @@ def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, 
     except InfeasiblePath as error:
         return path, result, stretch, None, (*notes, f"the bang-bang refinement is not returned: {error.detail}")
     return switched, timing, stretch, switching_times(refined.controls, robot.joint_names), notes
+
+
+def _timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstacles, clearance) -> _Timed:
+    """The global search (``planners.search``, Jeong & Lee section 2): the best grid path of
+    each tube, then each one's local optimization (section 2.6) within its share of the budget;
+    the fastest optimized path that keeps the clearance is timed by phase_plane through the
+    limit gate. The grid path's own curve stands in where its optimization finds nothing."""
+    if not isinstance(spec, FreeMotion):
+        raise InvalidRequest("timing.method 'search' finds the path itself: give a free path (path.kind 'free', start and goal)")
+    if _moving(spec.start_velocity) is not None or _moving(spec.end_velocity) is not None or timing.duration is not None:
+        raise InvalidRequest("the search plans the fastest motion from rest to rest: leave timing.boundary and timing.duration out")
+    found = global_search(
+        robot, limits, kinds, spec.start, spec.goal, timing.search, spec.revolutions, obstacles, clearance, deadline.within(0.0, 0.3)
+    )
+    tubes = found.result.tubes
+    optimized, failures = [], []
+    for index, tube in enumerate(tubes):
+        remaining = deadline.remaining()
+        # the rounds share what is left, three quarters of it (the rest: timing, gate, sampling)
+        allowance = None if remaining is None else 0.75 * remaining / (len(tubes) - index)
+        part = deadline.within(0.3 + 0.6 * index / len(tubes), 0.3 + 0.6 * (index + 1) / len(tubes))
+        part.progress(0.0, f"local optimization of tube {index + 1} of {len(tubes)}")
+        try:
+            local = optimize_locally(robot, tube.points, limits, kinds, obstacles, clearance, part, allowance_s=allowance)
+        except InfeasiblePath as error:
+            failures.append(f"tube {index + 1}: {error.detail}")
+            continue
+        optimized.append((local.duration, index, local))
+    plain = dataclasses.replace(timing, method="phase_plane", search=None, start_velocity=None, end_velocity=None)
+    candidates: list[tuple[GeometricPath, int, LocalOptimum | None]] = [
+        (item.path, index, item) for _, index, item in sorted(optimized, key=lambda item: item[:2])
+    ]
+    candidates += [(GridSplinePath(tube.points), index, None) for index, tube in enumerate(tubes)]
+    for path, index, optimum in candidates:
+        try:
+            if obstacles:
+                check_clearance(path, robot, list(obstacles), clearance, deadline)
+            timed = _timed_path(robot, path, PhasePlaneMethod(), plain, kinds, limits, deadline.within(0.9, 1.0), threshold)
+        except InfeasiblePath as error:
+            failures.append(f"tube {index + 1}{' (optimized)' if optimum is not None else ''}: {error.detail}")
+            continue
+        end = path.evaluate(np.array([1.0])).q[0]
+        turns = [
+            f"joint {robot.joint_names[j]!r} ends at {end[j]:.6g} rad, the goal's angle {turn:+.0f} revolution"
+            for j in range(robot.dof)
+            if (turn := round((end[j] - spec.goal[j]) / (2.0 * np.pi))) != 0
+        ]
+        notes = [*timed.notes, *turns]
+        if optimum is None:
+            notes.append("the local optimization found no better path: the best grid path's own curve is returned")
+        elif optimum.statistics.stopped == "allowance spent":
+            notes.append(
+                "the local optimization stopped when its share of the time budget was spent: a job with a larger "
+                "budget_s may find a faster path"
+            )
+        report = found.as_dict(index)
+        report["local"] = [_local_report(tubes[i].time, item) for _, i, item in sorted(optimized, key=lambda item: item[1])]
+        report["final_time"] = timed.timing.duration
+        return timed._replace(method="search", notes=tuple(notes), search=report)
+    raise InfeasiblePath("no path the search found could be followed: " + "; ".join(failures))
+
+
+def _local_report(grid_time: float, local) -> dict:
+    """A tube's local optimization for the answer's ``search.local`` (times in s)."""
+    stats = local.statistics
+    return {
+        "grid_time": grid_time,
+        "seed_time": stats.seed_duration if np.isfinite(stats.seed_duration) else None,
+        "time": local.duration,
+        "control_points": [r.control_points for r in stats.rounds],
+        "round_times": [r.duration if np.isfinite(r.duration) else None for r in stats.rounds],
+        "evaluations": stats.evaluations,
+        "stopped": stats.stopped,
+        "wall_s": stats.wall_s,
+    }
 
 
 def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -434,10 +515,15 @@ def plan(
         )
     timing_part = deadline.within(0.0, 0.9)
     checked_first = None
-    if obstacles and isinstance(path_spec, FreeMotion):
-        raise InvalidRequest("path.obstacles are not served on free paths yet: give waypoints that clear them")
+    if obstacles and isinstance(path_spec, FreeMotion) and method.name != "search":
+        raise InvalidRequest(
+            "path.obstacles on a free path are served by timing.method 'search' (the global search among obstacles); "
+            "collocation does not see obstacles"
+        )
     with numerical_breakdown_is_failure(method.name):
-        if isinstance(path_spec, FreeMotion) or method.name == "collocation":
+        if method.name == "search":
+            timed = _timed_search(robot, path_spec, timing, kinds, limits, timing_part, threshold, obstacles, clearance)
+        elif isinstance(path_spec, FreeMotion) or method.name == "collocation":
             timed = _timed_free_motion(robot, path_spec, method, timing, kinds, limits, timing_part, threshold)
         elif timing.synchronization == "none":
             timing_part.progress(0.0, "joint moves")
@@ -511,6 +597,7 @@ def plan(
         solver=timed.solver,
         switching_times=switching,
         clearance=found_clearance,
+        search=timed.search,
     )
 
 

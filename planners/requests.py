@@ -10,6 +10,8 @@ from numpy.typing import ArrayLike
 
 from planners.constraints import CONSTRAINT_KINDS
 from planners.errors import InvalidRequest
+from planners.search.graph import SearchOptions
+from planners.search.method import SearchMethod
 from planners.timing import METHODS
 from planners.timing.base import TimingMethod
 from planners.timing.classical import ClassicalMethod
@@ -75,6 +77,8 @@ class Timing:
         tool_speed: Largest linear speed of the tool frame's origin, m/s; ``None``: none.
         tool_angular_speed: Largest angular speed of the tool frame, rad/s; ``None``: none.
         tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
+        search: Options of the global search (``timing.method = "search"``); ``None``: the
+            defaults of ``planners.search.SearchOptions``.
     """
 
     method: str = "phase_plane"
@@ -96,6 +100,7 @@ class Timing:
     tool_speed: float | None = None
     tool_angular_speed: float | None = None
     tool_frame: str | None = None
+    search: SearchOptions | None = None
 
 
 def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
@@ -186,7 +191,11 @@ def timing_method(timing: Timing) -> TimingMethod:
         return MinCostMethod(timing.torque_weight)
     if timing.method == "collocation":
         return CollocationMethod()
+    if timing.method == "search":
+        return SearchMethod()
+    if timing.search is not None:
+        raise InvalidRequest(f"timing.search sets up timing.method 'search', not {timing.method!r}")
     named = METHODS.get(timing.method)
     if named is None:
-        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted(METHODS)}")
+        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted([*METHODS, 'collocation', 'search'])}")
     return named

@@ -56,6 +56,7 @@ class PlannedTrajectory:
     #: Free paths with time-optimal (bang-bang) torques: {joint name: [t, ...]} in s, the
     #: instants where each saturated torque changes sides.
     switching_times: dict[str, list[float]] | None = None
+    search: dict | None = None
 
 
 def require_finite(method: str, **quantities) -> None:

@@ -17,6 +17,7 @@ from planners.deadline import NO_DEADLINE
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.free_path import FreeMotion
 from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
+from planners.search import SearchOptions
 from robots import InvalidLimits, UnknownRobot
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
 from service.problems import non_finite_answer
@@ -56,6 +57,10 @@ def _timing(request: TrajectoryRequest) -> Timing:
         tool_speed=limits.tool_speed,
         tool_angular_speed=limits.tool_angular_speed,
         tool_frame=limits.tool_frame,
+        search=None if timing.search is None else SearchOptions(
+            cells=None if timing.search.cells is None else tuple(timing.search.cells),
+            **timing.search.model_dump(exclude={"cells"}),
+        ),
     )
 
 
@@ -229,6 +234,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "obstacle": result.clearance.obstacle,
             "s": result.clearance.s,
         },
+        "search": result.search,
     }
 
 

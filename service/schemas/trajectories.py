@@ -120,9 +120,9 @@ class CartesianPathRequest(Schema):
 
 class FreePathRequest(Schema):
     """Start and goal only: the path and its timing are optimized together (timing.method
-    `collocation`)."""
+    `collocation`), or searched globally among obstacles (timing.method `search`)."""
 
-    kind: Literal["free"] = Field(description="`free`: start and goal only (timing.method `collocation`).")
+    kind: Literal["free"] = Field(description="`free`: start and goal only (timing.method `collocation` or `search`).")
     start: JointVector = Field(description="Start configuration (rad, m), at rest unless timing.boundary says otherwise.")
     goal: JointVector = Field(description="Goal configuration (rad, m).")
     revolutions: bool = Field(
@@ -130,10 +130,11 @@ class FreePathRequest(Schema):
     )
     obstacles: list[ObstacleRequest] = Field(
         default=[],
-        max_length=0,
-        description="Not served on free paths yet (the global search among obstacles is to come): must be "
-        "empty; give waypoints that clear the obstacles instead.",
+        max_length=MAX_OBSTACLES,
+        description="Obstacles in the world frame (spheres, boxes, capsules), with timing.method `search`: every "
+        "link keeps path.clearance from them along the motion found; the answer reports min_clearance.",
     )
+    clearance: float = CLEARANCE
 
 
 def _path_kind(value) -> str:
@@ -219,7 +220,52 @@ class TrapezoidRequest(Schema):
 if TYPE_CHECKING:  # the names are known when the methods are imported
     MethodName = str
 else:
-    MethodName = Literal[(*METHODS, "collocation")]
+    MethodName = Literal[(*METHODS, "collocation", "search")]
+
+
+class SearchRequest(Schema):
+    """Options of the global search (timing.method `search`, Jeong & Lee section 2): the grid of
+    joint space, the turns allowed, the upper bound's margin and the tubes."""
+
+    cells: Annotated[list[Annotated[int, Field(ge=1, le=1000)]], Field(min_length=1, max_length=MAX_JOINTS)] | None = Field(
+        default=None,
+        description="Grid intervals per joint across the search region (one value for every joint, or one per "
+        "joint); the step is then adjusted so that the goal lies on the grid. Default: 16 per joint for two "
+        "joints, 8 for three; arms with more joints search a roadmap.",
+    )
+    margin: Annotated[float, Field(ge=0.0, le=10.0)] = Field(
+        default=0.5,
+        description="How far the search region reaches beyond the box of start and goal along every joint, as "
+        "a multiple of the largest joint span from start to goal (within the joint limits).",
+    )
+    max_turn: Annotated[float, Field(gt=0.0, lt=180.0)] | None = Field(
+        default=None,
+        description="Largest turn between consecutive moves (degrees, in grid units); sharper turns are not "
+        "searched. Default: 45 on a lattice, 90 on a roadmap.",
+    )
+    upper_margin: Annotated[float, Field(ge=0.0, le=10.0)] = Field(
+        default=0.02,
+        description="epsilon of the upper bound t_u = (1 + epsilon) t~ (relative): grid paths within it of the "
+        "best are kept as candidates, one per tube.",
+    )
+    tube_radius: Annotated[float, Field(gt=0.0, le=100.0)] | None = Field(
+        default=None,
+        description="D_max (rad or m): grid paths within this joint-space (Hausdorff) distance of a better "
+        "one belong to its tube. Default: three grid steps.",
+    )
+    tubes: Annotated[int, Field(ge=1, le=20)] = Field(default=3, description="Most tubes (best grid paths of distinct regions) kept.")
+    graph: Literal["auto", "lattice", "roadmap"] = Field(
+        default="auto",
+        description="`lattice`: grid points joined to their 3^n - 1 neighbours; `roadmap`: seeded random "
+        "configurations joined to their nearest neighbours (for arms with many joints); `auto`: a lattice up "
+        "to three joints.",
+    )
+    roadmap_points: Annotated[int, Field(ge=1, le=2000)] = Field(default=150, description="Random configurations of a roadmap (count).")
+    neighbors: Annotated[int, Field(ge=1, le=50)] = Field(default=10, description="Nearest neighbours each roadmap point is joined to (count).")
+    seed: Annotated[int, Field(ge=0, le=2**31 - 1)] = Field(default=0, description="Seed of the roadmap's random configurations.")
+    max_expansions: Annotated[int, Field(ge=1, le=5_000_000)] = Field(
+        default=200_000, description="Most partial paths the branch and bound expands (count)."
+    )
 
 
 class TimingRequest(Schema):
@@ -230,7 +276,8 @@ class TimingRequest(Schema):
         description="`phase_plane` (time-optimal, default), `toppra`, `min_cost` (minimum of the "
         "integral of 1 + beta |tau|^2), `jerk_limited` (time-optimal with jerk limits too), `ruckig` "
         "(jerk-limited, two waypoints), a time law "
-        "(`cubic`, `quintic`, `trapezoidal`, `cycloidal`), or `collocation` (free path).",
+        "(`cubic`, `quintic`, `trapezoidal`, `cycloidal`), or on a free path `collocation` or `search` (global "
+        "search among obstacles).",
     )
     constraints: list[Literal["velocity", "acceleration", "torque", "jerk"]] = Field(
         default=["velocity", "acceleration", "torque"],
@@ -259,6 +306,9 @@ class TimingRequest(Schema):
         "times the straight joint line as one, all joints starting and stopping together; `none` runs "
         "every joint at its own full speed to its goal, so faster joints finish early and the joint "
         "path is no longer straight (lecture \"Trajectory Planning\").",
+    )
+    search: SearchRequest | None = Field(
+        default=None, description="Options of the global search (timing.method `search`); defaults when left out."
     )
     limit_margin: Annotated[float, Field(ge=0.0, le=0.5)] = Field(
         default=0.0,
@@ -396,6 +446,38 @@ class ClearancePublic(BaseModel):
     s: float = Field(description="Where along the path (path parameter, 0 to 1).")
 
 
+class SearchPublic(BaseModel):
+    """What the global search did (timing.method `search`; Jeong & Lee section 2)."""
+
+    graph: str = Field(description="`lattice` or `roadmap`.")
+    grid_points: int = Field(description="Grid points of the graph (count).")
+    grid_edges: int = Field(description="Moves between grid points (count).")
+    grid_shape: list[int] = Field(description="Grid points per joint of a lattice; empty for a roadmap.")
+    turns: int = Field(description="Edges of the direction-augmented graph: pairs of consecutive moves without a sharp turn (count).")
+    removed_by_obstacles: int = Field(description="Pieces of curve (B-spline spans) removed as configuration-space obstacles (count).")
+    points_blocked: int = Field(description="Grid points closer to an obstacle than path.clearance (count).")
+    v_max: float | None = Field(description="V_max of the maximum speed test t1 (joint units/s); null where no limit bounds the speed.")
+    expanded: int = Field(description="Partial paths branched (count).")
+    generated: int = Field(description="Subsets of grid paths created (count).")
+    pruned: dict[str, int] = Field(description="Subsets discarded by each lower bound t1, t2, t3, t4, and by the upper bound t_u (counts).")
+    t4_evaluations: int = Field(description="Grid paths timed by the phase-plane method (count).")
+    candidates: int = Field(description="Grid paths found within t_u (count).")
+    best_grid_time: float | None = Field(description="t~: the best grid path's time (s), on the search's grid.")
+    upper_bound: float | None = Field(description="t_u at the end (s).")
+    complete: bool = Field(description="Whether the search ended by its bounds (the best grid path is the best of the graph).")
+    prepare_s: float = Field(description="Time building the graph, its obstacles and bounds (s).")
+    search_s: float = Field(description="Time of the branch and bound (s).")
+    tube_radius: float = Field(description="D_max (joint units).")
+    tubes: list[dict] = Field(description="The best grid path of each tube, best first: time (s), bounds t1, t2, t3 (s) and points (joint configurations; the curve is the uniform cubic B-spline with these control points).")
+    chosen_tube: int = Field(description="The tube whose grid path the answer follows (index into tubes).")
+    region: dict = Field(description="The region of joint space searched: lower and upper corners.")
+    shadows: dict | None = Field(
+        default=None,
+        description="Planar two-joint arms among obstacles: the configuration-space occupancy grid (joints, q, occupied) "
+        "and the obstacle shadows of the tip per elbow branch (points in the arm's plane, m).",
+    )
+
+
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
@@ -424,6 +506,7 @@ class TrajectoryResponse(BaseModel):
     min_clearance: ClearancePublic | None = Field(
         default=None, description="With path.obstacles: the closest approach of any link to any obstacle."
     )
+    search: SearchPublic | None = Field(default=None, description="timing.method `search`: what the global search did.")
     warnings: list[str] = Field(description="What the answer should be read with: dropped waypoints, singularities, turns of continuous joints.")
 
 

@@ -2,7 +2,7 @@
 // (POST /v1/trajectories, /compare, or a job for free paths) and draws the answer with Plotly.
 "use strict";
 
-const FALLBACK_METHODS = ["phase_plane", "toppra", "min_cost", "quintic", "cubic", "trapezoidal", "cycloidal", "ruckig", "collocation"];
+const FALLBACK_METHODS = ["phase_plane", "toppra", "min_cost", "quintic", "cubic", "trapezoidal", "cycloidal", "ruckig", "collocation", "search"];
 const CONSTRAINTS = ["velocity", "acceleration", "torque", "jerk"];
 
 const PRESETS = {
@@ -18,6 +18,13 @@ const PRESETS = {
     robot: "geering_2r",
     path: {kind: "free", start: [0.0, 0.0], goal: [0.76, 0.0], revolutions: true},
     methods: ["collocation"],
+    constraints: ["torque"],
+  },
+  "Geering arm around a sphere (global search, Jeong & Lee §2)": {
+    robot: "geering_2r",
+    path: {kind: "free", start: [0.0, 0.0], goal: [0.76, 0.0], revolutions: true,
+           obstacles: [{kind: "sphere", center: [0.52, 0.28, 0.0], radius: 0.05}]},
+    methods: ["search"],
     constraints: ["torque"],
   },
   "Yamamoto arm, straight line": {
@@ -152,7 +159,7 @@ async function plan() {
       const body = {robot, path, methods, timing: {constraints: timing.constraints}};
       compared = await postJSON("/v1/trajectories/compare", body);
     }
-    await show(answer, compared, await limitsOf(robot));
+    await show(answer, compared, await limitsOf(robot), path);
     $("status").textContent = `planned in ${answer.solve_ms.toFixed(1)} ms`;
     document.body.dataset.planned = "true";
   } catch (error) {
@@ -181,7 +188,7 @@ function showDurations(compared) {
   table.hidden = false;
 }
 
-async function show(answer, compared, limits) {
+async function show(answer, compared, limits, path) {
   $("results").hidden = false;
   $("duration").textContent = `${answer.method}: ${answer.duration.toFixed(4)} s`;
   $("duration").dataset.duration = String(answer.duration);
@@ -190,7 +197,7 @@ async function show(answer, compared, limits) {
   showDurations(compared);
   drawPhasePlane(answer);
   drawJoints(answer, limits);
-  await drawArm(answer);
+  await drawArm(answer, path);
 }
 
 const LAYOUT = {margin: {l: 55, r: 15, t: 40, b: 45}, font: {size: 11}, legend: {orientation: "h"}};
@@ -248,7 +255,7 @@ function drawJoints(answer, limits) {
   Plotly.newPlot("joints", traces, layout, {responsive: true});
 }
 
-async function drawArm(answer) {
+async function drawArm(answer, path) {
   const count = Math.min(12, answer.samples.t.length);
   const indices = [...Array(count).keys()].map((k) => Math.round((k * (answer.samples.t.length - 1)) / Math.max(1, count - 1)));
   const figure = await postJSON(`/v1/robots/${encodeURIComponent(answer.robot)}/skeleton`, {q: indices.map((i) => answer.samples.q[i])});
@@ -262,10 +269,30 @@ async function drawArm(answer) {
     if (!planar) Object.assign(trace, {type: "scatter3d", z: points.map((p) => p[2])});
     return trace;
   });
+  if (planar) traces.unshift(...obstacleTraces(answer, path));
   const layout = {...LAYOUT, title: {text: "The arm, stroboscopically (light: start, dark: end)"}};
   if (planar) Object.assign(layout, {xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}, scaleanchor: "x"}});
   else layout.scene = {aspectmode: "data", xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}}, zaxis: {title: {text: "z (m)"}}};
   Plotly.newPlot("arm", traces, layout, {responsive: true});
+}
+
+function obstacleTraces(answer, path) {
+  // a planar arm's picture: the obstacle shadows of the search (the tip positions where a link
+  // would meet an obstacle, per elbow branch; Jeong & Lee §2.2) and the spheres themselves
+  const traces = [];
+  const shadows = answer.search && answer.search.shadows;
+  const colors = ["rgba(230, 126, 34, 0.25)", "rgba(142, 68, 173, 0.25)"];
+  if (shadows) {
+    shadows.shadows.forEach((branch, k) => traces.push({x: branch.points.map((p) => p[0]), y: branch.points.map((p) => p[1]), mode: "markers",
+      marker: {size: 3, color: colors[k % colors.length]}, name: `obstacle shadow, ${branch.branch}`, hoverinfo: "skip"}));
+  }
+  for (const obstacle of (path && path.obstacles) || []) {
+    if (obstacle.kind !== "sphere") continue;
+    const angles = [...Array(49).keys()].map((k) => (2 * Math.PI * k) / 48);
+    traces.push({x: angles.map((a) => obstacle.center[0] + obstacle.radius * Math.cos(a)), y: angles.map((a) => obstacle.center[1] + obstacle.radius * Math.sin(a)),
+                 mode: "lines", fill: "toself", line: {color: "#555"}, fillcolor: "rgba(85, 85, 85, 0.5)", name: "obstacle"});
+  }
+  return traces;
 }
 
 init().catch((error) => showError(`The page could not start: ${error.message}`));

@@ -1,0 +1,131 @@
+"""``search``: the name under which a free motion is searched globally (``planners.search``). It
+does not time a given path, so ``solve`` refuses one; ``global_search`` is the search itself,
+from a free motion to its best grid paths, their statistics and, for planar arms among
+obstacles, the obstacle shadows."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from planners.collision import Obstacle
+from planners.constraints import PathConstraints
+from planners.deadline import NO_DEADLINE, Deadline
+from planners.errors import InfeasiblePath, InvalidRequest
+from planners.search.branch_and_bound import SearchResult, branch_and_bound
+from planners.search.graph import DEFAULT_OPTIONS, SearchOptions
+from planners.search.problem import build_problem, toward_goal
+from planners.search.shadows import obstacle_shadows
+from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
+from robots import JointLimits, Robot
+
+
+class SearchMethod(TimingMethod):
+    """Global search of path and timing among obstacles (see ``planners.search``)."""
+
+    name = "search"
+    kinds = frozenset({"velocity", "acceleration", "torque"})
+
+    def solve(
+        self,
+        constraints: PathConstraints,
+        boundary: Boundary = AT_REST,
+        duration: float | None = None,
+        deadline: Deadline = NO_DEADLINE,
+    ) -> PathTiming:
+        raise InvalidRequest("search finds the path itself: give a free path (start and goal)")
+
+
+@dataclass(frozen=True)
+class GlobalSearch:
+    """A search's result, its region of joint space ((n_dof,) corners) and, for a planar arm
+    among obstacles, its obstacle shadows (``planners.search.shadows``)."""
+
+    result: SearchResult
+    low: np.ndarray
+    high: np.ndarray
+    shadows: dict | None
+
+    def as_dict(self, chosen: int = 0) -> dict:
+        """The answer's ``search`` (JSON-ready): the statistics, the tubes' best grid paths
+        (``chosen`` the one returned), the region searched and the shadows."""
+        body = self.result.statistics.as_dict()
+        body["tube_radius"] = self.result.tube_radius
+        body["tubes"] = [
+            {"time": tube.time, "t1": tube.bounds[0], "t2": tube.bounds[1], "t3": tube.bounds[2], "points": tube.points.tolist()}
+            for tube in self.result.tubes
+        ]
+        body["chosen_tube"] = chosen
+        body["region"] = {"lower": self.low.tolist(), "upper": self.high.tolist()}
+        body["shadows"] = self.shadows
+        return body
+
+
+def global_search(
+    robot: Robot,
+    limits: JointLimits,
+    kinds: tuple[str, ...],
+    start: np.ndarray,
+    goal: np.ndarray,
+    options: SearchOptions | None = None,
+    revolutions: bool = True,
+    obstacles: tuple[Obstacle, ...] = (),
+    clearance: float = 0.01,
+    deadline: Deadline = NO_DEADLINE,
+) -> GlobalSearch:
+    """The best grid paths from ``start`` to ``goal`` at rest: the problem built once
+    (``build_problem``), then ``branch_and_bound`` toward each revolution variant of the goal
+    in turn (grid paths that end one revolution apart are never in one tube, so each variant
+    is a homotopy class with its own upper bound). The tubes are the best grid path of each
+    variant, best first, then the next tubes of the variants by time, ``options.tubes`` in all.
+
+    Raises:
+        InvalidRequest, InfeasiblePath: see ``build_problem`` and ``branch_and_bound`` (the
+            latter when no variant has a grid path).
+        BudgetExceeded: ``deadline`` passed.
+    """
+    options = options or DEFAULT_OPTIONS
+    problem = build_problem(
+        robot, limits, kinds, start, goal, options, revolutions, obstacles, clearance, deadline.within(0.0, 0.4)
+    )
+    variants = len(problem.graph.goals)
+    results, failures = [], []
+    for index in range(variants):
+        part = deadline.within(0.4 + 0.6 * index / variants, 0.4 + 0.6 * (index + 1) / variants)
+        try:
+            results.append(branch_and_bound(toward_goal(problem, index), options, part))
+        except InfeasiblePath as error:
+            failures.append(error)
+    if not results:
+        raise failures[0]
+    result = _merged(results, problem.prepare_s, options.tubes)
+    points = problem.graph.points
+    low, high = points.min(axis=0), points.max(axis=0)
+    shadows = obstacle_shadows(robot, list(obstacles), clearance, low, high) if obstacles else None
+    return GlobalSearch(result, low, high, shadows)
+
+
+def _merged(results: list[SearchResult], prepare_s: float, count: int) -> SearchResult:
+    """One result of the searches toward each goal variant: statistics summed (the upper bound
+    is that of the best variant's search), tubes as ``global_search`` says."""
+    firsts = sorted((r.tubes[0] for r in results), key=lambda tube: tube.time)
+    rest = sorted((tube for r in results for tube in r.tubes[1:]), key=lambda tube: tube.time)
+    tubes = tuple(sorted([*firsts, *rest][: max(1, count)], key=lambda tube: tube.time))
+    candidates = tuple(sorted((c for r in results for c in r.candidates), key=lambda c: c.time))
+    best = min(results, key=lambda r: r.tubes[0].time)
+    statistics = dataclasses.replace(
+        best.statistics,
+        expanded=sum(r.statistics.expanded for r in results),
+        generated=sum(r.statistics.generated for r in results),
+        pruned={key: sum(r.statistics.pruned[key] for r in results) for key in best.statistics.pruned},
+        t4_evaluations=sum(r.statistics.t4_evaluations for r in results),
+        candidates=len(candidates),
+        best_grid_time=tubes[0].time,
+        complete=all(r.statistics.complete for r in results),
+        prepare_s=prepare_s,
+        search_s=sum(r.statistics.search_s for r in results),
+        goal_variants=len(results),
+    )
+    return SearchResult(tubes, candidates, statistics, best.tube_radius)
