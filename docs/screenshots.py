@@ -1,7 +1,9 @@
-"""The README's screenshots of the web page: the ur5 example and the Geering free-path example,
-planned in a real browser (Playwright driving chromium) against a server started here.
+"""The README's screenshots of the web page: the ur5 example, the Geering free-path example and
+the Geering arm around a sphere (the global search), planned in a real browser (Playwright
+driving chromium) against a server started here.
 
-    python docs/screenshots.py        # writes docs/page_ur5.png and docs/page_geering_free.png
+    python docs/screenshots.py [FILE ...]   # writes docs/page_ur5.png, docs/page_geering_free.png
+                                            # and docs/page_geering_search.png, or the files named
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ sys.path.insert(0, str(HERE.parent))
 
 from tests.live_server import LiveServer  # noqa: E402
 
-SHOTS = {"page_ur5.png": 0, "page_geering_free.png": 1}  # file: index of the page's example
+SHOTS = {"page_ur5.png": 0, "page_geering_free.png": 1, "page_geering_search.png": 2}  # file: index of the page's example
 
 
 def main() -> None:
@@ -26,6 +28,8 @@ def main() -> None:
         browser = playwright.chromium.launch(executable_path=chromium, args=["--no-sandbox", "--disable-dev-shm-usage"])
         page = browser.new_page(viewport={"width": 1400, "height": 1300})
         for name, preset in SHOTS.items():
+            if sys.argv[1:] and name not in sys.argv[1:]:
+                continue
             page.goto(f"http://127.0.0.1:{server.port}/")
             page.wait_for_selector("body[data-ready=true]")
             page.select_option("#preset", index=preset)

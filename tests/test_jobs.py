@@ -202,24 +202,28 @@ def test_the_queue_is_bounded(tmp_path):
 
 
 def test_progress_advances_on_a_collocation_job(client):
-    """The Geering example's collocation reports each initial guess: watched until two of them
-    went by, then cancelled."""
+    """The Geering example's collocation reports its stages (its initial guesses, the re-timing,
+    the switching times, the sampling) as it goes: watched to the end, the fractions never go
+    back. Progress is written at most every ``PROGRESS_WRITE_S``, and the 15 guesses may all
+    fit in one such interval, so at least one of them is seen, not every one."""
     example = json.loads((EXAMPLES / "geering_free_motion.json").read_text())
     job_id = _submit(client, {"trajectory": example})
     seen: dict[str, float] = {}
     give_up = time.monotonic() + 120
-    while len(seen) < 2 and time.monotonic() < give_up:
+    while time.monotonic() < give_up:
         job = client.get(f"/v1/jobs/{job_id}").json()
-        assert job["status"] in ("queued", "running"), job
+        if job["status"] not in ("queued", "running"):
+            break
         fraction, stage = job["progress"]["fraction"], job["progress"]["stage"]
-        if stage.startswith("collocation: guess "):
-            assert fraction >= max(seen.values(), default=0.0)
-            seen.setdefault(stage, fraction)
+        assert fraction >= max(seen.values(), default=0.0), (stage, fraction, seen)
+        seen.setdefault(stage, fraction)
         time.sleep(0.02)
-    client.delete(f"/v1/jobs/{job_id}")
-    assert len(seen) == 2 and sorted(seen.values()) == list(seen.values()), seen
-    assert len(set(seen.values())) == 2 and all(0.0 <= value < 1.0 for value in seen.values())
-    assert all(stage.endswith(" of 15") for stage in seen)
+    assert job["status"] == "done" and job["progress"] == {"fraction": 1.0, "stage": "done"}, job
+    guesses = [stage for stage in seen if stage.startswith("collocation: guess ")]
+    assert guesses and all(stage.endswith(" of 15") for stage in guesses), seen
+    later = [stage for stage in seen if not stage.startswith(("collocation: guess ", "starting"))]
+    assert len(later) >= 2 and all(0.0 < seen[stage] < 1.0 for stage in [*guesses, *later]), seen
+    assert max(seen[stage] for stage in guesses) < min(seen[stage] for stage in later), seen
 
 
 def _report_three(progress) -> str:

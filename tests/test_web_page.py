@@ -20,7 +20,9 @@ def browser_page():
     from playwright.sync_api import sync_playwright
 
     assert CHROMIUM, "a real browser is needed: apt-get install chromium (make test does it)"
-    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false") as server, sync_playwright() as playwright:
+    # a job's default budget of 20 s: the page's search runs as a job, which then returns the best
+    # curve its local optimization reached in that time
+    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false", TOPTRAJ_JOB_BUDGET_S="20") as server, sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
         page = browser.new_page(viewport={"width": 1400, "height": 1300})
         base = f"http://127.0.0.1:{server.port}"
@@ -79,6 +81,27 @@ def test_an_error_shows_the_problem_detail(browser_page):
     page.click("#plan")
     page.wait_for_selector("#error:not([hidden])", timeout=30_000)
     assert "outside the limits" in page.inner_text("#error") and "422" in page.inner_text("#error")
+
+
+def test_the_search_preset_draws_the_obstacle_and_its_shadows(browser_page):
+    """The Geering arm around a sphere (Jeong & Lee section 2): planned as a job by the global
+    search, the arm's picture shows the sphere and the obstacle shadows of section 2.2."""
+    page, base, _, outside = browser_page
+    page.goto(base + "/")
+    page.wait_for_selector("body[data-ready=true]")
+    page.select_option("#preset", "Geering arm around a sphere (global search, Jeong & Lee §2)")
+    assert page.input_value("#robot") == "geering_2r"
+    page.click("#plan")
+    page.wait_for_selector("body[data-planned=true], #error:not([hidden])", timeout=120_000)
+    assert not page.is_visible("#error"), page.inner_text("#error")
+    shown = float(page.get_attribute("#duration", "data-duration"))
+    assert shown >= 0.9755 * 0.998  # never below the obstacle-free optimum (the paper's 0.9755 s)
+    assert page.inner_text("#duration").startswith("search: ")
+    names = page.evaluate("() => document.getElementById('arm').data.map((trace) => trace.name)")
+    assert "obstacle" in names
+    assert any(name.startswith("obstacle shadow") for name in names)
+    assert sum(name.startswith("t = ") for name in names) == 12
+    assert outside == []
 
 
 @pytest.mark.parametrize("docs", ["/docs", "/redoc"])
