@@ -570,7 +570,12 @@ def plan(
         )
     utilization = _utilization(timed.stretches, margin)
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
-    if kappa_max > NEAR_SINGULAR_KAPPA:
+    if not np.isfinite(kappa_max):
+        notes.append(
+            f"the arm passes through a singularity at t = {samples.t[worst]:.4g} s: its Jacobian loses rank "
+            "there (the condition number is infinite)"
+        )
+    elif kappa_max > NEAR_SINGULAR_KAPPA:
         notes.append(
             f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} "
             f"at t = {samples.t[worst]:.4g} s"

@@ -71,6 +71,7 @@ def test_ur5_limits_hold_on_a_dense_resampling(ur5_result):
     assert max(ratio.max() for ratio in ratios.values()) >= 0.995
     assert not [note for note in ur5_result["warnings"] if "limit" in note]
     assert ur5_result["conditioning"]["kappa_max"] is None  # the start has the wrist singular (q5 = 0)
+    assert any(note.startswith("the arm passes through a singularity at t = 0 s: its Jacobian loses rank") for note in ur5_result["warnings"])
 
 
 def test_ur5_phase_plane_stays_under_the_mvc(ur5_result):
