@@ -27,3 +27,5 @@ def test_example_is_answered(client, example):
         assert all(row.get("duration") for row in result["results"]), result
     else:
         assert result["duration"] > 0 and not [note for note in result["warnings"] if "limit" in note]
+    if body["path"].get("obstacles"):
+        assert result["min_clearance"]["distance"] >= body["path"]["clearance"]

@@ -205,7 +205,7 @@ def test_progress_advances_on_a_collocation_job(client):
     """The Geering example's collocation reports its stages (its initial guesses, the re-timing,
     the switching times, the sampling) as it goes: watched to the end, the fractions never go
     back. Progress is written at most every ``PROGRESS_WRITE_S``, and the 15 guesses may all
-    fit in one such interval, so at least one of them is seen, not every one."""
+    fit in one such interval, so not every stage is seen."""
     example = json.loads((EXAMPLES / "geering_free_motion.json").read_text())
     job_id = _submit(client, {"trajectory": example})
     seen: dict[str, float] = {}
@@ -219,11 +219,13 @@ def test_progress_advances_on_a_collocation_job(client):
         seen.setdefault(stage, fraction)
         time.sleep(0.02)
     assert job["status"] == "done" and job["progress"] == {"fraction": 1.0, "stage": "done"}, job
-    guesses = [stage for stage in seen if stage.startswith("collocation: guess ")]
-    assert guesses and all(stage.endswith(" of 15") for stage in guesses), seen
-    later = [stage for stage in seen if not stage.startswith(("collocation: guess ", "starting"))]
-    assert len(later) >= 2 and all(0.0 < seen[stage] < 1.0 for stage in [*guesses, *later]), seen
-    assert max(seen[stage] for stage in guesses) < min(seen[stage] for stage in later), seen
+    stages = {stage: fraction for stage, fraction in seen.items() if stage not in ("", "starting")}
+    known = ("collocation: ", "re-timing along the collocation's path", "refining the switching times", "sampling")
+    assert len(stages) >= 2 and all(stage.startswith(known) for stage in stages), seen
+    assert all(stage.endswith(" of 15") for stage in stages if stage.startswith("collocation: guess ")), seen
+    fractions = list(stages.values())
+    assert fractions == sorted(fractions) and len(set(fractions)) == len(fractions), seen
+    assert all(0.0 < fraction < 1.0 for fraction in fractions), seen
 
 
 def _report_three(progress) -> str:

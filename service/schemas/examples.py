@@ -15,7 +15,10 @@ SUMMARIES = {
     "lecture_cartesian_line": "lecture arm: a Cartesian straight line through inverse kinematics",
     "yamamoto_min_cost": "Yamamoto's arm: minimum time plus energy (beta = 0.03) along a straight line",
     "geering_free_motion": "Geering's arm: free path, path and timing optimized together (tens of seconds; see /v1/jobs)",
+    "ur5_jerk_limited": "ur5: the spline example under a jerk limit too (jerk_limited)",
     "compare_methods": "several methods on one path",
+    "ur5_spline_obstacles": "ur5: the spline example above a table and beside a pole, keeping 2 cm of clearance (min_clearance in the answer)",
+    "geering_search_obstacle": "Geering's arm around a sphere: the global search among obstacles, then local optimization (tens of seconds; see /v1/jobs)",
 }
 
 
