@@ -13,6 +13,7 @@ from fastapi.testclient import TestClient
 import robots
 from planners.collision import BoxObstacle, SphereObstacle
 from planners.search import branch_and_bound, build_problem, enumerate_grid_paths
+from planners.search.branch_and_bound import NoGridPath
 from planners.search.graph import SearchOptions
 from planners.search.problem import toward_goal
 from robots.collision import robot_capsules, world_capsules
@@ -111,6 +112,35 @@ def test_the_candidates_within_the_upper_bound_are_those_of_enumeration():
     within = [path.time for path in every if path.time <= found.statistics.upper_bound * (1 + 1e-9)]
     assert sorted(c.time for c in found.candidates) == pytest.approx(within, rel=1e-12)
     assert len(within) > 1
+
+
+def test_a_goal_variant_no_grid_path_reaches_stops_at_its_allowance_and_the_others_at_their_cap():
+    """Around the sphere ACROSS, the elbow's goal one revolution up is reached by no grid path:
+    searched to the end its branch and bound would expand ``max_expansions`` partial paths
+    (about 10 s). Given an allowance it stops there; capped below a variant's best, a search
+    finds nothing faster and says so."""
+    sphere = SphereObstacle(np.array(ACROSS["center"]), ACROSS["radius"])
+    robot = robots.load("geering_2r")
+    options = SearchOptions()
+    problem = build_problem(robot, robot.limits, ("torque",), np.zeros(2), np.array([0.76, 0.0]), options, True, [sphere], 0.01)
+    outcomes = []
+    for goal in range(len(problem.graph.goals)):
+        try:
+            outcomes.append(branch_and_bound(toward_goal(problem, goal), options, allowance_s=5.0))
+        except NoGridPath as error:
+            outcomes.append(error)
+    stopped = [o for o in outcomes if isinstance(o, NoGridPath)]
+    assert len(stopped) == 1 and not stopped[0].statistics.complete
+    assert 0 < stopped[0].statistics.expanded < options.max_expansions
+    assert "within its share of the time budget" in str(stopped[0])
+    found = sorted((o for o in outcomes if not isinstance(o, NoGridPath)), key=lambda r: r.tubes[0].time)
+    assert found[0].tubes[0].time == pytest.approx(1.5107, abs=1e-4)  # the elbow's -2 pi turn
+    slower = found[1].tubes[0].time
+    goal = next(g for g, o in enumerate(outcomes) if o is found[1])
+    with pytest.raises(NoGridPath, match="faster than") as capped:
+        branch_and_bound(toward_goal(problem, goal), options, cap=0.99 * slower)
+    assert capped.value.statistics.complete
+    assert capped.value.statistics.expanded < found[1].statistics.expanded  # the cap pruned
 
 
 # --------------------------------------------------------------------------- the paper's arm

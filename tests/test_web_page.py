@@ -20,9 +20,9 @@ def browser_page():
     from playwright.sync_api import sync_playwright
 
     assert CHROMIUM, "a real browser is needed: apt-get install chromium (make test does it)"
-    # a job's default budget of 20 s: the page's search runs as a job, which then returns the best
+    # a job's default budget of 30 s: the page's search runs as a job, which then returns the best
     # curve its local optimization reached in that time
-    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false", TOPTRAJ_JOB_BUDGET_S="20") as server, sync_playwright() as playwright:
+    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false", TOPTRAJ_JOB_BUDGET_S="30") as server, sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
         page = browser.new_page(viewport={"width": 1400, "height": 1300})
         base = f"http://127.0.0.1:{server.port}"

@@ -76,7 +76,7 @@ class SearchStatistics:
         best_grid_time: t~, the best grid path's time (s).
         upper_bound: t_u at the end (s).
         complete: Whether the search ended by its bounds (the best grid path is proven the best
-            of the graph); false when ``max_expansions`` stopped it.
+            of the graph); false when ``max_expansions`` or its time allowance stopped it.
         prepare_s, search_s: Seconds building the problem and searching.
         goal_variants: Revolution variants of the goal searched, each with its own t_u.
     """
@@ -159,12 +159,21 @@ class _Node:
         return out[::-1]
 
 
+class NoGridPath(InfeasiblePath):
+    """No grid path was found: with its search's ``statistics``."""
+
+    def __init__(self, detail: str, statistics: SearchStatistics):
+        super().__init__(detail)
+        self.statistics = statistics
+
+
 class _Search:
-    def __init__(self, problem: SearchProblem, options: SearchOptions, deadline: Deadline):
+    def __init__(self, problem: SearchProblem, options: SearchOptions, deadline: Deadline, cap: float = np.inf, stop_at: float = np.inf):
         self.problem, self.options, self.deadline = problem, options, deadline
         graph = problem.graph
         self.goal_points = set(int(g) for g in graph.goals)
-        self.t_u = np.inf
+        self.t_u = cap
+        self.stop_at = stop_at
         self.heap: list = []
         self.count = 0
         self.found: list[GridPath] = []
@@ -308,6 +317,9 @@ class _Search:
             pops += 1
             if pops % CHECK_EVERY == 0:
                 self.deadline.check()
+                if time.monotonic() > self.stop_at:
+                    self.stats.complete = False
+                    break
                 if np.isfinite(self.t_u):
                     best = self.t_u / (1.0 + self.options.upper_margin)
                     self.deadline.progress(min(key / self.t_u, 1.0), f"search: branch and bound, {self.stats.expanded} expanded, t~ {best:.4g} s")
@@ -350,24 +362,47 @@ def select_tubes(candidates: list[GridPath], radius: float, count: int) -> list[
     return taken
 
 
-def branch_and_bound(problem: SearchProblem, options: SearchOptions | None = None, deadline: Deadline = NO_DEADLINE) -> SearchResult:
+def branch_and_bound(
+    problem: SearchProblem,
+    options: SearchOptions | None = None,
+    deadline: Deadline = NO_DEADLINE,
+    cap: float = np.inf,
+    allowance_s: float | None = None,
+) -> SearchResult:
     """The best grid paths of ``problem`` (see the module docstring).
 
+    Args:
+        cap: A first upper bound (s): subsets whose lower bound exceeds it are discarded from
+            the start (``global_search`` passes a multiple of another goal variant's best).
+        allowance_s: Seconds the search may take; then it stops with the grid paths found so
+            far (``statistics.complete`` false). ``None``: until its bounds end it.
+
     Raises:
-        InfeasiblePath: no grid path from start to goal can be followed (obstacles block every
-            one, or no timing meets the limits along any).
+        NoGridPath: no grid path from start to goal below ``cap`` can be followed (obstacles
+            block every one, or no timing meets the limits along any), or none was found
+            within ``allowance_s``.
         BudgetExceeded: ``deadline`` passed.
     """
     options = options or DEFAULT_OPTIONS
-    search = _Search(problem, options, deadline)
+    stop_at = np.inf if allowance_s is None else time.monotonic() + allowance_s
+    search = _Search(problem, options, deadline, cap, stop_at)
     search.run()
     if not search.found:
         stats = search.stats
-        raise InfeasiblePath(
-            f"the search found no grid path from start to goal that keeps the clearance and the limits "
+        if not stats.complete:
+            raise NoGridPath(
+                f"the search found no grid path within its share of the time budget or its max_expansions "
+                f"({stats.expanded} partial paths expanded): give it a larger budget (a job's budget_s), fewer "
+                "timing.search.cells or more timing.search.max_expansions",
+                stats,
+            )
+        below = f" faster than {cap:.4g} s" if np.isfinite(cap) else ""
+        raise NoGridPath(
+            f"the search found no grid path from start to goal{below} that keeps the clearance and the limits "
             f"({stats.grid_points} grid points, {stats.removed_by_obstacles} pieces of path removed by obstacles, "
             f"{stats.points_blocked} grid points blocked): refine timing.search.cells, widen timing.search.margin, "
-            "or move the obstacles"
+            "or move the obstacles",
+            stats,
         )
     scale = problem.graph.scale
     radius = options.tube_radius if options.tube_radius is not None else 3.0 * float(np.linalg.norm(scale))
