@@ -92,3 +92,28 @@ def test_angeles_5_17_orthogonal_3r():
 def test_singular_configuration_is_infinite():
     arm = _planar_2r(1.0, 0.5)
     assert _kappa(arm, [0.3, 0.0]) == np.inf
+
+
+@pytest.mark.parametrize("shape", [(6, 6), (6, 7), (3, 2), (3, 3), (6, 4), (6, 1)])
+def test_the_gram_matrix_route_equals_the_singular_values(shape):
+    """kappa_F from tr G tr G^-1 equals the value from the singular values, to 1e-9 relative,
+    on random matrices from isotropic to rank-deficient (those take the singular values)."""
+    rng = np.random.default_rng(sum(shape))
+    m, n = shape
+    stack = []
+    for exponent in np.linspace(0.0, 14.0, 60):  # condition numbers 1 to 1e14, then rank-deficient
+        u, _ = np.linalg.qr(rng.normal(size=(m, m)))
+        v, _ = np.linalg.qr(rng.normal(size=(n, n)))
+        sigma = np.logspace(0.0, -exponent, min(m, n))
+        stack.append((u[:, : len(sigma)] * sigma) @ v[:, : len(sigma)].T)
+    stack.append(np.zeros((m, n)))
+    stack = np.array(stack)
+    values = np.linalg.svd(stack, compute_uv=False)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        expected = np.sqrt(np.sum(values**2, axis=1) * np.sum(values**-2.0, axis=1)) / values.shape[1]
+    expected[values.min(axis=1) <= 1e-12 * np.maximum(values.max(axis=1), 1e-300)] = np.inf
+    kappa = frobenius_condition_number(stack)
+    finite = np.isfinite(expected)
+    assert np.array_equal(np.isfinite(kappa), finite)
+    assert kappa[finite] == pytest.approx(expected[finite], rel=1e-9)
+    assert frobenius_condition_number(stack[3]) == pytest.approx(expected[3], rel=1e-9)

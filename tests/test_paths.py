@@ -63,3 +63,21 @@ def test_continuous_joints_are_not_wrapped():
 def test_coincident_waypoints_are_refused():
     with pytest.raises(InvalidRequest, match=r"path.waypoints\[1\] and path.waypoints\[2\] coincide"):
         SplinePath(np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 1.0]]))
+
+
+@pytest.mark.parametrize("count", [2, 3, 4, 7, 40])
+def test_spline_coefficients_equal_scipys_natural_cubic_spline(count):
+    """The compiled tridiagonal solve gives scipy's natural cubic spline, to rounding."""
+    from scipy.interpolate import CubicSpline
+
+    rng = np.random.default_rng(count)
+    for _ in range(10):
+        waypoints = rng.uniform(-3.0, 3.0, (count, 6))
+        path = SplinePath(waypoints)
+        reference = CubicSpline(path.knots, waypoints, axis=0, bc_type="natural")
+        s = np.linspace(0.0, 1.0, 301)
+        points = path.evaluate(s)
+        scale = np.max(np.abs(reference.c))
+        assert np.max(np.abs(points.q - reference(s))) <= 1e-12 * scale
+        assert np.max(np.abs(points.dq - reference(s, 1))) <= 1e-12 * scale
+        assert np.max(np.abs(points.ddq - reference(s, 2))) <= 1e-12 * scale

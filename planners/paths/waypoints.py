@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-from scipy.interpolate import CubicSpline
 
 from planners.errors import InvalidRequest
 from planners.paths.base import GeometricPath, PathPoints
@@ -56,7 +55,7 @@ class SplinePath(_ThroughWaypoints):
         self.kinks = np.empty(0)
         # Power-basis coefficients per knot interval, shape (4, n_waypoints - 1, n_dof):
         # q = c0 h^3 + c1 h^2 + c2 h + c3 with h = s - knot.
-        self._coefficients = np.ascontiguousarray(CubicSpline(self.knots, self.waypoints, axis=0, bc_type="natural").c)
+        self._coefficients = natural_spline_coefficients(self.knots, self.waypoints)
 
     def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
@@ -67,6 +66,56 @@ class SplinePath(_ThroughWaypoints):
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
         interval = np.clip(np.searchsorted(self.knots, s, side="left" if side == "left" else "right") - 1, 0, len(self.knots) - 2)
         return 6.0 * self._coefficients[0, interval]
+
+
+@njit(cache=True, nogil=True)
+def natural_spline_coefficients(knots, values):  # pragma: no cover - compiled
+    """Power-basis coefficients (4, n_knots - 1, n_dof) of the C2 cubic spline through
+    ``values`` (n_knots, n_dof) at ``knots`` (n_knots,) with natural ends (d2q/ds2 = 0).
+
+    The second derivatives m_i at the knots solve the tridiagonal system (de Boor, *A Practical
+    Guide to Splines*, ch. IV; h_i = knots[i+1] - knots[i], d_i = (values[i+1] - values[i]) / h_i)
+
+        h_i-1 m_i-1 + 2 (h_i-1 + h_i) m_i + h_i m_i+1 = 6 (d_i - d_i-1),   m_0 = m_n = 0,
+
+    strictly diagonally dominant, so elimination without pivoting (Thomas) is stable; then on
+    piece i, with h = s - knots[i], q = c0 h^3 + c1 h^2 + c2 h + c3 where c0 = (m_i+1 - m_i) /
+    (6 h_i), c1 = m_i / 2, c2 = d_i - h_i (2 m_i + m_i+1) / 6, c3 = values[i].
+    """
+    n_pieces, n_dof = knots.shape[0] - 1, values.shape[1]
+    h = np.empty(n_pieces)
+    slope = np.empty((n_pieces, n_dof))
+    for i in range(n_pieces):
+        h[i] = knots[i + 1] - knots[i]
+        for j in range(n_dof):
+            slope[i, j] = (values[i + 1, j] - values[i, j]) / h[i]
+    m = np.zeros((n_pieces + 1, n_dof))
+    inner = n_pieces - 1
+    if inner > 0:
+        diagonal = np.empty(inner)
+        rhs = np.empty((inner, n_dof))
+        for k in range(inner):  # unknown k is m_(k+1)
+            diagonal[k] = 2.0 * (h[k] + h[k + 1])
+            for j in range(n_dof):
+                rhs[k, j] = 6.0 * (slope[k + 1, j] - slope[k, j])
+        for k in range(1, inner):  # forward elimination; the sub- and superdiagonal entry is h[k]
+            factor = h[k] / diagonal[k - 1]
+            diagonal[k] -= factor * h[k]
+            for j in range(n_dof):
+                rhs[k, j] -= factor * rhs[k - 1, j]
+        for j in range(n_dof):
+            m[inner, j] = rhs[inner - 1, j] / diagonal[inner - 1]
+        for k in range(inner - 2, -1, -1):
+            for j in range(n_dof):
+                m[k + 1, j] = (rhs[k, j] - h[k + 1] * m[k + 2, j]) / diagonal[k]
+    coefficients = np.empty((4, n_pieces, n_dof))
+    for i in range(n_pieces):
+        for j in range(n_dof):
+            coefficients[0, i, j] = (m[i + 1, j] - m[i, j]) / (6.0 * h[i])
+            coefficients[1, i, j] = 0.5 * m[i, j]
+            coefficients[2, i, j] = slope[i, j] - h[i] * (2.0 * m[i, j] + m[i + 1, j]) / 6.0
+            coefficients[3, i, j] = values[i, j]
+    return coefficients
 
 
 @njit(cache=True, nogil=True)
