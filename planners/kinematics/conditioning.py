@@ -55,8 +55,9 @@ def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
     exact = ~(np.isfinite(kappa) & (kappa <= GRAM_KAPPA))
     if exact.any():
         kappa[exact] = _from_singular_values(stack[exact])
-    kappa = kappa.reshape(jacobian.shape[:-2])
-    return float(kappa) if kappa.ndim == 0 else kappa
+    if jacobian.ndim == 2:
+        return float(kappa[0])
+    return kappa.reshape(jacobian.shape[:-2])
 
 
 def _from_singular_values(stack: np.ndarray) -> np.ndarray:
