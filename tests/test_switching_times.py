@@ -1,18 +1,19 @@
 """Switching times of the Geering arm's time-optimal motions against Jeong & Lee's figure
 captions (section 4.3, Figs. 1 to 4), from the free-path answer's ``switching_times``.
 
-The collocation (30 intervals, h = T / 30, about 36 ms) places each switch within one interval;
-read off its torques they are 2 to 5 ms from the refined ones here. The answer's switching
+The collocation (30 intervals, h = T / 30, 32.5 to 42 ms) places each switch within one
+interval; read off its torques they are up to 1.9 ms from the refined ones on Type 3. The answer's switching
 times come from the bang-bang refinement (``planners.free_path.switching``), exact to the
 integration (1 ms Runge-Kutta steps, goal error below 1e-8): the captions are matched within
 5 ms, the durations within the caption's last printed digit (Type 3: 0.97564 s against
 0.9755, 0.14 ms).
 
 A time-reversed motion u(t) -> -u(T - t) is as fast as the original on this arm
-(``switching.mirrored``). Types 3 and 4 are their own mirror images; for Types 1 and 2 the
-answer is the captions' orientation (u1 starts at its maximum, u2 at its minimum), which the
-tests check before comparing, mirroring the answer otherwise, so that like is compared with
-like.
+(``switching.mirrored``). Types 3 and 4 are their own mirror images; the captions of Types 1
+and 2 start u1 at its maximum and u2 at its minimum, and the Type 2 answer comes as the mirror
+image (u1 starting at its minimum: which of the two equally fast twins the collocation's
+initial guesses reach first), so the tests mirror an answer into the caption's orientation
+before comparing, like with like. ``benchmarks/switching_times.py`` prints every switch.
 """
 
 from __future__ import annotations
