@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -91,3 +92,14 @@ def test_plot_writes_a_page_with_the_three_figures(tmp_path, capsys):
     assert "https://cdn" not in page.split("</script>")[0][:2000]  # the library is inlined, not fetched
     missing = tmp_path / "none.html"
     assert main(["plot", str(tmp_path / "nope.json"), "-o", str(missing)]) == 2 and not missing.exists()
+
+
+@pytest.mark.skipif(shutil.which("make") is None or not (ROOT / "Makefile").exists(), reason="make (the README's set-up) is not installed here")
+def test_make_serve_takes_host_and_port():
+    """The README's serve command listens where HOST and PORT say, 127.0.0.1:8000 by default."""
+    def serve_line(*assignments):
+        printed = subprocess.run(["make", "-n", "-s", "serve", *assignments], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+        return next(line for line in printed.splitlines() if "toptraj serve" in line)
+
+    assert serve_line().endswith("toptraj serve --host 127.0.0.1 --port 8000")
+    assert serve_line("HOST=0.0.0.0", "PORT=8080").endswith("toptraj serve --host 0.0.0.0 --port 8080")

@@ -40,3 +40,17 @@ def test_a_problem_is_raised_with_its_facts(toptraj):
     with pytest.raises(ProblemError) as caught:
         toptraj.plan("nope", [[0.0], [1.0]])
     assert caught.value.status == 404
+
+
+def test_plan_in_background_runs_a_job_and_returns_its_answer(toptraj, client):
+    """A request as a job: submitted, polled, and returned as the synchronous answer would be;
+    a job's problem is raised with the synchronous endpoint's facts."""
+    request = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}, "timing": {"constraints": ["velocity"]}}
+    trajectory = toptraj.plan_in_background(request, budget_s=60, poll_s=0.05)
+    body = client.post("/v1/trajectories", json=request).json()
+    assert trajectory.duration == body["duration"]
+    np.testing.assert_array_equal(trajectory.q, np.array(body["samples"]["q"]))
+    impossible = {**request, "path": {"kind": "waypoints", "waypoints": [[0.0] * 6, [9.0] + [0.0] * 5]}}
+    with pytest.raises(ProblemError) as caught:
+        toptraj.plan_in_background(impossible, budget_s=60, poll_s=0.05)
+    assert caught.value.status == 422 and "outside the limits" in caught.value.detail

@@ -65,11 +65,27 @@ def test_the_page_plans_the_ur5_example_and_draws_it(browser_page):
     answer = json.loads(raw)
     assert shown == answer["duration"]
     assert page.inner_text("#duration").startswith(f"phase_plane: {answer['duration']:.4f} s")
+    # the warnings and the binding limit, as the API says them
+    assert page.locator("#warnings li").all_inner_texts() == answer["warnings"]
+    assert answer["binding"] is None and page.inner_text("#binding") == ""  # phase_plane names no binding limit
     assert _plotted(page, "phase-plane") >= 3  # speed, maximum velocity curve, switch points
     assert _plotted(page, "joints") >= 4 * 6  # q, qd, qdd, tau of six joints
     assert _plotted(page, "arm") == 12  # the arm at 12 instants
     rows = page.locator("#durations tbody tr")
     assert rows.count() == 3 and rows.nth(0).inner_text().startswith("phase_plane")
+    # each compared method's duration, and the limit that binds a time law, as /compare says them
+    methods = [rows.nth(k).locator("td").nth(0).inner_text() for k in range(3)]
+    status, _, raw = server.request("POST", "/v1/trajectories/compare", {
+        "robot": request["robot"], "path": request["path"], "methods": methods,
+        "timing": {"constraints": request["timing"]["constraints"]},
+    })
+    assert status == 200
+    for k, result in enumerate(json.loads(raw)["results"]):
+        cells = rows.nth(k).locator("td").all_inner_texts()
+        assert float(cells[1]) == pytest.approx(result["duration"], abs=5e-5)
+        binding = result["binding"]
+        assert cells[3].strip() == ("" if binding is None else f"{binding['kind']} {binding['joint'] or ''}".strip())
+    assert any(result["binding"] for result in json.loads(raw)["results"])  # the quintic's binding limit is shown
     assert outside == []
 
 
