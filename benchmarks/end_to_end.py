@@ -8,8 +8,9 @@ samples every 10 ms. Each round times, in a shuffled order:
   ours), ``JointVelocityConstraint``, ``JointAccelerationConstraint`` and
   ``JointTorqueConstraint`` with a ``pin.rnea`` callback, ``TOPPRA`` on 100 grid intervals,
   ``compute_trajectory`` (its constraint evaluation, both passes and the parameterization);
-* **RNEA floor**: 3 RNEA per grid point of the grid our answer was actually timed on, in one
-  batched call (``Robot.rnea``, Pinocchio's ``rneaInParallel``);
+* **RNEA floor**: 3 RNEA per grid point of the grid our answer was actually timed on (the
+  build grid and the points the phase-plane refinement added), in one batched call
+  (``Robot.rnea``, Pinocchio's ``rneaInParallel``);
 * **library**: ``planners.plan`` for the request (no HTTP, no JSON);
 * **planning thread**: what a server's planning thread does: the request's schema object to
   JSON bytes (``plan_request``, ``trajectory_body``, ``encode_json``);
@@ -96,6 +97,21 @@ def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100
         constraints, path, gridpoints=np.linspace(0.0, 1.0, intervals + 1), parametrizer="ParametrizeConstAccel"
     )
     return float(solver.compute_trajectory().duration)
+
+
+def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int]:
+    """(points of the grids the answer was timed on, points of the grids its constraints were
+    first built on), over its stretches: what ``planners.plan`` times, without the sampling."""
+    from planners.deadline import NO_DEADLINE
+    from planners.gate import gate_threshold
+    from planners.plan import _timed_path
+    from planners.requests import check_constraint_kinds, timing_method
+    from planners.waypoint_checks import make_path
+
+    method = timing_method(timing)
+    kinds = check_constraint_kinds(timing.constraints, method)
+    timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, robot.limits, NO_DEADLINE, gate_threshold(0.0))
+    return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 
 def rnea_floor(robot: robots.Robot, states: np.ndarray) -> None:
@@ -186,7 +202,7 @@ def main() -> int:
 
     timing, path_spec = _timing(request), _path(request.path, robot, request)
     answer = plan(robot, path_spec, timing, 0.01)
-    grid_points = len(answer.phase_plane.s)
+    grid_points, built_points = timing_grid_points(robot, path_spec, timing)
     rng = np.random.default_rng(0)
     states = rng.uniform(-1.0, 1.0, (3 * grid_points, 3, robot.dof))
 
@@ -222,7 +238,8 @@ def main() -> int:
         median = {name: float(np.median(values)) for name, values in times.items()}
         print(f"typical request: ur5, 4 spline waypoints, velocity + acceleration + torque, dt 0.01; "
               f"{args.rounds} interleaved rounds; duration {answer.duration:.4f} s (bare toppra "
-              f"{bare_toppra(robot, waypoints):.4f} s at 100 intervals); our grid {grid_points} points")
+              f"{bare_toppra(robot, waypoints):.4f} s at 100 intervals); timed on {grid_points} grid points "
+              f"({built_points} built, the rest added by the refinement)")
         for name, values in times.items():
             print(f"  {name:16s} p50 {1e3 * median[name]:8.3f} ms   p95 {1e3 * np.percentile(values, 95):8.3f} ms")
         goals = (

@@ -163,7 +163,7 @@ class Robot:
             np.asfortranarray(qd.T, dtype=float),
             np.asfortranarray(qdd.T, dtype=float),
         )
-        return np.asarray(tau).T.reshape(qd.shape)
+        return np.ascontiguousarray(np.asarray(tau).T).reshape(qd.shape)  # rows C-contiguous: orjson writes them directly
 
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """Joint torques for rows of ``q, qd, qdd`` (each (n_samples, n_dof)): Pinocchio's RNEA
