@@ -155,3 +155,43 @@ def test_obstacles_on_a_free_path_are_refused(client):
             "obstacles": [{"kind": "sphere", "center": [0.5, 0.2, 0], "radius": 0.05}]}, "timing": {"method": "collocation", "constraints": ["torque"]}}
     response = client.post("/v1/trajectories", json=body)
     assert response.status_code == 422 and "obstacles" in response.text
+
+
+def _tool_points(robot, q: np.ndarray) -> np.ndarray:
+    """The end effector's position (m) at every row of ``q``, by Pinocchio's forward kinematics."""
+    frame = robot.frame_id(robot.end_effector)
+    points = []
+    for configuration in robot.configuration(q):
+        pin.framesForwardKinematics(robot.model, robot.data, configuration)
+        points.append(robot.data.oMf[frame].translation.copy())
+    return np.array(points)
+
+
+def test_obstacles_on_a_cartesian_line(client):
+    """The lecture arm's tool on its straight line (the Cartesian example): a ball the tool
+    passes through is a 422 naming it; moved 0.1 m off the line, the motion goes by it, and the
+    reported clearance lies between the requested one and the tool point's own distance to the
+    ball (the last link's capsule holds the tool point)."""
+    body = {
+        "robot": "lecture_3r",
+        "path": {"kind": "cartesian", "start": [0.982793723247329, 0.474628419388735, 1.8266655408265058],
+                 "positions": [[0.2286, 0.1524, 0.254], [0.0762, 0.127, 0.2032]]},
+        "timing": {"method": "quintic", "constraints": ["velocity", "acceleration", "torque"]},
+    }
+    line = np.array(body["path"]["positions"])
+    middle = line.mean(axis=0)
+    ball = {"kind": "sphere", "center": middle.tolist(), "radius": 0.02}
+    response = client.post("/v1/trajectories", json={**body, "path": {**body["path"], "obstacles": [ball]}})
+    assert response.status_code == 422, response.text
+    problem = response.json()
+    assert problem["obstacle"] == 0 and "path.obstacles[0]" in problem["detail"] and 0.0 <= problem["s"] <= 1.0
+    direction = np.diff(line, axis=0)[0] / np.linalg.norm(np.diff(line, axis=0)[0])
+    aside = np.cross(direction, [0.0, 0.0, 1.0])
+    aside /= np.linalg.norm(aside)
+    ball["center"] = (middle + 0.1 * aside).tolist()
+    response = client.post("/v1/trajectories", json={**body, "path": {**body["path"], "obstacles": [ball], "clearance": 0.01}})
+    assert response.status_code == 200, response.text
+    found = response.json()["min_clearance"]
+    tips = _tool_points(robots.load("lecture_3r"), np.array(response.json()["samples"]["q"]))
+    tip_distance = float(np.min(np.linalg.norm(tips - np.array(ball["center"]), axis=1))) - ball["radius"]
+    assert found["obstacle"] == 0 and 0.01 <= found["distance"] <= tip_distance + 1e-9
