@@ -15,9 +15,12 @@ t_j,i of every joint and the duration T. The motion is integrated forward from t
 by Pinocchio's forward dynamics (``pinocchio.aba``, a classical Runge-Kutta step on each arc
 between consecutive switches of any joint, so that no step straddles a switch), and the goal
 state q(T) = q_b, v(T) = v_b gives 2 n equations. With as many unknowns as equations (Type 1
-of the paper: 3 switches and T) they are solved by Gauss-Newton (``scipy.optimize.least_squares``);
-with more (Types 2 to 4: 4 switches and T), the least-squares solution seeds a minimization of T
-under those equations (SLSQP), the switching-time optimization.
+of the paper: 3 switches and T) they are solved by Newton's method on a finite-difference
+Jacobian (``_newton``). With one unknown more (Types 2 to 4: 4 switches and T), one switching
+time p is held while Newton's method solves for the others, and T(p) is minimized by the secant
+method on dT/dp from the implicit function theorem (``_secant_minimum``); with still more,
+the Newton solution seeds a minimization of T under the goal equations (SLSQP): the
+switching-time optimization.
 
 Near a change of type (the paper's Types 1 and 2 at phi_b = 0.98) two switching structures
 give almost the same T; ``refine_switching`` therefore also tries the neighbouring structures
