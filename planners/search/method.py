@@ -89,10 +89,10 @@ def global_search(
     is a homotopy class with its own upper bound). The tubes are the best grid path of each
     variant, best first, then the next tubes of the variants by time, ``options.tubes`` in all.
     The variants are searched by their least time to go, and each after the first only for grid
-    paths faster than ``VARIANT_CAP`` times the best found before it (a variant no grid path
-    reaches, which would otherwise exhaust ``max_expansions``, then ends early); with a budget,
-    the variants' searches share ``SEARCH_SHARE`` of the time left, each stopping at its part
-    with the grid paths it found.
+    paths faster than ``VARIANT_CAP`` times the best found before it (the cap prunes its
+    subsets from the start). With a budget, the variants' searches share ``SEARCH_SHARE`` of
+    the time left, each stopping at its part with the grid paths it found: that is what ends
+    a variant no grid path reaches, which would otherwise run until ``max_expansions``.
 
     Raises:
         InvalidRequest, InfeasiblePath: see ``build_problem`` and ``branch_and_bound`` (the
