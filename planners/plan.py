@@ -289,7 +289,8 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
     """A free motion: the collocation's path, re-timed exactly along itself (phase_plane, or
     min_cost for beta > 0) so that every limit holds between the collocation instants too."""
     path, solver, collocation_timing, collocation = _free_motion(robot, spec, method, timing, limits, deadline.within(0.0, 0.8))
-    deadline.progress(0.8, "re-timing along the collocation's path")
+    retiming = deadline.within(0.8, 0.9, "re-timing along the collocation's path")
+    retiming.progress(0.0, "constraints")
     retimer = PhasePlaneMethod() if timing.torque_weight == 0.0 else MinCostMethod(timing.torque_weight)
     constraints = build_path_constraints(path, robot, limits, kinds, _grid(path, None, retimer, robot), deadline)
     moving = dataclasses.replace(
@@ -299,7 +300,7 @@ def _timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thr
     try:
         result, constraints, check = gated(
             robot, path, retimer, constraints, _boundary(path, moving, retimer), None, kinds, limits, threshold,
-            deadline.within(0.9, 1.0),
+            retiming.within(0.1, 1.0),
         )
         stretch = TimedStretch(path, result, constraints, check)
     except InfeasiblePath as error:

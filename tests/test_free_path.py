@@ -8,6 +8,7 @@ import pytest
 
 import robots
 from planners import Timing, plan
+from planners.deadline import Deadline
 from planners.free_path import FreeMotion
 
 
@@ -45,6 +46,21 @@ def test_geering_time_optimal_motions(goal, revolutions, paper_T, elbow_end):
     ratio = np.abs(result.samples.tau) / arm.limits.torque
     assert ratio.max() <= 1.005
     assert np.mean(ratio.max(axis=1) >= 0.98) >= 0.7
+
+
+def test_free_motion_progress_never_goes_back():
+    """Every progress report of a free motion, unthrottled: the fractions never decrease, from
+    the collocation's guesses through the re-timing and the switching refinement to sampling."""
+    reports: list[tuple[float, str]] = []
+    arm = robots.load("geering_2r")
+    motion = FreeMotion(np.zeros(2), np.array([0.98, 0.0]), revolutions=False)
+    deadline = Deadline(progress=lambda fraction, stage: reports.append((fraction, stage)))
+    plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002, deadline=deadline)
+    fractions = [fraction for fraction, _ in reports]
+    assert fractions == sorted(fractions), reports
+    stages = [stage for _, stage in reports]
+    assert "re-timing along the collocation's path: timing" in stages, stages
+    assert stages.index("refining the switching times") > stages.index("re-timing along the collocation's path: timing")
 
 
 def test_geering_larger_moves_prefer_the_revolution():

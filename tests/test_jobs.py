@@ -220,7 +220,7 @@ def test_progress_advances_on_a_collocation_job(client):
         time.sleep(0.02)
     assert job["status"] == "done" and job["progress"] == {"fraction": 1.0, "stage": "done"}, job
     stages = {stage: fraction for stage, fraction in seen.items() if stage not in ("", "starting")}
-    known = ("collocation: ", "re-timing along the collocation's path", "refining the switching times", "sampling")
+    known = ("collocation: ", "re-timing along the collocation's path: ", "refining the switching times", "sampling")
     assert len(stages) >= 2 and all(stage.startswith(known) for stage in stages), seen
     assert all(stage.endswith(" of 15") for stage in stages if stage.startswith("collocation: guess ")), seen
     fractions = list(stages.values())
