@@ -8,6 +8,11 @@ samples every 10 ms. Each round times, in a shuffled order:
   ours), ``JointVelocityConstraint``, ``JointAccelerationConstraint`` and
   ``JointTorqueConstraint`` with a ``pin.rnea`` callback, ``TOPPRA`` on 100 grid intervals,
   ``compute_trajectory`` (its constraint evaluation, both passes and the parameterization);
+* **drake** (when ``pydrake`` imports: ``pip install toptraj[bench]``): Drake's ``Toppra`` on
+  the same cubic (a ``PiecewisePolynomial.CubicHermite`` with toppra's spline's values and
+  slopes at its knots), the same limits and 100 grid intervals, on a ``MultibodyPlant`` of the
+  same URDF built beforehand: ``Toppra(...)``, the three ``Add...Limit`` calls and
+  ``SolvePathParameterization``;
 * **RNEA floor**: 3 RNEA per grid point of the grid our answer was actually timed on (the
   build grid and the points the phase-plane refinement added), in one batched call
   (``Robot.rnea``, Pinocchio's ``rneaInParallel``);
@@ -18,7 +23,7 @@ samples every 10 ms. Each round times, in a shuffled order:
   loopback connection, the body read in full.
 
 Prints the medians and the ratios of the goals (HTTP <= 1.0x bare toppra and <= 8x the RNEA
-floor; library <= 0.6x bare toppra), then (``--profile``) the stages of a request as shares
+floor; library <= 0.6x bare toppra) and, with Drake, the same against Drake's Toppra, then (``--profile``) the stages of a request as shares
 of its HTTP median, from ``cProfile`` over the planning thread's work.
 
     python benchmarks/end_to_end.py [--rounds 300] [--profile]
@@ -97,6 +102,37 @@ def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100
         constraints, path, gridpoints=np.linspace(0.0, 1.0, intervals + 1), parametrizer="ParametrizeConstAccel"
     )
     return float(solver.compute_trajectory().duration)
+
+
+def drake_solver(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100):
+    """One solve of Drake's Toppra on toppra's spline through ``waypoints`` (the bare toppra
+    probe's path) and the robot's limits, as a function returning the duration (s); ``None``
+    when pydrake is absent. The plant and the spline are built here, once."""
+    import toppra
+    from phase_plane_vs_toppra import drake_plant
+
+    plant = drake_plant(robot)
+    if plant is None:
+        return None
+    from pydrake.multibody.optimization import Toppra
+    from pydrake.trajectories import PiecewisePolynomial
+
+    knots = np.linspace(0.0, 1.0, len(waypoints))
+    slopes = toppra.SplineInterpolator(knots, waypoints)(knots, 1)
+    spline = PiecewisePolynomial.CubicHermite(knots, waypoints.T, slopes.T)
+    grid, limits = np.linspace(0.0, 1.0, intervals + 1), robot.limits
+
+    def solve() -> float:
+        problem = Toppra(spline, plant, grid)
+        problem.AddJointVelocityLimit(-limits.velocity, limits.velocity)
+        problem.AddJointAccelerationLimit(-limits.acceleration, limits.acceleration)
+        problem.AddJointTorqueLimit(-limits.torque, limits.torque)
+        result = problem.SolvePathParameterization()
+        if result is None:
+            raise RuntimeError("Drake's Toppra failed on the typical path")
+        return float(result.end_time())
+
+    return solve
 
 
 def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int]:
@@ -218,8 +254,10 @@ def main() -> int:
             if response.status != 200:
                 raise RuntimeError(f"HTTP {response.status}: {body[:300]!r}")
 
+        drake = drake_solver(robot, waypoints)
         probes = {
             "bare toppra": lambda: bare_toppra(robot, waypoints),
+            **({"drake": drake} if drake is not None else {}),
             "RNEA floor": lambda: rnea_floor(robot, states),
             "library": lambda: plan(robot, path_spec, timing, 0.01),
             "planning thread": lambda: encode_json(trajectory_body(plan_request(request))),
@@ -238,7 +276,8 @@ def main() -> int:
         median = {name: float(np.median(values)) for name, values in times.items()}
         print(f"typical request: ur5, 4 spline waypoints, velocity + acceleration + torque, dt 0.01; "
               f"{args.rounds} interleaved rounds; duration {answer.duration:.4f} s (bare toppra "
-              f"{bare_toppra(robot, waypoints):.4f} s at 100 intervals); timed on {grid_points} grid points "
+              f"{bare_toppra(robot, waypoints):.4f} s at 100 intervals"
+              f"{f', drake {drake():.4f} s' if drake is not None else ''}); timed on {grid_points} grid points "
               f"({built_points} built, the rest added by the refinement)")
         for name, values in times.items():
             print(f"  {name:16s} p50 {1e3 * median[name]:8.3f} ms   p95 {1e3 * np.percentile(values, 95):8.3f} ms")
@@ -250,6 +289,11 @@ def main() -> int:
         print()
         for label, ratio, goal in goals:
             print(f"  {label:24s} {ratio:7.2f}x   goal <= {goal:g}x   {'met' if ratio <= goal else 'MISSED'}")
+        if drake is None:
+            print("  drake: pydrake not installed (pip install toptraj[bench]); skipped")
+        else:
+            for name in ("HTTP", "library"):
+                print(f"  {name + ' p50 / drake':24s} {median[name] / median['drake']:7.2f}x")
         if args.profile:
             _profile(request, median["HTTP"])
     finally:

@@ -253,8 +253,18 @@ def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.nda
         return points, (empty,) * 5, tuple(rows)
     stacked = tuple(np.concatenate([block[i] for block in blocks], axis=1) for i in range(5))
     finite = np.isfinite(stacked[4][0])  # a row with an infinite limit constrains nothing
+    if finite.all():
+        return points, stacked, tuple(rows)
     stacked = tuple(array[:, finite] for array in stacked)
     return points, stacked, tuple(row for row, keep in zip(rows, finite) if keep)
+
+
+def _points_at(s: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Indices of the grid points of ``s`` that equal one of ``values`` (sorted); none
+    without values, the common case of a smooth path."""
+    if len(values) == 0:
+        return np.empty(0, dtype=np.intp)
+    return np.flatnonzero(np.isin(s, values))
 
 
 def _left_derivatives(path: GeometricPath, s: np.ndarray, points, third: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -296,10 +306,9 @@ def build_path_constraints(
         tool_bound = np.where(tool_sd_max < sd_max, tool_kind, -1)
         sd_max = np.minimum(sd_max, tool_sd_max)
     a_left, b_left, c_left, d_left = a, b, c, d
-    kink_index = np.flatnonzero(np.isin(s, path.kinks))
-    sd_max[kink_index] = 0.0
+    sd_max[_points_at(s, path.kinks)] = 0.0
     # The rows seen from the interval that ends at a corner or a break of the curvature.
-    kink_index = np.flatnonzero(np.isin(s, path.kinks) | np.isin(s, path.breaks))
+    kink_index = _points_at(s, np.concatenate([path.kinks, path.breaks]))
     if kink_index.size:
         _, (a_k, b_k, c_k, d_k, _), _ = _second_order_rows(
             path, robot, limits, kinds, s[kink_index], "left", deadline
