@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from planners.constraint_kernels import assemble_rows, velocity_bound
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
 from planners.tool_speed import tool_speed_bound
@@ -105,17 +106,23 @@ class PathConstraints:
             if self.jerk_left is not None:
                 left_dq, left_ddq, left_dddq = (merge(mine, theirs) for mine, theirs in zip(self.jerk_left, extra.jerk[:3]))
                 jerk_left = (left_dq, left_ddq, left_dddq)
+        right = tuple(merge(mine, theirs) for mine, theirs in zip((self.a, self.b, self.c, self.d), (extra.a, extra.b, extra.c, extra.d)))
+        # Without corners or breaks the rows seen from the left are the very same arrays.
+        same = self.a_left is self.a and self.b_left is self.b and self.c_left is self.c and self.d_left is self.d
+        left = right if same else tuple(
+            merge(mine, theirs) for mine, theirs in zip((self.a_left, self.b_left, self.c_left, self.d_left), (extra.a, extra.b, extra.c, extra.d))
+        )
         return PathConstraints(
             s=merge(self.s, extra.s),
             sd_max=merge(self.sd_max, extra.sd_max),
-            a=merge(self.a, extra.a),
-            b=merge(self.b, extra.b),
-            c=merge(self.c, extra.c),
-            d=merge(self.d, extra.d),
-            a_left=merge(self.a_left, extra.a),
-            b_left=merge(self.b_left, extra.b),
-            c_left=merge(self.c_left, extra.c),
-            d_left=merge(self.d_left, extra.d),
+            a=right[0],
+            b=right[1],
+            c=right[2],
+            d=right[3],
+            a_left=left[0],
+            b_left=left[1],
+            c_left=left[2],
+            d_left=left[3],
             lower=merge(self.lower, extra.lower),
             upper=merge(self.upper, extra.upper),
             rows=self.rows,
@@ -201,6 +208,13 @@ class LinearRows:
     upper: np.ndarray
 
 
+def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> np.ndarray:
+    """(3 n, n_dof): RNEA(q, 0, 0) = g, RNEA(q, 0, q') = M q' + g and RNEA(q, q', q'') =
+    M q'' + C(q, q') q' + g at the n rows of ``q, dq, ddq``, in one batched call."""
+    zero = np.zeros_like(dq)
+    return robot.rnea(np.concatenate((q, q, q)), np.concatenate((zero, zero, dq)), np.concatenate((zero, dq, ddq)))
+
+
 def path_dynamics(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray):
     """Torque coefficients along a path: ``tau = a u + b x + c + d sd`` for sd > 0.
 
@@ -210,10 +224,8 @@ def path_dynamics(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray):
     Returns:
         a, b, c, d: Each (n_samples, n_dof), in N m (N for prismatic joints).
     """
-    n_samples, n_dof = dq.shape
-    zero = np.zeros((n_samples, n_dof))
-    # One batched RNEA over the three evaluations at every sample: g, M q' + g, M q'' + C q' + g.
-    stacked = robot.rnea(np.vstack([q, q, q]), np.vstack([zero, zero, dq]), np.vstack([zero, dq, ddq]))
+    n_samples = len(dq)
+    stacked = _rnea_terms(robot, q, dq, ddq)
     c = stacked[:n_samples].copy()
     a = stacked[n_samples : 2 * n_samples] - c
     b = stacked[2 * n_samples :] - c
@@ -226,37 +238,34 @@ def path_dynamics(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray):
 CHUNK_POINTS = 1024
 
 
-def _chunked_path_dynamics(robot: Robot, points, deadline: Deadline):
-    """``path_dynamics`` along ``points``, CHUNK_POINTS at a time, checking ``deadline``."""
-    parts = []
-    for start in range(0, len(points.q), CHUNK_POINTS):
-        deadline.check()
-        rows = slice(start, start + CHUNK_POINTS)
-        parts.append(path_dynamics(robot, points.q[rows], points.dq[rows], points.ddq[rows]))
-    return tuple(np.concatenate([part[i] for part in parts]) for i in range(4))
-
-
 def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline):
+    """The path's points at ``s`` and their second-order rows ``(a, b, c, d, lower, upper)``
+    (each (n, m): acceleration rows, then torque rows, of the joints whose limit is finite:
+    a row with an infinite limit constrains nothing), with their (kind, joint) labels. The
+    torque rows take one batched RNEA per ``CHUNK_POINTS`` points, the deadline checked
+    before each; ``planners.constraint_kernels.assemble_rows`` writes them."""
     points = path.evaluate(s, side)
-    blocks, rows = [], []
-    n_dof = path.dof
-    if "acceleration" in kinds:
-        bound = np.broadcast_to(limits.acceleration, points.dq.shape)
-        blocks.append((points.dq, points.ddq, np.zeros_like(points.dq), np.zeros_like(points.dq), bound))
-        rows += [("acceleration", j) for j in range(n_dof)]
-    if "torque" in kinds:
-        a, b, c, d = _chunked_path_dynamics(robot, points, deadline)
-        blocks.append((a, b, c, d, np.broadcast_to(limits.torque, a.shape)))
-        rows += [("torque", j) for j in range(n_dof)]
-    if not blocks:
-        empty = np.zeros((len(s), 0))
-        return points, (empty,) * 5, tuple(rows)
-    stacked = tuple(np.concatenate([block[i] for block in blocks], axis=1) for i in range(5))
-    finite = np.isfinite(stacked[4][0])  # a row with an infinite limit constrains nothing
-    if finite.all():
-        return points, stacked, tuple(rows)
-    stacked = tuple(array[:, finite] for array in stacked)
-    return points, stacked, tuple(row for row, keep in zip(rows, finite) if keep)
+    nothing = np.empty(0, dtype=np.intp)
+    accelerated = np.flatnonzero(np.isfinite(limits.acceleration)) if "acceleration" in kinds else nothing
+    torqued = np.flatnonzero(np.isfinite(limits.torque)) if "torque" in kinds else nothing
+    rows = tuple(("acceleration", int(j)) for j in accelerated) + tuple(("torque", int(j)) for j in torqued)
+    n = len(s)
+    arrays = tuple(np.empty((n, len(rows))) for _ in range(6))
+    if not rows:
+        return points, arrays, rows
+    no_torque = np.empty((0, path.dof))
+    acceleration = np.asarray(limits.acceleration, dtype=float)
+    torque = np.asarray(limits.torque, dtype=float)
+    for start in range(0, n, CHUNK_POINTS):
+        deadline.check()
+        part = slice(start, start + CHUNK_POINTS)
+        dq, ddq = points.dq[part], points.ddq[part]
+        tau = _rnea_terms(robot, points.q[part], dq, ddq) if torqued.size else no_torque
+        assemble_rows(
+            dq, ddq, tau, robot.coulomb_friction, robot.viscous_friction, accelerated, acceleration, torqued, torque,
+            *(array[part] for array in arrays),
+        )
+    return points, arrays, rows
 
 
 def _points_at(s: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -290,15 +299,12 @@ def build_path_constraints(
     """Evaluate the requested ``kinds`` of limits (subset of velocity, acceleration, torque)
     along ``path`` at the grid ``s`` (which must hold the path's kinks); a tool-speed limit
     (``limits.tool``) joins the first-order bound sd_max."""
-    points, (a, b, c, d, bound), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
+    points, (a, b, c, d, lower, upper), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
     deadline.check()
     sd_max = np.full(len(s), np.inf)
     velocity_joint = np.full(len(s), -1)
     if "velocity" in kinds:
-        with np.errstate(divide="ignore"):
-            per_joint = limits.velocity / np.abs(points.dq)
-        sd_max = np.min(per_joint, axis=1)
-        velocity_joint = np.where(np.isfinite(sd_max), np.argmin(per_joint, axis=1), -1)
+        velocity_bound(points.dq, np.asarray(limits.velocity, dtype=float), sd_max, velocity_joint)
     tool_bound = None
     if limits.tool is not None:
         deadline.check()
@@ -310,7 +316,7 @@ def build_path_constraints(
     # The rows seen from the interval that ends at a corner or a break of the curvature.
     kink_index = _points_at(s, np.concatenate([path.kinks, path.breaks]))
     if kink_index.size:
-        _, (a_k, b_k, c_k, d_k, _), _ = _second_order_rows(
+        _, (a_k, b_k, c_k, d_k, _, _), _ = _second_order_rows(
             path, robot, limits, kinds, s[kink_index], "left", deadline
         )
         a_left, b_left, c_left, d_left = a.copy(), b.copy(), c.copy(), d.copy()
@@ -328,8 +334,8 @@ def build_path_constraints(
         b_left=b_left,
         c_left=c_left,
         d_left=d_left,
-        lower=-bound,
-        upper=bound.copy(),
+        lower=lower,
+        upper=upper,
         rows=rows,
         joint_names=robot.joint_names,
         jerk=None if third is None else (points.dq, points.ddq, third, limits.jerk),

@@ -67,6 +67,7 @@ class Robot:
     _angle_index_of_pair: np.ndarray = field(repr=False)
     _plain_q_index: np.ndarray = field(repr=False)
     _plain_v_index: np.ndarray = field(repr=False)
+    _identity_configuration: bool = field(default=False, repr=False, compare=False)
     _local: threading.local = field(default_factory=threading.local, repr=False, compare=False)
     limit_sources: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False, compare=False)
     locked_joints: dict[str, float] = field(default_factory=dict, repr=False, compare=False)
@@ -112,6 +113,7 @@ class Robot:
             _angle_index_of_pair=np.asarray(pair_angle, dtype=int),
             _plain_q_index=np.asarray(plain_q, dtype=int),
             _plain_v_index=np.asarray(plain_v, dtype=int),
+            _identity_configuration=not cos_index and plain_q == list(range(model.nq)) and plain_v == list(range(model.nv)),
             limit_sources=dict(limit_sources or {}),
             locked_joints=dict(locked_joints or {}),
             notes=tuple(notes),
@@ -139,6 +141,8 @@ class Robot:
 
     def configuration(self, q: np.ndarray) -> np.ndarray:
         """Pinocchio configuration(s) of shape (..., nq) from joint coordinates (..., n_dof)."""
+        if self._identity_configuration:  # Pinocchio's q is the joint coordinates in order
+            return np.array(q, dtype=float)
         q = np.asarray(q, dtype=float)
         out = np.empty(q.shape[:-1] + (self.model.nq,))
         out[..., self._plain_q_index] = q[..., self._plain_v_index]

@@ -61,3 +61,43 @@ def test_corners_stop_the_motion_and_keep_both_sides():
     assert constraints.sd_max[corner] == 0.0
     assert constraints.a_left[corner][:2] == pytest.approx([2.0, 0.0])  # coming along joint 0
     assert constraints.a[corner][:2] == pytest.approx([0.0, 2.0])  # leaving along joint 1
+
+
+def test_rows_of_finite_limits_only_in_chunks(monkeypatch):
+    """Rows exist only for finite limits (acceleration rows first, then torque), sd_max and its
+    binding joint follow min_j v_j / |q'_j| (a joint at rest or without a limit never binds), and
+    computing the torque rows a few points at a time gives the same numbers."""
+    import dataclasses
+
+    from planners import constraints as module
+
+    robot = robots.load("ur5")
+    waypoints = RNG.uniform(-1, 1, (4, 6))
+    waypoints[:, 3] = 0.4  # joint 3 never moves: q'_3 = 0
+    path = SplinePath(waypoints)
+    limits = dataclasses.replace(
+        robot.limits,
+        velocity=np.where(np.arange(6) == 1, np.inf, robot.limits.velocity),
+        acceleration=np.where(np.arange(6) == 2, np.inf, robot.limits.acceleration),
+        torque=np.where(np.arange(6) == 0, np.inf, robot.limits.torque),
+    )
+    s = path_grid(path, 50)
+    kinds = ("velocity", "acceleration", "torque")
+    whole = build_path_constraints(path, robot, limits, kinds, s)
+    assert whole.rows == tuple(("acceleration", j) for j in (0, 1, 3, 4, 5)) + tuple(("torque", j) for j in range(1, 6))
+    points = path.evaluate(s)
+    with np.errstate(divide="ignore"):
+        per_joint = limits.velocity / np.abs(points.dq)
+    assert np.array_equal(whole.sd_max, np.min(per_joint, axis=1))
+    assert np.array_equal(whole.velocity_joint, np.argmin(per_joint, axis=1))
+    assert not np.any(np.isin(whole.velocity_joint, (1, 3)))
+    assert np.array_equal(whole.a[:, :5], points.dq[:, [0, 1, 3, 4, 5]])
+    assert np.array_equal(whole.upper[0], np.concatenate([limits.acceleration[[0, 1, 3, 4, 5]], limits.torque[1:]]))
+    assert np.array_equal(whole.lower, -whole.upper)
+    torque = module.path_dynamics(robot, points.q, points.dq, points.ddq)
+    for mine, reference in zip((whole.a, whole.b, whole.c, whole.d), torque):
+        assert mine[:, 5:] == pytest.approx(reference[:, 1:], rel=1e-12, abs=1e-12)
+    monkeypatch.setattr(module, "CHUNK_POINTS", 7)
+    chunked = build_path_constraints(path, robot, limits, kinds, s)
+    for name in ("a", "b", "c", "d", "lower", "upper", "sd_max"):
+        assert np.array_equal(getattr(chunked, name), getattr(whole, name)), name

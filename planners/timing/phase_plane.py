@@ -206,7 +206,7 @@ class _Grid(NamedTuple):
         ))  # fmt: skip
         s = np.ascontiguousarray(constraints.s, dtype=np.float64)
         x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
-        return cls(constraints, s, rows, x_bound, bool(np.any(rows[3] != 0.0) or np.any(rows[7] != 0.0)))
+        return cls(constraints, s, rows, x_bound, bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any())))
 
     def friction_reference(self) -> np.ndarray:
         """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
@@ -313,9 +313,11 @@ def _has_zero_inertia_row(constraints: PathConstraints, i: int) -> bool:
     """Whether a row of interval ``i`` in the interpolation discretization (``interval_rows``)
     has a u-coefficient within 1e-6 of its scale of zero (viscous friction left out)."""
     ds = constraints.s[i + 1] - constraints.s[i]
-    a = np.concatenate([constraints.a[i], constraints.a_left[i + 1] + 2.0 * ds * constraints.b_left[i + 1]])
-    b = np.concatenate([constraints.b[i], constraints.b_left[i + 1]])
-    return bool(np.any(np.abs(a) <= 1e-6 * np.maximum(np.abs(a) + np.abs(b), 1e-300)))
+    for a, b in ((constraints.a[i], constraints.b[i]), (constraints.a_left[i + 1] + 2.0 * ds * constraints.b_left[i + 1], constraints.b_left[i + 1])):
+        size = np.abs(a)
+        if (size <= 1e-6 * np.maximum(size + np.abs(b), 1e-300)).any():
+            return True
+    return False
 
 
 def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) -> InfeasiblePath:
