@@ -14,7 +14,9 @@ At a corner of the path (a kink, where q' jumps) the motion must stop, so sd_max
 the rows seen from the interval that ends there (``*_left``) differ from those of the interval
 that starts there; so do they at a break (where q'' jumps: a line meeting a circular blend).
 The torque coefficients come from Pinocchio's RNEA: a = rnea(q, 0, q') - g,
-b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never see a robot.
+b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never see a robot; one
+batched RNEA per chunk of grid points, then one compiled pass
+(``planners.constraint_kernels``) writes every row and the velocity bound.
 """
 
 from __future__ import annotations
