@@ -69,7 +69,7 @@ TYPICAL = {
 #: that appears in the profile counts; nested stages are subtracted from their parents).
 STAGES = (
     ("request to library arguments", ("plan_request",), ("plan",)),
-    ("path construction and checks", ("make_path", "_check_path_within_limits"), ()),
+    ("path construction and checks", ("make_path", "check_path_within_limits"), ()),
     ("constraint build (grid rows)", ("build_path_constraints",), ()),
     ("timing solve (incl. refinement)", ("solve_well_scaled",), ()),
     ("dense limit check (the gate)", ("check_limits",), ()),
@@ -140,13 +140,13 @@ def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int
     first built on), over its stretches: what ``planners.plan`` times, without the sampling."""
     from planners.deadline import NO_DEADLINE
     from planners.gate import gate_threshold
-    from planners.plan import _timed_path
+    from planners.timed import timed_path
     from planners.requests import check_constraint_kinds, timing_method
     from planners.waypoint_checks import make_path
 
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)
-    timed = _timed_path(robot, make_path(robot, path_spec), method, timing, kinds, robot.limits, NO_DEADLINE, gate_threshold(0.0))
+    timed = timed_path(robot, make_path(robot, path_spec), method, timing, kinds, robot.limits, NO_DEADLINE, gate_threshold(0.0))
     return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 
