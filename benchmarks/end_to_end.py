@@ -140,8 +140,8 @@ def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int
     first built on), over its stretches: what ``planners.plan`` times, without the sampling."""
     from planners.deadline import NO_DEADLINE
     from planners.gate import gate_threshold
-    from planners.timed import timed_path
     from planners.requests import check_constraint_kinds, timing_method
+    from planners.timed import timed_path
     from planners.waypoint_checks import make_path
 
     method = timing_method(timing)

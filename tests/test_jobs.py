@@ -420,15 +420,17 @@ def test_the_geering_free_path_example_runs_as_a_job_while_requests_are_served(c
     served, stages, next_request = 0, set(), time.monotonic()
     while (job := client.get(f"/v1/jobs/{job_id}").json())["status"] not in ENDED:
         stages.add(job["progress"]["stage"])
-        if job["status"] == "running" and time.monotonic() >= next_request:
+        seen_collocation = any(stage.startswith("collocation") for stage in stages)
+        if job["status"] == "running" and seen_collocation and time.monotonic() >= next_request:
             # Now and then only: on two busy cores, requests in a row would halve the job's share.
+            # Only once the collocation was seen: on a loaded machine a request can outlast it.
             response = client.post("/v1/trajectories", json=QUICK)
             assert response.status_code == 200, response.text
             served += 1
             next_request = time.monotonic() + 2.0
         time.sleep(0.2)
     assert job["status"] == "done", job["error"]
-    assert served >= 1 and any(stage.startswith("collocation") for stage in stages)
+    assert served >= 1 and any(stage.startswith("collocation") for stage in stages), (served, stages)
     # Jeong & Lee's type-3 motion: T = 0.9755 s with the elbow turning a full revolution.
     assert job["result"]["duration"] == pytest.approx(0.9755, rel=1e-2)
     assert job["result"]["solver"]["duration"] == pytest.approx(0.9755, rel=1e-2)

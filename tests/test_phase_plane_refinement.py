@@ -12,9 +12,10 @@ from benchmarks.accuracy import KINDS, random_waypoints
 from planners.constraints import PathConstraints, build_path_constraints
 from planners.errors import InfeasiblePath
 from planners.grid import path_grid
-from planners.kernels import interval_bounds, switch_excess
+from planners.kernels import interval_bounds
 from planners.mvc import acceleration_bounds, admissible_set
 from planners.paths import SplinePath
+from planners.refinement_kernels import switch_excess
 from planners.timing import PhasePlaneMethod
 from planners.timing.phase_plane import interval_rows, midpoint_duration, midpoint_stage_rows
 

@@ -46,8 +46,9 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
-from planners.kernels import point_bounds, refinement, sweeps
+from planners.kernels import point_bounds, sweeps
 from planners.mvc import admissible_set
+from planners.refinement_kernels import refinement
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
@@ -95,7 +96,7 @@ _MAX_PIECES = 8
 #: Refinement aims at this fraction of the tolerance, so that one round usually suffices.
 _AIM = 0.85
 #: Weight, in the estimated error, of the estimates that may cancel in its signed sum or
-#: estimate nothing (``planners.kernels.refinement``): a guard against their own errors.
+#: estimate nothing (``planners.refinement_kernels.refinement``): a guard against their own errors.
 _GUARD = 0.15
 #: The refined grid has at most 2^max_refinements times the intervals of the given one (what
 #: halving every interval in each round would give), or this many, whichever is more.
@@ -110,7 +111,7 @@ class PhasePlaneMethod(TimingMethod):
             estimated from the midpoint discretization on the same grid (second order, so it
             stands for the exact answer), from the time each interval would save by switching
             inside it, and from the chord error along the maximum velocity curve
-            (``planners.kernels.refinement``); intervals are split where the estimates lie,
+            (``planners.refinement_kernels.refinement``); intervals are split where the estimates lie,
             each into as many pieces as its share asks for, with the constraint rows evaluated
             anew at the new points, until the estimate falls below ``tolerance`` or
             ``max_refinements`` rounds are done.
@@ -219,7 +220,7 @@ class _Grid(NamedTuple):
 class _Profile(NamedTuple):
     """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
     envelope (N + 1,), the admissible upper x_i of each interval (N,) and how much faster each
-    interval could be crossed at its bounds (N,, ``planners.kernels.switch_excess``)."""
+    interval could be crossed at its bounds (N,, ``planners.refinement_kernels.switch_excess``)."""
 
     x: np.ndarray
     capped: np.ndarray

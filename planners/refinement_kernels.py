@@ -1,0 +1,209 @@
+"""Compiled error estimates of the phase-plane method (numba): how much time each grid interval
+of a conservative (interpolation) profile loses, from the midpoint discretization on the same grid,
+from a switch inside the interval (``switch_excess``) and from the chord along a curved maximum
+velocity curve, and the pieces each interval is split into so that the estimated duration error
+falls to the tolerance (``refinement``). ``planners.timing.phase_plane`` explains the scheme;
+these loops hold no knowledge of paths or robots (``nogil``, cached on disk).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_INF = np.inf
+
+
+@njit(cache=True, nogil=True)
+def _time_at_bounds(length, x0, x1, beta, alpha, c0, c1):  # pragma: no cover - compiled
+    """Time over an interval of ``length`` from x0 to x1 (x = sd^2) at the bounds: accelerate
+    at u = ``beta`` > 0 from x0, follow the ceiling c(t) (linear from c0 to c1), decelerate at
+    u = ``alpha`` < 0 into x1. -1 where these bounds cannot join the two ends."""
+    slope = (c1 - c0) / length
+    # Acceleration meets the ceiling at t_a, the deceleration leaves it at t_d.
+    t_a = (c0 - x0) / (2.0 * beta - slope) if 2.0 * beta > slope else length
+    t_d = length - (c1 - x1) / (-2.0 * alpha + slope) if -2.0 * alpha + slope > 0.0 else 0.0
+    if 0.0 <= t_a < t_d <= length:
+        top_a = c0 + slope * t_a
+        top_d = c0 + slope * t_d
+        cruise = 2.0 * (t_d - t_a) / (np.sqrt(top_a) + np.sqrt(top_d))
+        return (np.sqrt(top_a) - np.sqrt(x0)) / beta + cruise + (np.sqrt(top_d) - np.sqrt(x1)) / -alpha
+    # Below the ceiling all the way: the two curves meet at t_m.
+    t_m = (x1 - 2.0 * alpha * length - x0) / (2.0 * (beta - alpha))
+    if not 0.0 <= t_m <= length:
+        return -1.0
+    top = x0 + 2.0 * beta * t_m
+    return (np.sqrt(top) - np.sqrt(x0)) / beta + (np.sqrt(top) - np.sqrt(x1)) / -alpha
+
+
+@njit(cache=True, nogil=True)
+def switch_excess(ds, p, q, r, x, ceiling):  # pragma: no cover - compiled
+    """How much faster than the discrete profile x (N + 1,) each interval could be crossed at
+    its bounds (N,). With u constant per interval in the discrete profile, where the optimal
+    profile switches inside an interval (starts from rest, reaches the maximum velocity curve,
+    leaves it to decelerate), the constant-u interval is slower by an amount that a second
+    discretization on the same grid does not see. The maximum path acceleration at x_i,
+    the maximum deceleration at x_i+1 and the admissible upper x at the grid points
+    (``ceiling``, N + 1, linear in between) stand for the interval's bounds."""
+    n_stages, n_rows = p.shape
+    excess = np.zeros(n_stages)
+    for i in range(n_stages):
+        x0 = x[i]
+        x1 = x[i + 1]
+        beta = _INF
+        alpha = -_INF
+        for k in range(n_rows):
+            fastest = r[i, k] + q[i, k] * x0
+            if fastest < beta:
+                beta = fastest
+            slowest = p[i, k] + q[i, k] * x1
+            if slowest > alpha:
+                alpha = slowest
+        c0 = ceiling[i]
+        c1 = ceiling[i + 1]
+        if not (beta > 0.0 and alpha < 0.0 and beta < _INF and alpha > -_INF and c0 < _INF and c1 < _INF):
+            continue
+        c0 = max(c0, x0)
+        c1 = max(c1, x1)
+        if x0 + x1 <= 0.0:
+            continue
+        fast = _time_at_bounds(ds[i], x0, x1, beta, alpha, c0, c1)
+        if fast >= 0.0:
+            chord = 2.0 * ds[i] / (np.sqrt(x0) + np.sqrt(x1))
+            if chord > fast:
+                excess[i] = chord - fast
+    return excess
+
+
+@njit(cache=True, nogil=True)
+def _interval_time(ds, x0, x1):  # pragma: no cover - compiled
+    """Time over an interval of length ds with x = sd^2 linear from x0 to x1."""
+    total = np.sqrt(x0) + np.sqrt(x1)
+    return 2.0 * ds / (total if total > 1e-300 else 1e-300)
+
+
+@njit(cache=True, nogil=True)
+def _pieces(error, order, shrink, pieces):  # pragma: no cover - compiled
+    """Raise ``pieces`` (N,) to the pieces per interval that bring the sum of ``error`` (N,),
+    each part falling as k^-order, to ``shrink`` times itself with the fewest pieces in all
+    (Lagrange multipliers: k_i = e_i^(1 / (order + 1)) (sum_j e_j^(1 / (order + 1)) /
+    (shrink sum_j e_j))^(1 / order))."""
+    total = 0.0
+    weights = 0.0
+    for i in range(error.shape[0]):
+        total += error[i]
+        weights += error[i] ** (1.0 / (order + 1.0))
+    if not total > 0.0:
+        return
+    scale = (weights / (shrink * total)) ** (1.0 / order)
+    for i in range(error.shape[0]):
+        wanted = error[i] ** (1.0 / (order + 1.0)) * scale
+        if wanted > pieces[i]:
+            pieces[i] = wanted
+
+
+@njit(cache=True, nogil=True)
+def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, room):  # pragma: no cover - compiled
+    """Error estimate of the profile x (N + 1,) on the grid s, and where to refine it.
+
+    Each interval's error, this discretization's time minus the exact one, is estimated from:
+
+    * first order: its time here minus its time in the midpoint discretization x_mid (second
+      order, so it stands for the exact answer where the profile is resolved). The
+      conservative discretization is the slower wherever both resolve the profile; where the
+      midpoint one comes out slower, it does not resolve the interval either: that marks the
+      interval (a second-order part below) but estimates no error of this profile;
+    * second order: ``switch`` (N,), the time it would save by switching inside it
+      (``switch_excess``, which neither discretization sees), and the chord error where the
+      profile rides on the ``ceiling`` of admissible x (N + 1,) at both ends: x linear in s
+      runs along the chord of the curved ceiling, which neither discretization checks between
+      grid points. With x'' from second differences, the chord's time minus the curve's is
+      -x'' ds^3 / (24 x^(3/2)) (faster under a convex ceiling, slower under a concave one).
+
+    The estimated relative error is |the signed sum| plus ``guard`` times the magnitudes that
+    may cancel in it or estimate nothing (chord errors, unresolved intervals): a guard against
+    errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are split into
+    equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order one;
+    the fewest pieces that bring the estimate to ``aim`` times the tolerance (``_pieces``, the
+    larger of the two kinds, at most ``max_pieces`` per interval and ``room`` new points in
+    all, the worst intervals first).
+
+    Returns the new points (sorted, each strictly inside an interval; empty when the estimate
+    is within the tolerance) and the estimated relative error.
+    """
+    n_stages = s.shape[0] - 1
+    first = np.empty(n_stages)
+    second = np.empty(n_stages)
+    curvature = np.zeros(n_stages + 1)
+    for i in range(1, n_stages):
+        left = (ceiling[i] - ceiling[i - 1]) / (s[i] - s[i - 1])
+        right = (ceiling[i + 1] - ceiling[i]) / (s[i + 1] - s[i])
+        curvature[i] = 2.0 * (right - left) / (s[i + 1] - s[i - 1])
+    if n_stages >= 2:
+        curvature[0] = curvature[1]
+        curvature[n_stages] = curvature[n_stages - 1]
+    duration = 0.0
+    signed = 0.0
+    uncertain = 0.0
+    for i in range(n_stages):
+        ds = s[i + 1] - s[i]
+        here = _interval_time(ds, x[i], x[i + 1])
+        duration += here
+        first[i] = here - _interval_time(ds, x_mid[i], x_mid[i + 1])
+        chord = 0.0
+        riding = (
+            x[i] > 0.0
+            and x[i + 1] > 0.0
+            and x[i] >= ceiling[i] * (1.0 - 1e-6)
+            and x[i + 1] >= ceiling[i + 1] * (1.0 - 1e-6)
+            and ceiling[i] < _INF
+            and ceiling[i + 1] < _INF
+        )
+        if riding:
+            mean = 0.5 * (x[i] + x[i + 1])
+            chord = -0.5 * (curvature[i] + curvature[i + 1]) * ds**3 / (24.0 * mean**1.5)
+            if not np.isfinite(chord):
+                chord = 0.0
+        # The conservative discretization is slower than the exact profile wherever both
+        # resolve it; where the midpoint one comes out slower, it is its own error (it does
+        # not resolve the interval either), which marks the interval but is no estimate.
+        unresolved = max(-first[i], 0.0)
+        first[i] = max(first[i], 0.0)
+        second[i] = switch[i] + abs(chord) + unresolved
+        signed += first[i] + switch[i] + chord
+        uncertain += abs(chord) + unresolved
+    exact = duration - signed
+    if not exact > 0.0:
+        exact = duration
+    error = (abs(signed) + guard * uncertain) / exact
+    if not error > tolerance or room <= 0:
+        return np.empty(0), error
+    shrink = aim * tolerance / error
+    wanted = np.ones(n_stages)
+    _pieces(first, 1.0, shrink, wanted)
+    _pieces(second, 2.0, shrink, wanted)
+    pieces = np.empty(n_stages, dtype=np.int64)
+    added = 0
+    for i in range(n_stages):
+        k = np.ceil(wanted[i])
+        pieces[i] = max_pieces if k > max_pieces else int(k)
+        if (s[i + 1] - s[i]) / pieces[i] < 1e-12:
+            pieces[i] = 1  # no pieces shorter than rounding resolves
+        added += pieces[i] - 1
+    if added > room:
+        # Too many for the grid's cap: the worst intervals first, each as asked.
+        worst = np.argsort(-(first + second), kind="mergesort")
+        used = 0
+        for index in worst:
+            if used + pieces[index] - 1 <= room:
+                used += pieces[index] - 1
+            else:
+                pieces[index] = 1
+        added = used
+    points = np.empty(added)
+    at = 0
+    for i in range(n_stages):
+        for j in range(1, pieces[i]):
+            points[at] = s[i] + (s[i + 1] - s[i]) * j / pieces[i]
+            at += 1
+    return points, error
