@@ -217,56 +217,51 @@ def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) ->
     return robot.rnea(np.concatenate((q, q, q)), np.concatenate((zero, zero, dq)), np.concatenate((zero, dq, ddq)))
 
 
-def path_dynamics(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray):
-    """Torque coefficients along a path: ``tau = a u + b x + c + d sd`` for sd > 0.
-
-    Args:
-        q, dq, ddq: Path and its s-derivatives, each (n_samples, n_dof).
-
-    Returns:
-        a, b, c, d: Each (n_samples, n_dof), in N m (N for prismatic joints).
-    """
-    n_samples = len(dq)
-    stacked = _rnea_terms(robot, q, dq, ddq)
-    c = stacked[:n_samples].copy()
-    a = stacked[n_samples : 2 * n_samples] - c
-    b = stacked[2 * n_samples :] - c
-    c += robot.coulomb_friction * np.sign(dq)
-    d = robot.viscous_friction * dq
-    return a, b, c, d
-
-
 #: Grid points whose torque rows are computed between two deadline checks (about 20 ms).
 CHUNK_POINTS = 1024
 
 
-def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline):
-    """The path's points at ``s`` and their second-order rows ``(a, b, c, d, lower, upper)``
-    (each (n, m): acceleration rows, then torque rows, of the joints whose limit is finite:
-    a row with an infinite limit constrains nothing), with their (kind, joint) labels. The
-    torque rows take one batched RNEA per ``CHUNK_POINTS`` points, the deadline checked
-    before each; ``planners.constraint_kernels.assemble_rows`` writes them."""
-    points = path.evaluate(s, side)
+def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, deadline: Deadline = NO_DEADLINE):
+    """The second-order rows ``(a, b, c, d, lower, upper)`` at n points of a path (``q, dq,
+    ddq``, each (n, n_dof)) and their (kind, joint) labels: each array (n, m), acceleration rows
+    then torque rows, of the joints whose limit is finite (a row with an infinite limit
+    constrains nothing). The torque rows take one batched RNEA per ``CHUNK_POINTS`` points, the
+    deadline checked before each; ``planners.constraint_kernels.assemble_rows`` writes them."""
     nothing = np.empty(0, dtype=np.intp)
     accelerated = np.flatnonzero(np.isfinite(limits.acceleration)) if "acceleration" in kinds else nothing
     torqued = np.flatnonzero(np.isfinite(limits.torque)) if "torque" in kinds else nothing
     rows = tuple(("acceleration", int(j)) for j in accelerated) + tuple(("torque", int(j)) for j in torqued)
-    n = len(s)
+    n = len(q)
     arrays = tuple(np.empty((n, len(rows))) for _ in range(6))
     if not rows:
-        return points, arrays, rows
-    no_torque = np.empty((0, path.dof))
+        return arrays, rows
+    no_torque = np.empty((0, dq.shape[1]))
     acceleration = np.asarray(limits.acceleration, dtype=float)
     torque = np.asarray(limits.torque, dtype=float)
     for start in range(0, n, CHUNK_POINTS):
         deadline.check()
         part = slice(start, start + CHUNK_POINTS)
-        dq, ddq = points.dq[part], points.ddq[part]
-        tau = _rnea_terms(robot, points.q[part], dq, ddq) if torqued.size else no_torque
+        tau = _rnea_terms(robot, q[part], dq[part], ddq[part]) if torqued.size else no_torque
         assemble_rows(
-            dq, ddq, tau, robot.coulomb_friction, robot.viscous_friction, accelerated, acceleration, torqued, torque,
+            dq[part], ddq[part], tau, robot.coulomb_friction, robot.viscous_friction, accelerated, acceleration, torqued, torque,
             *(array[part] for array in arrays),
         )
+    return arrays, rows
+
+
+def speed_bound(limits: JointLimits, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """sd_max = min_j v_j / |q'_j| (n,, 1/s; inf where no joint moves) at the points of ``dq``
+    (n, n_dof), and the joint that sets it (-1 where none does)."""
+    sd_max = np.empty(len(dq))
+    binding = np.empty(len(dq), dtype=np.intp)
+    velocity_bound(dq, np.asarray(limits.velocity, dtype=float), sd_max, binding)
+    return sd_max, binding
+
+
+def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline):
+    """The path's points at ``s`` and their rows (``grid_rows``)."""
+    points = path.evaluate(s, side)
+    arrays, rows = grid_rows(robot, limits, kinds, points.q, points.dq, points.ddq, deadline)
     return points, arrays, rows
 
 
@@ -306,7 +301,7 @@ def build_path_constraints(
     sd_max = np.full(len(s), np.inf)
     velocity_joint = np.full(len(s), -1)
     if "velocity" in kinds:
-        velocity_bound(points.dq, np.asarray(limits.velocity, dtype=float), sd_max, velocity_joint)
+        sd_max, velocity_joint = speed_bound(limits, points.dq)
     tool_bound = None
     if limits.tool is not None:
         deadline.check()

@@ -94,7 +94,15 @@ def test_rows_of_finite_limits_only_in_chunks(monkeypatch):
     assert np.array_equal(whole.a[:, :5], points.dq[:, [0, 1, 3, 4, 5]])
     assert np.array_equal(whole.upper[0], np.concatenate([limits.acceleration[[0, 1, 3, 4, 5]], limits.torque[1:]]))
     assert np.array_equal(whole.lower, -whole.upper)
-    torque = module.path_dynamics(robot, points.q, points.dq, points.ddq)
+    # tau = a u + b x + c + d sd: g = RNEA(q, 0, 0), a = RNEA(q, 0, q') - g, b = RNEA(q, q', q'') - g
+    zero = np.zeros_like(points.dq)
+    g = robot.rnea(points.q, zero, zero)
+    torque = (
+        robot.rnea(points.q, zero, points.dq) - g,
+        robot.rnea(points.q, points.dq, points.ddq) - g,
+        g + robot.coulomb_friction * np.sign(points.dq),
+        robot.viscous_friction * points.dq,
+    )
     for mine, reference in zip((whole.a, whole.b, whole.c, whole.d), torque):
         assert mine[:, 5:] == pytest.approx(reference[:, 1:], rel=1e-12, abs=1e-12)
     monkeypatch.setattr(module, "CHUNK_POINTS", 7)

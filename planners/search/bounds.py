@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from planners.constraints import build_path_constraints, path_dynamics
+from planners.constraints import build_path_constraints, grid_rows, speed_bound
 from planners.kernels import interval_bounds, point_bounds
 from planners.search.curve import GridSplinePath
 from planners.search.pieces import INTERVALS, Pieces
@@ -75,24 +75,10 @@ def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
     """Rows ``a u + b x + c in [lower, upper]`` at configurations q with parameter derivatives
     dq, ddq (each (k, n)), viscous friction relaxed below the speed bound, and that bound
     x_bound (k,): the rows of ``planners.constraints.build_path_constraints``."""
-    blocks = []
     x_bound = np.full(len(q), _INF)
     if "velocity" in kinds:
-        with np.errstate(divide="ignore"):
-            x_bound = np.min(limits.velocity / np.abs(dq), axis=1) ** 2
-    if "acceleration" in kinds:
-        zero = np.zeros_like(dq)
-        blocks.append((dq, ddq, zero, zero, np.broadcast_to(limits.acceleration, dq.shape)))
-    if "torque" in kinds:
-        a, b, c, d = path_dynamics(robot, q, dq, ddq)
-        blocks.append((a, b, c, d, np.broadcast_to(limits.torque, a.shape)))
-    if not blocks:
-        empty = np.zeros((len(q), 0))
-        return empty, empty, empty, empty, empty, empty, x_bound
-    a, b, c, d, bound = (np.concatenate([block[i] for block in blocks], axis=1) for i in range(5))
-    finite = np.isfinite(bound[0])
-    a, b, c, d, bound = a[:, finite], b[:, finite], c[:, finite], d[:, finite], bound[:, finite]
-    lower, upper = -bound, bound.copy()
+        x_bound = speed_bound(limits, dq)[0] ** 2
+    (a, b, c, d, lower, upper), _ = grid_rows(robot, limits, kinds, q, dq, ddq)
     if np.any(d != 0.0):
         speed = np.sqrt(x_bound)[:, None]
         with np.errstate(invalid="ignore"):
