@@ -2,7 +2,7 @@
 arms from tests/data and catalog arms), every path-timing method, spline and stop-and-go paths,
 half of them starting with two tiny segments (a recorded path), with and without a margin.
 
-    python benchmarks/limits_study.py --cases 40
+    python benchmarks/limits_study.py --cases 40 [--methods phase_plane,toppra] [--grid-points 30]
 
 Each answer is checked on its own samples at dt = 1 ms (joint velocity, acceleration, torque,
 and accelerations as finite differences of the returned velocities). Prints, per method, the
@@ -64,16 +64,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=40, help="requests per robot")
     parser.add_argument("--seed", type=int, default=3)
+    parser.add_argument("--methods", default=",".join(METHODS), help="comma-separated; the cases cycle through them")
+    parser.add_argument("--grid-points", type=int, default=None, help="timing.grid_points of every request (default: the service's)")
     args = parser.parse_args()
+    methods = tuple(args.methods.split(","))
     rng = np.random.default_rng(args.seed)
-    stats = {method: {"answers": 0, "refused": 0, "worst": 0.0, "worst_margin": 0.0} for method in METHODS}
+    stats = {method: {"answers": 0, "refused": 0, "worst": 0.0, "worst_margin": 0.0} for method in methods}
     for robot in test_arms():
         for case in range(args.cases):
-            method = METHODS[case % len(METHODS)]
+            method = methods[case % len(methods)]
             margin = 0.002 if case % 3 == 0 else 0.0
             spec = WaypointPath(waypoints(robot, rng, case % 2 == 0), "linear" if case % 5 == 0 else "spline")
             try:
-                result = plan(robot, spec, Timing(method=method, constraints=KINDS, limit_margin=margin), dt=1e-3)
+                result = plan(robot, spec, Timing(method=method, constraints=KINDS, limit_margin=margin, grid_points=args.grid_points), dt=1e-3)
             except (InfeasiblePath, TimingFailed):
                 stats[method]["refused"] += 1
                 continue

@@ -21,9 +21,12 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
 
 * ``pp``: ``phase_plane`` as a user of toptraj pays for it: the constraint build
   (``build_path_constraints``: path derivatives and a batched Pinocchio RNEA at each grid point)
-  plus ``PhasePlaneMethod().solve`` (which evaluates the constraints anew at the points its grid
-  refinement adds; the share of the time spent evaluating rows is printed too). ``solve``: the
-  solve alone, on constraints built beforehand.
+  plus ``PhasePlaneMethod(excursion=None).solve`` (which evaluates the constraints anew at the
+  points its grid refinement adds; the share of the time spent evaluating rows is printed too).
+  ``solve``: the solve alone, on constraints built beforehand. Its refinement aims at the
+  duration alone, as the other methods' grids do: none of them holds the limits between grid
+  points (``--excursion``: with phase_plane's default refinement of the limits' excursions
+  between grid points too, which a coarse grid pays for with points).
 * ``adapter``: the ``toppra`` method of toptraj: the same constraint build plus
   ``ToppraMethod().solve`` (toppra's Seidel solver on the precomputed rows).
 * ``toppra``: toppra used directly through its public API, as a user of toppra pays for it:
@@ -344,14 +347,19 @@ def main() -> int:
         help="cpu: the process's CPU time (time.process_time; a run's time does not grow with the waits "
         "for other processes on a shared machine); wall: time.perf_counter",
     )
+    parser.add_argument(
+        "--excursion", action="store_true",
+        help="phase_plane with its default refinement of the limits' excursions between grid points",
+    )
     args = parser.parse_args()
     names = args.robots.split(",")
     _clock[0] = CLOCKS[args.clock]
+    phase_plane = PhasePlaneMethod() if args.excursion else PhasePlaneMethod(excursion=None)
 
     warm = robots.load("ur5")
     warm_waypoints, warm_path = random_path(warm, np.random.default_rng(0))
     for run in (
-        toptraj_runner(PhasePlaneMethod(), warm_path, warm),
+        toptraj_runner(phase_plane, warm_path, warm),
         toptraj_runner(ToppraMethod(), warm_path, warm),
         toppra_runner(warm, warm_waypoints, warm_path),
     ):
@@ -386,7 +394,7 @@ def main() -> int:
                 done += 1
                 continue
             runs = {
-                "pp": toptraj_runner(PhasePlaneMethod(), path, robot),
+                "pp": toptraj_runner(phase_plane, path, robot),
                 "toppra": toppra_runner(robot, waypoints, path),
                 "toppra-i": toppra_runner(robot, waypoints, path, interpolation=True),
                 "adapter": toptraj_runner(ToppraMethod(), path, robot),
@@ -462,7 +470,8 @@ def main() -> int:
     clock = "CPU time of the process" if args.clock == "cpu" else "wall time"
     print()
     print(f"Times: {clock}, best of {args.repeats}, the methods interleaved. Ratio = the other method's time /")
-    print("phase_plane's (> 1: phase_plane is faster). pp = build_path_constraints + PhasePlaneMethod().solve")
+    print("phase_plane's (> 1: phase_plane is faster). pp = build_path_constraints + PhasePlaneMethod().solve,")
+    print(f"its refinement {'with' if args.excursion else 'without'} the limits' excursions between grid points")
     print("(eval: its share spent evaluating constraint rows, the build and the rows at refinement points);")
     print("toppra = toppra's public API with its default discretizations (collocation for torque), its own")
     print("constraint evaluation included; toppra-i = the same with the interpolation discretization for torque")

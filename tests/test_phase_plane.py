@@ -131,11 +131,13 @@ def _random_spline(robot, rng, n_waypoints):
 @pytest.mark.parametrize("name", ["ur5", "panda"])
 def test_agrees_with_fine_toppra_on_random_paths(name):
     """50 seeded random spline paths: within 0.1 % of TOPP-RA on a 3000-interval grid, limits
-    held on a dense resampling, and never longer than TOPP-RA on the default grid."""
+    held on a dense resampling, and, refining for the duration alone (TOPP-RA holds the limits
+    at the grid points only), never longer than TOPP-RA on the default grid."""
     robot = robots.load(name)
     rng = np.random.default_rng(1234 if name == "ur5" else 4321)
     kinds = ("velocity", "acceleration", "torque")
     phase_plane, toppra = PhasePlaneMethod(), ToppraMethod()
+    duration_only = PhasePlaneMethod(excursion=None)
     worst = 0.0
     for _ in range(50):
         path = _random_spline(robot, rng, int(rng.integers(2, 6)))
@@ -146,7 +148,7 @@ def test_agrees_with_fine_toppra_on_random_paths(name):
         gap = abs(ours.duration / reference.duration - 1)
         worst = max(worst, gap)
         assert gap <= 1e-3
-        assert ours.duration <= baseline.duration * (1 + 1e-9)
+        assert duration_only.solve(default).duration <= baseline.duration * (1 + 1e-9)
         utilization = check_limits(path, ours, robot, robot.limits).utilization
         assert max(value.max() for value in utilization.values()) <= 1.005
     assert worst < 1e-3

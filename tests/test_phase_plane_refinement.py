@@ -1,6 +1,6 @@
 """The compiled phase-plane kernels against the numpy rows they replace, and the grid
 refinement's error estimate against converged durations: from a coarse grid, the default
-answer lands within its tolerance."""
+answer lands within its tolerance and holds the limits between its grid points."""
 
 from __future__ import annotations
 
@@ -11,11 +11,13 @@ import robots
 from benchmarks.accuracy import KINDS, random_waypoints
 from planners.constraints import PathConstraints, build_path_constraints
 from planners.errors import InfeasiblePath
+from planners.gate import LIMIT_TOLERANCE
 from planners.grid import path_grid
 from planners.kernels import interval_bounds
+from planners.limit_check import check_limits
 from planners.mvc import acceleration_bounds, admissible_set
 from planners.paths import SplinePath
-from planners.refinement_kernels import switch_excess
+from planners.refinement_kernels import row_excursions, switch_excess
 from planners.timing import PhasePlaneMethod
 from planners.timing.phase_plane import interval_rows, midpoint_duration, midpoint_stage_rows
 
@@ -121,3 +123,56 @@ def test_a_coarse_grid_is_refined_to_the_tolerance(name):
         result = PhasePlaneMethod().solve(build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, 25)))
         assert abs(result.duration / converged - 1) <= 1e-3, (name, compared, result.duration, converged, len(result.s))
         compared += 1
+
+
+def _excursions(c, x_bound, target):
+    """``row_excursions`` of one row ``u + c(s)`` in [-1, 1] (a = 1, b = d = 0) and the speed
+    bound x <= x_bound (joint 0 binding throughout) on the grid s = 0, 0.1, ..., 1, with x = 1
+    throughout (u = 0)."""
+    n = len(c)
+    ones, zeros = np.ones((n, 1)), np.zeros((n, 1))
+    rows = (ones, zeros, c[:, None], zeros)
+    s, binding = np.linspace(0.0, 1.0, n), np.zeros(n, dtype=np.int64)
+    return row_excursions(s, *rows, *rows, -ones, ones.copy(), x_bound, binding, np.ones(n), target, 8)
+
+
+def test_row_excursions_split_as_the_closed_form_asks():
+    """A row and a speed bound that hold at both ends of the interval [0.5, 0.6] and bulge
+    between them by a parabola: c(s) = 1 + K ((h/2)^2 - (s - 0.55)^2) peaks at 1 + K h^2 / 4
+    midway (the cubic through four grid points is exact for it), so the interval is split into
+    ceil(sqrt(K h^2 / 4 / target)) pieces and no other; likewise 1 / x_bound with x = 1, where
+    the velocity peaks at sqrt(1 + K h^2 / 4) of its limit."""
+    s = np.linspace(0.0, 1.0, 11)
+    bulge = 0.0025 - (s - 0.55) ** 2  # (h/2)^2 - (s - s_m)^2: zero at 0.5 and 0.6
+    target = 3e-4
+    least = _excursions(1.0 + 1.0 * bulge, np.full(11, np.inf), target)
+    expected = np.ones(10, dtype=int)
+    expected[5] = np.ceil(np.sqrt(1.0 * 0.0025 / target))  # 3
+    np.testing.assert_array_equal(least, expected)
+
+    speed = 1.0 / (1.0 + 4.0 * bulge)  # x_bound: x = 1 touches it at 0.5 and 0.6
+    least = _excursions(np.zeros(11), speed, target)
+    expected[5] = np.ceil(np.sqrt((np.sqrt(1.0 + 4.0 * 0.0025) - 1.0) / target))  # 5
+    np.testing.assert_array_equal(least, expected)
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda"])
+def test_a_coarse_grid_holds_the_limits_between_its_points(name):
+    """On 30 intervals (a few per spline segment) the rows hold at the grid points only; the
+    refinement of their excursions keeps every limit within the gate's tolerance on the dense
+    check without the gate's help, where refining for the duration alone exceeds it."""
+    robot = robots.load(name)
+    rng = np.random.default_rng(11)
+    worst = {"default": 1.0, "duration only": 1.0}
+    for _ in range(8):
+        path = SplinePath(random_waypoints(robot, rng))
+        constraints = build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path, 30))
+        for label, method in (("default", PhasePlaneMethod()), ("duration only", PhasePlaneMethod(excursion=None))):
+            try:
+                timing = method.solve(constraints)
+            except InfeasiblePath:
+                continue
+            utilization = check_limits(path, timing, robot, robot.limits).utilization
+            worst[label] = max(worst[label], max(value.max() for value in utilization.values()))
+    assert worst["default"] <= LIMIT_TOLERANCE
+    assert worst["duration only"] > LIMIT_TOLERANCE

