@@ -61,6 +61,8 @@ class PathConstraints:
             (N + 1,), -1 where no velocity limit applies.
         tool_bound: Where a tool-speed limit (``planners.tool_speed``) sets sd_max instead, the
             index of that limit in ``TOOL_KINDS`` (N + 1,), -1 elsewhere; ``None`` without one.
+        knots: The s of the path's knots (where a derivative of q(s) jumps, so the rows are
+            not smooth across them even where they are continuous); ``None`` when unknown.
         evaluate: Builds the same constraints at other values of s (for methods that refine).
     """
 
@@ -82,6 +84,7 @@ class PathConstraints:
     jerk_left: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     velocity_joint: np.ndarray | None = None
     tool_bound: np.ndarray | None = None
+    knots: np.ndarray | None = None
     evaluate: Callable[[np.ndarray], PathConstraints] | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -133,6 +136,7 @@ class PathConstraints:
             tool_bound=None if self.tool_bound is None else merge(self.tool_bound, extra.tool_bound),
             jerk=jerk,
             jerk_left=jerk_left,
+            knots=self.knots,
             evaluate=self.evaluate,
         )
 
@@ -339,5 +343,6 @@ def build_path_constraints(
         jerk_left=None if third is None else _left_derivatives(path, s, points, third),
         velocity_joint=velocity_joint,
         tool_bound=tool_bound,
+        knots=np.asarray(path.knots, dtype=float),
         evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),
     )

@@ -216,137 +216,157 @@ def refinement(s, x, x_mid, ceiling, switch, least, tolerance, aim, guard, max_p
 
 
 @njit(cache=True, nogil=True)
-def _cubic_weights(nodes, at):  # pragma: no cover - compiled
-    """Lagrange weights of the polynomial through ``nodes`` (k,) evaluated at ``at``."""
-    weights = np.ones(nodes.shape[0])
-    for j in range(nodes.shape[0]):
-        for k in range(nodes.shape[0]):
+def _lagrange_weights(nodes, count, at, weights):  # pragma: no cover - compiled
+    """Write into ``weights[:count]`` the Lagrange weights of the polynomial through
+    ``nodes[:count]`` evaluated at ``at``."""
+    for j in range(count):
+        weight = 1.0
+        for k in range(count):
             if k != j:
-                weights[j] *= (at - nodes[k]) / (nodes[j] - nodes[k])
-    return weights
+                weight *= (at - nodes[k]) / (nodes[j] - nodes[k])
+        weights[j] = weight
 
 
 #: Where within an interval (fractions of its width) ``row_excursions`` looks: a parabolic
 #: excursion, wherever its peak lies, comes within an eighth of the interval of one of them.
 _INNER = (0.25, 0.5, 0.75)
+#: A limit is looked at between two grid points only where it is used to within this fraction
+#: at one of them: a bulge of more than this within one interval would need curvatures no
+#: spline of the grid's resolution has (and the dense check stays the judge).
+_NEAR = 0.05
 
 
 @njit(cache=True, nogil=True)
-def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, x_bound, binding, x, target, max_pieces):  # pragma: no cover - compiled
+def _row_value(a, b, c, d, point, k, u, x, sd):  # pragma: no cover - compiled
+    """``a u + b x + c + d sd`` of row k at grid point ``point``."""
+    return a[point, k] * u + b[point, k] * x + c[point, k] + d[point, k] * sd
+
+
+@njit(cache=True, nogil=True)
+def _excess(value, lower, upper):  # pragma: no cover - compiled
+    """How far ``value`` lies beyond [lower, upper], relative to the larger finite bound; -inf
+    where neither bound is finite."""
+    scale = 0.0
+    if upper < _INF:
+        scale = abs(upper)
+    if lower > -_INF:
+        scale = max(scale, abs(lower))
+    if scale <= 0.0:
+        return -_INF
+    return max(value - upper, lower - value) / scale
+
+
+@njit(cache=True, nogil=True)
+def _smooth_at(point, knot, a, b, c, a_left, b_left, c_left):  # pragma: no cover - compiled
+    """Whether the rows are smooth through grid ``point``: not a knot of the path, no jump."""
+    if knot[point]:
+        return False
+    for k in range(a.shape[1]):
+        if a_left[point, k] != a[point, k] or b_left[point, k] != b[point, k] or c_left[point, k] != c[point, k]:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, x_bound, binding, knot, x, target, max_pieces):  # pragma: no cover - compiled
     """The fewest pieces (N,) into which each interval of the profile x (N + 1,) on the grid s
     must be split for its rows and its first-order bound x <= ``x_bound`` (N + 1,) to stay
     within ``target`` (relative to the limit) of their bounds at its quarter points; ``binding``
-    (N + 1,) names the joint whose velocity limit sets x_bound at each grid point.
+    (N + 1,) names the joint whose velocity limit sets x_bound at each grid point, ``knot``
+    (N + 1,) marks the path's knots.
 
     The interpolation discretization holds every row ``a u + b x + c + d sd`` at both ends of
     an interval (u constant, x linear in s); between them the row departs from the chord of its
-    end values by about -r'' ds^2 / 8 at the middle, with r'' from the curvature of a, b, c and
-    d along s. The coefficients at the quarter points come from the cubic through the rows at the two ends and
-    at their outer neighbours (seen from this interval's side of each grid point; a quadratic
-    or nothing where a corner or a break of the path, a jump of the rows, stands in the way),
-    so no dynamics is evaluated. Likewise the speed: x_bound = sd_max^2 is least where a joint's
-    |q'| / v peaks, often between grid points, and the velocity reaches sqrt(x / x_bound) of its
-    limit, with 1 / x_bound from the same nodes where the same joint binds (it is smooth along
-    one joint's bound only). The excursion falls with the square of the piece length: k
-    pieces leave e / k^2 of an excess e, so k = ceil(sqrt(e / target)), at most ``max_pieces``.
-    The dense limit check (``planners.gate``) stays the judge; this only keeps the grid fine
-    where the limits curve.
+    end values by about -r'' ds^2 / 8 at the middle, with r'' from the curvature of a, b, c
+    and d along s. At the quarter points the row is the cubic, in s, through its values (at
+    the interval's u and x there) at the two ends and at their outer neighbours, each seen from
+    this interval's side; a quadratic where a knot of the path or a jump of the rows stands
+    beyond an end, nothing where both do. No dynamics is evaluated. Likewise the speed:
+    x_bound = sd_max^2 is least where a joint's |q'| / v peaks, often between grid points, and
+    the velocity reaches sqrt(x / x_bound) of its limit, with 1 / x_bound from the same nodes
+    where the joint that binds at both ends binds (it is smooth along one joint's bound only).
+    Only limits used to within ``_NEAR`` at an end of the interval are looked at. The excursion
+    falls with the square of the piece length: k pieces leave e / k^2 of an excess e, so
+    k = ceil(sqrt(e / target)), at most ``max_pieces``. The dense limit check
+    (``planners.gate``) stays the judge; this only keeps the grid fine where the limits curve.
     """
     n_stages = s.shape[0] - 1
     n_rows = a.shape[1]
     least = np.ones(n_stages, dtype=np.int64)
     nodes = np.empty(4)
-    rows = np.empty((4, 4, n_rows))  # (node, coefficient a b c d, row)
-    coefficient = np.empty(4)
+    points = np.empty(4, dtype=np.int64)
+    weights = np.empty(4)
     speed_nodes = np.empty(4)
     inverse_bound = np.empty(4)
+    speed_weights = np.empty(4)
+    near = np.empty(n_rows, dtype=np.bool_)
     for i in range(n_stages):
         h = s[i + 1] - s[i]
         if h <= 0.0:
             continue
+        u = (x[i + 1] - x[i]) / (2.0 * h)
+        sd_start, sd_end = np.sqrt(max(x[i], 0.0)), np.sqrt(max(x[i + 1], 0.0))
+        any_near = False
+        for k in range(n_rows):
+            start = _excess(_row_value(a, b, c, d, i, k, u, x[i], sd_start), lower[i, k], upper[i, k])
+            end = _excess(_row_value(a_left, b_left, c_left, d_left, i + 1, k, u, x[i + 1], sd_end), lower[i, k], upper[i, k])
+            near[k] = max(start, end) >= -_NEAR
+            any_near = any_near or near[k]
+        speed_near = binding[i] >= 0 and binding[i] == binding[i + 1] and (
+            x[i] >= (1.0 - _NEAR) ** 2 * x_bound[i] or x[i + 1] >= (1.0 - _NEAR) ** 2 * x_bound[i + 1]
+        )
+        if not (any_near or speed_near):
+            continue
+        # The nodes: the interval's ends and their outer neighbours where the rows are smooth.
         count = 0
-        # The left neighbour joins the cubic only where the rows do not jump at s_i.
-        smooth_start = i >= 1
-        for k in range(n_rows):
-            if a_left[i, k] != a[i, k] or b_left[i, k] != b[i, k] or c_left[i, k] != c[i, k]:
-                smooth_start = False
-        smooth_end = i + 2 <= n_stages
-        for k in range(n_rows):
-            if i + 1 < n_stages and (a_left[i + 1, k] != a[i + 1, k] or b_left[i + 1, k] != b[i + 1, k] or c_left[i + 1, k] != c[i + 1, k]):
-                smooth_end = False
-        if smooth_start:
-            nodes[count] = s[i - 1]
-            for k in range(n_rows):
-                rows[count, 0, k] = a[i - 1, k]
-                rows[count, 1, k] = b[i - 1, k]
-                rows[count, 2, k] = c[i - 1, k]
-                rows[count, 3, k] = d[i - 1, k]
+        if i >= 1 and _smooth_at(i, knot, a, b, c, a_left, b_left, c_left):
+            points[count] = i - 1
             count += 1
-        nodes[count] = s[i]
-        for k in range(n_rows):
-            rows[count, 0, k] = a[i, k]
-            rows[count, 1, k] = b[i, k]
-            rows[count, 2, k] = c[i, k]
-            rows[count, 3, k] = d[i, k]
-        count += 1
-        nodes[count] = s[i + 1]
-        for k in range(n_rows):
-            rows[count, 0, k] = a_left[i + 1, k]
-            rows[count, 1, k] = b_left[i + 1, k]
-            rows[count, 2, k] = c_left[i + 1, k]
-            rows[count, 3, k] = d_left[i + 1, k]
-        count += 1
-        if smooth_end:
-            nodes[count] = s[i + 2]
-            for k in range(n_rows):
-                rows[count, 0, k] = a[i + 2, k]
-                rows[count, 1, k] = b[i + 2, k]
-                rows[count, 2, k] = c[i + 2, k]
-                rows[count, 3, k] = d[i + 2, k]
+        points[count] = i
+        points[count + 1] = i + 1
+        count += 2
+        if i + 2 <= n_stages and _smooth_at(i + 1, knot, a, b, c, a_left, b_left, c_left):
+            points[count] = i + 2
             count += 1
         if count < 3:
             continue
-        u = (x[i + 1] - x[i]) / (2.0 * h)
-        first = i - 1 if smooth_start else i
-        worst = 0.0
-        # The speed's nodes: those where the joint that binds at both ends binds too (1 / x_bound
-        # is smooth only along one joint's bound; none where the ends differ or at a corner).
+        for node in range(count):
+            nodes[node] = s[points[node]]
         speed_count = 0
-        if binding[i] == binding[i + 1]:
+        if speed_near:
             for node in range(count):
-                bound = x_bound[first + node]
-                if binding[first + node] == binding[i] and bound > 0.0:
+                bound = x_bound[points[node]]
+                if binding[points[node]] == binding[i] and bound > 0.0:
                     speed_nodes[speed_count] = nodes[node]
                     inverse_bound[speed_count] = 1.0 / bound if bound < _INF else 0.0
                     speed_count += 1
+        worst = 0.0
         for fraction in _INNER:
             at = s[i] + fraction * h
-            weights = _cubic_weights(nodes[:count], at)
             x_at = x[i] + fraction * (x[i + 1] - x[i])
-            sd_at = np.sqrt(max(x_at, 0.0))
             if speed_count >= 2 and x_at > 0.0:
-                speed_weights = _cubic_weights(speed_nodes[:speed_count], at)
+                _lagrange_weights(speed_nodes, speed_count, at, speed_weights)
                 inverse = 0.0
                 for node in range(speed_count):
                     inverse += speed_weights[node] * inverse_bound[node]
                 if inverse > 0.0:
                     worst = max(worst, np.sqrt(x_at * inverse) - 1.0)
+            if not any_near:
+                continue
+            sd_at = np.sqrt(max(x_at, 0.0))
+            _lagrange_weights(nodes, count, at, weights)
             for k in range(n_rows):
-                coefficient[:] = 0.0
-                for node in range(count):
-                    for term in range(4):
-                        coefficient[term] += weights[node] * rows[node, term, k]
-                value = coefficient[0] * u + coefficient[1] * x_at + coefficient[2] + coefficient[3] * sd_at
-                scale = 0.0
-                if upper[i, k] < _INF:
-                    scale = max(scale, abs(upper[i, k]))
-                if lower[i, k] > -_INF:
-                    scale = max(scale, abs(lower[i, k]))
-                if scale <= 0.0:
+                if not near[k]:
                     continue
-                excess = max(value - upper[i, k], lower[i, k] - value) / scale
-                if excess > worst:
-                    worst = excess
+                value = 0.0
+                for node in range(count):
+                    point = points[node]
+                    # The rows at an interval's far end (and beyond it) as seen from the left.
+                    if point > i:
+                        value += weights[node] * _row_value(a_left, b_left, c_left, d_left, point, k, u, x_at, sd_at)
+                    else:
+                        value += weights[node] * _row_value(a, b, c, d, point, k, u, x_at, sd_at)
+                worst = max(worst, _excess(value, lower[i, k], upper[i, k]))
         if worst > target:
             pieces = np.ceil(np.sqrt(worst / target))
             least[i] = max_pieces if pieces > max_pieces else int(pieces)

@@ -155,14 +155,20 @@ class PhasePlaneMethod(TimingMethod):
                 break
             room = most_intervals - (len(grid.s) - 1)
             ceiling = np.append(profile.x_high, grid.x_bound[-1])
-            least = (
-                np.ones(len(grid.s) - 1, dtype=np.int64) if self.excursion is None
-                else row_excursions(grid.s, *grid.rows, grid.x_bound, grid.binding, profile.x, self.excursion, _MAX_PIECES)
-            )
-            extra, _ = refinement(
-                grid.s, profile.x, reference.x, ceiling, profile.switch_excess, least,
+            ones = np.ones(len(grid.s) - 1, dtype=np.int64)
+            extra, error = refinement(
+                grid.s, profile.x, reference.x, ceiling, profile.switch_excess, ones,
                 self.tolerance, _AIM, _GUARD, _MAX_PIECES, room,
             )
+            if extra.size == 0 and self.excursion is not None:
+                # The duration is within the tolerance: the limits' excursions between grid
+                # points decide the last split.
+                least = row_excursions(grid.s, *grid.rows, grid.x_bound, grid.binding, grid.knot, profile.x, self.excursion, _MAX_PIECES)
+                if (least > 1).any():
+                    extra, _ = refinement(
+                        grid.s, profile.x, reference.x, ceiling, profile.switch_excess, least,
+                        self.tolerance, _AIM, _GUARD, _MAX_PIECES, room,
+                    )
             if extra.size == 0:
                 break
             deadline.check()
@@ -171,6 +177,8 @@ class PhasePlaneMethod(TimingMethod):
             # The profile on the coarser grid is a close reference for viscous friction.
             x_ref = np.interp(grid.s, previous.s, profile.x) if grid.friction else None
             profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False, x_ref=x_ref)
+            if error <= self.tolerance:
+                break  # split for the limits' excursions alone
         switches = _switch_points(grid.constraints, profile)
         return TimeScaling(grid.s, np.sqrt(profile.x), switches)
 
@@ -205,13 +213,15 @@ class _Grid(NamedTuple):
     """The constraints on one grid as contiguous arrays for the kernels: s (N + 1,), the rows
     seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
     first-order bound x_bound = sd_max^2 (N + 1,), the joint whose velocity limit sets it (N + 1,,
-    -1 where none or unknown) and whether any row has viscous friction."""
+    -1 where none or unknown), whether each grid point is a knot of the path (N + 1,) and whether
+    any row has viscous friction."""
 
     constraints: PathConstraints
     s: np.ndarray
     rows: _Rows
     x_bound: np.ndarray
     binding: np.ndarray
+    knot: np.ndarray
     friction: bool
 
     @classmethod
@@ -228,8 +238,10 @@ class _Grid(NamedTuple):
         x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
         joint = constraints.velocity_joint
         binding = np.full(len(s), -1, dtype=np.int64) if joint is None else np.ascontiguousarray(joint, dtype=np.int64)
+        knots = constraints.knots
+        knot = np.zeros(len(s), dtype=np.bool_) if knots is None else np.isin(s, knots)
         friction = bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any()))
-        return cls(constraints, s, rows, x_bound, binding, friction)
+        return cls(constraints, s, rows, x_bound, binding, knot, friction)
 
     def friction_reference(self) -> np.ndarray:
         """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
