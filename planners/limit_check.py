@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.constraints import PathConstraints
+from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.tool_speed import TOOL_KINDS, tool_speeds
@@ -165,19 +166,15 @@ def check_limits(
     utilization, worst = {}, None
     over = np.zeros(len(states.s), dtype=bool)
     for kind, value in values.items():
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.abs(value)
-            ratio *= 1.0 / limit_of[kind]  # 0 where a joint is unlimited
-            if not np.isfinite(ratio).all():
-                ratio = np.nan_to_num(ratio, nan=0.0, posinf=np.inf)
-        utilization[kind] = ratio.max(axis=0) if kind not in TOOL_KINDS else ratio.max()
-        if kind not in kinds and kind not in TOOL_KINDS:
-            continue
-        per_state = ratio.max(axis=1)
-        state = int(np.argmax(per_state))
-        if worst is None or per_state[state] > worst.ratio:
-            joint = -1 if kind in TOOL_KINDS else int(np.argmax(ratio[state]))
-            worst = Excess(float(per_state[state]), kind, joint, float(states.s[state]))
-        over |= per_state > threshold
+        checked = kind in kinds or kind in TOOL_KINDS
+        peak = np.empty(value.shape[1])
+        ratio, state, column = utilization_pass(
+            np.ascontiguousarray(value, dtype=float), np.asarray(limit_of[kind], dtype=float),
+            threshold if checked else np.inf, peak, over,
+        )
+        utilization[kind] = peak if kind not in TOOL_KINDS else peak.max()
+        if checked and len(states.s) and (worst is None or ratio > worst.ratio):
+            joint = -1 if kind in TOOL_KINDS else int(column)
+            worst = Excess(float(ratio), kind, joint, float(states.s[state]))
     intervals = np.empty(0, dtype=int) if states.interval is None else np.unique(states.interval[over])
     return LimitCheck(utilization, worst, intervals)

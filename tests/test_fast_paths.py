@@ -14,6 +14,7 @@ import robots
 from planners.constraints import build_path_constraints
 from planners.grid import path_grid
 from planners.limit_check import _torques, check_limits, joint_motion
+from planners.limit_kernels import utilization_pass
 from planners.paths import SplinePath
 from planners.timing import PhasePlaneMethod, ToppraMethod
 from robots.catalog import robot_from_model
@@ -59,3 +60,25 @@ def test_dense_check_torques_from_rows_equal_rnea(name, method):
     slow = check_limits(path, timing, robot, robot.limits, KINDS, 1.003, constraints.s)
     for kind in KINDS:
         np.testing.assert_allclose(fast.utilization[kind], slow.utilization[kind], rtol=1e-12)
+
+
+def test_utilization_pass_equals_the_numpy_reduction():
+    """The compiled pass of the dense check against |value| / limit in numpy: the peak of each
+    joint, the worst state and joint, and the states beyond the threshold, with unlimited
+    joints (inf), a zero limit, infinite and NaN values (NaN ratios count as 0)."""
+    rng = np.random.default_rng(8)
+    value = rng.normal(0.0, 1.0, (400, 5))
+    value[17, 2], value[30, 1], value[41, 4], value[50, 0] = np.inf, np.nan, np.inf, 0.0
+    limit = np.array([0.0, 2.0, 1.5, np.inf, np.inf])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.nan_to_num(np.abs(value) / limit, nan=0.0, posinf=np.inf)
+    over = np.zeros(400, dtype=bool)
+    over[3] = True  # set by an earlier kind: kept
+    peak = np.empty(5)
+    worst, state, joint = utilization_pass(value, limit, 1.2, peak, over)
+    np.testing.assert_array_equal(peak, ratio.max(axis=0))
+    per_state = ratio.max(axis=1)
+    assert (worst, state, joint) == (per_state.max(), int(np.argmax(per_state)), int(np.argmax(ratio[np.argmax(per_state)])))
+    expected = per_state > 1.2
+    expected[3] = True
+    np.testing.assert_array_equal(over, expected)

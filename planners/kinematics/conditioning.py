@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from planners.kinematics.condition_kernels import gram_condition_numbers
 from robots import Robot
 
 #: A warning is raised above this condition number.
@@ -34,24 +35,16 @@ def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
     rank-deficient (sigma_min <= 1e-12 sigma_max). A stack (k, m, n) gives k values.
 
     With G = J^T J (m >= n) or J J^T (m < n), the k = min(m, n) squared singular values are G's
-    eigenvalues, so sum sigma_i^2 = tr G and sum sigma_i^-2 = tr G^-1: a batched inverse of the
-    small Gram matrices instead of their singular value decompositions (four times faster on a
-    stack of 6 x 6). Where that gives kappa_F > ``GRAM_KAPPA`` (or G cannot be inverted), the
-    value comes from the singular values instead, which also decide rank deficiency.
+    eigenvalues, so sum sigma_i^2 = tr G and sum sigma_i^-2 = tr G^-1: the small Gram matrices'
+    Cholesky factors, compiled (``planners.kinematics.condition_kernels``), instead of their
+    singular value decompositions. Where that gives kappa_F > ``GRAM_KAPPA`` (or G is not
+    positive definite), the value comes from the singular values instead, which also decide
+    rank deficiency.
     """
     jacobian = np.asarray(jacobian, dtype=float)
-    stack = jacobian.reshape((-1, *jacobian.shape[-2:]))
-    m, n = stack.shape[-2:]
-    gram = stack.transpose(0, 2, 1) @ stack if m >= n else stack @ stack.transpose(0, 2, 1)
-    count = min(m, n)
-    kappa = np.full(len(stack), np.inf)
-    try:
-        inverse = np.linalg.inv(gram)
-    except np.linalg.LinAlgError:
-        inverse = None
-    if inverse is not None:
-        with np.errstate(invalid="ignore", over="ignore"):
-            kappa = np.sqrt(np.trace(gram, axis1=1, axis2=2) * np.trace(inverse, axis1=1, axis2=2)) / count
+    stack = np.ascontiguousarray(jacobian.reshape((-1, *jacobian.shape[-2:])))
+    kappa = np.empty(len(stack))
+    gram_condition_numbers(stack, kappa)
     exact = ~(np.isfinite(kappa) & (kappa <= GRAM_KAPPA))
     if exact.any():
         kappa[exact] = _from_singular_values(stack[exact])
