@@ -238,8 +238,10 @@ class _Grid(NamedTuple):
         x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
         joint = constraints.velocity_joint
         binding = np.full(len(s), -1, dtype=np.int64) if joint is None else np.ascontiguousarray(joint, dtype=np.int64)
-        knots = constraints.knots
-        knot = np.zeros(len(s), dtype=np.bool_) if knots is None else np.isin(s, knots)
+        knot = np.zeros(len(s), dtype=np.bool_)
+        if constraints.knots is not None and len(constraints.knots):
+            at = np.minimum(np.searchsorted(s, constraints.knots), len(s) - 1)
+            knot[at[s[at] == constraints.knots]] = True
         friction = bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any()))
         return cls(constraints, s, rows, x_bound, binding, knot, friction)
 
