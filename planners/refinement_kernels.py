@@ -103,10 +103,8 @@ def _pieces(error, order, shrink, pieces):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def refinement(s, x, x_mid, ceiling, switch, least, tolerance, aim, guard, max_pieces, room):  # pragma: no cover - compiled
-    """Error estimate of the profile x (N + 1,) on the grid s, and where to refine it; every
-    interval is split into at least ``least`` (N,) pieces (``row_excursions``), whatever the
-    duration error.
+def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard):  # pragma: no cover - compiled
+    """Error estimate of the profile x (N + 1,) on the grid s, and how finely to refine it.
 
     Each interval's error, this discretization's time minus the exact one, is estimated from:
 
@@ -124,14 +122,14 @@ def refinement(s, x, x_mid, ceiling, switch, least, tolerance, aim, guard, max_p
 
     The estimated relative error is |the signed sum| plus ``guard`` times the magnitudes that
     may cancel in it or estimate nothing (chord errors, unresolved intervals): a guard against
-    errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are split into
-    equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order one;
-    the fewest pieces that bring the estimate to ``aim`` times the tolerance (``_pieces``, the
-    larger of the two kinds, at most ``max_pieces`` per interval and ``room`` new points in
-    all, the worst intervals first).
+    errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are to be split
+    into equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order
+    one; the fewest pieces that bring the estimate to ``aim`` times the tolerance (``_pieces``,
+    the larger of the two kinds).
 
-    Returns the new points (sorted, each strictly inside an interval; empty when the estimate
-    is within the tolerance) and the estimated relative error.
+    Returns the pieces wanted per interval (N,; all 1 when the estimate is within the
+    tolerance), each interval's estimated error (N,, s: which to split first when the grid's
+    cap allows fewer points, ``split_points``) and the estimated relative error.
     """
     n_stages = s.shape[0] - 1
     first = np.empty(n_stages)
@@ -178,16 +176,21 @@ def refinement(s, x, x_mid, ceiling, switch, least, tolerance, aim, guard, max_p
     if not exact > 0.0:
         exact = duration
     error = (abs(signed) + guard * uncertain) / exact
-    split = error > tolerance
-    for i in range(n_stages):
-        split = split or least[i] > 1
-    if not split or room <= 0:
-        return np.empty(0), error
-    wanted = least.astype(np.float64)
+    wanted = np.ones(n_stages)
     if error > tolerance:
         shrink = aim * tolerance / error
         _pieces(first, 1.0, shrink, wanted)
         _pieces(second, 2.0, shrink, wanted)
+    return wanted, first + second, error
+
+
+@njit(cache=True, nogil=True)
+def split_points(s, wanted, priority, max_pieces, room):  # pragma: no cover - compiled
+    """The points that split each interval of the grid s (N + 1,) into ceil(``wanted``) (N,)
+    equal pieces, at most ``max_pieces`` per interval and ``room`` new points in all (the
+    intervals of the highest ``priority`` (N,) first, each as asked); sorted, each strictly
+    inside its interval, none closer than rounding resolves."""
+    n_stages = s.shape[0] - 1
     pieces = np.empty(n_stages, dtype=np.int64)
     added = 0
     for i in range(n_stages):
@@ -198,7 +201,7 @@ def refinement(s, x, x_mid, ceiling, switch, least, tolerance, aim, guard, max_p
         added += pieces[i] - 1
     if added > room:
         # Too many for the grid's cap: the worst intervals first, each as asked.
-        worst = np.argsort(-(first + second), kind="mergesort")
+        worst = np.argsort(-priority, kind="mergesort")
         used = 0
         for index in worst:
             if used + pieces[index] - 1 <= room:
@@ -212,8 +215,7 @@ def refinement(s, x, x_mid, ceiling, switch, least, tolerance, aim, guard, max_p
         for j in range(1, pieces[i]):
             points[at] = s[i] + (s[i + 1] - s[i]) * j / pieces[i]
             at += 1
-    return points, error
-
+    return points
 
 @njit(cache=True, nogil=True)
 def _lagrange_weights(nodes, count, at, weights):  # pragma: no cover - compiled
@@ -292,7 +294,7 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
     """
     n_stages = s.shape[0] - 1
     n_rows = a.shape[1]
-    least = np.ones(n_stages, dtype=np.int64)
+    least = np.ones(n_stages)
     nodes = np.empty(4)
     points = np.empty(4, dtype=np.int64)
     weights = np.empty(4)
@@ -368,6 +370,5 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
                         value += weights[node] * _row_value(a, b, c, d, point, k, u, x_at, sd_at)
                 worst = max(worst, _excess(value, lower[i, k], upper[i, k]))
         if worst > target:
-            pieces = np.ceil(np.sqrt(worst / target))
-            least[i] = max_pieces if pieces > max_pieces else int(pieces)
+            least[i] = min(np.ceil(np.sqrt(worst / target)), max_pieces)
     return least

@@ -52,7 +52,7 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.kernels import point_bounds, sweeps
 from planners.mvc import admissible_set
-from planners.refinement_kernels import refinement, row_excursions
+from planners.refinement_kernels import refinement, row_excursions, split_points
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
@@ -155,20 +155,16 @@ class PhasePlaneMethod(TimingMethod):
                 break
             room = most_intervals - (len(grid.s) - 1)
             ceiling = np.append(profile.x_high, grid.x_bound[-1])
-            ones = np.ones(len(grid.s) - 1, dtype=np.int64)
-            extra, error = refinement(
-                grid.s, profile.x, reference.x, ceiling, profile.switch_excess, ones,
-                self.tolerance, _AIM, _GUARD, _MAX_PIECES, room,
+            wanted, priority, error = refinement(
+                grid.s, profile.x, reference.x, ceiling, profile.switch_excess, self.tolerance, _AIM, _GUARD
             )
-            if extra.size == 0 and self.excursion is not None:
-                # The duration is within the tolerance: the limits' excursions between grid
-                # points decide the last split.
-                least = row_excursions(grid.s, *grid.rows, grid.x_bound, grid.binding, grid.knot, profile.x, self.excursion, _MAX_PIECES)
-                if (least > 1).any():
-                    extra, _ = refinement(
-                        grid.s, profile.x, reference.x, ceiling, profile.switch_excess, least,
-                        self.tolerance, _AIM, _GUARD, _MAX_PIECES, room,
-                    )
+            if error <= self.tolerance:
+                if self.excursion is None:
+                    break
+                # The duration is within its tolerance: the limits' excursions between grid
+                # points decide a last split.
+                wanted = row_excursions(grid.s, *grid.rows, grid.x_bound, grid.binding, grid.knot, profile.x, self.excursion, _MAX_PIECES)
+            extra = split_points(grid.s, wanted, priority, _MAX_PIECES, room)
             if extra.size == 0:
                 break
             deadline.check()
