@@ -31,6 +31,7 @@ from planners.constraint_kernels import assemble_rows, velocity_bound
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
 from planners.tool_speed import tool_speed_bound
+from planners.torque_interpolation import MAX_TRAVEL, interpolate_rows
 from robots import JointLimits, Robot
 
 CONSTRAINT_KINDS = ("velocity", "acceleration", "torque", "jerk")
@@ -63,7 +64,10 @@ class PathConstraints:
             index of that limit in ``TOOL_KINDS`` (N + 1,), -1 elsewhere; ``None`` without one.
         knots: The s of the path's knots (where a derivative of q(s) jumps, so the rows are
             not smooth across them even where they are continuous); ``None`` when unknown.
-        evaluate: Builds the same constraints at other values of s (for methods that refine).
+        q: The path's points at the grid, (N + 1, n_dof); ``None`` when unknown.
+        evaluate: Builds the same constraints at other values of s (for methods that refine);
+            given these constraints too, it may interpolate the torque rows from them
+            (``build_path_constraints``).
     """
 
     s: np.ndarray
@@ -85,19 +89,22 @@ class PathConstraints:
     velocity_joint: np.ndarray | None = None
     tool_bound: np.ndarray | None = None
     knots: np.ndarray | None = None
-    evaluate: Callable[[np.ndarray], PathConstraints] | None = field(default=None, repr=False, compare=False)
+    q: np.ndarray | None = None
+    evaluate: Callable[..., PathConstraints] | None = field(default=None, repr=False, compare=False)
 
     @property
     def can_refine(self) -> bool:
         """Whether rows can be evaluated at new values of s (``with_points``)."""
         return self.evaluate is not None
 
-    def with_points(self, extra_s: np.ndarray) -> PathConstraints:
+    def with_points(self, extra_s: np.ndarray, interpolate: bool = False) -> PathConstraints:
         """These constraints on the grid refined by ``extra_s`` (values strictly inside grid
-        intervals, never at a corner), evaluating the rows only at the new points."""
+        intervals, never at a corner), evaluating the rows only at the new points; with
+        ``interpolate``, the torque rows are interpolated from these rows where that is
+        accurate (``build_path_constraints``), for a method refining its own grid."""
         if self.evaluate is None:
             raise ValueError("these constraints cannot be evaluated at other points (refinable is False)")
-        extra = self.evaluate(np.asarray(extra_s, dtype=float))
+        extra = self.evaluate(np.asarray(extra_s, dtype=float), self if interpolate else None)
         order = np.argsort(np.concatenate([self.s, extra.s]), kind="stable")
 
         def merge(mine, theirs):
@@ -137,6 +144,7 @@ class PathConstraints:
             jerk=jerk,
             jerk_left=jerk_left,
             knots=self.knots,
+            q=None if self.q is None or extra.q is None else merge(self.q, extra.q),
             evaluate=self.evaluate,
         )
 
@@ -159,6 +167,24 @@ class PathConstraints:
             jerk_left=None,
             evaluate=None,
         )
+
+    def smooth_points(self) -> np.ndarray:
+        """(N + 1,): the grid points through which the rows are smooth (so that a polynomial
+        through them interpolates the rows): interior, no knot of the path, the same rows
+        from both sides."""
+        smooth = np.ones(len(self.s), dtype=bool)
+        smooth[[0, -1]] = False
+        if self.knots is not None and len(self.knots):
+            smooth &= ~np.isin(self.s, self.knots)
+        for right, left in ((self.a, self.a_left), (self.b, self.b_left), (self.c, self.c_left), (self.d, self.d_left)):
+            if right is not left:
+                smooth &= np.all(right == left, axis=1)
+        return smooth
+
+    def travel(self) -> np.ndarray | None:
+        """(N,): the joints' travel over each grid interval, sum over the joints of
+        |q(s_i+1) - q(s_i)| (rad); ``None`` when the grid's points are unknown."""
+        return None if self.q is None else np.abs(np.diff(self.q, axis=0)).sum(axis=1)
 
     @property
     def has_friction(self) -> bool:
@@ -225,12 +251,15 @@ def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) ->
 CHUNK_POINTS = 1024
 
 
-def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, deadline: Deadline = NO_DEADLINE):
+def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, deadline: Deadline = NO_DEADLINE, known=None, s=None):
     """The second-order rows ``(a, b, c, d, lower, upper)`` at n points of a path (``q, dq,
     ddq``, each (n, n_dof)) and their (kind, joint) labels: each array (n, m), acceleration rows
     then torque rows, of the joints whose limit is finite (a row with an infinite limit
     constrains nothing). The torque rows take one batched RNEA per ``CHUNK_POINTS`` points, the
-    deadline checked before each; ``planners.constraint_kernels.assemble_rows`` writes them."""
+    deadline checked before each; ``planners.constraint_kernels.assemble_rows`` writes them.
+    With ``known`` (``PathConstraints`` on a grid around the points) and the points' ``s`` on
+    it, M q', M q'' + C q' q' and g are interpolated from its rows where that is accurate
+    (``_interpolated_terms``), and the RNEA runs at the other points only."""
     nothing = np.empty(0, dtype=np.intp)
     accelerated = np.flatnonzero(np.isfinite(limits.acceleration)) if "acceleration" in kinds else nothing
     torqued = np.flatnonzero(np.isfinite(limits.torque)) if "torque" in kinds else nothing
@@ -242,15 +271,64 @@ def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.nd
     no_torque = np.empty((0, dq.shape[1]))
     acceleration = np.asarray(limits.acceleration, dtype=float)
     torque = np.asarray(limits.torque, dtype=float)
+    terms = None if known is None or not torqued.size else _interpolated_terms(robot, known, torqued, s, q, dq, ddq, deadline)
     for start in range(0, n, CHUNK_POINTS):
         deadline.check()
         part = slice(start, start + CHUNK_POINTS)
-        tau = _rnea_terms(robot, q[part], dq[part], ddq[part]) if torqued.size else no_torque
+        if terms is not None:
+            tau = terms[:, part].reshape(-1, dq.shape[1])
+        else:
+            tau = _rnea_terms(robot, q[part], dq[part], ddq[part]) if torqued.size else no_torque
         assemble_rows(
             dq[part], ddq[part], tau, robot.coulomb_friction, robot.viscous_friction, accelerated, acceleration, torqued, torque,
             *(array[part] for array in arrays),
         )
     return arrays, rows
+
+
+#: Largest estimated error of an interpolated M q', M q'' + C q' q' or g (``_interpolated_terms``),
+#: a fraction of the term's largest magnitude along the known grid.
+TERM_TOLERANCE = 1e-6
+#: A term's magnitude is taken as at least this fraction of the joint's torque limit (g of a
+#: vertical joint is zero all along).
+_TERM_FLOOR = 1e-3
+
+
+def _interpolated_terms(robot: Robot, known: PathConstraints, torqued: np.ndarray, s, q, dq, ddq, deadline: Deadline) -> np.ndarray | None:
+    """g, M q' + g and M q'' + C q' q' + g (the RNEA terms of ``_rnea_terms``) at the n points
+    ``s`` (each strictly inside an interval of ``known``'s grid) of ``q, dq, ddq``, as (3, n, n_dof): for the torqued joints interpolated from the rows of
+    ``known`` (``planners.torque_interpolation.interpolate_rows``, each term apart, within
+    ``TERM_TOLERANCE`` of its largest magnitude on that grid, at least ``_TERM_FLOOR`` of the limit) where its grid resolves them, by
+    RNEA at the other points. ``None`` (all by RNEA) when ``known`` cannot serve: no points or
+    rows of its own, or Coulomb friction (whose sign its rows hold inside c)."""
+    columns = [known.rows.index(("torque", int(j))) if ("torque", int(j)) in known.rows else -1 for j in torqued]
+    travel = known.travel()
+    coulomb = np.asarray(robot.coulomb_friction, dtype=float)[torqued]
+    if travel is None or min(columns) < 0 or np.any(coulomb != 0.0) or len(known.s) < 5:
+        return None
+    grid = known.s
+    zero = np.zeros((len(grid), len(columns)))
+    limit = np.maximum(known.upper[0, columns], -known.lower[0, columns])
+    right = np.stack([known.a[:, columns], known.b[:, columns], known.c[:, columns], zero])
+    left = np.stack([known.a_left[:, columns], known.b_left[:, columns], known.c_left[:, columns], zero])
+    smooth = known.smooth_points()
+    interval = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
+    n = len(s)
+    values = np.zeros((3, n, len(columns)))
+    exact = np.zeros(n, dtype=bool)
+    for term in range(3):
+        factors = np.zeros((n, 4))
+        factors[:, term] = 1.0
+        scale = np.abs(right[term]).max(axis=0) + _TERM_FLOOR * limit
+        interpolate_rows(grid, smooth, right, left, travel, MAX_TRAVEL, scale, s, interval, factors, TERM_TOLERANCE, values[term], exact)
+    a, b, g = values
+    terms = np.zeros((3, n, dq.shape[1]))
+    terms[0][:, torqued], terms[1][:, torqued], terms[2][:, torqued] = g, a + g, b + g
+    if exact.any():
+        deadline.check()
+        tau = _rnea_terms(robot, q[exact], dq[exact], ddq[exact])
+        terms[:, exact] = tau.reshape(3, -1, dq.shape[1])
+    return terms
 
 
 def speed_bound(limits: JointLimits, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -262,10 +340,10 @@ def speed_bound(limits: JointLimits, dq: np.ndarray) -> tuple[np.ndarray, np.nda
     return sd_max, binding
 
 
-def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline):
+def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline, known=None):
     """The path's points at ``s`` and their rows (``grid_rows``)."""
     points = path.evaluate(s, side)
-    arrays, rows = grid_rows(robot, limits, kinds, points.q, points.dq, points.ddq, deadline)
+    arrays, rows = grid_rows(robot, limits, kinds, points.q, points.dq, points.ddq, deadline, known, s)
     return points, arrays, rows
 
 
@@ -296,11 +374,14 @@ def build_path_constraints(
     kinds: tuple[str, ...],
     s: np.ndarray,
     deadline: Deadline = NO_DEADLINE,
+    known: PathConstraints | None = None,
 ) -> PathConstraints:
     """Evaluate the requested ``kinds`` of limits (subset of velocity, acceleration, torque)
     along ``path`` at the grid ``s`` (which must hold the path's kinks); a tool-speed limit
-    (``limits.tool``) joins the first-order bound sd_max."""
-    points, (a, b, c, d, lower, upper), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
+    (``limits.tool``) joins the first-order bound sd_max. With ``known`` (these constraints on
+    a grid the points of ``s`` lie strictly inside), the torque rows are interpolated from its
+    rows where that is accurate (``grid_rows``)."""
+    points, (a, b, c, d, lower, upper), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline, known)
     deadline.check()
     sd_max = np.full(len(s), np.inf)
     velocity_joint = np.full(len(s), -1)
@@ -344,5 +425,6 @@ def build_path_constraints(
         velocity_joint=velocity_joint,
         tool_bound=tool_bound,
         knots=np.asarray(path.knots, dtype=float),
-        evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),
+        q=points.q,
+        evaluate=lambda extra_s, known=None: build_path_constraints(path, robot, limits, kinds, extra_s, deadline, known),
     )

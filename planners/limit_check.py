@@ -29,6 +29,7 @@ from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.tool_speed import TOOL_KINDS, tool_speeds
+from planners.torque_interpolation import MAX_TRAVEL, interpolate_rows
 from robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included: the ends and the quarter points.
@@ -38,6 +39,10 @@ from robots import JointLimits, Robot
 #: height (seven states: 35/36, at 1.7 times the dynamics evaluations).
 POINTS_PER_INTERVAL = 5
 KINDS = ("velocity", "acceleration", "torque", "jerk")
+#: Largest estimated error, as a fraction of the joint's torque limit, of a torque interpolated
+#: between grid points from the rows (``planners.torque_interpolation``); a state whose estimate
+#: is larger gets Pinocchio's RNEA. Far below the gate's ``LIMIT_TOLERANCE`` - 1.
+INTERPOLATION_TOLERANCE = 1e-5
 
 
 @dataclass(frozen=True)
@@ -97,30 +102,64 @@ def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, np.ndarray, n
 
 
 def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | None) -> np.ndarray:
-    """Joint torques (n, n_dof) at ``states``. At a state on the grid of ``constraints`` (when
-    they hold a torque row for every joint) the torque is the row ``a u + b x + c + d sd`` the
-    build computed there with Pinocchio's RNEA (the same number, to rounding), on the side the
-    state belongs to; the RNEA runs, batched, at every other state. States at rest are left to
-    the RNEA: the rows carry Coulomb friction for a moving joint."""
+    """Joint torques (n, n_dof) at ``states``. At a moving state on the grid of ``constraints``
+    (when they hold a torque row for every joint) the torque is the row ``a u + b x + c + d sd``
+    the build computed there with Pinocchio's RNEA (the same number, to rounding), on the side
+    the state belongs to; between grid points it is interpolated from those rows
+    (``planners.torque_interpolation``) where the grid resolves them and the interpolation's
+    estimated error is within ``INTERPOLATION_TOLERANCE`` of the limit. The RNEA runs, batched,
+    at every other state."""
     column = {} if constraints is None else {joint: k for k, (kind, joint) in enumerate(constraints.rows) if kind == "torque"}
     if constraints is None or len(column) != robot.dof:
         return robot.inverse_dynamics(q, qd, qdd)
     columns = [column[joint] for joint in range(robot.dof)]
     grid = constraints.s
     index = np.clip(np.searchsorted(grid, states.s), 0, len(grid) - 1)
-    on_grid = (grid[index] == states.s) & (states.sd > 0.0)
+    at_point = grid[index] == states.s
+    on_grid = at_point & (states.sd > 0.0)
     tau = np.empty_like(qd)
-    between = ~on_grid
-    tau[between] = robot.inverse_dynamics(q[between], qd[between], qdd[between])
+    coulomb = np.asarray(robot.coulomb_friction, dtype=float)
+    stacks = {}
     for left, rows in ((False, (constraints.a, constraints.b, constraints.c, constraints.d)),
                        (True, (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left))):
+        stack = np.stack([row[:, columns] for row in rows])
         mask = on_grid & (states.left == left)
-        if not mask.any():
-            continue
-        point = index[mask]
-        a, b, c, d = (row[point][:, columns] for row in rows)
-        sd, sdd = states.sd[mask, None], states.sdd[mask, None]
-        tau[mask] = a * sdd + b * (sd * sd) + c + d * sd
+        if mask.any():
+            a, b, c, d = stack[:, index[mask]]
+            sd, sdd = states.sd[mask, None], states.sdd[mask, None]
+            tau[mask] = a * sdd + b * (sd * sd) + c + d * sd
+        if np.any(coulomb):
+            # g = c - F sign(q'), with the signs the build used, read off the moving states on
+            # the grid (unknown elsewhere).
+            sign = np.full((len(grid), robot.dof), np.nan)
+            sign[index[mask]] = np.sign(qd[mask])
+            stack[2] -= np.where(coulomb != 0.0, coulomb * sign, 0.0)
+        stacks[left] = stack
+    between = np.flatnonzero(~on_grid)
+    if between.size == 0:
+        return tau
+    s, sd = states.s[between], states.sd[between]
+    interval = np.where(
+        states.left[between], np.searchsorted(grid, s, side="left"), np.searchsorted(grid, s, side="right")
+    ) - 1
+    factors = np.stack([states.sdd[between], sd * sd, np.ones_like(sd), sd], axis=1)
+    travel = constraints.travel()
+    exact = np.zeros(between.size, dtype=bool)
+    part = np.empty((between.size, robot.dof))
+    if travel is None:
+        exact[:] = True
+    else:
+        interpolate_rows(
+            grid, constraints.smooth_points(), stacks[False], stacks[True], travel, MAX_TRAVEL,
+            np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
+            s, np.clip(interval, 0, len(grid) - 2), factors, INTERPOLATION_TOLERANCE, part, exact,
+        )
+    if np.any(coulomb):
+        part += coulomb * np.sign(qd[between])
+    if exact.any():
+        again = between[exact]
+        part[exact] = robot.inverse_dynamics(q[again], qd[again], qdd[again])
+    tau[between] = part
     return tau
 
 

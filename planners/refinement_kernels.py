@@ -218,7 +218,7 @@ def split_points(s, wanted, priority, max_pieces, room):  # pragma: no cover - c
     return points
 
 @njit(cache=True, nogil=True)
-def _lagrange_weights(nodes, count, at, weights):  # pragma: no cover - compiled
+def lagrange_weights(nodes, count, at, weights):  # pragma: no cover - compiled
     """Write into ``weights[:count]`` the Lagrange weights of the polynomial through
     ``nodes[:count]`` evaluated at ``at``."""
     for j in range(count):
@@ -347,7 +347,7 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
             at = s[i] + fraction * h
             x_at = x[i] + fraction * (x[i + 1] - x[i])
             if speed_count >= 2 and x_at > 0.0:
-                _lagrange_weights(speed_nodes, speed_count, at, speed_weights)
+                lagrange_weights(speed_nodes, speed_count, at, speed_weights)
                 inverse = 0.0
                 for node in range(speed_count):
                     inverse += speed_weights[node] * inverse_bound[node]
@@ -356,7 +356,7 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
             if not any_near:
                 continue
             sd_at = np.sqrt(max(x_at, 0.0))
-            _lagrange_weights(nodes, count, at, weights)
+            lagrange_weights(nodes, count, at, weights)
             for k in range(n_rows):
                 if not near[k]:
                     continue

@@ -1,0 +1,119 @@
+"""Joint torques between the grid points of a path's constraints, from the rows the build
+computed there (numba, ``nogil``, cached): the dense limit check's torques without a dynamics
+evaluation per state where the rows' interpolation is accurate, and with one where it is not.
+
+Along q(s) the torque of joint j at a state (s, sd, sdd) is (Jeong & Lee eq. (3.4b) with
+x = sd^2, u = sdd, and the URDF's joint friction)
+
+    tau_j = a_j(s) u + b_j(s) x + g_j(s) + d_j(s) sd + F_j sign(q'_j(s) sd),
+
+with a = M q', b = M q'' + C(q, q') q', g the gravity torque and d = D q' (N m, or N m s for
+d), each smooth in s between the path's knots (q(s) is a polynomial there). The rows
+``a u + b x + c + d sd`` the constraint build computed with Pinocchio's RNEA hold a, b, d and
+c = g + F sign(q') at the grid points. At a state between them, a, b, g and d are each read
+from the cubic through four consecutive grid points that no knot, corner or break of the path
+separates (Lagrange, on the non-uniform grid; the two nearest on each side where the run of
+smooth points allows), and the Coulomb term is added at the state itself. The interpolation
+error is estimated by the cubic through the next run of four points (one node shifted): it
+is of the fifth order in the grid's spacing, which a second cubic off by one node estimates
+to within a factor of order one. Where that estimate exceeds ``tolerance`` of the joint's
+torque limit, or fewer than five grid points are smooth around the state, the state is
+marked for Pinocchio's RNEA instead.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from planners.refinement_kernels import lagrange_weights
+
+#: Largest joint travel (rad, summed over the joints) of a grid interval whose rows are
+#: interpolated: the rows are trigonometric in q, and a grid coarser than this does not resolve
+#: them well enough for the interpolation's error estimate to be trusted (on ur5 with 60
+#: intervals over moves of several rad, a cubic and a quartic agree and both miss by 3.6e-5
+#: of the limit).
+MAX_TRAVEL = 0.1
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def interpolate_rows(grid, smooth, right, left, travel, max_travel, limit, s, interval, factors, tolerance, tau, exact):  # pragma: no cover - compiled
+    """Write a u + b x + g + d sd (the torques of n states, without Coulomb friction; or, with
+    ``factors`` picking one row, that row) into ``tau`` (n, n_dof), and mark in ``exact`` (n,)
+    the states whose interpolation is not trusted (their rows of ``tau`` are left unset).
+
+    Args:
+        grid: Grid of s the rows were built on, (N + 1,).
+        smooth: (N + 1,): the rows are smooth through the grid point (an interior point that is
+            no knot of the path and where the rows from both sides agree).
+        right, left: a, b, g and d of each joint's torque at each grid point, (4, N + 1, n_dof),
+            from the right and from the left of the point (they differ at corners and breaks);
+            NaN where unknown (the states that would read them go to RNEA).
+        travel: Sum over the joints of |q(s_i+1) - q(s_i)| of each grid interval, (N,), rad.
+        max_travel: Largest ``travel`` of an interval whose rows are interpolated: a coarser
+            grid does not resolve rows trigonometric in q well enough for the estimate.
+        limit: Torque limit per joint, (n_dof,), N m (finite): the scale of ``tolerance``.
+        s, interval: The states' s and the grid interval i each lies in (grid[i] <= s <=
+            grid[i + 1]; the state belongs to that interval's side of a grid point), (n,).
+        factors: u, x, 1 and sd of each state, (n, 4): tau = a u + b x + g + d sd.
+        tolerance: Largest estimated interpolation error trusted, a fraction of the limit.
+    """
+    n_grid = grid.shape[0]
+    n_dof = right.shape[2]
+    quartic = np.empty(5)
+    cubic = np.empty(4)
+    shifted = np.empty(4)
+    nodes = np.empty(5)
+    for state in range(s.shape[0]):
+        i = interval[state]
+        lo = i
+        while lo > i - 2 and lo > 0 and smooth[lo]:
+            lo -= 1
+        hi = i + 1
+        while hi < i + 3 and hi < n_grid - 1 and smooth[hi]:
+            hi += 1
+        if hi - lo + 1 < 5:
+            exact[state] = True
+            continue
+        # Five consecutive smooth points around the interval: the quartic through them gives
+        # the value, the cubics through their first and last four the error estimate.
+        start = min(max(i - 2, lo), hi - 4)
+        resolved = True
+        for node in range(start, start + 4):
+            resolved = resolved and travel[node] <= max_travel
+        if not resolved:
+            exact[state] = True
+            continue
+        for k in range(5):
+            nodes[k] = grid[start + k]
+        lagrange_weights(nodes, 5, s[state], quartic)
+        lagrange_weights(nodes, 4, s[state], cubic)
+        lagrange_weights(nodes[1:], 4, s[state], shifted)
+        trusted = True
+        for j in range(n_dof):
+            # Each row's value and error apart: their errors may cancel in one state's torque
+            # and add up in the next one's.
+            value = 0.0
+            error = 0.0
+            for row in range(4):
+                quartic_value = 0.0
+                cubic_value = 0.0
+                shifted_value = 0.0
+                for k in range(5):
+                    node = start + k
+                    # A node beyond the interval's far end is seen from the left, as the interval sees it.
+                    entry = left[row, node, j] if node > i else right[row, node, j]
+                    quartic_value += quartic[k] * entry
+                    if k < 4:
+                        cubic_value += cubic[k] * entry
+                    if k > 0:
+                        shifted_value += shifted[k - 1] * entry
+                factor = factors[state, row]
+                value += factor * quartic_value
+                error += abs(factor) * max(abs(quartic_value - cubic_value), abs(quartic_value - shifted_value))
+            if not error <= tolerance * limit[j]:
+                trusted = False
+                break
+            tau[state, j] = value
+        if not trusted:
+            exact[state] = True

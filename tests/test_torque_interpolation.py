@@ -1,0 +1,191 @@
+"""Torques and torque rows interpolated from a grid's rows (``planners.torque_interpolation``)
+against Pinocchio's RNEA: the dense check's torques between grid points (within
+``INTERPOLATION_TOLERANCE`` of the limit where interpolated, RNEA itself where the grid does not
+resolve the rows, interpolated at most states of an ordinary request), and the rows a
+refinement adds (within ``TERM_TOLERANCE``, RNEA with Coulomb friction or a coarse grid)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import robots
+from planners.constraints import _TERM_FLOOR, TERM_TOLERANCE, build_path_constraints
+from planners.grid import path_grid
+from planners.limit_check import INTERPOLATION_TOLERANCE, _torques, joint_motion
+from planners.paths import SplinePath, StopAndGoPath
+from planners.paths.blended import BlendedPath
+from planners.timing import PhasePlaneMethod, ToppraMethod
+from planners.torque_interpolation import MAX_TRAVEL
+from robots import Robot
+from robots.catalog import robot_from_model
+from robots.urdf_check import check_urdf
+
+KINDS = ("velocity", "acceleration", "torque")
+
+
+class _CountingRnea:
+    """Counts the states whose torques go to ``Robot.inverse_dynamics``."""
+
+    def __init__(self, monkeypatch):
+        self.states = 0
+        original = Robot.inverse_dynamics
+
+        def counted(robot, q, qd, qdd):
+            self.states += len(np.atleast_2d(q))
+            return original(robot, q, qd, qdd)
+
+        monkeypatch.setattr(Robot, "inverse_dynamics", counted)
+
+
+def _wide_path(robot, seed: int, spread: float = 3.0):
+    rng = np.random.default_rng(seed)
+    lower = np.maximum(robot.limits.position_lower, -spread)
+    upper = np.minimum(robot.limits.position_upper, spread)
+    return SplinePath(rng.uniform(lower, upper, (int(rng.integers(2, 6)), robot.dof)))
+
+
+def _timed_states(robot, path, grid, method=ToppraMethod()):
+    constraints = build_path_constraints(path, robot, robot.limits, KINDS, grid)
+    timing = method.solve(constraints)
+    states = timing.dense_states(5, constraints.s)
+    return constraints, states, joint_motion(path, states)
+
+
+@pytest.mark.parametrize("name", ["ur5", "yamamoto_2r", "panda"])
+@pytest.mark.parametrize("intervals", [30, 60, 120])
+def test_within_tolerance_on_coarse_grids_of_wide_motions(name, intervals):
+    """Moves of up to 6 rad per joint on coarse grids, where a cubic and a quartic through the
+    rows can agree with each other and both miss the torque (by 3.6e-5 of the limit on ur5
+    with 60 intervals): the grid's travel decides, and every state stays within tolerance."""
+    robot = robots.load(name)
+    worst = 0.0
+    for seed in range(10):
+        path = _wide_path(robot, seed)
+        grid = np.unique(np.concatenate([np.linspace(0.0, 1.0, intervals + 1), path.knots]))
+        try:
+            constraints, states, (q, qd, qdd, _) = _timed_states(robot, path, grid)
+        except Exception:  # an infeasible random path times nothing
+            continue
+        tau = _torques(robot, states, q, qd, qdd, constraints)
+        worst = max(worst, float(np.max(np.abs(tau - robot.inverse_dynamics(q, qd, qdd)) / robot.limits.torque)))
+    assert worst <= INTERPOLATION_TOLERANCE
+
+
+def test_a_grid_that_does_not_resolve_the_rows_gets_rnea(monkeypatch):
+    """Every interval of a 12-interval grid over a 3-waypoint path moves the joints by more
+    than ``MAX_TRAVEL``: every state off the grid is computed by RNEA."""
+    robot = robots.load("ur5")
+    path = SplinePath(np.array([[0.0, -1.2, 1.0, 0.0, 0.0, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3], [2.0, -1.3, 1.2, 0.2, 0.4, 1.2]]))
+    grid = path_grid(path, 12)
+    constraints, states, (q, qd, qdd, _) = _timed_states(robot, path, grid)
+    assert np.all(np.abs(np.diff(path.evaluate(grid).q, axis=0)).sum(axis=1) > MAX_TRAVEL)
+    counter = _CountingRnea(monkeypatch)
+    tau = _torques(robot, states, q, qd, qdd, constraints)
+    assert counter.states == np.count_nonzero(~np.isin(states.s, grid) | (states.sd == 0.0))
+    monkeypatch.undo()
+    np.testing.assert_allclose(tau, robot.inverse_dynamics(q, qd, qdd), rtol=0, atol=1e-12 * robot.limits.torque.max())
+
+
+def test_most_states_of_an_ordinary_request_are_interpolated(monkeypatch):
+    """The typical request's path on its default grid: fewer than a tenth of the states off the
+    grid need RNEA, and the torques are within a hundredth of the tolerance."""
+    robot = robots.load("ur5")
+    waypoints = [[0, -1.2, 1, 0, 0, 0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3], [1.5, -0.5, 0.8, -1.0, 1.0, 0.8], [2.0, -1.3, 1.2, 0.2, 0.4, 1.2]]
+    path = SplinePath(np.array(waypoints, dtype=float))
+    constraints, states, (q, qd, qdd, _) = _timed_states(robot, path, path_grid(path), PhasePlaneMethod())
+    between = np.count_nonzero(~np.isin(states.s, constraints.s))
+    counter = _CountingRnea(monkeypatch)
+    tau = _torques(robot, states, q, qd, qdd, constraints)
+    assert counter.states < 0.1 * between
+    monkeypatch.undo()
+    assert np.max(np.abs(tau - robot.inverse_dynamics(q, qd, qdd)) / robot.limits.torque) <= 0.01 * INTERPOLATION_TOLERANCE
+
+
+def test_rows_are_not_interpolated_across_a_corner():
+    """A stop-and-go path: the rows jump at the corner, and the states beside it keep RNEA's
+    torques (interpolation never reaches over the corner)."""
+    robot = robots.load("ur5")
+    path = StopAndGoPath(np.array([[0.0, -1.2, 1.0, 0.0, 0.0, 0.0], [0.3, -1.1, 1.2, -0.2, 0.2, 0.1], [0.1, -1.3, 1.1, 0.1, 0.3, 0.3]]))
+    constraints, states, (q, qd, qdd, _) = _timed_states(robot, path, path_grid(path))
+    tau = _torques(robot, states, q, qd, qdd, constraints)
+    assert np.max(np.abs(tau - robot.inverse_dynamics(q, qd, qdd)) / robot.limits.torque) <= INTERPOLATION_TOLERANCE
+
+
+def test_rows_are_not_interpolated_across_a_break_of_the_curvature():
+    """A blended path: q'' jumps where a straight piece meets a blend, and so does the row b;
+    states next to those breaks stay within tolerance."""
+    robot = robots.load("ur5")
+    waypoints = np.array([[0.0, -1.2, 1.0, 0.0, 0.0, 0.0], [0.6, -1.0, 1.3, -0.4, 0.5, 0.2], [1.2, -1.3, 1.1, 0.1, 0.3, 0.9]])
+    path = BlendedPath(waypoints, 0.1)
+    assert len(path.breaks)
+    constraints, states, (q, qd, qdd, _) = _timed_states(robot, path, path_grid(path), PhasePlaneMethod())
+    tau = _torques(robot, states, q, qd, qdd, constraints)
+    assert np.max(np.abs(tau - robot.inverse_dynamics(q, qd, qdd)) / robot.limits.torque) <= INTERPOLATION_TOLERANCE
+
+
+def _refined_by_interpolation(robot, path, grid, extra, monkeypatch):
+    """The constraints on ``grid`` refined by ``extra`` with interpolated torque rows, those
+    evaluated everywhere by RNEA, and the number of new points that took an RNEA."""
+    import planners.constraints as constraints_module
+
+    constraints = build_path_constraints(path, robot, robot.limits, KINDS, grid)
+    evaluated = []
+    original = constraints_module._rnea_terms
+
+    def counted(robot_, q, dq, ddq):
+        evaluated.append(len(q))
+        return original(robot_, q, dq, ddq)
+
+    monkeypatch.setattr(constraints_module, "_rnea_terms", counted)
+    refined = constraints.with_points(extra, interpolate=True)
+    monkeypatch.undo()
+    return refined, build_path_constraints(path, robot, robot.limits, KINDS, refined.s), sum(evaluated)
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "yamamoto_2r"])
+def test_refinement_rows_interpolated_within_their_tolerance(name, monkeypatch):
+    """Rows at the midpoints of every other interval of a default grid (what a phase-plane
+    refinement adds): interpolated at nearly all of them, each torque term within
+    TERM_TOLERANCE of its magnitude (plus the floor) of the rows RNEA gives there, and the
+    acceleration rows, the speed bound and viscous friction exact."""
+    robot = robots.load(name)
+    rng = np.random.default_rng(3)
+    lower = np.maximum(robot.limits.position_lower, -2.0)
+    upper = np.minimum(robot.limits.position_upper, 2.0)
+    path = SplinePath(rng.uniform(0.5 * lower, 0.5 * upper, (4, robot.dof)))
+    grid = path_grid(path)
+    extra = 0.5 * (grid[:-1] + grid[1:])[::2]
+    refined, exact, evaluated = _refined_by_interpolation(robot, path, grid, extra, monkeypatch)
+    assert evaluated < 0.1 * len(extra)
+    np.testing.assert_array_equal(refined.s, exact.s)
+    np.testing.assert_array_equal(refined.sd_max, exact.sd_max)
+    torque = np.array([kind == "torque" for kind, _ in exact.rows])
+    for name_ in ("a", "b", "c", "d"):
+        mine, theirs = getattr(refined, name_), getattr(exact, name_)
+        np.testing.assert_array_equal(mine[:, ~torque], theirs[:, ~torque])
+        limit = exact.upper[0, torque]
+        scale = np.abs(theirs[:, torque]).max(axis=0) + _TERM_FLOOR * limit
+        assert np.all(np.abs(mine[:, torque] - theirs[:, torque]) <= TERM_TOLERANCE * scale)
+    np.testing.assert_array_equal(refined.d, exact.d)
+
+
+def test_refinement_rows_by_rnea_with_coulomb_friction_or_a_coarse_grid(monkeypatch):
+    """Coulomb friction (its sign inside c) and a grid that moves the joints by more than
+    MAX_TRAVEL per interval leave every new point to RNEA: the rows are the exact ones."""
+    text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()
+    pendulum = robot_from_model("pendulum_1r", check_urdf(text), "upload", None)
+    ur5 = robots.load("ur5")
+    cases = [
+        (pendulum, SplinePath(np.array([[-0.5], [0.4], [1.0]])), None),
+        (ur5, SplinePath(np.array([[0.0, -1.2, 1.0, 0.0, 0.0, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3], [2.0, -1.3, 1.2, 0.2, 0.4, 1.2]])), 12),
+    ]
+    for robot, path, intervals in cases:
+        grid = path_grid(path, intervals)
+        extra = 0.5 * (grid[:-1] + grid[1:])
+        refined, exact, evaluated = _refined_by_interpolation(robot, path, grid, extra, monkeypatch)
+        assert evaluated == len(extra)
+        for name_ in ("a", "b", "c", "d"):
+            np.testing.assert_allclose(getattr(refined, name_), getattr(exact, name_), rtol=1e-12, atol=1e-12)
