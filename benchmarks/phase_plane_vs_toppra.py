@@ -151,10 +151,10 @@ def toptraj_runner(method, path, robot):
 
         def timed(evaluate):
             # Refined constraints keep the evaluate of the ones they refine (with_points).
-            def evaluate_timed(extra_s):
+            def evaluate_timed(extra_s, known=None):
                 started = _now()
                 try:
-                    return evaluate(extra_s)
+                    return evaluate(extra_s, known)
                 finally:
                     spent[0] += _now() - started
 

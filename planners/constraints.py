@@ -301,10 +301,11 @@ def _interpolated_terms(robot: Robot, known: PathConstraints, torqued: np.ndarra
     ``TERM_TOLERANCE`` of its largest magnitude on that grid, at least ``_TERM_FLOOR`` of the limit) where its grid resolves them, by
     RNEA at the other points. ``None`` (all by RNEA) when ``known`` cannot serve: no points or
     rows of its own, or Coulomb friction (whose sign its rows hold inside c)."""
-    columns = [known.rows.index(("torque", int(j))) if ("torque", int(j)) in known.rows else -1 for j in torqued]
     travel = known.travel()
-    coulomb = np.asarray(robot.coulomb_friction, dtype=float)[torqued]
-    if travel is None or min(columns) < 0 or np.any(coulomb != 0.0) or len(known.s) < 5:
+    if travel is None or len(travel) < 4 or not np.any(travel <= MAX_TRAVEL):
+        return None  # a grid that resolves nothing: no interpolation to try
+    columns = [known.rows.index(("torque", int(j))) if ("torque", int(j)) in known.rows else -1 for j in torqued]
+    if min(columns) < 0 or np.any(np.asarray(robot.coulomb_friction, dtype=float)[torqued] != 0.0):
         return None
     grid = known.s
     zero = np.zeros((len(grid), len(columns)))

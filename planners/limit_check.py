@@ -119,22 +119,24 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     on_grid = at_point & (states.sd > 0.0)
     tau = np.empty_like(qd)
     coulomb = np.asarray(robot.coulomb_friction, dtype=float)
-    stacks = {}
-    for left, rows in ((False, (constraints.a, constraints.b, constraints.c, constraints.d)),
-                       (True, (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left))):
-        stack = np.stack([row[:, columns] for row in rows])
-        mask = on_grid & (states.left == left)
+    friction = bool(np.any(coulomb))
+    right = (constraints.a, constraints.b, constraints.c, constraints.d)
+    left = (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)
+    stacks = {False: np.stack([row[:, columns] for row in right])}
+    # Without corners or breaks the rows from the left are the very arrays from the right.
+    stacks[True] = stacks[False] if all(l is r for l, r in zip(left, right)) and not friction else np.stack([row[:, columns] for row in left])
+    for side, stack in stacks.items():
+        mask = on_grid & (states.left == side)
         if mask.any():
             a, b, c, d = stack[:, index[mask]]
             sd, sdd = states.sd[mask, None], states.sdd[mask, None]
             tau[mask] = a * sdd + b * (sd * sd) + c + d * sd
-        if np.any(coulomb):
+        if friction:
             # g = c - F sign(q'), with the signs the build used, read off the moving states on
             # the grid (unknown elsewhere).
             sign = np.full((len(grid), robot.dof), np.nan)
             sign[index[mask]] = np.sign(qd[mask])
             stack[2] -= np.where(coulomb != 0.0, coulomb * sign, 0.0)
-        stacks[left] = stack
     between = np.flatnonzero(~on_grid)
     if between.size == 0:
         return tau
@@ -154,7 +156,7 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
             np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
             s, np.clip(interval, 0, len(grid) - 2), factors, INTERPOLATION_TOLERANCE, part, exact,
         )
-    if np.any(coulomb):
+    if friction:
         part += coulomb * np.sign(qd[between])
     if exact.any():
         again = between[exact]
