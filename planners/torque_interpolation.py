@@ -1,24 +1,27 @@
-"""Joint torques between the grid points of a path's constraints, from the rows the build
-computed there (numba, ``nogil``, cached): the dense limit check's torques without a dynamics
-evaluation per state where the rows' interpolation is accurate, and with one where it is not.
+"""Joint torques, and torque rows, between the grid points of a path's constraints, from the
+rows the build computed there with Pinocchio's RNEA (numba, ``nogil``, cached): the dense limit
+check's torques (``planners.limit_check``) and the rows a refining method adds
+(``planners.constraints``, ``PathConstraints.with_points``) without a dynamics evaluation per
+point where the interpolation is accurate, and with one where it is not.
 
 Along q(s) the torque of joint j at a state (s, sd, sdd) is (Jeong & Lee eq. (3.4b) with
 x = sd^2, u = sdd, and the URDF's joint friction)
 
     tau_j = a_j(s) u + b_j(s) x + g_j(s) + d_j(s) sd + F_j sign(q'_j(s) sd),
 
-with a = M q', b = M q'' + C(q, q') q', g the gravity torque and d = D q' (N m, or N m s for
-d), each smooth in s between the path's knots (q(s) is a polynomial there). The rows
-``a u + b x + c + d sd`` the constraint build computed with Pinocchio's RNEA hold a, b, d and
-c = g + F sign(q') at the grid points. At a state between them, a, b, g and d are each read
-from the cubic through four consecutive grid points that no knot, corner or break of the path
-separates (Lagrange, on the non-uniform grid; the two nearest on each side where the run of
-smooth points allows), and the Coulomb term is added at the state itself. The interpolation
-error is estimated by the cubic through the next run of four points (one node shifted): it
-is of the fifth order in the grid's spacing, which a second cubic off by one node estimates
-to within a factor of order one. Where that estimate exceeds ``tolerance`` of the joint's
-torque limit, or fewer than five grid points are smooth around the state, the state is
-marked for Pinocchio's RNEA instead.
+with a = M q', b = M q'' + C(q, q') q', g the gravity torque and d = D q' (N m s^2, N m s^2,
+N m and N m s), each smooth in s between the path's knots (q(s) is a polynomial there, and the
+dynamics trigonometric in q). The rows ``a u + b x + c + d sd`` hold a, b, d and
+c = g + F sign(q') at the grid points; the Coulomb term is taken out of c and added at the
+point itself. At a point between grid points, each of a, b, g and d is read from the quartic
+(Lagrange, on the non-uniform grid) through five consecutive grid points that no knot, corner
+or break of the path separates, the interval holding the point among the middle ones where the
+run of smooth points allows. Its error is estimated by the larger difference from the cubics
+through the first and the last four of those points (their error is one order lower; each row
+apart, weighted by |u|, x, 1 and sd, since the rows' errors may cancel at one point and add up
+at the next). A point is left to RNEA where that estimate exceeds ``tolerance`` of its scale,
+where fewer than five smooth grid points surround it, or where an interval among them moves
+the joints by more than ``MAX_TRAVEL``.
 """
 
 from __future__ import annotations
