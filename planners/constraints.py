@@ -31,7 +31,7 @@ from planners.constraint_kernels import assemble_rows, velocity_bound
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
 from planners.tool_speed import tool_speed_bound
-from planners.torque_interpolation import MAX_TRAVEL, interpolate_rows
+from planners.torque_interpolation import MAX_TRAVEL, grid_travel, terms_between
 from robots import JointLimits, Robot
 
 CONSTRAINT_KINDS = ("velocity", "acceleration", "torque", "jerk")
@@ -168,24 +168,6 @@ class PathConstraints:
             evaluate=None,
         )
 
-    def smooth_points(self) -> np.ndarray:
-        """(N + 1,): the grid points through which the rows are smooth (so that a polynomial
-        through them interpolates the rows): interior, no knot of the path, the same rows
-        from both sides."""
-        smooth = np.ones(len(self.s), dtype=bool)
-        smooth[[0, -1]] = False
-        if self.knots is not None and len(self.knots):
-            smooth &= ~np.isin(self.s, self.knots)
-        for right, left in ((self.a, self.a_left), (self.b, self.b_left), (self.c, self.c_left), (self.d, self.d_left)):
-            if right is not left:
-                smooth &= np.all(right == left, axis=1)
-        return smooth
-
-    def travel(self) -> np.ndarray | None:
-        """(N,): the joints' travel over each grid interval, sum over the joints of
-        |q(s_i+1) - q(s_i)| (rad); ``None`` when the grid's points are unknown."""
-        return None if self.q is None else np.abs(np.diff(self.q, axis=0)).sum(axis=1)
-
     @property
     def has_friction(self) -> bool:
         """Whether any row has a term linear in sd (viscous joint friction)."""
@@ -286,44 +268,21 @@ def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.nd
     return arrays, rows
 
 
-#: Largest estimated error of an interpolated M q', M q'' + C q' q' or g (``_interpolated_terms``),
-#: a fraction of the term's largest magnitude along the known grid.
-TERM_TOLERANCE = 1e-6
-#: A term's magnitude is taken as at least this fraction of the joint's torque limit (g of a
-#: vertical joint is zero all along).
-_TERM_FLOOR = 1e-3
-
-
 def _interpolated_terms(robot: Robot, known: PathConstraints, torqued: np.ndarray, s, q, dq, ddq, deadline: Deadline) -> np.ndarray | None:
-    """g, M q' + g and M q'' + C q' q' + g (the RNEA terms of ``_rnea_terms``) at the n points
-    ``s`` (each strictly inside an interval of ``known``'s grid) of ``q, dq, ddq``, as (3, n, n_dof): for the torqued joints interpolated from the rows of
-    ``known`` (``planners.torque_interpolation.interpolate_rows``, each term apart, within
-    ``TERM_TOLERANCE`` of its largest magnitude on that grid, at least ``_TERM_FLOOR`` of the limit) where its grid resolves them, by
-    RNEA at the other points. ``None`` (all by RNEA) when ``known`` cannot serve: no points or
-    rows of its own, or Coulomb friction (whose sign its rows hold inside c)."""
-    travel = known.travel()
-    if travel is None or len(travel) < 4 or not np.any(travel <= MAX_TRAVEL):
+    """g, M q' + g and M q'' + C q' q' + g (the blocks of ``_rnea_terms``) at the n points ``s``
+    of ``q, dq, ddq`` (each strictly inside an interval of ``known``'s grid), (3, n, n_dof): for
+    the torqued joints read from the rows of ``known`` where its grid resolves them
+    (``planners.torque_interpolation.terms_between``), by RNEA at the other points. ``None``
+    (all by RNEA) when ``known`` cannot serve: no points of its own, a torqued joint without
+    its row, Coulomb friction (whose sign its rows hold inside c), or no interval it resolves."""
+    travel = grid_travel(known)
+    if travel is None or not np.any(travel <= MAX_TRAVEL):
         return None  # a grid that resolves nothing: no interpolation to try
     columns = [known.rows.index(("torque", int(j))) if ("torque", int(j)) in known.rows else -1 for j in torqued]
     if min(columns) < 0 or np.any(np.asarray(robot.coulomb_friction, dtype=float)[torqued] != 0.0):
         return None
-    grid = known.s
-    zero = np.zeros((len(grid), len(columns)))
-    limit = np.maximum(known.upper[0, columns], -known.lower[0, columns])
-    right = np.stack([known.a[:, columns], known.b[:, columns], known.c[:, columns], zero])
-    left = np.stack([known.a_left[:, columns], known.b_left[:, columns], known.c_left[:, columns], zero])
-    smooth = known.smooth_points()
-    interval = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
-    n = len(s)
-    values = np.zeros((3, n, len(columns)))
-    exact = np.zeros(n, dtype=bool)
-    for term in range(3):
-        factors = np.zeros((n, 4))
-        factors[:, term] = 1.0
-        scale = np.abs(right[term]).max(axis=0) + _TERM_FLOOR * limit
-        interpolate_rows(grid, smooth, right, left, travel, MAX_TRAVEL, scale, s, interval, factors, TERM_TOLERANCE, values[term], exact)
-    a, b, g = values
-    terms = np.zeros((3, n, dq.shape[1]))
+    (a, b, g), exact = terms_between(known, columns, travel, s)
+    terms = np.zeros((3, len(s), dq.shape[1]))
     terms[0][:, torqued], terms[1][:, torqued], terms[2][:, torqued] = g, a + g, b + g
     if exact.any():
         deadline.check()

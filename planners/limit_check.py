@@ -29,7 +29,7 @@ from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.tool_speed import TOOL_KINDS, tool_speeds
-from planners.torque_interpolation import MAX_TRAVEL, interpolate_rows
+from planners.torque_interpolation import MAX_TRAVEL, grid_travel, interpolate_rows, smooth_points
 from robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included: the ends and the quarter points.
@@ -145,14 +145,14 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
         states.left[between], np.searchsorted(grid, s, side="left"), np.searchsorted(grid, s, side="right")
     ) - 1
     factors = np.stack([states.sdd[between], sd * sd, np.ones_like(sd), sd], axis=1)
-    travel = constraints.travel()
+    travel = grid_travel(constraints)
     exact = np.zeros(between.size, dtype=bool)
     part = np.empty((between.size, robot.dof))
     if travel is None:
         exact[:] = True
     else:
         interpolate_rows(
-            grid, constraints.smooth_points(), stacks[False], stacks[True], travel, MAX_TRAVEL,
+            grid, smooth_points(constraints), stacks[False], stacks[True], travel, MAX_TRAVEL,
             np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
             s, np.clip(interval, 0, len(grid) - 2), factors, INTERPOLATION_TOLERANCE, part, exact,
         )

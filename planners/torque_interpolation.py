@@ -37,6 +37,59 @@ from planners.refinement_kernels import lagrange_weights
 #: intervals over moves of several rad, a cubic and a quartic agree and both miss by 3.6e-5
 #: of the limit).
 MAX_TRAVEL = 0.1
+#: Largest estimated error of an interpolated M q', M q'' + C q' q' or g (``terms_between``), a
+#: fraction of the term's largest magnitude along the grid.
+TERM_TOLERANCE = 1e-6
+#: A term's magnitude is taken as at least this fraction of the joint's torque limit (g of a
+#: vertical joint is zero all along).
+TERM_FLOOR = 1e-3
+
+
+def smooth_points(constraints) -> np.ndarray:
+    """(N + 1,): the grid points of ``constraints`` (a ``PathConstraints``) through which the
+    rows are smooth, so that a polynomial through them interpolates the rows: interior, no knot
+    of the path, the same rows from both sides."""
+    grid = constraints.s
+    smooth = np.ones(len(grid), dtype=bool)
+    smooth[[0, -1]] = False
+    if constraints.knots is not None and len(constraints.knots):
+        smooth &= ~np.isin(grid, constraints.knots)
+    sides = ((constraints.a, constraints.a_left), (constraints.b, constraints.b_left),
+             (constraints.c, constraints.c_left), (constraints.d, constraints.d_left))
+    for right, left in sides:
+        if right is not left:
+            smooth &= np.all(right == left, axis=1)
+    return smooth
+
+
+def grid_travel(constraints) -> np.ndarray | None:
+    """(N,): the joints' travel over each grid interval of ``constraints``, the sum over the
+    joints of |q(s_i+1) - q(s_i)| (rad); ``None`` when its grid's points are unknown."""
+    return None if constraints.q is None else np.abs(np.diff(constraints.q, axis=0)).sum(axis=1)
+
+
+def terms_between(known, columns: list[int], travel: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """a = M q', b = M q'' + C q' q' and g of the torque rows ``columns`` (k of them) of the
+    constraints ``known`` (a ``PathConstraints`` without Coulomb friction in those rows, whose
+    grid's intervals move the joints by ``travel``, rad) at the n points ``s``, each strictly
+    inside an interval of its grid: (values (3, n, k), exact (n,)), each term within
+    ``TERM_TOLERANCE`` of its largest magnitude on the grid (at least ``TERM_FLOOR`` of the
+    limit) by the estimate, and ``exact`` marking the points left to RNEA (their values unset)."""
+    grid = known.s
+    zero = np.zeros((len(grid), len(columns)))
+    limit = np.maximum(known.upper[0, columns], -known.lower[0, columns])
+    right = np.stack([known.a[:, columns], known.b[:, columns], known.c[:, columns], zero])
+    left = np.stack([known.a_left[:, columns], known.b_left[:, columns], known.c_left[:, columns], zero])
+    smooth = smooth_points(known)
+    interval = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
+    values = np.zeros((3, len(s), len(columns)))
+    exact = np.zeros(len(s), dtype=bool)
+    for term in range(3):
+        factors = np.zeros((len(s), 4))
+        factors[:, term] = 1.0
+        scale = np.abs(right[term]).max(axis=0) + TERM_FLOOR * limit
+        interpolate_rows(grid, smooth, right, left, travel, MAX_TRAVEL, scale, s, interval, factors, TERM_TOLERANCE, values[term], exact)
+    return values, exact
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

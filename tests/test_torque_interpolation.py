@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 import robots
-from planners.constraints import _TERM_FLOOR, TERM_TOLERANCE, build_path_constraints
+from planners.constraints import build_path_constraints
 from planners.grid import path_grid
 from planners.limit_check import INTERPOLATION_TOLERANCE, _torques, joint_motion
 from planners.paths import SplinePath, StopAndGoPath
 from planners.paths.blended import BlendedPath
 from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.torque_interpolation import MAX_TRAVEL
+from planners.torque_interpolation import MAX_TRAVEL, TERM_FLOOR, TERM_TOLERANCE
 from robots import Robot
 from robots.catalog import robot_from_model
 from robots.urdf_check import check_urdf
@@ -167,7 +167,7 @@ def test_refinement_rows_interpolated_within_their_tolerance(name, monkeypatch):
         mine, theirs = getattr(refined, name_), getattr(exact, name_)
         np.testing.assert_array_equal(mine[:, ~torque], theirs[:, ~torque])
         limit = exact.upper[0, torque]
-        scale = np.abs(theirs[:, torque]).max(axis=0) + _TERM_FLOOR * limit
+        scale = np.abs(theirs[:, torque]).max(axis=0) + TERM_FLOOR * limit
         assert np.all(np.abs(mine[:, torque] - theirs[:, torque]) <= TERM_TOLERANCE * scale)
     np.testing.assert_array_equal(refined.d, exact.d)
 
