@@ -84,19 +84,62 @@ def terms_between(known, columns: list[int], travel: np.ndarray, s: np.ndarray) 
     interval = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
     values = np.zeros((3, len(s), len(columns)))
     exact = np.zeros(len(s), dtype=bool)
-    for term in range(3):
-        factors = np.zeros((len(s), 4))
-        factors[:, term] = 1.0
-        scale = np.abs(right[term]).max(axis=0) + TERM_FLOOR * limit
-        interpolate_rows(grid, smooth, right, left, travel, MAX_TRAVEL, scale, s, interval, factors, TERM_TOLERANCE, values[term], exact)
+    scale = np.abs(right[:3]).max(axis=1) + TERM_FLOOR * limit
+    interpolate_terms(grid, smooth, right, left, travel, MAX_TRAVEL, scale, s, interval, TERM_TOLERANCE, values, exact)
     return values, exact
+
+
+@njit(cache=True, nogil=True)
+def _stencil(grid, smooth, travel, max_travel, i, at, nodes, quartic, cubic, shifted):  # pragma: no cover - compiled
+    """The first of five consecutive grid points around interval i through which the rows are
+    smooth and which the grid resolves (each interval among them moving the joints by at most
+    ``max_travel``), with the weights at ``at`` of the quartic through them and of the cubics
+    through their first and last four written; -1 where there are none."""
+    n_grid = grid.shape[0]
+    lo = i
+    while lo > i - 2 and lo > 0 and smooth[lo]:
+        lo -= 1
+    hi = i + 1
+    while hi < i + 3 and hi < n_grid - 1 and smooth[hi]:
+        hi += 1
+    if hi - lo + 1 < 5:
+        return -1
+    start = min(max(i - 2, lo), hi - 4)
+    for node in range(start, start + 4):
+        if not travel[node] <= max_travel:
+            return -1
+    for k in range(5):
+        nodes[k] = grid[start + k]
+    lagrange_weights(nodes, 5, at, quartic)
+    lagrange_weights(nodes, 4, at, cubic)
+    lagrange_weights(nodes[1:], 4, at, shifted)
+    return start
+
+
+@njit(cache=True, nogil=True)
+def _row_at(right, left, row, j, i, start, quartic, cubic, shifted):  # pragma: no cover - compiled
+    """(value, estimated error) of row ``row`` of joint j from the stencil at ``start``: the
+    quartic's value and its larger difference from the two cubics. A node beyond the interval's
+    far end is seen from the left, as the interval sees it."""
+    quartic_value = 0.0
+    cubic_value = 0.0
+    shifted_value = 0.0
+    for k in range(5):
+        node = start + k
+        entry = left[row, node, j] if node > i else right[row, node, j]
+        quartic_value += quartic[k] * entry
+        if k < 4:
+            cubic_value += cubic[k] * entry
+        if k > 0:
+            shifted_value += shifted[k - 1] * entry
+    return quartic_value, max(abs(quartic_value - cubic_value), abs(quartic_value - shifted_value))
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def interpolate_rows(grid, smooth, right, left, travel, max_travel, limit, s, interval, factors, tolerance, tau, exact):  # pragma: no cover - compiled
-    """Write a u + b x + g + d sd (the torques of n states, without Coulomb friction; or, with
-    ``factors`` picking one row, that row) into ``tau`` (n, n_dof), and mark in ``exact`` (n,)
-    the states whose interpolation is not trusted (their rows of ``tau`` are left unset).
+    """Write a u + b x + g + d sd, the torques of n states without Coulomb friction, into
+    ``tau`` (n, n_dof), and mark in ``exact`` (n,) the states whose interpolation is not trusted
+    (their rows of ``tau`` are left unset).
 
     Args:
         grid: Grid of s the rows were built on, (N + 1,).
@@ -114,62 +157,46 @@ def interpolate_rows(grid, smooth, right, left, travel, max_travel, limit, s, in
         factors: u, x, 1 and sd of each state, (n, 4): tau = a u + b x + g + d sd.
         tolerance: Largest estimated interpolation error trusted, a fraction of the limit.
     """
-    n_grid = grid.shape[0]
-    n_dof = right.shape[2]
-    quartic = np.empty(5)
-    cubic = np.empty(4)
-    shifted = np.empty(4)
-    nodes = np.empty(5)
+    nodes, quartic, cubic, shifted = np.empty(5), np.empty(5), np.empty(4), np.empty(4)
     for state in range(s.shape[0]):
         i = interval[state]
-        lo = i
-        while lo > i - 2 and lo > 0 and smooth[lo]:
-            lo -= 1
-        hi = i + 1
-        while hi < i + 3 and hi < n_grid - 1 and smooth[hi]:
-            hi += 1
-        if hi - lo + 1 < 5:
+        start = _stencil(grid, smooth, travel, max_travel, i, s[state], nodes, quartic, cubic, shifted)
+        if start < 0:
             exact[state] = True
             continue
-        # Five consecutive smooth points around the interval: the quartic through them gives
-        # the value, the cubics through their first and last four the error estimate.
-        start = min(max(i - 2, lo), hi - 4)
-        resolved = True
-        for node in range(start, start + 4):
-            resolved = resolved and travel[node] <= max_travel
-        if not resolved:
-            exact[state] = True
-            continue
-        for k in range(5):
-            nodes[k] = grid[start + k]
-        lagrange_weights(nodes, 5, s[state], quartic)
-        lagrange_weights(nodes, 4, s[state], cubic)
-        lagrange_weights(nodes[1:], 4, s[state], shifted)
-        trusted = True
-        for j in range(n_dof):
-            # Each row's value and error apart: their errors may cancel in one state's torque
-            # and add up in the next one's.
+        for j in range(right.shape[2]):
+            # Each row's error apart: the rows' errors may cancel in one state's torque and
+            # add up in the next one's.
             value = 0.0
             error = 0.0
             for row in range(4):
-                quartic_value = 0.0
-                cubic_value = 0.0
-                shifted_value = 0.0
-                for k in range(5):
-                    node = start + k
-                    # A node beyond the interval's far end is seen from the left, as the interval sees it.
-                    entry = left[row, node, j] if node > i else right[row, node, j]
-                    quartic_value += quartic[k] * entry
-                    if k < 4:
-                        cubic_value += cubic[k] * entry
-                    if k > 0:
-                        shifted_value += shifted[k - 1] * entry
                 factor = factors[state, row]
-                value += factor * quartic_value
-                error += abs(factor) * max(abs(quartic_value - cubic_value), abs(quartic_value - shifted_value))
+                if factor != 0.0:
+                    row_value, row_error = _row_at(right, left, row, j, i, start, quartic, cubic, shifted)
+                    value += factor * row_value
+                    error += abs(factor) * row_error
             if not error <= tolerance * limit[j]:
-                trusted = False
+                exact[state] = True
                 break
             tau[state, j] = value
-        if not trusted:
-            exact[state] = True
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def interpolate_terms(grid, smooth, right, left, travel, max_travel, scale, s, interval, tolerance, values, exact):  # pragma: no cover - compiled
+    """Write rows a, b and g (the first three of ``right`` and ``left``) of each joint at n
+    points into ``values`` (3, n, n_dof), each within ``tolerance`` of its ``scale`` (3, n_dof)
+    by the estimate, and mark in ``exact`` (n,) the points where one is not (their values left
+    unset). The other arguments as for ``interpolate_rows``."""
+    nodes, quartic, cubic, shifted = np.empty(5), np.empty(5), np.empty(4), np.empty(4)
+    for point in range(s.shape[0]):
+        i = interval[point]
+        start = _stencil(grid, smooth, travel, max_travel, i, s[point], nodes, quartic, cubic, shifted)
+        if start < 0:
+            exact[point] = True
+            continue
+        for j in range(right.shape[2]):
+            for row in range(3):
+                value, error = _row_at(right, left, row, j, i, start, quartic, cubic, shifted)
+                if not error <= tolerance * scale[row, j]:
+                    exact[point] = True
+                values[row, point, j] = value
