@@ -124,7 +124,8 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     left = (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)
     stacks = {False: np.stack([row[:, columns] for row in right])}
     # Without corners or breaks the rows from the left are the very arrays from the right.
-    stacks[True] = stacks[False] if all(l is r for l, r in zip(left, right)) and not friction else np.stack([row[:, columns] for row in left])
+    same = all(mine is theirs for mine, theirs in zip(left, right))
+    stacks[True] = stacks[False] if same and not friction else np.stack([row[:, columns] for row in left])
     for side, stack in stacks.items():
         mask = on_grid & (states.left == side)
         if mask.any():

@@ -47,9 +47,9 @@ def _wide_path(robot, seed: int, spread: float = 3.0):
     return SplinePath(rng.uniform(lower, upper, (int(rng.integers(2, 6)), robot.dof)))
 
 
-def _timed_states(robot, path, grid, method=ToppraMethod()):
+def _timed_states(robot, path, grid, method=None):
     constraints = build_path_constraints(path, robot, robot.limits, KINDS, grid)
-    timing = method.solve(constraints)
+    timing = (method or ToppraMethod()).solve(constraints)
     states = timing.dense_states(5, constraints.s)
     return constraints, states, joint_motion(path, states)
 
