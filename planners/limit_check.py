@@ -115,8 +115,7 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     columns = [column[joint] for joint in range(robot.dof)]
     grid = constraints.s
     index = np.clip(np.searchsorted(grid, states.s), 0, len(grid) - 1)
-    at_point = grid[index] == states.s
-    on_grid = at_point & (states.sd > 0.0)
+    on_grid = (grid[index] == states.s) & (states.sd > 0.0)
     tau = np.empty_like(qd)
     coulomb = np.asarray(robot.coulomb_friction, dtype=float)
     friction = bool(np.any(coulomb))

@@ -217,6 +217,7 @@ def split_points(s, wanted, priority, max_pieces, room):  # pragma: no cover - c
             at += 1
     return points
 
+
 @njit(cache=True, nogil=True)
 def lagrange_weights(nodes, count, at, weights):  # pragma: no cover - compiled
     """Write into ``weights[:count]`` the Lagrange weights of the polynomial through
@@ -259,23 +260,13 @@ def _excess(value, lower, upper):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _smooth_at(point, knot, a, b, c, a_left, b_left, c_left):  # pragma: no cover - compiled
-    """Whether the rows are smooth through grid ``point``: not a knot of the path, no jump."""
-    if knot[point]:
-        return False
-    for k in range(a.shape[1]):
-        if a_left[point, k] != a[point, k] or b_left[point, k] != b[point, k] or c_left[point, k] != c[point, k]:
-            return False
-    return True
-
-
-@njit(cache=True, nogil=True)
-def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, x_bound, binding, knot, x, target, max_pieces):  # pragma: no cover - compiled
+def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, x_bound, binding, smooth, x, target, max_pieces):  # pragma: no cover - compiled
     """The fewest pieces (N,) into which each interval of the profile x (N + 1,) on the grid s
     must be split for its rows and its first-order bound x <= ``x_bound`` (N + 1,) to stay
     within ``target`` (relative to the limit) of their bounds at its quarter points; ``binding``
-    (N + 1,) names the joint whose velocity limit sets x_bound at each grid point, ``knot``
-    (N + 1,) marks the path's knots.
+    (N + 1,) names the joint whose velocity limit sets x_bound at each grid point, ``smooth``
+    (N + 1,) marks the grid points through which the rows are smooth (no knot of the path, no
+    jump; ``planners.torque_interpolation.smooth_points``).
 
     The interpolation discretization holds every row ``a u + b x + c + d sd`` at both ends of
     an interval (u constant, x linear in s); between them the row departs from the chord of its
@@ -321,13 +312,13 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
             continue
         # The nodes: the interval's ends and their outer neighbours where the rows are smooth.
         count = 0
-        if i >= 1 and _smooth_at(i, knot, a, b, c, a_left, b_left, c_left):
+        if i >= 1 and smooth[i]:
             points[count] = i - 1
             count += 1
         points[count] = i
         points[count + 1] = i + 1
         count += 2
-        if i + 2 <= n_stages and _smooth_at(i + 1, knot, a, b, c, a_left, b_left, c_left):
+        if i + 2 <= n_stages and smooth[i + 1]:
             points[count] = i + 2
             count += 1
         if count < 3:

@@ -48,12 +48,14 @@ TERM_FLOOR = 1e-3
 def smooth_points(constraints) -> np.ndarray:
     """(N + 1,): the grid points of ``constraints`` (a ``PathConstraints``) through which the
     rows are smooth, so that a polynomial through them interpolates the rows: interior, no knot
-    of the path, the same rows from both sides."""
+    of the path, the same rows from both sides (also where ``phase_plane``'s excursion estimate,
+    ``planners.refinement_kernels.row_excursions``, may reach across a grid point)."""
     grid = constraints.s
     smooth = np.ones(len(grid), dtype=bool)
     smooth[[0, -1]] = False
     if constraints.knots is not None and len(constraints.knots):
-        smooth &= ~np.isin(grid, constraints.knots)
+        at = np.minimum(np.searchsorted(grid, constraints.knots), len(grid) - 1)
+        smooth[at[grid[at] == constraints.knots]] = False
     sides = ((constraints.a, constraints.a_left), (constraints.b, constraints.b_left),
              (constraints.c, constraints.c_left), (constraints.d, constraints.d_left))
     for right, left in sides:

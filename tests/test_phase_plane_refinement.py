@@ -132,8 +132,8 @@ def _excursions(c, x_bound, target):
     n = len(c)
     ones, zeros = np.ones((n, 1)), np.zeros((n, 1))
     rows = (ones, zeros, c[:, None], zeros)
-    s, binding, knot = np.linspace(0.0, 1.0, n), np.zeros(n, dtype=np.int64), np.zeros(n, dtype=bool)
-    return row_excursions(s, *rows, *rows, -ones, ones.copy(), x_bound, binding, knot, np.ones(n), target, 8)
+    s, binding, smooth = np.linspace(0.0, 1.0, n), np.zeros(n, dtype=np.int64), np.ones(n, dtype=bool)
+    return row_excursions(s, *rows, *rows, -ones, ones.copy(), x_bound, binding, smooth, np.ones(n), target, 8)
 
 
 def test_row_excursions_split_as_the_closed_form_asks():

@@ -54,6 +54,7 @@ from planners.kernels import point_bounds, sweeps
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions, split_points
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from planners.torque_interpolation import smooth_points
 
 #: Relative slack when comparing x values computed along different routes.
 _SLACK = 1e-9
@@ -163,7 +164,7 @@ class PhasePlaneMethod(TimingMethod):
                     break
                 # The duration is within its tolerance: the limits' excursions between grid
                 # points decide a last split.
-                wanted = row_excursions(grid.s, *grid.rows, grid.x_bound, grid.binding, grid.knot, profile.x, self.excursion, _MAX_PIECES)
+                wanted = row_excursions(grid.s, *grid.rows, grid.x_bound, grid.binding, grid.smooth, profile.x, self.excursion, _MAX_PIECES)
             extra = split_points(grid.s, wanted, priority, _MAX_PIECES, room)
             if extra.size == 0:
                 break
@@ -209,15 +210,15 @@ class _Grid(NamedTuple):
     """The constraints on one grid as contiguous arrays for the kernels: s (N + 1,), the rows
     seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
     first-order bound x_bound = sd_max^2 (N + 1,), the joint whose velocity limit sets it (N + 1,,
-    -1 where none or unknown), whether each grid point is a knot of the path (N + 1,) and whether
-    any row has viscous friction."""
+    -1 where none or unknown), whether the rows are smooth through each grid point (N + 1,,
+    ``planners.torque_interpolation.smooth_points``) and whether any row has viscous friction."""
 
     constraints: PathConstraints
     s: np.ndarray
     rows: _Rows
     x_bound: np.ndarray
     binding: np.ndarray
-    knot: np.ndarray
+    smooth: np.ndarray
     friction: bool
 
     @classmethod
@@ -234,12 +235,8 @@ class _Grid(NamedTuple):
         x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
         joint = constraints.velocity_joint
         binding = np.full(len(s), -1, dtype=np.int64) if joint is None else np.ascontiguousarray(joint, dtype=np.int64)
-        knot = np.zeros(len(s), dtype=np.bool_)
-        if constraints.knots is not None and len(constraints.knots):
-            at = np.minimum(np.searchsorted(s, constraints.knots), len(s) - 1)
-            knot[at[s[at] == constraints.knots]] = True
         friction = bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any()))
-        return cls(constraints, s, rows, x_bound, binding, knot, friction)
+        return cls(constraints, s, rows, x_bound, binding, smooth_points(constraints), friction)
 
     def friction_reference(self) -> np.ndarray:
         """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
