@@ -29,7 +29,7 @@ from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.tool_speed import TOOL_KINDS, tool_speeds
-from planners.torque_interpolation import MAX_TRAVEL, grid_travel, interpolate_rows, smooth_points
+from planners.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel, smooth_points
 from robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included: the ends and the quarter points.
@@ -106,62 +106,30 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     (when they hold a torque row for every joint) the torque is the row ``a u + b x + c + d sd``
     the build computed there with Pinocchio's RNEA (the same number, to rounding), on the side
     the state belongs to; between grid points it is interpolated from those rows
-    (``planners.torque_interpolation``) where the grid resolves them and the interpolation's
-    estimated error is within ``INTERPOLATION_TOLERANCE`` of the limit. The RNEA runs, batched,
-    at every other state."""
+    (``planners.torque_interpolation.dense_torques``) where the grid resolves them, the
+    interpolation's estimated error is within ``INTERPOLATION_TOLERANCE`` of the limit and no
+    joint has Coulomb friction (whose sign, inside c, is the grid point's). The RNEA runs,
+    batched, at every other state."""
     column = {} if constraints is None else {joint: k for k, (kind, joint) in enumerate(constraints.rows) if kind == "torque"}
     if constraints is None or len(column) != robot.dof:
         return robot.inverse_dynamics(q, qd, qdd)
     columns = [column[joint] for joint in range(robot.dof)]
-    grid = constraints.s
-    index = np.clip(np.searchsorted(grid, states.s), 0, len(grid) - 1)
-    on_grid = (grid[index] == states.s) & (states.sd > 0.0)
-    tau = np.empty_like(qd)
-    coulomb = np.asarray(robot.coulomb_friction, dtype=float)
-    friction = bool(np.any(coulomb))
-    right = (constraints.a, constraints.b, constraints.c, constraints.d)
-    left = (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)
-    stacks = {False: np.stack([row[:, columns] for row in right])}
+    right = np.stack([row[:, columns] for row in (constraints.a, constraints.b, constraints.c, constraints.d)])
+    sides = (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)
     # Without corners or breaks the rows from the left are the very arrays from the right.
-    same = all(mine is theirs for mine, theirs in zip(left, right))
-    stacks[True] = stacks[False] if same and not friction else np.stack([row[:, columns] for row in left])
-    for side, stack in stacks.items():
-        mask = on_grid & (states.left == side)
-        if mask.any():
-            a, b, c, d = stack[:, index[mask]]
-            sd, sdd = states.sd[mask, None], states.sdd[mask, None]
-            tau[mask] = a * sdd + b * (sd * sd) + c + d * sd
-        if friction:
-            # g = c - F sign(q'), with the signs the build used, read off the moving states on
-            # the grid (unknown elsewhere).
-            sign = np.full((len(grid), robot.dof), np.nan)
-            sign[index[mask]] = np.sign(qd[mask])
-            stack[2] -= np.where(coulomb != 0.0, coulomb * sign, 0.0)
-    between = np.flatnonzero(~on_grid)
-    if between.size == 0:
-        return tau
-    s, sd = states.s[between], states.sd[between]
-    interval = np.where(
-        states.left[between], np.searchsorted(grid, s, side="left"), np.searchsorted(grid, s, side="right")
-    ) - 1
-    factors = np.stack([states.sdd[between], sd * sd, np.ones_like(sd), sd], axis=1)
+    same = all(mine is theirs for mine, theirs in zip(sides, (constraints.a, constraints.b, constraints.c, constraints.d)))
+    left = right if same else np.stack([row[:, columns] for row in sides])
     travel = grid_travel(constraints)
-    exact = np.zeros(between.size, dtype=bool)
-    part = np.empty((between.size, robot.dof))
-    if travel is None:
-        exact[:] = True
-    else:
-        interpolate_rows(
-            grid, smooth_points(constraints), stacks[False], stacks[True], travel, MAX_TRAVEL,
-            np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
-            s, np.clip(interval, 0, len(grid) - 2), factors, INTERPOLATION_TOLERANCE, part, exact,
-        )
-    if friction:
-        part += coulomb * np.sign(qd[between])
+    interpolate = travel is not None and not np.any(robot.coulomb_friction)
+    tau = np.empty_like(qd)
+    exact = np.zeros(len(states.s), dtype=bool)
+    dense_torques(
+        constraints.s, smooth_points(constraints), right, left, np.zeros(0) if travel is None else travel, MAX_TRAVEL,
+        np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
+        states.s, states.sd, states.sdd, states.left, interpolate, INTERPOLATION_TOLERANCE, tau, exact,
+    )
     if exact.any():
-        again = between[exact]
-        part[exact] = robot.inverse_dynamics(q[again], qd[again], qdd[again])
-    tau[between] = part
+        tau[exact] = robot.inverse_dynamics(q[exact], qd[exact], qdd[exact])
     return tau
 
 

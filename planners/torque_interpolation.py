@@ -14,7 +14,7 @@ N m and N m s), each smooth in s between the path's knots (q(s) is a polynomial 
 dynamics trigonometric in q). The rows ``a u + b x + c + d sd`` hold a, b, d and
 c = g + F sign(q') at the grid points; the Coulomb term is taken out of c and added at the
 point itself. At a point between grid points, each of a, b, g and d is read from the quartic
-(Lagrange, on the non-uniform grid) through five consecutive grid points that no knot, corner
+(Newton's divided differences, on the non-uniform grid) through five consecutive grid points that no knot, corner
 or break of the path separates, the interval holding the point among the middle ones where the
 run of smooth points allows. Its error is estimated by the larger difference from the cubics
 through the first and the last four of those points (their error is one order lower; each row
@@ -28,8 +28,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-
-from planners.refinement_kernels import lagrange_weights
 
 #: Largest joint travel (rad, summed over the joints) of a grid interval whose rows are
 #: interpolated: the rows are trigonometric in q, and a grid coarser than this does not resolve
@@ -92,12 +90,12 @@ def terms_between(known, columns: list[int], travel: np.ndarray, s: np.ndarray) 
 
 
 @njit(cache=True, nogil=True)
-def _stencil(grid, smooth, travel, max_travel, i, at, nodes, quartic, cubic, shifted):  # pragma: no cover - compiled
+def _stencil(smooth, travel, max_travel, i):  # pragma: no cover - compiled
     """The first of five consecutive grid points around interval i through which the rows are
     smooth and which the grid resolves (each interval among them moving the joints by at most
-    ``max_travel``), with the weights at ``at`` of the quartic through them and of the cubics
-    through their first and last four written; -1 where there are none."""
-    n_grid = grid.shape[0]
+    ``max_travel``), the interval among the middle ones where the run of smooth points allows;
+    -1 where there are none."""
+    n_grid = smooth.shape[0]
     lo = i
     while lo > i - 2 and lo > 0 and smooth[lo]:
         lo -= 1
@@ -110,71 +108,121 @@ def _stencil(grid, smooth, travel, max_travel, i, at, nodes, quartic, cubic, shi
     for node in range(start, start + 4):
         if not travel[node] <= max_travel:
             return -1
-    for k in range(5):
-        nodes[k] = grid[start + k]
-    lagrange_weights(nodes, 5, at, quartic)
-    lagrange_weights(nodes, 4, at, cubic)
-    lagrange_weights(nodes[1:], 4, at, shifted)
     return start
 
 
 @njit(cache=True, nogil=True)
-def _row_at(right, left, row, j, i, start, quartic, cubic, shifted):  # pragma: no cover - compiled
-    """(value, estimated error) of row ``row`` of joint j from the stencil at ``start``: the
-    quartic's value and its larger difference from the two cubics. A node beyond the interval's
-    far end is seen from the left, as the interval sees it."""
-    quartic_value = 0.0
-    cubic_value = 0.0
-    shifted_value = 0.0
-    for k in range(5):
-        node = start + k
-        entry = left[row, node, j] if node > i else right[row, node, j]
-        quartic_value += quartic[k] * entry
-        if k < 4:
-            cubic_value += cubic[k] * entry
-        if k > 0:
-            shifted_value += shifted[k - 1] * entry
-    return quartic_value, max(abs(quartic_value - cubic_value), abs(quartic_value - shifted_value))
+def _divided_differences(grid, right, left, n_rows, i, start, coefficients, spans):  # pragma: no cover - compiled
+    """Newton coefficients f[x0], f[x0, x1], ..., f[x0, ..., x4] of the quartic through the five
+    grid points from ``start`` of each of the first ``n_rows`` rows of each joint, into
+    ``coefficients`` (rows, n_dof, 5); ``spans`` (5, 5) is scratch for 1 / (x_k - x_k-order).
+    A node beyond interval i's far end is seen from the left, as the interval sees it."""
+    for order in range(1, 5):
+        for k in range(order, 5):
+            spans[order, k] = 1.0 / (grid[start + k] - grid[start + k - order])
+    for row in range(n_rows):
+        for j in range(right.shape[2]):
+            for k in range(5):
+                node = start + k
+                coefficients[row, j, k] = left[row, node, j] if node > i else right[row, node, j]
+            for order in range(1, 5):
+                for k in range(4, order - 1, -1):
+                    coefficients[row, j, k] = (coefficients[row, j, k] - coefficients[row, j, k - 1]) * spans[order, k]
+
+
+@njit(cache=True, nogil=True)
+def _node_products(grid, start, at, products):  # pragma: no cover - compiled
+    """(x - x0), (x - x0)(x - x1), ..., (x - x0)...(x - x3) at x = ``at`` for the five nodes from
+    ``start``, into ``products[1:5]`` (``products[0]`` = 1), and (x - x1)...(x - x4) into
+    ``products[5]``. The quartic minus the cubic through its first four nodes is
+    f[x0..x4] products[4], minus the cubic through its last four f[x0..x4] products[5]."""
+    products[0] = 1.0
+    for k in range(1, 5):
+        products[k] = products[k - 1] * (at - grid[start + k - 1])
+    shifted = 1.0
+    for k in range(1, 5):
+        shifted *= at - grid[start + k]
+    products[5] = shifted
+
+
+@njit(cache=True, nogil=True)
+def _row_at(coefficients, row, j, products):  # pragma: no cover - compiled
+    """(value, estimated error) of row ``row`` of joint j: the quartic's value (Newton form) and
+    its larger difference from the two cubics through four of its nodes."""
+    value = 0.0
+    for k in range(4, -1, -1):
+        value += coefficients[row, j, k] * products[k]
+    top = abs(coefficients[row, j, 4])
+    return value, top * max(abs(products[4]), abs(products[5]))
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def interpolate_rows(grid, smooth, right, left, travel, max_travel, limit, s, interval, factors, tolerance, tau, exact):  # pragma: no cover - compiled
-    """Write a u + b x + g + d sd, the torques of n states without Coulomb friction, into
-    ``tau`` (n, n_dof), and mark in ``exact`` (n,) the states whose interpolation is not trusted
-    (their rows of ``tau`` are left unset).
+def dense_torques(grid, smooth, right, left, travel, max_travel, limit, s, sd, sdd, from_left, interpolate, tolerance, tau, exact):  # pragma: no cover - compiled
+    """Write a u + b x + c + d sd, the torques of n states (s, sd, u = sdd, x = sd^2), into
+    ``tau`` (n, n_dof), and mark in ``exact`` (n,) the states left to RNEA (their rows of
+    ``tau`` unset). A moving state on a grid point reads the rows there, on its side; a state
+    between grid points reads them from the quartic through the five grid points around it
+    (``_stencil``) where ``interpolate`` and the estimated error of every joint's torque is
+    within ``tolerance`` of its limit.
 
     Args:
         grid: Grid of s the rows were built on, (N + 1,).
         smooth: (N + 1,): the rows are smooth through the grid point (an interior point that is
             no knot of the path and where the rows from both sides agree).
-        right, left: a, b, g and d of each joint's torque at each grid point, (4, N + 1, n_dof),
-            from the right and from the left of the point (they differ at corners and breaks);
-            NaN where unknown (the states that would read them go to RNEA).
+        right, left: a, b, c and d of each joint's torque at each grid point, (4, N + 1, n_dof),
+            from the right and from the left of the point (they differ at corners and breaks).
         travel: Sum over the joints of |q(s_i+1) - q(s_i)| of each grid interval, (N,), rad.
         max_travel: Largest ``travel`` of an interval whose rows are interpolated: a coarser
             grid does not resolve rows trigonometric in q well enough for the estimate.
         limit: Torque limit per joint, (n_dof,), N m (finite): the scale of ``tolerance``.
-        s, interval: The states' s and the grid interval i each lies in (grid[i] <= s <=
-            grid[i + 1]; the state belongs to that interval's side of a grid point), (n,).
-        factors: u, x, 1 and sd of each state, (n, 4): tau = a u + b x + g + d sd.
+        s, sd, sdd: The states, (n,) each, s within [grid[0], grid[-1]].
+        from_left: (n,): the state ends the interval before its grid point (else it starts the
+            one after, or lies inside one).
+        interpolate: Whether states between grid points may be interpolated at all (c holds
+            no Coulomb friction, whose sign differs between the grid points and the states).
         tolerance: Largest estimated interpolation error trusted, a fraction of the limit.
     """
-    nodes, quartic, cubic, shifted = np.empty(5), np.empty(5), np.empty(4), np.empty(4)
+    n_grid = grid.shape[0]
+    n_dof = right.shape[2]
+    coefficients = np.empty((4, n_dof, 5))
+    spans = np.empty((5, 5))
+    products = np.empty(6)
+    factors = np.empty(4)
+    held = (-1, -1)  # the interval and stencil whose coefficients are held
     for state in range(s.shape[0]):
-        i = interval[state]
-        start = _stencil(grid, smooth, travel, max_travel, i, s[state], nodes, quartic, cubic, shifted)
+        at = s[state]
+        speed = sd[state]
+        factors[0], factors[1], factors[2], factors[3] = sdd[state], speed * speed, 1.0, speed
+        k = np.searchsorted(grid, at)
+        on_grid = k < n_grid and grid[k] == at
+        if on_grid and speed > 0.0:
+            rows = left if from_left[state] else right
+            for j in range(n_dof):
+                tau[state, j] = rows[0, k, j] * factors[0] + rows[1, k, j] * factors[1] + rows[2, k, j] + rows[3, k, j] * speed
+            continue
+        if not interpolate:
+            exact[state] = True
+            continue
+        # The interval the state belongs to: the one ending at its grid point from the left.
+        i = k - 1 if (from_left[state] or not on_grid) else k
+        i = min(max(i, 0), n_grid - 2)
+        start = _stencil(smooth, travel, max_travel, i)
         if start < 0:
             exact[state] = True
             continue
-        for j in range(right.shape[2]):
+        if held != (i, start):
+            _divided_differences(grid, right, left, 4, i, start, coefficients, spans)
+            held = (i, start)
+        _node_products(grid, start, at, products)
+        for j in range(n_dof):
             # Each row's error apart: the rows' errors may cancel in one state's torque and
             # add up in the next one's.
             value = 0.0
             error = 0.0
             for row in range(4):
-                factor = factors[state, row]
+                factor = factors[row]
                 if factor != 0.0:
-                    row_value, row_error = _row_at(right, left, row, j, i, start, quartic, cubic, shifted)
+                    row_value, row_error = _row_at(coefficients, row, j, products)
                     value += factor * row_value
                     error += abs(factor) * row_error
             if not error <= tolerance * limit[j]:
@@ -188,17 +236,25 @@ def interpolate_terms(grid, smooth, right, left, travel, max_travel, scale, s, i
     """Write rows a, b and g (the first three of ``right`` and ``left``) of each joint at n
     points into ``values`` (3, n, n_dof), each within ``tolerance`` of its ``scale`` (3, n_dof)
     by the estimate, and mark in ``exact`` (n,) the points where one is not (their values left
-    unset). The other arguments as for ``interpolate_rows``."""
-    nodes, quartic, cubic, shifted = np.empty(5), np.empty(5), np.empty(4), np.empty(4)
+    unset). ``interval`` (n,) holds the grid interval of each point; the other arguments as for
+    ``dense_torques``."""
+    coefficients = np.empty((3, right.shape[2], 5))
+    spans = np.empty((5, 5))
+    products = np.empty(6)
+    held = (-1, -1)
     for point in range(s.shape[0]):
         i = interval[point]
-        start = _stencil(grid, smooth, travel, max_travel, i, s[point], nodes, quartic, cubic, shifted)
+        start = _stencil(smooth, travel, max_travel, i)
         if start < 0:
             exact[point] = True
             continue
+        if held != (i, start):
+            _divided_differences(grid, right, left, 3, i, start, coefficients, spans)
+            held = (i, start)
+        _node_products(grid, start, s[point], products)
         for j in range(right.shape[2]):
             for row in range(3):
-                value, error = _row_at(right, left, row, j, i, start, quartic, cubic, shifted)
+                value, error = _row_at(coefficients, row, j, products)
                 if not error <= tolerance * scale[row, j]:
                     exact[point] = True
                 values[row, point, j] = value

@@ -50,7 +50,7 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
-from planners.kernels import point_bounds, sweeps
+from planners.kernels import point_bounds, sweeps, zero_inertia_intervals
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions, split_points
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
@@ -96,6 +96,9 @@ def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> L
     )
 
 
+#: A switching point is singular where a row's u-coefficient in its interval is within this
+#: fraction of the row's scale of zero (``planners.kernels.zero_inertia_intervals``).
+_ZERO_INERTIA_SWITCH = 1e-6
 #: Pieces into which one refinement round may split an interval at most.
 _MAX_PIECES = 8
 #: Refinement aims at this fraction of the tolerance, so that one round usually suffices.
@@ -320,34 +323,28 @@ def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tup
     """Where the profile changes between accelerating (at beta) and following the envelope."""
     s = constraints.s
     capped, envelope, x_high = profile.capped, profile.envelope, profile.x_high
+    changes = np.flatnonzero(capped[1:] != capped[:-1]) + 1
+    if not changes.size:
+        return ()
+    # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
+    at = np.minimum(changes, len(x_high) - 1)
+    on_mvc = envelope[changes] >= x_high[at] * (1 - 1e-6)
+    singular = zero_inertia_intervals(
+        constraints.s, constraints.a, constraints.b, constraints.a_left, constraints.b_left, at, _ZERO_INERTIA_SWITCH
+    )
     points = []
-    for i in np.flatnonzero(np.diff(capped.astype(int)) != 0) + 1:
+    for k, i in enumerate(changes):
         if capped[i]:
             points.append((float(s[i]), "deceleration"))
-            continue
-        # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
-        at = min(int(i), len(x_high) - 1)
-        on_mvc = envelope[i] >= x_high[at] * (1 - 1e-6)
-        if not on_mvc:
+        elif not on_mvc[k]:
             points.append((float(s[i]), "acceleration"))
-        elif _has_zero_inertia_row(constraints, at):
+        elif singular[k]:
             points.append((float(s[i]), "singular"))
         elif i >= 1 and i + 1 < len(x_high) and abs(x_high[i + 1] - x_high[i - 1]) > 0.25 * max(x_high[i], 1e-12):
             points.append((float(s[i]), "discontinuity"))
         else:
             points.append((float(s[i]), "tangent"))
     return tuple(points)
-
-
-def _has_zero_inertia_row(constraints: PathConstraints, i: int) -> bool:
-    """Whether a row of interval ``i`` in the interpolation discretization (``interval_rows``)
-    has a u-coefficient within 1e-6 of its scale of zero (viscous friction left out)."""
-    ds = constraints.s[i + 1] - constraints.s[i]
-    for a, b in ((constraints.a[i], constraints.b[i]), (constraints.a_left[i + 1] + 2.0 * ds * constraints.b_left[i + 1], constraints.b_left[i + 1])):
-        size = np.abs(a)
-        if (size <= 1e-6 * np.maximum(size + np.abs(b), 1e-300)).any():
-            return True
-    return False
 
 
 def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) -> InfeasiblePath:
