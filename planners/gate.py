@@ -13,6 +13,7 @@ import numpy as np
 from planners.constraints import PathConstraints
 from planners.errors import InfeasiblePath
 from planners.limit_check import Excess, LimitCheck, check_limits
+from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.timing.law_timing import LawTiming
@@ -136,10 +137,13 @@ def samples_exceed(
         speeds = tool_speeds(robot, limits.tool, samples.q, samples.qd)
         checks.append(("tool", speeds, limits.tool.bounds))  # columns in the order of TOOL_KINDS
     for kind, values, limit in checks:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.nan_to_num(np.abs(values) / limit, nan=0.0)
-        if ratio.size and ratio.max() > threshold:
-            sample, joint = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        if not values.size:
+            continue
+        ratio, sample, joint = utilization_pass(
+            np.ascontiguousarray(values, dtype=float), np.asarray(limit, dtype=float), np.inf,
+            np.empty(values.shape[1]), np.zeros(len(values), dtype=bool),
+        )
+        if ratio > threshold:
             if kind == "tool":
                 return TOOL_KINDS[int(joint)], int(sample), -1
             return kind, int(sample), int(joint)

@@ -113,19 +113,15 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     column = {} if constraints is None else {joint: k for k, (kind, joint) in enumerate(constraints.rows) if kind == "torque"}
     if constraints is None or len(column) != robot.dof:
         return robot.inverse_dynamics(q, qd, qdd)
-    columns = [column[joint] for joint in range(robot.dof)]
-    right = np.stack([row[:, columns] for row in (constraints.a, constraints.b, constraints.c, constraints.d)])
-    sides = (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)
-    # Without corners or breaks the rows from the left are the very arrays from the right.
-    same = all(mine is theirs for mine, theirs in zip(sides, (constraints.a, constraints.b, constraints.c, constraints.d)))
-    left = right if same else np.stack([row[:, columns] for row in sides])
+    columns = np.array([column[joint] for joint in range(robot.dof)], dtype=np.int64)
     travel = grid_travel(constraints)
     interpolate = travel is not None and not np.any(robot.coulomb_friction)
     tau = np.empty_like(qd)
     exact = np.zeros(len(states.s), dtype=bool)
     dense_torques(
-        constraints.s, smooth_points(constraints), right, left, np.zeros(0) if travel is None else travel, MAX_TRAVEL,
-        np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
+        constraints.s, smooth_points(constraints), (constraints.a, constraints.b, constraints.c, constraints.d),
+        (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left), columns,
+        np.zeros(0) if travel is None else travel, MAX_TRAVEL, np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
         states.s, states.sd, states.sdd, states.left, interpolate, INTERPOLATION_TOLERANCE, tau, exact,
     )
     if exact.any():

@@ -75,17 +75,14 @@ def terms_between(known, columns: list[int], travel: np.ndarray, s: np.ndarray) 
     inside an interval of its grid: (values (3, n, k), exact (n,)), each term within
     ``TERM_TOLERANCE`` of its largest magnitude on the grid (at least ``TERM_FLOOR`` of the
     limit) by the estimate, and ``exact`` marking the points left to RNEA (their values unset)."""
-    grid = known.s
-    zero = np.zeros((len(grid), len(columns)))
-    limit = np.maximum(known.upper[0, columns], -known.lower[0, columns])
-    right = np.stack([known.a[:, columns], known.b[:, columns], known.c[:, columns], zero])
-    left = np.stack([known.a_left[:, columns], known.b_left[:, columns], known.c_left[:, columns], zero])
-    smooth = smooth_points(known)
-    interval = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
-    values = np.zeros((3, len(s), len(columns)))
+    columns_ = np.asarray(columns, dtype=np.int64)
+    limit = np.maximum(known.upper[0, columns_], -known.lower[0, columns_])
+    values = np.zeros((3, len(s), len(columns_)))
     exact = np.zeros(len(s), dtype=bool)
-    scale = np.abs(right[:3]).max(axis=1) + TERM_FLOOR * limit
-    interpolate_terms(grid, smooth, right, left, travel, MAX_TRAVEL, scale, s, interval, TERM_TOLERANCE, values, exact)
+    interpolate_terms(
+        known.s, smooth_points(known), (known.a, known.b, known.c), (known.a_left, known.b_left, known.c_left), columns_,
+        travel, MAX_TRAVEL, TERM_FLOOR * limit, np.asarray(s, dtype=float), TERM_TOLERANCE, values, exact,
+    )
     return values, exact
 
 
@@ -112,19 +109,21 @@ def _stencil(smooth, travel, max_travel, i):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _divided_differences(grid, right, left, n_rows, i, start, coefficients, spans):  # pragma: no cover - compiled
+def _divided_differences(grid, right, left, columns, i, start, coefficients, spans):  # pragma: no cover - compiled
     """Newton coefficients f[x0], f[x0, x1], ..., f[x0, ..., x4] of the quartic through the five
-    grid points from ``start`` of each of the first ``n_rows`` rows of each joint, into
-    ``coefficients`` (rows, n_dof, 5); ``spans`` (5, 5) is scratch for 1 / (x_k - x_k-order).
-    A node beyond interval i's far end is seen from the left, as the interval sees it."""
+    grid points from ``start`` of each row of ``right`` and ``left`` (tuples of (N + 1, m)
+    arrays, seen from the right and from the left of each point), columns ``columns`` (k,), into
+    ``coefficients`` (rows, k, 5); ``spans`` (5, 5) is scratch for 1 / (x_k - x_k-order). A node
+    beyond interval i's far end is seen from the left, as the interval sees it."""
     for order in range(1, 5):
         for k in range(order, 5):
             spans[order, k] = 1.0 / (grid[start + k] - grid[start + k - order])
-    for row in range(n_rows):
-        for j in range(right.shape[2]):
+    for row in range(len(right)):
+        for j in range(columns.shape[0]):
+            column = columns[j]
             for k in range(5):
                 node = start + k
-                coefficients[row, j, k] = left[row, node, j] if node > i else right[row, node, j]
+                coefficients[row, j, k] = left[row][node, column] if node > i else right[row][node, column]
             for order in range(1, 5):
                 for k in range(4, order - 1, -1):
                     coefficients[row, j, k] = (coefficients[row, j, k] - coefficients[row, j, k - 1]) * spans[order, k]
@@ -157,7 +156,7 @@ def _row_at(coefficients, row, j, products):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def dense_torques(grid, smooth, right, left, travel, max_travel, limit, s, sd, sdd, from_left, interpolate, tolerance, tau, exact):  # pragma: no cover - compiled
+def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit, s, sd, sdd, from_left, interpolate, tolerance, tau, exact):  # pragma: no cover - compiled
     """Write a u + b x + c + d sd, the torques of n states (s, sd, u = sdd, x = sd^2), into
     ``tau`` (n, n_dof), and mark in ``exact`` (n,) the states left to RNEA (their rows of
     ``tau`` unset). A moving state on a grid point reads the rows there, on its side; a state
@@ -169,8 +168,9 @@ def dense_torques(grid, smooth, right, left, travel, max_travel, limit, s, sd, s
         grid: Grid of s the rows were built on, (N + 1,).
         smooth: (N + 1,): the rows are smooth through the grid point (an interior point that is
             no knot of the path and where the rows from both sides agree).
-        right, left: a, b, c and d of each joint's torque at each grid point, (4, N + 1, n_dof),
+        right, left: The rows a, b, c and d at each grid point, a tuple of four (N + 1, m),
             from the right and from the left of the point (they differ at corners and breaks).
+        columns: The torque row of each joint, (n_dof,).
         travel: Sum over the joints of |q(s_i+1) - q(s_i)| of each grid interval, (N,), rad.
         max_travel: Largest ``travel`` of an interval whose rows are interpolated: a coarser
             grid does not resolve rows trigonometric in q well enough for the estimate.
@@ -183,7 +183,7 @@ def dense_torques(grid, smooth, right, left, travel, max_travel, limit, s, sd, s
         tolerance: Largest estimated interpolation error trusted, a fraction of the limit.
     """
     n_grid = grid.shape[0]
-    n_dof = right.shape[2]
+    n_dof = columns.shape[0]
     coefficients = np.empty((4, n_dof, 5))
     spans = np.empty((5, 5))
     products = np.empty(6)
@@ -196,9 +196,10 @@ def dense_torques(grid, smooth, right, left, travel, max_travel, limit, s, sd, s
         k = np.searchsorted(grid, at)
         on_grid = k < n_grid and grid[k] == at
         if on_grid and speed > 0.0:
-            rows = left if from_left[state] else right
+            a, b, c, d = left if from_left[state] else right
             for j in range(n_dof):
-                tau[state, j] = rows[0, k, j] * factors[0] + rows[1, k, j] * factors[1] + rows[2, k, j] + rows[3, k, j] * speed
+                column = columns[j]
+                tau[state, j] = a[k, column] * factors[0] + b[k, column] * factors[1] + c[k, column] + d[k, column] * speed
             continue
         if not interpolate:
             exact[state] = True
@@ -211,7 +212,7 @@ def dense_torques(grid, smooth, right, left, travel, max_travel, limit, s, sd, s
             exact[state] = True
             continue
         if held != (i, start):
-            _divided_differences(grid, right, left, 4, i, start, coefficients, spans)
+            _divided_differences(grid, right, left, columns, i, start, coefficients, spans)
             held = (i, start)
         _node_products(grid, start, at, products)
         for j in range(n_dof):
@@ -232,27 +233,37 @@ def dense_torques(grid, smooth, right, left, travel, max_travel, limit, s, sd, s
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def interpolate_terms(grid, smooth, right, left, travel, max_travel, scale, s, interval, tolerance, values, exact):  # pragma: no cover - compiled
-    """Write rows a, b and g (the first three of ``right`` and ``left``) of each joint at n
-    points into ``values`` (3, n, n_dof), each within ``tolerance`` of its ``scale`` (3, n_dof)
-    by the estimate, and mark in ``exact`` (n,) the points where one is not (their values left
-    unset). ``interval`` (n,) holds the grid interval of each point; the other arguments as for
-    ``dense_torques``."""
-    coefficients = np.empty((3, right.shape[2], 5))
+def interpolate_terms(grid, smooth, right, left, columns, travel, max_travel, floor, s, tolerance, values, exact):  # pragma: no cover - compiled
+    """Write rows a, b and g (``right`` and ``left``: tuples of three (N + 1, m), c = g without
+    Coulomb friction) of the joints' columns ``columns`` (k,) at n points ``s`` (each inside the
+    grid) into ``values`` (3, n, k), each within ``tolerance`` of its scale (its largest
+    magnitude from the right over the grid, plus ``floor`` (k,)) by the estimate, and mark in
+    ``exact`` (n,) the points where one is not (their values left unset). The other arguments
+    as for ``dense_torques``."""
+    n_grid = grid.shape[0]
+    n_columns = columns.shape[0]
+    scale = np.empty((3, n_columns))
+    for row in range(3):
+        for j in range(n_columns):
+            largest = 0.0
+            for node in range(n_grid):
+                largest = max(largest, abs(right[row][node, columns[j]]))
+            scale[row, j] = largest + floor[j]
+    coefficients = np.empty((3, n_columns, 5))
     spans = np.empty((5, 5))
     products = np.empty(6)
     held = (-1, -1)
     for point in range(s.shape[0]):
-        i = interval[point]
+        i = min(max(np.searchsorted(grid, s[point], side="right") - 1, 0), n_grid - 2)
         start = _stencil(smooth, travel, max_travel, i)
         if start < 0:
             exact[point] = True
             continue
         if held != (i, start):
-            _divided_differences(grid, right, left, 3, i, start, coefficients, spans)
+            _divided_differences(grid, right, left, columns, i, start, coefficients, spans)
             held = (i, start)
         _node_products(grid, start, s[point], products)
-        for j in range(right.shape[2]):
+        for j in range(n_columns):
             for row in range(3):
                 value, error = _row_at(coefficients, row, j, products)
                 if not error <= tolerance * scale[row, j]:
