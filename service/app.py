@@ -12,6 +12,7 @@ from starlette.concurrency import run_in_threadpool
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.isolated import start_worker_server
+from planners.kinematics.conditioning import frobenius_condition_number
 from planners.threads import single_blas_thread
 from service.body_limit import BodySizeLimit
 from service.jobs import JOB_MODULES, job_runner
@@ -24,7 +25,8 @@ from service.workers import PlanningWorkers
 
 def _warm_up() -> None:
     """Build every catalog robot, import toppra and cvxpy, and load the compiled phase-plane
-    kernels once, so that first requests are fast."""
+    kernels once (and conditioning's singular-value kernel, on a singular Jacobian), so that
+    first requests are fast."""
     for name in robots.catalog_names():
         robots.load(name)
     import cvxpy  # noqa: F401
@@ -32,6 +34,7 @@ def _warm_up() -> None:
 
     arm = robots.load("yamamoto_2r")
     plan(arm, WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
+    frobenius_condition_number(np.zeros((6, 6)))
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:

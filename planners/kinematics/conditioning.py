@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from planners.kinematics.condition_kernels import gram_condition_numbers
+from planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
 from robots import Robot
 
 #: A warning is raised above this condition number.
@@ -47,20 +47,13 @@ def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
     gram_condition_numbers(stack, kappa)
     exact = ~(np.isfinite(kappa) & (kappa <= GRAM_KAPPA))
     if exact.any():
-        kappa[exact] = _from_singular_values(stack[exact])
+        chosen = np.ascontiguousarray(stack[exact])
+        values = np.empty(len(chosen))
+        singular_value_condition_numbers(chosen, values)
+        kappa[exact] = values
     if jacobian.ndim == 2:
         return float(kappa[0])
     return kappa.reshape(jacobian.shape[:-2])
-
-
-def _from_singular_values(stack: np.ndarray) -> np.ndarray:
-    """kappa_F of each matrix of ``stack`` (k, m, n) from its singular values."""
-    values = np.linalg.svd(stack, compute_uv=False)
-    count = values.shape[-1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        kappa = np.sqrt(np.sum(values**2, axis=-1) * np.sum(values**-2.0, axis=-1)) / count
-    singular = values.min(axis=-1) <= 1e-12 * np.maximum(values.max(axis=-1), 1e-300)
-    return np.where(singular, np.inf, kappa)
 
 
 def characteristic_length(robot: Robot) -> float:

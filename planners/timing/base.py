@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import abc
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -86,6 +87,11 @@ class PathTiming(abc.ABC):
         """Path speed sd (1/s) at the given values of s, for the phase-plane picture."""
 
 
+def _read_only(array: np.ndarray) -> np.ndarray:
+    array.setflags(write=False)
+    return array
+
+
 @dataclass(frozen=True)
 class TimeScaling(PathTiming):
     """A time scaling s(t) with piecewise-constant path acceleration.
@@ -115,16 +121,16 @@ class TimeScaling(PathTiming):
                 f"s = {self.s[index + 1]:.4g}"
             )
 
-    @property
+    @cached_property
     def sdd(self) -> np.ndarray:
-        """Path acceleration of each interval, shape (K,), in 1/s^2."""
-        return (self.sd[1:] ** 2 - self.sd[:-1] ** 2) / (2.0 * np.diff(self.s))
+        """Path acceleration of each interval, shape (K,), in 1/s^2 (computed once, read-only)."""
+        return _read_only((self.sd[1:] ** 2 - self.sd[:-1] ** 2) / (2.0 * np.diff(self.s)))
 
-    @property
+    @cached_property
     def t(self) -> np.ndarray:
-        """Time at each grid point, shape (K + 1,), in s."""
+        """Time at each grid point, shape (K + 1,), in s (computed once, read-only)."""
         dt = 2.0 * np.diff(self.s) / (self.sd[:-1] + self.sd[1:])
-        return np.concatenate(([0.0], np.cumsum(dt)))
+        return _read_only(np.concatenate(([0.0], np.cumsum(dt))))
 
     @property
     def duration(self) -> float:
