@@ -89,6 +89,23 @@ def test_a_grid_that_does_not_resolve_the_rows_gets_rnea(monkeypatch):
     np.testing.assert_allclose(tau, robot.inverse_dynamics(q, qd, qdd), rtol=0, atol=1e-12 * robot.limits.torque.max())
 
 
+def test_with_coulomb_friction_the_states_between_grid_points_get_rnea(monkeypatch):
+    """Coulomb friction sits in c with its sign at each grid point: on the friction pendulum
+    every state off the grid (or at rest) goes to RNEA, and every torque is RNEA's (with the
+    URDF's friction) to rounding, on a grid fine enough to be interpolated without it."""
+    text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()
+    pendulum = robot_from_model("pendulum_1r", check_urdf(text), "upload", None)
+    assert np.any(pendulum.coulomb_friction)
+    path = SplinePath(np.array([[-0.5], [0.4], [1.0]]))
+    constraints, states, (q, qd, qdd, _) = _timed_states(pendulum, path, path_grid(path), PhasePlaneMethod())
+    assert np.all(np.abs(np.diff(constraints.q, axis=0)).sum(axis=1) <= MAX_TRAVEL)
+    counter = _CountingRnea(monkeypatch)
+    tau = _torques(pendulum, states, q, qd, qdd, constraints)
+    assert counter.states == np.count_nonzero(~np.isin(states.s, constraints.s) | (states.sd == 0.0))
+    monkeypatch.undo()
+    np.testing.assert_allclose(tau, pendulum.inverse_dynamics(q, qd, qdd), rtol=0, atol=1e-12 * pendulum.limits.torque.max())
+
+
 def test_most_states_of_an_ordinary_request_are_interpolated(monkeypatch):
     """The typical request's path on its default grid: fewer than a tenth of the states off the
     grid need RNEA, and the torques are within a hundredth of the tolerance."""
