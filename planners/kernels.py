@@ -391,21 +391,3 @@ def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, fric
     return x, capped, envelope, floor, failed, x_high, switch_excess(ds, p, q, r, x, ceiling)
 
 
-
-
-@njit(cache=True, nogil=True)
-def zero_inertia_intervals(s, ra, rb, la, lb, intervals, tolerance):  # pragma: no cover - compiled
-    """Whether each of ``intervals`` (k,) has a row whose u-coefficient in the interpolation
-    discretization (``interval_bounds``: ``ra_i`` at its start, ``la_i+1 + 2 ds lb_i+1`` at its
-    end; rows ``ra, rb, la, lb`` each (N + 1, m), viscous friction left out) is within
-    ``tolerance`` of its scale |a| + |b| of zero, (k,) bool."""
-    found = np.zeros(intervals.shape[0], dtype=np.bool_)
-    for index in range(intervals.shape[0]):
-        i = intervals[index]
-        ds = s[i + 1] - s[i]
-        for j in range(ra.shape[1]):
-            for a, b in ((ra[i, j], rb[i, j]), (la[i + 1, j] + 2.0 * ds * lb[i + 1, j], lb[i + 1, j])):
-                size = abs(a)
-                if size <= tolerance * max(size + abs(b), 1e-300):
-                    found[index] = True
-    return found

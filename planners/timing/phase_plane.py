@@ -50,7 +50,7 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
-from planners.kernels import point_bounds, sweeps, zero_inertia_intervals
+from planners.kernels import point_bounds, sweeps
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions, split_points
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
@@ -97,7 +97,7 @@ def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> L
 
 
 #: A switching point is singular where a row's u-coefficient in its interval is within this
-#: fraction of the row's scale of zero (``planners.kernels.zero_inertia_intervals``).
+#: fraction of the row's scale of zero (``_zero_inertia_rows``).
 _ZERO_INERTIA_SWITCH = 1e-6
 #: Pieces into which one refinement round may split an interval at most.
 _MAX_PIECES = 8
@@ -329,9 +329,7 @@ def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tup
     # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
     at = np.minimum(changes, len(x_high) - 1)
     on_mvc = envelope[changes] >= x_high[at] * (1 - 1e-6)
-    singular = zero_inertia_intervals(
-        constraints.s, constraints.a, constraints.b, constraints.a_left, constraints.b_left, at, _ZERO_INERTIA_SWITCH
-    )
+    singular = _zero_inertia_rows(constraints, at)
     points = []
     for k, i in enumerate(changes):
         if capped[i]:
@@ -345,6 +343,22 @@ def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tup
         else:
             points.append((float(s[i]), "tangent"))
     return tuple(points)
+
+
+def _zero_inertia_rows(constraints: PathConstraints, intervals: np.ndarray) -> np.ndarray:
+    """Whether each of ``intervals`` (k,) has a row in the interpolation discretization
+    (``interval_rows``) whose u-coefficient is within ``_ZERO_INERTIA_SWITCH`` of its scale of
+    zero (viscous friction left out), (k,) bool."""
+    after = intervals + 1
+    ds = (constraints.s[after] - constraints.s[intervals])[:, None]
+    found = np.zeros(len(intervals), dtype=bool)
+    for a, b in (
+        (constraints.a[intervals], constraints.b[intervals]),
+        (constraints.a_left[after] + 2.0 * ds * constraints.b_left[after], constraints.b_left[after]),
+    ):
+        size = np.abs(a)
+        found |= (size <= _ZERO_INERTIA_SWITCH * np.maximum(size + np.abs(b), 1e-300)).any(axis=1)
+    return found
 
 
 def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) -> InfeasiblePath:
