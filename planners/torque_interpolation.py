@@ -12,16 +12,18 @@ x = sd^2, u = sdd, and the URDF's joint friction)
 with a = M q', b = M q'' + C(q, q') q', g the gravity torque and d = D q' (N m s^2, N m s^2,
 N m and N m s), each smooth in s between the path's knots (q(s) is a polynomial there, and the
 dynamics trigonometric in q). The rows ``a u + b x + c + d sd`` hold a, b, d and
-c = g + F sign(q') at the grid points; the Coulomb term is taken out of c and added at the
-point itself. At a point between grid points, each of a, b, g and d is read from the quartic
-(Newton's divided differences, on the non-uniform grid) through five consecutive grid points that no knot, corner
-or break of the path separates, the interval holding the point among the middle ones where the
-run of smooth points allows. Its error is estimated by the larger difference from the cubics
-through the first and the last four of those points (their error is one order lower; each row
-apart, weighted by |u|, x, 1 and sd, since the rows' errors may cancel at one point and add up
-at the next). A point is left to RNEA where that estimate exceeds ``tolerance`` of its scale,
-where fewer than five smooth grid points surround it, or where an interval among them moves
-the joints by more than ``MAX_TRAVEL``.
+c = g + F sign(q') at the grid points, the Coulomb term with the grid point's sign: with
+Coulomb friction, the points between grid points take RNEA. At a point between grid points,
+each of a, b, c and d is read from the quartic (Newton's divided differences, on the
+non-uniform grid) through five consecutive grid points that no knot, corner or break of the
+path separates, the interval holding the point among the middle ones where the run of smooth
+points allows. Its error is estimated by the larger difference from the cubics through the
+first and the last four of those points (their error is one order lower; each equals the
+quartic's top coefficient times a product of node distances; each row apart, weighted by |u|,
+x, 1 and sd, since the rows' errors may cancel at one point and add up at the next). A point is
+left to RNEA where that estimate exceeds ``tolerance`` of its scale, where fewer than five
+smooth grid points surround it, or where an interval among them moves the joints by more than
+``MAX_TRAVEL``.
 """
 
 from __future__ import annotations
