@@ -108,7 +108,8 @@ class PathConstraints:
         order = np.argsort(np.concatenate([self.s, extra.s]), kind="stable")
 
         def merge(mine, theirs):
-            return np.concatenate([mine, theirs])[order]
+            # np.take gathers whole rows at once; indexing with [order] goes element by element.
+            return np.take(np.concatenate([mine, theirs]), order, axis=0)
 
         jerk = jerk_left = None
         if self.jerk is not None:
