@@ -352,9 +352,10 @@ def _zero_inertia_rows(constraints: PathConstraints, intervals: np.ndarray) -> n
     after = intervals + 1
     ds = (constraints.s[after] - constraints.s[intervals])[:, None]
     found = np.zeros(len(intervals), dtype=bool)
+    b_after = np.take(constraints.b_left, after, axis=0)
     for a, b in (
-        (constraints.a[intervals], constraints.b[intervals]),
-        (constraints.a_left[after] + 2.0 * ds * constraints.b_left[after], constraints.b_left[after]),
+        (np.take(constraints.a, intervals, axis=0), np.take(constraints.b, intervals, axis=0)),
+        (np.take(constraints.a_left, after, axis=0) + 2.0 * ds * b_after, b_after),
     ):
         size = np.abs(a)
         found |= (size <= _ZERO_INERTIA_SWITCH * np.maximum(size + np.abs(b), 1e-300)).any(axis=1)
