@@ -24,6 +24,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -31,7 +32,7 @@ from planners.constraint_kernels import assemble_rows, velocity_bound
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
 from planners.tool_speed import tool_speed_bound
-from planners.torque_interpolation import MAX_TRAVEL, grid_travel, terms_between
+from planners.torque_interpolation import MAX_TRAVEL, grid_travel, smooth_points, terms_between
 from robots import JointLimits, Robot
 
 CONSTRAINT_KINDS = ("velocity", "acceleration", "torque", "jerk")
@@ -168,6 +169,14 @@ class PathConstraints:
             jerk_left=None,
             evaluate=None,
         )
+
+    @cached_property
+    def smooth(self) -> np.ndarray:
+        """(N + 1,): the grid points through which the rows are smooth, computed once
+        (``planners.torque_interpolation.smooth_points``), read-only."""
+        smooth = smooth_points(self)
+        smooth.setflags(write=False)
+        return smooth
 
     @property
     def has_friction(self) -> bool:

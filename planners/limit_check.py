@@ -29,7 +29,7 @@ from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.tool_speed import TOOL_KINDS, tool_speeds
-from planners.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel, smooth_points
+from planners.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel
 from robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included: the ends and the quarter points.
@@ -119,7 +119,7 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     tau = np.empty_like(qd)
     exact = np.zeros(len(states.s), dtype=bool)
     dense_torques(
-        constraints.s, smooth_points(constraints), (constraints.a, constraints.b, constraints.c, constraints.d),
+        constraints.s, constraints.smooth, (constraints.a, constraints.b, constraints.c, constraints.d),
         (constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left), columns,
         np.zeros(0) if travel is None else travel, MAX_TRAVEL, np.maximum(constraints.upper[0, columns], -constraints.lower[0, columns]),
         states.s, states.sd, states.sdd, states.left, interpolate, INTERPOLATION_TOLERANCE, tau, exact,

@@ -82,7 +82,7 @@ def terms_between(known, columns: list[int], travel: np.ndarray, s: np.ndarray) 
     values = np.zeros((3, len(s), len(columns_)))
     exact = np.zeros(len(s), dtype=bool)
     interpolate_terms(
-        known.s, smooth_points(known), (known.a, known.b, known.c), (known.a_left, known.b_left, known.c_left), columns_,
+        known.s, known.smooth, (known.a, known.b, known.c), (known.a_left, known.b_left, known.c_left), columns_,
         travel, MAX_TRAVEL, TERM_FLOOR * limit, np.asarray(s, dtype=float), TERM_TOLERANCE, values, exact,
     )
     return values, exact

@@ -54,7 +54,6 @@ from planners.kernels import point_bounds, sweeps
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions, split_points
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
-from planners.torque_interpolation import smooth_points
 
 #: Relative slack when comparing x values computed along different routes.
 _SLACK = 1e-9
@@ -239,7 +238,7 @@ class _Grid(NamedTuple):
         joint = constraints.velocity_joint
         binding = np.full(len(s), -1, dtype=np.int64) if joint is None else np.ascontiguousarray(joint, dtype=np.int64)
         friction = bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any()))
-        return cls(constraints, s, rows, x_bound, binding, smooth_points(constraints), friction)
+        return cls(constraints, s, rows, x_bound, binding, constraints.smooth, friction)
 
     def friction_reference(self) -> np.ndarray:
         """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
