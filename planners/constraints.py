@@ -126,7 +126,7 @@ class PathConstraints:
         left = right if same else tuple(
             merge(mine, theirs) for mine, theirs in zip((self.a_left, self.b_left, self.c_left, self.d_left), (extra.a, extra.b, extra.c, extra.d))
         )
-        return PathConstraints(
+        merged = PathConstraints(
             s=merge(self.s, extra.s),
             sd_max=merge(self.sd_max, extra.sd_max),
             a=right[0],
@@ -149,6 +149,13 @@ class PathConstraints:
             q=None if self.q is None or extra.q is None else merge(self.q, extra.q),
             evaluate=self.evaluate,
         )
+        # The new points lie strictly inside intervals, where the rows are the same from both
+        # sides: they are smooth unless one is a knot the grid did not hold.
+        new_smooth = np.ones(len(extra.s), dtype=bool) if self.knots is None else ~np.isin(extra.s, self.knots)
+        smooth = merge(self.smooth, new_smooth)
+        smooth.setflags(write=False)
+        merged.__dict__["smooth"] = smooth  # seeds the cached property: smooth_points(merged)
+        return merged
 
     def time_scaled(self, kappa: float) -> PathConstraints:
         """The same limits in a scaled time: with x = kappa x' and u = kappa u' (time runs

@@ -109,3 +109,29 @@ def test_rows_of_finite_limits_only_in_chunks(monkeypatch):
     chunked = build_path_constraints(path, robot, limits, kinds, s)
     for name in ("a", "b", "c", "d", "lower", "upper", "sd_max"):
         assert np.array_equal(getattr(chunked, name), getattr(whole, name)), name
+
+
+@pytest.mark.parametrize("make", ["corners", "spline_off_grid_knot"])
+def test_refined_constraints_know_their_smooth_points(make):
+    """``with_points`` hands the refined grid the smooth points (``PathConstraints.smooth``) it
+    derives from the coarse grid's: the same as computing them afresh, at corners (rows that
+    differ from the two sides) and where a new point falls on a knot the grid did not hold."""
+    from planners.torque_interpolation import smooth_points
+
+    robot = robots.load("ur5")
+    kinds = ("velocity", "acceleration", "torque")
+    if make == "corners":
+        path = StopAndGoPath(np.array([[0, 0, 0, 0, 0, 0], [1, 0, 0, 0, 0, 0], [1, 1, 0, 0, 0, 0.0]]))
+        s = path_grid(path, 20)
+        extra = 0.5 * (s[:-1] + s[1:])[::3]
+    else:
+        path = SplinePath(RNG.uniform(-1, 1, (3, 6)))
+        s = np.linspace(0.0, 1.0, 7)  # the inner knot is no grid point
+        extra = np.array([0.1, path.knots[1], 0.9])
+    constraints = build_path_constraints(path, robot, robot.limits, kinds, s)
+    refined = constraints.with_points(extra, interpolate=True)
+    np.testing.assert_array_equal(refined.smooth, smooth_points(refined))
+    assert not refined.smooth.flags.writeable
+    if make == "spline_off_grid_knot":
+        assert path.knots[1] not in s
+        assert not refined.smooth[np.flatnonzero(refined.s == path.knots[1])[0]]
