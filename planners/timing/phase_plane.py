@@ -328,7 +328,11 @@ def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tup
     # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
     at = np.minimum(changes, len(x_high) - 1)
     on_mvc = envelope[changes] >= x_high[at] * (1 - 1e-6)
-    singular = _zero_inertia_rows(constraints, at)
+    # Only a departure from the MVC can be singular.
+    departs = ~capped[changes] & on_mvc
+    singular = np.zeros(len(changes), dtype=bool)
+    if departs.any():
+        singular[departs] = _zero_inertia_rows(constraints, at[departs])
     points = []
     for k, i in enumerate(changes):
         if capped[i]:
