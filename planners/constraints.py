@@ -115,46 +115,34 @@ class PathConstraints:
         jerk = jerk_left = None
         if self.jerk is not None:
             assert extra.jerk is not None  # evaluated with the same limits
-            dq, ddq, dddq = (merge(mine, theirs) for mine, theirs in zip(self.jerk[:3], extra.jerk[:3]))
-            jerk = (dq, ddq, dddq, self.jerk[3])
+            jerk = (*(merge(mine, theirs) for mine, theirs in zip(self.jerk[:3], extra.jerk[:3])), self.jerk[3])
             if self.jerk_left is not None:
-                left_dq, left_ddq, left_dddq = (merge(mine, theirs) for mine, theirs in zip(self.jerk_left, extra.jerk[:3]))
-                jerk_left = (left_dq, left_ddq, left_dddq)
+                jerk_left = tuple(merge(mine, theirs) for mine, theirs in zip(self.jerk_left, extra.jerk[:3]))
         right = tuple(merge(mine, theirs) for mine, theirs in zip((self.a, self.b, self.c, self.d), (extra.a, extra.b, extra.c, extra.d)))
         # Without corners or breaks the rows seen from the left are the very same arrays.
         same = self.a_left is self.a and self.b_left is self.b and self.c_left is self.c and self.d_left is self.d
         left = right if same else tuple(
             merge(mine, theirs) for mine, theirs in zip((self.a_left, self.b_left, self.c_left, self.d_left), (extra.a, extra.b, extra.c, extra.d))
         )
-        merged = PathConstraints(
+        merged = dataclasses.replace(  # rows, joint_names, knots and evaluate stay
+            self,
             s=merge(self.s, extra.s),
             sd_max=merge(self.sd_max, extra.sd_max),
-            a=right[0],
-            b=right[1],
-            c=right[2],
-            d=right[3],
-            a_left=left[0],
-            b_left=left[1],
-            c_left=left[2],
-            d_left=left[3],
+            a=right[0], b=right[1], c=right[2], d=right[3],
+            a_left=left[0], b_left=left[1], c_left=left[2], d_left=left[3],
             lower=merge(self.lower, extra.lower),
             upper=merge(self.upper, extra.upper),
-            rows=self.rows,
-            joint_names=self.joint_names,
             velocity_joint=None if self.velocity_joint is None else merge(self.velocity_joint, extra.velocity_joint),
             tool_bound=None if self.tool_bound is None else merge(self.tool_bound, extra.tool_bound),
             jerk=jerk,
             jerk_left=jerk_left,
-            knots=self.knots,
             q=None if self.q is None or extra.q is None else merge(self.q, extra.q),
-            evaluate=self.evaluate,
         )
-        # The new points lie strictly inside intervals, where the rows are the same from both
-        # sides: they are smooth unless one is a knot the grid did not hold.
-        new_smooth = np.ones(len(extra.s), dtype=bool) if self.knots is None else ~np.isin(extra.s, self.knots)
-        smooth = merge(self.smooth, new_smooth)
-        smooth.setflags(write=False)
-        merged.__dict__["smooth"] = smooth  # seeds the cached property: smooth_points(merged)
+        # Seeds the cached ``smooth``: the new points lie strictly inside intervals, where the rows
+        # are the same from both sides, so they are smooth unless one is a knot off the grid.
+        new = np.ones(len(extra.s), dtype=bool) if self.knots is None else ~np.isin(extra.s, self.knots)
+        merged.__dict__["smooth"] = merge(self.smooth, new)
+        merged.smooth.setflags(write=False)
         return merged
 
     def time_scaled(self, kappa: float) -> PathConstraints:
