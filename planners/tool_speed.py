@@ -12,15 +12,15 @@ linear in the path speed sd. A bound |v| <= v_max is therefore a first-order bou
 
 of the same form as a joint velocity limit (``PathConstraints.sd_max``), and every timing method
 that reads ``sd_max`` holds it. The dense limit check computes |v| and |w| at its states from
-the frame's velocity (forward kinematics with the joint velocities).
+the frame's Jacobian (``planners.kinematics.frame_jacobians``).
 """
 
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 
 from planners.errors import InvalidRequest
+from planners.kinematics.frame_jacobians import frame_jacobians
 from robots import Robot, ToolSpeedLimit
 
 #: Names of the tool limits, as ``peak_utilization`` and error messages show them.
@@ -56,15 +56,8 @@ def tool_speed_limit(robot: Robot, frame: str | None, speed: float | None, angul
 def frame_twists(robot: Robot, frame_id: int, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
     """The frame's twist J(q) qd at each row of ``q``, ``qd`` (n, n_dof): shape (n, 6), linear
     velocity of its origin (m/s) then angular velocity (rad/s), in world-aligned axes."""
-    model, data = robot.model, robot.data
-    configurations = robot.configuration(np.atleast_2d(q))
-    qd = np.atleast_2d(qd)
-    twists = np.empty((len(configurations), 6))
-    frame = pin.LOCAL_WORLD_ALIGNED
-    for row, (configuration, velocity) in enumerate(zip(configurations, qd)):
-        pin.forwardKinematics(model, data, configuration, velocity)
-        twists[row] = pin.getFrameVelocity(model, data, frame_id, frame).vector
-    return twists
+    jacobians = frame_jacobians(robot, frame_id, q)
+    return np.einsum("nij,nj->ni", jacobians, np.atleast_2d(np.asarray(qd, dtype=float)))
 
 
 def tool_speeds(robot: Robot, tool: ToolSpeedLimit, q: np.ndarray, qd: np.ndarray) -> np.ndarray:

@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
 
+from robots.chain import Chain, chain_of
 from robots.limits import JointLimits
 
 
@@ -125,6 +127,12 @@ class Robot:
         return Robot.from_model, (
             self.name, self.model, self.source, self.end_effector, self.limits, self.limit_sources, self.locked_joints, self.notes
         )
+
+    @cached_property
+    def chain(self) -> Chain | None:
+        """The kinematic tree as arrays (``robots.chain``), ``None`` when a joint is neither
+        revolute nor prismatic."""
+        return chain_of(self.model)
 
     @property
     def dof(self) -> int:

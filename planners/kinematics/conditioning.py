@@ -18,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
+from planners.kinematics.frame_jacobians import frame_jacobians
 from robots import Robot
 
 #: A warning is raised above this condition number.
@@ -76,16 +77,7 @@ def task_jacobian(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> 
 def task_jacobians(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> np.ndarray:
     """``task_jacobian`` at every row of ``q`` (n_samples, n_dof): shape (n_samples, 3 or 6,
     n_dof)."""
-    model, data = robot.model, robot.data
-    configurations = robot.configuration(q)
-    jacobians = np.empty((len(q), 6, robot.dof))
-    frame = pin.LOCAL_WORLD_ALIGNED
-    if robot.dof == 1:  # Pinocchio returns a (6,) vector, not a (6, 1) matrix, for a one-joint model
-        for row, configuration in enumerate(configurations):
-            jacobians[row, :, 0] = pin.computeFrameJacobian(model, data, configuration, frame_id, frame)
-    else:
-        for row, configuration in enumerate(configurations):
-            jacobians[row] = pin.computeFrameJacobian(model, data, configuration, frame_id, frame)
+    jacobians = frame_jacobians(robot, frame_id, q)
     if robot.dof <= 3:
         return jacobians[:, :3]
     return np.concatenate([jacobians[:, 3:], jacobians[:, :3] / length], axis=1)

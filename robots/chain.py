@@ -1,0 +1,68 @@
+"""A robot's kinematic tree as plain arrays, for compiled kinematics over many configurations
+(``planners.kinematics.chain``): each joint's placement in its parent, its axis, whether it
+turns or slides, and which joint coordinate moves it.
+
+Only joints of one degree of freedom about or along a fixed axis are described: Pinocchio's
+revolute (RX, RY, RZ, unaligned, and their unbounded forms, which toptraj's joint coordinates
+hold as one angle) and prismatic joints (PX, PY, PZ, unaligned). A model with any other joint
+has no ``Chain``; its kinematics stay with Pinocchio.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+_REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned",
+             "JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"}
+_PRISMATIC = {"JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"}
+
+
+@dataclass(frozen=True)
+class Chain:
+    """The joints of a model (Pinocchio's order, the universe left out; n joints).
+
+    Attributes:
+        parent: (n,) int64, each joint's parent joint (an index into these arrays), -1 for the
+            base.
+        prismatic: (n,) bool, the joint slides (else it turns).
+        axis: (n, 3), the joint's unit axis in its own frame.
+        rotation: (n, 3, 3), the rotation of the joint's frame at zero in its parent's frame.
+        translation: (n, 3), the origin of the joint's frame in its parent's frame (m).
+        coordinate: (n,) int64, the joint coordinate (tangent index) that moves the joint.
+    """
+
+    parent: np.ndarray
+    prismatic: np.ndarray
+    axis: np.ndarray
+    rotation: np.ndarray
+    translation: np.ndarray
+    coordinate: np.ndarray
+
+
+def chain_of(model: pin.Model) -> Chain | None:
+    """The ``Chain`` of ``model``, or ``None`` when it has a joint other than a revolute or a
+    prismatic one. Each axis is read from the joint's motion subspace (its angular part for a
+    revolute joint, its linear part for a prismatic one)."""
+    joints = list(model.joints)[1:]
+    if any(joint.shortname() not in _REVOLUTE | _PRISMATIC or joint.nv != 1 for joint in joints):
+        return None
+    axes, prismatic = [], []
+    for joint in joints:
+        data = joint.createData()
+        joint.calc(data, np.array([1.0, 0.0]) if joint.nq == 2 else np.zeros(joint.nq))
+        motion = np.asarray(data.S, dtype=float).ravel()
+        slides = joint.shortname() in _PRISMATIC
+        axes.append(motion[:3] if slides else motion[3:])
+        prismatic.append(slides)
+    placements = [model.jointPlacements[index] for index in range(1, model.njoints)]
+    return Chain(
+        parent=np.asarray([model.parents[index] - 1 for index in range(1, model.njoints)], dtype=np.int64),
+        prismatic=np.asarray(prismatic, dtype=np.bool_),
+        axis=np.ascontiguousarray(axes, dtype=float),
+        rotation=np.ascontiguousarray([placement.rotation for placement in placements], dtype=float),
+        translation=np.ascontiguousarray([placement.translation for placement in placements], dtype=float),
+        coordinate=np.asarray([joint.idx_v for joint in joints], dtype=np.int64),
+    )
