@@ -191,7 +191,7 @@ def test_switching_times_in_the_answer_schema(type_3):
     """The answer carries switching_times per joint name (s), declared in the OpenAPI."""
     from service.app import create_app
     from service.planning import trajectory_body
-    from service.schemas.trajectories import TrajectoryResponse
+    from service.schemas.answers import TrajectoryResponse
     from service.settings import Settings
 
     body = TrajectoryResponse.model_validate(trajectory_body(type_3)).model_dump()

@@ -9,8 +9,9 @@ from fastapi.responses import Response
 
 from service.planning import compare_request, encode_json, plan_request, render
 from service.problems import problem_responses
+from service.schemas.answers import CompareResponse, TrajectoryResponse
 from service.schemas.examples import openapi_examples
-from service.schemas.trajectories import CompareRequest, CompareResponse, TrajectoryRequest, TrajectoryResponse
+from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
 
