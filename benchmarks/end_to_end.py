@@ -14,8 +14,9 @@ samples every 10 ms. Each round times, in a shuffled order:
   same URDF built beforehand: ``Toppra(...)``, the three ``Add...Limit`` calls and
   ``SolvePathParameterization``;
 * **RNEA floor**: 3 RNEA per grid point of the grid our answer was actually timed on (the
-  build grid and the points the phase-plane refinement added), in one batched call
-  (``Robot.rnea``, Pinocchio's ``rneaInParallel``);
+  build grid and the points the phase-plane refinement added), in one batched call of
+  Pinocchio's ``rneaInParallel`` on one thread (an anchor outside our code: ``Robot.rnea``
+  takes toptraj's own compiled pass);
 * **library**: ``planners.plan`` for the request (no HTTP, no JSON);
 * **planning thread**: what a server's planning thread does: the request's schema object to
   JSON bytes (``plan_request``, ``trajectory_body``, ``encode_json``);
@@ -47,6 +48,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -86,7 +88,6 @@ STAGES = (
 
 def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100) -> float:
     """One toppra solve through its public API; returns the duration (s)."""
-    import pinocchio as pin
     import toppra
 
     model, data, limits = robot.model, robot.model.createData(), robot.limits
@@ -152,9 +153,10 @@ def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int
     return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 
-def rnea_floor(robot: robots.Robot, states: np.ndarray) -> None:
-    """3 RNEA per grid point, batched: ``states`` is (3 * points, 3, n_dof) of q, qd, qdd."""
-    robot.rnea(states[:, 0], states[:, 1], states[:, 2])
+def rnea_floor(pool: pin.ModelPool, states: np.ndarray) -> None:
+    """3 RNEA per grid point, batched: ``states`` is (3, n_dof, 3 * points) of q, qd, qdd,
+    Fortran-ordered as Pinocchio's ``rneaInParallel`` takes them."""
+    pin.rneaInParallel(1, pool, states[0], states[1], states[2])
 
 
 def _free_port() -> int:
@@ -244,7 +246,8 @@ def main() -> int:
     answer = plan(robot, path_spec, timing, 0.01)
     grid_points, built_points = timing_grid_points(robot, path_spec, timing)
     rng = np.random.default_rng(0)
-    states = rng.uniform(-1.0, 1.0, (3 * grid_points, 3, robot.dof))
+    states = [np.asfortranarray(rng.uniform(-1.0, 1.0, (robot.dof, 3 * grid_points))) for _ in range(3)]
+    pool = pin.ModelPool(robot.model, 1)
 
     port = _free_port()
     server = _serve(port)
@@ -262,7 +265,7 @@ def main() -> int:
         probes = {
             "bare toppra": lambda: bare_toppra(robot, waypoints),
             **({"drake": drake} if drake is not None else {}),
-            "RNEA floor": lambda: rnea_floor(robot, states),
+            "RNEA floor": lambda: rnea_floor(pool, states),
             "library": lambda: plan(robot, path_spec, timing, 0.01),
             "planning thread": lambda: encode_json(trajectory_body(plan_request(request))),
             "HTTP": http_call,

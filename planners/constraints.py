@@ -13,7 +13,7 @@ bounds sd <= sd_max(s); acceleration and torque limits give second-order rows
 At a corner of the path (a kink, where q' jumps) the motion must stop, so sd_max = 0 there, and
 the rows seen from the interval that ends there (``*_left``) differ from those of the interval
 that starts there; so do they at a break (where q'' jumps: a line meeting a circular blend).
-The torque coefficients come from Pinocchio's RNEA: a = rnea(q, 0, q') - g,
+The torque coefficients come from the RNEA (``Robot.rnea_sets``): a = rnea(q, 0, q') - g,
 b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never see a robot; one
 batched RNEA per chunk of grid points, then one compiled pass
 (``planners.constraint_kernels``) writes every row and the velocity bound.
@@ -229,9 +229,10 @@ class LinearRows:
 
 def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> np.ndarray:
     """(3 n, n_dof): RNEA(q, 0, 0) = g, RNEA(q, 0, q') = M q' + g and RNEA(q, q', q'') =
-    M q'' + C(q, q') q' + g at the n rows of ``q, dq, ddq``, in one batched call."""
+    M q'' + C(q, q') q' + g at the n rows of ``q, dq, ddq``, in one batched call whose three
+    sets share the joint placements (``Robot.rnea_sets``)."""
     zero = np.zeros_like(dq)
-    return robot.rnea(np.concatenate((q, q, q)), np.concatenate((zero, zero, dq)), np.concatenate((zero, dq, ddq)))
+    return robot.rnea_sets(q, np.stack((zero, zero, dq)), np.stack((zero, dq, ddq))).reshape(-1, dq.shape[1])
 
 
 #: Grid points whose torque rows are computed between two deadline checks (about 20 ms).

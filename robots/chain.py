@@ -1,6 +1,7 @@
-"""A robot's kinematic tree as plain arrays, for compiled kinematics over many configurations
-(``planners.kinematics.chain``): each joint's placement in its parent, its axis, whether it
-turns or slides, and which joint coordinate moves it.
+"""A robot's kinematic tree as plain arrays, for compiled kinematics and dynamics over many
+configurations (``planners.kinematics.frame_jacobians``, ``robots.chain_dynamics``): each
+joint's placement in its parent, its axis, whether it turns or slides, which joint coordinate
+moves it, and the inertia of the body it carries.
 
 Only joints of one degree of freedom about or along a fixed axis are described: Pinocchio's
 revolute (RX, RY, RZ, unaligned, and their unbounded forms, which toptraj's joint coordinates
@@ -32,6 +33,11 @@ class Chain:
         rotation: (n, 3, 3), the rotation of the joint's frame at zero in its parent's frame.
         translation: (n, 3), the origin of the joint's frame in its parent's frame (m).
         coordinate: (n,) int64, the joint coordinate (tangent index) that moves the joint.
+        mass: (n,), the mass of the body the joint carries (kg).
+        lever: (n, 3), that body's centre of mass in the joint's frame (m).
+        inertia: (n, 3, 3), its rotational inertia about the centre of mass, joint axes (kg m^2).
+        armature: (n_dof,), the rotor inertia added on each joint coordinate (kg m^2 or kg).
+        gravity: (3,), the gravity vector in the base frame (m/s^2).
     """
 
     parent: np.ndarray
@@ -40,6 +46,11 @@ class Chain:
     rotation: np.ndarray
     translation: np.ndarray
     coordinate: np.ndarray
+    mass: np.ndarray
+    lever: np.ndarray
+    inertia: np.ndarray
+    armature: np.ndarray
+    gravity: np.ndarray
 
 
 def chain_of(model: pin.Model) -> Chain | None:
@@ -58,6 +69,7 @@ def chain_of(model: pin.Model) -> Chain | None:
         axes.append(motion[:3] if slides else motion[3:])
         prismatic.append(slides)
     placements = [model.jointPlacements[index] for index in range(1, model.njoints)]
+    bodies = [model.inertias[index] for index in range(1, model.njoints)]
     return Chain(
         parent=np.asarray([model.parents[index] - 1 for index in range(1, model.njoints)], dtype=np.int64),
         prismatic=np.asarray(prismatic, dtype=np.bool_),
@@ -65,4 +77,9 @@ def chain_of(model: pin.Model) -> Chain | None:
         rotation=np.ascontiguousarray([placement.rotation for placement in placements], dtype=float),
         translation=np.ascontiguousarray([placement.translation for placement in placements], dtype=float),
         coordinate=np.asarray([joint.idx_v for joint in joints], dtype=np.int64),
+        mass=np.asarray([body.mass for body in bodies], dtype=float),
+        lever=np.ascontiguousarray([body.lever for body in bodies], dtype=float).reshape(-1, 3),
+        inertia=np.ascontiguousarray([body.inertia for body in bodies], dtype=float).reshape(-1, 3, 3),
+        armature=np.asarray(model.armature, dtype=float).copy(),
+        gravity=np.asarray(model.gravity.linear, dtype=float).copy(),
     )

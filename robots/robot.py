@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from robots.chain import Chain, chain_of
+from robots.chain_dynamics import chain_rnea
 from robots.limits import JointLimits
 
 
@@ -160,22 +161,36 @@ class Robot:
         return out
 
     def rnea(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        """Pinocchio's RNEA for rows of ``q, qd, qdd`` (each (n_samples, n_dof)), in one batched
-        call on the calling thread's model pool; shape (n_samples, n_dof), N m (N)."""
-        q, qd, qdd = np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(qdd)
+        """Inverse dynamics (Pinocchio's RNEA, armature included) for rows of ``q, qd, qdd``
+        (each (n_samples, n_dof)); shape (n_samples, n_dof), N m (N). Arms with a ``chain``
+        take the compiled pass of ``robots.chain_dynamics``, the others one batched Pinocchio
+        call on the calling thread's model pool."""
+        qd = np.atleast_2d(qd)
+        return self.rnea_sets(q, qd[np.newaxis], np.atleast_2d(qdd)[np.newaxis])[0]
+
+    def rnea_sets(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Inverse dynamics at the configurations ``q`` (n, n_dof), each with ``n_sets`` pairs
+        of velocities and accelerations ``qd[m], qdd[m]`` (each (n_sets, n, n_dof)): shape
+        (n_sets, n, n_dof), each set's rows C-contiguous (orjson writes them directly). With a
+        ``chain`` the sets share one computation of the joint placements."""
+        q = np.atleast_2d(q)
+        qd, qdd = np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float)
         if q.shape[0] == 0:
-            return np.empty_like(qd, dtype=float)
+            return np.empty(qd.shape)
+        if self.chain is not None:
+            return chain_rnea(self.chain, q, qd, qdd)
         pool = getattr(self._local, "pool", None)
         if pool is None:
             pool = self._local.pool = pin.ModelPool(self.model, 1)
+        n_sets, n = qd.shape[:2]
         tau = pin.rneaInParallel(
             1,
             pool,
-            np.asfortranarray(self.configuration(q).T),
-            np.asfortranarray(qd.T, dtype=float),
-            np.asfortranarray(qdd.T, dtype=float),
+            np.asfortranarray(np.tile(self.configuration(q), (n_sets, 1)).T),
+            np.asfortranarray(qd.reshape(n_sets * n, -1).T),
+            np.asfortranarray(qdd.reshape(n_sets * n, -1).T),
         )
-        return np.ascontiguousarray(np.asarray(tau).T).reshape(qd.shape)  # rows C-contiguous: orjson writes them directly
+        return np.ascontiguousarray(np.asarray(tau).T).reshape(qd.shape)
 
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """Joint torques for rows of ``q, qd, qdd`` (each (n_samples, n_dof)): Pinocchio's RNEA
