@@ -20,7 +20,8 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
 ``SplineInterpolator``, is built beforehand for every method):
 
 * ``pp``: ``phase_plane`` as a user of toptraj pays for it: the constraint build
-  (``build_path_constraints``: path derivatives and a batched Pinocchio RNEA at each grid point)
+  (``build_path_constraints``: path derivatives and the batched RNEA of ``Robot.rnea_sets`` at each
+  grid point)
   plus ``PhasePlaneMethod(excursion=None).solve`` (which evaluates the constraints anew at the
   points its grid refinement adds; the share of the time spent evaluating rows is printed too).
   ``solve``: the solve alone, on constraints built beforehand. Its refinement aims at the
@@ -50,7 +51,8 @@ phase_plane given the other method's grid. Prints one line per path, then the me
 of each ratio, per robot and overall, and every path where phase_plane is slower.
 
 Times are the CPU time of the process (``time.process_time``) by default: every method runs in
-this one thread (Pinocchio's batched RNEA with one thread, toppra's Cython solver, Drake), and on
+this one thread (toptraj's compiled RNEA, Pinocchio's RNEA in toppra's callbacks, toppra's
+Cython solver, Drake), and on
 a shared machine a run's wall time also holds the waits for other processes, which grow with
 the run's length. ``--clock wall`` times with ``time.perf_counter`` instead.
 
