@@ -16,11 +16,11 @@ by Pinocchio's forward dynamics (``pinocchio.aba``, a classical Runge-Kutta step
 between consecutive switches of any joint, so that no step straddles a switch), and the goal
 state q(T) = q_b, v(T) = v_b gives 2 n equations. With as many unknowns as equations (Type 1
 of the paper: 3 switches and T) they are solved by Newton's method on a finite-difference
-Jacobian (``_newton``). With one unknown more (Types 2 to 4: 4 switches and T), one switching
-time p is held while Newton's method solves for the others, and T(p) is minimized by the secant
-method on dT/dp from the implicit function theorem (``_secant_minimum``); with still more,
-the Newton solution seeds a minimization of T under the goal equations (SLSQP): the
-switching-time optimization.
+Jacobian (``root_finding.newton``). With one unknown more (Types 2 to 4: 4 switches and T),
+one switching time p is held while Newton's method solves for the others, and T(p) is minimized
+by the secant method on dT/dp from the implicit function theorem
+(``root_finding.secant_minimum``); with still more, the Newton solution seeds a minimization of
+T under the goal equations (SLSQP): the switching-time optimization.
 
 Near a change of type (the paper's Types 1 and 2 at phi_b = 0.98) two switching structures
 give almost the same T; ``refine_switching`` therefore also tries the neighbouring structures
@@ -38,6 +38,7 @@ from scipy.optimize import minimize
 
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.free_path.collocation import CollocationResult, FreeMotion
+from planners.free_path.root_finding import held_newton, jacobian, newton, secant_minimum
 from planners.via_points import ConstantSpeedTiming, ViaPath
 from robots import JointLimits, Robot
 
@@ -179,37 +180,6 @@ class _Shooting:
         return q, v, record
 
 
-def _jacobian(function, x: np.ndarray, value: np.ndarray, step: float = 1e-6) -> np.ndarray:
-    """Forward differences of ``function`` at ``x`` (where it is ``value``)."""
-    columns = []
-    for i in range(len(x)):
-        shifted = x.copy()
-        shifted[i] += step
-        columns.append((function(shifted) - value) / step)
-    return np.array(columns).T
-
-
-def _newton(function, x: np.ndarray, tolerance: float, iterations: int = 30) -> np.ndarray:
-    """Gauss-Newton steps of least norm (the pseudo-inverse: square or with more unknowns than
-    equations) towards function(x) = 0, halved while they do not reduce the residual."""
-    value = function(x)
-    for _ in range(iterations):
-        norm = np.abs(value).max()
-        if norm < tolerance:
-            break
-        step = np.linalg.lstsq(_jacobian(function, x, value), -value, rcond=None)[0]
-        for _ in range(20):
-            trial = x + step
-            trial_value = function(trial)
-            if np.abs(trial_value).max() < norm:
-                x, value = trial, trial_value
-                break
-            step = step / 2
-        else:
-            break
-    return x
-
-
 def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> BangBang | None:
     """Switching times and T that reach the goal, the shortest such when there are more unknowns
     than goal equations; ``None`` when the goal is not met or the switches leave their order.
@@ -234,13 +204,13 @@ def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> BangBang
             offset += count
         return np.concatenate(gaps)
 
-    theta = _newton(residual, seed.unknowns(), 1e-9)
+    theta = newton(residual, seed.unknowns(), 1e-9)
     if np.abs(residual(theta)).max() > 1e-6 or ordering(theta).min() < -1e-9:
         return None
     free = len(theta) - len(target)
     held: int | np.ndarray | None = None
     if free == 1:
-        theta, held = _secant_minimum(residual, theta)
+        theta, held = secant_minimum(residual, theta)
     elif free > 1:
         theta = minimize(
             lambda x: x[-1],
@@ -248,7 +218,7 @@ def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> BangBang
             jac=lambda x: np.eye(len(x))[-1],
             method="SLSQP",
             constraints=[
-                {"type": "eq", "fun": residual, "jac": lambda x: _jacobian(residual, x, residual(x))},
+                {"type": "eq", "fun": residual, "jac": lambda x: jacobian(residual, x, residual(x))},
                 {"type": "ineq", "fun": ordering},
             ],
             options={"maxiter": 100, "ftol": 1e-12},
@@ -256,69 +226,12 @@ def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> BangBang
         held = np.arange(len(target), len(theta) - 1)
     # Polished on the final step, the held switching times (if any) where they were chosen.
     if held is None:
-        theta = _newton(lambda x: residual(x, FINAL_STEP), theta, GOAL_TOLERANCE)
+        theta = newton(lambda x: residual(x, FINAL_STEP), theta, GOAL_TOLERANCE)
     else:
-        theta = _held(lambda x, h=held: residual(x, FINAL_STEP), theta, np.atleast_1d(held), GOAL_TOLERANCE)
+        theta = held_newton(lambda x, h=held: residual(x, FINAL_STEP), theta, np.atleast_1d(held), GOAL_TOLERANCE)
     if ordering(theta).min() < -1e-9 or np.abs(residual(theta, FINAL_STEP)).max() > 1e-6:
         return None
     return seed.with_unknowns(theta)
-
-
-def _held(function, theta: np.ndarray, held: np.ndarray, tolerance: float) -> np.ndarray:
-    """Newton's method on the unknowns other than ``held`` (indices), which keep their values."""
-    others = np.setdiff1d(np.arange(len(theta)), held)
-
-    def reduced(x):
-        full = theta.copy()
-        full[others] = x
-        return function(full)
-
-    result = theta.copy()
-    result[others] = _newton(reduced, theta[others], tolerance)
-    return result
-
-
-#: First trial step (s) of the held switching time, and the largest step of the secant method.
-SECANT_FIRST, SECANT_LONGEST, SECANT_TOLERANCE = 2e-3, 2e-2, 1e-8
-
-
-def _secant_minimum(residual, theta: np.ndarray, iterations: int = 30) -> tuple[np.ndarray, int]:
-    """The shortest T along the one-dimensional family of solutions through ``theta``: the
-    switching time p that the family's tangent moves most is held, and dT/dp = 0 is solved by
-    the secant method, each trial corrected back onto the family by Newton's method."""
-    J = _jacobian(residual, theta, residual(theta))
-    tangent = np.linalg.svd(J)[2][-1]
-    p = int(np.argmax(np.abs(tangent[:-1])))
-    others = np.setdiff1d(np.arange(len(theta)), [p])
-
-    def slope(x):
-        """dT/dp on the family at the solution x, and d(others)/dp."""
-        value = residual(x)
-        jacobian = _jacobian(residual, x, value)
-        derivative = -np.linalg.solve(jacobian[:, others], jacobian[:, p])
-        return derivative[-1], derivative
-
-    g, direction = slope(theta)
-    previous = None
-    for _ in range(iterations):
-        if previous is None:
-            step = -np.sign(g) * SECANT_FIRST
-        else:
-            curvature = (g - previous[1]) / (theta[p] - previous[0])
-            step = -g / curvature if curvature > 0 else -np.sign(g) * SECANT_LONGEST
-        step = float(np.clip(step, -SECANT_LONGEST, SECANT_LONGEST))
-        trial = theta.copy()
-        trial[p] += step
-        trial[others] += direction * step
-        trial = _held(residual, trial, np.array([p]), 1e-10)
-        if np.abs(residual(trial)).max() > 1e-7:
-            break
-        previous = (theta[p], g)
-        theta = trial
-        g, direction = slope(theta)
-        if abs(step) < SECANT_TOLERANCE:
-            break
-    return theta, p
 
 
 def _neighbours(seed: BangBang) -> list[BangBang]:
