@@ -31,7 +31,8 @@ from planners.errors import BudgetExceeded
 from planners.isolated import run_isolated
 from robots.errors import ToptrajError
 from service.jobs import work
-from service.jobs.store import ClaimedJob, Job, JobStore, JobStoreUnavailable, owner_name
+from service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
+from service.jobs.store import JobStore
 
 logger = logging.getLogger("toptraj.jobs")
 

@@ -16,7 +16,8 @@ from starlette.concurrency import run_in_threadpool
 import robots
 from planners.errors import InvalidRequest
 from robots.errors import ToptrajError, excerpt
-from service.jobs.store import Job, JobStore
+from service.jobs.records import Job
+from service.jobs.store import JobStore
 from service.problems import PROBLEM_JSON, problem_responses
 from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
 
