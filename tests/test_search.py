@@ -13,8 +13,8 @@ from fastapi.testclient import TestClient
 import robots
 from planners.collision import BoxObstacle, SphereObstacle
 from planners.search import branch_and_bound, build_problem, enumerate_grid_paths
-from planners.search.branch_and_bound import NoGridPath
 from planners.search.graph import SearchOptions
+from planners.search.outcome import NoGridPath
 from planners.search.problem import toward_goal
 from robots.collision import robot_capsules, world_capsules
 from service.app import create_app

@@ -14,8 +14,9 @@ from planners.collision import Obstacle
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
-from planners.search.branch_and_bound import NoGridPath, SearchResult, SearchStatistics, branch_and_bound
+from planners.search.branch_and_bound import branch_and_bound
 from planners.search.graph import DEFAULT_OPTIONS, SearchOptions
+from planners.search.outcome import NoGridPath, SearchResult, SearchStatistics
 from planners.search.problem import build_problem, toward_goal
 from planners.search.shadows import obstacle_shadows
 from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
