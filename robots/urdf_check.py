@@ -32,8 +32,9 @@ zero moment, the other two equal, ``finger_edu``'s lower link). Once built, the 
 inertia matrix at the zero configuration must be positive definite (condition number at most
 1e10): every moving joint moves some inertia about its axis, which is what the planners need.
 
-At most 1000 links, 1000 joints and 64 moving joints; no ``<!DOCTYPE>`` (entities could make
-Pinocchio's parser read something else than this check did).
+At most 1000 links, 1000 joints and 64 moving joints (the tree's checks: ``robots.urdf_tree``);
+no ``<!DOCTYPE>`` (entities could make Pinocchio's parser read something else than this check
+did).
 """
 
 from __future__ import annotations
@@ -47,11 +48,7 @@ import numpy as np
 import pinocchio as pin
 
 from robots.errors import InvalidURDF, excerpt
-
-MOVING_JOINTS = ("revolute", "continuous", "prismatic")
-MAX_MOVING_JOINTS = 64
-MAX_LINKS = 1_000
-MAX_JOINTS = 1_000
+from robots.urdf_tree import MOVING_JOINTS, check_structure
 
 MAX_OFFSET = 100.0  # m, each coordinate of an origin
 MAX_ANGLE = 100.0  # rad, each angle of an origin's rpy
@@ -271,94 +268,6 @@ def _check_joint_numbers(joint: ElementTree.Element, kind: str, where: str) -> N
                 _within(value, -MAX_OTHER, MAX_OTHER, where, f"<{tag}> {name}", "")
 
 
-def _named(elements: list[ElementTree.Element], tag: str) -> dict[str, ElementTree.Element]:
-    named: dict[str, ElementTree.Element] = {}
-    for element in elements:
-        name = element.get("name")
-        if not name:
-            raise InvalidURDF(f"a <{tag}> has no name")
-        if name in named:
-            raise InvalidURDF(f"two <{tag}> elements are named {excerpt(name)}; names must be unique")
-        named[name] = element
-    return named
-
-
-def _parent_joints(links: dict, joints: dict) -> dict[str, str]:
-    """Map child link -> the one joint whose child it is; checks that the links form one tree.
-
-    Walks iteratively, so that a chain of any length is checked in linear time and constant stack.
-    """
-    parent_joint: dict[str, str] = {}
-    for name, joint in joints.items():
-        where = f"joint {excerpt(name)}"
-        parent, child = joint.find("parent"), joint.find("child")
-        if parent is None or child is None:
-            raise InvalidURDF(f"{where}: needs <parent link=...> and <child link=...>")
-        for end in (parent, child):
-            if end.get("link") not in links:
-                raise InvalidURDF(f"{where}: refers to link {excerpt(end.get('link'))}, which is not defined")
-        child_name = child.get("link")
-        if child_name in parent_joint:
-            raise InvalidURDF(
-                f"{where}: link {excerpt(child_name)} is already the child of joint "
-                f"{excerpt(parent_joint[child_name])}; a URDF is a tree, each link has at most one parent joint"
-            )
-        parent_joint[child_name] = name
-    roots = [name for name in links if name not in parent_joint]
-    if len(roots) > 1:
-        raise InvalidURDF(
-            f"links {excerpt(roots[0])} and {excerpt(roots[1])} both have no parent joint; "
-            "a URDF is one tree with a single root link"
-        )
-    children: dict[str, list[str]] = {}
-    for child_name, joint_name in parent_joint.items():
-        children.setdefault(joints[joint_name].find("parent").get("link"), []).append(child_name)
-    reached = set(roots)
-    stack = list(roots)
-    while stack:
-        for child_name in children.get(stack.pop(), []):
-            reached.add(child_name)
-            stack.append(child_name)
-    unreached = [name for name in links if name not in reached]
-    if unreached:
-        raise InvalidURDF(_cycle_message(unreached[0], parent_joint, joints))
-    return parent_joint
-
-
-def _cycle_message(start: str, parent_joint: dict[str, str], joints: dict) -> str:
-    """Follow parent joints from ``start`` (a link no root reaches) until a link repeats."""
-    seen: dict[str, int] = {}
-    path: list[str] = []
-    link = start
-    while link not in seen:
-        seen[link] = len(path)
-        path.append(parent_joint[link])
-        link = joints[parent_joint[link]].find("parent").get("link")
-    cycle = path[seen[link] :]
-    named = ", ".join(excerpt(name) for name in cycle[:5]) + (", ..." if len(cycle) > 5 else "")
-    return f"joint {excerpt(cycle[0])}: joints {named} form a cycle; a URDF is a tree without cycles"
-
-
-def _check_structure(root: ElementTree.Element) -> tuple[dict, dict, dict[str, str]]:
-    link_elements, joint_elements = root.findall("link"), root.findall("joint")
-    if len(link_elements) > MAX_LINKS:
-        raise InvalidURDF(f"the URDF has {len(link_elements)} links; at most {MAX_LINKS} are served")
-    if len(joint_elements) > MAX_JOINTS:
-        raise InvalidURDF(f"the URDF has {len(joint_elements)} joints; at most {MAX_JOINTS} are served")
-    links, joints = _named(link_elements, "link"), _named(joint_elements, "joint")
-    for name, joint in joints.items():
-        if joint.get("type") not in (*MOVING_JOINTS, "fixed"):
-            raise InvalidURDF(
-                f"joint {excerpt(name)}: type {excerpt(joint.get('type'))} is not supported (fixed-base arms only)"
-            )
-    moving = [name for name, joint in joints.items() if joint.get("type") in MOVING_JOINTS]
-    if not moving:
-        raise InvalidURDF("the URDF has no revolute, continuous or prismatic joint")
-    if len(moving) > MAX_MOVING_JOINTS:
-        raise InvalidURDF(f"the URDF has {len(moving)} moving joints; at most {MAX_MOVING_JOINTS} are served")
-    return links, joints, _parent_joints(links, joints)
-
-
 def _check_mass_behind_moving_joints(links: dict, joints: dict, masses: dict[str, float]) -> None:
     rigid_children: dict[str, list[str]] = {}
     for joint in joints.values():
@@ -413,7 +322,7 @@ def check_urdf(urdf: str) -> pin.Model:
     if root.tag != "robot":
         tag = root.tag if len(root.tag) <= 40 else f"{root.tag[:40]}..."
         raise InvalidURDF(f"the root element is <{tag}>, expected <robot>")
-    links, joints, _ = _check_structure(root)
+    links, joints, _ = check_structure(root)
     masses = {}
     for name, link in links.items():
         where = f"link {excerpt(name)}"
