@@ -53,6 +53,8 @@ import pinocchio as pin
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from anchors import bare_toppra, drake_solver  # noqa: E402
+
 import robots  # noqa: E402
 from service.planning import encode_json, plan_request, trajectory_body  # noqa: E402
 from service.schemas.trajectories import TrajectoryRequest  # noqa: E402
@@ -84,58 +86,6 @@ STAGES = (
     ("response body", ("trajectory_body",), ()),
     ("JSON encoding", ("encode_json",), ()),
 )
-
-
-def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100) -> float:
-    """One toppra solve through its public API; returns the duration (s)."""
-    import toppra
-
-    model, data, limits = robot.model, robot.model.createData(), robot.limits
-    path = toppra.SplineInterpolator(np.linspace(0.0, 1.0, len(waypoints)), waypoints)
-    constraints = [
-        toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])),
-        toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits.acceleration, limits.acceleration])),
-        toppra.constraint.JointTorqueConstraint(
-            lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
-            np.column_stack([-limits.torque, limits.torque]),
-            np.zeros(robot.dof),
-        ),
-    ]
-    solver = toppra.algorithm.TOPPRA(
-        constraints, path, gridpoints=np.linspace(0.0, 1.0, intervals + 1), parametrizer="ParametrizeConstAccel"
-    )
-    return float(solver.compute_trajectory().duration)
-
-
-def drake_solver(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100):
-    """One solve of Drake's Toppra on toppra's spline through ``waypoints`` (the bare toppra
-    probe's path) and the robot's limits, as a function returning the duration (s); ``None``
-    when pydrake is absent. The plant and the spline are built here, once."""
-    import toppra
-    from phase_plane_vs_toppra import drake_plant
-
-    plant = drake_plant(robot)
-    if plant is None:
-        return None
-    from pydrake.multibody.optimization import Toppra
-    from pydrake.trajectories import PiecewisePolynomial
-
-    knots = np.linspace(0.0, 1.0, len(waypoints))
-    slopes = toppra.SplineInterpolator(knots, waypoints)(knots, 1)
-    spline = PiecewisePolynomial.CubicHermite(knots, waypoints.T, slopes.T)
-    grid, limits = np.linspace(0.0, 1.0, intervals + 1), robot.limits
-
-    def solve() -> float:
-        problem = Toppra(spline, plant, grid)
-        problem.AddJointVelocityLimit(-limits.velocity, limits.velocity)
-        problem.AddJointAccelerationLimit(-limits.acceleration, limits.acceleration)
-        problem.AddJointTorqueLimit(-limits.torque, limits.torque)
-        result = problem.SolvePathParameterization()
-        if result is None:
-            raise RuntimeError("Drake's Toppra failed on the typical path")
-        return float(result.end_time())
-
-    return solve
 
 
 def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int]:

@@ -5,7 +5,7 @@ spline inside the joint limits) on ur5, panda, geering_2r and yamamoto_2r, under
 acceleration and torque limits (each robot's limits as loaded; the two-link arms have torque
 limits only). For each path:
 
-* the converged duration T* is the Richardson extrapolation 2 T(2N) - T(N) of the
+* the converged duration T* (``converged.py``) is the Richardson extrapolation 2 T(2N) - T(N) of the
   conservative (interpolation) discretization, N = 10,000 intervals and every interval then
   halved, checked against the midpoint (second-order) discretization on the 2N intervals: the
   two must agree within 1e-5 (else the same on 20,000 and 40,000 intervals; else the path is
@@ -30,7 +30,8 @@ What each time includes (the path object itself, ``SplinePath`` or toppra's
   between grid points too, which a coarse grid pays for with points).
 * ``adapter``: the ``toppra`` method of toptraj: the same constraint build plus
   ``ToppraMethod().solve`` (toppra's Seidel solver on the precomputed rows).
-* ``toppra``: toppra used directly through its public API, as a user of toppra pays for it:
+* ``toppra``: toppra used directly through its public API (``anchors.py``), as a user of toppra
+  pays for it:
   ``SplineInterpolator`` through the same waypoints and knots (natural ends: the same spline),
   ``JointVelocityConstraint``, ``JointAccelerationConstraint``, ``JointTorqueConstraint`` (toppra's
   default discretizations: interpolation for acceleration, collocation for torque, which holds
@@ -64,30 +65,25 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
-import re
 import sys
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import pinocchio as pin
+from anchors import drake_plant, drake_runner, toppra_runner
+from converged import CONVERGED, KINDS, converged_duration, random_path
 
 import robots
 from planners.constraints import build_path_constraints
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.grid import path_grid
-from planners.paths import SplinePath
 from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.timing.phase_plane import midpoint_duration
 
 LADDER = (25, 50, 75, 100, 150, 200, 300, 450, 600, 900, 1200, 1800, 2400, 3600, 5000, 7200, 10000)
-KINDS = ("velocity", "acceleration", "torque")
 ROBOTS = ("ur5", "panda", "geering_2r", "yamamoto_2r")
 ACCURACY = 1e-3
 #: Fine grids on which Drake's Toppra is also run (untimed), to report where it fails.
 DRAKE_FINE = (2400, 4096)
-#: Largest disagreement of the two estimates of the converged duration.
-CONVERGED = 1e-5
 
 #: The clock the runs are timed with (``--clock``): the process's CPU time by default.
 CLOCKS = {"cpu": time.process_time, "wall": time.perf_counter}
@@ -100,47 +96,6 @@ def _now() -> float:
 
 logging.getLogger("toppra").setLevel(logging.ERROR)
 logging.getLogger("drake").setLevel(logging.CRITICAL)
-
-
-def random_path(robot, rng) -> tuple[np.ndarray, SplinePath]:
-    """2 to 5 waypoints within the middle 70 % of each joint's range (+-pi for continuous joints),
-    drawn until the spline through them stays within the joint limits."""
-    lower = np.where(np.isfinite(robot.limits.position_lower), robot.limits.position_lower, -np.pi)
-    upper = np.where(np.isfinite(robot.limits.position_upper), robot.limits.position_upper, np.pi)
-    middle, half = 0.5 * (lower + upper), 0.35 * (upper - lower)
-    while True:
-        waypoints = middle + rng.uniform(-1, 1, (int(rng.integers(2, 6)), robot.dof)) * half
-        path = SplinePath(waypoints)
-        q = path(np.linspace(0.0, 1.0, 1000))
-        if np.all(q >= robot.limits.position_lower) and np.all(q <= robot.limits.position_upper):
-            return waypoints, path
-
-
-def _halved(grid: np.ndarray) -> np.ndarray:
-    """``grid`` with every interval split in two."""
-    fine = np.empty(2 * len(grid) - 1)
-    fine[0::2] = grid
-    fine[1::2] = 0.5 * (grid[:-1] + grid[1:])
-    return fine
-
-
-def converged_duration(path, robot) -> tuple[float, float]:
-    """T* and its relative gap to the midpoint estimate (see the module docstring): on 10,000
-    and 20,000 intervals, or on 20,000 and 40,000 where those two disagree by more than
-    CONVERGED."""
-    unrefined = PhasePlaneMethod(max_refinements=0)
-    coarse_grid = path_grid(path, 10_000)
-    coarse = unrefined.solve(build_path_constraints(path, robot, robot.limits, KINDS, coarse_grid)).duration
-    for _ in range(2):
-        fine_grid = _halved(coarse_grid)
-        constraints = build_path_constraints(path, robot, robot.limits, KINDS, fine_grid)
-        fine = unrefined.solve(constraints).duration
-        richardson = 2.0 * fine - coarse
-        gap = abs(midpoint_duration(constraints) / richardson - 1.0)
-        if gap <= CONVERGED:
-            break
-        coarse_grid, coarse = fine_grid, fine
-    return richardson, gap
 
 
 def toptraj_runner(method, path, robot):
@@ -171,105 +126,6 @@ def toptraj_runner(method, path, robot):
         done = _now()
         spent[0] += built - started
         return done - started - (replaced - built), done - replaced, result.duration, f"{len(result.s) - 1}", spent[0]
-
-    return run
-
-
-def toppra_runner(robot, waypoints, path, interpolation: bool = False):
-    """(total, nan, duration, "") of toppra through its public API at n intervals, with its
-    default discretizations or (``interpolation``) the interpolation one for torque too. Limits
-    that are infinite (the two-link arms have only torque limits) are left out, as a toppra
-    user would."""
-    import toppra
-    import toppra.algorithm
-    import toppra.constraint
-
-    model = robot.model
-    data = model.createData()
-    damping = robot.viscous_friction
-    to_configuration = robot.configuration if np.any(robot.continuous) else (lambda q: q)
-
-    def inverse_dynamics(q, v, a):
-        return pin.rnea(model, data, to_configuration(q), v, a) + damping * v
-
-    spline = toppra.SplineInterpolator(path.knots, waypoints, bc_type="natural")
-    limits = robot.limits
-
-    def constraints():
-        made = []
-        if np.all(np.isfinite(limits.velocity)):
-            made.append(toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])))
-        if np.all(np.isfinite(limits.acceleration)):
-            made.append(
-                toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits.acceleration, limits.acceleration]))
-            )
-        scheme = toppra.constraint.DiscretizationType.Interpolation if interpolation else toppra.constraint.DiscretizationType.Collocation
-        made.append(
-            toppra.constraint.JointTorqueConstraint(
-                inverse_dynamics, np.column_stack([-limits.torque, limits.torque]), robot.coulomb_friction, scheme
-            )
-        )
-        return made
-
-    def run(n):
-        grid = path_grid(path, n)
-        started = _now()
-        instance = toppra.algorithm.TOPPRA(constraints(), spline, gridpoints=grid, solver_wrapper="seidel")
-        _, sd, _ = instance.compute_parameterization(0.0, 0.0)
-        done = _now()
-        if sd is None:
-            raise TimingFailed("toppra found no parameterization")
-        return done - started, np.nan, float(np.sum(2.0 * np.diff(grid) / (sd[1:] + sd[:-1]))), "", np.nan
-
-    return run
-
-
-def drake_plant(robot):
-    """Drake's MultibodyPlant of ``robot``'s URDF without visual and collision elements (their
-    meshes are package:// URIs), or ``None`` when pydrake is absent."""
-    try:
-        from pydrake.multibody.parsing import Parser
-        from pydrake.multibody.plant import MultibodyPlant
-    except ImportError:
-        return None
-    from robots.catalog import EXAMPLE_ARMS, example_urdf_path
-
-    with open(example_urdf_path(EXAMPLE_ARMS[robot.name].loader)) as handle:
-        text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
-    plant = MultibodyPlant(0.0)
-    Parser(plant).AddModelsFromString(text, "urdf")
-    if 'name="world"' not in text:
-        plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(plant.GetBodyByName(robot.model.names[1]).name()))
-    plant.Finalize()
-    names = tuple(plant.get_joint(index).name() for index in plant.GetJointIndices() if plant.get_joint(index).num_positions() == 1)
-    if names[: robot.dof] != robot.joint_names:
-        raise RuntimeError(f"Drake's joint order {names} differs from Pinocchio's {robot.joint_names}")
-    return plant
-
-
-def drake_runner(plant, robot, waypoints, path, failures: list):
-    """(total, nan, duration, "") of Drake's Toppra at n intervals; grids where it fails are
-    appended to ``failures``."""
-    from pydrake.multibody.optimization import Toppra
-    from pydrake.trajectories import PiecewisePolynomial
-
-    # Cubic Hermite through the knots with the spline's own slopes: the same cubic per segment.
-    spline = PiecewisePolynomial.CubicHermite(path.knots, waypoints.T, path.evaluate(path.knots).dq.T)
-    limits = robot.limits
-
-    def run(n):
-        grid = path_grid(path, n)
-        started = _now()
-        toppra = Toppra(spline, plant, grid)
-        toppra.AddJointVelocityLimit(-limits.velocity, limits.velocity)
-        toppra.AddJointAccelerationLimit(-limits.acceleration, limits.acceleration)
-        toppra.AddJointTorqueLimit(-limits.torque, limits.torque)
-        result = toppra.SolvePathParameterization()
-        done = _now()
-        if result is None:
-            failures.append(n)
-            raise TimingFailed("Drake's Toppra failed")
-        return done - started, np.nan, float(result.end_time()), "", np.nan
 
     return run
 
@@ -363,7 +219,7 @@ def main() -> int:
     for run in (
         toptraj_runner(phase_plane, warm_path, warm),
         toptraj_runner(ToppraMethod(), warm_path, warm),
-        toppra_runner(warm, warm_waypoints, warm_path),
+        toppra_runner(warm, warm_waypoints, warm_path, _now),
     ):
         run(50)
 
@@ -397,13 +253,13 @@ def main() -> int:
                 continue
             runs = {
                 "pp": toptraj_runner(phase_plane, path, robot),
-                "toppra": toppra_runner(robot, waypoints, path),
-                "toppra-i": toppra_runner(robot, waypoints, path, interpolation=True),
+                "toppra": toppra_runner(robot, waypoints, path, _now),
+                "toppra-i": toppra_runner(robot, waypoints, path, _now, interpolation=True),
                 "adapter": toptraj_runner(ToppraMethod(), path, robot),
             }
             if plant is not None:
                 failures = drake_failures.setdefault(done, [])
-                runs["drake"] = drake_runner(plant, robot, waypoints, path, failures)
+                runs["drake"] = drake_runner(plant, robot, waypoints, path, _now, failures)
             scans = {method: scan(run, reference) for method, run in runs.items()}
             if "drake" in runs:
                 for n in DRAKE_FINE:  # not timed: does it solve on fine grids at all?
