@@ -19,7 +19,8 @@ from planners.grid import path_grid
 from planners.paths import GeometricPath
 from planners.requests import Timing
 from planners.search.curve import GridSplinePath
-from planners.search.local import LocalOptimum, optimize_locally
+from planners.search.local import optimize_locally
+from planners.search.local_outcome import LocalOptimum
 from planners.search.method import global_search
 from planners.timed import Timed, moving_velocity, path_boundary, timed_path, timing_grid
 from planners.timing.min_cost import MinCostMethod
