@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import itertools
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
@@ -34,45 +33,13 @@ from scipy.optimize import minimize
 from planners.constraints import build_path_constraints
 from planners.deadline import NO_DEADLINE, Deadline, Progress
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.free_path.motion import CollocationResult, FreeMotion
 from planners.free_path.sparse import SparseCollocation, solve_sparse
 from planners.grid import path_grid
 from planners.isolated import run_isolated
 from planners.paths.waypoints import SplinePath
 from planners.timing.phase_plane import PhasePlaneMethod
 from robots import JointLimits, Robot
-
-DEFAULT_INTERVALS = 30
-
-
-@dataclass(frozen=True)
-class FreeMotion:
-    """Start and goal configurations (n_dof,), optional boundary velocities (rad/s), the number
-    of collocation intervals, and whether continuous joints may reach their goal one revolution
-    either way (``revolutions``)."""
-
-    start: np.ndarray
-    goal: np.ndarray
-    start_velocity: np.ndarray | None = None
-    end_velocity: np.ndarray | None = None
-    intervals: int = DEFAULT_INTERVALS
-    revolutions: bool = True
-
-
-@dataclass(frozen=True)
-class CollocationResult:
-    """The optimized motion at K + 1 instants: times (K+1,), q, v, a, tau (K+1, n_dof); its cost
-    J (s), the solver's status and iteration count, and the winning initial guess."""
-
-    t: np.ndarray
-    q: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
-    tau: np.ndarray
-    cost: float
-    status: str
-    iterations: int
-    initial_guess: str
-    solve_s: float
 
 
 class _Problem:

@@ -19,7 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planners.free_path.collocation import FreeMotion, _optimize_motion
+from planners.free_path.collocation import _optimize_motion
+from planners.free_path.motion import FreeMotion
 from planners.free_path.switching import BangBang, refine_collocation, refine_switching
 from robots import Robot
 
