@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
@@ -79,22 +80,31 @@ def non_finite_answer(content: Any) -> NonFiniteAnswer | None:
 
 
 def _first_non_finite(value: Any, where: str) -> tuple[str | None, float | None]:
-    if isinstance(value, float) and not math.isfinite(value):
-        return where, value
+    """(place, value) of the first NaN or infinity in ``value`` at ``where``, or (None, None).
+    Strings, integers and ``None`` inside a container are passed over and floats tested in
+    place, without a call each; arrays in one numpy pass."""
+    if isinstance(value, float):
+        return (None, None) if math.isfinite(value) else (where, value)
     if isinstance(value, np.ndarray):
-        bad = np.argwhere(~np.isfinite(value)) if value.dtype.kind == "f" else np.empty((0, value.ndim), dtype=int)
-        if len(bad) == 0:
+        if value.dtype.kind != "f" or np.isfinite(value).all():
             return None, None
-        return where + "".join(f"[{i}]" for i in bad[0]), float(value[tuple(bad[0])])
+        bad = np.argwhere(~np.isfinite(value))[0]
+        return where + "".join(f"[{i}]" for i in bad), float(value[tuple(bad)])
     if isinstance(value, dict):
-        items = ((f"{where}.{key}" if where else str(key), item) for key, item in value.items())
+        items: Iterable[tuple[Any, Any]] = value.items()
+        dotted = True
     elif isinstance(value, (list, tuple)):
         if _all_finite_numbers(value):
             return None, None
-        items = ((f"{where}[{index}]", item) for index, item in enumerate(value))
+        items, dotted = enumerate(value), False
     else:
         return None, None
-    for place, item in items:
+    for key, item in items:
+        if item is None or isinstance(item, (str, int)):
+            continue
+        if isinstance(item, float) and math.isfinite(item):
+            continue
+        place = (f"{where}.{key}" if where else str(key)) if dotted else f"{where}[{key}]"
         found = _first_non_finite(item, place)
         if found[0] is not None:
             return found

@@ -19,7 +19,7 @@ from planners.grid import path_grid
 from planners.results import require_finite
 from planners.timing.laws import quintic_coefficients
 from service.app import create_app
-from service.problems import FiniteJSONResponse, NonFiniteAnswer
+from service.problems import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
 from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
 
@@ -151,6 +151,28 @@ def test_json_encoder_refuses_non_finite_numbers_and_says_where():
     assert FiniteJSONResponse({"a": [1.0, 2.5]}).body == b'{"a":[1.0,2.5]}'
     with pytest.raises(NonFiniteAnswer, match=r"holds nan at samples\.qd\[1\]\[0\]"):
         FiniteJSONResponse({"samples": {"qd": [[0.0], [float("nan")]]}})
+
+
+@pytest.mark.parametrize(
+    ("body", "named"),
+    [
+        ({"ok": 1.5, "peaks": [{"joint": "a", "ratio": 0.5}, {"joint": "b", "ratio": -np.inf}]}, "peaks[1].ratio = -inf"),
+        ({"n": 3, "flag": True, "note": None, "q": np.array([[0.0, 1.0], [2.0, np.nan]])}, "q[1][1] = nan"),
+        ({"s": "x", "pair": (1, np.float64(np.inf))}, "pair[1] = inf"),
+        ([{"fine": [0.0, 1.0]}, {"t": [0.5, np.nan, np.inf]}], "[1].t[1] = nan"),
+        (np.array([1.0, 2.0]), None),
+        ({"i": np.arange(3), "text": "nan", "deep": [[{"x": [1.0]}]]}, None),
+    ],
+)
+def test_the_first_non_finite_number_is_named_wherever_it_sits(body, named):
+    """Strings, integers, booleans and None are passed over; floats, numpy scalars and arrays
+    at any depth of dicts, lists and tuples are tested, and the first bad one is named."""
+    error = non_finite_answer(body)
+    if named is None:
+        assert error is None
+    else:
+        place, value = named.split(" = ")
+        assert f"holds {value} at {place or 'its top level'}," in str(error)
 
 
 def test_a_numerical_breakdown_in_a_planner_is_a_422(client, monkeypatch):
