@@ -190,9 +190,14 @@ def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
     return {"results": results}
 
 
-def _finite_or_none(values) -> list[float | None]:
-    """Non-finite values (an unbounded MVC, a singular Jacobian) as JSON nulls."""
-    return [float(v) if math.isfinite(v) else None for v in values]
+def _finite_or_none(values) -> np.ndarray | list[float | None]:
+    """Non-finite values (an unbounded MVC, a singular Jacobian) as JSON nulls: an array of
+    more than one value as it is when all are finite (orjson writes it directly), else a list
+    of floats with ``None`` in place of the others."""
+    array = np.asarray(values, dtype=float)
+    if len(array) > 1 and np.isfinite(array).all():
+        return array
+    return [float(v) if math.isfinite(v) else None for v in array]
 
 
 def trajectory_body(result: PlannedTrajectory) -> dict:
