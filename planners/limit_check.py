@@ -41,7 +41,7 @@ POINTS_PER_INTERVAL = 5
 KINDS = ("velocity", "acceleration", "torque", "jerk")
 #: Largest estimated error, as a fraction of the joint's torque limit, of a torque interpolated
 #: between grid points from the rows (``planners.torque_interpolation``); a state whose estimate
-#: is larger gets Pinocchio's RNEA. Far below the gate's ``LIMIT_TOLERANCE`` - 1.
+#: is larger gets the RNEA (``Robot.inverse_dynamics``). Far below the gate's ``LIMIT_TOLERANCE`` - 1.
 INTERPOLATION_TOLERANCE = 1e-5
 
 
@@ -104,7 +104,7 @@ def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, np.ndarray, n
 def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | None) -> np.ndarray:
     """Joint torques (n, n_dof) at ``states``. At a moving state on the grid of ``constraints``
     (when they hold a torque row for every joint) the torque is the row ``a u + b x + c + d sd``
-    the build computed there with Pinocchio's RNEA (the same number, to rounding), on the side
+    the build computed there with the RNEA (the same number, to rounding), on the side
     the state belongs to; between grid points it is interpolated from those rows
     (``planners.torque_interpolation.dense_torques``) where the grid resolves them, the
     interpolation's estimated error is within ``INTERPOLATION_TOLERANCE`` of the limit and no

@@ -1,5 +1,5 @@
 """Joint torques, and torque rows, between the grid points of a path's constraints, from the
-rows the build computed there with Pinocchio's RNEA (numba, ``nogil``, cached): the dense limit
+rows the build computed there with the RNEA (numba, ``nogil``, cached): the dense limit
 check's torques (``planners.limit_check``) and the rows a refining method adds
 (``planners.constraints``, ``PathConstraints.with_points``) without a dynamics evaluation per
 point where the interpolation is accurate, and with one where it is not.

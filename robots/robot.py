@@ -193,8 +193,8 @@ class Robot:
         return np.ascontiguousarray(np.asarray(tau).T).reshape(qd.shape)
 
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        """Joint torques for rows of ``q, qd, qdd`` (each (n_samples, n_dof)): Pinocchio's RNEA
-        plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``."""
+        """Joint torques for rows of ``q, qd, qdd`` (each (n_samples, n_dof)): the RNEA
+        (``rnea``) plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``."""
         qd = np.atleast_2d(qd)
         tau = self.rnea(q, qd, qdd)
         if np.any(self.viscous_friction) or np.any(self.coulomb_friction):
