@@ -103,8 +103,8 @@ def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int
     return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 
-def rnea_floor(pool: pin.ModelPool, states: np.ndarray) -> None:
-    """3 RNEA per grid point, batched: ``states`` is (3, n_dof, 3 * points) of q, qd, qdd,
+def rnea_floor(pool: pin.ModelPool, states: list[np.ndarray]) -> None:
+    """3 RNEA per grid point, batched: ``states`` holds q, qd and qdd, each (n_dof, 3 * points),
     Fortran-ordered as Pinocchio's ``rneaInParallel`` takes them."""
     pin.rneaInParallel(1, pool, states[0], states[1], states[2])
 

@@ -1,7 +1,8 @@
 """A robot's kinematic tree as plain arrays, for compiled kinematics and dynamics over many
 configurations (``planners.kinematics.frame_jacobians``, ``robots.chain_dynamics``): each
 joint's placement in its parent, its axis, whether it turns or slides, which joint coordinate
-moves it, and the inertia of the body it carries.
+moves it, and the inertia of the body it carries; and the rotation about a joint's axis
+(``axis_rotation``, Rodrigues) that both compiled passes compose.
 
 Only joints of one degree of freedom about or along a fixed axis are described: Pinocchio's
 revolute (RX, RY, RZ, unaligned, and their unbounded forms, which toptraj's joint coordinates
@@ -15,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from numba import njit
 
 _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned",
              "JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"}
@@ -83,3 +85,20 @@ def chain_of(model: pin.Model) -> Chain | None:
         armature=np.asarray(model.armature, dtype=float).copy(),
         gravity=np.asarray(model.gravity.linear, dtype=float).copy(),
     )
+
+
+@njit(cache=True, nogil=True)
+def axis_rotation(axis, angle, out):  # pragma: no cover - compiled
+    """Rot(axis, angle) = I + sin(angle) [axis]x + (1 - cos(angle)) [axis]x^2 (Rodrigues) of the
+    unit ``axis`` (3,) by ``angle`` (rad) into ``out`` (3, 3)."""
+    sine, versine = np.sin(angle), 1.0 - np.cos(angle)
+    x, y, z = axis[0], axis[1], axis[2]
+    out[0, 0] = 1.0 - versine * (y * y + z * z)
+    out[1, 1] = 1.0 - versine * (x * x + z * z)
+    out[2, 2] = 1.0 - versine * (x * x + y * y)
+    out[0, 1] = versine * x * y - sine * z
+    out[1, 0] = versine * x * y + sine * z
+    out[0, 2] = versine * x * z + sine * y
+    out[2, 0] = versine * x * z - sine * y
+    out[1, 2] = versine * y * z - sine * x
+    out[2, 1] = versine * y * z + sine * x

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from robots.chain import Chain
+from robots.chain import Chain, axis_rotation
 
 
 def chain_rnea(chain: Chain, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
@@ -67,9 +67,9 @@ def _inertia_times(mass, lever, inertia, v0, v1, v2, w0, w1, w2):  # pragma: no 
 
 
 @njit(cache=True, nogil=True)
-def _placements(q_row, prismatic, axis, rotation, translation, coordinate, out_rotation, out_origin):  # pragma: no cover - compiled
+def _placements(q_row, prismatic, axis, rotation, translation, coordinate, turn, out_rotation, out_origin):  # pragma: no cover - compiled
     """Each joint's frame in its parent's at the configuration ``q_row`` (n_dof,): rotations
-    (n_joints, 3, 3) and origins (n_joints, 3) into the two outputs."""
+    (n_joints, 3, 3) and origins (n_joints, 3) into the two outputs (``turn``: (3, 3) scratch)."""
     for j in range(axis.shape[0]):
         value = q_row[coordinate[j]]
         x, y, z = axis[j, 0], axis[j, 1], axis[j, 2]
@@ -80,16 +80,11 @@ def _placements(q_row, prismatic, axis, rotation, translation, coordinate, out_r
                 slide = rotation[j, row, 0] * x + rotation[j, row, 1] * y + rotation[j, row, 2] * z
                 out_origin[j, row] = translation[j, row] + slide * value
             continue
-        sine, versine = np.sin(value), 1.0 - np.cos(value)
-        turn = (
-            (1.0 - versine * (y * y + z * z), versine * x * y - sine * z, versine * x * z + sine * y),
-            (versine * x * y + sine * z, 1.0 - versine * (x * x + z * z), versine * y * z - sine * x),
-            (versine * x * z - sine * y, versine * y * z + sine * x, 1.0 - versine * (x * x + y * y)),
-        )
+        axis_rotation(axis[j], value, turn)
         for row in range(3):
             for column in range(3):
                 out_rotation[j, row, column] = (
-                    rotation[j, row, 0] * turn[0][column] + rotation[j, row, 1] * turn[1][column] + rotation[j, row, 2] * turn[2][column]
+                    rotation[j, row, 0] * turn[0, column] + rotation[j, row, 1] * turn[1, column] + rotation[j, row, 2] * turn[2, column]
                 )
             out_origin[j, row] = translation[j, row]
 
@@ -105,8 +100,9 @@ def rnea_sets(q, qd, qdd, parent, prismatic, axis, rotation, translation, coordi
     motion = np.empty((n_sets, n_joints, 6))  # velocity (linear; angular), joint axes
     acceleration = np.empty((n_sets, n_joints, 6))
     force = np.empty((n_sets, n_joints, 6))  # (force; moment about the joint's origin)
+    turn = np.empty((3, 3))
     for sample in range(q.shape[0]):
-        _placements(q[sample], prismatic, axis, rotation, translation, coordinate, placed, origin)
+        _placements(q[sample], prismatic, axis, rotation, translation, coordinate, turn, placed, origin)
         for j in range(n_joints):
             k, i = parent[j], coordinate[j]
             R, p = placed[j], origin[j]

@@ -191,13 +191,17 @@ def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
 
 
 def _finite_or_none(values) -> np.ndarray | list[float | None]:
-    """Non-finite values (an unbounded MVC, a singular Jacobian) as JSON nulls: an array of
-    more than one value as it is when all are finite (orjson writes it directly), else a list
-    of floats with ``None`` in place of the others."""
+    """Non-finite values (an unbounded MVC) as JSON nulls: the array as it is when all are
+    finite (orjson writes it directly), else a list with ``None`` in their place."""
     array = np.asarray(values, dtype=float)
-    if len(array) > 1 and np.isfinite(array).all():
+    if np.isfinite(array).all():
         return array
-    return [float(v) if math.isfinite(v) else None for v in array]
+    return [_finite_scalar(v) for v in array]
+
+
+def _finite_scalar(value: float) -> float | None:
+    """A non-finite value (a singular Jacobian's condition number) as a JSON null."""
+    return float(value) if math.isfinite(value) else None
 
 
 def trajectory_body(result: PlannedTrajectory) -> dict:
@@ -224,8 +228,8 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "kind": result.binding.kind, "joint": result.binding.joint, "s": result.binding.s
         },
         "conditioning": {
-            "kappa_min": _finite_or_none([conditioning.kappa_min])[0],
-            "kappa_max": _finite_or_none([conditioning.kappa_max])[0],
+            "kappa_min": _finite_scalar(conditioning.kappa_min),
+            "kappa_max": _finite_scalar(conditioning.kappa_max),
             "characteristic_length": conditioning.characteristic_length,
         },
         "cost": result.cost,

@@ -27,6 +27,7 @@ import pinocchio as pin
 from numba import njit
 
 from robots import Robot
+from robots.chain import axis_rotation
 
 
 def frame_jacobians(robot: Robot, frame_id: int, q: np.ndarray) -> np.ndarray:
@@ -48,22 +49,6 @@ def frame_jacobians(robot: Robot, frame_id: int, q: np.ndarray) -> np.ndarray:
         placed.parentJoint - 1, np.ascontiguousarray(placed.placement.translation, dtype=float), jacobians,
     )
     return jacobians
-
-
-@njit(cache=True, nogil=True)
-def _turn(axis, angle, out):  # pragma: no cover - compiled
-    """Rot(axis, angle) (Rodrigues) into ``out`` (3, 3)."""
-    sine, versine = np.sin(angle), 1.0 - np.cos(angle)
-    x, y, z = axis[0], axis[1], axis[2]
-    out[0, 0] = 1.0 - versine * (y * y + z * z)
-    out[1, 1] = 1.0 - versine * (x * x + z * z)
-    out[2, 2] = 1.0 - versine * (x * x + y * y)
-    out[0, 1] = versine * x * y - sine * z
-    out[1, 0] = versine * x * y + sine * z
-    out[0, 2] = versine * x * z + sine * y
-    out[2, 0] = versine * x * z - sine * y
-    out[1, 2] = versine * y * z - sine * x
-    out[2, 1] = versine * y * z + sine * x
 
 
 @njit(cache=True, nogil=True)
@@ -105,7 +90,7 @@ def chain_jacobians(q, parent, prismatic, axis, rotation, translation, coordinat
                     for column in range(3):
                         frame_rotation[j, row, column] = before[row, column]
             else:
-                _turn(axis[j], value, turn)
+                axis_rotation(axis[j], value, turn)
                 for row in range(3):
                     for column in range(3):
                         frame_rotation[j, row, column] = (
