@@ -20,7 +20,7 @@ _INF = np.inf
 ZERO_INERTIA = 1e-10
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _gap(p, q, r, w, i, x):  # pragma: no cover - compiled
     """phi(x) = min_j (r_j + w_j x) - max_k (p_k + q_k x) at point i, its slope there, and the
     intercept of the active piece (so its root is -intercept / slope without cancellation)."""
@@ -100,7 +100,7 @@ def admissible_intervals(p, q, r, w, x_low, x_high):  # pragma: no cover - compi
     return x_low, x_high
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _row_bounds(a, b, c, lo, hi):  # pragma: no cover - compiled
     """Row ``lo <= a u + b x + c <= hi`` as bounds on u, ``low + slope x <= u <= high + slope x``:
     (low, slope, high, False), NaN intercepts read as no bound. A zero-inertia row (a = 0)

@@ -14,7 +14,7 @@ from numba import njit
 _INF = np.inf
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _time_at_bounds(length, x0, x1, beta, alpha, c0, c1):  # pragma: no cover - compiled
     """Time over an interval of ``length`` from x0 to x1 (x = sd^2) at the bounds: accelerate
     at u = ``beta`` > 0 from x0, follow the ceiling c(t) (linear from c0 to c1), decelerate at
@@ -75,14 +75,14 @@ def switch_excess(ds, p, q, r, x, ceiling):  # pragma: no cover - compiled
     return excess
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _interval_time(ds, x0, x1):  # pragma: no cover - compiled
     """Time over an interval of length ds with x = sd^2 linear from x0 to x1."""
     total = np.sqrt(x0) + np.sqrt(x1)
     return 2.0 * ds / (total if total > 1e-300 else 1e-300)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _pieces(error, order, shrink, pieces):  # pragma: no cover - compiled
     """Raise ``pieces`` (N,) to the pieces per interval that bring the sum of ``error`` (N,),
     each part falling as k^-order, to ``shrink`` times itself with the fewest pieces in all
