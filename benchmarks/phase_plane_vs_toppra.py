@@ -108,10 +108,10 @@ def toptraj_runner(method, path, robot):
 
         def timed(evaluate):
             # Refined constraints keep the evaluate of the ones they refine (with_points).
-            def evaluate_timed(extra_s, known=None):
+            def evaluate_timed(extra_s):
                 started = _now()
                 try:
-                    return evaluate(extra_s, known)
+                    return evaluate(extra_s)
                 finally:
                     spent[0] += _now() - started
 

@@ -32,7 +32,7 @@ from planners.constraint_kernels import assemble_rows, velocity_bound
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath
 from planners.tool_speed import tool_speed_bound
-from planners.torque_interpolation import MAX_TRAVEL, grid_travel, smooth_points, terms_between
+from planners.torque_interpolation import smooth_points
 from robots import JointLimits, Robot
 
 CONSTRAINT_KINDS = ("velocity", "acceleration", "torque", "jerk")
@@ -66,9 +66,7 @@ class PathConstraints:
         knots: The s of the path's knots (where a derivative of q(s) jumps, so the rows are
             not smooth across them even where they are continuous); ``None`` when unknown.
         q: The path's points at the grid, (N + 1, n_dof); ``None`` when unknown.
-        evaluate: Builds the same constraints at other values of s (for methods that refine);
-            given these constraints too, it may interpolate the torque rows from them
-            (``build_path_constraints``).
+        evaluate: Builds the same constraints at other values of s (for methods that refine).
     """
 
     s: np.ndarray
@@ -98,14 +96,13 @@ class PathConstraints:
         """Whether rows can be evaluated at new values of s (``with_points``)."""
         return self.evaluate is not None
 
-    def with_points(self, extra_s: np.ndarray, interpolate: bool = False) -> PathConstraints:
+    def with_points(self, extra_s: np.ndarray) -> PathConstraints:
         """These constraints on the grid refined by ``extra_s`` (values strictly inside grid
-        intervals, never at a corner), evaluating the rows only at the new points; with
-        ``interpolate``, the torque rows are interpolated from these rows where that is
-        accurate (``build_path_constraints``), for a method refining its own grid."""
+        intervals, never at a corner), evaluating the rows only at the new points (the same
+        rows a build on the refined grid computes there)."""
         if self.evaluate is None:
             raise ValueError("these constraints cannot be evaluated at other points (refinable is False)")
-        extra = self.evaluate(np.asarray(extra_s, dtype=float), self if interpolate else None)
+        extra = self.evaluate(np.asarray(extra_s, dtype=float))
         order = np.argsort(np.concatenate([self.s, extra.s]), kind="stable")
 
         def merge(mine, theirs):
@@ -239,15 +236,12 @@ def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) ->
 CHUNK_POINTS = 1024
 
 
-def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, deadline: Deadline = NO_DEADLINE, known=None, s=None):
+def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, deadline: Deadline = NO_DEADLINE):
     """The second-order rows ``(a, b, c, d, lower, upper)`` at n points of a path (``q, dq,
     ddq``, each (n, n_dof)) and their (kind, joint) labels: each array (n, m), acceleration rows
     then torque rows, of the joints whose limit is finite (a row with an infinite limit
     constrains nothing). The torque rows take one batched RNEA per ``CHUNK_POINTS`` points, the
-    deadline checked before each; ``planners.constraint_kernels.assemble_rows`` writes them.
-    With ``known`` (``PathConstraints`` on a grid around the points) and the points' ``s`` on
-    it, M q', M q'' + C q' q' and g are interpolated from its rows where that is accurate
-    (``_interpolated_terms``), and the RNEA runs at the other points only."""
+    deadline checked before each; ``planners.constraint_kernels.assemble_rows`` writes them."""
     nothing = np.empty(0, dtype=np.intp)
     accelerated = np.flatnonzero(np.isfinite(limits.acceleration)) if "acceleration" in kinds else nothing
     torqued = np.flatnonzero(np.isfinite(limits.torque)) if "torque" in kinds else nothing
@@ -259,42 +253,15 @@ def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.nd
     no_torque = np.empty((0, dq.shape[1]))
     acceleration = np.asarray(limits.acceleration, dtype=float)
     torque = np.asarray(limits.torque, dtype=float)
-    terms = None if known is None or not torqued.size else _interpolated_terms(robot, known, torqued, s, q, dq, ddq, deadline)
     for start in range(0, n, CHUNK_POINTS):
         deadline.check()
         part = slice(start, start + CHUNK_POINTS)
-        if terms is not None:
-            tau = terms[:, part].reshape(-1, dq.shape[1])
-        else:
-            tau = _rnea_terms(robot, q[part], dq[part], ddq[part]) if torqued.size else no_torque
+        tau = _rnea_terms(robot, q[part], dq[part], ddq[part]) if torqued.size else no_torque
         assemble_rows(
             dq[part], ddq[part], tau, robot.coulomb_friction, robot.viscous_friction, accelerated, acceleration, torqued, torque,
             *(array[part] for array in arrays),
         )
     return arrays, rows
-
-
-def _interpolated_terms(robot: Robot, known: PathConstraints, torqued: np.ndarray, s, q, dq, ddq, deadline: Deadline) -> np.ndarray | None:
-    """g, M q' + g and M q'' + C q' q' + g (the blocks of ``_rnea_terms``) at the n points ``s``
-    of ``q, dq, ddq`` (each strictly inside an interval of ``known``'s grid), (3, n, n_dof): for
-    the torqued joints read from the rows of ``known`` where its grid resolves them
-    (``planners.torque_interpolation.terms_between``), by RNEA at the other points. ``None``
-    (all by RNEA) when ``known`` cannot serve: no points of its own, a torqued joint without
-    its row, Coulomb friction (whose sign its rows hold inside c), or no interval it resolves."""
-    travel = grid_travel(known)
-    if travel is None or not np.any(travel <= MAX_TRAVEL):
-        return None  # a grid that resolves nothing: no interpolation to try
-    columns = [known.rows.index(("torque", int(j))) if ("torque", int(j)) in known.rows else -1 for j in torqued]
-    if min(columns) < 0 or np.any(np.asarray(robot.coulomb_friction, dtype=float)[torqued] != 0.0):
-        return None
-    (a, b, g), exact = terms_between(known, columns, travel, s)
-    terms = np.zeros((3, len(s), dq.shape[1]))
-    terms[0][:, torqued], terms[1][:, torqued], terms[2][:, torqued] = g, a + g, b + g
-    if exact.any():
-        deadline.check()
-        tau = _rnea_terms(robot, q[exact], dq[exact], ddq[exact])
-        terms[:, exact] = tau.reshape(3, -1, dq.shape[1])
-    return terms
 
 
 def speed_bound(limits: JointLimits, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -306,10 +273,10 @@ def speed_bound(limits: JointLimits, dq: np.ndarray) -> tuple[np.ndarray, np.nda
     return sd_max, binding
 
 
-def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline, known=None):
+def _second_order_rows(path, robot: Robot, limits: JointLimits, kinds, s: np.ndarray, side: str, deadline: Deadline):
     """The path's points at ``s`` and their rows (``grid_rows``)."""
     points = path.evaluate(s, side)
-    arrays, rows = grid_rows(robot, limits, kinds, points.q, points.dq, points.ddq, deadline, known, s)
+    arrays, rows = grid_rows(robot, limits, kinds, points.q, points.dq, points.ddq, deadline)
     return points, arrays, rows
 
 
@@ -340,14 +307,11 @@ def build_path_constraints(
     kinds: tuple[str, ...],
     s: np.ndarray,
     deadline: Deadline = NO_DEADLINE,
-    known: PathConstraints | None = None,
 ) -> PathConstraints:
     """Evaluate the requested ``kinds`` of limits (subset of velocity, acceleration, torque)
     along ``path`` at the grid ``s`` (which must hold the path's kinks); a tool-speed limit
-    (``limits.tool``) joins the first-order bound sd_max. With ``known`` (these constraints on
-    a grid the points of ``s`` lie strictly inside), the torque rows are interpolated from its
-    rows where that is accurate (``grid_rows``)."""
-    points, (a, b, c, d, lower, upper), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline, known)
+    (``limits.tool``) joins the first-order bound sd_max."""
+    points, (a, b, c, d, lower, upper), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
     deadline.check()
     sd_max = np.full(len(s), np.inf)
     velocity_joint = np.full(len(s), -1)
@@ -392,5 +356,5 @@ def build_path_constraints(
         tool_bound=tool_bound,
         knots=np.asarray(path.knots, dtype=float),
         q=points.q,
-        evaluate=lambda extra_s, known=None: build_path_constraints(path, robot, limits, kinds, extra_s, deadline, known),
+        evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),
     )

@@ -1,8 +1,9 @@
-"""Joint torques, and torque rows, between the grid points of a path's constraints, from the
-rows the build computed there with the RNEA (numba, ``nogil``, cached): the dense limit
-check's torques (``planners.limit_check``) and the rows a refining method adds
-(``planners.constraints``, ``PathConstraints.with_points``) without a dynamics evaluation per
-point where the interpolation is accurate, and with one where it is not.
+"""Joint torques between the grid points of a path's constraints, from the rows the build
+computed there with the RNEA (numba, ``nogil``, cached): the dense limit check's torques
+(``planners.limit_check``) without a dynamics evaluation per state where the interpolation is
+accurate, and with one where it is not. (The rows a refining method adds at new grid points
+take the RNEA itself, ``PathConstraints.with_points``: with the compiled pass of
+``robots.chain_dynamics`` that is as fast as interpolating them, and exact.)
 
 Along q(s) the torque of joint j at a state (s, sd, sdd) is (Jeong & Lee eq. (3.4b) with
 x = sd^2, u = sdd, and the URDF's joint friction)
@@ -37,12 +38,6 @@ from numba import njit
 #: intervals over moves of several rad, a cubic and a quartic agree and both miss by 3.6e-5
 #: of the limit).
 MAX_TRAVEL = 0.1
-#: Largest estimated error of an interpolated M q', M q'' + C q' q' or g (``terms_between``), a
-#: fraction of the term's largest magnitude along the grid.
-TERM_TOLERANCE = 1e-6
-#: A term's magnitude is taken as at least this fraction of the joint's torque limit (g of a
-#: vertical joint is zero all along).
-TERM_FLOOR = 1e-3
 
 
 def smooth_points(constraints) -> np.ndarray:
@@ -68,24 +63,6 @@ def grid_travel(constraints) -> np.ndarray | None:
     """(N,): the joints' travel over each grid interval of ``constraints``, the sum over the
     joints of |q(s_i+1) - q(s_i)| (rad); ``None`` when its grid's points are unknown."""
     return None if constraints.q is None else np.abs(np.diff(constraints.q, axis=0)).sum(axis=1)
-
-
-def terms_between(known, columns: list[int], travel: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """a = M q', b = M q'' + C q' q' and g of the torque rows ``columns`` (k of them) of the
-    constraints ``known`` (a ``PathConstraints`` without Coulomb friction in those rows, whose
-    grid's intervals move the joints by ``travel``, rad) at the n points ``s``, each strictly
-    inside an interval of its grid: (values (3, n, k), exact (n,)), each term within
-    ``TERM_TOLERANCE`` of its largest magnitude on the grid (at least ``TERM_FLOOR`` of the
-    limit) by the estimate, and ``exact`` marking the points left to RNEA (their values unset)."""
-    columns_ = np.asarray(columns, dtype=np.int64)
-    limit = np.maximum(known.upper[0, columns_], -known.lower[0, columns_])
-    values = np.zeros((3, len(s), len(columns_)))
-    exact = np.zeros(len(s), dtype=bool)
-    interpolate_terms(
-        known.s, known.smooth, (known.a, known.b, known.c), (known.a_left, known.b_left, known.c_left), columns_,
-        travel, MAX_TRAVEL, TERM_FLOOR * limit, np.asarray(s, dtype=float), TERM_TOLERANCE, values, exact,
-    )
-    return values, exact
 
 
 @njit(cache=True, nogil=True)
@@ -232,42 +209,3 @@ def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit,
                 exact[state] = True
                 break
             tau[state, j] = value
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def interpolate_terms(grid, smooth, right, left, columns, travel, max_travel, floor, s, tolerance, values, exact):  # pragma: no cover - compiled
-    """Write rows a, b and g (``right`` and ``left``: tuples of three (N + 1, m), c = g without
-    Coulomb friction) of the joints' columns ``columns`` (k,) at n points ``s`` (each inside the
-    grid) into ``values`` (3, n, k), each within ``tolerance`` of its scale (its largest
-    magnitude from the right over the grid, plus ``floor`` (k,)) by the estimate, and mark in
-    ``exact`` (n,) the points where one is not (their values left unset). The other arguments
-    as for ``dense_torques``."""
-    n_grid = grid.shape[0]
-    n_columns = columns.shape[0]
-    scale = np.empty((3, n_columns))
-    for row in range(3):
-        for j in range(n_columns):
-            largest = 0.0
-            for node in range(n_grid):
-                largest = max(largest, abs(right[row][node, columns[j]]))
-            scale[row, j] = largest + floor[j]
-    coefficients = np.empty((3, n_columns, 5))
-    spans = np.empty((5, 5))
-    products = np.empty(6)
-    held = (-1, -1)
-    for point in range(s.shape[0]):
-        i = min(max(np.searchsorted(grid, s[point], side="right") - 1, 0), n_grid - 2)
-        start = _stencil(smooth, travel, max_travel, i)
-        if start < 0:
-            exact[point] = True
-            continue
-        if held != (i, start):
-            _divided_differences(grid, right, left, columns, i, start, coefficients, spans)
-            held = (i, start)
-        _node_products(grid, start, s[point], products)
-        for j in range(n_columns):
-            for row in range(3):
-                value, error = _row_at(coefficients, row, j, products)
-                if not error <= tolerance * scale[row, j]:
-                    exact[point] = True
-                values[row, point, j] = value

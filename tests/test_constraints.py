@@ -129,7 +129,7 @@ def test_refined_constraints_know_their_smooth_points(make):
         s = np.linspace(0.0, 1.0, 7)  # the inner knot is no grid point
         extra = np.array([0.1, path.knots[1], 0.9])
     constraints = build_path_constraints(path, robot, robot.limits, kinds, s)
-    refined = constraints.with_points(extra, interpolate=True)
+    refined = constraints.with_points(extra)
     np.testing.assert_array_equal(refined.smooth, smooth_points(refined))
     assert not refined.smooth.flags.writeable
     if make == "spline_off_grid_knot":

@@ -172,7 +172,7 @@ class PhasePlaneMethod(TimingMethod):
                 break
             deadline.check()
             previous = grid
-            grid = _Grid.of(grid.constraints.with_points(extra, interpolate=True))
+            grid = _Grid.of(grid.constraints.with_points(extra))
             # The profile on the coarser grid is a close reference for viscous friction.
             x_ref = np.interp(grid.s, previous.s, profile.x) if grid.friction else None
             profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False, x_ref=x_ref)
