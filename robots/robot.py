@@ -135,6 +135,14 @@ class Robot:
         revolute nor prismatic."""
         return chain_of(self.model)
 
+    @cached_property
+    def neutral_reach(self) -> float:
+        """Distance (m) from the first joint to the ``end_effector`` frame at the neutral
+        posture (computed once; the model never changes)."""
+        data = self.model.createData()
+        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
+        return float(np.linalg.norm(data.oMf[self.frame_id(self.end_effector)].translation - data.oMi[1].translation))
+
     @property
     def dof(self) -> int:
         """Number of degrees of freedom (actuated joints)."""

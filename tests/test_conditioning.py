@@ -1,4 +1,5 @@
-"""Kinematic conditioning against Angeles' problems 5.16 and 5.17."""
+"""Kinematic conditioning against Angeles' problems 5.16 and 5.17, and the characteristic length
+of the papers' two-link arms."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import pinocchio as pin
 import pytest
 from scipy.optimize import minimize
 
+import robots
 from planners.kinematics.conditioning import frobenius_condition_number, task_jacobian
 from robots.catalog import robot_from_model
 
@@ -117,3 +119,15 @@ def test_the_gram_matrix_route_equals_the_singular_values(shape):
     assert np.array_equal(np.isfinite(kappa), finite)
     assert kappa[finite] == pytest.approx(expected[finite], rel=1e-9)
     assert frobenius_condition_number(stack[3]) == pytest.approx(expected[3], rel=1e-9)
+
+
+@pytest.mark.parametrize(("name", "reach"), [("geering_2r", 0.4 + 0.25), ("yamamoto_2r", 0.2 + 0.2)])
+def test_the_characteristic_length_is_the_reach_at_the_neutral_posture(name, reach):
+    """L of the two-link arms of the papers, stretched out at q = 0: the sum of their link
+    lengths (the URDFs' joint and tip offsets), the same at every call."""
+    from planners.kinematics.conditioning import characteristic_length, conditioning_along
+
+    robot = robots.load(name)
+    assert robot.neutral_reach == pytest.approx(reach, abs=1e-15)
+    assert characteristic_length(robot) == robot.neutral_reach
+    assert conditioning_along(robot, np.array([[0.3, 0.5], [0.1, -0.4]]))[2] == pytest.approx(reach, abs=1e-15)

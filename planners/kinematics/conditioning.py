@@ -15,7 +15,6 @@ the n largest singular values when n < 6.
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 
 from planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
 from planners.kinematics.frame_jacobians import frame_jacobians
@@ -59,12 +58,8 @@ def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
 
 def characteristic_length(robot: Robot) -> float:
     """Default L: distance from the first joint to the end effector at the neutral posture
-    (at least 5 cm)."""
-    data = robot.data
-    pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
-    tip = data.oMf[robot.frame_id(robot.end_effector)].translation
-    base = data.oMi[1].translation
-    return max(float(np.linalg.norm(tip - base)), 0.05)
+    (``Robot.neutral_reach``), at least 5 cm."""
+    return max(robot.neutral_reach, 0.05)
 
 
 def task_jacobian(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> np.ndarray:
