@@ -60,6 +60,25 @@ def test_every_arm_has_pinocchios_inverse_dynamics(robot):
         np.testing.assert_allclose(robot.rnea(q, qd[m], qdd[m]), expected, rtol=0, atol=1e-13 * scale)
 
 
+
+@pytest.mark.parametrize("robot", list(_robots()), ids=lambda robot: robot.name)
+def test_sets_at_rest_take_the_shorter_pass_with_the_same_numbers(robot):
+    """Leading sets without velocity skip the velocity terms, which are zero: their torques
+    equal, bit for bit, those of the same sets behind a moving one (which take the full pass),
+    and Pinocchio's."""
+    rng = np.random.default_rng(5)
+    q = rng.uniform(-2.5, 2.5, (15, robot.dof))
+    qd = rng.uniform(-2.0, 2.0, (3, 15, robot.dof))
+    qdd = rng.uniform(-5.0, 5.0, (3, 15, robot.dof))
+    qd[[0, 1]] = 0.0
+    leading = robot.rnea_sets(q, qd, qdd)
+    behind = robot.rnea_sets(q, qd[[2, 0, 1]], qdd[[2, 0, 1]])
+    np.testing.assert_array_equal(leading, behind[[1, 2, 0]])
+    for m in range(3):
+        expected = _pinocchio(robot, q, qd[m], qdd[m])
+        np.testing.assert_allclose(leading[m], expected, rtol=0, atol=1e-13 * max(1.0, float(np.abs(expected).max())))
+
+
 def test_the_lopsided_arm_feels_what_the_test_changed():
     """The lopsided model's torques differ from the plain one's (the inertias and the armature
     reach the compiled pass, not only Pinocchio)."""
