@@ -21,13 +21,18 @@ samples every 10 ms. Each round times, in a shuffled order:
 * **planning thread**: what a server's planning thread does: the request's schema object to
   JSON bytes (``plan_request``, ``trajectory_body``, ``encode_json``);
 * **HTTP**: ``POST /v1/trajectories`` to ``toptraj serve --workers 1`` over one keep-alive
-  loopback connection, the body read in full.
+  loopback connection, the body read in full;
+* **HTTP again**: the same request once more right after each HTTP probe (not a probe of its
+  own in the shuffle, so that no HTTP probe follows it): the server answers it without having
+  been idle, as a server under steady load does.
 
 Prints the medians and the ratios of the goals (HTTP <= 1.0x bare toppra and <= 8x the RNEA
 floor; library <= 0.6x bare toppra) and, with Drake, the same against Drake's Toppra, then (``--profile``) the stages of a request as shares
 of its HTTP median: the planning thread's median split by ``cProfile``'s shares of its work, the
-HTTP stack the rest. Both medians come from the interleaved rounds, where each probe finds the
-caches as the others left them (the same work timed in a loop of its own is about 1.5 ms faster).
+HTTP stack the rest (split into what the server spends when it comes to the request without
+having been idle, HTTP again - planning thread, and the rest, HTTP - HTTP again: waking from
+idle). The medians come from the interleaved rounds, where each probe finds the caches as the
+others left them (the same work timed in a loop of its own is about 1.5 ms faster).
 
     python benchmarks/end_to_end.py [--rounds 300] [--profile]
 """
@@ -142,7 +147,7 @@ def _timed(function) -> float:
     return time.perf_counter() - started
 
 
-def _profile(request: TrajectoryRequest, http_median_s: float, thread_median_s: float, calls: int = 100) -> None:
+def _profile(request: TrajectoryRequest, http_median_s: float, again_median_s: float, thread_median_s: float, calls: int = 100) -> None:
     """Stage shares of the HTTP median: the planning thread's median (interleaved with the other
     probes, as the HTTP median is) split by cProfile's shares of its work, and the HTTP stack as
     the difference of the two medians."""
@@ -169,11 +174,12 @@ def _profile(request: TrajectoryRequest, http_median_s: float, thread_median_s: 
         accounted += seconds
         rows.append((label, seconds))
     rows.append(("rest of the planning thread", unprofiled - accounted))
-    rows.append(("HTTP stack (HTTP median - planning thread)", http_median_s - unprofiled))
+    rows.append(("HTTP stack, server busy (HTTP again - thread)", again_median_s - unprofiled))
+    rows.append(("server waking from idle (HTTP - HTTP again)", http_median_s - again_median_s))
     print(f"\nstages of the typical request (shares of the HTTP median {1e3 * http_median_s:.2f} ms; cProfile, "
           f"its overhead scaled out):")
     for label, seconds in sorted(rows, key=lambda row: -row[1]):
-        print(f"  {label:44s} {1e3 * seconds:7.3f} ms  {100 * seconds / http_median_s:5.1f} %")
+        print(f"  {label:46s} {1e3 * seconds:7.3f} ms  {100 * seconds / http_median_s:5.1f} %")
 
 
 def main() -> int:
@@ -223,13 +229,15 @@ def main() -> int:
         for function in probes.values():  # warm-up
             for _ in range(5):
                 function()
-        times = {name: [] for name in probes}
+        times: dict[str, list[float]] = {name: [] for name in (*probes, "HTTP again")}
         order = list(probes)
         shuffle = random.Random(1)
         for _ in range(args.rounds):
             shuffle.shuffle(order)
             for name in order:
                 times[name].append(_timed(probes[name]))
+                if name == "HTTP":
+                    times["HTTP again"].append(_timed(http_call))
         median = {name: float(np.median(values)) for name, values in times.items()}
         print(f"typical request: ur5, 4 spline waypoints, velocity + acceleration + torque, dt 0.01; "
               f"{args.rounds} interleaved rounds; duration {answer.duration:.4f} s (bare toppra "
@@ -246,13 +254,14 @@ def main() -> int:
         print()
         for label, ratio, goal in goals:
             print(f"  {label:24s} {ratio:7.2f}x   goal <= {goal:g}x   {'met' if ratio <= goal else 'MISSED'}")
+        print(f"  {'HTTP again / bare toppra':24s} {median['HTTP again'] / median['bare toppra']:7.2f}x   (the server without its idle gap)")
         if drake is None:
             print("  drake: pydrake not installed (pip install toptraj[bench]); skipped")
         else:
             for name in ("HTTP", "library"):
                 print(f"  {name + ' p50 / drake':24s} {median[name] / median['drake']:7.2f}x")
         if args.profile:
-            _profile(request, median["HTTP"], median["planning thread"])
+            _profile(request, median["HTTP"], median["HTTP again"], median["planning thread"])
     finally:
         server.terminate()
         server.wait(timeout=10)
