@@ -60,3 +60,12 @@ def path_grid(path: GeometricPath, n_intervals: int | None = None) -> np.ndarray
     s[:-1] = j * (lengths / counts)[segment] + knots[segment]
     s[-1] = 1.0
     return s
+
+
+def spread_indices(n: int, most: int) -> np.ndarray:
+    """At most ``most`` (>= 1) indices into a sequence of ``n``, evenly spread from the first to
+    the last, increasing: every index when ``n <= most``. (With n > most the step
+    (n - 1) / (most - 1) exceeds 1, so the rounded positions never repeat.)"""
+    if n <= most:
+        return np.arange(n)
+    return np.linspace(0, n - 1, most).round().astype(np.intp)

@@ -18,7 +18,7 @@ from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is
 from planners.free_path import FreeMotion
 from planners.free_path.switching import collocation_switches, switching_times
 from planners.gate import TimedStretch, gate_threshold, samples_exceed
-from planners.grid import MAX_POINTS
+from planners.grid import MAX_POINTS, spread_indices
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.mvc import admissible_set
 from planners.paths.cartesian import CartesianLine
@@ -69,7 +69,7 @@ def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.n
         start, width = getattr(item.stretch, "start", 0.0), getattr(item.stretch, "width", 1.0)
         pieces.append((start + width * constraints.s, width * sd, width * mvc))
     s, sd, mvc = (np.concatenate([piece[i] for piece in pieces]) for i in range(3))
-    keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), MAX_PHASE_PLANE_POINTS)).round().astype(int))
+    keep = spread_indices(len(s), MAX_PHASE_PLANE_POINTS)
     return s[keep], sd[keep], mvc[keep]
 
 

@@ -168,11 +168,18 @@ def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit,
     products = np.empty(6)
     factors = np.empty(4)
     held = (-1, -1)  # the interval and stencil whose coefficients are held
+    rows = 4  # the rows with a nonzero coefficient in the held stencil (d, the viscous row, last)
+    k = 0
+    stencil_of, start = -1, -1  # the interval whose stencil ``start`` is
     for state in range(s.shape[0]):
         at = s[state]
         speed = sd[state]
         factors[0], factors[1], factors[2], factors[3] = sdd[state], speed * speed, 1.0, speed
-        k = np.searchsorted(grid, at)
+        # The states come in order of s (mostly): step the search on from the last one.
+        if k > 0 and grid[k - 1] >= at:
+            k = np.searchsorted(grid, at)
+        while k < n_grid and grid[k] < at:
+            k += 1
         on_grid = k < n_grid and grid[k] == at
         if on_grid and speed > 0.0:
             a, b, c, d = left if from_left[state] else right
@@ -186,20 +193,29 @@ def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit,
         # The interval the state belongs to: the one ending at its grid point from the left.
         i = k - 1 if (from_left[state] or not on_grid) else k
         i = min(max(i, 0), n_grid - 2)
-        start = _stencil(smooth, travel, max_travel, i)
+        if i != stencil_of:
+            start = _stencil(smooth, travel, max_travel, i)
+            stencil_of = i
         if start < 0:
             exact[state] = True
             continue
         if held != (i, start):
             _divided_differences(grid, right, left, columns, i, start, coefficients, spans)
             held = (i, start)
+            # Without viscous friction the d row is zero throughout, and so are its value and
+            # its error: three rows give the same sums.
+            rows = 3
+            for j in range(n_dof):
+                for node in range(5):
+                    if coefficients[3, j, node] != 0.0:
+                        rows = 4
         _node_products(grid, start, at, products)
         for j in range(n_dof):
             # Each row's error apart: the rows' errors may cancel in one state's torque and
             # add up in the next one's.
             value = 0.0
             error = 0.0
-            for row in range(4):
+            for row in range(rows):
                 factor = factors[row]
                 if factor != 0.0:
                     row_value, row_error = _row_at(coefficients, row, j, products)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from planners.grid import spread_indices
 from planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
 from planners.kinematics.frame_jacobians import frame_jacobians
 from robots import Robot
@@ -83,7 +84,7 @@ def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tu
     evenly spaced rows of ``q`` (n_samples, n_dof)."""
     length = characteristic_length(robot)
     frame_id = robot.frame_id(robot.end_effector)
-    rows = np.unique(np.linspace(0, len(q) - 1, min(len(q), max_points)).round().astype(int))
+    rows = spread_indices(len(q), max_points)
     kappas = np.atleast_1d(frobenius_condition_number(task_jacobians(robot, q[rows], frame_id, length)))
     worst = int(np.argmax(kappas))
     return float(kappas.min()), float(kappas.max()), length, int(rows[worst])

@@ -127,9 +127,14 @@ def cubic_pieces(knots, coefficients, s):  # pragma: no cover - compiled
     q = np.empty((n, n_dof))
     dq = np.empty((n, n_dof))
     ddq = np.empty((n, n_dof))
+    piece = 0
     for i in range(n):
-        piece = min(max(np.searchsorted(knots, s[i], side="right") - 1, 0), last)
-        h = s[i] - knots[piece]
+        # The piece holding s[i]: stepped on from the last one while s increases (the usual
+        # order), searched for where it does not.
+        at = s[i]
+        if at < knots[piece] or (piece < last and at >= knots[piece + 1]):
+            piece = min(max(np.searchsorted(knots, at, side="right") - 1, 0), last)
+        h = at - knots[piece]
         for j in range(n_dof):
             c0 = coefficients[0, piece, j]
             c1 = coefficients[1, piece, j]

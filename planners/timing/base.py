@@ -13,6 +13,7 @@ import numpy as np
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import TimingFailed
+from planners.limit_kernels import grid_states
 
 
 @dataclass(frozen=True)
@@ -160,30 +161,12 @@ class TimeScaling(PathTiming):
                 this timing gets states as far apart as ``points_per_interval`` per interval of
                 ``reference`` would be, at least its two ends. ``None``: this timing's grid.
         """
-        n_intervals = len(self.s) - 1
-        widths = np.diff(self.s)
-        if reference is None:
-            parts = np.full(n_intervals, max(points_per_interval, 2) - 1)
-        else:
-            reference = np.asarray(reference, dtype=float)
-            middle = 0.5 * (self.s[:-1] + self.s[1:])
-            holder = np.clip(np.searchsorted(reference, middle) - 1, 0, len(reference) - 2)
-            room = np.diff(reference)[holder]
-            parts = np.clip(np.ceil((max(points_per_interval, 2) - 1) * widths / room - 1e-9), 1, None).astype(int)
-        counts = parts + 1
-        interval = np.repeat(np.arange(n_intervals), counts)
-        step = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-        fraction = step / parts[interval]
-        s0, s1 = self.s[interval], self.s[interval + 1]
-        x = self.sd[interval] ** 2 + fraction * (self.sd[interval + 1] ** 2 - self.sd[interval] ** 2)
-        return DenseStates(
-            s=s0 + fraction * (s1 - s0),
-            sd=np.sqrt(np.maximum(x, 0.0)),
-            sdd=self.sdd[interval],
-            sddd=None,
-            left=step == parts[interval],
-            interval=interval,
+        grid = np.empty(0) if reference is None else np.ascontiguousarray(reference, dtype=float)
+        s, sd, sdd, left, interval = grid_states(
+            np.ascontiguousarray(self.s, dtype=float), np.ascontiguousarray(self.sd, dtype=float),
+            np.ascontiguousarray(self.sdd, dtype=float), grid, max(points_per_interval, 2),
         )
+        return DenseStates(s=s, sd=sd, sdd=sdd, sddd=None, left=left, interval=interval)
 
     def speed_at(self, s: np.ndarray) -> np.ndarray:
         x = np.interp(s, self.s, self.sd**2)
