@@ -1,7 +1,8 @@
 """The shortcuts of the typical request compute the numbers of the long way, to rounding: the
-spline's one-pass evaluation against SciPy's ``CubicSpline``, and the dense check's torques read
-from the grid rows against Pinocchio's RNEA at every state (friction included); more on the
-rows' interpolation between grid points in ``test_torque_interpolation.py``."""
+spline's one-pass evaluation against SciPy's ``CubicSpline``, the dense check's states against
+their array formulas, and its torques read from the grid rows against Pinocchio's RNEA at every
+state (friction included); more on the rows' interpolation between grid points in
+``test_torque_interpolation.py``."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from planners.limit_check import INTERPOLATION_TOLERANCE, _torques, check_limits
 from planners.limit_kernels import utilization_pass
 from planners.paths import SplinePath
 from planners.timing import PhasePlaneMethod, ToppraMethod
+from planners.timing.base import TimeScaling
 from robots.catalog import robot_from_model
 from robots.urdf_check import check_urdf
 
@@ -88,3 +90,55 @@ def test_utilization_pass_equals_the_numpy_reduction():
     expected = per_state > 1.2
     expected[3] = True
     np.testing.assert_array_equal(over, expected)
+
+
+def _dense_states_in_numpy(s, sd, sdd, reference, points):
+    """The dense states as array operations: each interval split into ceil((points - 1) w / w_ref)
+    parts (at least one; w_ref the width of the reference interval holding its middle), x = sd^2
+    linear in s across it."""
+    widths = np.diff(s)
+    if reference is None:
+        parts = np.full(len(widths), points - 1)
+    else:
+        holder = np.clip(np.searchsorted(reference, 0.5 * (s[:-1] + s[1:])) - 1, 0, len(reference) - 2)
+        parts = np.clip(np.ceil((points - 1) * widths / np.diff(reference)[holder] - 1e-9), 1, None).astype(int)
+    interval = np.repeat(np.arange(len(widths)), parts + 1)
+    step = np.arange(len(interval)) - np.repeat(np.cumsum(parts + 1) - (parts + 1), parts + 1)
+    fraction = step / parts[interval]
+    x = sd[interval] ** 2 + fraction * (sd[interval + 1] ** 2 - sd[interval] ** 2)
+    return (s[interval] + fraction * widths[interval], np.sqrt(np.maximum(x, 0.0)), sdd[interval], step == parts[interval], interval)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_dense_states_of_a_grid_timing_equal_the_array_formulas(seed):
+    """``TimeScaling.dense_states`` (one compiled pass) against the same states built with
+    array operations, bit for bit: random grids and speeds, with and without a coarser reference
+    grid, 2 to 7 states per interval."""
+    rng = np.random.default_rng(seed)
+    s = np.unique(np.concatenate(([0.0, 1.0], rng.uniform(0.0, 1.0, int(rng.integers(1, 80))))))
+    sd = rng.uniform(0.05, 3.0, len(s))
+    sd[0] = sd[-1] = 0.0
+    timing = TimeScaling(s, sd)
+    inner = rng.choice(s[1:-1], size=min(len(s) - 2, int(rng.integers(0, 12))), replace=False)
+    for reference in (None, np.unique(np.concatenate(([0.0, 1.0], inner)))):
+        for points in (2, 5, 7):
+            states = timing.dense_states(points, reference)
+            expected = _dense_states_in_numpy(s, sd, timing.sdd, reference, points)
+            for got, want in zip((states.s, states.sd, states.sdd, states.left, states.interval), expected):
+                np.testing.assert_array_equal(got, want)
+
+
+def test_dense_torques_do_not_depend_on_the_order_of_the_states():
+    """The torque interpolation steps from one state's grid interval to the next; states in
+    random order (searched for) get the torques and the RNEA marks they get in order."""
+    robot = robots.load("ur5")
+    path = SplinePath(np.array([[0.0, -1.2, 1.0, 0.0, 0.5, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3], [1.5, -0.5, 0.8, -1.0, 1.0, 0.8]]))
+    constraints = build_path_constraints(path, robot, robot.limits, KINDS, path_grid(path))
+    timing = PhasePlaneMethod().solve(constraints)
+    states = timing.dense_states(5, constraints.s)
+    q, qd, qdd, _ = joint_motion(path, states)
+    in_order = _torques(robot, states, q, qd, qdd, constraints)
+    shuffle = np.random.default_rng(3).permutation(len(states.s))
+    shuffled = type(states)(*(None if field is None else field[shuffle] for field in
+                              (states.s, states.sd, states.sdd, states.sddd, states.left, states.interval)))
+    np.testing.assert_array_equal(_torques(robot, shuffled, q[shuffle], qd[shuffle], qdd[shuffle], constraints), in_order[shuffle])

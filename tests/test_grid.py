@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from planners.errors import TimingFailed
-from planners.grid import MIN_POINTS_PER_SEGMENT, path_grid
+from planners.grid import MIN_POINTS_PER_SEGMENT, path_grid, spread_indices
 
 
 @pytest.mark.parametrize("n_intervals", [None, 25, 100, 1000])
@@ -33,3 +33,13 @@ def test_each_segment_is_spaced_as_linspace_spaces_it(n_intervals):
 def test_knots_that_are_no_increasing_finite_sequence_are_refused(knots):
     with pytest.raises(TimingFailed, match="not an increasing sequence"):
         path_grid(SimpleNamespace(knots=np.asarray(knots, dtype=float)), 25)
+
+
+def test_spread_indices_are_the_rounded_evenly_spaced_rows_without_repeats():
+    """At most ``most`` rows from the first to the last, evenly spread: the rounded positions
+    of ``np.linspace`` with repeats removed (never any to remove), every row when there are
+    few enough."""
+    for n in range(1, 260):
+        for most in (1, 2, 3, 7, 100, 200):
+            expected = np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))
+            np.testing.assert_array_equal(spread_indices(n, most), expected)
