@@ -14,6 +14,7 @@ from plotly.subplots import make_subplots
 
 import robots
 from planners import PlannedTrajectory
+from planners.grid import spread_indices
 from planners.kinematics.skeleton import skeleton
 
 #: Instants of the stroboscopic picture.
@@ -63,7 +64,7 @@ def joints_figure(result: PlannedTrajectory, limits) -> go.Figure:
 
 def arm_figure(result: PlannedTrajectory, robot: robots.Robot) -> go.Figure:
     t = result.samples.t
-    rows = np.unique(np.round(np.linspace(0, len(t) - 1, min(STROBE, len(t)))).astype(int))
+    rows = spread_indices(len(t), STROBE)
     _, points = skeleton(robot, result.samples.q[rows])
     planar = np.ptp(points[..., 2]) < 1e-9
     figure = go.Figure()
