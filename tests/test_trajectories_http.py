@@ -108,3 +108,19 @@ def test_paper_arm_torque_limited_straight_line(client, robot, waypoints, method
     assert (np.abs(tau).max(axis=0) / limit).max() <= 1.005
     assert (np.abs(tau).max(axis=0) / limit).max() >= 0.995  # bang-bang: a torque saturates
     assert result["samples"]["q"][-1] == pytest.approx(waypoints[-1], abs=1e-9)
+
+
+def test_request_models_are_frozen_and_share_their_defaults():
+    """A request is read, never changed: its models are frozen, so the default sub-models
+    (limits, boundary, cost, trapezoid) are hashable and every request shares them instead of
+    validating a deep copy of each."""
+    from pydantic import ValidationError
+
+    from service.schemas.trajectories import TrajectoryRequest
+
+    body = {"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS[:2]}, "timing": {"method": "phase_plane"}}
+    first, second = TrajectoryRequest.model_validate(body), TrajectoryRequest.model_validate(body)
+    for name in ("limits", "boundary", "cost", "trapezoid"):
+        assert getattr(first.timing, name) is getattr(second.timing, name), name
+    with pytest.raises(ValidationError, match="frozen"):
+        first.timing.limits.velocity_scale = 0.5

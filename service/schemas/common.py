@@ -15,9 +15,11 @@ from planners.ranges import Range
 
 class Schema(BaseModel):
     """Base of every request schema: extra fields, non-finite numbers and values of another JSON
-    type (`true` or `"0.1"` for a number) are errors, as the OpenAPI declares."""
+    type (`true` or `"0.1"` for a number) are errors, as the OpenAPI declares. A request is
+    read, never changed: frozen, its models are hashable, so pydantic shares a default
+    sub-model among requests instead of validating a deep copy of it for each one."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True, frozen=True)
 
 
 def _range_error(value: float, shown: str) -> PydanticCustomError:
