@@ -95,29 +95,47 @@ class PlanningWorkers:
         started = False
         try:
             await self._acquire(deadline, budget_s)
+            loop = asyncio.get_running_loop()
+            # One future of this loop, settled by the planning thread through one callback: the
+            # answer reaches the request in one turn of the loop, not a chain of wrapped futures.
+            answer: asyncio.Future = loop.create_future()
 
             def work():
                 try:
-                    return function(deadline)
+                    outcome = (function(deadline), None)
+                except BaseException as error:  # delivered to the request, as an executor would
+                    outcome = (None, error)
                 finally:
                     self._release()
+                try:
+                    loop.call_soon_threadsafe(_settle, answer, outcome)
+                except RuntimeError:  # the loop closed: nobody waits for the answer
+                    pass
 
             try:
-                future = asyncio.get_running_loop().run_in_executor(self._threads(), work)
+                self._threads().submit(work)
             except BaseException:
                 self._slots.release()
                 self._wake_first()
                 raise
             started = True
-            future.add_done_callback(_consume)
+            remaining = deadline.remaining()
+            timer = None if remaining is None else loop.call_later(max(remaining, 0.0), _settle, answer, _EXPIRED)
             try:
-                return await asyncio.wait_for(asyncio.shield(future), timeout=deadline.remaining())
-            except TimeoutError:
-                deadline.cancel()
-                raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s") from None
+                outcome = await answer
             except asyncio.CancelledError:  # the client went away, or the server stops
                 deadline.cancel()
                 raise
+            finally:
+                if timer is not None:
+                    timer.cancel()
+            if outcome is _EXPIRED:
+                deadline.cancel()
+                raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s")
+            result, error = outcome
+            if error is not None:
+                raise error
+            return result
         finally:
             if not started:
                 with self._lock:
@@ -189,7 +207,13 @@ class PlanningWorkers:
             executor.shutdown(wait=False)
 
 
-def _consume(future: asyncio.Future) -> None:
-    """Retrieve an error nobody awaits any more (a request past its budget)."""
-    if not future.cancelled():
-        future.exception()
+#: What the timer of ``PlanningWorkers.run`` settles a request's answer with when its budget ends.
+_EXPIRED = object()
+
+
+def _settle(answer: asyncio.Future, outcome) -> None:
+    """Settle a request's answer with ``outcome`` (``(result, error)``, or ``_EXPIRED``) unless
+    it was settled already: the first of the planning thread and the budget's timer wins, and
+    an answer nobody waits for any more (a request past its budget, or gone) is dropped."""
+    if not answer.done():
+        answer.set_result(outcome)
