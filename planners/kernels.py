@@ -1,7 +1,7 @@
 """Compiled inner loops of the phase-plane method (numba): the per-point admissible interval of
-x = sd^2, the bounds on u of each grid interval in either discretization, and the two sequential
-sweeps. Plain loops over small row counts, compiled once (``nogil``, so threads run them in
-parallel) and cached on disk; they hold no knowledge of paths or robots.
+x = sd^2 and the bounds on u of each grid interval in either discretization (the sweeps over
+them: ``planners.sweep_kernels``). Plain loops over small row counts, compiled once (``nogil``,
+so threads run them in parallel) and cached on disk; they hold no knowledge of paths or robots.
 
 Bounds on the path acceleration u come as lines: ``p + q x <= u <= r + q x`` per row, shape
 (N, m), with an intercept of -inf (p) or +inf (r) where a row gives no such bound (the two lines
@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-
-from planners.refinement_kernels import switch_excess
 
 _INF = np.inf
 #: |a| below this fraction of the row's scale |a| + |b| counts as zero (a zero-inertia point).
@@ -202,6 +200,39 @@ def _friction_share(d, root, half):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, p, q, r, x_low, x_high, singular, static_fail):  # pragma: no cover - compiled
+    """``interval_bounds``' rows without viscous friction, written into ``p, q, r`` (N, m
+    midpoint, 2 m interpolation) and ``x_low, x_high, singular, static_fail`` (N,): one line
+    per row at each end (or at the midpoint), the same arithmetic as the general loop there
+    without its halves and tangents."""
+    n_stages = s.shape[0] - 1
+    n_rows = ra.shape[1]
+    for i in range(n_stages):
+        ds = s[i + 1] - s[i]
+        for j in range(n_rows):
+            for end_ in range(1 if midpoint else 2):
+                if midpoint:
+                    b_mid = 0.5 * (rb[i, j] + lb[i + 1, j])
+                    a_mid = 0.5 * (ra[i, j] + la[i + 1, j]) + ds * b_mid
+                    low, slope, high, is_singular = _row_bounds(a_mid, b_mid, 0.5 * (rc[i, j] + lc[i + 1, j]), lower[i, j], upper[i, j])
+                elif end_ == 0:
+                    low, slope, high, is_singular = _row_bounds(ra[i, j], rb[i, j], rc[i, j], lower[i, j], upper[i, j])
+                else:
+                    b_next = lb[i + 1, j]
+                    a_next = la[i + 1, j] + 2.0 * ds * b_next
+                    low, slope, high, is_singular = _row_bounds(a_next, b_next, lc[i + 1, j], lower[i + 1, j], upper[i + 1, j])
+                column = j + end_ * n_rows
+                if is_singular:
+                    singular[i] = True
+                    if _store(i, column, low, slope, high, True, p, q, r, x_low, x_high):
+                        static_fail[i] = True
+                else:
+                    p[i, column] = low
+                    q[i, column] = slope
+                    r[i, column] = high
+
+
+@njit(cache=True, nogil=True)
 def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint):  # pragma: no cover - compiled
     """The rows of each grid interval i on its start state (u_i, x_i) as bounds on u, and the
     admissible x_i under them.
@@ -238,11 +269,14 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
     x_high = np.empty(n_stages)
     singular = np.zeros(n_stages, dtype=np.bool_)
     static_fail = np.zeros(n_stages, dtype=np.bool_)
+    for i in range(n_stages):
+        x_high[i] = x_bound[i]
+    if not friction:
+        _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, p, q, r, x_low, x_high, singular, static_fail)
     root_here = 1.0
     root_next = 1.0
-    for i in range(n_stages):
+    for i in range(n_stages if friction else 0):
         ds = s[i + 1] - s[i]
-        x_high[i] = x_bound[i]
         if friction:
             root_here = np.sqrt(max(x_ref[i], 1e-6))
             root_next = np.sqrt(max(x_ref[i + 1], 1e-6))
@@ -288,109 +322,3 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
         if static_fail[i] or x_low[i] > x_high[i]:
             x_high[i] = -1.0
     return p, q, r, x_low, x_high, singular
-
-
-@njit(cache=True, nogil=True)
-def backward_envelope(ds, p, q, r, w, x_low, x_high, x_end, slack):  # pragma: no cover - compiled
-    """The controllable sets, swept backward from the end state: for i = N-1 .. 0 the interval
-    [lower_i, upper_i] of admissible x_i from which some u in [alpha_i(x_i), beta_i(x_i)] lands
-    x_i + 2 ds_i u inside [lower_i+1, upper_i+1]. The upper end uses the least u (maximum
-    deceleration, u = max_k p_k + q_k x), the lower end the greatest (u = min_j r_j + w_j x).
-
-    Returns upper (N + 1,), lower (N + 1,) and the index of the first interval (from the end)
-    whose set is empty, or -1.
-    """
-    n_stages, n_rows = p.shape
-    upper = np.empty(n_stages + 1)
-    lower = np.empty(n_stages + 1)
-    upper[n_stages] = x_end
-    lower[n_stages] = x_end
-    for i in range(n_stages - 1, -1, -1):
-        step = 2.0 * ds[i]
-        ceiling = upper[i + 1]
-        floor = lower[i + 1]
-        high = x_high[i]
-        low = x_low[i]
-        for k in range(n_rows):
-            pk = p[i, k]
-            if pk != -_INF:
-                # x + step (p_k + q_k x) <= ceiling
-                denominator = 1.0 + step * q[i, k]
-                numerator = ceiling - step * pk
-                if denominator > 0.0:
-                    if numerator / denominator < high:
-                        high = numerator / denominator
-                elif denominator < 0.0:
-                    if numerator / denominator > low:
-                        low = numerator / denominator
-                elif numerator < 0.0:
-                    high = -1.0
-            rk = r[i, k]
-            if rk != _INF:
-                # x + step (r_k + w_k x) >= floor
-                denominator = 1.0 + step * w[i, k]
-                numerator = floor - step * rk
-                if denominator > 0.0:
-                    if numerator / denominator > low:
-                        low = numerator / denominator
-                elif denominator < 0.0:
-                    if numerator / denominator < high:
-                        high = numerator / denominator
-                elif numerator > 0.0:
-                    high = -1.0
-        upper[i] = high
-        lower[i] = low
-        if high < low - slack * (1.0 + abs(low)):
-            return upper, lower, i
-    return upper, lower, -1
-
-
-@njit(cache=True, nogil=True)
-def forward_profile(ds, r, w, envelope, x_start):  # pragma: no cover - compiled
-    """Maximum-acceleration sweep from the start, capped by the envelope: x (N + 1,) and, per
-    interval, whether the cap decided it (True) or the acceleration limit did (False)."""
-    n_stages, n_rows = r.shape
-    x = np.empty(n_stages + 1)
-    capped = np.zeros(n_stages, dtype=np.bool_)
-    x[0] = x_start
-    for i in range(n_stages):
-        xi = x[i]
-        fastest = _INF
-        for k in range(n_rows):
-            value = r[i, k] + w[i, k] * xi
-            if value < fastest:
-                fastest = value
-        reach = xi + 2.0 * ds[i] * fastest
-        if reach >= envelope[i + 1]:
-            x[i + 1] = envelope[i + 1]
-            capped[i] = True
-        else:
-            x[i + 1] = reach if reach > 0.0 else 0.0
-    return x, capped
-
-
-@njit(cache=True, nogil=True)
-def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, x_start, x_end, midpoint, slack):  # pragma: no cover - compiled
-    """One solve on the grid ``s`` (N + 1,): the interval bounds (``interval_bounds``, whose
-    arguments these are), the backward envelope from ``x_end`` and the forward profile from
-    ``min(x_start, envelope_0)``.
-
-    Returns x (N + 1,; empty when the backward sweep failed), capped (N,), envelope and floor
-    (N + 1,), the index of the interval where the backward sweep failed or -1, the admissible
-    upper x_i of each interval (N,) and the ``switch_excess`` of each interval (N,).
-    """
-    p, q, r, x_low, x_high, _ = interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint)
-    n_stages = s.shape[0] - 1
-    ds = np.empty(n_stages)
-    for i in range(n_stages):
-        ds[i] = s[i + 1] - s[i]
-    envelope, floor, failed = backward_envelope(ds, p, q, r, q, x_low, x_high, x_end, slack)
-    if failed >= 0:
-        return np.empty(0), np.empty(0, dtype=np.bool_), envelope, floor, failed, x_high, np.empty(0)
-    x, capped = forward_profile(ds, r, q, envelope, min(x_start, envelope[0]))
-    ceiling = np.empty(n_stages + 1)
-    ceiling[:n_stages] = x_high
-    ceiling[n_stages] = max(x_bound[n_stages], x_end) if x_bound[n_stages] < _INF else x_high[n_stages - 1]
-    return x, capped, envelope, floor, failed, x_high, switch_excess(ds, p, q, r, x, ceiling)
-
-

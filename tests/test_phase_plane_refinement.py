@@ -78,6 +78,32 @@ def test_interval_bounds_match_the_rows_they_stand_for(friction, midpoint):
             assert np.allclose(largest, theirs_largest, rtol=1e-9) and np.allclose(smallest, theirs_smallest, rtol=1e-9)
 
 
+@pytest.mark.parametrize("midpoint", [False, True])
+def test_frictionless_interval_bounds_are_the_general_loop_without_friction(midpoint):
+    """Without friction the kernel takes a loop of its own; with friction on and every viscous
+    coefficient zero, the general loop splits each row into its half against the upper bound
+    and its half against the lower bound, one bound on u each: together the same numbers, bit
+    for bit."""
+    rng = np.random.default_rng(7)
+    constraints = _random_constraints(rng, 90, 4, friction=False)
+    arrays = (constraints.a, constraints.b, constraints.c, constraints.d,
+              constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)  # fmt: skip
+    x_ref = rng.uniform(0.1, 3.0, len(constraints.s))
+    upper = rng.uniform(0.5, 2.0, constraints.upper.shape)
+    upper[:, -1] = np.inf  # a row without limit
+    common = (-rng.uniform(0.5, 2.0, upper.shape), upper, constraints.sd_max**2, x_ref)
+    p, q, r, x_low, x_high, singular = interval_bounds(constraints.s, *arrays, *common, False, midpoint)
+    p2, q2, r2, x_low2, x_high2, singular2 = interval_bounds(constraints.s, *arrays, *common, True, midpoint)
+    width = p.shape[1]
+    assert p2.shape[1] == 2 * width
+    assert midpoint or singular.any()  # zero-inertia rows are exercised
+    assert np.array_equal(singular, singular2)
+    assert np.array_equal(x_low, x_low2) and np.array_equal(x_high, x_high2)
+    assert np.array_equal(p, np.maximum(p2[:, :width], p2[:, width:]))
+    assert np.array_equal(r, np.minimum(r2[:, :width], r2[:, width:]))
+    assert np.array_equal(q, q2[:, :width]) and np.array_equal(q, q2[:, width:])
+
+
 def test_switch_excess_of_a_start_from_rest_is_the_closed_form():
     """One interval of length L from rest to x1 = sd_1^2 under u <= beta and x <= x1: the
     constant-u interval takes 2 L / sd_1; at the bounds, accelerating to x1 in x1 / (2 beta)

@@ -24,7 +24,7 @@ collapses to one value and the sweeps take it: no chattering, no special case.
 Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
 row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
 point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
-(``planners.kernels``): no LP is solved anywhere; one compiled call per sweep pair builds the
+(``planners.kernels``, ``planners.sweep_kernels``): no LP is solved anywhere; one compiled call per sweep pair builds the
 rows of every interval, linearizes viscous friction, finds the admissible intervals and runs
 both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
 amount, so the grid is refined where it costs time: the error of each interval is estimated from
@@ -50,9 +50,10 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
-from planners.kernels import point_bounds, sweeps
+from planners.kernels import point_bounds
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions, split_points
+from planners.sweep_kernels import sweeps
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 #: Relative slack when comparing x values computed along different routes.
@@ -281,7 +282,7 @@ def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoin
 
 
 def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profile:
-    """One sweep pair (``planners.kernels.sweeps``) on ``grid``; a failure is explained from the
+    """One sweep pair (``planners.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
     rows linearized around ``x_ref``."""
     x_bound, constraints = grid.x_bound, grid.constraints
     if x_end > x_bound[-1] * (1 + _SLACK) + _SLACK:
