@@ -200,36 +200,86 @@ def _friction_share(d, root, half):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _singular_row(i, column, x_from, x_to, p, q, r, x_low, x_high, singular, static_fail):  # pragma: no cover - compiled
+    """A zero-inertia row of interval i (``_row_bounds``: it admits x in [x_from, x_to]) in
+    ``column``: no bound on u there, the interval's admissible x narrowed, the interval marked
+    singular, and failed when the row fails at every x. (Rare, so the arrays it takes cost
+    nothing: numba counts the references of arrays passed to a call, which made a helper
+    called for every row five times slower than storing in place.)"""
+    singular[i] = True
+    if _store(i, column, x_from, 0.0, x_to, True, p, q, r, x_low, x_high):
+        static_fail[i] = True
+
+
+@njit(cache=True, nogil=True)
 def _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, p, q, r, x_low, x_high, singular, static_fail):  # pragma: no cover - compiled
-    """``interval_bounds``' rows without viscous friction, written into ``p, q, r`` (N, m
-    midpoint, 2 m interpolation) and ``x_low, x_high, singular, static_fail`` (N,): one line
-    per row at each end (or at the midpoint), the same arithmetic as the general loop there
-    without its halves and tangents."""
-    n_stages = s.shape[0] - 1
+    """``interval_bounds`` without viscous friction, into ``p, q, r`` (N, m midpoint, 2 m
+    interpolation) and ``x_low, x_high, singular, static_fail`` (N,): one line per row at
+    each end of an interval, or at its midpoint."""
     n_rows = ra.shape[1]
-    for i in range(n_stages):
+    for i in range(s.shape[0] - 1):
         ds = s[i + 1] - s[i]
         for j in range(n_rows):
-            for end_ in range(1 if midpoint else 2):
-                if midpoint:
-                    b_mid = 0.5 * (rb[i, j] + lb[i + 1, j])
-                    a_mid = 0.5 * (ra[i, j] + la[i + 1, j]) + ds * b_mid
-                    low, slope, high, is_singular = _row_bounds(a_mid, b_mid, 0.5 * (rc[i, j] + lc[i + 1, j]), lower[i, j], upper[i, j])
-                elif end_ == 0:
-                    low, slope, high, is_singular = _row_bounds(ra[i, j], rb[i, j], rc[i, j], lower[i, j], upper[i, j])
-                else:
-                    b_next = lb[i + 1, j]
-                    a_next = la[i + 1, j] + 2.0 * ds * b_next
-                    low, slope, high, is_singular = _row_bounds(a_next, b_next, lc[i + 1, j], lower[i + 1, j], upper[i + 1, j])
-                column = j + end_ * n_rows
+            if midpoint:
+                b_mid = 0.5 * (rb[i, j] + lb[i + 1, j])
+                a_mid = 0.5 * (ra[i, j] + la[i + 1, j]) + ds * b_mid
+                low, slope, high, is_singular = _row_bounds(a_mid, b_mid, 0.5 * (rc[i, j] + lc[i + 1, j]), lower[i, j], upper[i, j])
+                p[i, j], q[i, j], r[i, j] = low, slope, high
                 if is_singular:
-                    singular[i] = True
-                    if _store(i, column, low, slope, high, True, p, q, r, x_low, x_high):
-                        static_fail[i] = True
+                    _singular_row(i, j, low, high, p, q, r, x_low, x_high, singular, static_fail)
+            else:
+                low, slope, high, is_singular = _row_bounds(ra[i, j], rb[i, j], rc[i, j], lower[i, j], upper[i, j])
+                p[i, j], q[i, j], r[i, j] = low, slope, high
+                if is_singular:
+                    _singular_row(i, j, low, high, p, q, r, x_low, x_high, singular, static_fail)
+                b_next = lb[i + 1, j]
+                a_next = la[i + 1, j] + 2.0 * ds * b_next
+                low, slope, high, is_singular = _row_bounds(a_next, b_next, lc[i + 1, j], lower[i + 1, j], upper[i + 1, j])
+                p[i, j + n_rows], q[i, j + n_rows], r[i, j + n_rows] = low, slope, high
+                if is_singular:
+                    _singular_row(i, j + n_rows, low, high, p, q, r, x_low, x_high, singular, static_fail)
+
+
+@njit(cache=True, nogil=True)
+def _friction_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_ref, midpoint, p, q, r, x_low, x_high, singular, static_fail):  # pragma: no cover - compiled
+    """``interval_bounds`` with viscous friction, into ``p, q, r`` (N, 2 m midpoint, 4 m
+    interpolation) and ``x_low, x_high, singular, static_fail`` (N,): each row split into its
+    half against the upper bound and its half against the lower bound, the viscous term of each
+    replaced by its tangent at ``x_ref`` (``_friction_share``)."""
+    n_rows = ra.shape[1]
+    per_half = n_rows if midpoint else 2 * n_rows
+    for i in range(s.shape[0] - 1):
+        ds = s[i + 1] - s[i]
+        root_here = np.sqrt(max(x_ref[i], 1e-6))
+        root_next = np.sqrt(max(x_ref[i + 1], 1e-6))
+        for half in range(2):
+            for j in range(n_rows):
+                to_b, to_c = _friction_share(rd[i, j], root_here, half)
+                b_here, c_here = rb[i, j] + to_b, rc[i, j] + to_c
+                to_b, to_c = _friction_share(ld[i + 1, j], root_next, half)
+                b_next, c_next = lb[i + 1, j] + to_b, lc[i + 1, j] + to_c
+                if half == 0:
+                    lo_here, hi_here, lo_next, hi_next = -_INF, upper[i, j], -_INF, upper[i + 1, j]
                 else:
-                    p[i, column] = low
-                    q[i, column] = slope
-                    r[i, column] = high
+                    lo_here, hi_here, lo_next, hi_next = lower[i, j], _INF, lower[i + 1, j], _INF
+                k = half * per_half + j
+                if midpoint:
+                    b_mid = 0.5 * (b_here + b_next)
+                    a_mid = 0.5 * (ra[i, j] + la[i + 1, j]) + ds * b_mid
+                    low, slope, high, is_singular = _row_bounds(a_mid, b_mid, 0.5 * (c_here + c_next), lo_here, hi_here)
+                    p[i, k], q[i, k], r[i, k] = low, slope, high
+                    if is_singular:
+                        _singular_row(i, k, low, high, p, q, r, x_low, x_high, singular, static_fail)
+                else:
+                    low, slope, high, is_singular = _row_bounds(ra[i, j], b_here, c_here, lo_here, hi_here)
+                    p[i, k], q[i, k], r[i, k] = low, slope, high
+                    if is_singular:
+                        _singular_row(i, k, low, high, p, q, r, x_low, x_high, singular, static_fail)
+                    a_next = la[i + 1, j] + 2.0 * ds * b_next
+                    low, slope, high, is_singular = _row_bounds(a_next, b_next, c_next, lo_next, hi_next)
+                    p[i, k + n_rows], q[i, k + n_rows], r[i, k + n_rows] = low, slope, high
+                    if is_singular:
+                        _singular_row(i, k + n_rows, low, high, p, q, r, x_low, x_high, singular, static_fail)
 
 
 @njit(cache=True, nogil=True)
@@ -259,9 +309,7 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
     """
     n_stages = s.shape[0] - 1
     n_rows = ra.shape[1]
-    halves = 2 if friction else 1
-    per_half = n_rows if midpoint else 2 * n_rows
-    width = halves * per_half
+    width = (2 if friction else 1) * (n_rows if midpoint else 2 * n_rows)
     p = np.empty((n_stages, width))
     q = np.empty((n_stages, width))
     r = np.empty((n_stages, width))
@@ -271,52 +319,10 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
     static_fail = np.zeros(n_stages, dtype=np.bool_)
     for i in range(n_stages):
         x_high[i] = x_bound[i]
-    if not friction:
+    if friction:
+        _friction_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_ref, midpoint, p, q, r, x_low, x_high, singular, static_fail)
+    else:
         _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, p, q, r, x_low, x_high, singular, static_fail)
-    root_here = 1.0
-    root_next = 1.0
-    for i in range(n_stages if friction else 0):
-        ds = s[i + 1] - s[i]
-        if friction:
-            root_here = np.sqrt(max(x_ref[i], 1e-6))
-            root_next = np.sqrt(max(x_ref[i + 1], 1e-6))
-        for half in range(halves):
-            for j in range(n_rows):
-                b_here, c_here = rb[i, j], rc[i, j]
-                b_next, c_next = lb[i + 1, j], lc[i + 1, j]
-                lo_here, hi_here = lower[i, j], upper[i, j]
-                lo_next, hi_next = lower[i + 1, j], upper[i + 1, j]
-                if friction:
-                    to_b, to_c = _friction_share(rd[i, j], root_here, half)
-                    b_here += to_b
-                    c_here += to_c
-                    to_b, to_c = _friction_share(ld[i + 1, j], root_next, half)
-                    b_next += to_b
-                    c_next += to_c
-                    if half == 0:
-                        lo_here, lo_next = -_INF, -_INF
-                    else:
-                        hi_here, hi_next = _INF, _INF
-                k = half * per_half + j
-                for end_ in range(1 if midpoint else 2):
-                    if midpoint:
-                        b_mid = 0.5 * (b_here + b_next)
-                        a_mid = 0.5 * (ra[i, j] + la[i + 1, j]) + ds * b_mid
-                        low, slope, high, is_singular = _row_bounds(a_mid, b_mid, 0.5 * (c_here + c_next), lo_here, hi_here)
-                    elif end_ == 0:
-                        low, slope, high, is_singular = _row_bounds(ra[i, j], b_here, c_here, lo_here, hi_here)
-                    else:
-                        a_next = la[i + 1, j] + 2.0 * ds * b_next
-                        low, slope, high, is_singular = _row_bounds(a_next, b_next, c_next, lo_next, hi_next)
-                    column = k + end_ * n_rows
-                    if is_singular:
-                        singular[i] = True
-                        if _store(i, column, low, slope, high, True, p, q, r, x_low, x_high):
-                            static_fail[i] = True
-                    else:
-                        p[i, column] = low
-                        q[i, column] = slope
-                        r[i, column] = high
     admissible_intervals(p, q, r, q, x_low, x_high)
     for i in range(n_stages):
         if static_fail[i] or x_low[i] > x_high[i]:
