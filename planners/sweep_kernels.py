@@ -125,5 +125,3 @@ def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, fric
     ceiling[:n_stages] = x_high
     ceiling[n_stages] = max(x_bound[n_stages], x_end) if x_bound[n_stages] < _INF else x_high[n_stages - 1]
     return x, capped, envelope, floor, failed, x_high, switch_excess(ds, p, q, r, x, ceiling)
-
-

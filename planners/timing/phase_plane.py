@@ -24,9 +24,9 @@ collapses to one value and the sweeps take it: no chattering, no special case.
 Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
 row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
 point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
-(``planners.kernels``, ``planners.sweep_kernels``): no LP is solved anywhere; one compiled call per sweep pair builds the
-rows of every interval, linearizes viscous friction, finds the admissible intervals and runs
-both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
+(``planners.kernels``, ``planners.sweep_kernels``): no LP is solved anywhere; one compiled call
+per sweep pair builds the rows of every interval, linearizes viscous friction, finds the
+admissible intervals and runs both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
 amount, so the grid is refined where it costs time: the error of each interval is estimated from
 the midpoint discretization on the same grid (second-order accurate, but not conservative), from
 the time it would save by switching inside the interval (a start from rest, a switch onto or off
