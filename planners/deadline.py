@@ -6,7 +6,8 @@ from __future__ import annotations
 import copy
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 from planners.errors import BudgetExceeded
 
@@ -21,6 +22,8 @@ def _ignore(fraction: float, stage: str) -> None:
 class Deadline:
     """Raises ``BudgetExceeded`` from ``check()`` once ``budget_s`` seconds have passed since
     construction, or as soon as ``cancel()`` was called (by a caller that stopped waiting).
+    Work that cannot check it (a child process) registers how to stop it (``on_cancel``), and
+    ``cancel()`` stops it at once, in the caller's thread.
 
     Attributes:
         progress: ``progress(fraction, stage)`` reports how far the computation is (fraction in
@@ -32,11 +35,35 @@ class Deadline:
         self.budget_s = budget_s
         self._end = None if budget_s is None else time.monotonic() + budget_s
         self._cancelled = threading.Event()
+        # Shared with the parts made by ``within`` (shallow copies), as the event is.
+        self._stoppers: list[Callable[[], None]] = []
+        self._stoppers_lock = threading.Lock()
         self.progress: Progress = progress or _ignore
 
     def cancel(self) -> None:
-        """Make the next ``check()`` raise."""
+        """Make the next ``check()`` raise, and stop the work registered with ``on_cancel``."""
         self._cancelled.set()
+        with self._stoppers_lock:
+            stoppers = list(self._stoppers)
+        for stop in stoppers:
+            try:
+                stop()
+            except Exception:  # noqa: BLE001 - the work's own check stops it anyway
+                pass
+
+    @contextmanager
+    def on_cancel(self, stop: Callable[[], None]) -> Iterator[None]:
+        """While in this context, ``cancel()`` calls ``stop()`` (from the cancelling thread);
+        called at once when the deadline was cancelled already."""
+        with self._stoppers_lock:
+            self._stoppers.append(stop)
+        try:
+            if self._cancelled.is_set():
+                stop()
+            yield
+        finally:
+            with self._stoppers_lock:
+                self._stoppers.remove(stop)
 
     def remaining(self) -> float | None:
         """Seconds left (at least 0), or ``None`` without a budget."""

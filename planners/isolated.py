@@ -3,8 +3,9 @@ child process that is killed when the deadline passes.
 
 ``run_isolated(function, *args, deadline=...)`` starts a child process, calls
 ``function(*args)`` there and returns its result; the calling thread waits on a pipe and checks
-``deadline`` every ``POLL_S`` seconds, and once the deadline passes (or is cancelled) the child is
-killed and ``BudgetExceeded`` raised. The function must be a module-level function and its
+``deadline`` every ``POLL_S`` seconds, and once the deadline passes the child is killed and
+``BudgetExceeded`` raised. A cancelled deadline kills the child at once, from the cancelling
+thread (``Deadline.on_cancel``). The function must be a module-level function and its
 arguments and result plain picklable data (numpy arrays, dataclasses of them, a ``Robot``), never
 closures. The memory the child used goes back to the system when it exits. Without a deadline
 (``NO_DEADLINE``, the library's default) the function runs in the calling thread: there is
@@ -168,19 +169,23 @@ def run_isolated(function, *args, deadline: Deadline = NO_DEADLINE, progress: bo
     try:
         process.start()
         writer.close()
-        while True:
-            if not reader.poll(POLL_S):  # true once a message is there, or the child is gone
+        # A caller that stops waiting (a 504) kills the child at once, not at this thread's
+        # next poll: the work stops with the answer, whatever this thread is waiting for.
+        with deadline.on_cancel(process.kill):
+            while True:
+                if not reader.poll(POLL_S):  # true once a message is there, or the child is gone
+                    deadline.check()
+                    continue
+                try:
+                    kind, value = reader.recv()
+                except EOFError:
+                    process.join()
+                    deadline.check()  # killed on cancel: the budget, not the worker, ended it
+                    raise TimingFailed(f"the worker process stopped without an answer (exit code {process.exitcode})") from None
+                if kind != "progress":
+                    break
+                deadline.progress(*value)
                 deadline.check()
-                continue
-            try:
-                kind, value = reader.recv()
-            except EOFError:
-                process.join()
-                raise TimingFailed(f"the worker process stopped without an answer (exit code {process.exitcode})") from None
-            if kind != "progress":
-                break
-            deadline.progress(*value)
-            deadline.check()
     finally:
         if process.is_alive():
             process.kill()

@@ -79,6 +79,35 @@ def test_the_worker_is_killed_when_the_deadline_is_cancelled(tmp_path):
     assert _killed(pid_file)
 
 
+def test_cancelling_kills_the_worker_at_once_from_the_cancelling_thread(tmp_path, monkeypatch):
+    """A 504 cancels the deadline from the event loop: the worker dies then, not when the thread
+    waiting for it next polls (made 5 s here), so no work runs on after the answer."""
+    import planners.isolated
+
+    monkeypatch.setattr(planners.isolated, "POLL_S", 5.0)
+    pid_file = tmp_path / "pid"
+    deadline = Deadline(600)
+    outcome: list[BaseException] = []
+
+    def wait_for_worker():
+        try:
+            run_isolated(_spin, str(pid_file), deadline=deadline)
+        except BaseException as error:  # noqa: BLE001 - examined below
+            outcome.append(error)
+
+    waiting = threading.Thread(target=wait_for_worker, daemon=True)
+    waiting.start()
+    while not pid_file.exists() or not pid_file.read_text():
+        time.sleep(0.01)
+    deadline.cancel()
+    gone = time.monotonic() + 1.0
+    while not _killed(pid_file) and time.monotonic() < gone:
+        time.sleep(0.01)
+    assert _killed(pid_file)
+    waiting.join(10.0)
+    assert len(outcome) == 1 and isinstance(outcome[0], BudgetExceeded), outcome
+
+
 def test_a_robot_pickles_as_its_model():
     robot = robots.load("panda")
     copy = pickle.loads(pickle.dumps(robot))
