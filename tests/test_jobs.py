@@ -225,7 +225,8 @@ def test_progress_advances_on_a_collocation_job(client):
     assert all(stage.endswith(" of 15") for stage in stages if stage.startswith("collocation: guess ")), seen
     fractions = list(stages.values())
     assert fractions == sorted(fractions) and len(set(fractions)) == len(fractions), seen
-    assert all(0.0 < fraction < 1.0 for fraction in fractions), seen
+    # The first guess starts at 0: seen when the machine is slow enough for a poll to catch it.
+    assert all(0.0 <= fraction < 1.0 for fraction in fractions), seen
 
 
 def _report_three(progress) -> str:
