@@ -132,23 +132,19 @@ def _row_bounds(a, b, c, lo, hi):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _store(i, k, low, slope, high, singular, p, q, r, x_low, x_high):  # pragma: no cover - compiled
-    """Put one row's bounds (``_row_bounds``) at point i, row k; a zero-inertia row narrows
-    ``x_low[i], x_high[i]`` and leaves no bound on u. Returns whether the row fails at every x."""
-    if singular:
-        p[i, k] = -_INF
-        q[i, k] = 0.0
-        r[i, k] = _INF
-        if low > high:
-            return True
-        if high < x_high[i]:
-            x_high[i] = high
-        if low > x_low[i]:
-            x_low[i] = low
-        return False
-    p[i, k] = low
-    q[i, k] = slope
-    r[i, k] = high
+def _zero_inertia(i, k, x_from, x_to, p, q, r, x_low, x_high):  # pragma: no cover - compiled
+    """A zero-inertia row k at point (or interval) i, which admits x in [x_from, x_to]
+    (``_row_bounds``): no bound on u in its column, ``x_low[i], x_high[i]`` narrowed to it.
+    Returns whether the row fails at every x."""
+    p[i, k] = -_INF
+    q[i, k] = 0.0
+    r[i, k] = _INF
+    if x_from > x_to:
+        return True
+    if x_to < x_high[i]:
+        x_high[i] = x_to
+    if x_from > x_low[i]:
+        x_low[i] = x_from
     return False
 
 
@@ -175,7 +171,7 @@ def point_bounds(a, b, c, lower, upper, x_bound):  # pragma: no cover - compiled
             low, slope, high, is_singular = _row_bounds(a[i, k], b[i, k], c[i, k], lower[i, k], upper[i, k])
             if is_singular:
                 singular[i, k] = True
-                if _store(i, k, low, slope, high, True, p, q, r, x_low, x_high):
+                if _zero_inertia(i, k, low, high, p, q, r, x_low, x_high):
                     static_fail[i] = True
             else:
                 p[i, k] = low
@@ -207,7 +203,7 @@ def _singular_row(i, column, x_from, x_to, p, q, r, x_low, x_high, singular, sta
     nothing: numba counts the references of arrays passed to a call, which made a helper
     called for every row five times slower than storing in place.)"""
     singular[i] = True
-    if _store(i, column, x_from, 0.0, x_to, True, p, q, r, x_low, x_high):
+    if _zero_inertia(i, column, x_from, x_to, p, q, r, x_low, x_high):
         static_fail[i] = True
 
 

@@ -79,9 +79,10 @@ def backward_envelope(ds, p, q, r, x_low, x_high, x_end, slack):  # pragma: no c
 
 
 @njit(cache=True, nogil=True)
-def forward_profile(ds, r, w, envelope, x_start):  # pragma: no cover - compiled
-    """Maximum-acceleration sweep from the start, capped by the envelope: x (N + 1,) and, per
-    interval, whether the cap decided it (True) or the acceleration limit did (False)."""
+def forward_profile(ds, r, q, envelope, x_start):  # pragma: no cover - compiled
+    """Maximum-acceleration sweep from the start (u = min_j r_j + q_j x), capped by the
+    envelope: x (N + 1,) and, per interval, whether the cap decided it (True) or the
+    acceleration limit did (False)."""
     n_stages, n_rows = r.shape
     x = np.empty(n_stages + 1)
     capped = np.zeros(n_stages, dtype=np.bool_)
@@ -90,7 +91,7 @@ def forward_profile(ds, r, w, envelope, x_start):  # pragma: no cover - compiled
         xi = x[i]
         fastest = _INF
         for k in range(n_rows):
-            value = r[i, k] + w[i, k] * xi
+            value = r[i, k] + q[i, k] * xi
             if value < fastest:
                 fastest = value
         reach = xi + 2.0 * ds[i] * fastest
