@@ -8,6 +8,8 @@ these loops hold no knowledge of paths or robots (``nogil``, cached on disk).
 
 from __future__ import annotations
 
+import heapq
+
 import numpy as np
 from numba import njit
 
@@ -83,27 +85,38 @@ def _interval_time(ds, x0, x1):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pieces(error, order, shrink, pieces):  # pragma: no cover - compiled
-    """Raise ``pieces`` (N,) to the pieces per interval that bring the sum of ``error`` (N,),
-    each part falling as k^-order, to ``shrink`` times itself with the fewest pieces in all
-    (Lagrange multipliers: k_i = e_i^(1 / (order + 1)) (sum_j e_j^(1 / (order + 1)) /
-    (shrink sum_j e_j))^(1 / order))."""
-    total = 0.0
-    weights = 0.0
-    for i in range(error.shape[0]):
-        total += error[i]
-        weights += error[i] ** (1.0 / (order + 1.0))
-    if not total > 0.0:
-        return
-    scale = (weights / (shrink * total)) ** (1.0 / order)
-    for i in range(error.shape[0]):
-        wanted = error[i] ** (1.0 / (order + 1.0)) * scale
-        if wanted > pieces[i]:
-            pieces[i] = wanted
+def _gain(first, second, k):  # pragma: no cover - compiled
+    """How much an interval's error ``first / k + second / k^2`` falls from k to k + 1 pieces."""
+    return first * (1.0 / k - 1.0 / (k + 1.0)) + second * (1.0 / (k * k) - 1.0 / ((k + 1.0) * (k + 1.0)))
 
 
 @njit(cache=True, nogil=True)
-def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard):  # pragma: no cover - compiled
+def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - compiled
+    """Set ``pieces`` (N,) to the fewest whole pieces per interval, at most ``max_pieces`` each,
+    that bring the sum of the errors ``first / k + second / k^2`` (each (N,)) to ``shrink`` times
+    its value at k = 1. The sum is separable and convex in each k, so adding one piece at a time
+    where it removes the most error is optimal (a max-heap of the next piece's gain)."""
+    total = 0.0
+    heap = [(-0.0, 0)]
+    heap.pop()
+    for i in range(first.shape[0]):
+        total += first[i] + second[i]
+        pieces[i] = 1.0
+        gain = _gain(first[i], second[i], 1.0)
+        if gain > 0.0 and max_pieces > 1:
+            heap.append((-gain, i))
+    target = shrink * total
+    heapq.heapify(heap)
+    while total > target and len(heap) > 0:
+        negative, i = heapq.heappop(heap)
+        total += negative
+        pieces[i] += 1.0
+        if pieces[i] < max_pieces:
+            heapq.heappush(heap, (-_gain(first[i], second[i], pieces[i]), i))
+
+
+@njit(cache=True, nogil=True)
+def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces):  # pragma: no cover - compiled
     """Error estimate of the profile x (N + 1,) on the grid s, and how finely to refine it.
 
     Each interval's error, this discretization's time minus the exact one, is estimated from:
@@ -179,8 +192,7 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard):  # pragma: 
     wanted = np.ones(n_stages)
     if error > tolerance:
         shrink = aim * tolerance / error
-        _pieces(first, 1.0, shrink, wanted)
-        _pieces(second, 2.0, shrink, wanted)
+        _pieces(first, second, shrink, max_pieces, wanted)
     return wanted, first + second, error
 
 

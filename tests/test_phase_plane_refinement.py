@@ -17,7 +17,7 @@ from planners.kernels import interval_bounds
 from planners.limit_check import check_limits
 from planners.mvc import acceleration_bounds, admissible_set
 from planners.paths import SplinePath
-from planners.refinement_kernels import row_excursions, switch_excess
+from planners.refinement_kernels import _pieces, row_excursions, switch_excess
 from planners.timing import PhasePlaneMethod
 from planners.timing.phase_plane import interval_rows, midpoint_duration, midpoint_stage_rows
 
@@ -116,6 +116,26 @@ def test_switch_excess_of_a_start_from_rest_is_the_closed_form():
     sd_1 = np.sqrt(x1)
     exact = 2 * length / sd_1 - (sd_1 / beta + (length - x1 / (2 * beta)) / sd_1)
     assert excess[0] == pytest.approx(exact, rel=1e-12)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_refinement_splits_into_the_fewest_whole_pieces(seed):
+    """The pieces per interval are whole numbers: the fewest in all that bring the summed error
+    ``first / k + second / k^2`` to ``shrink`` times its value, each at most ``max_pieces``,
+    against every allocation of up to 6 pieces to each of 5 intervals (6^5 of them)."""
+    rng = np.random.default_rng(seed)
+    first = rng.exponential(1.0, 5) * (rng.random(5) < 0.8)
+    second = rng.exponential(1.0, 5) * (rng.random(5) < 0.6)
+    shrink = rng.uniform(0.3, 0.9)
+    pieces = np.ones(5)
+    _pieces(first, second, shrink, 6, pieces)
+    grids = np.stack(np.meshgrid(*([np.arange(1.0, 7.0)] * 5), indexing="ij"), axis=-1).reshape(-1, 5)
+    errors = (first / grids + second / grids**2).sum(axis=1)
+    target = shrink * (first + second).sum()
+    fewest = grids[errors <= target * (1 + 1e-12)].sum(axis=1).min()
+    assert np.all(pieces == np.round(pieces)) and pieces.max() <= 6
+    assert (first / pieces + second / pieces**2).sum() <= target * (1 + 1e-12)
+    assert pieces.sum() == fewest
 
 
 def _converged(path, robot) -> float:
