@@ -137,8 +137,8 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces):
     may cancel in it or estimate nothing (chord errors, unresolved intervals): a guard against
     errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are to be split
     into equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order
-    one; the fewest pieces that bring the estimate to ``aim`` times the tolerance (``_pieces``,
-    the larger of the two kinds).
+    one; the fewest whole pieces, at most ``max_pieces`` per interval, that bring the sum of
+    both parts to ``aim`` times the tolerance over the estimate of its value (``_pieces``).
 
     Returns the pieces wanted per interval (N,; all 1 when the estimate is within the
     tolerance), each interval's estimated error (N,, s: which to split first when the grid's
