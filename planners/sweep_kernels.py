@@ -111,7 +111,8 @@ def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, fric
 
     Returns x (N + 1,; empty when the backward sweep failed), capped (N,), envelope and floor
     (N + 1,), the index of the interval where the backward sweep failed or -1, the admissible
-    upper x_i of each interval (N,) and the ``switch_excess`` of each interval (N,).
+    upper x_i of each interval (N,) and the ``switch_excess`` of each interval (N,; zeros in the
+    midpoint discretization, whose profile only serves the conservative one as a reference).
     """
     p, q, r, x_low, x_high, _ = interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint)
     n_stages = s.shape[0] - 1
@@ -122,6 +123,8 @@ def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, fric
     if failed >= 0:
         return np.empty(0), np.empty(0, dtype=np.bool_), envelope, floor, failed, x_high, np.empty(0)
     x, capped = forward_profile(ds, r, q, envelope, min(x_start, envelope[0]))
+    if midpoint:
+        return x, capped, envelope, floor, failed, x_high, np.zeros(n_stages)
     ceiling = np.empty(n_stages + 1)
     ceiling[:n_stages] = x_high
     ceiling[n_stages] = max(x_bound[n_stages], x_end) if x_bound[n_stages] < _INF else x_high[n_stages - 1]
