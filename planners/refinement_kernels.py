@@ -90,20 +90,50 @@ def _gain(first, second, k):  # pragma: no cover - compiled
     return first * (1.0 / k - 1.0 / (k + 1.0)) + second * (1.0 / (k * k) - 1.0 / ((k + 1.0) * (k + 1.0)))
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _continuous_pieces(error, order, shrink, pieces):  # pragma: no cover - compiled
+    """Raise ``pieces`` (N,) to the real pieces per interval that bring the sum of ``error``
+    (N,), each part falling as k^-order, to ``shrink`` times itself with the fewest pieces in
+    all (Lagrange multipliers: k_i = e_i^(1 / (order + 1)) (sum_j e_j^(1 / (order + 1)) /
+    (shrink sum_j e_j))^(1 / order))."""
+    total = 0.0
+    weights = 0.0
+    for i in range(error.shape[0]):
+        total += error[i]
+        weights += error[i] ** (1.0 / (order + 1.0))
+    if not total > 0.0:
+        return
+    scale = (weights / (shrink * total)) ** (1.0 / order)
+    for i in range(error.shape[0]):
+        wanted = error[i] ** (1.0 / (order + 1.0)) * scale
+        if wanted > pieces[i]:
+            pieces[i] = wanted
+
+
 @njit(cache=True, nogil=True)
 def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - compiled
-    """Set ``pieces`` (N,) to the fewest whole pieces per interval, at most ``max_pieces`` each,
-    that bring the sum of the errors ``first / k + second / k^2`` (each (N,)) to ``shrink`` times
-    its value at k = 1. The sum is separable and convex in each k, so adding one piece at a time
-    where it removes the most error is optimal (a max-heap of the next piece's gain)."""
+    """Set ``pieces`` (N,) to whole pieces per interval that bring the sum of the errors
+    ``first / k + second / k^2`` (each (N,)) to ``shrink`` times its value at k = 1 with the
+    fewest pieces in all, each interval at most at its cap: the real pieces that bring each part
+    there on its own (``_continuous_pieces``, the larger of the two) rounded up, and at most
+    ``max_pieces``. Those caps reach the target unless ``max_pieces`` cuts them; then the
+    intervals take their caps, the real allocation's shares of a grid that one round cannot
+    make fine enough. Within the caps the sum is separable and convex in each k, so adding one
+    piece at a time where it removes the most error is optimal (a max-heap of the next piece's
+    gain)."""
+    n_stages = first.shape[0]
+    cap = np.ones(n_stages)
+    _continuous_pieces(first, 1.0, shrink, cap)
+    _continuous_pieces(second, 2.0, shrink, cap)
     total = 0.0
     heap = [(-0.0, 0)]
     heap.pop()
-    for i in range(first.shape[0]):
+    for i in range(n_stages):
         total += first[i] + second[i]
+        cap[i] = min(np.ceil(cap[i]), max_pieces)
         pieces[i] = 1.0
         gain = _gain(first[i], second[i], 1.0)
-        if gain > 0.0 and max_pieces > 1:
+        if gain > 0.0 and cap[i] > 1.0:
             heap.append((-gain, i))
     target = shrink * total
     heapq.heapify(heap)
@@ -111,7 +141,7 @@ def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - co
         negative, i = heapq.heappop(heap)
         total += negative
         pieces[i] += 1.0
-        if pieces[i] < max_pieces:
+        if pieces[i] < cap[i]:
             heapq.heappush(heap, (-_gain(first[i], second[i], pieces[i]), i))
 
 
@@ -137,8 +167,8 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces):
     may cancel in it or estimate nothing (chord errors, unresolved intervals): a guard against
     errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are to be split
     into equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order
-    one; the fewest whole pieces, at most ``max_pieces`` per interval, that bring the sum of
-    both parts to ``aim`` times the tolerance over the estimate of its value (``_pieces``).
+    one; the fewest whole pieces that bring the sum of both parts to ``aim`` times the tolerance
+    over the estimate of its value (``_pieces``; at most ``max_pieces`` per interval).
 
     Returns the pieces wanted per interval (N,; all 1 when the estimate is within the
     tolerance), each interval's estimated error (N,, s: which to split first when the grid's

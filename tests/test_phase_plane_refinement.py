@@ -121,8 +121,8 @@ def test_switch_excess_of_a_start_from_rest_is_the_closed_form():
 @pytest.mark.parametrize("seed", range(6))
 def test_refinement_splits_into_the_fewest_whole_pieces(seed):
     """The pieces per interval are whole numbers: the fewest in all that bring the summed error
-    ``first / k + second / k^2`` to ``shrink`` times its value, each at most ``max_pieces``,
-    against every allocation of up to 6 pieces to each of 5 intervals (6^5 of them)."""
+    ``first / k + second / k^2`` to ``shrink`` times its value, against every allocation of up
+    to 6 pieces to each of 5 intervals (6^5 of them)."""
     rng = np.random.default_rng(seed)
     first = rng.exponential(1.0, 5) * (rng.random(5) < 0.8)
     second = rng.exponential(1.0, 5) * (rng.random(5) < 0.6)
@@ -136,6 +136,25 @@ def test_refinement_splits_into_the_fewest_whole_pieces(seed):
     assert np.all(pieces == np.round(pieces)) and pieces.max() <= 6
     assert (first / pieces + second / pieces**2).sum() <= target * (1 + 1e-12)
     assert pieces.sum() == fewest
+
+
+def test_refinement_beyond_one_round_splits_as_the_real_allocation():
+    """Where ``max_pieces`` keeps one round from reaching the target, every interval takes the
+    real allocation of each error part on its own (k_i proportional to e_i^(1 / (order + 1)),
+    scaled to bring the part to ``shrink`` times itself) rounded up, at most ``max_pieces``:
+    the grid's shares for the next round, not every interval at the cap."""
+    rng = np.random.default_rng(3)
+    first, second = rng.exponential(1.0, 40), rng.exponential(1.0, 40) * (rng.random(40) < 0.5)
+    shrink, max_pieces = 0.01, 8
+    real = np.ones(40)
+    for error, order in ((first, 1.0), (second, 2.0)):
+        roots = error ** (1 / (order + 1))
+        real = np.maximum(real, roots * (roots.sum() / (shrink * error.sum())) ** (1 / order))
+    pieces = np.ones(40)
+    _pieces(first, second, shrink, max_pieces, pieces)
+    assert (first / pieces + second / pieces**2).sum() > shrink * (first + second).sum()  # out of reach
+    np.testing.assert_array_equal(pieces, np.minimum(np.ceil(real), max_pieces))
+    assert 1 < pieces.min() and pieces.min() < max_pieces  # the shares differ
 
 
 def _converged(path, robot) -> float:
