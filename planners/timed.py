@@ -28,18 +28,18 @@ from robots import Robot
 
 
 def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:
-    """Splines may overshoot between waypoints: refuse a path that leaves the joint range."""
-    dense = np.linspace(0.0, 1.0, 4 * len(s) + 1)
-    q = path(dense)
+    """Splines may overshoot between waypoints: refuse a path that leaves the joint range (where
+    it lies farthest outside on a spline; elsewhere, the first of 4 points per interval of the
+    grid ``s`` that does)."""
     lower, upper = robot.limits.position_lower, robot.limits.position_upper
-    outside = robot.outside_position_limits(q)
+    outside = path.outside_range(lower, upper, 4 * len(s) + 1)
     if outside is not None:
-        index, joint = outside
+        at, joint, value = outside
         raise InfeasiblePath(
             f"the interpolated path leaves the range [{lower[joint]:.6g}, {upper[joint]:.6g}] of joint "
-            f"{robot.joint_names[joint]!r} at s = {dense[index]:.4f} (q = {q[index, joint]:.6g}); "
+            f"{robot.joint_names[joint]!r} at s = {at:.4f} (q = {value:.6g}); "
             "add waypoints or use interpolation 'linear'",
-            s=float(dense[index]),
+            s=at,
             joint=robot.joint_names[joint],
         )
 

@@ -81,3 +81,27 @@ def test_spline_coefficients_equal_scipys_natural_cubic_spline(count):
         assert np.max(np.abs(points.q - reference(s))) <= 1e-12 * scale
         assert np.max(np.abs(points.dq - reference(s, 1))) <= 1e-12 * scale
         assert np.max(np.abs(points.ddq - reference(s, 2))) <= 1e-12 * scale
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_spline_finds_where_it_lies_farthest_outside_a_range(seed):
+    """A spline's farthest point beyond a joint range, found from its pieces' extremes, is the
+    one a sampling at 400,001 values of s finds (to the sampling's resolution), and a range the
+    spline stays within gives none; the sampled search of other paths finds a point outside
+    the same range."""
+    rng = np.random.default_rng(seed)
+    waypoints = rng.uniform(-1.0, 1.0, (5, 3))
+    path = SplinePath(waypoints)
+    dense = np.linspace(0.0, 1.0, 400_001)
+    q = path(dense)
+    # Each range just inside the waypoints' own span: only the overshoot between them leaves it.
+    lower, upper = waypoints.min(axis=0) + 0.05, waypoints.max(axis=0) - 0.05
+    excess = np.maximum(q - upper, lower - q)
+    row, joint = np.unravel_index(np.argmax(excess), excess.shape)
+    at, found_joint, value = path.outside_range(lower, upper, 0)
+    assert found_joint == joint
+    assert at == pytest.approx(dense[row], abs=2.5e-6)
+    assert value == pytest.approx(q[row, joint], abs=1e-9)
+    assert max(value - upper[joint], lower[joint] - value) >= excess[row, joint]
+    assert path.outside_range(q.min(axis=0) - 1e-6, q.max(axis=0) + 1e-6, 0) is None
+    assert StopAndGoPath(waypoints).outside_range(lower, upper, 101) is not None

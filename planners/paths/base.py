@@ -8,6 +8,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+#: Distance (joint units) by which a path may pass beyond a joint's range: rounding.
+RANGE_SLACK = 1e-9
+
 
 class PathPoints(NamedTuple):
     """A path and its s-derivatives at n_samples values of s, each of shape (n_samples, n_dof).
@@ -52,3 +55,16 @@ class GeometricPath(abc.ABC):
     def __call__(self, s: np.ndarray) -> np.ndarray:
         """q(s), shape (n_samples, n_dof)."""
         return self.evaluate(np.atleast_1d(np.asarray(s, dtype=float))).q
+
+    def outside_range(self, lower: np.ndarray, upper: np.ndarray, samples: int) -> tuple[float, int, float] | None:
+        """(s, joint, q) of a point where the path lies beyond [``lower``, ``upper``] (n_dof,
+        each) by more than ``RANGE_SLACK``, or ``None``: here the first of ``samples`` evenly
+        spaced values of s that does; a path of polynomial pieces finds its farthest point
+        exactly."""
+        dense = np.linspace(0.0, 1.0, samples)
+        q = self(dense)
+        outside = (q < lower - RANGE_SLACK) | (q > upper + RANGE_SLACK)
+        if not outside.any():
+            return None
+        row, joint = np.argwhere(outside)[0]
+        return float(dense[row]), int(joint), float(q[row, joint])

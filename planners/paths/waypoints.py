@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from planners.errors import InvalidRequest
-from planners.paths.base import GeometricPath, PathPoints
+from planners.paths.base import RANGE_SLACK, GeometricPath, PathPoints
 
 
 def chord_knots(waypoints: np.ndarray) -> np.ndarray:
@@ -60,6 +60,14 @@ class SplinePath(_ThroughWaypoints):
     def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
         return PathPoints(*cubic_pieces(self.knots, self._coefficients, s))
+
+    def outside_range(self, lower: np.ndarray, upper: np.ndarray, samples: int) -> tuple[float, int, float] | None:
+        """(s, joint, q) where the spline lies farthest beyond [``lower``, ``upper``], exactly
+        (``cubic_farthest_outside``; ``samples`` is not needed), or ``None`` within them."""
+        at, joint, value = cubic_farthest_outside(
+            self.knots, self._coefficients, np.asarray(lower, dtype=float), np.asarray(upper, dtype=float), RANGE_SLACK
+        )
+        return None if joint < 0 else (at, joint, value)
 
     def third_derivative(self, s: np.ndarray, side: str = "right") -> np.ndarray:
         """d3q/ds3 (constant per piece; at a knot, the piece on ``side``)."""
@@ -143,6 +151,45 @@ def cubic_pieces(knots, coefficients, s):  # pragma: no cover - compiled
             dq[i, j] = (3.0 * c0 * h + 2.0 * c1) * h + c2
             ddq[i, j] = 6.0 * c0 * h + 2.0 * c1
     return q, dq, ddq
+
+
+@njit(cache=True, nogil=True)
+def cubic_farthest_outside(knots, coefficients, lower, upper, slack):  # pragma: no cover - compiled
+    """(s, joint, q) where the piecewise cubic (power-basis ``coefficients`` (4, n_knots - 1,
+    n_dof) on ``knots``) lies farthest beyond [``lower``, ``upper``] (n_dof,), by more than
+    ``slack``; joint -1 where it stays within. Each piece's extremes lie at its ends or where
+    dq/ds = 3 c0 h^2 + 2 c1 h + c2 vanishes inside it (the roots taken without cancellation,
+    Press et al., *Numerical Recipes*, section 5.6)."""
+    best, at, joint, value = slack, 0.0, -1, 0.0
+    candidates = np.empty(4)
+    for piece in range(knots.shape[0] - 1):
+        length = knots[piece + 1] - knots[piece]
+        for j in range(coefficients.shape[2]):
+            c0, c1, c2, c3 = coefficients[0, piece, j], coefficients[1, piece, j], coefficients[2, piece, j], coefficients[3, piece, j]
+            candidates[0], candidates[1] = 0.0, length
+            count = 2
+            a, b = 3.0 * c0, 2.0 * c1
+            if a != 0.0:
+                discriminant = b * b - 4.0 * a * c2
+                if discriminant >= 0.0:
+                    half = -0.5 * (b + np.copysign(np.sqrt(discriminant), b))
+                    candidates[count] = half / a
+                    count += 1
+                    if half != 0.0:
+                        candidates[count] = c2 / half
+                        count += 1
+            elif b != 0.0:
+                candidates[count] = -c2 / b
+                count += 1
+            for k in range(count):
+                h = candidates[k]
+                if not 0.0 <= h <= length:
+                    continue
+                q = ((c0 * h + c1) * h + c2) * h + c3
+                excess = max(q - upper[j], lower[j] - q)
+                if excess > best:
+                    best, at, joint, value = excess, knots[piece] + h, j, q
+    return at, joint, value
 
 
 class StopAndGoPath(_ThroughWaypoints):
