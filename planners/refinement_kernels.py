@@ -8,8 +8,6 @@ these loops hold no knowledge of paths or robots (``nogil``, cached on disk).
 
 from __future__ import annotations
 
-import heapq
-
 import numpy as np
 from numba import njit
 
@@ -110,6 +108,24 @@ def _continuous_pieces(error, order, shrink, pieces):  # pragma: no cover - comp
             pieces[i] = wanted
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _sift_down(heap, key, size, position):  # pragma: no cover - compiled
+    """Restore the max-heap ``heap[:size]`` (indices into ``key``) below ``position``."""
+    item = heap[position]
+    value = key[item]
+    while True:
+        child = 2 * position + 1
+        if child >= size:
+            break
+        if child + 1 < size and key[heap[child + 1]] > key[heap[child]]:
+            child += 1
+        if key[heap[child]] <= value:
+            break
+        heap[position] = heap[child]
+        position = child
+    heap[position] = item
+
+
 @njit(cache=True, nogil=True)
 def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - compiled
     """Set ``pieces`` (N,) to whole pieces per interval that bring the sum of the errors
@@ -119,30 +135,38 @@ def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - co
     ``max_pieces``. Those caps reach the target unless ``max_pieces`` cuts them; then the
     intervals take their caps, the real allocation's shares of a grid that one round cannot
     make fine enough. Within the caps the sum is separable and convex in each k, so adding one
-    piece at a time where it removes the most error is optimal (a max-heap of the next piece's
-    gain)."""
+    piece at a time where it removes the most error is optimal (a binary max-heap of each
+    interval's next gain: O(pieces log N))."""
     n_stages = first.shape[0]
     cap = np.ones(n_stages)
     _continuous_pieces(first, 1.0, shrink, cap)
     _continuous_pieces(second, 2.0, shrink, cap)
     total = 0.0
-    heap = [(-0.0, 0)]
-    heap.pop()
+    key = np.empty(n_stages)
+    heap = np.empty(n_stages, dtype=np.int64)
+    size = 0
     for i in range(n_stages):
         total += first[i] + second[i]
         cap[i] = min(np.ceil(cap[i]), max_pieces)
         pieces[i] = 1.0
-        gain = _gain(first[i], second[i], 1.0)
-        if gain > 0.0 and cap[i] > 1.0:
-            heap.append((-gain, i))
+        key[i] = _gain(first[i], second[i], 1.0)
+        if key[i] > 0.0 and cap[i] > 1.0:
+            heap[size] = i
+            size += 1
     target = shrink * total
-    heapq.heapify(heap)
-    while total > target and len(heap) > 0:
-        negative, i = heapq.heappop(heap)
-        total += negative
+    for position in range(size // 2 - 1, -1, -1):
+        _sift_down(heap, key, size, position)
+    while total > target and size > 0:
+        i = heap[0]
+        total -= key[i]
         pieces[i] += 1.0
         if pieces[i] < cap[i]:
-            heapq.heappush(heap, (-_gain(first[i], second[i], pieces[i]), i))
+            key[i] = _gain(first[i], second[i], pieces[i])
+        else:
+            size -= 1
+            heap[0] = heap[size]
+        if size > 0:
+            _sift_down(heap, key, size, 0)
 
 
 @njit(cache=True, nogil=True)
