@@ -127,7 +127,7 @@ def _sift_down(heap, key, size, position):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - compiled
+def _pieces(first, second, shrink, max_pieces, room, pieces):  # pragma: no cover - compiled
     """Set ``pieces`` (N,) to whole pieces per interval that bring the sum of the errors
     ``first / k + second / k^2`` (each (N,)) to ``shrink`` times its value at k = 1 with the
     fewest pieces in all, each interval at most at its cap: the real pieces that bring each part
@@ -136,30 +136,42 @@ def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - co
     intervals take their caps, the real allocation's shares of a grid that one round cannot
     make fine enough. Within the caps the sum is separable and convex in each k, so adding one
     piece at a time where it removes the most error is optimal (a binary max-heap of each
-    interval's next gain: O(pieces log N))."""
+    interval's next gain), also for the least error with at most ``room`` new pieces, where the
+    grid's cap stops the adding first."""
     n_stages = first.shape[0]
     cap = np.ones(n_stages)
     _continuous_pieces(first, 1.0, shrink, cap)
     _continuous_pieces(second, 2.0, shrink, cap)
     total = 0.0
+    at_caps = 0.0
+    capped = 0.0
     key = np.empty(n_stages)
     heap = np.empty(n_stages, dtype=np.int64)
     size = 0
     for i in range(n_stages):
         total += first[i] + second[i]
         cap[i] = min(np.ceil(cap[i]), max_pieces)
+        at_caps += first[i] / cap[i] + second[i] / (cap[i] * cap[i])
+        capped += cap[i] - 1.0
         pieces[i] = 1.0
         key[i] = _gain(first[i], second[i], 1.0)
         if key[i] > 0.0 and cap[i] > 1.0:
             heap[size] = i
             size += 1
     target = shrink * total
+    if at_caps > target and capped <= room:
+        # Out of reach within the caps: every piece below them goes in.
+        for i in range(n_stages):
+            pieces[i] = cap[i]
+        return
     for position in range(size // 2 - 1, -1, -1):
         _sift_down(heap, key, size, position)
-    while total > target and size > 0:
+    added = 0
+    while total > target and size > 0 and added < room:
         i = heap[0]
         total -= key[i]
         pieces[i] += 1.0
+        added += 1
         if pieces[i] < cap[i]:
             key[i] = _gain(first[i], second[i], pieces[i])
         else:
@@ -170,7 +182,7 @@ def _pieces(first, second, shrink, max_pieces, pieces):  # pragma: no cover - co
 
 
 @njit(cache=True, nogil=True)
-def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces):  # pragma: no cover - compiled
+def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces, room):  # pragma: no cover - compiled
     """Error estimate of the profile x (N + 1,) on the grid s, and how finely to refine it.
 
     Each interval's error, this discretization's time minus the exact one, is estimated from:
@@ -192,7 +204,8 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces):
     errors of the estimates themselves. Where it exceeds ``tolerance``, intervals are to be split
     into equal pieces: k pieces leave e / k of a first-order part and e / k^2 of a second-order
     one; the fewest whole pieces that bring the sum of both parts to ``aim`` times the tolerance
-    over the estimate of its value (``_pieces``; at most ``max_pieces`` per interval).
+    over the estimate of its value (``_pieces``; at most ``max_pieces`` per interval and
+    ``room`` new pieces in all).
 
     Returns the pieces wanted per interval (N,; all 1 when the estimate is within the
     tolerance), each interval's estimated error (N,, s: which to split first when the grid's
@@ -246,7 +259,7 @@ def refinement(s, x, x_mid, ceiling, switch, tolerance, aim, guard, max_pieces):
     wanted = np.ones(n_stages)
     if error > tolerance:
         shrink = aim * tolerance / error
-        _pieces(first, second, shrink, max_pieces, wanted)
+        _pieces(first, second, shrink, max_pieces, room, wanted)
     return wanted, first + second, error
 
 

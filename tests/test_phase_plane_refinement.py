@@ -128,7 +128,7 @@ def test_refinement_splits_into_the_fewest_whole_pieces(seed):
     second = rng.exponential(1.0, 5) * (rng.random(5) < 0.6)
     shrink = rng.uniform(0.3, 0.9)
     pieces = np.ones(5)
-    _pieces(first, second, shrink, 6, pieces)
+    _pieces(first, second, shrink, 6, 10**9, pieces)
     grids = np.stack(np.meshgrid(*([np.arange(1.0, 7.0)] * 5), indexing="ij"), axis=-1).reshape(-1, 5)
     errors = (first / grids + second / grids**2).sum(axis=1)
     target = shrink * (first + second).sum()
@@ -151,10 +151,27 @@ def test_refinement_beyond_one_round_splits_as_the_real_allocation():
         roots = error ** (1 / (order + 1))
         real = np.maximum(real, roots * (roots.sum() / (shrink * error.sum())) ** (1 / order))
     pieces = np.ones(40)
-    _pieces(first, second, shrink, max_pieces, pieces)
+    _pieces(first, second, shrink, max_pieces, 10**9, pieces)
     assert (first / pieces + second / pieces**2).sum() > shrink * (first + second).sum()  # out of reach
     np.testing.assert_array_equal(pieces, np.minimum(np.ceil(real), max_pieces))
     assert 1 < pieces.min() and pieces.min() < max_pieces  # the shares differ
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_refinement_with_little_room_left_takes_the_pieces_that_remove_the_most_error(seed):
+    """Where the grid's cap leaves room for fewer new points than the target asks, the pieces
+    are the ``room`` that leave the least summed error, against every allocation of up to 6
+    pieces to each of 5 intervals with at most ``room`` new ones."""
+    rng = np.random.default_rng(seed)
+    first, second = rng.exponential(1.0, 5), rng.exponential(1.0, 5) * (rng.random(5) < 0.6)
+    shrink, room = 0.2, 4
+    pieces = np.ones(5)
+    _pieces(first, second, shrink, 6, room, pieces)
+    grids = np.stack(np.meshgrid(*([np.arange(1.0, 7.0)] * 5), indexing="ij"), axis=-1).reshape(-1, 5)
+    errors = (first / grids + second / grids**2).sum(axis=1)
+    fitting = (grids - 1).sum(axis=1) <= room
+    assert errors[fitting].min() > shrink * (first + second).sum() and (pieces - 1).sum() == room  # room used up
+    assert (first / pieces + second / pieces**2).sum() == pytest.approx(errors[fitting].min(), rel=1e-12)
 
 
 def _converged(path, robot) -> float:

@@ -160,7 +160,7 @@ class PhasePlaneMethod(TimingMethod):
             room = most_intervals - (len(grid.s) - 1)
             ceiling = np.append(profile.x_high, grid.x_bound[-1])
             wanted, priority, error = refinement(
-                grid.s, profile.x, reference.x, ceiling, profile.switch_excess, self.tolerance, _AIM, _GUARD, _MAX_PIECES
+                grid.s, profile.x, reference.x, ceiling, profile.switch_excess, self.tolerance, _AIM, _GUARD, _MAX_PIECES, room
             )
             if error <= self.tolerance:
                 if self.excursion is None:
