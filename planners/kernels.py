@@ -324,3 +324,23 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
         if static_fail[i] or x_low[i] > x_high[i]:
             x_high[i] = -1.0
     return p, q, r, x_low, x_high, singular
+
+
+@njit(cache=True, nogil=True)
+def zero_inertia_intervals(s, a, b, a_left, b_left, intervals, threshold):  # pragma: no cover - compiled
+    """Whether each of ``intervals`` (k,) of the grid s has a row of the interpolation
+    discretization whose u-coefficient is within ``threshold`` of its scale |a| + |b| of zero:
+    at the interval's start (a, b, each (N + 1, m)) or at its end as the interval sees it
+    (a_left + 2 ds b_left, b_left; ``phase_plane.interval_rows``), viscous friction left out;
+    (k,) bool."""
+    found = np.zeros(intervals.shape[0], dtype=np.bool_)
+    for n in range(intervals.shape[0]):
+        i = intervals[n]
+        ds = s[i + 1] - s[i]
+        for k in range(a.shape[1]):
+            start = abs(a[i, k])
+            end = abs(a_left[i + 1, k] + 2.0 * ds * b_left[i + 1, k])
+            if start <= threshold * max(start + abs(b[i, k]), 1e-300) or end <= threshold * max(end + abs(b_left[i + 1, k]), 1e-300):
+                found[n] = True
+                break
+    return found

@@ -102,10 +102,11 @@ class Timed(NamedTuple):
     switching_times: dict | None = None
 
 
-def timing_grid(path: GeometricPath, n_intervals: int | None, method: TimingMethod, robot: Robot) -> np.ndarray:
-    """The grid of ``path`` (``n_intervals``, else the default), within what ``method`` serves on
-    ``robot``: a long path's default grid is thinned to ``method.max_grid_intervals``."""
-    s = path_grid(path, n_intervals)
+def timing_grid(path: GeometricPath, n_intervals: int | None, method: TimingMethod, robot: Robot, s: np.ndarray | None = None) -> np.ndarray:
+    """The grid of ``path`` (``n_intervals``, else the default; ``s``: that grid, already
+    built), within what ``method`` serves on ``robot``: a long path's default grid is thinned to
+    ``method.max_grid_intervals``."""
+    s = path_grid(path, n_intervals) if s is None else s
     cap = method.max_grid_intervals(robot.dof)
     return s if len(s) - 1 <= cap else path_grid(path, cap)
 
@@ -124,8 +125,8 @@ def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool)
     )
 
 
-def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, duration, threshold, deadline):
-    s = timing_grid(stretch, grid_points, method, robot)
+def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, duration, threshold, deadline, grid=None):
+    s = timing_grid(stretch, grid_points, method, robot, grid)
     deadline.progress(0.0, "constraints")
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
     deadline.check()
@@ -138,12 +139,13 @@ def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, 
 def timed_path(robot, path, method, timing, kinds, limits, deadline, threshold) -> Timed:
     """A given path timed by ``method``; each stretch between corners (where the motion stops)
     on its own, as its own rest-to-rest problem, and every one through the limit gate."""
-    check_path_within_limits(robot, path, path_grid(path, timing.grid_points))
+    grid = path_grid(path, timing.grid_points)
+    check_path_within_limits(robot, path, grid)
     check_jerk_finite(path, kinds)
     boundary = path_boundary(path, timing, method)
     parts = stretches(path)
     widths = [getattr(part, "width", 1.0) for part in parts]
-    grid = [None if timing.grid_points is None else max(1, round(timing.grid_points * w)) for w in widths]
+    counts = [None if timing.grid_points is None else max(1, round(timing.grid_points * w)) for w in widths]
     boundaries = [
         _stretch_boundary(boundary, w, k == 0, k == len(parts) - 1) if len(parts) > 1 else boundary
         for k, w in enumerate(widths)
@@ -152,15 +154,15 @@ def timed_path(robot, path, method, timing, kinds, limits, deadline, threshold) 
     if timing.duration is not None and len(parts) > 1:
         shortest = [
             method.solve(build_path_constraints(part, robot, limits, kinds, path_grid(part, n), deadline), b, None, deadline).duration
-            for part, n, b in zip(parts, grid, boundaries)
+            for part, n, b in zip(parts, counts, boundaries)
         ]
         durations = [timing.duration * T / sum(shortest) for T in shortest]
     elif timing.duration is not None:
         durations = [timing.duration]
     shares = [deadline.within(k / len(parts), (k + 1) / len(parts)) for k in range(len(parts))]
     timed = [
-        _time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, share)
-        for part, n, b, T, share in zip(parts, grid, boundaries, durations, shares)
+        _time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, share, grid if part is path else None)
+        for part, n, b, T, share in zip(parts, counts, boundaries, durations, shares)
     ]
     if len(timed) == 1:
         result = timed[0].timing

@@ -13,7 +13,7 @@ from planners.constraints import PathConstraints, build_path_constraints
 from planners.errors import InfeasiblePath
 from planners.gate import LIMIT_TOLERANCE
 from planners.grid import path_grid
-from planners.kernels import interval_bounds
+from planners.kernels import interval_bounds, zero_inertia_intervals
 from planners.limit_check import check_limits
 from planners.mvc import acceleration_bounds, admissible_set
 from planners.paths import SplinePath
@@ -276,3 +276,24 @@ def test_a_refined_answer_is_the_answer_on_its_own_grid_built_afresh(name):
     assert len(refined.s) > len(constraints.s)  # refinement added points
     fresh = build_path_constraints(path, robot, robot.limits, KINDS, refined.s)
     np.testing.assert_array_equal(PhasePlaneMethod(max_refinements=0).solve(fresh).sd, refined.sd)
+
+
+def test_zero_inertia_intervals_are_the_interval_rows_with_a_vanishing_u_coefficient():
+    """``zero_inertia_intervals`` marks the intervals whose rows in the interpolation
+    discretization (``interval_rows``, built in numpy) have a u-coefficient within the threshold
+    of their scale |a| + |b|: rows with a = 0 at grid points, and rows whose coefficient the
+    interval's far end cancels (a_left + 2 ds b_left = 0)."""
+    rng = np.random.default_rng(8)
+    constraints = _random_constraints(rng, 200, 5, False)
+    s = constraints.s
+    far = 40  # a row that vanishes only as interval 40 sees its far end
+    constraints.a_left[far + 1, 3] = -2.0 * (s[far + 1] - s[far]) * constraints.b_left[far + 1, 3]
+    right = constraints.linearized(np.ones(len(s)))
+    left = constraints.linearized(np.ones(len(s)), "left")
+    stage = interval_rows(s, right, left)
+    size = np.abs(stage.a)
+    expected = (size <= 1e-6 * np.maximum(size + np.abs(stage.b), 1e-300)).any(axis=1)
+    intervals = np.arange(len(s) - 1, dtype=np.int64)
+    found = zero_inertia_intervals(s, constraints.a, constraints.b, constraints.a_left, constraints.b_left, intervals, 1e-6)
+    np.testing.assert_array_equal(found, expected)
+    assert expected[far] and 20 < expected.sum() < len(intervals)

@@ -50,7 +50,7 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
-from planners.kernels import point_bounds
+from planners.kernels import point_bounds, zero_inertia_intervals
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions, split_points
 from planners.sweep_kernels import sweeps
@@ -97,7 +97,7 @@ def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> L
 
 
 #: A switching point is singular where a row's u-coefficient in its interval is within this
-#: fraction of the row's scale of zero (``_zero_inertia_rows``).
+#: fraction of the row's scale of zero (``planners.kernels.zero_inertia_intervals``).
 _ZERO_INERTIA_SWITCH = 1e-6
 #: Pieces into which one refinement round may split an interval at most.
 _MAX_PIECES = 8
@@ -321,49 +321,35 @@ def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profi
 
 def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tuple[float, str], ...]:
     """Where the profile changes between accelerating (at beta) and following the envelope."""
-    s = constraints.s
     capped, envelope, x_high = profile.capped, profile.envelope, profile.x_high
-    changes = np.flatnonzero(capped[1:] != capped[:-1]) + 1
-    if not changes.size:
+    changes = (np.flatnonzero(capped[1:] != capped[:-1]) + 1).tolist()
+    if not changes:
         return ()
+    s, last = constraints.s, len(x_high) - 1
     # Leaving the envelope: the touch point on (or the deceleration curve from) the MVC.
-    at = np.minimum(changes, len(x_high) - 1)
-    on_mvc = envelope[changes] >= x_high[at] * (1 - 1e-6)
-    # Only a departure from the MVC can be singular.
-    departs = ~capped[changes] & on_mvc
-    singular = np.zeros(len(changes), dtype=bool)
-    if departs.any():
-        singular[departs] = _zero_inertia_rows(constraints, at[departs])
+    on_mvc = [bool(envelope[i] >= x_high[min(i, last)] * (1 - 1e-6)) for i in changes]
+    # Only a departure from the MVC can be singular: its intervals' rows, in one batch.
+    departs = [min(i, last) for i, on in zip(changes, on_mvc) if on and not capped[i]]
+    singular = {}
+    if departs:
+        found = zero_inertia_intervals(
+            s, constraints.a, constraints.b, constraints.a_left, constraints.b_left, np.array(departs, dtype=np.int64), _ZERO_INERTIA_SWITCH
+        )
+        singular = dict(zip(departs, found.tolist()))
     points = []
-    for k, i in enumerate(changes):
+    for i, on in zip(changes, on_mvc):
         if capped[i]:
-            points.append((float(s[i]), "deceleration"))
-        elif not on_mvc[k]:
-            points.append((float(s[i]), "acceleration"))
-        elif singular[k]:
-            points.append((float(s[i]), "singular"))
-        elif i >= 1 and i + 1 < len(x_high) and abs(x_high[i + 1] - x_high[i - 1]) > 0.25 * max(x_high[i], 1e-12):
-            points.append((float(s[i]), "discontinuity"))
+            kind = "deceleration"
+        elif not on:
+            kind = "acceleration"
+        elif singular[min(i, last)]:
+            kind = "singular"
+        elif 1 <= i < last and abs(x_high[i + 1] - x_high[i - 1]) > 0.25 * max(x_high[i], 1e-12):
+            kind = "discontinuity"
         else:
-            points.append((float(s[i]), "tangent"))
+            kind = "tangent"
+        points.append((float(s[i]), kind))
     return tuple(points)
-
-
-def _zero_inertia_rows(constraints: PathConstraints, intervals: np.ndarray) -> np.ndarray:
-    """Whether each of ``intervals`` (k,) has a row in the interpolation discretization
-    (``interval_rows``) whose u-coefficient is within ``_ZERO_INERTIA_SWITCH`` of its scale of
-    zero (viscous friction left out), (k,) bool."""
-    after = intervals + 1
-    ds = (constraints.s[after] - constraints.s[intervals])[:, None]
-    found = np.zeros(len(intervals), dtype=bool)
-    b_after = np.take(constraints.b_left, after, axis=0)
-    for a, b in (
-        (np.take(constraints.a, intervals, axis=0), np.take(constraints.b, intervals, axis=0)),
-        (np.take(constraints.a_left, after, axis=0) + 2.0 * ds * b_after, b_after),
-    ):
-        size = np.abs(a)
-        found |= (size <= _ZERO_INERTIA_SWITCH * np.maximum(size + np.abs(b), 1e-300)).any(axis=1)
-    return found
 
 
 def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) -> InfeasiblePath:
