@@ -1,7 +1,8 @@
 """Compiled inner loops of the phase-plane method (numba): the per-point admissible interval of
-x = sd^2 and the bounds on u of each grid interval in either discretization (the sweeps over
-them: ``planners.sweep_kernels``). Plain loops over small row counts, compiled once (``nogil``,
-so threads run them in parallel) and cached on disk; they hold no knowledge of paths or robots.
+x = sd^2, the bounds on u of each grid interval in either discretization (the sweeps over
+them: ``planners.sweep_kernels``) and the zero-inertia test of an interval's rows. Plain loops
+over small row counts, compiled once (``nogil``, so threads run them in parallel) and cached on
+disk; they hold no knowledge of paths or robots.
 
 Bounds on the path acceleration u come as lines: ``p + q x <= u <= r + q x`` per row, shape
 (N, m), with an intercept of -inf (p) or +inf (r) where a row gives no such bound (the two lines

@@ -17,7 +17,8 @@ from planners.kernels import interval_bounds, zero_inertia_intervals
 from planners.limit_check import check_limits
 from planners.mvc import acceleration_bounds, admissible_set
 from planners.paths import SplinePath
-from planners.refinement_kernels import _pieces, row_excursions, switch_excess
+from planners.refinement_kernels import row_excursions, switch_excess
+from planners.split_kernels import _pieces
 from planners.timing import PhasePlaneMethod
 from planners.timing.phase_plane import interval_rows, midpoint_duration, midpoint_stage_rows
 

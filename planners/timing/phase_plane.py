@@ -31,8 +31,9 @@ amount, so the grid is refined where it costs time: the error of each interval i
 the midpoint discretization on the same grid (second-order accurate, but not conservative), from
 the time it would save by switching inside the interval (a start from rest, a switch onto or off
 the MVC within one interval, which neither discretization sees) and from the chord error along
-a curved MVC; each interval is split into as many pieces as its share of the error asks for,
-with the constraint rows evaluated anew at the new points (one batched evaluation per round),
+a curved MVC; the intervals are split into whole pieces, the fewest in all that bring the
+estimate under the tolerance (each new piece where it removes the most error), with the
+constraint rows evaluated anew at the new points (one batched evaluation per round),
 until the estimated duration error is below the tolerance. The same rounds split the intervals
 where a limit, held at both ends, bulges past itself between them by more than a small fraction
 (``planners.refinement_kernels.row_excursions``: the rows and the speed bound at the quarter
@@ -52,7 +53,8 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.kernels import point_bounds, zero_inertia_intervals
 from planners.mvc import admissible_set
-from planners.refinement_kernels import refinement, row_excursions, split_points
+from planners.refinement_kernels import refinement, row_excursions
+from planners.split_kernels import split_points
 from planners.sweep_kernels import sweeps
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
