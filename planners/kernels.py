@@ -46,14 +46,18 @@ def _gap(p, q, r, w, i, x):  # pragma: no cover - compiled
     return highest - lowest, high_slope - low_slope, high_intercept - low_intercept
 
 
+#: ``interval_bounds``'s ``kept`` and ``before`` when nothing is kept from an earlier grid.
+NOTHING_KEPT = np.empty(0, dtype=np.int64)
+NOTHING_BEFORE = (np.empty((0, 0)), np.empty((0, 0)), np.empty((0, 0)), np.empty(0), np.empty(0))
 #: Stand-in for an unbounded x = sd^2 in the root search (sd = 1e6 1/s).
 _X_FAR = 1e12
 
 
 @njit(cache=True, nogil=True)
-def admissible_intervals(p, q, r, w, x_low, x_high):  # pragma: no cover - compiled
-    """Narrow ``[x_low, x_high]`` (each (N,), updated in place and returned) at every point to
-    the x for which some u lies between every lower and every upper line.
+def admissible_intervals(p, q, r, w, x_low, x_high, skip):  # pragma: no cover - compiled
+    """Narrow ``[x_low, x_high]`` (each (N,), updated in place and returned) at every point but
+    those ``skip`` (N,) marks to the x for which some u lies between every lower and every upper
+    line.
 
     phi(x) = min_j (r_j + w_j x) - max_k (p_k + q_k x) is concave and piecewise linear, and the
     admissible x are where phi >= 0. Started right of the interval (where phi < 0 falls), Newton's
@@ -63,6 +67,8 @@ def admissible_intervals(p, q, r, w, x_low, x_high):  # pragma: no cover - compi
     """
     n_points = p.shape[0]
     for i in range(n_points):
+        if skip[i]:
+            continue
         low = x_low[i]
         high = x_high[i]
         unbounded = high > _X_FAR
@@ -178,7 +184,7 @@ def point_bounds(a, b, c, lower, upper, x_bound):  # pragma: no cover - compiled
                 p[i, k] = low
                 q[i, k] = slope
                 r[i, k] = high
-    admissible_intervals(p, q, r, q, x_low, x_high)
+    admissible_intervals(p, q, r, q, x_low, x_high, np.zeros(n_points, dtype=np.bool_))
     for i in range(n_points):
         if static_fail[i] or x_low[i] > x_high[i]:
             x_high[i] = -1.0
@@ -209,12 +215,15 @@ def _singular_row(i, column, x_from, x_to, p, q, r, x_low, x_high, singular, sta
 
 
 @njit(cache=True, nogil=True)
-def _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, p, q, r, x_low, x_high, singular, static_fail):  # pragma: no cover - compiled
+def _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, skip, p, q, r, x_low, x_high, singular, static_fail):  # pragma: no cover - compiled
     """``interval_bounds`` without viscous friction, into ``p, q, r`` (N, m midpoint, 2 m
     interpolation) and ``x_low, x_high, singular, static_fail`` (N,): one line per row at
-    each end of an interval, or at its midpoint."""
+    each end of an interval, or at its midpoint; intervals ``skip`` (N,) marks are left as
+    they are."""
     n_rows = ra.shape[1]
     for i in range(s.shape[0] - 1):
+        if skip[i]:
+            continue
         ds = s[i + 1] - s[i]
         for j in range(n_rows):
             if midpoint:
@@ -280,7 +289,7 @@ def _friction_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_ref, mid
 
 
 @njit(cache=True, nogil=True)
-def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint):  # pragma: no cover - compiled
+def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint, kept, before):  # pragma: no cover - compiled
     """The rows of each grid interval i on its start state (u_i, x_i) as bounds on u, and the
     admissible x_i under them.
 
@@ -300,9 +309,14 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
     bound, the viscous term of each replaced by its tangent at x_ref (N + 1,), exactly as
     ``PathConstraints.linearized`` does; without, ``rd, ld`` and ``x_ref`` are not read.
 
+    ``kept`` (N,, or empty) names, for each interval, the same interval (the same ends, the same
+    rows there) of an earlier grid whose bounds ``before`` (its p, q, r, x_low, x_high, as this
+    returns them) holds, or -1: those are copied, not computed again (without friction, whose
+    linearization point may have moved).
+
     Returns p, q, r (N, k m with k = 1 midpoint, 2 interpolation, times 2 with friction),
     x_low, x_high (N,; x_high = -1 where none is admissible, capped by ``x_bound[i]``) and
-    singular (N,: the interval has a zero-inertia row).
+    singular (N,: the interval has a zero-inertia row, among those computed).
     """
     n_stages = s.shape[0] - 1
     n_rows = ra.shape[1]
@@ -314,13 +328,22 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
     x_high = np.empty(n_stages)
     singular = np.zeros(n_stages, dtype=np.bool_)
     static_fail = np.zeros(n_stages, dtype=np.bool_)
+    copied = np.zeros(n_stages, dtype=np.bool_)
     for i in range(n_stages):
         x_high[i] = x_bound[i]
+        if kept.shape[0] and kept[i] >= 0 and not friction:
+            k = kept[i]
+            p[i, :] = before[0][k]
+            q[i, :] = before[1][k]
+            r[i, :] = before[2][k]
+            x_low[i] = before[3][k]
+            x_high[i] = before[4][k]
+            copied[i] = True
     if friction:
         _friction_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_ref, midpoint, p, q, r, x_low, x_high, singular, static_fail)
     else:
-        _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, p, q, r, x_low, x_high, singular, static_fail)
-    admissible_intervals(p, q, r, q, x_low, x_high)
+        _frictionless_bounds(s, ra, rb, rc, la, lb, lc, lower, upper, midpoint, copied, p, q, r, x_low, x_high, singular, static_fail)
+    admissible_intervals(p, q, r, q, x_low, x_high, copied)
     for i in range(n_stages):
         if static_fail[i] or x_low[i] > x_high[i]:
             x_high[i] = -1.0

@@ -104,28 +104,31 @@ def forward_profile(ds, r, q, envelope, x_start):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, x_start, x_end, midpoint, slack):  # pragma: no cover - compiled
+def sweeps(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, x_start, x_end, midpoint, slack, kept, before):  # pragma: no cover - compiled
     """One solve on the grid ``s`` (N + 1,): the interval bounds (``interval_bounds``, whose
-    arguments these are), the backward envelope from ``x_end`` and the forward profile from
+    arguments these are, ``kept`` and ``before`` the bounds of an earlier grid's intervals that
+    this grid keeps), the backward envelope from ``x_end`` and the forward profile from
     ``min(x_start, envelope_0)``.
 
     Returns x (N + 1,; empty when the backward sweep failed), capped (N,), envelope and floor
     (N + 1,), the index of the interval where the backward sweep failed or -1, the admissible
-    upper x_i of each interval (N,) and the ``switch_excess`` of each interval (N,; zeros in the
-    midpoint discretization, whose profile only serves the conservative one as a reference).
+    upper x_i of each interval (N,), the ``switch_excess`` of each interval (N,; zeros in the
+    midpoint discretization, whose profile only serves the conservative one as a reference) and
+    the interval bounds (p, q, r, x_low, x_high: the ``before`` of a refined grid).
     """
-    p, q, r, x_low, x_high, _ = interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint)
+    p, q, r, x_low, x_high, _ = interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_ref, friction, midpoint, kept, before)
+    bounds = (p, q, r, x_low, x_high)
     n_stages = s.shape[0] - 1
     ds = np.empty(n_stages)
     for i in range(n_stages):
         ds[i] = s[i + 1] - s[i]
     envelope, floor, failed = backward_envelope(ds, p, q, r, x_low, x_high, x_end, slack)
     if failed >= 0:
-        return np.empty(0), np.empty(0, dtype=np.bool_), envelope, floor, failed, x_high, np.empty(0)
+        return np.empty(0), np.empty(0, dtype=np.bool_), envelope, floor, failed, x_high, np.empty(0), bounds
     x, capped = forward_profile(ds, r, q, envelope, min(x_start, envelope[0]))
     if midpoint:
-        return x, capped, envelope, floor, failed, x_high, np.zeros(n_stages)
+        return x, capped, envelope, floor, failed, x_high, np.zeros(n_stages), bounds
     ceiling = np.empty(n_stages + 1)
     ceiling[:n_stages] = x_high
     ceiling[n_stages] = max(x_bound[n_stages], x_end) if x_bound[n_stages] < _INF else x_high[n_stages - 1]
-    return x, capped, envelope, floor, failed, x_high, switch_excess(ds, p, q, r, x, ceiling)
+    return x, capped, envelope, floor, failed, x_high, switch_excess(ds, p, q, r, x, ceiling), bounds

@@ -13,14 +13,14 @@ from planners.constraints import PathConstraints, build_path_constraints
 from planners.errors import InfeasiblePath
 from planners.gate import LIMIT_TOLERANCE
 from planners.grid import path_grid
-from planners.kernels import interval_bounds, zero_inertia_intervals
+from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, zero_inertia_intervals
 from planners.limit_check import check_limits
 from planners.mvc import acceleration_bounds, admissible_set
 from planners.paths import SplinePath
 from planners.refinement_kernels import row_excursions, switch_excess
 from planners.split_kernels import _pieces
 from planners.timing import PhasePlaneMethod
-from planners.timing.phase_plane import interval_rows, midpoint_duration, midpoint_stage_rows
+from planners.timing.phase_plane import _kept_intervals, interval_rows, midpoint_duration, midpoint_stage_rows
 
 
 def _random_constraints(rng, n_points: int, n_rows: int, friction: bool) -> PathConstraints:
@@ -62,7 +62,8 @@ def test_interval_bounds_match_the_rows_they_stand_for(friction, midpoint):
     arrays = (constraints.a, constraints.b, constraints.c, constraints.d,
               constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left)  # fmt: skip
     p, q, r, x_low, x_high, _ = interval_bounds(
-        constraints.s, *arrays, constraints.lower, constraints.upper, constraints.sd_max**2, x_ref, friction, midpoint
+        constraints.s, *arrays, constraints.lower, constraints.upper, constraints.sd_max**2, x_ref, friction, midpoint,
+        NOTHING_KEPT, NOTHING_BEFORE,
     )
     empty = expected.x_max < expected.x_min
     assert empty.sum() > 5 and (~empty).sum() > 5, empty.sum()  # both kinds of intervals are exercised
@@ -93,8 +94,9 @@ def test_frictionless_interval_bounds_are_the_general_loop_without_friction(midp
     upper = rng.uniform(0.5, 2.0, constraints.upper.shape)
     upper[:, -1] = np.inf  # a row without limit
     common = (-rng.uniform(0.5, 2.0, upper.shape), upper, constraints.sd_max**2, x_ref)
-    p, q, r, x_low, x_high, singular = interval_bounds(constraints.s, *arrays, *common, False, midpoint)
-    p2, q2, r2, x_low2, x_high2, singular2 = interval_bounds(constraints.s, *arrays, *common, True, midpoint)
+    nothing = (NOTHING_KEPT, NOTHING_BEFORE)
+    p, q, r, x_low, x_high, singular = interval_bounds(constraints.s, *arrays, *common, False, midpoint, *nothing)
+    p2, q2, r2, x_low2, x_high2, singular2 = interval_bounds(constraints.s, *arrays, *common, True, midpoint, *nothing)
     width = p.shape[1]
     assert p2.shape[1] == 2 * width
     assert midpoint or singular.any()  # zero-inertia rows are exercised
@@ -103,6 +105,39 @@ def test_frictionless_interval_bounds_are_the_general_loop_without_friction(midp
     assert np.array_equal(p, np.maximum(p2[:, :width], p2[:, width:]))
     assert np.array_equal(r, np.minimum(r2[:, :width], r2[:, width:]))
     assert np.array_equal(q, q2[:, :width]) and np.array_equal(q, q2[:, width:])
+
+
+@pytest.mark.parametrize("midpoint", [False, True])
+def test_interval_bounds_kept_from_a_coarser_grid_are_the_bounds_computed_afresh(midpoint):
+    """The bounds of the intervals a refined grid keeps whole, copied from the coarser grid's
+    (``kept``, ``before``), and those computed for the new ones are the bounds computed afresh on
+    the refined grid, bit for bit (zero-inertia rows, a corner and empty intervals among them);
+    with friction nothing is copied, since the rows' linearization may have moved."""
+    rng = np.random.default_rng(12)
+    fine = _random_constraints(rng, 150, 4, friction=False)
+    coarse_points = np.flatnonzero((np.arange(150) % 3 != 1) | (np.arange(150) < 60))
+    arrays = (fine.a, fine.b, fine.c, fine.d, fine.a_left, fine.b_left, fine.c_left, fine.d_left, fine.lower, fine.upper)
+    x_bound = fine.sd_max**2
+
+    def bounds(points, kept, before, friction=False):
+        rows = (np.ascontiguousarray(array[points]) for array in arrays)
+        return interval_bounds(fine.s[points], *rows, x_bound[points], x_bound[points], friction, midpoint, kept, before)[:5]
+
+    everything = np.arange(150)
+    before = bounds(coarse_points, NOTHING_KEPT, NOTHING_BEFORE)
+    kept = _kept_intervals(fine.s, fine.s[coarse_points])
+    assert 50 < (kept >= 0).sum() < 140  # some intervals kept, some new
+    afresh = bounds(everything, NOTHING_KEPT, NOTHING_BEFORE)
+    for copied, computed in zip(bounds(everything, kept, before), afresh):
+        np.testing.assert_array_equal(copied, computed)
+    assert (afresh[4] < 0).any() and (afresh[4] >= 0).any()  # empty and admissible intervals
+    wrong = tuple(array + 1.0 for array in before)
+    copied_x_low = bounds(everything, kept, wrong)[3]
+    np.testing.assert_array_equal(copied_x_low[kept >= 0], afresh[3][kept >= 0] + 1.0)  # read, not recomputed
+    np.testing.assert_array_equal(copied_x_low[kept < 0], afresh[3][kept < 0])
+    # With friction the kept bounds are not read.
+    for friction_bounds, computed in zip(bounds(everything, kept, wrong, True), bounds(everything, NOTHING_KEPT, NOTHING_BEFORE, True)):
+        np.testing.assert_array_equal(friction_bounds, computed)
 
 
 def test_switch_excess_of_a_start_from_rest_is_the_closed_form():

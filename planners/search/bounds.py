@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from planners.constraints import build_path_constraints, grid_rows, speed_bound
-from planners.kernels import interval_bounds, point_bounds
+from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
 from planners.search.curve import GridSplinePath
 from planners.search.pieces import INTERVALS, Pieces
 from planners.timing.phase_plane import PhasePlaneMethod
@@ -148,7 +148,7 @@ def _interval_arrays(ds, start, end):
     if m == 0:
         empty = np.zeros((k, 0))
         return empty, empty, empty, np.where(np.isfinite(xb0), xb0, _INF), np.where(np.isfinite(xb1), xb1, _INF)
-    p, q, r, _, x_high, _ = interval_bounds(s, a, b, c, zero, a, b, c, zero, lower, upper, x_bound, x_bound, False, False)
+    p, q, r, _, x_high, _ = interval_bounds(s, a, b, c, zero, a, b, c, zero, lower, upper, x_bound, x_bound, False, False, NOTHING_KEPT, NOTHING_BEFORE)
     cap_end = point_bounds(
         np.ascontiguousarray(a1), np.ascontiguousarray(b1), np.ascontiguousarray(c1),
         np.ascontiguousarray(lo1), np.ascontiguousarray(up1), np.ascontiguousarray(xb1),

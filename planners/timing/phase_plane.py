@@ -51,7 +51,7 @@ from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
-from planners.kernels import point_bounds, zero_inertia_intervals
+from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, point_bounds, zero_inertia_intervals
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions
 from planners.split_kernels import split_points
@@ -154,9 +154,10 @@ class PhasePlaneMethod(TimingMethod):
         most_intervals = max(2**self.max_refinements * (len(constraints.s) - 1), _MIN_REFINED_INTERVALS)
         grid = _Grid.of(constraints)
         profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False)
+        kept, reference_bounds = NOTHING_KEPT, NOTHING_BEFORE
         for _ in range(self.max_refinements if constraints.can_refine else 0):
             try:
-                reference = _solve_on_grid(grid, x_ends, deadline, midpoint=True, x_ref=profile.x)
+                reference = _solve_on_grid(grid, x_ends, deadline, midpoint=True, x_ref=profile.x, kept=kept, before=reference_bounds)
             except InfeasiblePath:
                 break
             room = most_intervals - (len(grid.s) - 1)
@@ -178,7 +179,8 @@ class PhasePlaneMethod(TimingMethod):
             grid = _Grid.of(grid.constraints.with_points(extra))
             # The profile on the coarser grid is a close reference for viscous friction.
             x_ref = np.interp(grid.s, previous.s, profile.x) if grid.friction else None
-            profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False, x_ref=x_ref)
+            kept, reference_bounds = _kept_intervals(grid.s, previous.s), reference.bounds
+            profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False, x_ref=x_ref, kept=kept, before=profile.bounds)
             if error <= self.tolerance:
                 break  # split for the limits' excursions alone
         switches = _switch_points(grid.constraints, profile)
@@ -253,14 +255,16 @@ class _Grid(NamedTuple):
 
 class _Profile(NamedTuple):
     """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
-    envelope (N + 1,), the admissible upper x_i of each interval (N,) and how much faster each
-    interval could be crossed at its bounds (N,, ``planners.refinement_kernels.switch_excess``)."""
+    envelope (N + 1,), the admissible upper x_i of each interval (N,), how much faster each
+    interval could be crossed at its bounds (N,, ``planners.refinement_kernels.switch_excess``)
+    and the intervals' bounds (``planners.kernels.interval_bounds``' p, q, r, x_low, x_high)."""
 
     x: np.ndarray
     capped: np.ndarray
     envelope: np.ndarray
     x_high: np.ndarray
     switch_excess: np.ndarray
+    bounds: tuple = NOTHING_BEFORE
 
 
 def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -268,22 +272,32 @@ def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
     return 2.0 * np.diff(s) / np.maximum(root[:-1] + root[1:], 1e-300)
 
 
-def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoint: bool, x_ref=None) -> _Profile:
+def _kept_intervals(s: np.ndarray, coarser: np.ndarray) -> np.ndarray:
+    """For each interval of the refined grid ``s`` (N + 1,), the interval of the grid
+    ``coarser`` it refines that it keeps whole (the same two ends), or -1 (N,, int64)."""
+    at = np.minimum(np.searchsorted(coarser, s[:-1]), len(coarser) - 2)
+    whole = (coarser[at] == s[:-1]) & (coarser[at + 1] == s[1:])
+    return np.where(whole, at, -1).astype(np.int64)
+
+
+def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoint: bool, x_ref=None, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> _Profile:
     """Integrate on one grid, in the interpolation (conservative) or the midpoint
     discretization. Viscous friction is linearized around ``x_ref`` (default: a first pass
-    around the frictionless maximum velocity curve, then one around its answer)."""
+    around the frictionless maximum velocity curve, then one around its answer). ``kept`` and
+    ``before``: the intervals this grid keeps whole from a coarser one and that grid's bounds
+    in the same discretization (``_Profile.bounds``), copied instead of computed again."""
     passes = 1
     if x_ref is None:
         passes = 2 if grid.friction else 1
         x_ref = grid.friction_reference() if grid.friction else grid.x_bound
     for _ in range(passes):
         x_start, x_end = boundary
-        profile = _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), x_start, x_end, deadline, midpoint)
+        profile = _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), x_start, x_end, deadline, midpoint, kept, before)
         x_ref = profile.x
     return profile
 
 
-def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profile:
+def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> _Profile:
     """One sweep pair (``planners.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
     rows linearized around ``x_ref``."""
     x_bound, constraints = grid.x_bound, grid.constraints
@@ -294,8 +308,8 @@ def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profi
             s=1.0,
         )
     deadline.check()
-    x, capped, envelope, floor, failed, x_high, switch_excess = sweeps(
-        grid.s, *grid.rows, x_bound, x_ref, grid.friction, float(x_start), float(x_end), midpoint, _SLACK
+    x, capped, envelope, floor, failed, x_high, switch_excess, bounds = sweeps(
+        grid.s, *grid.rows, x_bound, x_ref, grid.friction, float(x_start), float(x_end), midpoint, _SLACK, kept, before
     )
     if failed >= 0:
         discretize = midpoint_stage_rows if midpoint else interval_rows
@@ -318,7 +332,7 @@ def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint) -> _Profi
             s=0.0,
         )
     x[0], x[-1] = x_start, x_end
-    return _Profile(np.maximum(x, 0.0), capped, envelope, x_high, switch_excess)
+    return _Profile(np.maximum(x, 0.0), capped, envelope, x_high, switch_excess, bounds)
 
 
 def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tuple[float, str], ...]:
