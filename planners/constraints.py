@@ -30,6 +30,7 @@ import numpy as np
 
 from planners.constraint_kernels import assemble_rows, velocity_bound
 from planners.deadline import NO_DEADLINE, Deadline
+from planners.grid import on_points
 from planners.paths.base import GeometricPath
 from planners.tool_speed import tool_speed_bound
 from planners.torque_interpolation import smooth_points
@@ -137,7 +138,7 @@ class PathConstraints:
         )
         # Seeds the cached ``smooth``: the new points lie strictly inside intervals, where the rows
         # are the same from both sides, so they are smooth unless one is a knot off the grid.
-        new = np.ones(len(extra.s), dtype=bool) if self.knots is None else ~np.isin(extra.s, self.knots)
+        new = np.ones(len(extra.s), dtype=bool) if self.knots is None else ~on_points(extra.s, self.knots)
         merged.__dict__["smooth"] = merge(self.smooth, new)
         merged.smooth.setflags(write=False)
         return merged
@@ -228,8 +229,13 @@ def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) ->
     """(3 n, n_dof): RNEA(q, 0, 0) = g, RNEA(q, 0, q') = M q' + g and RNEA(q, q', q'') =
     M q'' + C(q, q') q' + g at the n rows of ``q, dq, ddq``, in one batched call whose three
     sets share the joint placements (``Robot.rnea_sets``)."""
-    zero = np.zeros_like(dq)
-    return robot.rnea_sets(q, np.stack((zero, zero, dq)), np.stack((zero, dq, ddq))).reshape(-1, dq.shape[1])
+    velocities = np.zeros((3, *dq.shape))
+    velocities[2] = dq
+    accelerations = np.empty((3, *dq.shape))
+    accelerations[0] = 0.0
+    accelerations[1] = dq
+    accelerations[2] = ddq
+    return robot.rnea_sets(q, velocities, accelerations).reshape(-1, dq.shape[1])
 
 
 #: Grid points whose torque rows are computed between two deadline checks (about 20 ms).

@@ -9,6 +9,8 @@ places where the limits change fastest unsampled.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from planners.errors import TimingFailed
@@ -62,10 +64,22 @@ def path_grid(path: GeometricPath, n_intervals: int | None = None) -> np.ndarray
     return s
 
 
+@lru_cache(maxsize=256)
 def spread_indices(n: int, most: int) -> np.ndarray:
     """At most ``most`` (>= 1) indices into a sequence of ``n``, evenly spread from the first to
     the last, increasing: every index when ``n <= most``. (With n > most the step
-    (n - 1) / (most - 1) exceeds 1, so the rounded positions never repeat.)"""
-    if n <= most:
-        return np.arange(n)
-    return np.linspace(0, n - 1, most).round().astype(np.intp)
+    (n - 1) / (most - 1) exceeds 1, so the rounded positions never repeat.) Read-only, and
+    computed once per (n, most): the same few sizes recur from request to request."""
+    indices = np.arange(n) if n <= most else np.linspace(0, n - 1, most).round().astype(np.intp)
+    indices.setflags(write=False)
+    return indices
+
+
+def on_points(values: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(n,) bool: which of ``values`` (n,) equal one of the increasing ``points``: ``np.isin``
+    by one binary search per value, without sorting both."""
+    values = np.asarray(values, dtype=float)
+    if len(points) == 0:
+        return np.zeros(values.shape, dtype=bool)
+    at = np.minimum(np.searchsorted(points, values), len(points) - 1)
+    return np.asarray(points)[at] == values

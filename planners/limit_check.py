@@ -115,7 +115,7 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
         return robot.inverse_dynamics(q, qd, qdd)
     columns = np.array([column[joint] for joint in range(robot.dof)], dtype=np.int64)
     travel = grid_travel(constraints)
-    interpolate = travel is not None and not np.any(robot.coulomb_friction)
+    interpolate = travel is not None and not robot.has_coulomb_friction
     tau = np.empty_like(qd)
     exact = np.zeros(len(states.s), dtype=bool)
     dense_torques(

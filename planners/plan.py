@@ -77,6 +77,8 @@ def _utilization(stretches_, margin: float) -> dict[str, np.ndarray]:
     """Peak |value| / limit per kind and joint over every stretch, against the limits as
     requested (before any margin)."""
     kinds = stretches_[0].check.utilization.keys()
+    if len(stretches_) == 1:
+        return {kind: (1.0 - margin) * peak for kind, peak in stretches_[0].check.utilization.items()}
     return {
         kind: (1.0 - margin) * np.max([item.check.utilization[kind] for item in stretches_], axis=0)
         for kind in kinds

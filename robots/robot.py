@@ -143,6 +143,16 @@ class Robot:
         pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
         return float(np.linalg.norm(data.oMf[self.frame_id(self.end_effector)].translation - data.oMi[1].translation))
 
+    @cached_property
+    def has_friction(self) -> bool:
+        """Whether any joint has viscous or Coulomb friction (computed once)."""
+        return bool(np.any(self.viscous_friction) or np.any(self.coulomb_friction))
+
+    @cached_property
+    def has_coulomb_friction(self) -> bool:
+        """Whether any joint has Coulomb (dry) friction (computed once)."""
+        return bool(np.any(self.coulomb_friction))
+
     @property
     def dof(self) -> int:
         """Number of degrees of freedom (actuated joints)."""
@@ -205,7 +215,7 @@ class Robot:
         (``rnea``) plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``."""
         qd = np.atleast_2d(qd)
         tau = self.rnea(q, qd, qdd)
-        if np.any(self.viscous_friction) or np.any(self.coulomb_friction):
+        if self.has_friction:
             tau += self.viscous_friction * qd + self.coulomb_friction * np.sign(qd)
         return tau
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from planners.errors import TimingFailed
-from planners.grid import MIN_POINTS_PER_SEGMENT, path_grid, spread_indices
+from planners.grid import MIN_POINTS_PER_SEGMENT, on_points, path_grid, spread_indices
 
 
 @pytest.mark.parametrize("n_intervals", [None, 25, 100, 1000])
@@ -43,3 +43,11 @@ def test_spread_indices_are_the_rounded_evenly_spaced_rows_without_repeats():
         for most in (1, 2, 3, 7, 100, 200):
             expected = np.unique(np.linspace(0, n - 1, min(n, most)).round().astype(int))
             np.testing.assert_array_equal(spread_indices(n, most), expected)
+
+
+def test_on_points_is_membership_in_an_increasing_grid():
+    rng = np.random.default_rng(3)
+    grid = np.unique(rng.integers(0, 50, 20)) / 50.0
+    values = rng.integers(-5, 55, 200) / 50.0
+    np.testing.assert_array_equal(on_points(values, grid), np.isin(values, grid))
+    assert not on_points(values, np.empty(0)).any()

@@ -295,7 +295,7 @@ def refine_collocation(
     """The time-optimal (beta = 0) collocation's motion refined to exact bang-bang controls,
     seeded by the switches read off its torques; ``None`` where that does not apply (friction,
     unlimited torques) or does not reach the goal."""
-    frictionless = not (np.any(robot.viscous_friction) or np.any(robot.coulomb_friction))
+    frictionless = not robot.has_friction
     if not frictionless or not np.all(np.isfinite(limits.torque)):
         return None
     seed = collocation_switches(collocation.t, collocation.tau, limits.torque)

@@ -58,7 +58,7 @@ class SplinePath(_ThroughWaypoints):
         self._coefficients = natural_spline_coefficients(self.knots, self.waypoints)
 
     def evaluate(self, s: np.ndarray, side: str = "right") -> PathPoints:
-        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
+        s = np.minimum(np.maximum(np.asarray(s, dtype=float).ravel(), 0.0), 1.0)
         return PathPoints(*cubic_pieces(self.knots, self._coefficients, s))
 
     def outside_range(self, lower: np.ndarray, upper: np.ndarray, samples: int) -> tuple[float, int, float] | None:
