@@ -230,7 +230,30 @@ class Robot:
         return int(row), int(joint)
 
     def frame_id(self, frame: str) -> int:
-        """Index of ``frame`` in the model; ``KeyError`` when it has no such frame."""
-        if not self.model.existFrame(frame):
-            raise KeyError(frame)
-        return self.model.getFrameId(frame)
+        """Index of ``frame`` in the model; ``KeyError`` when it has no such frame (looked up
+        once per name: the model never changes)."""
+        known = self._frame_ids
+        if frame not in known:
+            if not self.model.existFrame(frame):
+                raise KeyError(frame)
+            known[frame] = self.model.getFrameId(frame)
+        return known[frame]
+
+    def frame_anchor(self, frame_id: int) -> tuple[int, np.ndarray]:
+        """The joint that carries frame ``frame_id`` (its index among the joints, -1 for the
+        universe) and the frame's origin in that joint's frame, (3,) in m (computed once per
+        frame; not to be written)."""
+        anchors = self._frame_anchors
+        if frame_id not in anchors:
+            placed = self.model.frames[frame_id]
+            origin = np.array(placed.placement.translation, dtype=float)
+            anchors[frame_id] = (int(placed.parentJoint) - 1, origin)
+        return anchors[frame_id]
+
+    @cached_property
+    def _frame_ids(self) -> dict[str, int]:
+        return {}
+
+    @cached_property
+    def _frame_anchors(self) -> dict[int, tuple[int, np.ndarray]]:
+        return {}

@@ -46,8 +46,9 @@ def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
     stack = np.ascontiguousarray(jacobian.reshape((-1, *jacobian.shape[-2:])))
     kappa = np.empty(len(stack))
     gram_condition_numbers(stack, kappa)
-    exact = ~(np.isfinite(kappa) & (kappa <= GRAM_KAPPA))
-    if exact.any():
+    trusted = kappa <= GRAM_KAPPA  # False where not a number, too
+    if not trusted.all():
+        exact = ~trusted
         chosen = np.ascontiguousarray(stack[exact])
         values = np.empty(len(chosen))
         singular_value_condition_numbers(chosen, values)
@@ -65,8 +66,8 @@ def characteristic_length(robot: Robot) -> float:
 
 def task_jacobian(robot: Robot, q: np.ndarray, frame_id: int, length: float) -> np.ndarray:
     """The end effector's Jacobian at ``q`` (n_dof,) as conditioned here: 3 translational rows
-    for arms of up to three joints; else angular rows over translational rows divided by
-    ``length``."""
+    for arms of up to three joints; else the translational rows divided by ``length`` over the
+    angular rows (the order of the rows changes no singular value)."""
     return task_jacobians(robot, np.atleast_2d(q), frame_id, length)[0]
 
 
@@ -76,7 +77,8 @@ def task_jacobians(robot: Robot, q: np.ndarray, frame_id: int, length: float) ->
     jacobians = frame_jacobians(robot, frame_id, q)
     if robot.dof <= 3:
         return jacobians[:, :3]
-    return np.concatenate([jacobians[:, 3:], jacobians[:, :3] / length], axis=1)
+    jacobians[:, :3] /= length
+    return jacobians
 
 
 def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tuple[float, float, float, int]:

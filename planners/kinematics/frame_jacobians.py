@@ -43,10 +43,9 @@ def frame_jacobians(robot: Robot, frame_id: int, q: np.ndarray) -> np.ndarray:
             # a one-joint model's Jacobian comes back as a (6,) vector
             jacobians[row] = np.reshape(pin.computeFrameJacobian(model, data, configuration, frame_id, frame), (6, robot.dof))
         return jacobians
-    placed = robot.model.frames[frame_id]
+    joint, origin = robot.frame_anchor(frame_id)
     chain_jacobians(
-        q, chain.parent, chain.prismatic, chain.axis, chain.rotation, chain.translation, chain.coordinate,
-        placed.parentJoint - 1, np.ascontiguousarray(placed.placement.translation, dtype=float), jacobians,
+        q, chain.parent, chain.prismatic, chain.axis, chain.rotation, chain.translation, chain.coordinate, joint, origin, jacobians,
     )
     return jacobians
 
