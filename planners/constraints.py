@@ -104,11 +104,11 @@ class PathConstraints:
         if self.evaluate is None:
             raise ValueError("these constraints cannot be evaluated at other points (refinable is False)")
         extra = self.evaluate(np.asarray(extra_s, dtype=float))
-        order = np.argsort(np.concatenate([self.s, extra.s]), kind="stable")
+        order = np.concatenate([self.s, extra.s]).argsort(kind="stable")
 
         def merge(mine, theirs):
-            # np.take gathers whole rows at once; indexing with [order] goes element by element.
-            return np.take(np.concatenate([mine, theirs]), order, axis=0)
+            # take gathers whole rows at once; indexing with [order] goes element by element.
+            return np.concatenate([mine, theirs]).take(order, axis=0)
 
         jerk = jerk_left = None
         if self.jerk is not None:
@@ -140,6 +140,7 @@ class PathConstraints:
         # are the same from both sides, so they are smooth unless one is a knot off the grid.
         new = np.ones(len(extra.s), dtype=bool) if self.knots is None else ~on_points(extra.s, self.knots)
         merged.__dict__["smooth"] = merge(self.smooth, new)
+        merged.__dict__["has_friction"] = self.has_friction or bool(extra.d.any())
         merged.smooth.setflags(write=False)
         return merged
 
@@ -171,10 +172,11 @@ class PathConstraints:
         smooth.setflags(write=False)
         return smooth
 
-    @property
+    @cached_property
     def has_friction(self) -> bool:
-        """Whether any row has a term linear in sd (viscous joint friction)."""
-        return bool(np.any(self.d != 0.0))
+        """Whether any row has a term linear in sd (viscous joint friction), seen from either
+        side of a grid point (computed once)."""
+        return bool(self.d.any() or (self.d_left is not self.d and self.d_left.any()))
 
     def linearized(self, x_ref: np.ndarray, side: str = "right") -> LinearRows:
         """Rows linear in (u, x), a conservative inner approximation of these constraints.
@@ -319,10 +321,10 @@ def build_path_constraints(
     (``limits.tool``) joins the first-order bound sd_max."""
     points, (a, b, c, d, lower, upper), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
     deadline.check()
-    sd_max = np.full(len(s), np.inf)
-    velocity_joint = np.full(len(s), -1)
     if "velocity" in kinds:
         sd_max, velocity_joint = speed_bound(limits, points.dq)
+    else:
+        sd_max, velocity_joint = np.full(len(s), np.inf), np.full(len(s), -1)
     tool_bound = None
     if limits.tool is not None:
         deadline.check()

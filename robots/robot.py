@@ -153,9 +153,9 @@ class Robot:
         """Whether any joint has Coulomb (dry) friction (computed once)."""
         return bool(np.any(self.coulomb_friction))
 
-    @property
+    @cached_property
     def dof(self) -> int:
-        """Number of degrees of freedom (actuated joints)."""
+        """Number of degrees of freedom (actuated joints; read once, the model never changes)."""
         return self.model.nv
 
     @property

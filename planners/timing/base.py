@@ -127,13 +127,16 @@ class TimeScaling(PathTiming):
     @cached_property
     def sdd(self) -> np.ndarray:
         """Path acceleration of each interval, shape (K,), in 1/s^2 (computed once, read-only)."""
-        return _read_only((self.sd[1:] ** 2 - self.sd[:-1] ** 2) / (2.0 * np.diff(self.s)))
+        sd, s = self.sd, self.s
+        return _read_only((sd[1:] ** 2 - sd[:-1] ** 2) / (2.0 * (s[1:] - s[:-1])))
 
     @cached_property
     def t(self) -> np.ndarray:
         """Time at each grid point, shape (K + 1,), in s (computed once, read-only)."""
-        dt = 2.0 * np.diff(self.s) / (self.sd[:-1] + self.sd[1:])
-        return _read_only(np.concatenate(([0.0], np.cumsum(dt))))
+        s, sd = self.s, self.sd
+        t = np.zeros(len(s))
+        np.cumsum(2.0 * (s[1:] - s[:-1]) / (sd[:-1] + sd[1:]), out=t[1:])
+        return _read_only(t)
 
     @property
     def duration(self) -> float:

@@ -161,7 +161,7 @@ class PhasePlaneMethod(TimingMethod):
             except InfeasiblePath:
                 break
             room = most_intervals - (len(grid.s) - 1)
-            ceiling = np.append(profile.x_high, grid.x_bound[-1])
+            ceiling = np.concatenate((profile.x_high, grid.x_bound[-1:]))
             wanted, priority, error = refinement(
                 grid.s, profile.x, reference.x, ceiling, profile.switch_excess, self.tolerance, _AIM, _GUARD, _MAX_PIECES, room
             )
@@ -242,8 +242,7 @@ class _Grid(NamedTuple):
         x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
         joint = constraints.velocity_joint
         binding = np.full(len(s), -1, dtype=np.int64) if joint is None else np.ascontiguousarray(joint, dtype=np.int64)
-        friction = bool(rows.d.any() or (rows.d_left is not rows.d and rows.d_left.any()))
-        return cls(constraints, s, rows, x_bound, binding, constraints.smooth, friction)
+        return cls(constraints, s, rows, x_bound, binding, constraints.smooth, constraints.has_friction)
 
     def friction_reference(self) -> np.ndarray:
         """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
