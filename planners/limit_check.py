@@ -181,5 +181,5 @@ def check_limits(
         if checked and len(states.s) and (worst is None or ratio > worst.ratio):
             joint = -1 if kind in TOOL_KINDS else int(column)
             worst = Excess(float(ratio), kind, joint, float(states.s[state]))
-    intervals = np.empty(0, dtype=int) if states.interval is None else np.unique(states.interval[over])
+    intervals = np.empty(0, dtype=int) if states.interval is None or not over.any() else np.unique(states.interval[over])
     return LimitCheck(utilization, worst, intervals)
