@@ -69,6 +69,11 @@ class Deadline:
         """Seconds left (at least 0), or ``None`` without a budget."""
         return None if self._end is None else max(0.0, self._end - time.monotonic())
 
+    def expect(self, seconds: float) -> None:
+        """Say that the next step, which does not check, takes about ``seconds``. A budget
+        stops work only at its checks, so this is a no-op here; a ``Leash`` slips at once when
+        the step would run past it."""
+
     def check(self) -> None:
         """Raise ``BudgetExceeded`` when the budget is spent or the caller cancelled."""
         if self._cancelled.is_set() or (self._end is not None and time.monotonic() > self._end):
@@ -92,3 +97,44 @@ class Deadline:
 
 
 NO_DEADLINE = Deadline()
+
+
+class LeashSlipped(BudgetExceeded):
+    """Work tried on a ``Leash`` ran past it, or asked for what a leash cannot give: it is to
+    run again on its own, under its whole budget."""
+
+
+class Leash(Deadline):
+    """A short deadline for trying a computation where it holds up others (a server's event
+    loop): ``check()`` raises ``LeashSlipped`` once ``leash_s`` seconds have passed, and
+    ``expect(seconds)`` when a step that does not check would end past them. Work that
+    sizes itself by its budget (``remaining()``) or waits on work that cannot check a deadline
+    (``on_cancel``, a worker process) gets ``LeashSlipped`` at once, before it starts: a leash
+    is not a budget, and such work must see the budget it was given.
+
+    Args:
+        leash_s: Seconds the try may take, from construction.
+    """
+
+    def __init__(self, leash_s: float):
+        super().__init__(leash_s)
+
+    def remaining(self) -> float | None:
+        """Raise ``LeashSlipped``: a leash says nothing of the budget."""
+        raise LeashSlipped("work that sizes itself by its budget runs on its own")
+
+    @contextmanager
+    def on_cancel(self, stop: Callable[[], None]) -> Iterator[None]:
+        """Raise ``LeashSlipped``: work that cannot check a deadline is not tried on a leash."""
+        raise LeashSlipped("work that cannot check a deadline runs on its own")
+        yield  # pragma: no cover - a context manager's generator
+
+    def expect(self, seconds: float) -> None:
+        """Raise ``LeashSlipped`` when a step of about ``seconds`` would end past the leash."""
+        if time.monotonic() + seconds > self._end:  # type: ignore[operator]
+            raise LeashSlipped(f"a step of about {seconds:.3g} s would run past the leash of {self.budget_s} s")
+
+    def check(self) -> None:
+        """Raise ``LeashSlipped`` once the leash has run out."""
+        if time.monotonic() > self._end:  # type: ignore[operator]
+            raise LeashSlipped(f"the try ran past its leash of {self.budget_s} s")

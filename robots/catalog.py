@@ -7,7 +7,6 @@ Models are built once per process and shared read-only; see ``Robot.data`` for p
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cache
 from importlib import resources
 from os.path import join
 
@@ -97,9 +96,26 @@ def example_urdf_path(loader_name: str) -> str:
     return join(getModelPath(subpath), subpath)
 
 
-@cache
+#: The catalog robots built in this process, by name.
+_built: dict[str, Robot] = {}
+
+
 def load_catalog_robot(name: str) -> Robot:
-    """The catalog robot ``name`` (a key of ``BUNDLED`` or ``EXAMPLE_ARMS``), built once per process."""
+    """The catalog robot ``name`` (a key of ``BUNDLED`` or ``EXAMPLE_ARMS``), built once per
+    process (two threads asking at once may both build it; one of the two is kept)."""
+    robot = _built.get(name)
+    if robot is None:
+        robot = _built.setdefault(name, _build(name))
+    return robot
+
+
+def catalog_robot_built(name: str) -> bool:
+    """Whether the catalog robot ``name`` is built already: ``load_catalog_robot`` returns it at once."""
+    return name in _built
+
+
+def _build(name: str) -> Robot:
+    """Build the catalog robot ``name`` from its URDF."""
     if name in BUNDLED:
         urdf = resources.files("robots").joinpath(f"urdf/{name}.urdf").read_text()
         return robot_from_model(name, pin.buildModelFromXML(urdf), "bundled", BUNDLED[name])

@@ -71,7 +71,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         default_response_class=FiniteJSONResponse,
     )
     app.state.settings = settings
-    app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue)
+    app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue, settings.plan_leash_s)
     app.state.jobs = job_runner(settings)
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)

@@ -31,6 +31,8 @@ class Settings(BaseSettings):
             number of cores; under ``toptraj serve --workers N``, the cores divided by N, at
             least 1: a process's planning threads share one interpreter lock, so more threads
             add no throughput, and N processes then run as many plannings as there are cores).
+        plan_leash_s: How long a planning is first tried on the event loop when no other
+            planning runs or waits, in s (``PlanningWorkers.run``; 0: always in a thread).
         plan_queue: Requests that may wait for a planning worker of this process (within
             their budget); beyond, 503 with ``Retry-After``.
         job_workers: Jobs (``/v1/jobs``) running at once, each in a worker process, over every
@@ -57,6 +59,7 @@ class Settings(BaseSettings):
     upload_cache_size: int = Field(default=DEFAULT_CACHE_SIZE, ge=1)
     max_response_bytes: int = Field(default=20_000_000, ge=1_000_000)
     plan_workers: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
+    plan_leash_s: float = Field(default=0.02, ge=0.0, le=0.1)
     plan_queue: int = Field(default=8, ge=0)
     job_workers: int = Field(default_factory=lambda: max(1, (os.cpu_count() or 1) // 2), ge=1)
     job_budget_s: float = Field(default=300.0, gt=0)

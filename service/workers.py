@@ -21,6 +21,7 @@ from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 
 from planners import Deadline
+from planners.deadline import Leash, LeashSlipped
 from planners.errors import BudgetExceeded
 from robots.errors import ToptrajError
 
@@ -65,10 +66,12 @@ class PlanningWorkers:
     Args:
         workers: Plannings run at once (default in the settings: the number of cores).
         queue: Requests that may wait for a free worker; beyond, 503.
+        leash_s: How long a planning that may run on the event loop is tried there, in s (see
+            ``run``); 0 never tries one.
     """
 
-    def __init__(self, workers: int, queue: int):
-        self.workers, self.queue = workers, queue
+    def __init__(self, workers: int, queue: int, leash_s: float = 0.0):
+        self.workers, self.queue, self.leash_s = workers, queue, leash_s
         self._executor: ThreadPoolExecutor | None = None
         # Thread primitives, not asyncio ones: a slot is freed by the planning thread itself when
         # it ends, whatever became of the event loop that started it.
@@ -77,9 +80,18 @@ class PlanningWorkers:
         self._admitted = 0
         self._waiting: deque[_Waiter] = deque()  # first come, first served
 
-    async def run(self, function, budget_s: float):
+    async def run(self, function, budget_s: float, leashed: bool = False):
         """``function(deadline)`` in a worker thread; past ``budget_s`` seconds from now (waiting
         for a worker included), cancel its deadline and raise ``BudgetExceeded``.
+
+        With ``leashed``, when no other planning runs or waits, ``function`` is first tried on
+        the event loop itself under a ``Leash`` of ``leash_s`` (shorter than the budget): a
+        short planning is answered without the two thread hand-offs (about 0.3 ms of a 5 ms
+        request), and one that runs past the leash, or sizes itself by its budget, slips it
+        and runs again in a thread under what is left of the budget. The loop is held up by at
+        most the leash (and the step in which it runs out), and only while the service is
+        otherwise idle: under load every planning runs in a thread. ``function`` must be free
+        of effects beyond its answer, as it may run twice.
 
         Raises:
             ServiceBusy: ``workers`` plannings run and ``queue`` more wait already.
@@ -90,10 +102,16 @@ class PlanningWorkers:
                 raise ServiceBusy(
                     f"all {self.workers} planning workers are busy and {self.queue} requests wait already; retry shortly"
                 )
+            idle = self._admitted == 0 and not self._waiting
             self._admitted += 1
         deadline = Deadline(budget_s)
         started = False
         try:
+            if leashed and idle and 0.0 < self.leash_s < budget_s:
+                try:
+                    return function(Leash(self.leash_s))
+                except LeashSlipped:
+                    pass  # again in a thread, under the same deadline
             await self._acquire(deadline, budget_s)
             loop = asyncio.get_running_loop()
             # One future of this loop, settled by the planning thread through one callback: the

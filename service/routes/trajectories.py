@@ -7,7 +7,7 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
-from service.planning import compare_request, encode_json, plan_request, render
+from service.planning import compare_request, encode_json, plan_request, render, worth_a_leash
 from service.problems import problem_responses
 from service.schemas.answers import CompareResponse, TrajectoryResponse
 from service.schemas.examples import openapi_examples
@@ -32,7 +32,8 @@ async def create_trajectory(
 ) -> Response:
     """Time the path of ``body`` for its robot under the requested limits and return the
     samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit.
-    The body is built and encoded in the planning thread, within the time budget."""
+    The body is built and encoded by the planning, within the time budget; a small request
+    (``worth_a_leash``) is first tried on the event loop."""
     settings = request.app.state.settings
 
     accept = request.headers.get("accept")
@@ -40,7 +41,7 @@ async def create_trajectory(
     def planned(deadline) -> tuple[bytes, str]:
         return render(plan_request(body, deadline, settings.max_response_bytes, accept), body, accept)
 
-    content, media_type = await request.app.state.planning.run(planned, settings.plan_budget_s)
+    content, media_type = await request.app.state.planning.run(planned, settings.plan_budget_s, leashed=worth_a_leash(body))
     return Response(content, media_type=media_type)
 
 
