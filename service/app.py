@@ -37,6 +37,10 @@ def _warm_up() -> None:
     frobenius_condition_number(np.zeros((6, 6)))
 
 
+#: FastAPI's telemetry options with every part off (``Settings.telemetry``).
+_NO_TELEMETRY = {"tracing": False, "metrics": False, "logs": False, "operation_spans": False}
+
+
 def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
@@ -69,6 +73,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         version="0.1.0",
         lifespan=lifespan,
         default_response_class=FiniteJSONResponse,
+        telemetry=None if settings.telemetry else _NO_TELEMETRY,
     )
     app.state.settings = settings
     app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue, settings.plan_leash_s)

@@ -43,6 +43,10 @@ class Settings(BaseSettings):
         max_jobs: Most jobs the job store keeps (``jobs.sqlite3``); the oldest ended go first.
         job_max_age_s: Seconds an ended job is kept, at most.
         max_job_store_bytes: Most bytes of requests, answers and errors the job store keeps.
+        telemetry: FastAPI's OpenTelemetry instrumentation of each request (spans, metrics and
+            logs through the process's OpenTelemetry providers, ``FastAPI(telemetry=...)``).
+            Off by default: the service sets up no provider, and the instrumentation's checks
+            on every request cost time even then.
         ray_address: A Ray cluster for batches (``POST /v1/batches``): ``auto``,
             ``ray://host:port`` or ``local`` (a Ray started in the job's process); none: a batch
             runs in the server's own job worker process.
@@ -68,4 +72,5 @@ class Settings(BaseSettings):
     max_jobs: int = Field(default=1_000, ge=1)
     job_max_age_s: float = Field(default=7 * 86_400.0, gt=0)
     max_job_store_bytes: int = Field(default=1_000_000_000, ge=1_000_000)
+    telemetry: bool = False
     ray_address: str | None = None
