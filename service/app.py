@@ -19,6 +19,7 @@ from service.jobs import JOB_MODULES, job_runner
 from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.routes import batches, health, jobs, trajectories, web
 from service.routes import robots as robot_routes
+from service.serving import open_connections
 from service.settings import Settings
 from service.workers import PlanningWorkers
 
@@ -76,7 +77,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         telemetry=None if settings.telemetry else _NO_TELEMETRY,
     )
     app.state.settings = settings
-    app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue, settings.plan_leash_s)
+    app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue, settings.plan_leash_s, open_connections)
     app.state.jobs = job_runner(settings)
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)

@@ -61,6 +61,14 @@ RETRY_S = 1.0
 
 _log = logging.getLogger("uvicorn.error")
 _RESOURCE_ERRORS = {errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM}
+#: The connection sockets the balanced servers of this process accepted (``open_connections``).
+_accepted: weakref.WeakSet[socket.socket] = weakref.WeakSet()
+
+
+def open_connections() -> int:
+    """How many connections the balanced servers of this process hold open (0 when it serves
+    none: a test client, or uvicorn's own loop)."""
+    return sum(1 for connection in list(_accepted) if connection.fileno() != -1)
 
 
 class BalancedEventLoop(_BaseLoop):
@@ -149,6 +157,7 @@ async def _accept_in_turns(loop: asyncio.AbstractEventLoop, listening: socket.so
             continue
         connection.setblocking(False)
         held.add(connection)
+        _accepted.add(connection)
         try:
             await loop.connect_accepted_socket(protocol_factory, connection)
         except (OSError, ValueError) as error:  # the peer went away before it was served

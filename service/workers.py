@@ -18,6 +18,7 @@ from __future__ import annotations
 import asyncio
 import threading
 from collections import deque
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
 from planners import Deadline
@@ -68,10 +69,15 @@ class PlanningWorkers:
         queue: Requests that may wait for a free worker; beyond, 503.
         leash_s: How long a planning that may run on the event loop is tried there, in s (see
             ``run``); 0 never tries one.
+        connections: How many connections the process holds open
+            (``service.serving.open_connections``). A planning is tried on the loop only while
+            it holds at most one: a loop held by a try cannot take its turn at accepting, and a
+            burst of connections would then all go to the other server processes.
     """
 
-    def __init__(self, workers: int, queue: int, leash_s: float = 0.0):
+    def __init__(self, workers: int, queue: int, leash_s: float = 0.0, connections: Callable[[], int] = lambda: 0):
         self.workers, self.queue, self.leash_s = workers, queue, leash_s
+        self._connections = connections
         self._executor: ThreadPoolExecutor | None = None
         # Thread primitives, not asyncio ones: a slot is freed by the planning thread itself when
         # it ends, whatever became of the event loop that started it.
@@ -84,14 +90,14 @@ class PlanningWorkers:
         """``function(deadline)`` in a worker thread; past ``budget_s`` seconds from now (waiting
         for a worker included), cancel its deadline and raise ``BudgetExceeded``.
 
-        With ``leashed``, when no other planning runs or waits, ``function`` is first tried on
-        the event loop itself under a ``Leash`` of ``leash_s`` (shorter than the budget): a
-        short planning is answered without the two thread hand-offs (about 0.3 ms of a 5 ms
-        request), and one that runs past the leash, or sizes itself by its budget, slips it
-        and runs again in a thread under what is left of the budget. The loop is held up by at
-        most the leash (and the step in which it runs out), and only while the service is
-        otherwise idle: under load every planning runs in a thread. ``function`` must be free
-        of effects beyond its answer, as it may run twice.
+        With ``leashed``, when no other planning runs or waits (``_alone``), ``function`` is
+        first tried on the event loop itself under a ``Leash`` of ``leash_s`` (shorter than the
+        budget): a short planning is answered without the two thread hand-offs (about 0.3 ms
+        of a 5 ms request), and one that runs past the leash, or sizes itself by its budget,
+        slips it and runs again in a thread under what is left of the budget. The loop is held
+        up by at most the leash (and the step in which it runs out), and only while the
+        service is otherwise idle: under load every planning runs in a thread. ``function``
+        must be free of effects beyond its answer, as it may run twice.
 
         Raises:
             ServiceBusy: ``workers`` plannings run and ``queue`` more wait already.
@@ -102,12 +108,11 @@ class PlanningWorkers:
                 raise ServiceBusy(
                     f"all {self.workers} planning workers are busy and {self.queue} requests wait already; retry shortly"
                 )
-            idle = self._admitted == 0 and not self._waiting
             self._admitted += 1
         deadline = Deadline(budget_s)
         started = False
         try:
-            if leashed and idle and 0.0 < self.leash_s < budget_s:
+            if leashed and 0.0 < self.leash_s < budget_s and await self._alone():
                 try:
                     return function(Leash(self.leash_s))
                 except LeashSlipped:
@@ -158,6 +163,18 @@ class PlanningWorkers:
             if not started:
                 with self._lock:
                     self._admitted -= 1
+
+    async def _alone(self) -> bool:
+        """Whether this request's planning is the only one admitted, on the only connection the
+        process holds, once the requests that reached the server with it had their turn: one
+        turn of the event loop lets them (and a ``/health`` probe among them) reach their own
+        admission first, so that requests arriving together, as under load, all go to the
+        threads instead of queueing behind one another on the loop."""
+        if self._connections() > 1:
+            return False
+        await asyncio.sleep(0)
+        with self._lock:
+            return self._admitted == 1 and not self._waiting
 
     async def _acquire(self, deadline: Deadline, budget_s: float) -> None:
         """Take a slot, after every request that was waiting before this one.

@@ -162,10 +162,47 @@ def test_a_busy_pool_or_a_budget_within_the_leash_runs_the_planning_in_a_thread_
 
     asyncio.run(main())
     assert [thread is threading.main_thread() for thread, _ in calls] == [False]
+    # Nor while the process holds other connections: its accept would wait for the try.
+    calls.clear()
+    _run(PlanningWorkers(workers=1, queue=2, leash_s=0.05, connections=lambda: 2), _recording(calls))
+    assert [thread is threading.main_thread() for thread, _ in calls] == [False]
     # And a planning not marked leashed never runs on the loop.
     calls.clear()
     _run(PlanningWorkers(workers=1, queue=2, leash_s=0.05), _recording(calls), leashed=False)
     assert [thread is threading.main_thread() for thread, _ in calls] == [False]
+
+
+def test_requests_arriving_together_all_go_to_the_threads_and_a_probe_among_them_is_answered_first():
+    async def main():
+        pool = PlanningWorkers(workers=2, queue=4, leash_s=0.05)
+        calls: list = []
+        order: list[str] = []
+
+        async def probe():  # as /health: answered on the loop, without planning
+            order.append("probe")
+
+        both = threading.Barrier(2, timeout=10.0)  # the two plannings overlap
+
+        def planning(deadline):
+            order.append("planning")
+            calls.append(threading.current_thread())
+            if both is not None:
+                both.wait()
+            return "answer"
+
+        together = await asyncio.gather(pool.run(planning, 60.0, leashed=True), pool.run(planning, 60.0, leashed=True))
+        assert together == ["answer", "answer"]
+        assert all(thread is not threading.main_thread() for thread in calls)
+        # Alone, a planning is tried on the loop, after what came with it.
+        calls.clear(), order.clear()
+        both = None
+        await asyncio.gather(pool.run(planning, 60.0, leashed=True), probe())
+        pool.close()
+        return calls, order
+
+    calls, order = asyncio.run(main())
+    assert calls == [threading.main_thread()]
+    assert order == ["probe", "planning"]
 
 
 def test_expect_slips_a_leash_only_for_a_step_that_would_end_past_it():

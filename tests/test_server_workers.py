@@ -17,7 +17,7 @@ import pytest
 
 from robots.store import UploadStore
 from service.cli import APP_FACTORY, main, plan_threads_per_process
-from service.serving import LOOP, SWITCH_INTERVAL_S, BalancedEventLoop, new_event_loop
+from service.serving import LOOP, SWITCH_INTERVAL_S, BalancedEventLoop, new_event_loop, open_connections
 from tests.live_server import LiveServer
 from tests.test_upload_store import PLAN, app_client, arm
 
@@ -72,6 +72,7 @@ async def _serve_on_a_given_socket() -> None:
     for k, (reader, writer) in enumerate(clients):
         writer.write(b"ping %d" % k)
         assert await reader.readexactly(6) == b"ping %d" % k
+    assert open_connections() == 3  # what a planning asks before a try on the loop
     server.close()
     await server.wait_closed()
     assert not server.is_serving() and listening.fileno() == -1
@@ -80,6 +81,12 @@ async def _serve_on_a_given_socket() -> None:
     assert await reader.readexactly(6) == b"still!"
     for _, writer in clients:
         writer.close()
+        await writer.wait_closed()
+    for _ in range(100):
+        if open_connections() == 0:
+            break
+        await asyncio.sleep(0.01)
+    assert open_connections() == 0
 
 
 def test_the_balanced_loop_serves_a_shared_socket_and_stops_at_close():
