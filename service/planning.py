@@ -36,8 +36,9 @@ RESERVED_BYTES = 256_000
 
 
 #: Timing methods whose requests may be tried on the event loop first: they check their
-#: deadline between short steps and do not size their work by it.
-LEASHED_METHODS = frozenset({"phase_plane", "toppra", "cubic", "quintic", "trapezoidal", "cycloidal"})
+#: deadline between short steps and do not size their work by it. Not ``toppra``, whose solve
+#: (toppra's own, 20 to 70 ms on 8 ur5 waypoints) checks none: a try would run it whole.
+LEASHED_METHODS = frozenset({"phase_plane", "cubic", "quintic", "trapezoidal", "cycloidal"})
 #: Most waypoints of a request tried on the event loop first: the typical request (4 on ur5)
 #: plans in 3 to 6 ms, ten waypoints in 9 to 14 ms, thirty in about 30 ms.
 LEASHED_WAYPOINTS = 8
@@ -45,13 +46,14 @@ LEASHED_WAYPOINTS = 8
 
 def worth_a_leash(request: TrajectoryRequest) -> bool:
     """Whether ``request`` is small enough to be tried on the event loop first
-    (``PlanningWorkers.run``): a few waypoints without obstacles, a built catalog robot, a
-    method of ``LEASHED_METHODS`` on the default grid or a small one. Anything else would
+    (``PlanningWorkers.run``): a few waypoints without obstacles nor via points, a built
+    catalog robot, a method of ``LEASHED_METHODS`` on the default grid or a small one. Anything else would
     mostly slip the leash, and the try would be time lost."""
     path, timing = request.path, request.timing
     return (
         isinstance(path, WaypointsPath)
         and len(path.waypoints) <= LEASHED_WAYPOINTS
+        and path.interpolation != "via"  # each segment timed by bisection: 0.5 s on 8 ur5 waypoints
         and not path.obstacles
         and timing.method in LEASHED_METHODS
         and (timing.grid_points or 0) <= 1_000

@@ -227,6 +227,11 @@ def test_only_small_waypoint_requests_on_a_checking_method_are_worth_a_leash():
         assert not worth_a_leash(TrajectoryRequest.model_validate(_example(example))), example
     many = {**typical, "path": {**typical["path"], "waypoints": typical["path"]["waypoints"] * 3}}
     assert not worth_a_leash(TrajectoryRequest.model_validate(many))
+    via = {**typical, "path": {**typical["path"], "interpolation": "via"}, "timing": {**typical["timing"], "method": "quintic"}}
+    assert not worth_a_leash(TrajectoryRequest.model_validate(via))
+    assert worth_a_leash(TrajectoryRequest.model_validate({**via, "path": typical["path"]}))
+    toppra = {**typical, "timing": {**typical["timing"], "method": "toppra"}}  # its solve checks no deadline
+    assert not worth_a_leash(TrajectoryRequest.model_validate(toppra))
     uploaded = {**typical, "robot": "not_built_here"}
     assert not worth_a_leash(TrajectoryRequest.model_validate(uploaded))
 
