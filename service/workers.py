@@ -115,8 +115,9 @@ class PlanningWorkers:
             if leashed and 0.0 < self.leash_s < budget_s and await self._alone():
                 try:
                     return function(Leash(self.leash_s))
-                except LeashSlipped:
-                    pass  # again in a thread, under the same deadline
+                except LeashSlipped:  # again in a thread, under the same deadline, if any is left
+                    if deadline.remaining() == 0.0:
+                        raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s") from None
             await self._acquire(deadline, budget_s)
             loop = asyncio.get_running_loop()
             # One future of this loop, settled by the planning thread through one callback: the

@@ -107,6 +107,20 @@ def test_a_planning_over_its_budget_after_slipping_gets_the_budget_error_at_the_
     assert len(calls) == 2
 
 
+def test_a_try_that_overran_the_whole_budget_is_the_budget_error_without_a_second_run():
+    calls: list = []
+
+    def overrun(deadline):
+        time.sleep(0.08)  # a step that checks nothing, past the budget
+        deadline.check()
+        return "answer"
+
+    with pytest.raises(BudgetExceeded, match="planning exceeded its time budget of 0.05 s") as raised:
+        _run(PlanningWorkers(workers=1, queue=2, leash_s=0.02), _recording(calls, overrun), budget_s=0.05)
+    assert not isinstance(raised.value, LeashSlipped)
+    assert len(calls) == 1
+
+
 def test_the_event_loop_is_free_while_a_slipped_planning_runs_in_its_thread():
     async def main():
         pool = PlanningWorkers(workers=1, queue=2, leash_s=0.01)
