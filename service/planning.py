@@ -47,8 +47,8 @@ LEASHED_WAYPOINTS = 8
 def worth_a_leash(request: TrajectoryRequest) -> bool:
     """Whether ``request`` is small enough to be tried on the event loop first
     (``PlanningWorkers.run``): a few waypoints without obstacles nor via points, a built
-    catalog robot, a method of ``LEASHED_METHODS`` on the default grid or a small one. Anything else would
-    mostly slip the leash, and the try would be time lost."""
+    catalog robot, a method of ``LEASHED_METHODS`` on the default grid or a small one.
+    Anything else would mostly slip the leash, and the try would be time lost."""
     path, timing = request.path, request.timing
     return (
         isinstance(path, WaypointsPath)

@@ -61,7 +61,8 @@ RETRY_S = 1.0
 
 _log = logging.getLogger("uvicorn.error")
 _RESOURCE_ERRORS = {errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM}
-#: The connection sockets the balanced servers of this process accepted (``open_connections``).
+#: The connection sockets the balanced servers of this process accepted: what its turn at
+#: accepting waits on, and what a planning asks before a try on the event loop.
 _accepted: weakref.WeakSet[socket.socket] = weakref.WeakSet()
 
 
@@ -139,12 +140,11 @@ async def _wait_readable(loop: asyncio.AbstractEventLoop, sock: socket.socket) -
 
 async def _accept_in_turns(loop: asyncio.AbstractEventLoop, listening: socket.socket, protocol_factory) -> None:
     """Accept connections on ``listening`` one per turn until it is closed."""
-    held: weakref.WeakSet[socket.socket] = weakref.WeakSet()  # accepted connection sockets
     while listening.fileno() != -1:
         await _wait_readable(loop, listening)
-        open_connections = sum(1 for connection in held if connection.fileno() != -1)
-        if open_connections:
-            await asyncio.sleep(min(open_connections, MAX_TURNS) * TURN_S)
+        held = open_connections()
+        if held:
+            await asyncio.sleep(min(held, MAX_TURNS) * TURN_S)
         try:
             connection, _ = listening.accept()
         except (BlockingIOError, InterruptedError, ConnectionAbortedError):
@@ -156,7 +156,6 @@ async def _accept_in_turns(loop: asyncio.AbstractEventLoop, listening: socket.so
             await asyncio.sleep(RETRY_S)
             continue
         connection.setblocking(False)
-        held.add(connection)
         _accepted.add(connection)
         try:
             await loop.connect_accepted_socket(protocol_factory, connection)

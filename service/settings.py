@@ -31,8 +31,9 @@ class Settings(BaseSettings):
             number of cores; under ``toptraj serve --workers N``, the cores divided by N, at
             least 1: a process's planning threads share one interpreter lock, so more threads
             add no throughput, and N processes then run as many plannings as there are cores).
-        plan_leash_s: How long a planning is first tried on the event loop when no other
-            planning runs or waits, in s (``PlanningWorkers.run``; 0: always in a thread).
+        plan_leash_s: How long a small planning (``service.planning.worth_a_leash``) is first
+            tried on the event loop when its process holds no other planning nor connection,
+            in s (``PlanningWorkers.run``; 0: always in a thread).
         plan_queue: Requests that may wait for a planning worker of this process (within
             their budget); beyond, 503 with ``Retry-After``.
         job_workers: Jobs (``/v1/jobs``) running at once, each in a worker process, over every
