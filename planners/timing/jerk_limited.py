@@ -136,7 +136,7 @@ class JerkLimitedMethod(TimingMethod):
                 break
             finer = constraints.with_points(0.5 * (constraints.s[:-1] + constraints.s[1:]))
             started = time.perf_counter()
-            finer_best = self._grid_solution(finer, boundary, deadline)
+            finer_best = self._grid_solution(finer, boundary, deadline, start=best)
             elapsed = time.perf_counter() - started
             gap = relative_gap(best.duration, finer_best.duration)
             how = f"second grid: the difference from the solution on a grid of half as many points ({len(constraints.s) - 1} intervals)"
@@ -152,10 +152,15 @@ class JerkLimitedMethod(TimingMethod):
                 )
         return best
 
-    def _grid_solution(self, constraints: PathConstraints, boundary: Boundary, deadline: Deadline) -> JerkTimeScaling:
-        """The sequence of restricted LPs on the grid of ``constraints`` (module docstring)."""
-        reference = PhasePlaneMethod(max_refinements=0).solve(constraints, boundary, None, deadline)
-        x_ref = np.maximum(reference.speed_at(constraints.s) ** 2, 0.0)
+    def _grid_solution(
+        self, constraints: PathConstraints, boundary: Boundary, deadline: Deadline, start: JerkTimeScaling | None = None
+    ) -> JerkTimeScaling:
+        """The sequence of restricted LPs on the grid of ``constraints`` (module docstring), the
+        first restriction taken around the jerk-free optimum, or around ``start`` (the solution
+        on a coarser grid, which saves most of the LPs)."""
+        if start is None:
+            reference = PhasePlaneMethod(max_refinements=0).solve(constraints, boundary, None, deadline)
+        x_ref = np.maximum((reference if start is None else start).speed_at(constraints.s) ** 2, 0.0)
         problem = RestrictedProgram(constraints, boundary, x_ref, deadline)
         # The first restriction is taken around the jerk-free optimum, which is no feasible
         # point itself; its LP solution is, and every later step starts from a feasible point.
@@ -196,8 +201,8 @@ class JerkLimitedMethod(TimingMethod):
 
     def _affordable(self, constraints: PathConstraints, elapsed: float, deadline: Deadline) -> bool:
         """Whether a grid twice as fine fits the grid budget and (at about four times the last
-        solve's time) the time left."""
-        if 2 * (len(constraints.s) - 1) > self.grid_budget:
+        solve's time) the time left, on constraints that can be evaluated at new points."""
+        if not constraints.can_refine or 2 * (len(constraints.s) - 1) > self.grid_budget:
             return False
         remaining = deadline.remaining()
         return remaining is None or remaining > 4.0 * elapsed + 1.0
