@@ -80,6 +80,9 @@ from planners.timing.phase_plane import PhasePlaneMethod
 #: Where the limits give no constant-jerk phase at an end at rest, the first interval is
 #: this fraction of the grid's own first interval.
 FALLBACK_FIRST_INTERVAL = 1e-3
+#: Relative gain below which the LPs on a refined grid, started from the coarser solution,
+#: stop: a hundredth of the gap the refinement aims at.
+WARM_TOLERANCE = 1e-2 * TARGET_GAP
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
 MIN_FIRST_INTERVAL = 1e-5
 
@@ -131,12 +134,17 @@ class JerkLimitedMethod(TimingMethod):
         best = self._grid_solution(constraints, boundary, deadline)
         elapsed = time.perf_counter() - started
         gap, how = self._second_grid(constraints, original, boundary, best, deadline)
-        for _ in range(self.max_refinements):
+        for done in range(self.max_refinements):
             if gap is None or gap <= TARGET_GAP or not self._affordable(constraints, elapsed, deadline):
+                break
+            # The error about halves with each doubling (first order; the LPs cost four times
+            # as much): where the doublings left would not bring it to the target, the answer
+            # states its gap instead.
+            if gap / 2 ** (self.max_refinements - done) > TARGET_GAP:
                 break
             finer = constraints.with_points(0.5 * (constraints.s[:-1] + constraints.s[1:]))
             started = time.perf_counter()
-            finer_best = self._grid_solution(finer, boundary, deadline, start=best)
+            finer_best = self._grid_solution(finer, boundary, deadline, start=best, tolerance=WARM_TOLERANCE)
             elapsed = time.perf_counter() - started
             gap = relative_gap(best.duration, finer_best.duration)
             how = f"second grid: the difference from the solution on a grid of half as many points ({len(constraints.s) - 1} intervals)"
@@ -153,11 +161,14 @@ class JerkLimitedMethod(TimingMethod):
         return best
 
     def _grid_solution(
-        self, constraints: PathConstraints, boundary: Boundary, deadline: Deadline, start: JerkTimeScaling | None = None
+        self, constraints: PathConstraints, boundary: Boundary, deadline: Deadline, start: JerkTimeScaling | None = None,
+        tolerance: float | None = None,
     ) -> JerkTimeScaling:
         """The sequence of restricted LPs on the grid of ``constraints`` (module docstring), the
         first restriction taken around the jerk-free optimum, or around ``start`` (the solution
-        on a coarser grid, which saves most of the LPs)."""
+        on a coarser grid, which saves most of the LPs), stopped at a relative gain below
+        ``tolerance`` (the method's own by default)."""
+        tolerance = self.tolerance if tolerance is None else max(tolerance, self.tolerance)
         if start is None:
             reference = PhasePlaneMethod(max_refinements=0).solve(constraints, boundary, None, deadline)
         x_ref = np.maximum((reference if start is None else start).speed_at(constraints.s) ** 2, 0.0)
@@ -180,7 +191,7 @@ class JerkLimitedMethod(TimingMethod):
             if gain <= 0.0:
                 break
             x, u, best = x_step, u_step, candidate
-            if gain <= self.tolerance * best.duration:
+            if gain <= tolerance * best.duration:
                 break
         return best
 
