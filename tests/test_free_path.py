@@ -82,6 +82,10 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     # 0.5515; the collocation's own and the re-timed one within 0.5 %.
     assert cheap.solver["cost"] == pytest.approx(0.5515, rel=5e-3)
     assert cheap.cost == pytest.approx(0.5515, rel=5e-3)
+    # The stated gap (the cost on 12 collocation intervals against 30) bounds the distance
+    # from the converged cost.
+    assert "second grid" in cheap.solver["gap_basis"]
+    assert abs(cheap.solver["cost"] - 0.5515) / 0.5515 <= cheap.solver["optimality_gap"] <= 5e-3
     assert cheap.peak_utilization["torque"].max() <= 1.005
     fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
     assert fast.duration < cheap.duration
@@ -90,6 +94,7 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     assert fast.solver["switching"] == "refined"
     assert fast.duration <= fast.solver["duration"]
     assert fast.duration == pytest.approx(0.20599, rel=5e-4)
+    assert fast.solver["optimality_gap"] <= 1e-4
 
 
 def test_ur5_smoke():

@@ -24,7 +24,9 @@ import robots
 from planners import Timing, WaypointPath, plan
 from planners.constraints import build_path_constraints
 from planners.grid import path_grid
+from planners.timing.jerk_closed_form import ScalarLimits, double_s
 from planners.timing.jerk_limited import JerkLimitedMethod
+from planners.timing.jerk_segments import segment_starts
 from planners.waypoint_checks import make_path
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")
@@ -174,3 +176,18 @@ def test_a_grid_answer_states_its_gap_and_is_refined_below_a_tenth_of_a_percent(
     assert refined.duration < unrefined.duration
     # The estimate of the unrefined answer holds against the refined one.
     assert (unrefined.duration - refined.duration) / refined.duration <= unrefined.optimality_gap
+
+
+@pytest.mark.parametrize(
+    "limits, expected",
+    [
+        (ScalarLimits(np.inf, np.inf, 6.0), 4.0 * (1.0 / 12.0) ** (1.0 / 3.0)),  # jerk alone
+        (ScalarLimits(np.inf, 0.5, 40.0), _textbook_duration(1.0, 1e12, 0.5, 40.0)),  # no velocity bound
+        (ScalarLimits(0.2, np.inf, 40.0), _textbook_duration(1.0, 0.2, 1e12, 40.0)),  # no acceleration bound
+    ],
+)
+def test_the_double_s_profile_without_a_velocity_or_an_acceleration_bound(limits, expected):
+    durations, jerks = double_s(1.0, limits)
+    assert durations.sum() == pytest.approx(expected, rel=1e-9)
+    end = segment_starts(durations, jerks, (0.0, 0.0, 0.0))[-1]
+    assert end == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)
