@@ -23,8 +23,12 @@ from planners.search.local import optimize_locally
 from planners.search.local_outcome import LocalOptimum
 from planners.search.method import global_search
 from planners.timed import Timed, moving_velocity, path_boundary, timed_path, timing_grid
+from planners.timing.jerk_accuracy import TARGET_GAP
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
+
+#: Most collocation intervals a request may ask for (timing.grid_points).
+MAX_INTERVALS = 100
 
 
 def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
@@ -33,8 +37,8 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
         raise InvalidRequest(
             "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
         )
-    if timing.grid_points is not None and not 4 <= timing.grid_points <= 100:
-        raise InvalidRequest(f"timing.grid_points sets the collocation intervals, 4 to 100; got {timing.grid_points}")
+    if timing.grid_points is not None and not 4 <= timing.grid_points <= MAX_INTERVALS:
+        raise InvalidRequest(f"timing.grid_points sets the collocation intervals, 4 to {MAX_INTERVALS}; got {timing.grid_points}")
     if timing.grid_points is not None:
         path_spec = dataclasses.replace(path_spec, intervals=timing.grid_points)
     unlimited = np.full(robot.dof, np.inf)
@@ -45,7 +49,12 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
     )
     result = optimize_motion(robot, limits, path_spec, timing.torque_weight, deadline)
     path, timed = collocation_path(result)
-    solver = {
+    return path, _solver_report(result), timed, result
+
+
+def _solver_report(result) -> dict:
+    """The collocation's figures for the answer's ``solver``."""
+    return {
         "cost": result.cost,
         "duration": float(result.t[-1]),
         "status": result.status,
@@ -53,7 +62,6 @@ def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
         "initial_guess": result.initial_guess,
         "solve_s": result.solve_s,
     }
-    return path, solver, timed, result
 
 
 def timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, threshold) -> Timed:
@@ -81,12 +89,23 @@ def timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thre
         stretch = checked(robot, path, result, "collocation", kinds, limits, threshold, constraints)
         notes = (f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})",)
     switching = None
+    source = collocation
     if timing.torque_weight == 0.0:
         deadline.progress(0.9, "refining the switching times")
-        path, result, stretch, switching, notes = _switched(
+        path, result, stretch, switching, notes, winner, source = _switched(
             robot, spec, collocation, (path, result, stretch), kinds, limits, threshold, notes, deadline
         )
-        solver = {**solver, "switching": "refined" if switching is not None else "read off the samples"}
+        solver = {**solver, **_solver_report(winner), "switching": "refined" if switching is not None else "read off the samples"}
+    solver = {**solver, "optimality_gap": source.optimality_gap, "gap_basis": source.gap_basis}
+    if timing.torque_weight == 0.0 and source.optimality_gap is not None and source.optimality_gap > TARGET_GAP:
+        advice = (
+            f": more timing.grid_points (collocation intervals, up to {MAX_INTERVALS}) bring it closer"
+            if len(collocation.t) - 1 < MAX_INTERVALS else ""
+        )
+        notes = (
+            *notes,
+            f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis}){advice}",
+        )
     cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
     return Timed(path, result, (stretch,), "collocation", notes, cost, solver, switching_times=switching)
 
@@ -94,18 +113,27 @@ def timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thre
 def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, deadline):
     """The time-optimal free motion with exact bang-bang torques (``planners.free_path.switching``)
     in place of ``timed`` (path, timing, stretch) when it reaches the goal, is not longer and
-    passes the limit gate; with its switching times (else ``None``)."""
+    passes the limit gate; with its switching times (else ``None``). The collocation's rivals
+    (``CollocationResult.rivals``) are refined too and the shortest refined motion wins; the
+    collocation result it came from is returned, and the result whose ``optimality_gap`` the
+    answer states (the refined motion, or else the collocation)."""
     path, result, stretch = timed
-    refined = refine_collocation(robot, limits, spec, collocation, deadline)
-    if refined is None or refined.duration > result.duration:
-        return path, result, stretch, None, notes
+    refined, winner = None, collocation
+    # The rivals (other goals the fine grid found close) are compared on exact terms too: the
+    # collocation's grid error can exceed their difference.
+    for candidate in (collocation, *collocation.rivals):
+        motion = refine_collocation(robot, limits, spec, candidate, deadline)
+        if motion is not None and (refined is None or motion.duration < refined.duration):
+            refined, winner = motion, candidate
+    if refined is None or (winner is collocation and refined.duration > result.duration):
+        return path, result, stretch, None, notes, collocation, collocation
     switched, timing = switched_path(refined)
     constraints = build_path_constraints(switched, robot, limits, kinds, path_grid(switched), deadline)
     try:
         stretch = checked(robot, switched, timing, "collocation", kinds, limits, threshold, constraints)
     except InfeasiblePath as error:
-        return path, result, stretch, None, (*notes, f"the bang-bang refinement is not returned: {error.detail}")
-    return switched, timing, stretch, switching_times(refined.controls, robot.joint_names), notes
+        return path, result, stretch, None, (*notes, f"the bang-bang refinement is not returned: {error.detail}"), collocation, collocation
+    return switched, timing, stretch, switching_times(refined.controls, robot.joint_names), notes, winner, refined
 
 
 def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstacles, clearance) -> Timed:

@@ -34,8 +34,8 @@ def arm():
     return robots.load("geering_2r")
 
 
-def _answer(arm, phi_b, revolutions):
-    motion = FreeMotion(np.zeros(2), np.array([phi_b, 0.0]), revolutions=revolutions)
+def _answer(arm, phi_b, revolutions, elbow=0.0):
+    motion = FreeMotion(np.zeros(2), np.array([phi_b, elbow]), revolutions=revolutions)
     return plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002)
 
 
@@ -46,7 +46,9 @@ def type_2(arm):
 
 @pytest.fixture(scope="module")
 def type_3(arm):
-    return _answer(arm, 0.76, revolutions=True)
+    """The paper's Fig. 3 motion, asked for by its goal (at phi_b = 0.76 itself the elbow's
+    return, Type 1, is 0.7 ms faster: ``test_at_0_76_the_elbow_returns``)."""
+    return _answer(arm, 0.76, revolutions=False, elbow=-2 * np.pi)
 
 
 @pytest.fixture(scope="module")
@@ -199,3 +201,33 @@ def test_switching_times_in_the_answer_schema(type_3):
     assert body["switching_times"]["psi"] == pytest.approx([type_3.duration / 2], abs=1e-4)
     field = create_app(Settings(preload_robots=False)).openapi()["components"]["schemas"]["TrajectoryResponse"]["properties"]["switching_times"]
     assert "(s)" in field["description"]
+
+
+def test_at_0_76_the_elbow_returns(arm, type_3):
+    """phi_b = 0.76 lies 1.3 mrad below the bisected Type 1 / Type 3 boundary [0.7609, 0.7617]:
+    with the elbow free the answer is the psi_b = 0 motion (0.974963 s), the one asked for by
+    its goal, not the -2 pi one (0.975644 s), which the 30-interval collocation ranks first."""
+    free = _answer(arm, 0.76, revolutions=True)
+    returning = _answer(arm, 0.76, revolutions=False)
+    assert free.solver["switching"] == returning.solver["switching"] == type_3.solver["switching"] == "refined"
+    assert free.samples.q[-1] == pytest.approx([0.76, 0.0], abs=1e-9)
+    assert free.duration == pytest.approx(returning.duration, rel=1e-9)
+    assert free.duration == pytest.approx(0.974963, abs=1e-6)
+    assert type_3.duration == pytest.approx(0.975644, abs=1e-6)
+    assert free.solver["optimality_gap"] <= 1e-6
+
+
+def test_at_1_74_the_switches_are_refined_to_the_type_3_optimum(arm, type_3):
+    """Near its boundary with Type 4, Type 3's inner u1 arcs last about 30 ms: the collocation's
+    torque crosses zero three times within them without saturating, and reading only the
+    first crossing gave a structure that reaches no goal. The answer is the optimum of the Type 3
+    family continued from phi_b = 0.76 (an independent computation: switching times solved step
+    by step from Fig. 3's motion)."""
+    answer = _answer(arm, 1.74, revolutions=True)
+    assert answer.solver["switching"] == "refined"
+    assert answer.samples.q[-1] == pytest.approx([1.74, -2 * np.pi], abs=1e-9)
+    reference = _family(arm, type_3, 0.76).at(1.74)
+    assert reference is not None and reference.label() == "(max, min, max, min); (min, max)"
+    assert answer.duration == pytest.approx(reference.duration, rel=1e-6)
+    assert answer.solver["optimality_gap"] <= 1e-6
+    assert "second integration" in answer.solver["gap_basis"]

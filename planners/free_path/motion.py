@@ -30,7 +30,11 @@ class FreeMotion:
 @dataclass(frozen=True)
 class CollocationResult:
     """The optimized motion at K + 1 instants: times (K+1,), q, v, a, tau (K+1, n_dof); its cost
-    J (s), the solver's status and iteration count, and the winning initial guess."""
+    J (s), the solver's status and iteration count, and the winning initial guess; ``rivals``:
+    the fine-grid solutions to the other goals (the elbow a revolution either way) whose coarse
+    cost came close, costlier on the fine grid, for a comparison on exact terms (the bang-bang
+    refinement); the same goal's cost on the coarse grid (``coarse_intervals``), for the estimate
+    of the fine grid's error."""
 
     t: np.ndarray
     q: np.ndarray
@@ -42,3 +46,23 @@ class CollocationResult:
     iterations: int
     initial_guess: str
     solve_s: float
+    rivals: tuple[CollocationResult, ...] = ()
+    coarse_cost: float | None = None
+    coarse_intervals: int = 0
+
+    @property
+    def optimality_gap(self) -> float | None:
+        """Estimated relative distance of the cost from the optimum of the collocation's problem
+        (its goal): the difference from the same goal's solution on the coarse grid, which
+        bounds the fine grid's error from above where the error shrinks with the interval.
+        ``None`` when unknown."""
+        if self.coarse_cost is None:
+            return None
+        return max(0.0, (self.coarse_cost - self.cost) / self.cost)
+
+    @property
+    def gap_basis(self) -> str:
+        """How ``optimality_gap`` was obtained."""
+        if self.coarse_cost is None:
+            return "none"
+        return f"second grid: the cost on {self.coarse_intervals} intervals against {len(self.t) - 1}"

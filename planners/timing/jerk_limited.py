@@ -46,17 +46,31 @@ the duration on the default grid). Where every limit is the same along the whole
 straight joint line under velocity, acceleration and jerk limits) and the solution has at most
 nine phases, ``planners.timing.jerk_polish`` refines it in time, as segments of constant jerk
 with free switching times: the exact optimum there (Berscheid & Kroeger's profile, the same as
-ruckig's along the line).
+ruckig's along the line). Where, moreover, the motion goes from rest to rest and every row
+reduces to a symmetric bound on sd, sdd or sddd alone, the optimum is the double-S profile in
+closed form (``planners.timing.jerk_closed_form``), returned without solving anything: the
+polish is a local method started from the grid solution's phases, and misses the optimum
+(keeping the grid solution, up to 2 % above it) where those phases differ from the profile's.
+
+Every answer carries an estimate of its distance from the optimum (``optimality_gap``): zero
+for the closed form, else the difference from the solution on a second grid of half as many
+points (``planners.timing.jerk_accuracy``); above ``TARGET_GAP`` the grid is doubled, at most
+``max_refinements`` times, while the grid budget and the time left allow.
 """
 
 from __future__ import annotations
+
+import dataclasses
+import time
 
 import numpy as np
 
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
-from planners.errors import InvalidRequest
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.timing.base import AT_REST, Boundary, TimingMethod
+from planners.timing.jerk_accuracy import TARGET_GAP, coarser, relative_gap
+from planners.timing.jerk_closed_form import closed_form_timing
 from planners.timing.jerk_polish import polish
 from planners.timing.jerk_program import RestrictedProgram
 from planners.timing.jerk_scaling import JerkTimeScaling
@@ -66,6 +80,11 @@ from planners.timing.phase_plane import PhasePlaneMethod
 #: Where the limits give no constant-jerk phase at an end at rest, the first interval is
 #: this fraction of the grid's own first interval.
 FALLBACK_FIRST_INTERVAL = 1e-3
+#: Relative gain below which the LPs on a refined grid, started from the coarser solution,
+#: stop: a hundredth of the gap the refinement aims at.
+WARM_TOLERANCE = 1e-2 * TARGET_GAP
+#: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
+MIN_FIRST_INTERVAL = 1e-5
 
 
 class JerkLimitedMethod(TimingMethod):
@@ -75,6 +94,9 @@ class JerkLimitedMethod(TimingMethod):
     Args:
         tolerance: Relative decrease of the duration below which the iteration stops.
         max_iterations: Most LPs solved.
+        polish: Whether to refine the grid solution in time where the limits do not change.
+        max_refinements: Most doublings of the grid while the estimated gap of the answer
+            (``planners.timing.jerk_accuracy``) exceeds ``TARGET_GAP``.
     """
 
     name = "jerk_limited"
@@ -85,10 +107,11 @@ class JerkLimitedMethod(TimingMethod):
     #: 2,000 intervals solve in about a second per LP.
     grid_budget = 12_000
 
-    def __init__(self, tolerance: float = 1e-7, max_iterations: int = 60, polish: bool = True):
+    def __init__(self, tolerance: float = 1e-7, max_iterations: int = 60, polish: bool = True, max_refinements: int = 2):
         self.tolerance = tolerance
         self.max_iterations = max_iterations
         self.polish = polish
+        self.max_refinements = max_refinements
 
     def solve(
         self,
@@ -101,9 +124,54 @@ class JerkLimitedMethod(TimingMethod):
             raise InvalidRequest("timing.method 'jerk_limited' needs the jerk constraint")
         if boundary.sdd_start or boundary.sdd_end:
             raise InvalidRequest("timing.method 'jerk_limited' starts and ends with zero acceleration")
+        if boundary.sd_start == 0.0 and boundary.sd_end == 0.0 and _uniform(constraints):
+            exact = closed_form_timing(constraints)
+            if exact is not None:
+                return exact
+        original = constraints.s
         constraints = _graded(constraints, boundary)
-        reference = PhasePlaneMethod(max_refinements=0).solve(constraints, boundary, None, deadline)
-        x_ref = np.maximum(reference.speed_at(constraints.s) ** 2, 0.0)
+        started = time.perf_counter()
+        best = self._grid_solution(constraints, boundary, deadline)
+        elapsed = time.perf_counter() - started
+        gap, how = self._second_grid(constraints, original, boundary, best, deadline)
+        for done in range(self.max_refinements):
+            if gap is None or gap <= TARGET_GAP or not self._affordable(constraints, elapsed, deadline):
+                break
+            # The error about halves with each doubling (first order; the LPs cost four times
+            # as much): where the doublings left would not bring it to the target, the answer
+            # states its gap instead.
+            if gap / 2 ** (self.max_refinements - done) > TARGET_GAP:
+                break
+            finer = constraints.with_points(0.5 * (constraints.s[:-1] + constraints.s[1:]))
+            started = time.perf_counter()
+            finer_best = self._grid_solution(finer, boundary, deadline, start=best, tolerance=WARM_TOLERANCE)
+            elapsed = time.perf_counter() - started
+            gap = relative_gap(best.duration, finer_best.duration)
+            how = f"second grid: the difference from the solution on a grid of half as many points ({len(constraints.s) - 1} intervals)"
+            constraints, best = finer, finer_best
+        best = dataclasses.replace(best, optimality_gap_estimate=gap, optimality_gap_how=how)
+        if self.polish and _uniform(constraints):
+            polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
+            if polished is not None:
+                # Shorter than the grid solution and feasible: no farther from the optimum.
+                return dataclasses.replace(
+                    polished, optimality_gap_estimate=gap,
+                    optimality_gap_how=f"bounded by the grid solution's estimate, which it improves on ({how})",
+                )
+        return best
+
+    def _grid_solution(
+        self, constraints: PathConstraints, boundary: Boundary, deadline: Deadline, start: JerkTimeScaling | None = None,
+        tolerance: float | None = None,
+    ) -> JerkTimeScaling:
+        """The sequence of restricted LPs on the grid of ``constraints`` (module docstring), the
+        first restriction taken around the jerk-free optimum, or around ``start`` (the solution
+        on a coarser grid, which saves most of the LPs), stopped at a relative gain below
+        ``tolerance`` (the method's own by default)."""
+        tolerance = self.tolerance if tolerance is None else max(tolerance, self.tolerance)
+        if start is None:
+            reference = PhasePlaneMethod(max_refinements=0).solve(constraints, boundary, None, deadline)
+        x_ref = np.maximum((reference if start is None else start).speed_at(constraints.s) ** 2, 0.0)
         problem = RestrictedProgram(constraints, boundary, x_ref, deadline)
         # The first restriction is taken around the jerk-free optimum, which is no feasible
         # point itself; its LP solution is, and every later step starts from a feasible point.
@@ -123,13 +191,32 @@ class JerkLimitedMethod(TimingMethod):
             if gain <= 0.0:
                 break
             x, u, best = x_step, u_step, candidate
-            if gain <= self.tolerance * best.duration:
+            if gain <= tolerance * best.duration:
                 break
-        if self.polish and _uniform(constraints):
-            polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
-            if polished is not None:
-                return polished
         return best
+
+    def _second_grid(self, constraints, original, boundary, best, deadline) -> tuple[float | None, str]:
+        """The estimated relative gap of ``best`` and how it was obtained: the difference from
+        the solution on every other grid point (``planners.timing.jerk_accuracy``)."""
+        coarse = coarser(constraints, original)
+        if coarse is None:
+            return None, "none: the grid is too coarse for a second one"
+        try:
+            coarse_best = self._grid_solution(coarse, boundary, deadline)
+        except (InfeasiblePath, TimingFailed) as error:
+            return None, f"none: the second grid's solve failed ({error.detail})"
+        return (
+            relative_gap(coarse_best.duration, best.duration),
+            f"second grid: the difference from the solution on a grid of half as many points ({len(coarse.s) - 1} intervals)",
+        )
+
+    def _affordable(self, constraints: PathConstraints, elapsed: float, deadline: Deadline) -> bool:
+        """Whether a grid twice as fine fits the grid budget and (at about four times the last
+        solve's time) the time left, on constraints that can be evaluated at new points."""
+        if not constraints.can_refine or 2 * (len(constraints.s) - 1) > self.grid_budget:
+            return False
+        remaining = deadline.remaining()
+        return remaining is None or remaining > 4.0 * elapsed + 1.0
 
 
 def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:
@@ -194,7 +281,11 @@ def _graded(constraints: PathConstraints, boundary: Boundary) -> PathConstraints
     ):
         if not at_rest:
             continue
-        phase = _start_phase(constraints, point)
+        # A phase shorter than the floor (a jerk limit far above what the other limits let
+        # matter) would put grid points within rounding of the end, and rows of size 1 / h^2
+        # into the program: the first interval is then the floor, over which the jerk limit
+        # does not bind.
+        phase = max(_start_phase(constraints, point), room * MIN_FIRST_INTERVAL / _REST_POINTS[0])
         if not np.isfinite(phase):
             phase = room * FALLBACK_FIRST_INTERVAL / _REST_POINTS[0]
         offsets = phase * _REST_POINTS
