@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from planners.collision import Obstacle, check_clearance
+from planners.collision.obstacles import check_obstacles
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.free_path import FreeMotion
@@ -128,6 +129,7 @@ def plan(
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)
     check_timing(timing, dt)
+    check_obstacles(obstacles)
     if exact_period and any(
         v is not None and np.any(np.asarray(v) != 0.0) for v in (timing.start_velocity, timing.end_velocity)
     ):
