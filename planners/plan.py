@@ -22,6 +22,7 @@ from planners.gate import TimedStretch, gate_threshold, samples_exceed
 from planners.grid import MAX_POINTS, spread_indices
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.mvc import admissible_set
+from planners.paths.blended import MIN_BLEND, BlendedPath
 from planners.paths.cartesian import CartesianLine
 from planners.ranges import DT, check_timing
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
@@ -194,6 +195,12 @@ def plan(
                 checked_first = check_clearance(path, robot, list(obstacles), clearance, deadline)
             timed = timed_path(robot, path, method, timing, kinds, limits, timing_part.within(0.1, 1.0), threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
+    if isinstance(path, BlendedPath) and path.tight_corners:
+        notes.append(
+            f"path.max_deviation = {path.max_deviation:g} is too small to blend the corners at waypoints "
+            f"{', '.join(map(str, path.tight_corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
+            "stops there"
+        )
     deadline.check()
     found_clearance = None
     if obstacles:
