@@ -5,15 +5,18 @@ bounded time and text, never a 500."""
 
 from __future__ import annotations
 
+import hashlib
 import time
 from pathlib import Path
 
 import pytest
 
+import robots
 from robots.bounded_yaml import MAX_ALIASES, MAX_CHARS, MAX_DEPTH, MAX_NODES
 from robots.catalog import example_urdf_path
-from robots.errors import MAX_DETAIL_CHARS, excerpt
+from robots.errors import MAX_DETAIL_CHARS, InvalidURDF, excerpt
 from robots.ranges import LIMITS
+from robots.upload_options import UploadOptions
 
 UR5 = Path(example_urdf_path("ur5")).read_text()
 KEYS = {"velocity": "max_velocity", "acceleration": "max_acceleration", "jerk": "max_jerk", "torque": "max_effort"}
@@ -223,3 +226,19 @@ def test_excerpt_is_bounded_whatever_the_value():
     assert excerpt("short") == "'short'"
     assert excerpt({"a": 1}) == "a mapping of 1 key"
     assert excerpt(object()) == "a value of type object"
+
+
+def test_a_stored_upload_whose_limits_left_their_range_no_longer_loads(tmp_path):
+    """Options stored before the ranges were checked (1e-300 rad/s^2) are checked when the
+    robot is built: the load names the joint, the limit and its source instead of planning."""
+    previous = robots.upload_store()
+    try:
+        store = robots.configure_uploads(tmp_path)
+        options = UploadOptions(joint_limits={"elbow_joint": {"acceleration": 1e-300}})
+        store.put("ur5_stale", hashlib.sha256(UR5.encode()).hexdigest(), UR5, 6, options.to_json())
+        with pytest.raises(InvalidURDF) as raised:
+            robots.load("ur5_stale")
+        assert "the stored upload 'ur5_stale' no longer passes the checks" in raised.value.detail
+        assert "joint 'elbow_joint': the acceleration limit 1e-300 rad/s^2 from joint_limits.yaml" in raised.value.detail
+    finally:
+        robots.configure_uploads(previous.data_dir, max_uploads=previous.max_uploads, max_bytes=previous.max_bytes)
