@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from planners.collision import Obstacle, check_clearance
+from planners.collision.obstacles import check_obstacles
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.free_path import FreeMotion
@@ -21,8 +22,9 @@ from planners.gate import TimedStretch, gate_threshold, samples_exceed
 from planners.grid import MAX_POINTS, spread_indices
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.mvc import admissible_set
+from planners.paths.blended import MIN_BLEND, BlendedPath
 from planners.paths.cartesian import CartesianLine
-from planners.ranges import check_timing
+from planners.ranges import DT, check_timing
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
 from planners.timed import timed_path, timed_unsynchronized, timed_via_points
@@ -128,6 +130,7 @@ def plan(
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)
     check_timing(timing, dt)
+    check_obstacles(obstacles)
     if exact_period and any(
         v is not None and np.any(np.asarray(v) != 0.0) for v in (timing.start_velocity, timing.end_velocity)
     ):
@@ -192,6 +195,12 @@ def plan(
                 checked_first = check_clearance(path, robot, list(obstacles), clearance, deadline)
             timed = timed_path(robot, path, method, timing, kinds, limits, timing_part.within(0.1, 1.0), threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
+    if isinstance(path, BlendedPath) and path.tight_corners:
+        notes.append(
+            f"path.max_deviation = {path.max_deviation:g} is too small to blend the corners at waypoints "
+            f"{', '.join(map(str, path.tight_corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
+            "stops there"
+        )
     deadline.check()
     found_clearance = None
     if obstacles:
@@ -200,11 +209,7 @@ def plan(
     deadline.progress(0.9, "sampling")
     require_finite(timed.method, duration=result.duration)
     if result.duration / dt > max_samples - 2:
-        raise InvalidRequest(
-            f"output.dt = {dt:g} s gives {math.ceil(result.duration / dt) + 1} samples over the "
-            f"{result.duration:.4g} s motion; at most {max_samples} are served: use output.dt >= "
-            f"{_round_up(result.duration / (max_samples - 2)):g} s"
-        )
+        raise InvalidRequest(_too_many_samples(result.duration, dt, max_samples, timing))
     deadline.expect((result.duration / dt + 2) * robot.dof * SAMPLE_SECONDS)
     samples = sample_trajectory(path, result, robot, dt, exact_period)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
@@ -258,6 +263,28 @@ def plan(
         clearance=found_clearance,
         search=timed.search,
     )
+
+
+def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> str:
+    """Why ``duration`` (s) sampled every ``dt`` (s) is not served, and advice that can be
+    followed: the smallest ``output.dt`` that fits when it lies in ``DT``, else the limits that
+    make the motion this slow (no ``output.dt`` beyond its own range is ever advised)."""
+    given = f"output.dt = {dt:g} s gives {math.ceil(duration / dt) + 1} samples over the {duration:.4g} s motion; at most {max_samples} are served"
+    needed = _round_up(duration / (max_samples - 2))
+    if needed <= DT.high:
+        return f"{given}: use output.dt >= {needed:g} s"
+    slowing = [f"timing.limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None]
+    slowing += ["the velocity and acceleration limits (timing.limits and their scales)"]
+    return (
+        f"{given}, and even the largest output.dt ({DT.high:g} s) serves at most {_round_down(DT.high * (max_samples - 2)):g} s "
+        f"of motion: the limits make this motion too slow to serve; raise {' or '.join(slowing)}"
+    )
+
+
+def _round_down(value: float, digits: int = 3) -> float:
+    """``value`` rounded down to ``digits`` significant digits."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.floor(value / scale) * scale
 
 
 def _round_up(value: float, digits: int = 3) -> float:

@@ -14,32 +14,16 @@ A ``Range`` bounds a magnitude: positive quantities (limits, durations, scale fa
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
 from planners.errors import InvalidRequest
-
-
-class Range(NamedTuple):
-    """Closed interval [low, high] of a quantity, with its unit for messages."""
-
-    low: float
-    high: float
-    unit: str
-
-    def describe(self) -> str:
-        """``[low, high] unit`` as a message shows it."""
-        return f"[{self.low:g}, {self.high:g}]{' ' + self.unit if self.unit else ''}"
-
-    def holds(self, value: float) -> bool:
-        """Whether ``value`` lies in the range (NaN never does)."""
-        return self.low <= value <= self.high
-
-    def holds_signed(self, value: float) -> bool:
-        """Whether ``value`` lies in [-high, high] (NaN never does)."""
-        return -self.high <= value <= self.high
-
+from robots.ranges import ACCELERATION as ACCELERATION
+from robots.ranges import JERK as JERK
+from robots.ranges import LIMITS as LIMITS
+from robots.ranges import TORQUE as TORQUE
+from robots.ranges import VELOCITY as VELOCITY
+from robots.ranges import Range as Range
 
 #: Joint coordinates (rad or m): a continuous joint may turn many times, not 1e300.
 COORDINATE = Range(0.0, 1e4, "rad or m")
@@ -47,17 +31,14 @@ COORDINATE = Range(0.0, 1e4, "rad or m")
 DURATION = Range(1e-3, 1e4, "s")
 #: Sample period of the returned trajectory (s): 1 MHz is faster than any drive's loop.
 DT = Range(1e-6, 10.0, "s")
-#: Per-joint limit overrides, and the magnitude of boundary states (rad or m, per s^k).
-VELOCITY = Range(1e-6, 1e3, "rad/s")
-ACCELERATION = Range(1e-6, 1e5, "rad/s^2")
-JERK = Range(1e-6, 1e8, "rad/s^3")
-TORQUE = Range(1e-6, 1e5, "N m")
+#: Per-joint limit overrides and the magnitude of boundary states (rad or m, per s^k) lie in
+#: the ranges of the robots' own limits: ``robots.ranges`` VELOCITY, ACCELERATION, JERK, TORQUE.
+
 #: Tool-speed limits (m/s, rad/s).
 TOOL_SPEED = Range(1e-6, 1e3, "m/s")
 TOOL_ANGULAR_SPEED = Range(1e-6, 1e3, "rad/s")
 #: Largest distance of a blended corner from its waypoint (joint-space norm, rad or m).
 MAX_DEVIATION = Range(1e-9, 1e4, "rad or m")
-LIMITS = {"velocity": VELOCITY, "acceleration": ACCELERATION, "jerk": JERK, "torque": TORQUE}
 #: Factors on a robot's limits.
 SCALE = Range(1e-3, 1e3, "")
 #: Switching fractions of the trapezoidal law (acceleration ends at tau1, cruise at tau2).

@@ -10,12 +10,29 @@ MAX_DETAIL_CHARS = 2_000
 
 
 def excerpt(value: object, limit: int = 60) -> str:
-    """``repr(value)`` cut to about ``limit`` characters, saying how long the whole was: names
-    and values from a request appear in messages only this way."""
-    text = repr(value)
-    if len(text) <= limit:
-        return text
-    return f"{text[:limit]}... ({len(str(value))} characters)"
+    """``value`` as a message shows it, in about ``limit`` characters whatever its size: a
+    string or bytes as the ``repr`` of its first characters and how long the whole is, an
+    integer of more than 30 digits by its number of digits, a list or mapping by its type and
+    length (never its items, which may nest or repeat without end, as YAML aliases do), a
+    number, boolean or ``None`` as its ``repr``, anything else by its type. Names and values
+    from a request or an uploaded file appear in messages only this way."""
+    if isinstance(value, str | bytes):
+        text = repr(value[: limit + 1])
+        if len(value) <= limit and len(text) <= limit + 3:
+            return text
+        return f"{text[:limit]}... ({len(value)} {'characters' if isinstance(value, str) else 'bytes'})"
+    if isinstance(value, bool) or value is None or isinstance(value, float):
+        return repr(value)
+    if isinstance(value, int):
+        if value.bit_length() <= 99:  # at most 30 digits
+            return repr(value)
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    if isinstance(value, list | tuple | set | frozenset | dict):
+        count = len(value)
+        noun = "mapping" if isinstance(value, dict) else type(value).__name__
+        items = "key" if isinstance(value, dict) else "item"
+        return f"a {noun} of {count} {items}{'' if count == 1 else 's'}"
+    return f"a value of type {type(value).__name__}"
 
 
 class ToptrajError(Exception):

@@ -17,6 +17,17 @@ from importlib import resources
 import numpy as np
 
 from robots.errors import InvalidLimits
+from robots.ranges import LIMITS, limit_problem
+
+#: How a message names each source of a limit.
+_SOURCE_NAMES = {"urdf": "the URDF", "limits.toml": "the service's limits.toml"}
+
+
+def _source_name(source: str) -> str:
+    """A source of ``limits_with_sources`` as a message names it."""
+    if source.startswith("default: "):
+        return f"the default rule ({source.removeprefix('default: ')})"
+    return _SOURCE_NAMES.get(source, source)
 
 LIMIT_KINDS = ("position_lower", "position_upper", "velocity", "acceleration", "jerk", "torque")
 
@@ -154,9 +165,16 @@ def limits_with_sources(
     default rule for acceleration (velocity / ``seconds_to_full_speed``) and jerk
     (acceleration / ``seconds_to_full_acceleration``) where nothing gave them.
 
+    Every velocity, acceleration, jerk and torque limit, whatever its source, lies in the
+    accepted range of its kind (``robots.ranges``) or is ``inf`` (no limit).
+
     Returns:
         The limits; {kind: one source per joint}, sources being "urdf", "limits.toml",
         "joint_limits.yaml" or "default: ..." (the rule); the notes.
+
+    Raises:
+        InvalidLimits: a limit outside its accepted range, naming the joint, the limit and its
+            source.
     """
     table = _limit_table()
     entry = table.get(robot_name, {})
@@ -205,6 +223,11 @@ def limits_with_sources(
                 values[kind] = values[kind].copy()
                 values[kind][k] = given[kind][k]
                 sources[kind][k] = "joint_limits.yaml"
+    for kind in LIMITS:
+        for joint, value in enumerate(values[kind]):
+            problem = limit_problem(kind, float(value), names[joint], _source_name(sources[kind][joint]))
+            if problem is not None:
+                raise InvalidLimits(problem)
     limits = JointLimits(
         values["position_lower"], values["position_upper"], values["velocity"], values["acceleration"], values["jerk"],
         values["torque"],

@@ -20,9 +20,14 @@ MoveIt's ``joint_limits.yaml``.
   notes say so. Position limits stay the URDF's (noted when the file gives them), and
   MoveIt's default scaling factors are not applied (noted): requests scale limits themselves.
 
+The text is read by ``robots.bounded_yaml`` (at most 100,000 characters, 32 levels, 10,000
+values with aliases expanded, 1,000 aliases; string keys, each once per mapping), and the same
+structure given as JSON is held to the same depth and count. Every maximum lies in the accepted
+range of its kind (``robots.ranges``: the range of a request's ``timing.limits`` overrides).
+
 Options are checked against the URDF's model before anything is stored; a wrong joint name, a
-value outside the joint's range, a non-positive limit or a malformed file is an ``InvalidUpload``
-(422) naming the joint and the key.
+value outside the joint's range, a limit outside its accepted range or a malformed file is an
+``InvalidUpload`` (422) naming the joint, the key and, for a limit, its source and range.
 """
 
 from __future__ import annotations
@@ -35,7 +40,9 @@ import numpy as np
 import pinocchio as pin
 import yaml
 
+from robots import bounded_yaml
 from robots.errors import ToptrajError, excerpt
+from robots.ranges import limit_problem
 
 #: The keys of a joint's entry in joint_limits.yaml, and the limit kind each maximum sets.
 _MAXIMA = {"max_velocity": "velocity", "max_acceleration": "acceleration", "max_jerk": "jerk", "max_effort": "torque"}
@@ -45,7 +52,7 @@ _POSITION_KEYS = {"has_position_limits", "min_position", "max_position", "angle_
 _KNOWN_KEYS = set(_MAXIMA) | set(_FLAGS.values()) | _POSITION_KEYS
 _SCALING_KEYS = {"default_velocity_scaling_factor", "default_acceleration_scaling_factor"}
 #: Largest joint_limits text accepted, in characters.
-MAX_LIMITS_CHARS = 200_000
+MAX_LIMITS_CHARS = bounded_yaml.MAX_CHARS
 
 
 class InvalidUpload(ToptrajError):
@@ -99,34 +106,67 @@ def _short(name) -> str:
 
 
 def _number(value, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InvalidUpload(f"{where} must be a finite number, got {excerpt(repr(value), 40)}")
-    return float(value)
+    """``value`` as a finite float; an integer too large for a float counts as not finite."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise InvalidUpload(f"{where} must be a finite number, got {excerpt(value, 40)}")
+    try:
+        number = float(value)
+    except OverflowError:
+        number = math.inf
+    if not math.isfinite(number):
+        raise InvalidUpload(f"{where} must be a finite number, got {excerpt(value, 40)}")
+    return number
+
+
+def _check_json_structure(given) -> None:
+    """Hold a joint_limits given as JSON to the bounds of the YAML text (``robots.bounded_yaml``):
+    at most ``MAX_DEPTH`` levels and ``MAX_NODES`` values, walked without recursion."""
+    stack, count = [(given, 1)], 0
+    while stack:
+        value, depth = stack.pop()
+        count += 1
+        if depth > bounded_yaml.MAX_DEPTH or count > bounded_yaml.MAX_NODES:
+            raise InvalidUpload(
+                f"joint_limits nests more than {bounded_yaml.MAX_DEPTH} levels deep or holds more than "
+                f"{bounded_yaml.MAX_NODES} values; a joint_limits.yaml needs 3 levels and a few values per joint"
+            )
+        if isinstance(value, dict):
+            stack.extend((item, depth + 1) for item in value.values())
+        elif isinstance(value, list):
+            stack.extend((item, depth + 1) for item in value)
+
+
+def _parsed(given):
+    """The structure of a joint_limits text (YAML, read within ``robots.bounded_yaml``'s bounds)
+    or of one given as JSON (held to the same bounds)."""
+    if not isinstance(given, str):
+        _check_json_structure(given)
+        return given
+    try:
+        return bounded_yaml.load(given)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        context, problem = getattr(error, "context", None), getattr(error, "problem", None) or str(error)
+        problem = excerpt(f"{context}, {problem}" if context else problem, 200)[1:-1]
+        if isinstance(error, bounded_yaml.BoundedYAMLError):
+            raise InvalidUpload(f"joint_limits is refused{where}: {problem}") from None
+        raise InvalidUpload(f"joint_limits is not valid YAML{where}: {problem}") from None
 
 
 def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
     """{joint: {kind: value}} and notes from a joint_limits.yaml text or its parsed structure."""
-    if isinstance(given, str):
-        if len(given) > MAX_LIMITS_CHARS:
-            raise InvalidUpload(f"joint_limits holds {len(given)} characters; at most {MAX_LIMITS_CHARS} are read")
-        try:
-            given = yaml.safe_load(given)
-        except yaml.YAMLError as error:
-            mark = getattr(error, "problem_mark", None)
-            where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-            raise InvalidUpload(
-                f"joint_limits is not valid YAML{where}: {excerpt(str(getattr(error, 'problem', error)), 80)}"
-            ) from None
+    given = _parsed(given)
     if not isinstance(given, dict) or not isinstance(given.get("joint_limits"), dict):
         raise InvalidUpload(
             "joint_limits must hold a 'joint_limits' mapping of joint names to their limits, as MoveIt's "
             "joint_limits.yaml does (joint_limits: {joint: {has_acceleration_limits: true, max_acceleration: 10.0}})"
         )
     notes = []
-    unknown = sorted(set(given) - {"joint_limits"} - _SCALING_KEYS)
+    unknown = sorted(set(given) - {"joint_limits"} - _SCALING_KEYS, key=str)
     if unknown:
         raise InvalidUpload(f"joint_limits: unknown top-level key {excerpt(unknown[0], 40)}; expected 'joint_limits'")
-    scaling = sorted(set(given) & _SCALING_KEYS)
+    scaling = sorted(set(given) & _SCALING_KEYS, key=str)
     if scaling:
         notes.append(f"joint_limits.yaml's {', '.join(scaling)} not applied: requests scale limits (timing.limits)")
     limits: dict[str, dict[str, float]] = {}
@@ -135,9 +175,9 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
         where = f"joint_limits.{_short(joint)}"
         if not isinstance(entry, dict):
             raise InvalidUpload(f"{where} must be a mapping of limit keys (max_velocity, max_acceleration, ...)")
-        unknown = sorted(set(entry) - _KNOWN_KEYS)
+        unknown = sorted(set(entry) - _KNOWN_KEYS, key=str)
         if unknown:
-            raise InvalidUpload(f"{where}: unknown key {excerpt(str(unknown[0]), 40)}; known: {', '.join(sorted(_KNOWN_KEYS))}")
+            raise InvalidUpload(f"{where}: unknown key {excerpt(unknown[0], 40)}; known: {', '.join(sorted(_KNOWN_KEYS))}")
         values = {}
         for key, kind in _MAXIMA.items():
             flag = entry.get(_FLAGS[kind], False)
@@ -148,8 +188,9 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
             if key not in entry:
                 raise InvalidUpload(f"{where}: {_FLAGS[kind]} is true but {key} is missing")
             value = _number(entry[key], f"{where}.{key}")
-            if value <= 0.0:
-                raise InvalidUpload(f"{where}.{key} must be positive, got {value:g}")
+            problem = limit_problem(kind, value, _short(joint), "joint_limits.yaml")
+            if problem is not None:
+                raise InvalidUpload(f"{where}.{key}: {problem}")
             values[kind] = value
         if entry.get("has_position_limits"):
             positions.append(str(joint))

@@ -20,7 +20,7 @@ from collections import OrderedDict
 from pathlib import Path
 
 from robots.catalog import catalog_names, is_catalog_robot, robot_from_model
-from robots.errors import CatalogRobotReadOnly, InvalidRobotName, InvalidURDF, RobotConflict, UnknownRobot, excerpt
+from robots.errors import CatalogRobotReadOnly, InvalidLimits, InvalidRobotName, InvalidURDF, RobotConflict, UnknownRobot, excerpt
 from robots.robot import Robot
 from robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, StoredUpload, UploadStore, default_data_dir
 from robots.upload_options import InvalidUpload, UploadOptions, apply_locks, yaml_limit_arrays
@@ -112,6 +112,7 @@ def build_upload(name: str, urdf: str, options: UploadOptions) -> Robot:
     Raises:
         InvalidURDF: the text is not a usable fixed-base arm.
         InvalidUpload: the options do not fit the URDF.
+        InvalidLimits: a limit outside the accepted range of its kind (``robots.ranges``).
     """
     full = check_urdf(urdf)
     model = apply_locks(full, options.locked_joints)
@@ -156,7 +157,7 @@ def load_upload(name: str) -> Robot | None:
     digest, urdf, options = stored
     try:
         return _build(name, (digest, options), urdf)
-    except (InvalidURDF, InvalidUpload) as error:
+    except (InvalidURDF, InvalidUpload, InvalidLimits) as error:
         raise InvalidURDF(f"the stored upload {excerpt(name)} no longer passes the checks: {error.detail}") from None
 
 
@@ -169,6 +170,7 @@ def register_urdf(urdf: str, name: str | None = None, options: UploadOptions | N
         InvalidRobotName: ``name`` breaks ``NAME_PATTERN``.
         InvalidURDF: the text is not a usable fixed-base arm (see ``robots.urdf_check``).
         InvalidUpload: the options do not fit the URDF (``robots.upload_options``).
+        InvalidLimits: a limit outside the accepted range of its kind (``robots.ranges``).
         RobotConflict: ``name`` is a catalog robot or holds a different upload.
         UploadStoreFull: the store is at its cap of uploads or bytes.
     """

@@ -14,14 +14,17 @@ origins ``rpy``                              each angle within +-100 rad
 geometry sizes (box, cylinder, sphere)       0 to 100 m; mesh scale within +-1000
 mass                                         1e-12 to 1e6 kg (0 only for a massless link)
 inertia tensor entries                       within +-1e6 kg m^2
-effort limit                                 1e-6 to 1e6 N m (or N)
-velocity limit                               1e-6 to 1e6 rad/s (or m/s)
+effort limit                                 1e-6 to 1e5 N m (or N)
+velocity limit                               1e-6 to 1e3 rad/s (or m/s)
 position limits                              within +-1e4 rad (or m), lower < upper
 damping, friction                            0 to 1e6
 ==========================================  =========================================
 
-The lower bound of 1e-6 on effort and velocity refuses limits such as 1e-308 that are positive
-in name only (no real drive is that weak; every duration would overflow). Every ``<inertial>``
+The effort and velocity bounds are those of every torque and velocity limit, whatever its
+source (``robots.ranges``, the ranges of a request's ``timing.limits`` too); the lower bound of
+1e-6 refuses limits such as 1e-308 that are positive in name only (no real drive is that weak;
+every duration would overflow). An effort or velocity of 0 is refused as well: the URDF
+specification makes both attributes required limits, not "unlimited". Every ``<inertial>``
 has a positive mass, except a massless frame (mass and tensor all zero, as Panda's
 ``panda_link8``). An inertia tensor must be one that a body can have: positive definite, with
 principal moments that satisfy the triangle inequality ``I1 + I2 >= I3`` (up to a relative 1e-3
@@ -48,6 +51,7 @@ import numpy as np
 import pinocchio as pin
 
 from robots.errors import InvalidURDF, excerpt
+from robots.ranges import TORQUE, VELOCITY
 from robots.urdf_tree import MOVING_JOINTS, check_structure
 
 MAX_OFFSET = 100.0  # m, each coordinate of an origin
@@ -56,8 +60,8 @@ MAX_SIZE = 100.0  # m, box sides, radii and lengths
 MAX_MESH_SCALE = 1e3
 MIN_MASS, MAX_MASS = 1e-12, 1e6  # kg
 MAX_INERTIA = 1e6  # kg m^2, each tensor entry
-EFFORT_RANGE = (1e-6, 1e6)  # N m (revolute) or N (prismatic)
-VELOCITY_RANGE = (1e-6, 1e6)  # rad/s or m/s
+EFFORT_RANGE = (TORQUE.low, TORQUE.high)  # N m (revolute) or N (prismatic)
+VELOCITY_RANGE = (VELOCITY.low, VELOCITY.high)  # rad/s or m/s
 MAX_POSITION = 1e4  # rad or m
 MAX_DAMPING = 1e6  # N m s/rad or N s/m
 MAX_FRICTION = 1e6  # N m or N
@@ -230,7 +234,11 @@ def _check_limits(joint: ElementTree.Element, kind: str, where: str) -> None:
             raise InvalidURDF(f"{where}: <limit> has no {name}")
         if value <= 0.0:
             raise InvalidURDF(f"{where}: {name} limit must be positive, got {value:g}")
-        _within(value, lowest, highest, where, f"{name} limit", unit)
+        if not lowest <= value <= highest:
+            raise InvalidURDF(
+                f"{where}: {name} limit {value:g} {unit} in the URDF is outside the accepted range "
+                f"[{lowest:g}, {highest:g}] (the range of every {name} limit, a request's timing.limits too)"
+            )
     lower, upper = values["lower"], values["upper"]
     if kind == "continuous":
         return

@@ -226,3 +226,33 @@ def test_bad_blends_are_422(client, path, words):
     assert response.status_code == 422, response.text
     for word in words:
         assert word in response.text
+
+
+@pytest.mark.parametrize("method", ["phase_plane", "toppra", "min_cost"])
+def test_a_blend_too_small_to_follow_is_a_corner_where_the_motion_stops(client, method):
+    """max_deviation 1e-9 rad blends the UR5 corners over a few 1e-10 of the path, which no
+    timing grid resolves (the acceleration limit was exceeded by 23 %): those corners are stops,
+    the answer says so, and the motion is the stop-and-go one (linear interpolation)."""
+    assert BlendedPath(np.array(UR5_WAYPOINTS), 1e-9).tight_corners == (1, 2)
+    assert BlendedPath(np.array(UR5_WAYPOINTS), 1e-3).tight_corners == ()
+    durations, answers = {}, {}
+    for interpolation in ("linear", "blend"):
+        body = {
+            "robot": "ur5",
+            "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS, "interpolation": interpolation,
+                     **({"max_deviation": 1e-9} if interpolation == "blend" else {})},
+            "timing": {"method": method},
+            "output": {"dt": 0.01},
+        }
+        response = client.post("/v1/trajectories", json=body)
+        assert response.status_code == 200, response.text
+        answers[interpolation] = response.json()
+        durations[interpolation] = answers[interpolation]["duration"]
+        for values in answers[interpolation]["peak_utilization"].values():
+            assert max(values) <= 1.003
+    assert durations["blend"] == pytest.approx(durations["linear"], rel=1e-9)
+    assert any(
+        "path.max_deviation = 1e-09 is too small to blend the corners at waypoints 1, 2" in warning
+        and "the motion stops there" in warning
+        for warning in answers["blend"]["warnings"]
+    )

@@ -175,19 +175,29 @@ def test_a_queued_job_cancelled_never_runs(client):
     assert client.post("/v1/trajectories", json=QUICK).status_code == 200
     cancelled = client.delete(f"/v1/jobs/{queued}")
     assert cancelled.status_code == 200 and cancelled.json()["status"] == "cancelled"
-    assert client.delete(f"/v1/jobs/{queued}").json()["status"] == "cancelled"  # again: harmless
     assert client.delete(f"/v1/jobs/{running}").json()["status"] == "cancelled"
     time.sleep(1.5)  # the worker is free: a queued job would have been claimed by now
     job = client.get(f"/v1/jobs/{queued}").json()
     assert job["status"] == "cancelled" and job["started_at"] is None and job["result"] is None
     assert client.get(f"/v1/jobs/{queued}/result").status_code == 409
+    # Deleting it again removes the cancelled job.
+    assert client.delete(f"/v1/jobs/{queued}").status_code == 204
+    assert client.get(f"/v1/jobs/{queued}").status_code == 404
 
 
-def test_an_ended_job_cannot_be_cancelled(client):
+def test_an_ended_job_is_deleted_with_its_answer(client):
     job_id = _submit(client, {"trajectory": QUICK})
     _wait(client, job_id)
+    store = client.app.state.jobs.store
+    jobs, stored = store.usage()
+    assert client.get(f"/v1/jobs/{job_id}/result").status_code == 200
     response = client.delete(f"/v1/jobs/{job_id}")
-    assert response.status_code == 409 and "status done" in response.json()["detail"]
+    assert response.status_code == 204 and response.content == b""
+    assert client.get(f"/v1/jobs/{job_id}").status_code == 404
+    assert client.get(f"/v1/jobs/{job_id}/result").status_code == 404
+    assert job_id not in [job["id"] for job in client.get("/v1/jobs", params={"limit": 100}).json()["jobs"]]
+    assert store.usage()[0] == jobs - 1 and store.usage()[1] < stored  # the answer's bytes are gone too
+    assert client.delete(f"/v1/jobs/{job_id}").status_code == 404
 
 
 def test_the_queue_is_bounded(tmp_path):

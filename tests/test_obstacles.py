@@ -195,3 +195,13 @@ def test_obstacles_on_a_cartesian_line(client):
     tips = _tool_points(robots.load("lecture_3r"), np.array(response.json()["samples"]["q"]))
     tip_distance = float(np.min(np.linalg.norm(tips - np.array(ball["center"]), axis=1))) - ball["radius"]
     assert found["obstacle"] == 0 and 0.01 <= found["distance"] <= tip_distance + 1e-9
+
+
+@pytest.mark.parametrize("orientation, norm", [([0.0, 0.0, 0.0, 0.0], "0"), ([0.0, 0.0, 1e-30, 0.0], "1e-30"),
+                                               ([0.0, 0.0, 0.0, 0.5], "0.5"), ([0.0, 0.0, 1.0, 1.0], "1.41421")])
+def test_a_box_orientation_that_is_no_unit_quaternion_is_named(client, orientation, norm):
+    box = {"kind": "box", "center": [0.6, 0.0, 0.2], "size": [0.2, 0.2, 0.2], "orientation": orientation}
+    sphere = {"kind": "sphere", "center": [0.0, 0.0, 2.0], "radius": 0.1}
+    response = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [sphere, box]}})
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"].startswith(f"path.obstacles[1].orientation has norm {norm}; a box's orientation is a unit quaternion")

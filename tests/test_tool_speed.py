@@ -4,6 +4,8 @@ reaches it, for every path kind and every method that takes constraints."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -197,3 +199,23 @@ def test_a_free_path_refuses_a_tool_limit(client):
     response = client.post("/v1/trajectories", json=body)
     assert response.status_code == 422, response.text
     assert "collocation" in response.json()["detail"]
+
+
+@pytest.mark.parametrize("limits, named", [({"tool_speed": 1e-6}, "raise timing.limits.tool_speed or the velocity"),
+                                           ({"velocity": [1e-6] * 6}, "raise the velocity and acceleration limits")])
+def test_a_motion_too_slow_for_any_dt_gets_advice_it_can_follow(client, limits, named):
+    """No output.dt within its range (at most 10 s) serves a motion of days: the answer says
+    which limits to raise instead of advising an output.dt beyond its own range."""
+    body = {
+        "robot": "ur5",
+        "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS[:2]},
+        "timing": {"method": "phase_plane", "limits": limits},
+        "output": {"dt": 0.01},
+    }
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"]
+    assert "even the largest output.dt (10 s) serves at most" in detail and named in detail
+    assert all(float(value) <= 10.0 for value in re.findall(r"output\.dt >= ([0-9.e+-]+)", detail))
+    fitting = {**body, "output": {"dt": 10.0}}
+    assert client.post("/v1/trajectories", json=fitting).status_code == 422  # advice was right: no dt serves

@@ -115,7 +115,8 @@ def test_the_default_rule_is_named_where_nothing_gave_a_limit(client):
         ({"joint_limits": "joint_limits:\n  elbow:\n    has_acceleration_limits: true\n    max_acceleration: 1.0\n"},
          "joint_limits names 'elbow'"),
         ({"joint_limits": "joint_limits:\n  panda_joint1:\n    has_acceleration_limits: true\n    max_acceleration: -1.0\n"},
-         "joint_limits.panda_joint1.max_acceleration must be positive"),
+         "joint_limits.panda_joint1.max_acceleration: joint 'panda_joint1': the acceleration limit -1 rad/s^2 from "
+         "joint_limits.yaml is outside the accepted range"),
         ({"joint_limits": "joint_limits:\n  panda_joint1:\n    has_acceleration_limits: true\n"},
          "has_acceleration_limits is true but max_acceleration is missing"),
         ({"joint_limits": "joint_limits:\n  panda_joint1: [\n"}, "not valid YAML at line"),

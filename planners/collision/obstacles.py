@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from planners.errors import InvalidRequest
+
+#: How far from 1 the norm of a box's orientation quaternion may be (rounded printing), as for
+#: the poses of a cartesian path.
+UNIT_TOLERANCE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -48,3 +55,18 @@ class CapsuleObstacle:
 
 
 Obstacle = SphereObstacle | BoxObstacle | CapsuleObstacle
+
+
+def check_obstacles(obstacles: tuple[Obstacle, ...] | list[Obstacle]) -> None:
+    """InvalidRequest naming the obstacle unless every box's orientation is a unit quaternion
+    (norm within ``UNIT_TOLERANCE`` of 1): a zero or tiny one has no rotation to normalize to."""
+    for index, obstacle in enumerate(obstacles):
+        if not isinstance(obstacle, BoxObstacle):
+            continue
+        quaternion = np.asarray(obstacle.orientation, dtype=float)
+        norm = float(np.linalg.norm(quaternion)) if quaternion.shape == (4,) else math.nan
+        if not abs(norm - 1.0) <= UNIT_TOLERANCE:
+            raise InvalidRequest(
+                f"path.obstacles[{index}].orientation has norm {norm:.6g}; a box's orientation is a unit quaternion "
+                "[qx, qy, qz, qw] (norm 1 within 1e-3), e.g. [0, 0, 0, 1] for a box along the world's axes"
+            )

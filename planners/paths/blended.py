@@ -24,7 +24,8 @@ and along its start tangent and theta = sigma_local / r,
 so dq/ds is continuous everywhere and d2q/ds2 jumps where a line meets a circle (``breaks``: the
 motion does not stop there, but the limits seen from either side differ). A corner that turns
 back on itself (alpha = pi) cannot be blended and is a corner where the motion stops
-(``kinks``), as is one whose blend would be shorter than ``MIN_BLEND`` of the path.
+(``kinks``), as is one whose blend would be shorter than ``MIN_BLEND`` of the path
+(``tight_corners`` names those, for a note in the answer).
 """
 
 from __future__ import annotations
@@ -36,8 +37,12 @@ from planners.paths.base import GeometricPath, PathPoints
 #: 1 - cos(alpha) below this: the segments continue straight on (no blend needed, the direction
 #: changes by less than 1.5e-6 rad).
 STRAIGHT = 1e-12
-#: A blend shorter than this fraction of the path is a corner where the motion stops.
-MIN_BLEND = 1e-12
+#: A blend shorter than this fraction of the path (its angle times its tangent distance) is a
+#: corner where the motion stops: a fifth of the finest spacing of a timing grid (20,000 points),
+#: below which the grids cannot resolve the blend's curvature (max_deviation 1e-9 rad on a UR5
+#: path exceeded the acceleration limit by 23 %, and min_cost's solver failed up to 1e-6 of the
+#: path); the speed such a blend allows, sqrt(acceleration limit x radius), is nearly a stop.
+MIN_BLEND = 1e-5
 
 
 class BlendedPath(GeometricPath):
@@ -52,6 +57,8 @@ class BlendedPath(GeometricPath):
         length: Total arc length L in joint space (joint units).
         deviations: Distance of each interior waypoint from its blend, shape (n_waypoints - 2,)
             (0 where the path passes the waypoint: a straight continuation or a stop).
+        tight_corners: Indices of the waypoints whose blend would be shorter than ``MIN_BLEND``
+            of the path: corners where the motion stops.
     """
 
     def __init__(self, waypoints: np.ndarray, max_deviation: float):
@@ -64,10 +71,12 @@ class BlendedPath(GeometricPath):
         directions = segments / lengths[:, None]
         scale = lengths.sum()
         # Pieces: (kind, start point, direction or x, y, center, radius, length); kind 0 line, 1 arc.
-        pieces, corners, deviations = [], [], []
+        pieces, corners, deviations, tight = [], [], [], []
         position = waypoints[0]
         for i in range(1, len(waypoints) - 1):
             blend = _blend(waypoints[i], directions[i - 1], directions[i], lengths[i - 1], lengths[i], self.max_deviation)
+            if blend is not None and blend[4] * blend[5] <= MIN_BLEND * scale:
+                tight.append(i)
             if blend is None or blend[4] * blend[5] <= MIN_BLEND * scale:
                 # Straight on (the segments are one line), or a corner that cannot be blended.
                 reverse = directions[i - 1] @ directions[i] < 1.0 - STRAIGHT
@@ -97,6 +106,7 @@ class BlendedPath(GeometricPath):
         self.kinks = junctions[stop]
         self.breaks = junctions[~stop]
         self.deviations = np.array(deviations)
+        self.tight_corners = tuple(tight)
         self._is_arc = np.array([piece[0] == "arc" for piece in pieces])
         n_pieces = len(pieces)
         # Per piece: origin and direction (lines) or center, x, y (arcs), and the radius.

@@ -212,6 +212,18 @@ class JobStore:
             raise JobEnded(f"job {job_id} has ended already (status {job.status}); there is nothing to cancel")
         return job
 
+    def delete(self, job_id: str) -> bool:
+        """Delete job ``job_id`` with its stored result and error if it has ended; whether one
+        was deleted (``False``: no such job, or it has not ended)."""
+        if not self.path.exists():
+            return False
+        ended = ", ".join(repr(status) for status in ENDED)
+        with self._transaction() as connection:
+            deleted = connection.execute(f"DELETE FROM jobs WHERE id = ? AND status IN ({ended})", (job_id,)).rowcount
+        if deleted:
+            self._vacuum()
+        return bool(deleted)
+
     # Runners ------------------------------------------------------------------------------
     def has_queued(self) -> bool:
         """Whether some job waits (a cheap read, before claiming)."""

@@ -16,7 +16,7 @@ from starlette.concurrency import run_in_threadpool
 import robots
 from planners.errors import InvalidRequest
 from robots.errors import ToptrajError, excerpt
-from service.jobs.records import Job
+from service.jobs.records import Job, JobEnded
 from service.jobs.store import JobStore
 from service.problems import PROBLEM_JSON, problem_responses
 from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
@@ -235,15 +235,25 @@ def get_job_result(job_id: str, request: Request) -> Response:
 
 @router.delete(
     "/{job_id}",
-    summary="Cancel a job",
+    summary="Cancel a job, or delete an ended one",
     response_model=JobPublic,
-    responses={404: _problem(404, "No job has that id."), 409: _problem(409, "The job has ended already.")},
+    responses={
+        204: {"description": "The job had ended (done, failed, cancelled, interrupted): it and its answer are deleted."},
+        404: _problem(404, "No job has that id."),
+    },
 )
 def cancel_job(job_id: str, request: Request) -> Response:
-    """Cancel a queued or running job: a queued one never runs; a running one's worker process
-    is killed. Cancelling a cancelled job again is harmless; one that has ended otherwise is a 409."""
-    job = request.app.state.jobs.cancel(job_id)
-    if job is None:
-        _job(_store(request), job_id)
-    return _job_response(job)
-
+    """Cancel a queued or running job (200, the job cancelled): a queued one never runs; a
+    running one's worker process is killed. A job that has ended (done, failed, cancelled,
+    interrupted) is deleted with its stored answer (204); GET answers 404 for it afterwards."""
+    store = _store(request)
+    if _job(store, job_id).status in ("queued", "running"):
+        try:
+            cancelled = request.app.state.jobs.cancel(job_id)
+        except JobEnded:
+            cancelled = None  # it ended meanwhile: deleted below
+        if cancelled is not None:
+            return _job_response(cancelled)
+    if not store.delete(job_id):
+        return _job_response(_job(store, job_id))  # pruned meanwhile (404), or cancelled by another request
+    return Response(status_code=204)

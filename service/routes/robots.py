@@ -85,9 +85,15 @@ async def upload_robot(body: RobotCreate) -> RobotPublic:
     and limits in MoveIt's ``joint_limits.yaml`` form (``joint_limits``). Uploading the same
     URDF with the same options under the same name again is harmless. The answer says where
     each limit comes from and what was not used (``limit_sources``, ``notes``)."""
-    options = upload_options(body.locked_joints, body.joint_limits)
-    robot = await run_in_threadpool(robots.register_urdf, body.urdf, body.name, options)
+    robot = await run_in_threadpool(_register, body)
     return robot_public(robot)
+
+
+def _register(body: RobotCreate) -> robots.Robot:
+    """Read the options (YAML within its bounds) and store the upload: in a worker thread, so
+    that neither the parse nor the build holds the event loop."""
+    options = upload_options(body.locked_joints, body.joint_limits)
+    return robots.register_urdf(body.urdf, body.name, options)
 
 
 @router.delete(

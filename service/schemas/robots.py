@@ -84,7 +84,11 @@ class RobotCreate(Schema):
         description="Limits in the form of MoveIt's `joint_limits.yaml`: its text, or the same structure as "
         "JSON (`{\"joint_limits\": {joint: {\"has_acceleration_limits\": true, \"max_acceleration\": 10.0, ...}}}`). "
         "Acceleration and jerk limits (rad/s^2, rad/s^3) are taken as given; velocity and effort limits "
-        "(rad/s, N m) only tighten the URDF's. The robot's `limit_sources` and `notes` say what was applied.",
+        "(rad/s, N m) only tighten the URDF's. The robot's `limit_sources` and `notes` say what was applied. "
+        "Each limit lies in the range of its kind (the range of `timing.limits` of a trajectory request: velocity "
+        "[1e-6, 1e3], acceleration [1e-6, 1e5], jerk [1e-6, 1e8], effort [1e-6, 1e5]). The text holds at most "
+        "100,000 characters, 32 levels of nesting, 10,000 values with its aliases expanded and 1,000 aliases; keys "
+        "are strings, each once per mapping; one document.",
     )
 
 

@@ -47,7 +47,7 @@ class BoxObstacleRequest(Schema):
         description="Edge lengths [sx, sy, sz] (m) along the box's own axes."
     )
     orientation: Annotated[list[Annotated[float, Field(ge=-1.0, le=1.0)]], Field(min_length=4, max_length=4)] = Field(
-        default=[0.0, 0.0, 0.0, 1.0], description="Unit quaternion [qx, qy, qz, qw] from the box's axes to the world's."
+        default=[0.0, 0.0, 0.0, 1.0], description="Unit quaternion [qx, qy, qz, qw] from the box's axes to the world's (norm 1 within 1e-3)."
     )
 
 
