@@ -73,7 +73,13 @@ def main(argv: list[str] | None = None) -> int:
     batch.add_argument("-o", "--output", required=True, help="the JSON Lines file of results (appended; resumed)")
     batch.add_argument("--workers", type=int, default=None, help="Ray workers (CPUs) of a local Ray (default: the cores)")
     batch.add_argument("--ray-address", default=None, help="an existing Ray cluster: auto or ray://host:port (default: a local Ray)")
-    batch.set_defaults(run=lambda args: commands_.batch(args.requests, args.output, args.workers, args.ray_address))
+    batch.add_argument("--budget", type=float, default=None, help="planning budget of each request, in s (default: 20; a line over it is a 504)")
+    batch.add_argument(
+        "--retry-failed", action="store_true", help="plan again the lines answered with a budget error (504) or another 5xx"
+    )
+    batch.set_defaults(
+        run=lambda args: commands_.batch(args.requests, args.output, args.workers, args.ray_address, args.budget, args.retry_failed)
+    )
     args = parser.parse_args(argv)
     return args.run(args)
 
