@@ -9,6 +9,7 @@ import sys
 
 from service import commands as commands_
 from service.serving import LOOP
+from service.stopping import GRACEFUL_S
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
 APP_FACTORY = "service.app:create_app"
@@ -37,8 +38,17 @@ def _serve(args) -> int:
     # A line per request costs the event loop about 0.2 ms of a 7 ms request (uvicorn's access
     # formatter and a write per line), so it is asked for, as gunicorn's is; errors are logged
     # either way.
+    # A stop (SIGTERM, Ctrl-C) ends every process within seconds (service.stopping): open
+    # requests get GRACEFUL_S to finish.
     uvicorn.run(
-        APP_FACTORY, factory=True, host=args.host, port=args.port, workers=args.workers, loop=LOOP, access_log=args.access_log
+        APP_FACTORY,
+        factory=True,
+        host=args.host,
+        port=args.port,
+        workers=args.workers,
+        loop=LOOP,
+        access_log=args.access_log,
+        timeout_graceful_shutdown=GRACEFUL_S,
     )
     return 0
 
