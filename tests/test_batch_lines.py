@@ -24,7 +24,7 @@ import pytest
 import service.batches.work as batch_work
 from planners import Deadline
 from service.batches import lines as lines_
-from service.batches import run_batch
+from service.batches import run_batch, runner
 from service.batches.lines import MAX_DEPTH, nesting_depth, request_key
 from service.batches.work import answer, answer_chunk
 from service.cli import main
@@ -188,6 +188,47 @@ def test_retry_failed_plans_the_504s_and_5xx_again_within_the_given_budget(tmp_p
     assert (report.skipped, report.planned) == (1, 2) and len(pool.keys) == 2
     assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 200, 2: 200, 3: 404}
     assert not list(tmp_path.glob("*.resuming"))
+
+
+class _Hanging(_Done):
+    """A task whose worker never ends (a solver step that cannot check its deadline)."""
+
+
+class HangingPool(InProcessPool):
+    """``InProcessPool`` whose tasks holding ``OTHER`` never end until cancelled."""
+
+    def __init__(self):
+        super().__init__()
+        self.cancelled: list = []
+
+    def submit(self, chunk, budget_s):
+        if any(text == json.dumps(OTHER) for _, text in chunk):
+            self.chunks.append(list(chunk))
+            return _Hanging(None)
+        return super().submit(chunk, budget_s)
+
+    def wait(self, handles, timeout_s):
+        ready = [h for h in handles if not isinstance(h, _Hanging)]
+        if not ready:
+            time.sleep(timeout_s)
+        return ready, [h for h in handles if isinstance(h, _Hanging)]
+
+    def cancel(self, handles):
+        self.cancelled += handles
+
+
+def test_a_task_past_its_budget_is_killed_and_its_lines_are_504s(tmp_path, monkeypatch):
+    monkeypatch.setattr(runner, "CHUNK", 1)
+    monkeypatch.setattr(runner, "TASK_SLACK_S", 0.5)
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text(json.dumps(OTHER) + "\n" + json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n")
+    pool = HangingPool()
+    started = time.monotonic()
+    report = run_batch(requests, output, budget_s=0.5, pool=lambda: pool)
+    assert time.monotonic() - started < 0.5 + 0.5 + 1.0  # its budget, the slack, the polls
+    assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 504, 2: 200, 3: 504}
+    assert "--retry-failed" in _by_line(output)[1]["body"]["detail"]
+    assert len(pool.cancelled) == 1 and not report.interrupted
 
 
 @pytest.mark.parametrize("budget", ["0", "-1", "nan", "1e9"])

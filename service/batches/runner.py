@@ -41,6 +41,9 @@ CHUNK = 4
 BUDGET_S = 20.0
 #: Largest planning budget of one request, in s.
 MAX_BUDGET_S = 3600.0
+#: Time a task may take beyond its requests' budgets (a worker process starting and importing
+#: the planning stack), in s; past it the task is killed and its requests are 504 lines.
+TASK_SLACK_S = 10.0
 #: Longest wait for a task before the driver looks at ``stop`` again, in s.
 WAIT_S = 0.2
 
@@ -184,6 +187,26 @@ def _failed(chunk: list[tuple[str, str]], error: BaseException) -> list[tuple[st
     return [(key, 500, problem_body(500, "Worker failed", detail)) for key, _ in chunk]
 
 
+def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, out, numbers: dict[str, list[int]]) -> int:
+    """Kill the tasks that ran past their requests' budgets plus ``TASK_SLACK_S`` (a solver
+    step that cannot check its deadline) and write their requests as 504 lines; how many
+    lines were written. A task counts as started once it is among the ``runner.cpus`` oldest
+    still running (Ray starts tasks in the order submitted, one per CPU)."""
+    now = time.monotonic()
+    for handle in list(running)[: runner.cpus]:
+        started_at.setdefault(handle, now)
+    overdue = [h for h, since in started_at.items() if now > since + len(running[h]) * budget_s + TASK_SLACK_S]
+    if not overdue:
+        return 0
+    runner.cancel(overdue)
+    detail = f"the planning did not end within its budget of {budget_s:g} s and was stopped; run the batch again with --retry-failed, or a larger --budget"
+    written = 0
+    for handle in overdue:
+        del started_at[handle]
+        written += _write(out, numbers, [(key, 504, problem_body(504, "Time budget exceeded", detail)) for key, _ in running.pop(handle)])
+    return written
+
+
 def count_lines(path: Path) -> int:
     """Lines of ``path`` (a last line without its newline counted)."""
     count, last = 0, b"\n"
@@ -251,7 +274,8 @@ def run_batch(
             chunks = [[(key, texts[key]) for key in keys[k : k + CHUNK]] for k in range(0, len(keys), CHUNK)]
             del texts, keys
             window = 2 * runner.cpus + 1
-            running: dict[Any, list[tuple[str, str]]] = {}
+            running: dict[Any, list[tuple[str, str]]] = {}  # in the order submitted
+            started_at: dict[Any, float] = {}
             next_chunk = 0
             while (running or next_chunk < len(chunks)) and not stop.is_set():
                 while next_chunk < len(chunks) and len(running) < window and not stop.is_set():
@@ -259,7 +283,9 @@ def run_batch(
                     chunks[next_chunk] = []  # its texts are the task's now
                     next_chunk += 1
                 ready, _ = runner.wait(list(running), WAIT_S)
+                written += _kill_overdue(runner, running, started_at, budget_s, out, numbers)
                 for handle in ready:
+                    started_at.pop(handle, None)
                     chunk = running.pop(handle)
                     try:
                         answers = runner.result(handle)
