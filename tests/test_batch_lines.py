@@ -96,7 +96,7 @@ def _hostile_file(path: Path, monkeypatch) -> dict[int, int]:
     monkeypatch.setattr(lines_, "MAX_LINE_BYTES", 20_000)
     deep = "[" * 1300 + "]" * 1300  # 2.6 KB: RecursionError in a recursive parser
     lines: list[tuple[bytes, int]] = [
-        (json.dumps(GOOD).encode(), 200),
+        (b"\xef\xbb\xbf" + json.dumps(GOOD).encode(), 200),  # a byte order mark before the first line
         (b"not json", 400),
         (deep.encode(), 400),
         (b'{"robot": "ur5", "path": ' + b"[" * 60 + b"]" * 60 + b"}", 400),
@@ -291,15 +291,16 @@ def test_a_batch_job_out_of_budget_answers_each_line_it_did_not_reach_with_a_504
 
 
 def test_sigint_stops_a_ray_batch_within_seconds_and_leaves_no_process(tmp_path):
-    """Two Ctrl-C (SIGINT to the driver alone): it stops within seconds with status 130, says
-    how to resume, keeps whole result lines only, and every process it started is gone."""
+    """Two Ctrl-C (SIGINT to the driver's process group): it stops within seconds with status
+    130, says how to resume, keeps whole result lines only (a worker interrupted writes no
+    error line), and every process it started is gone."""
     pytest.importorskip("ray")
     requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
     requests.write_text("".join(json.dumps({**GOOD, "output": {"dt": 0.001 + 1e-6 * k}}) + "\n" for k in range(3000)))
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     driver = subprocess.Popen(
         [sys.executable, "-m", "service.cli", "batch", str(requests), "-o", str(output), "--workers", "2"],
-        stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path,
+        stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path, start_new_session=True,
     )
     try:
         deadline = time.monotonic() + 60
@@ -308,9 +309,9 @@ def test_sigint_stops_a_ray_batch_within_seconds_and_leaves_no_process(tmp_path)
             time.sleep(0.1)
         children = psutil.Process(driver.pid).children(recursive=True)
         assert any("raylet" in child.name() for child in children)
-        driver.send_signal(signal.SIGINT)
+        os.killpg(driver.pid, signal.SIGINT)  # as Ctrl-C in a terminal: to the driver and every process of its group
         time.sleep(0.3)
-        driver.send_signal(signal.SIGINT)  # a second one changes nothing
+        os.killpg(driver.pid, signal.SIGINT)  # a second one changes nothing
         started = time.monotonic()
         err = driver.communicate(timeout=15)[1]
         assert time.monotonic() - started < 10

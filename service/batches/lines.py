@@ -117,6 +117,8 @@ def read_requests(path: Path, skip: set[int] | frozenset[int] = frozenset()) -> 
                     detail = f"line {number}: the line has {size} bytes; a request line has at most {MAX_LINE_BYTES}"
                     yield RequestLine(number, _digest(b"%d" % size), problem=(413, problem_body(413, "Line too long", detail)))
                 continue
+            if number == 1:
+                raw = raw.removeprefix(b"\xef\xbb\xbf")  # a byte order mark some editors write
             if number not in skip:
                 yield parse_line(number, raw)
 
