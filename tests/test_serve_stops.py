@@ -163,3 +163,15 @@ def test_descendants_are_read_from_proc():
         for pid in [*descendants(child.pid), child.pid]:
             os.kill(pid, signal.SIGKILL)
         child.wait()
+
+
+def test_a_supervisor_killed_outright_takes_its_processes_with_it(server):
+    """SIGKILL runs no handler: the server processes learn it from the kernel (their parent
+    gone) and end as on SIGTERM."""
+    server.wait_for_log("Waiting for application startup", count=2)
+    assert len(server.marked()) >= 3
+    server.process.kill()
+    started = time.monotonic()
+    while server.marked() and time.monotonic() - started < GONE_S + 5:
+        time.sleep(0.05)
+    assert not server.marked() and time.monotonic() - started < GONE_S
