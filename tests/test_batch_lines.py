@@ -174,6 +174,17 @@ def test_a_stopped_run_keeps_what_finished_and_resumes_by_line_number(tmp_path):
     assert not set(pool.keys) & {row["key"] for row in partial.values()}  # nothing planned twice
 
 
+def test_a_stop_before_the_planning_starts_no_pool(tmp_path):
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text("not json\n" + json.dumps(GOOD) + "\n")
+    stop = threading.Event()
+    stop.set()
+    report = run_batch(requests, output, stop=stop, pool=lambda: pytest.fail("no pool may start"))
+    assert report.interrupted and report.planned == 0
+    assert sorted(_by_line(output)) == []
+    assert run_batch(requests, output, pool=InProcessPool).planned == 2
+
+
 def test_retry_failed_plans_the_504s_and_5xx_again_within_the_given_budget(tmp_path):
     requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
     requests.write_text(json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n" + json.dumps({**GOOD, "robot": "nope"}) + "\n")

@@ -257,6 +257,9 @@ def run_batch(
 
     with open(output_path, "ab") as out:
         for line in read_requests(requests_path, skip=set(done)):
+            if stop.is_set():  # before any planning: what was read is resumed later
+                out.flush()
+                return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=True)
             if line.problem is not None:
                 out.write(result_line(line.number, line.key, *line.problem))
                 written += 1
@@ -265,8 +268,8 @@ def run_batch(
                 texts.setdefault(line.key, line.text)
         out.flush()
         report()
-        if not texts:
-            return BatchReport(total, skipped, written, time.perf_counter() - started)
+        if not texts or stop.is_set():
+            return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=bool(texts))
         runner = (pool or (lambda: RayPool(ray_address, workers)))()
         try:
             runner.share(_uploads_named(list(texts.values())))
@@ -283,7 +286,6 @@ def run_batch(
                     chunks[next_chunk] = []  # its texts are the task's now
                     next_chunk += 1
                 ready, _ = runner.wait(list(running), WAIT_S)
-                written += _kill_overdue(runner, running, started_at, budget_s, out, numbers)
                 for handle in ready:
                     started_at.pop(handle, None)
                     chunk = running.pop(handle)
@@ -294,7 +296,9 @@ def run_batch(
                             continue  # cancelled by the stop: resumed later
                         answers = _failed(chunk, error)
                     written += _write(out, numbers, answers)
-                if ready:
+                overdue = _kill_overdue(runner, running, started_at, budget_s, out, numbers)
+                written += overdue
+                if ready or overdue:
                     report()
             interrupted = bool(running) or next_chunk < len(chunks)
             if interrupted:
