@@ -170,8 +170,8 @@ def batch(
     stop = threading.Event()
 
     def interrupted(signum, frame) -> None:
-        if not stop.is_set():
-            print("\nstopping: keeping the finished lines, cancelling the others ...", file=sys.stderr, flush=True)
+        if not stop.is_set():  # a raw write: the handler may interrupt a write to sys.stderr
+            os.write(2, b"\nstopping: keeping the finished lines, cancelling the others ...\n")
         stop.set()
 
     previous = signal.signal(signal.SIGINT, interrupted)
