@@ -14,6 +14,7 @@ from planners import Timing, WaypointPath, plan
 from planners.isolated import start_worker_server
 from planners.kinematics.conditioning import frobenius_condition_number
 from planners.threads import single_blas_thread
+from service import stopping
 from service.body_limit import BodySizeLimit
 from service.jobs import JOB_MODULES, job_runner
 from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
@@ -60,10 +61,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         if settings.preload_robots:
             await run_in_threadpool(_warm_up)
         await run_in_threadpool(app.state.jobs.start)
+        stopping.serving()  # a stop is graceful from here on
         yield
         # Running plannings end at their next deadline check; an app started again (as test
         # clients do, even overlapping) gets fresh threads under the same slots.
         app.state.planning.close()
+        app.state.jobs.stop_running()
+        stopping.stopped()  # in a server process: its fork server too, which may still be importing
         await run_in_threadpool(app.state.jobs.close)
 
     # /docs and /redoc with Swagger UI's and ReDoc's scripts from the installed fastapi-offline

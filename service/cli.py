@@ -9,6 +9,7 @@ import sys
 
 from service import commands as commands_
 from service.serving import LOOP
+from service.stopping import GRACEFUL_S
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
 APP_FACTORY = "service.app:create_app"
@@ -37,8 +38,17 @@ def _serve(args) -> int:
     # A line per request costs the event loop about 0.2 ms of a 7 ms request (uvicorn's access
     # formatter and a write per line), so it is asked for, as gunicorn's is; errors are logged
     # either way.
+    # A stop (SIGTERM, Ctrl-C) ends every process within seconds (service.stopping): open
+    # requests get GRACEFUL_S to finish.
     uvicorn.run(
-        APP_FACTORY, factory=True, host=args.host, port=args.port, workers=args.workers, loop=LOOP, access_log=args.access_log
+        APP_FACTORY,
+        factory=True,
+        host=args.host,
+        port=args.port,
+        workers=args.workers,
+        loop=LOOP,
+        access_log=args.access_log,
+        timeout_graceful_shutdown=GRACEFUL_S,
     )
     return 0
 
@@ -73,7 +83,13 @@ def main(argv: list[str] | None = None) -> int:
     batch.add_argument("-o", "--output", required=True, help="the JSON Lines file of results (appended; resumed)")
     batch.add_argument("--workers", type=int, default=None, help="Ray workers (CPUs) of a local Ray (default: the cores)")
     batch.add_argument("--ray-address", default=None, help="an existing Ray cluster: auto or ray://host:port (default: a local Ray)")
-    batch.set_defaults(run=lambda args: commands_.batch(args.requests, args.output, args.workers, args.ray_address))
+    batch.add_argument("--budget", type=float, default=None, help="planning budget of each request, in s (default: 20; a line over it is a 504)")
+    batch.add_argument(
+        "--retry-failed", action="store_true", help="plan again the lines answered with a budget error (504) or another 5xx"
+    )
+    batch.set_defaults(
+        run=lambda args: commands_.batch(args.requests, args.output, args.workers, args.ray_address, args.budget, args.retry_failed)
+    )
     args = parser.parse_args(argv)
     return args.run(args)
 

@@ -142,23 +142,59 @@ def plot(source: str, output: str) -> int:
         return 2
 
 
-def batch(requests: str, output: str, workers: int | None, ray_address: str | None) -> int:
-    """``toptraj batch FILE -o OUT``: every request line planned (on Ray), a result line each,
-    resumable (``service.batches``)."""
+def batch(
+    requests: str,
+    output: str,
+    workers: int | None,
+    ray_address: str | None,
+    budget_s: float | None = None,
+    retry_failed: bool = False,
+) -> int:
+    """``toptraj batch FILE -o OUT``: every request line planned (on Ray), one result line per
+    line, resumable (``service.batches``). Ctrl-C stops within seconds, keeps what finished,
+    prints the command that resumes and exits with 130; a second Ctrl-C changes nothing."""
+    import shlex
+    import signal
+    import threading
+
     from service.batches import run_batch
-    from service.batches.runner import progress_bar
+    from service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
 
     if workers is not None and workers < 1:
         print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)
         return 2
+    budget = BUDGET_S if budget_s is None else budget_s
+    if not 0.0 < budget <= MAX_BUDGET_S:  # NaN too
+        print(json.dumps(_problem("Invalid option", 400, f"--budget must be in (0, {MAX_BUDGET_S:g}] s, not {budget_s:g}")), file=sys.stderr)
+        return 2
+    stop = threading.Event()
+
+    def interrupted(signum, frame) -> None:
+        if not stop.is_set():  # a raw write: the handler may interrupt a write to sys.stderr
+            os.write(2, b"\nstopping: keeping the finished lines, cancelling the others ...\n")
+        stop.set()
+
+    previous = signal.signal(signal.SIGINT, interrupted)
     try:
-        report = run_batch(requests, output, workers, ray_address, progress_bar())
+        report = run_batch(requests, output, workers, ray_address, progress_bar(), budget, retry_failed, stop)
+    except RayMissing as error:
+        print(json.dumps(_problem("Ray is not installed", 400, str(error))), file=sys.stderr)
+        return 2
     except OSError as error:
         print(json.dumps(_problem("Cannot read or write", 400, str(error))), file=sys.stderr)
         return 2
-    print(
-        f"{report.planned} planned, {report.skipped} already in {output}, {report.total} in all, "
-        f"{report.seconds:.1f} s ({report.rate:.1f} requests/s)",
-        file=sys.stderr,
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    summary = (
+        f"{report.planned} answered, {report.skipped} already in {output}, {report.total} in all, "
+        f"{report.seconds:.1f} s ({report.rate:.1f} lines/s)"
     )
-    return 0
+    if not report.interrupted:
+        print(summary, file=sys.stderr)
+        return 0
+    command = ["toptraj", "batch", requests, "-o", output]
+    for option, value in (("--workers", workers), ("--ray-address", ray_address), ("--budget", budget_s)):
+        if value is not None:
+            command += [option, f"{value:g}" if isinstance(value, float) else str(value)]
+    print(f"interrupted: {summary}\nresume with: {shlex.join(command)}", file=sys.stderr)
+    return 130

@@ -12,7 +12,7 @@ together) takes them all before a sleeping one is scheduled: measured on a loade
 machine, four simultaneous connections all landed on one of two processes in 14 of 30 bursts
 with uvloop's loop, 19 of 30 with asyncio's, and sixteen in 5 to 10 of 30.
 
-``new_event_loop`` (uvicorn's ``loop`` setting, ``LOOP``) makes the event loop of each server
+``new_event_loop`` (through uvicorn's ``loop`` setting, ``LOOP``) makes the event loop of each server
 process, a ``BalancedEventLoop``: uvloop's when it is installed, else asyncio's. Its servers on a given listening socket (the one
 uvicorn shares among its processes) take one connection per turn, and a process that already
 holds ``k`` open connections lets a waiting connection wait ``min(k, MAX_TURNS) x TURN_S``
@@ -49,7 +49,7 @@ else:
         _BaseLoop = asyncio.SelectorEventLoop
 
 #: uvicorn's ``loop`` setting naming the event loop class of each server process.
-LOOP = "service.serving:new_event_loop"
+LOOP = "service.serving:new_server_loop"
 #: The interpreter's thread switch interval in a server process, in s (Python's default: 5 ms).
 SWITCH_INTERVAL_S = 0.001
 #: Wait per open connection before a process takes the next one, in s.
@@ -83,9 +83,19 @@ class BalancedEventLoop(_BaseLoop):
         return _ServerInTurns(self, sock, protocol_factory, kwargs.get("backlog", 100))
 
 
+def new_server_loop() -> asyncio.AbstractEventLoop:
+    """The event loop of a ``toptraj serve`` process (uvicorn's ``loop`` setting, ``LOOP``):
+    ``new_event_loop``'s, once the process's stop watch runs (``service.stopping``; uvicorn
+    makes the loop before it installs its signal handlers and before it loads the app)."""
+    from service import stopping
+
+    stopping.watch()
+    return new_event_loop()
+
+
 def new_event_loop() -> asyncio.AbstractEventLoop:
-    """The event loop of a server process (uvicorn's ``loop`` setting, ``LOOP``); sets the
-    process's thread switch interval to ``SWITCH_INTERVAL_S``."""
+    """The event loop of a server process; sets the process's thread switch interval to
+    ``SWITCH_INTERVAL_S``."""
     sys.setswitchinterval(SWITCH_INTERVAL_S)
     return BalancedEventLoop()
 

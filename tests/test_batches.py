@@ -12,7 +12,7 @@ import pytest
 
 import robots
 from service.batches import run_batch
-from service.batches.lines import done_keys, request_key
+from service.batches.lines import request_key, resume_output
 from service.planning import plan_request, render
 from service.schemas.trajectories import TrajectoryRequest
 from tests.test_upload_store import PLAN, arm
@@ -72,7 +72,7 @@ def test_errors_are_lines_too(tmp_path):
     )
     run_batch(requests, tmp_path / "results.jsonl")
     results = _results(tmp_path / "results.jsonl")
-    assert {n: r["status"] for n, r in results.items()} == {1: 400, 2: 404, 4: 422, 5: 422}
+    assert {n: r["status"] for n, r in results.items()} == {1: 400, 2: 404, 3: 400, 4: 422, 5: 422}
     assert "outside the limits" in results[5]["body"]["detail"] and results[2]["body"]["title"] == "Unknown robot"
 
 
@@ -88,11 +88,12 @@ def test_a_resumed_batch_plans_nothing_twice(tmp_path):
     text = output.read_text()
     output.write_text(text + text.splitlines()[-1][:40])
     report = run_batch(requests, output)
-    assert (report.total, report.skipped, report.planned) == (6, 4, 2)
-    rows = output.read_text().splitlines()
-    assert len(rows) == 5 and len({json.loads(r)["key"] for r in rows}) == 5
+    assert (report.total, report.skipped, report.planned) == (6, 3, 3)
+    rows = [json.loads(r) for r in output.read_text().splitlines()]
+    assert sorted(r["line"] for r in rows) == [1, 2, 3, 4, 5, 6]
+    assert {r["line"]: r["key"] for r in rows} == {n: request_key(line) for n, line in enumerate([*lines, repeated], start=1)}
     assert run_batch(requests, output).planned == 0
-    assert done_keys(output) == {request_key(line) for line in lines}
+    assert resume_output(output) == {n: 200 for n in range(1, 7)}
 
 
 def test_an_uploaded_robot_reaches_the_ray_workers(tmp_path):

@@ -29,7 +29,7 @@ def test_serve_runs_the_app_factory_in_one_process_per_core_by_default(monkeypat
     assert main(["serve"]) == 0
     app, options = calls[-1]
     assert app == APP_FACTORY == "service.app:create_app" and options["factory"] is True
-    assert options["loop"] == LOOP == "service.serving:new_event_loop"
+    assert options["loop"] == LOOP == "service.serving:new_server_loop"
     assert (options["host"], options["port"], options["workers"]) == ("127.0.0.1", 8000, os.cpu_count())
     assert os.environ["TOPTRAJ_PLAN_WORKERS"] == str(plan_threads_per_process(os.cpu_count()))
 

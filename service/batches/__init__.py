@@ -1,12 +1,15 @@
 """Many requests at once: ``toptraj batch requests.jsonl -o results.jsonl`` plans a file of
-request lines on Ray (a local Ray over this machine's cores, or a cluster), writes a result line
-per request line, and resumes where an earlier run stopped.
+request lines on Ray (a local Ray over this machine's cores, or a cluster), writes exactly one
+result line per line of the file (a line that cannot be read is a 4xx line), and resumes by
+line number where an earlier run stopped (``--retry-failed``: the 504s and 5xx too).
 
-* ``lines``: request lines, their keys (a hash of the request) and the result lines.
+* ``lines``: request lines read within bounds, their keys (a hash of the request), the result
+  lines and the output file made ready to resume.
 * ``work``: one request answered, as the service answers it (runs on a Ray worker).
-* ``runner``: the batch driver: Ray, a bounded window of tasks, the output file, progress.
+* ``runner``: the batch driver: Ray, a bounded window of tasks, the output file, progress, a
+  stop that keeps what finished.
 """
 
-from service.batches.runner import BatchReport, run_batch
+from service.batches.runner import BatchReport, RayMissing, run_batch
 
-__all__ = ["BatchReport", "run_batch"]
+__all__ = ["BatchReport", "RayMissing", "run_batch"]

@@ -1,66 +1,176 @@
 """Request lines and result lines of a batch (JSON Lines).
 
 A request line is the body of ``POST /v1/trajectories`` or, when it names ``methods``, of
-``POST /v1/trajectories/compare``. Its key is the SHA-256 of its canonical JSON (keys sorted,
-no spaces), or of the line's text when it is no JSON: the same request gets the same key
-whatever its formatting. A result line is ``{"key", "line", "status", "body"}``: the 1-based
-line number, the HTTP status the service would answer and its body (the answer, or the
-problem+json).
+``POST /v1/trajectories/compare``. Every line of the file, whatever it holds, gets exactly one
+result line carrying its 1-based line number::
+
+    {"line": 7, "key": "<sha-256 hex>", "status": 200, "body": {...}}
+
+``status`` is the HTTP status the service would answer and ``body`` its body (the answer, or
+the problem+json). ``key`` is the SHA-256 of the request's canonical JSON (keys sorted, no
+spaces), or of the line's bytes when it is no JSON object: identical requests share a key (and
+one computation) whatever their formatting, but each line has its own result line. Result
+lines are written in the order they finish; sort by ``line`` for the file's order.
+
+A line is read without trusting it: at most ``MAX_LINE_BYTES`` bytes are kept (the rest of a
+longer line is skipped unread), its nesting depth is counted by a scan that cannot recurse
+before any parser sees it, and a line that is empty, too long, too deep, not UTF-8, not JSON
+or not a JSON object becomes its own 4xx result line (``RequestLine.problem``).
 """
 
 from __future__ import annotations
 
 import hashlib
-import json
+import os
+import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
+import orjson
+
+#: Longest request line read, in bytes (the HTTP API's default body cap).
+MAX_LINE_BYTES = 2_000_000
+#: Deepest nesting of arrays and objects in a request line (a request needs 5).
+MAX_DEPTH = 32
+#: Characters of a parser's message kept in a problem's detail.
+_MAX_DETAIL = 200
+#: A JSON string (its brackets are no nesting): quotes around non-quote runs and escapes.
+_STRING = re.compile(rb'"(?:[^"\\]+|\\.)*"', re.DOTALL)
+_OPEN = np.frombuffer(b"[{", dtype=np.uint8)
+_CLOSE = np.frombuffer(b"]}", dtype=np.uint8)
 
 
 @dataclass(frozen=True)
 class RequestLine:
-    """One request: its 1-based ``number``, its ``text`` and its ``key``."""
+    """Line ``number`` (1-based) of a request file: its request ``text`` and ``key``, or the
+    ``problem`` (status, problem+json bytes) that is its result when it cannot be read."""
 
     number: int
-    text: str
     key: str
+    text: str = ""
+    problem: tuple[int, bytes] | None = None
 
 
-def request_key(text: str) -> str:
-    """The key of a request line: SHA-256 of its canonical JSON, or of its text."""
+def problem_body(status: int, title: str, detail: str) -> bytes:
+    """A problem+json body (``detail`` cut to a bounded length)."""
+    if len(detail) > 4 * _MAX_DETAIL:
+        detail = detail[: 4 * _MAX_DETAIL] + "..."
+    return orjson.dumps({"type": "about:blank", "title": title, "status": status, "detail": detail})
+
+
+def nesting_depth(data: bytes) -> int:
+    """The deepest nesting of ``[`` and ``{`` in ``data`` (outside JSON strings), counted
+    without recursion: strings removed by one regular expression, then a running sum of +1 per
+    opening and -1 per closing bracket. An unterminated string counts its brackets."""
+    codes = np.frombuffer(_STRING.sub(b"", data), dtype=np.uint8)
+    steps = np.isin(codes, _OPEN).astype(np.int64) - np.isin(codes, _CLOSE)
+    return int(np.cumsum(steps).max(initial=0))
+
+
+def _digest(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def parse_line(number: int, raw: bytes) -> RequestLine:
+    """Line ``number`` of a file as a request, or as the 4xx problem that is its result."""
+    data = raw.strip(b" \t\r\n")
+
+    def refused(status: int, title: str, detail: str) -> RequestLine:
+        return RequestLine(number, _digest(data), problem=(status, problem_body(status, title, f"line {number}: {detail}")))
+
+    if not data:
+        return refused(400, "Empty line", "the line is blank; put one request (a JSON object) on each line, or remove the line")
+    depth = nesting_depth(data)
+    if depth > MAX_DEPTH:
+        return refused(400, "Too deeply nested", f"the line nests arrays and objects {depth} deep; a request nests at most {MAX_DEPTH}")
     try:
-        canonical = json.dumps(json.loads(text), sort_keys=True, separators=(",", ":"))
-    except ValueError:
-        canonical = text
-    return hashlib.sha256(canonical.encode()).hexdigest()
+        body = orjson.loads(data)
+    except orjson.JSONDecodeError as error:
+        return refused(400, "Malformed JSON", f"the line is not JSON (UTF-8): {str(error)[:_MAX_DETAIL]}")
+    if not isinstance(body, dict):
+        return refused(
+            422, "Invalid request", f"the line is a JSON {type(body).__name__}; a request is a JSON object (a POST /v1/trajectories body)"
+        )
+    return RequestLine(number, _digest(orjson.dumps(body, option=orjson.OPT_SORT_KEYS)), text=data.decode())
 
 
-def read_requests(path: Path) -> list[RequestLine]:
-    """The non-blank lines of ``path`` as requests."""
-    requests = []
-    with open(path, encoding="utf-8") as handle:
-        for number, text in enumerate(handle, start=1):
-            text = text.strip()
-            if text:
-                requests.append(RequestLine(number, text, request_key(text)))
-    return requests
+def request_key(text: str | bytes) -> str:
+    """The key of a request line (``RequestLine.key``)."""
+    return parse_line(1, text.encode() if isinstance(text, str) else text).key
 
 
-def done_keys(path: Path) -> set[str]:
-    """Keys of the results already in ``path`` (none if it does not exist). A line that does
-    not parse (the last one of an interrupted run) is ignored, and the file is cut back to the
-    lines that do, so that appending continues cleanly."""
+def read_requests(path: Path, skip: set[int] | frozenset[int] = frozenset()) -> Iterator[RequestLine]:
+    """Every line of ``path`` but the numbers in ``skip``, as requests (``parse_line``); a line
+    longer than ``MAX_LINE_BYTES`` is a 413 problem, its bytes beyond the cap skipped unread."""
+    with open(path, "rb") as handle:
+        number = 0
+        while raw := handle.readline(MAX_LINE_BYTES + 1):
+            number += 1
+            if len(raw) > MAX_LINE_BYTES and not raw.endswith(b"\n"):
+                size = len(raw)
+                while not raw.endswith(b"\n") and (raw := handle.readline(1 << 20)):
+                    size += len(raw)
+                size -= raw.endswith(b"\n")
+                if number not in skip:
+                    detail = f"line {number}: the line has {size} bytes; a request line has at most {MAX_LINE_BYTES}"
+                    yield RequestLine(number, _digest(b"%d" % size), problem=(413, problem_body(413, "Line too long", detail)))
+                continue
+            if number == 1:
+                raw = raw.removeprefix(b"\xef\xbb\xbf")  # a byte order mark some editors write
+            if number not in skip:
+                yield parse_line(number, raw)
+
+
+def result_line(number: int, key: str, status: int, body: bytes) -> bytes:
+    """A result line ``{"line", "key", "status", "body"}`` with its newline, the body (JSON
+    bytes) spliced in as it is."""
+    head = orjson.dumps({"line": number, "key": key, "status": status})[:-1]
+    return head + b',"body":' + body + b"}\n"
+
+
+def retryable(status: int) -> bool:
+    """A result worth computing again (``--retry-failed``): a budget error (504) or a 5xx."""
+    return status >= 500
+
+
+def resume_output(path: Path, retry_failed: bool = False) -> dict[int, int]:
+    """The status of each line number already answered in ``path`` (none if it does not
+    exist), with ``path`` made ready for appending: cut back before the first line that is no
+    whole result line (the last one of an interrupted run), a line number's second result
+    dropped, and with ``retry_failed`` the retryable results dropped (written to a new file
+    that replaces the old one, so an interruption leaves one or the other)."""
     if not path.exists():
-        return set()
-    keys, keep = set(), 0
+        return {}
+    done: dict[int, int] = {}
+    keep: list[tuple[int, int]] = []  # (offset, length) of the lines kept
+    offset, dropped = 0, False
     with open(path, "rb") as handle:
         for raw in handle:
-            if not raw.endswith(b"\n"):
-                break
             try:
-                keys.add(json.loads(raw)["key"])
+                if not raw.endswith(b"\n"):
+                    raise ValueError("cut short")
+                row = orjson.loads(raw)
+                number, status = int(row["line"]), int(row["status"])
             except (ValueError, KeyError, TypeError):
                 break
-            keep += len(raw)
-    with open(path, "r+b") as handle:
-        handle.truncate(keep)
-    return keys
+            if number in done or (retry_failed and retryable(status)):
+                dropped = True
+            else:
+                done[number] = status
+                keep.append((offset, len(raw)))
+            offset += len(raw)
+    if not dropped:
+        with open(path, "r+b") as handle:
+            handle.truncate(offset)
+        return done
+    fresh = path.with_name(path.name + ".resuming")
+    with open(path, "rb") as source, open(fresh, "wb") as target:
+        for start, length in keep:
+            source.seek(start)
+            target.write(source.read(length))
+        target.flush()
+        os.fsync(target.fileno())
+    os.replace(fresh, path)
+    return done

@@ -1,57 +1,85 @@
-"""The batch driver: request lines planned on Ray, results appended as they come.
+"""The batch driver: request lines planned on Ray, a result line per request line appended as
+they come, and an interruption (Ctrl-C) that stops within seconds and leaves a file to resume.
 
-Ray runs ``work.answer_chunk`` as tasks of ``CHUNK`` requests each (a typical request plans in
-tens of milliseconds; a task costs about a millisecond of Ray's own), at most ``2 x workers``
-tasks in flight, so memory stays bounded whatever the batch's length. Each result line carries
-its request's line number and key; lines are written in the order they finish. What travels to
-the workers: the request texts and the URDF texts of the uploaded robots the batch names (a
-catalog robot is built by each worker from its own installation). What stays with the driver:
-the output file, the upload store, the progress.
+Each line is read and checked first (``lines.read_requests``); a line that cannot be read is
+written as its 4xx result at once. The readable requests are grouped by key (identical requests
+computed once, a result line written for each of their lines) and planned by ``RayPool``: tasks
+of ``CHUNK`` requests each (a typical request plans in tens of milliseconds; a task costs about
+a millisecond of Ray's own), at most ``2 x workers + 1`` tasks in flight, so memory stays
+bounded whatever the batch's length. What travels to the workers: the request texts and the
+URDF texts of the uploaded robots the batch names (a catalog robot is built by each worker from
+its own installation). What stays with the driver: the output file, the upload store, the
+progress.
+
+Resuming: the lines already answered in the output file are skipped by line number; with
+``retry_failed``, those answered with a budget error (504) or another 5xx are planned again
+(``lines.resume_output``). Stopping (``stop`` set, as ``toptraj batch`` does on Ctrl-C): no task
+is submitted any more, the result lines of the tasks already finished are written, the others
+are cancelled (their workers killed), and a Ray started here is shut down with its processes.
 """
 
 from __future__ import annotations
 
-import json
 import os
 import sys
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
+
+import orjson
 
 import robots
 from robots.catalog import is_catalog_robot
-from service.batches.lines import done_keys, read_requests
+from service.batches.lines import problem_body, read_requests, result_line, resume_output
 
 #: Requests per Ray task.
 CHUNK = 4
 #: Planning budget of one request in a batch, in s (as the synchronous endpoint's default).
 BUDGET_S = 20.0
+#: Largest planning budget of one request, in s.
+MAX_BUDGET_S = 3600.0
+#: Time a task may take beyond its requests' budgets (a worker process starting and importing
+#: the planning stack), in s; past it the task is killed and its requests are 504 lines.
+TASK_SLACK_S = 10.0
+#: Longest wait for a task before the driver looks at ``stop`` again, in s.
+WAIT_S = 0.2
+
+#: What ``toptraj batch`` needs and how to get it.
+RAY_MISSING = "toptraj batch plans on Ray, which is not installed: pip install 'toptraj[ray]'"
+
+
+class RayMissing(RuntimeError):
+    """Ray (the ``ray`` extra) is not installed."""
 
 
 @dataclass(frozen=True)
 class BatchReport:
-    """What a run did: requests in the file, already done before it, planned now, seconds."""
+    """What a run did: lines in the file, already answered before it, answered now (each
+    line of a group of identical requests counted), seconds, and whether it was stopped
+    before the end (``stop``)."""
 
     total: int
     skipped: int
     planned: int
     seconds: float
+    interrupted: bool = False
 
     @property
     def rate(self) -> float:
-        """Requests planned per second by this run."""
+        """Lines answered per second by this run."""
         return self.planned / self.seconds if self.seconds > 0 else 0.0
 
 
-def _uploads_named(texts: list[str]) -> dict[str, tuple[str, str]]:
+def _uploads_named(texts: Sequence[str]) -> dict[str, tuple[str, str]]:
     """URDF texts and options of the uploaded robots the requests name (catalog robots need none)."""
     names = set()
     for text in texts:
         try:
-            body = json.loads(text)
-        except ValueError:
+            body = orjson.loads(text)
+        except orjson.JSONDecodeError:
             continue
         if isinstance(body, dict) and isinstance(body.get("robot"), str) and not is_catalog_robot(body["robot"]):
             names.add(body["robot"])
@@ -77,22 +105,116 @@ def progress_bar(stream: TextIO = sys.stderr) -> Callable[[int, int, float], Non
     return show
 
 
-def _start_ray(address: str | None, workers: int | None):
-    import ray
+class RayPool:
+    """Chunks of requests computed as Ray tasks (``work.answer_chunk``): on the cluster at
+    ``address`` (``auto``, ``ray://host:port``), or on a local Ray with ``workers`` CPUs
+    (default: the cores) started here and shut down by ``close`` with its processes.
 
-    if ray.is_initialized():
-        return ray
-    if address in (None, "local"):
-        ray.init(
-            num_cpus=workers or os.cpu_count() or 1,
-            include_dashboard=False,
-            object_store_memory=100 * 1024 * 1024,
-            log_to_driver=False,
-            configure_logging=False,
-        )
-    else:
-        ray.init(address=address, log_to_driver=False, configure_logging=False)
-    return ray
+    Raises:
+        RayMissing: Ray is not installed.
+    """
+
+    def __init__(self, address: str | None = None, workers: int | None = None):
+        try:
+            import ray
+        except ImportError:
+            raise RayMissing(RAY_MISSING) from None
+        from service.batches.work import answer_chunk
+
+        self._ray = ray
+        self._started_here = False
+        if not ray.is_initialized():
+            if address in (None, "local"):
+                ray.init(
+                    num_cpus=workers or os.cpu_count() or 1,
+                    include_dashboard=False,
+                    object_store_memory=100 * 1024 * 1024,
+                    log_to_driver=False,
+                    configure_logging=False,
+                )
+            else:
+                ray.init(address=address, log_to_driver=False, configure_logging=False)
+            self._started_here = True
+        self._remote = ray.remote(num_cpus=1, max_retries=2)(answer_chunk)
+        self._uploads: Any = ray.put({})
+        self.cpus = int(ray.available_resources().get("CPU", workers or 1) or 1)
+
+    def share(self, uploads: dict[str, tuple[str, str]]) -> None:
+        """The uploaded robots (``_uploads_named``) every later task receives."""
+        self._uploads = self._ray.put(uploads)
+
+    def submit(self, chunk: list[tuple[str, str]], budget_s: float) -> Any:
+        """Start computing ``chunk`` of (key, text); a handle for ``wait`` and ``result``."""
+        return self._remote.remote(chunk, self._uploads, budget_s)
+
+    def wait(self, handles: list, timeout_s: float) -> tuple[list, list]:
+        """(finished, still running) of ``handles``, once one finished or after ``timeout_s``."""
+        ready, rest = self._ray.wait(handles, num_returns=1, timeout=timeout_s)
+        if ready and rest:
+            more, rest = self._ray.wait(rest, num_returns=len(rest), timeout=0)
+            ready += more
+        return ready, rest
+
+    def result(self, handle: Any) -> list[tuple[str, int, bytes]]:
+        """(key, status, body) of each request of a finished task (raises its failure)."""
+        return self._ray.get(handle)
+
+    def cancel(self, handles: list) -> None:
+        """Stop these tasks, killing the workers that run them."""
+        for handle in handles:
+            self._ray.cancel(handle, force=True)
+
+    def close(self) -> None:
+        """Shut down a Ray started here (its processes with it)."""
+        if self._started_here:
+            self._ray.shutdown()
+
+
+def _write(out, numbers: dict[str, list[int]], answers: list[tuple[str, int, bytes]]) -> int:
+    """Write a result line per line number of each answered request; how many were written."""
+    written = 0
+    for key, status, body in answers:
+        for number in numbers.pop(key, ()):
+            out.write(result_line(number, key, status, body))
+            written += 1
+    out.flush()
+    return written
+
+
+def _failed(chunk: list[tuple[str, str]], error: BaseException) -> list[tuple[str, int, bytes]]:
+    """The 500 of each request of a task that failed as a whole (its worker died)."""
+    detail = f"the worker planning this line failed ({type(error).__name__}); run the batch again with --retry-failed"
+    return [(key, 500, problem_body(500, "Worker failed", detail)) for key, _ in chunk]
+
+
+def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, out, numbers: dict[str, list[int]]) -> int:
+    """Kill the tasks that ran past their requests' budgets plus ``TASK_SLACK_S`` (a solver
+    step that cannot check its deadline) and write their requests as 504 lines; how many
+    lines were written. A task counts as started once it is among the ``runner.cpus`` oldest
+    still running (Ray starts tasks in the order submitted, one per CPU)."""
+    now = time.monotonic()
+    for handle in list(running)[: runner.cpus]:
+        started_at.setdefault(handle, now)
+    overdue = [h for h, since in started_at.items() if now > since + len(running[h]) * budget_s + TASK_SLACK_S]
+    if not overdue:
+        return 0
+    runner.cancel(overdue)
+    detail = f"the planning did not end within its budget of {budget_s:g} s and was stopped; run the batch again with --retry-failed, or a larger --budget"
+    written = 0
+    for handle in overdue:
+        del started_at[handle]
+        written += _write(out, numbers, [(key, 504, problem_body(504, "Time budget exceeded", detail)) for key, _ in running.pop(handle)])
+    return written
+
+
+def count_lines(path: Path) -> int:
+    """Lines of ``path`` (a last line without its newline counted)."""
+    count, last = 0, b"\n"
+    with open(path, "rb") as handle:
+        while block := handle.read(1 << 20):
+            count += block.count(b"\n")
+            last = block[-1:]
+    return count + (last != b"\n")
 
 
 def run_batch(
@@ -102,39 +224,91 @@ def run_batch(
     ray_address: str | None = None,
     progress: Callable[[int, int, float], None] | None = None,
     budget_s: float = BUDGET_S,
+    retry_failed: bool = False,
+    stop: threading.Event | None = None,
+    pool: Callable[[], Any] | None = None,
 ) -> BatchReport:
-    """Plan every request of ``requests_path`` not yet answered in ``output_path`` and append
-    their result lines to it. ``ray_address``: ``None``/``"local"`` starts a local Ray with
-    ``workers`` CPUs (default: the cores), else an existing cluster (``auto`` or
-    ``ray://host:port``)."""
-    from service.batches.work import answer_chunk
+    """Answer every line of ``requests_path`` not yet answered in ``output_path`` (with
+    ``retry_failed``, nor answered with a 504 or another 5xx) and append their result lines to
+    it, each request planned within ``budget_s`` s. ``ray_address``: ``None``/``"local"``
+    starts a local Ray with ``workers`` CPUs (default: the cores), else an existing cluster
+    (``auto`` or ``ray://host:port``); ``pool`` makes another pool (``RayPool``'s methods).
+    Once ``stop`` is set the run ends within about a second, its finished results written
+    (``BatchReport.interrupted``).
 
+    Raises:
+        RayMissing: Ray is not installed (and lines need planning).
+        OSError: a file cannot be read or written.
+    """
     started = time.perf_counter()
     requests_path, output_path = Path(requests_path), Path(output_path)
-    requests = read_requests(requests_path)
-    done = done_keys(output_path)
-    todo = [r for r in requests if r.key not in done]
-    todo = list({r.key: r for r in todo}.values())  # a request repeated in the file is planned once
-    skipped = len(requests) - len(todo)
-    if not todo:
-        return BatchReport(len(requests), skipped, 0, time.perf_counter() - started)
-    ray = _start_ray(ray_address, workers)
-    remote = ray.remote(num_cpus=1, max_retries=2)(answer_chunk)
-    uploads = ray.put(_uploads_named([r.text for r in todo]))
-    chunks = [[(r.key, r.text, r.number) for r in todo[k : k + CHUNK]] for k in range(0, len(todo), CHUNK)]
-    window = 2 * int(ray.available_resources().get("CPU", workers or 1) or 1) + 1
-    pending: list = []
-    next_chunk, finished = 0, 0
+    stop = stop or threading.Event()
+    total = count_lines(requests_path)
+    done = resume_output(output_path, retry_failed)
+    skipped = sum(1 for number in done if number <= total)
+    numbers: dict[str, list[int]] = {}  # key -> the line numbers of its request
+    texts: dict[str, str] = {}
+    written = 0
+    todo = total - skipped
+
+    def report() -> None:
+        if progress:
+            progress(written, todo, time.perf_counter() - started)
+
     with open(output_path, "ab") as out:
-        while pending or next_chunk < len(chunks):
-            while next_chunk < len(chunks) and len(pending) < window:
-                pending.append(remote.remote(chunks[next_chunk], uploads, budget_s))
-                next_chunk += 1
-            ready, pending = ray.wait(pending, num_returns=1)
-            for line in ray.get(ready[0]):
-                out.write(line)
-                finished += 1
-            out.flush()
-            if progress:
-                progress(finished, len(todo), time.perf_counter() - started)
-    return BatchReport(len(requests), skipped, len(todo), time.perf_counter() - started)
+        for line in read_requests(requests_path, skip=set(done)):
+            if stop.is_set():  # before any planning: what was read is resumed later
+                out.flush()
+                return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=True)
+            if line.problem is not None:
+                out.write(result_line(line.number, line.key, *line.problem))
+                written += 1
+            else:
+                numbers.setdefault(line.key, []).append(line.number)
+                texts.setdefault(line.key, line.text)
+        out.flush()
+        report()
+        if not texts or stop.is_set():
+            return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=bool(texts))
+        runner = (pool or (lambda: RayPool(ray_address, workers)))()
+        try:
+            runner.share(_uploads_named(list(texts.values())))
+            keys = list(texts)
+            chunks = [[(key, texts[key]) for key in keys[k : k + CHUNK]] for k in range(0, len(keys), CHUNK)]
+            del texts, keys
+            window = 2 * runner.cpus + 1
+            running: dict[Any, list[tuple[str, str]]] = {}  # in the order submitted
+            started_at: dict[Any, float] = {}
+            next_chunk = 0
+            while (running or next_chunk < len(chunks)) and not stop.is_set():
+                while next_chunk < len(chunks) and len(running) < window and not stop.is_set():
+                    running[runner.submit(chunks[next_chunk], budget_s)] = chunks[next_chunk]
+                    chunks[next_chunk] = []  # its texts are the task's now
+                    next_chunk += 1
+                ready, _ = runner.wait(list(running), WAIT_S)
+                for handle in ready:
+                    started_at.pop(handle, None)
+                    chunk = running.pop(handle)
+                    try:
+                        answers = runner.result(handle)
+                    except Exception as error:  # the task as a whole: a worker died
+                        if stop.is_set():
+                            continue  # cancelled by the stop: resumed later
+                        answers = _failed(chunk, error)
+                    written += _write(out, numbers, answers)
+                overdue = _kill_overdue(runner, running, started_at, budget_s, out, numbers)
+                written += overdue
+                if ready or overdue:
+                    report()
+            interrupted = bool(running) or next_chunk < len(chunks)
+            if interrupted:
+                ready, rest = runner.wait(list(running), 0) if running else ([], [])
+                for handle in ready:
+                    try:
+                        written += _write(out, numbers, runner.result(handle))
+                    except Exception:  # noqa: S112 - cancelled or failed: resumed later
+                        continue
+                runner.cancel(rest)
+        finally:
+            runner.close()
+    return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted)

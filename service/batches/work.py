@@ -4,7 +4,7 @@ equals the synchronous endpoint's answer."""
 
 from __future__ import annotations
 
-import json
+import logging
 import tempfile
 
 import orjson
@@ -14,9 +14,12 @@ import robots
 from planners.deadline import Deadline
 from robots import ToptrajError
 from robots.upload_options import UploadOptions
+from service.batches.lines import problem_body
 from service.commands import validation_problem
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+
+logger = logging.getLogger("toptraj.batches")
 
 _configured = False
 
@@ -36,18 +39,16 @@ def _uploads_here(uploads: dict[str, tuple[str, str]]) -> None:
         robots.register_urdf(urdf, name, UploadOptions.from_json(options))
 
 
-def _problem_bytes(status: int, title: str, detail: str, **extra) -> bytes:
-    return orjson.dumps({"type": "about:blank", "title": title, "status": status, "detail": detail, **extra})
-
-
 def answer(text: str, budget_s: float) -> tuple[int, bytes]:
-    """(status, body as JSON bytes) of one request line: 200 and the answer, or the problem's
-    status and problem+json. ``budget_s`` bounds the computation as the synchronous budget
-    does. The answer stays the bytes the endpoint would send (never decoded and re-encoded)."""
+    """(status, body as JSON bytes) of one request line (a JSON object, ``lines.parse_line``):
+    200 and the answer, or the problem's status and problem+json; anything unexpected is
+    this line's 500, never the batch's. ``budget_s`` bounds the computation as the synchronous
+    budget does. The answer stays the bytes the endpoint would send (never decoded and
+    re-encoded)."""
     try:
-        body = json.loads(text)
-    except ValueError as error:
-        return 400, _problem_bytes(400, "Malformed JSON", f"the line is not JSON: {error}")
+        body = orjson.loads(text)
+    except orjson.JSONDecodeError as error:
+        return 400, problem_body(400, "Malformed JSON", f"the line is not JSON: {str(error)[:200]}")
     try:
         if isinstance(body, dict) and "methods" in body:
             return 200, encode_json(compare_request(CompareRequest.model_validate_json(text), Deadline(budget_s)))
@@ -58,17 +59,13 @@ def answer(text: str, budget_s: float) -> tuple[int, bytes]:
         return 422, orjson.dumps(validation_problem(error))
     except ToptrajError as error:
         extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
-        return error.status, _problem_bytes(error.status, error.title, error.detail, **extra)
+        return error.status, orjson.dumps({"type": "about:blank", "title": error.title, "status": error.status, "detail": error.detail, **extra})
+    except Exception as error:  # a solver's own failure: this line's answer, logged
+        logger.error("a batch line failed unexpectedly", exc_info=error)
+        return 500, problem_body(500, "Internal error", f"an unexpected {type(error).__name__} occurred while planning this line")
 
 
-def result_line(key: str, number: int, status: int, body: bytes) -> bytes:
-    """A result line ``{"key", "line", "status", "body"}`` with its newline, the body spliced in
-    as it is."""
-    head = orjson.dumps({"key": key, "line": number, "status": status})[:-1]
-    return head + b',"body":' + body + b"}\n"
-
-
-def answer_chunk(chunk: list[tuple[str, str, int]], uploads: dict[str, tuple[str, str]], budget_s: float) -> list[bytes]:
-    """Result lines (bytes) of a chunk of (key, text, line number) requests."""
+def answer_chunk(chunk: list[tuple[str, str]], uploads: dict[str, tuple[str, str]], budget_s: float) -> list[tuple[str, int, bytes]]:
+    """(key, status, body) of each (key, request text) of a chunk."""
     _uploads_here(uploads)
-    return [result_line(key, number, *answer(text, budget_s)) for key, text, number in chunk]
+    return [(key, *answer(text, budget_s)) for key, text in chunk]

@@ -172,8 +172,7 @@ class JobRunner:
             self._stopping.set()
             running = list(self._running.values())
         self._wake.set()
-        for entry in running:
-            entry.stop()
+        self.stop_running()
         dispatcher.join(timeout_s)
         for entry in running:
             if entry.thread is not None:
@@ -186,6 +185,15 @@ class JobRunner:
             logger.error("jobs of %s not marked interrupted: %s", self.owner, error.detail)
         with _LIVE_LOCK:
             _LIVE_TOKENS.discard(self._token)
+
+    def stop_running(self) -> None:
+        """Stop the work of the jobs running here (their outcome is left to ``close``, which
+        marks them interrupted): a job waiting for its worker process to start ends once the
+        fork server answers or is gone."""
+        with self._lock:
+            running = list(self._running.values())
+        for entry in running:
+            entry.stop()
 
     def wake(self) -> None:
         """Look for queued work now (a job was submitted)."""
@@ -306,9 +314,11 @@ class JobRunner:
             return "failed", None, problem_of(
                 BudgetExceeded(f"the job exceeded its time budget of {job.budget_s:g} s; submit it with a larger budget_s")
             )
-        except ToptrajError as error:
-            return "failed", None, problem_of(error)
         except Exception as error:
+            if entry.stopped:  # its process killed, or its fork server gone: not its failure
+                return None
+            if isinstance(error, ToptrajError):
+                return "failed", None, problem_of(error)
             logger.error("job %s failed unexpectedly", job.id, exc_info=error)
             return "failed", None, problem_of(error)
         if len(result) > self.setup.max_response_bytes:

@@ -47,31 +47,44 @@ def _compare(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
 
 
 def _batch(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
-    """Every request of a batch (``POST /v1/batches``) answered as its own endpoint would,
-    errors included, within the job's budget: here one after another, or on the Ray cluster at
-    ``setup.ray_address`` (``TOPTRAJ_RAY_ADDRESS``)."""
-    from service.batches.work import answer_chunk
-
+    """Every request of a batch (``POST /v1/batches``) answered as its own endpoint would: a
+    line's failure, whatever it is, is that line's result (``batches.work.answer``), and a line
+    the job's budget did not reach is a 504 of its own, so the job ends with every answer it
+    has. Here one after another, or on the Ray cluster at ``setup.ray_address``
+    (``TOPTRAJ_RAY_ADDRESS``)."""
     items = orjson.loads(request)["requests"]
-    lines = [(str(k), orjson.dumps(item).decode(), k + 1) for k, item in enumerate(items)]
-    budget = min(BATCH_REQUEST_BUDGET_S, deadline.remaining() or BATCH_REQUEST_BUDGET_S)
-    if setup.ray_address:
-        return encode_json({"results": _on_ray(lines, setup, deadline)})
-    results = []
-    for k, line in enumerate(lines):
-        deadline.check()
-        deadline.progress(k / len(lines), f"batch: request {k + 1} of {len(lines)}")
-        results.extend(answer_chunk([line], {}, min(budget, deadline.remaining() or budget)))
-    return encode_json({"results": [_without_key(row) for row in results]})
+    texts = [orjson.dumps(item).decode() for item in items]
+    answers = _on_ray(texts, setup, deadline) if setup.ray_address else _here(texts, deadline)
+    return encode_json(
+        {"results": [{"line": k + 1, "status": status, "body": orjson.loads(body)} for k, (status, body) in enumerate(answers)]}
+    )
 
 
-def _without_key(line: bytes) -> dict:
-    row = orjson.loads(line)
-    del row["key"]
-    return row
+def _not_reached(budget_s: float | None) -> tuple[int, bytes]:
+    from service.batches.lines import problem_body
+
+    detail = f"the batch's time budget of {budget_s:g} s was spent before this request was planned; submit it again, or the batch with a larger budget_s"
+    return 504, problem_body(504, "Time budget exceeded", detail)
 
 
-def _on_ray(lines, setup: WorkerSetup, deadline: Deadline) -> list[dict]:
+def _line_budget(deadline: Deadline) -> float:
+    """Seconds a line may take: its own budget, within what is left of the job's."""
+    remaining = deadline.remaining()
+    return BATCH_REQUEST_BUDGET_S if remaining is None else min(BATCH_REQUEST_BUDGET_S, remaining)
+
+
+def _here(texts: list[str], deadline: Deadline) -> list[tuple[int, bytes]]:
+    from service.batches.work import answer
+
+    answers = []
+    for k, text in enumerate(texts):
+        deadline.progress(k / len(texts), f"batch: request {k + 1} of {len(texts)}")
+        budget = _line_budget(deadline)
+        answers.append(answer(text, budget) if budget > MIN_LINE_BUDGET_S else _not_reached(deadline.budget_s))
+    return answers
+
+
+def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tuple[int, bytes]]:
     import ray
 
     from service.batches.runner import _uploads_named
@@ -80,22 +93,38 @@ def _on_ray(lines, setup: WorkerSetup, deadline: Deadline) -> list[dict]:
     if not ray.is_initialized():
         ray.init(address=None if setup.ray_address == "local" else setup.ray_address, log_to_driver=False, configure_logging=False)
     remote = ray.remote(num_cpus=1)(answer_chunk)
-    uploads = ray.put(_uploads_named([text for _, text, _ in lines]))
-    pending = [remote.remote([line], uploads, BATCH_REQUEST_BUDGET_S) for line in lines]
-    results = []
-    while pending:
-        deadline.check()
-        ready, pending = ray.wait(pending, num_returns=1, timeout=0.5)
+    uploads = ray.put(_uploads_named(texts))
+    budget = _line_budget(deadline)
+    pending = {remote.remote([(str(k), text)], uploads, budget): k for k, text in enumerate(texts)}
+    answers: list[tuple[int, bytes] | None] = [None] * len(texts)
+    while pending and _line_budget(deadline) > 0.0:
+        ready, _ = ray.wait(list(pending), num_returns=1, timeout=0.5)
         for ref in ready:
-            results.extend(ray.get(ref))
-        deadline.progress(len(results) / len(lines), f"batch: {len(results)} of {len(lines)} on Ray")
-    return sorted((_without_key(row) for row in results), key=lambda row: row["line"])
+            k = pending.pop(ref)
+            try:
+                [(_, status, body)] = ray.get(ref)
+                answers[k] = (status, body)
+            except Exception as error:  # the task as a whole: its worker died
+                answers[k] = (500, _worker_failed(error))
+        done = len(texts) - len(pending)
+        deadline.progress(done / len(texts), f"batch: {done} of {len(texts)} on Ray")
+    for ref in pending:
+        ray.cancel(ref, force=True)
+    return [answer if answer is not None else _not_reached(deadline.budget_s) for answer in answers]
+
+
+def _worker_failed(error: BaseException) -> bytes:
+    from service.batches.lines import problem_body
+
+    return problem_body(500, "Worker failed", f"the worker planning this request failed ({type(error).__name__}); submit it again")
 
 
 #: Each kind of job and the function computing it.
 KINDS = {"trajectory": _trajectory, "compare": _compare, "batch": _batch}
 #: Planning budget of one request of a batch, in s (as the synchronous endpoint's default).
 BATCH_REQUEST_BUDGET_S = 20.0
+#: Least time left of a batch job's budget in which another request is started, in s.
+MIN_LINE_BUDGET_S = 0.05
 
 
 def compute(kind: str, request: str, budget_s: float, setup: WorkerSetup, progress: Progress) -> bytes:
