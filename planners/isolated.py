@@ -53,6 +53,9 @@ from planners.threads import single_blas_thread
 POLL_S = 0.02
 #: Shortest interval between two progress reports of one stage sent by a child, in s.
 PROGRESS_S = 0.1
+#: How much lower the CPU priority of a heavy planning's worker process is (``nice``): it
+#: shares the cores with a server's short requests, which keep theirs.
+LOW_PRIORITY = 10
 #: Modules the fork server imports once, so that children start with them loaded.
 PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.free_path.collocation"]
 

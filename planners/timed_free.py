@@ -17,7 +17,7 @@ from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.free_path.switching import refine_collocation, switched_path, switching_times
 from planners.gate import TimedStretch, checked, gated
 from planners.grid import path_grid
-from planners.isolated import run_isolated
+from planners.isolated import LOW_PRIORITY, run_isolated
 from planners.paths import GeometricPath
 from planners.requests import Timing
 from planners.search.curve import GridSplinePath
@@ -30,9 +30,6 @@ from planners.timed import Timed, moving_velocity, path_boundary, timed_path, ti
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 
-#: How much lower the CPU priority of a search's worker process is (``os.nice``): a search
-#: shares the cores with the server's short requests, which keep theirs.
-SEARCH_NICE = 10
 #: A search's worker process may grow its address space by this multiple of its memory
 #: estimate, plus ``SEARCH_MEMORY_SLACK`` (the solver stacks' arenas and libraries' own
 #: mappings): beyond, ``MemoryError`` there, answered as ``OverMemory``.
@@ -130,7 +127,7 @@ def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstac
     The search's memory is estimated from its settings first (``planners.search.memory``,
     ``OverMemory`` beyond ``timing.search.memory_bytes``). Under a deadline the whole search
     runs in a worker process (``planners.isolated``) at a lower CPU priority
-    (``SEARCH_NICE``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
+    (``planners.isolated.LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
     killed when the budget is spent or the caller cancels, its memory gone with it."""
     if not isinstance(spec, FreeMotion):
         raise InvalidRequest("timing.method 'search' finds the path itself: give a free path (path.kind 'free', start and goal)")
@@ -143,7 +140,7 @@ def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstac
         need = 0
     return run_isolated(
         _searched, robot, spec, timing, kinds, limits, deadline.end, deadline.budget_s, threshold, obstacles, clearance,
-        deadline=deadline, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK, nice=SEARCH_NICE,
+        deadline=deadline, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK, nice=LOW_PRIORITY,
     )
 
 

@@ -84,7 +84,7 @@ def point_distances(
     """Smallest signed distance (m) of the arm's link capsules (``robots.collision``) to any
     obstacle at each configuration (k, n_dof); distances above ``exact_below`` may be lower
     bounds (``planners.collision.distance.capsule_distance``). ``deadline`` is checked
-    before each ``BATCH`` of configurations."""
+    before each obstacle of each ``BATCH`` of configurations."""
     out = np.empty(len(q))
     capsules = robot_capsules(robot)
     joints = np.array([c.joint for c in capsules])
@@ -101,8 +101,11 @@ def point_distances(
         rotation, translation = placed[0][:, joints], placed[1][:, joints]
         a = np.einsum("kcij,cj->kci", rotation, local_a) + translation
         b = np.einsum("kcij,cj->kci", rotation, local_b) + translation
-        distances = [capsule_distance(a, b, radius, obstacle, exact_below).min(axis=1) for obstacle in obstacles]
-        out[begin : begin + BATCH] = np.min(distances, axis=0)
+        nearest = np.full(len(rows), np.inf)
+        for obstacle in obstacles:
+            deadline.check()
+            np.minimum(nearest, capsule_distance(a, b, radius, obstacle, exact_below).min(axis=1), out=nearest)
+        out[begin : begin + BATCH] = nearest
     return out
 
 

@@ -80,18 +80,33 @@ def _lattice_spans_per_point(n_dof: int, max_turn: float) -> int:
     return int((within * turns[None, :]).sum())
 
 
-def roadmap_bytes(n_dof: int, points: int, neighbors: int, max_turn: float) -> int:
-    """Estimated bytes of a roadmap search over ``points`` graph points (start and goals
-    included) each joined to ``neighbors`` others, turns of at most ``max_turn`` degrees."""
+def roadmap_spans(points: int, neighbors: int, max_turn: float) -> float:
+    """Estimated spans of a roadmap of ``points`` graph points (start and goals included) each
+    joined to ``neighbors`` others, turns of at most ``max_turn`` degrees: an upper bound of
+    the measured counts (module docstring)."""
     k = max(2, min(neighbors, points - 1))
-    spans = ROADMAP_SPANS * (1.0 if max_turn <= 90.0 else 4.0) * points * k**3
-    return int(BASE_BYTES + spans * SPAN_BYTES_PER_JOINT * n_dof + 24 * points**2)
+    return ROADMAP_SPANS * (1.0 if max_turn <= 90.0 else 4.0) * points * k**3
+
+
+def roadmap_bytes(n_dof: int, points: int, neighbors: int, max_turn: float) -> int:
+    """Estimated bytes of a roadmap search (``roadmap_spans``) on an ``n_dof``-joint arm."""
+    return int(BASE_BYTES + roadmap_spans(points, neighbors, max_turn) * SPAN_BYTES_PER_JOINT * n_dof + 24 * points**2)
 
 
 def lattice_bytes(n_dof: int, points: int, max_turn: float) -> int:
     """Estimated bytes of a lattice search over ``points`` grid points."""
     spans = points * _lattice_spans_per_point(n_dof, max_turn)
     return int(BASE_BYTES + spans * SPAN_BYTES_PER_JOINT * n_dof)
+
+
+def search_spans(robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool) -> float:
+    """Estimated spans of curve of a search with these settings (an upper bound)."""
+    kind = _graph_kind(robot, options)
+    if kind == "lattice":
+        points = math.prod(len(axis) for axis in lattice_axes(robot, start, goal, options, revolutions))
+        return float(points * _lattice_spans_per_point(robot.dof, _max_turn(kind, options)))
+    points = int(options.roadmap_points) + 1 + goal_variants(robot, revolutions)
+    return roadmap_spans(points, int(options.neighbors), _max_turn(kind, options))
 
 
 def search_bytes(robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool) -> int:
