@@ -120,13 +120,31 @@ def test_a_search_beyond_the_memory_cap_gets_422_naming_the_largest_setting_serv
     assert served(150, 10)
 
 
-def test_the_memory_of_a_search_goes_back_when_its_request_ends():
+def test_the_memory_of_a_search_goes_back_when_its_request_ends(monkeypatch):
+    # a search of about 2 GB (300 roadmap points, 12 neighbours, no obstacle) under a cap raised
+    # to 8 GiB, stopped by a 3 s budget while it builds its spans
+    monkeypatch.setenv("TOPTRAJ_SEARCH_MEMORY_BYTES", str(8 * 2**30))
     process = psutil.Process()
-    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=2.0))) as client:
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=3.0))) as client:
         client.get("/v1/robots/ur5")
         before = process.memory_info().rss
-        response = client.post("/v1/trajectories", json=_ur5_search({}, 2.0))
+        response = client.post("/v1/trajectories", json=_ur5_search({"roadmap_points": 300, "neighbors": 12}, 3.0, ()))
         assert response.status_code == 504, response.text[:300]
         time.sleep(2.0)  # what the search would have built meanwhile, had it run on
         grown = process.memory_info().rss - before
     assert grown < 200e6, f"the process holds {grown / 1e6:.0f} MB more after the search"
+
+
+def test_a_search_job_obeys_the_same_memory_cap(tmp_path):
+    settings = Settings(preload_robots=False, data_dir=tmp_path, job_workers=1, job_budget_s=5.0)
+    body = _ur5_search({"roadmap_points": 500, "neighbors": 50}, 5.0)
+    with TestClient(create_app(settings)) as client:
+        synchronous = client.post("/v1/trajectories", json=body)
+        assert synchronous.status_code == 422 and "at most" in synchronous.json()["detail"]
+        submitted = client.post("/v1/jobs", json={"trajectory": body})
+        assert submitted.status_code == 202, submitted.text[:300]
+        give_up = time.monotonic() + 30.0
+        while (job := client.get(f"/v1/jobs/{submitted.json()['id']}").json())["status"] in ("queued", "running"):
+            assert time.monotonic() < give_up, job
+            time.sleep(0.05)
+    assert job["status"] == "failed" and job["error"] == synchronous.json()
