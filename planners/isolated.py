@@ -55,7 +55,7 @@ POLL_S = 0.02
 PROGRESS_S = 0.1
 #: How much lower the CPU priority of a heavy planning's worker process is (``nice``): it
 #: shares the cores with a server's short requests, which keep theirs.
-LOW_PRIORITY = 10
+LOW_PRIORITY = 5
 #: Modules the fork server imports once, so that children start with them loaded.
 PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.free_path.collocation"]
 
@@ -157,8 +157,10 @@ def _limit_memory(memory_bytes: int) -> bool:
     held = _address_space()
     if not held:
         return False
+    _, hard = resource.getrlimit(resource.RLIMIT_AS)
+    soft = held + memory_bytes if hard == resource.RLIM_INFINITY else min(held + memory_bytes, hard)
     try:
-        resource.setrlimit(resource.RLIMIT_AS, (held + memory_bytes, resource.RLIM_INFINITY))
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
     except (ValueError, OSError):
         return False
     return True
@@ -178,8 +180,9 @@ def _child(connection, function, args, progress: bool, memory_bytes: int | None 
     except MemoryError:
         # the allowance is what the work's estimate said it needs, with room to spare: an
         # estimate too low is this clear error, not the system killing a process
-        if limited:
-            resource.setrlimit(resource.RLIMIT_AS, (resource.RLIM_INFINITY, resource.RLIM_INFINITY))
+        if limited:  # room to answer
+            hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+            resource.setrlimit(resource.RLIMIT_AS, (hard, hard))
         allowance = f" of {memory_bytes / 2**30:.3g} GiB" if memory_bytes is not None else ""
         outcome = ("error", OverMemory(f"the computation ran out of its memory allowance{allowance}: ask for a smaller problem"))
     except Exception as error:  # returned to the parent, which raises it

@@ -14,7 +14,8 @@ import psutil
 import pytest
 
 from service.app import create_app
-from service.planning import heavy
+from service.planning import heavy, heavy_request
+from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 from service.settings import Settings
 from tests.live_server import LiveServer
 from tests.test_search_budget import UR5_BOX, UR5_GOAL, UR5_START
@@ -137,3 +138,10 @@ def test_two_searches_over_budget_leave_the_typical_request_its_latency_and_the_
         while (held := _tree_rss(server)) - warm > 200e6 and time.monotonic() < give_up:
             time.sleep(0.1)
         assert held - warm < 200e6, f"{(held - warm) / 1e6:.0f} MB above the warm figure 5 s after the 504s"
+
+
+def test_a_comparison_is_heavy_when_one_of_its_methods_is():
+    path = {"waypoints": TYPICAL["path"]["waypoints"]}
+    assert heavy_request(CompareRequest.model_validate({"robot": "ur5", "path": path, "methods": ["phase_plane", "min_cost"]}))
+    assert not heavy_request(CompareRequest.model_validate({"robot": "ur5", "path": path, "methods": ["phase_plane", "quintic"]}))
+    assert not heavy_request(TrajectoryRequest.model_validate(TYPICAL))
