@@ -12,7 +12,7 @@ import numpy as np
 from planners.collision import check_clearance
 from planners.constraints import build_path_constraints
 from planners.deadline import Deadline
-from planners.errors import InfeasiblePath, InvalidRequest
+from planners.errors import InfeasiblePath, InvalidRequest, OverMemory
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.free_path.switching import refine_collocation, switched_path, switching_times
 from planners.gate import TimedStretch, checked, gated
@@ -138,10 +138,16 @@ def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstac
         need = check_search_memory(robot, spec.start, spec.goal, options, spec.revolutions)
     else:  # refused by the search itself, with the joint named
         need = 0
-    return run_isolated(
-        _searched, robot, spec, timing, kinds, limits, deadline.end, deadline.budget_s, threshold, obstacles, clearance,
-        deadline=deadline, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK, nice=LOW_PRIORITY,
-    )
+    try:
+        return run_isolated(
+            _searched, robot, spec, timing, kinds, limits, deadline.end, deadline.budget_s, threshold, obstacles, clearance,
+            deadline=deadline, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK, nice=LOW_PRIORITY,
+        )
+    except OverMemory as error:
+        raise OverMemory(
+            f"the search needed more memory than its estimate of {need / 2**30:.3g} GiB allowed ({error.detail}): "
+            "lower timing.search.roadmap_points or neighbors (cells on a lattice)"
+        ) from None
 
 
 def _searched(robot, spec, timing, kinds, limits, end, budget_s, threshold, obstacles, clearance, progress) -> Timed:

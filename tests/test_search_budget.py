@@ -148,3 +148,17 @@ def test_a_search_job_obeys_the_same_memory_cap(tmp_path):
             assert time.monotonic() < give_up, job
             time.sleep(0.05)
     assert job["status"] == "failed" and job["error"] == synchronous.json()
+
+
+def test_an_estimate_too_low_is_a_clear_error_not_the_system_killing_a_process(monkeypatch):
+    # as if the estimate said 1 byte: the search's worker process gets 64 MB of room, runs out
+    # while it builds its spans (about 0.5 GB), and the answer says so
+    import planners.timed_free as timed_free
+
+    monkeypatch.setattr(timed_free, "check_search_memory", lambda *args, **kwargs: 1)
+    monkeypatch.setattr(timed_free, "SEARCH_MEMORY_SLACK", 64 * 2**20)
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=30.0))) as client:
+        response = client.post("/v1/trajectories", json=_ur5_search({}, 30.0, ()))
+    assert response.status_code == 422, response.text[:300]
+    assert response.json()["title"] == "Computation over its memory cap"
+    assert "memory allowance" in response.json()["detail"] and "timing.search.roadmap_points" in response.json()["detail"]
