@@ -116,8 +116,10 @@ def test_a_search_beyond_the_memory_cap_gets_422_naming_the_largest_setting_serv
     # the advice is followable, and the largest: one more is refused
     assert 1 <= most < 2000 and served(most, 50) and not served(most + 1, 50)
     assert 1 <= fewest < 50 and served(2000, fewest) and not served(2000, fewest + 1)
-    # the default search is served
+    # the default searches are served: ur5's roadmap, and the three-joint lattice (1.45 GB)
     assert served(150, 10)
+    lecture = robots.load("lecture_3r")
+    check_search_memory(lecture, np.zeros(3), np.array([1.5, 0.0, 0.0]), SearchOptions(), True, cap)
 
 
 def test_the_memory_of_a_search_goes_back_when_its_request_ends(monkeypatch):

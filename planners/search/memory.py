@@ -12,25 +12,28 @@ the cube of a node's degree:
   69,058,450 at 2000/50), 0.20-0.23 on panda, 0.28-0.31 on the two-joint Geering arm; taken as
   ``ROADMAP_SPANS`` = 0.35 up to 90 degrees and four times that beyond (a turn then admits up to
   twice as many moves, and a span is two turns).
-* lattice (``lattice_graph``): every interior grid point has the same moves, so K is at most
-  P sum_m sum_{m' within m} t(m'), t(m) the moves a move m may turn into (``max_turn``): an
-  exact bound where no boundary cuts moves (the Geering arm's default lattice: 15,544 spans,
-  bound 20,808).
+* lattice (``lattice_graph``): counted from the shape (``lattice_spans``): every chain of
+  three moves, each turning into the next, at every grid point from which it stays on the
+  grid; 15,792 for the Geering arm's default lattice (15,544 built), 63,900 at 32 cells
+  (63,726), 198,656 for the three-joint lattice of ``benchmarks/search_growth.py`` at 8 cells
+  (197,484).
 
-Bytes per span: ``SPAN_BYTES_PER_JOINT`` n, from the peak RSS of ``build_problem`` and
-``global_search`` on ur5 (n = 6) over the process's RSS before it: 590 MB for 33,956 spans
-(150 roadmap points, 10 neighbours; 17.4 kB a span), 2,580 MB for 189,703 (150/20; 13.6 kB),
-503 MB for 32,001 with a box obstacle (15.7 kB), 2,505 MB for 182,606 with it (13.7 kB); a
-whole ``global_search`` at 150/10 peaked at 523 MB without the box and 503 MB with it. Taken
-as 2,800 bytes per joint (16.8 kB a span on ur5), plus the roadmap's distance matrix
-(3 P^2 eight-byte numbers, built row block by row block).
+Bytes per span: ``SPAN_BYTES_PER_JOINT`` n, from the peak RSS of ``build_problem`` over the
+process's RSS before it: on ur5 (n = 6) 590 MB for 33,956 spans (150 roadmap points, 10
+neighbours; 17.4 kB a span), 2,580 MB for 189,703 (150/20; 13.6 kB), 503 MB for 32,001 with
+a box obstacle (15.7 kB), 2,505 MB for 182,606 with it (13.7 kB), a whole ``global_search`` at
+150/10 523 MB without the box and 503 MB with it; on the three-joint lattice 1,454 MB for
+197,484 spans (7.4 kB, 2.5 kB a joint) and 459 MB for 56,446 (8.1 kB); on the Geering arm
+272 MB for 63,726 (4.3 kB, 2.1 kB a joint). Taken as 2,800 bytes per joint, plus the
+roadmap's distance matrix (3 P^2 eight-byte numbers, built row block by row block).
 
 The estimate is conservative: ur5's default search (150 points, 10 neighbours) is estimated at
-0.9 GB for a measured 0.52-0.59 GB peak. A search estimated above its cap is refused before it
-starts (``check_search_memory``: ``OverMemory`` naming the setting and the largest value served
-with the others unchanged); a worker process running one is also capped by the system
-(``planners.isolated``, twice the estimate), so that an estimate that is too low is a clear
-error rather than the system killing a process.
+0.86 GiB for a measured 0.52-0.59 GB peak, the three-joint lattice's default at 1.59 GiB for
+1.45 GB. A search estimated above its cap (``DEFAULT_SEARCH_MEMORY``, 2 GiB) is refused before
+it starts (``check_search_memory``: ``OverMemory`` naming the setting and the largest value
+served with the others unchanged); a worker process running one is also capped by the system
+(``planners.timed_free``: twice the estimate and 1 GiB), so that an estimate that is too low
+is a clear error rather than the system killing a process.
 """
 
 from __future__ import annotations
@@ -54,6 +57,8 @@ from robots import Robot
 
 #: C of K ~ C P k^3 for a roadmap whose turns reach at most 90 degrees (see the module).
 ROADMAP_SPANS = 0.35
+#: Joints up to which a lattice's spans are counted exactly (``lattice_spans``).
+EXACT_LATTICE_JOINTS = 4
 #: Bytes a span takes per joint (see the module).
 SPAN_BYTES_PER_JOINT = 2_800
 #: Bytes of the process's own bookkeeping of a search besides its spans.
@@ -70,14 +75,39 @@ def _max_turn(kind: str, options: SearchOptions) -> float:
     return options.max_turn if options.max_turn is not None else DEFAULT_MAX_TURN[kind]
 
 
-def _lattice_spans_per_point(n_dof: int, max_turn: float) -> int:
-    """sum_m sum_{m' within m} t(m') over the lattice's 3^n - 1 moves m (module docstring)."""
+def _moves_within(n_dof: int, max_turn: float) -> tuple[np.ndarray, np.ndarray]:
+    """The lattice's 3^n - 1 moves (N, n) and which pairs (m, m') a move may turn into (N, N)."""
     moves = np.array([m for m in itertools.product((-1, 0, 1), repeat=n_dof) if any(m)], dtype=float)
     unit = moves / np.linalg.norm(moves, axis=1, keepdims=True)
     cosine = unit @ unit.T
     within = (cosine >= math.cos(math.radians(min(max(max_turn, 0.0), 180.0))) - 1e-9) & (cosine > -1.0 + 1e-9)
+    return moves, within
+
+
+def lattice_spans(shape: tuple[int, ...], max_turn: float) -> float:
+    """Spans of a lattice of ``shape`` grid points per joint: every chain of three moves
+    (m1, m2, m3), each turning into the next, counted at every grid point p from which p,
+    p + m1, p + m1 + m2 and p + m1 + m2 + m3 all lie on the grid (the product over the joints
+    of the axis length less the chain's extent along it), plus the spans from the start and
+    into the goal. Beyond ``EXACT_LATTICE_JOINTS`` joints (3^n - 1 moves), a bound: every point
+    times sum_m sum_{m' within m} t(m'), t(m) the moves a move m may turn into."""
+    n = len(shape)
+    moves, within = _moves_within(n, max_turn)
     turns = within.sum(axis=1)
-    return int((within * turns[None, :]).sum())
+    ends = 2.0 * len(moves) * float(turns.max())  # spans from the start and into the goal, at most
+    if n > EXACT_LATTICE_JOINTS:
+        return math.prod(shape) * float((within * turns[None, :]).sum()) + ends
+    length = np.array(shape, dtype=float)
+    total = 0.0
+    for middle in range(len(moves)):
+        first, last = np.flatnonzero(within[:, middle]), np.flatnonzero(within[middle])
+        a = moves[first][:, None, :]  # (F, 1, n)
+        b = moves[middle][None, None, :]
+        c = moves[last][None, :, :]  # (1, L, n)
+        corners = np.stack(np.broadcast_arrays(np.zeros_like(a + c), a, a + b, a + b + c))  # (4, F, L, n)
+        extent = corners.max(axis=0) - corners.min(axis=0)
+        total += float(np.prod(np.maximum(length - extent, 0.0), axis=2).sum())
+    return total + ends
 
 
 def roadmap_spans(points: int, neighbors: int, max_turn: float) -> float:
@@ -93,18 +123,17 @@ def roadmap_bytes(n_dof: int, points: int, neighbors: int, max_turn: float) -> i
     return int(BASE_BYTES + roadmap_spans(points, neighbors, max_turn) * SPAN_BYTES_PER_JOINT * n_dof + 24 * points**2)
 
 
-def lattice_bytes(n_dof: int, points: int, max_turn: float) -> int:
-    """Estimated bytes of a lattice search over ``points`` grid points."""
-    spans = points * _lattice_spans_per_point(n_dof, max_turn)
-    return int(BASE_BYTES + spans * SPAN_BYTES_PER_JOINT * n_dof)
+def lattice_bytes(shape: tuple[int, ...], max_turn: float) -> int:
+    """Estimated bytes of a lattice search of ``shape`` grid points per joint."""
+    return int(BASE_BYTES + lattice_spans(shape, max_turn) * SPAN_BYTES_PER_JOINT * len(shape))
 
 
 def search_spans(robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool) -> float:
     """Estimated spans of curve of a search with these settings (an upper bound)."""
     kind = _graph_kind(robot, options)
     if kind == "lattice":
-        points = math.prod(len(axis) for axis in lattice_axes(robot, start, goal, options, revolutions))
-        return float(points * _lattice_spans_per_point(robot.dof, _max_turn(kind, options)))
+        shape = tuple(len(axis) for axis in lattice_axes(robot, start, goal, options, revolutions))
+        return lattice_spans(shape, _max_turn(kind, options))
     points = int(options.roadmap_points) + 1 + goal_variants(robot, revolutions)
     return roadmap_spans(points, int(options.neighbors), _max_turn(kind, options))
 
@@ -113,8 +142,8 @@ def search_bytes(robot: Robot, start: np.ndarray, goal: np.ndarray, options: Sea
     """Estimated peak bytes of ``global_search`` with these settings (before any work)."""
     kind = _graph_kind(robot, options)
     if kind == "lattice":
-        points = math.prod(len(axis) for axis in lattice_axes(robot, start, goal, options, revolutions))
-        return lattice_bytes(robot.dof, points, _max_turn(kind, options))
+        shape = tuple(len(axis) for axis in lattice_axes(robot, start, goal, options, revolutions))
+        return lattice_bytes(shape, _max_turn(kind, options))
     points = int(options.roadmap_points) + 1 + goal_variants(robot, revolutions)
     return roadmap_bytes(robot.dof, points, int(options.neighbors), _max_turn(kind, options))
 
@@ -154,7 +183,7 @@ def check_search_memory(
 
         def lattice_fits(cells: int) -> bool:
             grid = lattice_axes(robot, start, goal, _with(options, cells=(cells,)), revolutions)
-            return lattice_bytes(n, math.prod(len(axis) for axis in grid), max_turn) <= cap_bytes
+            return lattice_bytes(tuple(len(axis) for axis in grid), max_turn) <= cap_bytes
 
         cells = _largest(lattice_fits, 1, 1_000)
         advice = (
