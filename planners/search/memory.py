@@ -44,7 +44,7 @@ import math
 
 import numpy as np
 
-from planners.errors import OverMemory
+from planners.errors import InvalidRequest, OverMemory
 from planners.search.graph import (
     DEFAULT_MAX_TURN,
     LATTICE_MAX_JOINTS,
@@ -53,7 +53,9 @@ from planners.search.graph import (
     goal_variants,
     lattice_axes,
 )
+from planners.search.problem import GRAPH_KINDS
 from robots import Robot
+from robots.errors import excerpt
 
 #: C of K ~ C P k^3 for a roadmap whose turns reach at most 90 degrees (see the module).
 ROADMAP_SPANS = 0.35
@@ -66,6 +68,8 @@ BASE_BYTES = 32 * 2**20
 
 
 def _graph_kind(robot: Robot, options: SearchOptions) -> str:
+    if options.graph not in GRAPH_KINDS:
+        raise InvalidRequest(f"timing.search.graph {excerpt(options.graph)} is unknown; use one of {list(GRAPH_KINDS)}")
     if options.graph == "auto":
         return "lattice" if robot.dof <= LATTICE_MAX_JOINTS else "roadmap"
     return options.graph
