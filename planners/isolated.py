@@ -10,7 +10,7 @@ arguments and result plain picklable data (numpy arrays, dataclasses of them, a 
 closures. The memory the child used goes back to the system when it exits. Without a deadline
 (``NO_DEADLINE``, the library's default) the function runs in the calling thread: there is
 nothing to stop it for. A call made inside a worker process (a job's) runs inline too: the
-worker is killed as a whole.
+worker is killed as a whole (its ``memory_bytes`` holds for the call).
 
 With ``memory_bytes``, the child's address space may grow by at most that many bytes beyond what
 it holds when it starts (``RLIMIT_AS``): work that would need more gets ``MemoryError`` there,
@@ -210,7 +210,22 @@ def run_isolated(
         Whatever ``function`` raised, re-raised here.
     """
     if deadline is NO_DEADLINE or _in_worker:
-        return function(*args, **({"progress": deadline.progress} if progress else {}))
+        kwargs = {"progress": deadline.progress} if progress else {}
+        if not (_in_worker and memory_bytes is not None):
+            return function(*args, **kwargs)
+        # in a worker process (a job's): the same memory allowance, for this call only
+        before = resource.getrlimit(resource.RLIMIT_AS)
+        limited = _limit_memory(memory_bytes)
+        try:
+            return function(*args, **kwargs)
+        except MemoryError:
+            if not limited:
+                raise
+            resource.setrlimit(resource.RLIMIT_AS, before)
+            raise OverMemory(f"the computation ran out of its memory allowance of {memory_bytes / 2**30:.3g} GiB: ask for a smaller problem") from None
+        finally:
+            if limited:
+                resource.setrlimit(resource.RLIMIT_AS, before)
     context = _get_context()
     reader, writer = context.Pipe(duplex=False)
     process = context.Process(target=_child, args=(writer, function, args, progress, memory_bytes, nice), daemon=True)

@@ -160,3 +160,18 @@ def test_a_worker_over_its_memory_allowance_gets_a_clear_error_not_the_system_ki
 def test_a_worker_may_run_at_a_lower_cpu_priority():
     assert run_isolated(_priority, deadline=Deadline(60), nice=5) == min(_priority() + 5, 19)
     assert run_isolated(_priority, deadline=Deadline(60)) == _priority()
+
+
+def _nested(megabytes: int) -> tuple[int, int]:
+    """A call with a memory allowance made inside a worker process (inline), then the same
+    allocation after it."""
+    try:
+        inside = run_isolated(_allocate, megabytes, deadline=Deadline(60), memory_bytes=2**28)
+    except OverMemory:
+        inside = -1
+    return inside, _allocate(megabytes)
+
+
+def test_a_call_inside_a_worker_process_keeps_its_memory_allowance_for_the_call():
+    assert run_isolated(_nested, 512, deadline=Deadline(60)) == (-1, 512 * 2**17)
+    assert run_isolated(_nested, 64, deadline=Deadline(60)) == (64 * 2**17, 64 * 2**17)
