@@ -65,6 +65,20 @@ class Deadline:
             with self._stoppers_lock:
                 self._stoppers.remove(stop)
 
+    @classmethod
+    def ending_at(cls, end: float | None, budget_s: float | None, progress: Progress | None = None) -> Deadline:
+        """A deadline that passes at ``end`` (``time.monotonic()``, the same clock in every
+        process of the machine) and names ``budget_s`` when it does: the deadline of a caller,
+        carried into a worker process (``planners.isolated``)."""
+        deadline = cls(budget_s, progress)
+        deadline._end = end
+        return deadline
+
+    @property
+    def end(self) -> float | None:
+        """When the budget is spent (``time.monotonic()``), or ``None`` without a budget."""
+        return self._end
+
     def remaining(self) -> float | None:
         """Seconds left (at least 0), or ``None`` without a budget."""
         return None if self._end is None else max(0.0, self._end - time.monotonic())

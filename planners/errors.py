@@ -41,6 +41,13 @@ class TimingFailed(ToptrajError):
     title = "Timing method failed"
 
 
+class OverMemory(ToptrajError):
+    """A computation needs, or took, more memory than it is allowed: its settings ask for too
+    large a problem (the detail names the setting and the largest value served)."""
+
+    title = "Computation over its memory cap"
+
+
 class BudgetExceeded(ToptrajError):
     """The computation ran past its time budget."""
 

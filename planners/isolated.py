@@ -10,7 +10,13 @@ arguments and result plain picklable data (numpy arrays, dataclasses of them, a 
 closures. The memory the child used goes back to the system when it exits. Without a deadline
 (``NO_DEADLINE``, the library's default) the function runs in the calling thread: there is
 nothing to stop it for. A call made inside a worker process (a job's) runs inline too: the
-worker is killed as a whole.
+worker is killed as a whole (its ``memory_bytes`` holds for the call).
+
+With ``memory_bytes``, the child's address space may grow by at most that many bytes beyond what
+it holds when it starts (``RLIMIT_AS``): work that would need more gets ``MemoryError`` there,
+answered as ``OverMemory``, never the system killing a process for memory. With ``nice``, the
+child runs at that lower CPU priority (``os.nice``), so that the server's short requests keep
+their latency while it computes.
 
 A child ends as soon as its caller is gone, even one killed outright (``_end_with_caller``).
 
@@ -32,6 +38,7 @@ from __future__ import annotations
 import ctypes
 import multiprocessing
 import os
+import resource
 import select
 import signal
 import threading
@@ -39,13 +46,16 @@ import time
 from collections.abc import Sequence
 
 from planners.deadline import NO_DEADLINE, Deadline
-from planners.errors import TimingFailed
+from planners.errors import OverMemory, TimingFailed
 from planners.threads import single_blas_thread
 
 #: Seconds between two deadline checks while waiting for the child.
 POLL_S = 0.02
 #: Shortest interval between two progress reports of one stage sent by a child, in s.
 PROGRESS_S = 0.1
+#: How much lower the CPU priority of a heavy planning's worker process is (``nice``): it
+#: shares the cores with a server's short requests, which keep theirs.
+LOW_PRIORITY = 5
 #: Modules the fork server imports once, so that children start with them loaded.
 PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.free_path.collocation"]
 
@@ -133,14 +143,48 @@ def _end_with_caller(connection) -> None:
     threading.Thread(target=watch, name="toptraj-caller-watch", daemon=True).start()
 
 
-def _child(connection, function, args, progress: bool) -> None:
+def _address_space() -> int:
+    """Bytes of address space this process holds (``VmSize``), or 0 where unknown."""
+    try:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def _limit_memory(memory_bytes: int) -> bool:
+    """Let this process's address space grow by at most ``memory_bytes``; whether it could."""
+    held = _address_space()
+    if not held:
+        return False
+    _, hard = resource.getrlimit(resource.RLIMIT_AS)
+    soft = held + memory_bytes if hard == resource.RLIM_INFINITY else min(held + memory_bytes, hard)
+    try:
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+    except (ValueError, OSError):
+        return False
+    return True
+
+
+def _child(connection, function, args, progress: bool, memory_bytes: int | None = None, nice: int = 0) -> None:
     global _in_worker
     _in_worker = True
     _end_with_caller(connection)
     single_blas_thread()
+    if nice:
+        os.nice(nice)
+    limited = memory_bytes is not None and _limit_memory(memory_bytes)
     try:
         kwargs = {"progress": _PipeProgress(connection)} if progress else {}
         outcome = ("result", function(*args, **kwargs))
+    except MemoryError:
+        # the allowance is what the work's estimate said it needs, with room to spare: an
+        # estimate too low is this clear error, not the system killing a process
+        if limited:  # room to answer
+            hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+            resource.setrlimit(resource.RLIMIT_AS, (hard, hard))
+        allowance = f" of {memory_bytes / 2**30:.3g} GiB" if memory_bytes is not None else ""
+        outcome = ("error", OverMemory(f"the computation ran out of its memory allowance{allowance}: ask for a smaller problem"))
     except Exception as error:  # returned to the parent, which raises it
         outcome = ("error", error)
     try:
@@ -151,21 +195,40 @@ def _child(connection, function, args, progress: bool) -> None:
         connection.close()
 
 
-def run_isolated(function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False):
+def run_isolated(
+    function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0
+):
     """``function(*args)`` computed in a child process, killed once ``deadline`` passes; with
     ``progress``, ``function(*args, progress=report)``, its reports relayed to
-    ``deadline.progress``.
+    ``deadline.progress``. ``memory_bytes``: the most the child's address space may grow;
+    ``nice``: how much lower its CPU priority is (both ignored where it runs inline).
 
     Raises:
+        OverMemory: the child needed more than ``memory_bytes``.
         BudgetExceeded: the deadline passed or was cancelled (the child is killed first).
         TimingFailed: the child died without an answer (e.g. killed by the system for memory).
         Whatever ``function`` raised, re-raised here.
     """
     if deadline is NO_DEADLINE or _in_worker:
-        return function(*args, **({"progress": deadline.progress} if progress else {}))
+        kwargs = {"progress": deadline.progress} if progress else {}
+        if not (_in_worker and memory_bytes is not None):
+            return function(*args, **kwargs)
+        # in a worker process (a job's): the same memory allowance, for this call only
+        before = resource.getrlimit(resource.RLIMIT_AS)
+        limited = _limit_memory(memory_bytes)
+        try:
+            return function(*args, **kwargs)
+        except MemoryError:
+            if not limited:
+                raise
+            resource.setrlimit(resource.RLIMIT_AS, before)
+            raise OverMemory(f"the computation ran out of its memory allowance of {memory_bytes / 2**30:.3g} GiB: ask for a smaller problem") from None
+        finally:
+            if limited:
+                resource.setrlimit(resource.RLIMIT_AS, before)
     context = _get_context()
     reader, writer = context.Pipe(duplex=False)
-    process = context.Process(target=_child, args=(writer, function, args, progress), daemon=True)
+    process = context.Process(target=_child, args=(writer, function, args, progress, memory_bytes, nice), daemon=True)
     try:
         process.start()
         writer.close()

@@ -11,16 +11,20 @@ import numpy as np
 
 from planners.collision import check_clearance
 from planners.constraints import build_path_constraints
-from planners.errors import InfeasiblePath, InvalidRequest
+from planners.deadline import Deadline
+from planners.errors import InfeasiblePath, InvalidRequest, OverMemory
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.free_path.switching import refine_collocation, switched_path, switching_times
 from planners.gate import TimedStretch, checked, gated
 from planners.grid import path_grid
+from planners.isolated import LOW_PRIORITY, run_isolated
 from planners.paths import GeometricPath
 from planners.requests import Timing
 from planners.search.curve import GridSplinePath
+from planners.search.graph import DEFAULT_OPTIONS
 from planners.search.local import optimize_locally
 from planners.search.local_outcome import LocalOptimum
+from planners.search.memory import check_search_memory
 from planners.search.method import global_search
 from planners.timed import Timed, moving_velocity, path_boundary, timed_path, timing_grid
 from planners.timing.jerk_accuracy import TARGET_GAP
@@ -29,6 +33,11 @@ from planners.timing.phase_plane import PhasePlaneMethod
 
 #: Most collocation intervals a request may ask for (timing.grid_points).
 MAX_INTERVALS = 100
+#: A search's worker process may grow its address space by this multiple of its memory
+#: estimate, plus ``SEARCH_MEMORY_SLACK`` (the solver stacks' arenas and libraries' own
+#: mappings): beyond, ``MemoryError`` there, answered as ``OverMemory``.
+SEARCH_MEMORY_ROOM = 2
+SEARCH_MEMORY_SLACK = 2**30
 
 
 def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
@@ -140,11 +149,46 @@ def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstac
     """The global search (``planners.search``, Jeong & Lee section 2): the best grid path of
     each tube, then each one's local optimization (section 2.6) within its share of the budget;
     the fastest optimized path that keeps the clearance is timed by phase_plane through the
-    limit gate. The grid path's own curve stands in where its optimization finds nothing."""
+    limit gate. The grid path's own curve stands in where its optimization finds nothing.
+
+    The search's memory is estimated from its settings first (``planners.search.memory``,
+    ``OverMemory`` beyond ``timing.search.memory_bytes``). Under a deadline the whole search
+    runs in a worker process (``planners.isolated``) at a lower CPU priority
+    (``planners.isolated.LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
+    killed when the budget is spent or the caller cancels, its memory gone with it."""
     if not isinstance(spec, FreeMotion):
         raise InvalidRequest("timing.method 'search' finds the path itself: give a free path (path.kind 'free', start and goal)")
     if moving_velocity(spec.start_velocity) is not None or moving_velocity(spec.end_velocity) is not None or timing.duration is not None:
         raise InvalidRequest("the search plans the fastest motion from rest to rest: leave timing.boundary and timing.duration out")
+    options = timing.search or DEFAULT_OPTIONS
+    if robot.outside_position_limits(spec.start) is None and robot.outside_position_limits(spec.goal) is None:
+        need = check_search_memory(robot, spec.start, spec.goal, options, spec.revolutions)
+    else:  # refused by the search itself, with the joint named
+        need = 0
+    try:
+        return run_isolated(
+            _searched, robot, spec, timing, kinds, limits, deadline.end, deadline.budget_s, threshold, obstacles, clearance,
+            deadline=deadline, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK, nice=LOW_PRIORITY,
+        )
+    except OverMemory as error:
+        raise OverMemory(
+            f"the search needed more memory than its estimate of {need / 2**30:.3g} GiB allowed ({error.detail}): "
+            "lower timing.search.roadmap_points or neighbors (cells on a lattice)"
+        ) from None
+
+
+def _searched(robot, spec, timing, kinds, limits, end, budget_s, threshold, obstacles, clearance, progress) -> Timed:
+    """``timed_search``'s work, in its worker process under the caller's deadline (ending at
+    ``end``, ``time.monotonic()``), reporting to ``progress``."""
+    deadline = Deadline.ending_at(end, budget_s, progress)
+    timed = _search(robot, spec, timing, kinds, limits, deadline, threshold, obstacles, clearance)
+    # the constraints' re-evaluation holds this process's deadline: it does not travel back
+    stretches = tuple(item._replace(constraints=dataclasses.replace(item.constraints, evaluate=None)) for item in timed.stretches)
+    return timed._replace(stretches=stretches)
+
+
+def _search(robot, spec, timing, kinds, limits, deadline, threshold, obstacles, clearance) -> Timed:
+    """``timed_search``'s work under ``deadline``."""
     found = global_search(
         robot, limits, kinds, spec.start, spec.goal, timing.search, spec.revolutions, obstacles, clearance, deadline.within(0.0, 0.3)
     )

@@ -66,6 +66,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         # Running plannings end at their next deadline check; an app started again (as test
         # clients do, even overlapping) gets fresh threads under the same slots.
         app.state.planning.close()
+        app.state.heavy_planning.close()
         app.state.jobs.stop_running()
         stopping.stopped()  # in a server process: its fork server too, which may still be importing
         await run_in_threadpool(app.state.jobs.close)
@@ -82,6 +83,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue, settings.plan_leash_s, open_connections)
+    app.state.heavy_planning = PlanningWorkers(settings.plan_heavy_workers, settings.plan_heavy_queue, label="heavy planning")
     app.state.jobs = job_runner(settings)
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)

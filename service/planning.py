@@ -19,6 +19,7 @@ from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.free_path import FreeMotion
 from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from planners.search import SearchOptions
+from planners.search.graph import DEFAULT_SEARCH_MEMORY
 from robots import InvalidLimits, UnknownRobot
 from robots.catalog import catalog_robot_built
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
@@ -59,6 +60,31 @@ def worth_a_leash(request: TrajectoryRequest) -> bool:
         and (timing.grid_points or 0) <= 1_000
         and catalog_robot_built(request.robot)
     )
+
+
+#: Timing methods whose plannings are heavy whatever their size (``heavy``).
+HEAVY_METHODS = frozenset({"search", "collocation", "jerk_limited"})
+#: Grid intervals from which a min_cost planning is heavy (its default grid is larger): about
+#: 0.7 s on 4 ur5 waypoints at 200 intervals, 1.3 s at its default grid, 2 s at 1,000.
+HEAVY_MIN_COST_POINTS = 100
+
+
+def heavy(method: str, path_kind: str, grid_points: int | None) -> bool:
+    """Whether a planning is heavy: it takes seconds of CPU and up to a gigabyte (a search, a
+    collocation or any free path, jerk_limited's linear programs, min_cost's convex program on
+    more than ``HEAVY_MIN_COST_POINTS`` intervals or on its default grid). Heavy plannings are
+    admitted apart from the others (``service.workers``: ``plan_heavy_workers`` at once per
+    process, ``plan_heavy_queue`` waiting), so that the short requests keep their threads and
+    their latency while heavy ones run."""
+    if method in HEAVY_METHODS or path_kind == "free":
+        return True
+    return method == "min_cost" and (grid_points is None or grid_points > HEAVY_MIN_COST_POINTS)
+
+
+def heavy_request(request: TrajectoryRequest | CompareRequest) -> bool:
+    """``heavy`` for a trajectory request, or for any method of a comparison."""
+    methods = request.methods if isinstance(request, CompareRequest) else [request.timing.method]
+    return any(heavy(method, request.path.kind, request.timing.grid_points) for method in methods)
 
 
 def _timing(request: TrajectoryRequest) -> Timing:
@@ -107,13 +133,17 @@ def plan_request(
     deadline: Deadline | None = None,
     max_body_bytes: int | None = None,
     accept: str | None = None,
+    search_memory_bytes: int = DEFAULT_SEARCH_MEMORY,
 ) -> PlannedTrajectory:
     """Plan ``request`` with the library (no HTTP involved); with ``max_body_bytes``, refuse an
     ``output.dt`` whose samples would not fit in a body of that size (422 naming the smallest
     ``dt`` that fits). ``accept`` (the HTTP Accept header) may choose CSV, which puts the samples
-    on whole periods."""
+    on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
+    (``planners.search.memory``)."""
     robot = robots.load(request.robot)
     timing = _timing(request)
+    if timing.method == "search":
+        timing = dataclasses.replace(timing, search=dataclasses.replace(timing.search or SearchOptions(), memory_bytes=search_memory_bytes))
     if request.path.kind == "free":
         timing = dataclasses.replace(timing, start_velocity=None, end_velocity=None)
     output = request.output

@@ -8,6 +8,7 @@ from pathlib import Path
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from planners.search.graph import DEFAULT_SEARCH_MEMORY
 from robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
 from robots.uploads import DEFAULT_CACHE_SIZE
 
@@ -36,6 +37,14 @@ class Settings(BaseSettings):
             in s (``PlanningWorkers.run``; 0: always in a thread).
         plan_queue: Requests that may wait for a planning worker of this process (within
             their budget); beyond, 503 with ``Retry-After``.
+        plan_heavy_workers: Heavy plannings (``service.planning.heavy``: search, collocation,
+            jerk_limited, min_cost on large grids) run at once in this process, in threads of
+            their own: they never take the threads of ``plan_workers``.
+        plan_heavy_queue: Heavy plannings that may wait for a heavy worker of this process
+            (within their budget); beyond, 503 with ``Retry-After``.
+        search_memory_bytes: Most memory one search may take by its estimate
+            (``planners.search.memory``, 2 GiB by default): beyond, 422 naming the largest
+            ``roadmap_points``, ``neighbors`` or ``cells`` served.
         job_workers: Jobs (``/v1/jobs``) running at once, each in a worker process, over every
             server process on the data directory (default: half the cores, at least 1).
         job_budget_s: Default computing time of a job once running, in s.
@@ -66,6 +75,9 @@ class Settings(BaseSettings):
     plan_workers: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
     plan_leash_s: float = Field(default=0.02, ge=0.0, le=0.1)
     plan_queue: int = Field(default=8, ge=0)
+    plan_heavy_workers: int = Field(default=1, ge=1)
+    plan_heavy_queue: int = Field(default=2, ge=0)
+    search_memory_bytes: int = Field(default=DEFAULT_SEARCH_MEMORY, ge=2**20)
     job_workers: int = Field(default_factory=lambda: max(1, (os.cpu_count() or 1) // 2), ge=1)
     job_budget_s: float = Field(default=300.0, gt=0)
     job_max_budget_s: float = Field(default=3_600.0, gt=0)

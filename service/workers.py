@@ -73,10 +73,14 @@ class PlanningWorkers:
             (``service.serving.open_connections``). A planning is tried on the loop only while
             it holds at most one: a loop held by a try cannot take its turn at accepting, and a
             burst of connections would then all go to the other server processes.
+        label: What its workers run, in the 503's detail (``"heavy planning"`` for the lane
+            of heavy plannings, ``service.planning.heavy``).
     """
 
-    def __init__(self, workers: int, queue: int, leash_s: float = 0.0, connections: Callable[[], int] = lambda: 0):
-        self.workers, self.queue, self.leash_s = workers, queue, leash_s
+    def __init__(
+        self, workers: int, queue: int, leash_s: float = 0.0, connections: Callable[[], int] = lambda: 0, label: str = "planning"
+    ):
+        self.workers, self.queue, self.leash_s, self.label = workers, queue, leash_s, label
         self._connections = connections
         self._executor: ThreadPoolExecutor | None = None
         # Thread primitives, not asyncio ones: a slot is freed by the planning thread itself when
@@ -106,7 +110,7 @@ class PlanningWorkers:
         with self._lock:
             if self._admitted >= self.workers + self.queue:
                 raise ServiceBusy(
-                    f"all {self.workers} planning workers are busy and {self.queue} requests wait already; retry shortly"
+                    f"all {self.workers} {self.label} workers are busy and {self.queue} requests wait already; retry shortly"
                 )
             self._admitted += 1
         deadline = Deadline(budget_s)
@@ -223,7 +227,7 @@ class PlanningWorkers:
         """The pool of planning threads, opened on first use and again after ``close``."""
         with self._lock:
             if self._executor is None:
-                self._executor = ThreadPoolExecutor(max_workers=self.workers, thread_name_prefix="toptraj-plan")
+                self._executor = ThreadPoolExecutor(max_workers=self.workers, thread_name_prefix=f"toptraj-{self.label.replace(' ', '-')}")
             return self._executor
 
     def _release(self) -> None:

@@ -14,6 +14,7 @@ import pytest
 
 import robots
 from planners import BudgetExceeded, Deadline, InfeasiblePath
+from planners.errors import OverMemory
 from planners.isolated import run_isolated
 
 
@@ -137,3 +138,40 @@ def test_the_service_process_keeps_to_one_blas_thread():
 
     create_app(Settings(preload_robots=False))
     assert _blas_threads() == 1
+
+
+def _allocate(megabytes: int) -> int:
+    block = np.ones(megabytes * 2**20 // 8)  # touched, so that it is really held
+    return int(block.size)
+
+
+def _priority() -> int:
+    return os.getpriority(os.PRIO_PROCESS, 0)
+
+
+def test_a_worker_over_its_memory_allowance_gets_a_clear_error_not_the_system_killing_it():
+    with pytest.raises(OverMemory, match="memory allowance of 0.25 GiB"):
+        run_isolated(_allocate, 1024, deadline=Deadline(60), memory_bytes=2**28)
+    # within its allowance the same work is done, and the allowance is the worker's alone
+    assert run_isolated(_allocate, 64, deadline=Deadline(60), memory_bytes=2**28) == 64 * 2**17
+    assert _allocate(512) == 512 * 2**17
+
+
+def test_a_worker_may_run_at_a_lower_cpu_priority():
+    assert run_isolated(_priority, deadline=Deadline(60), nice=5) == min(_priority() + 5, 19)
+    assert run_isolated(_priority, deadline=Deadline(60)) == _priority()
+
+
+def _nested(megabytes: int) -> tuple[int, int]:
+    """A call with a memory allowance made inside a worker process (inline), then the same
+    allocation after it."""
+    try:
+        inside = run_isolated(_allocate, megabytes, deadline=Deadline(60), memory_bytes=2**28)
+    except OverMemory:
+        inside = -1
+    return inside, _allocate(megabytes)
+
+
+def test_a_call_inside_a_worker_process_keeps_its_memory_allowance_for_the_call():
+    assert run_isolated(_nested, 512, deadline=Deadline(60)) == (-1, 512 * 2**17)
+    assert run_isolated(_nested, 64, deadline=Deadline(60)) == (64 * 2**17, 64 * 2**17)

@@ -16,7 +16,7 @@ import numpy as np
 
 from planners.collision import Obstacle, clearance_along
 from planners.collision.distance import capsule_distance
-from planners.deadline import Deadline
+from planners.deadline import NO_DEADLINE, Deadline
 from planners.search.curve import BASIS
 from planners.search.pieces import Pieces
 from robots import Robot
@@ -26,8 +26,10 @@ from robots.collision import robot_capsules
 COARSE_STEP = 0.02
 #: The same where the coarse samples leave the piece undecided.
 FINE_STEP = 0.002
-#: Configurations whose distances are computed at once.
+#: Configurations whose distances are computed at once (between two deadline checks).
 BATCH = 4_000
+#: Intervals refined at once by ``clear_pieces`` (each takes three new distances).
+REFINED = 20_000
 
 
 _AXES = {"X": np.array([1.0, 0.0, 0.0]), "Y": np.array([0.0, 1.0, 0.0]), "Z": np.array([0.0, 0.0, 1.0])}
@@ -76,10 +78,13 @@ def joint_placements(robot: Robot, q: np.ndarray):
     return rotation, translation
 
 
-def point_distances(robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exact_below: float = np.inf) -> np.ndarray:
+def point_distances(
+    robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exact_below: float = np.inf, deadline: Deadline = NO_DEADLINE
+) -> np.ndarray:
     """Smallest signed distance (m) of the arm's link capsules (``robots.collision``) to any
     obstacle at each configuration (k, n_dof); distances above ``exact_below`` may be lower
-    bounds (``planners.collision.distance.capsule_distance``)."""
+    bounds (``planners.collision.distance.capsule_distance``). ``deadline`` is checked
+    before each obstacle of each ``BATCH`` of configurations."""
     out = np.empty(len(q))
     capsules = robot_capsules(robot)
     joints = np.array([c.joint for c in capsules])
@@ -87,6 +92,7 @@ def point_distances(robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exac
     local_b = np.array([c.b for c in capsules])
     radius = np.array([c.radius for c in capsules])
     for begin in range(0, len(q), BATCH):
+        deadline.check()
         rows = q[begin : begin + BATCH]
         placed = joint_placements(robot, rows)
         if placed is None:
@@ -95,8 +101,11 @@ def point_distances(robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exac
         rotation, translation = placed[0][:, joints], placed[1][:, joints]
         a = np.einsum("kcij,cj->kci", rotation, local_a) + translation
         b = np.einsum("kcij,cj->kci", rotation, local_b) + translation
-        distances = [capsule_distance(a, b, radius, obstacle, exact_below).min(axis=1) for obstacle in obstacles]
-        out[begin : begin + BATCH] = np.min(distances, axis=0)
+        nearest = np.full(len(rows), np.inf)
+        for obstacle in obstacles:
+            deadline.check()
+            np.minimum(nearest, capsule_distance(a, b, radius, obstacle, exact_below).min(axis=1), out=nearest)
+        out[begin : begin + BATCH] = nearest
     return out
 
 
@@ -145,7 +154,7 @@ def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: li
     one: a sample closer than the clearance, or an interval still undecided then, removes the
     span.
     """
-    distance = point_distances(robot, points, obstacles)
+    distance = point_distances(robot, points, obstacles, deadline=deadline)
     weights = joint_reaches(robot)
     control = pieces.control
     hull = (np.abs(control - control[:, 1:2]) * weights).sum(axis=2).max(axis=1)
@@ -155,41 +164,54 @@ def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: li
         return keep, distance
     speed = (np.abs(np.diff(control, axis=1)).max(axis=1) * weights).sum(axis=1)  # S per span
     blocked = np.zeros(len(pieces), dtype=bool)
-    # samples at the span's interval ends
     count = pieces.first[1] - pieces.first[0]
+    # the undecided spans a group at a time, each group refined to the end before the next:
+    # the work between two deadline checks and the memory held stay bounded whatever the count
+    group = max(1, REFINED // (count + 1))
+    for begin in range(0, len(undecided), group):
+        _refine(undecided[begin : begin + group], count, control, speed, blocked, robot, obstacles, clearance, deadline)
+    keep[undecided] = ~blocked[undecided]
+    return keep, distance
+
+
+def _refine(spans: np.ndarray, count: int, control: np.ndarray, speed: np.ndarray, blocked: np.ndarray, robot: Robot,
+            obstacles: list[Obstacle], clearance: float, deadline: Deadline) -> None:
+    """``clear_pieces``' samples and refinement of ``spans`` (indices, shape (m,)): sets
+    ``blocked`` (K,) of those that come within ``clearance`` or stay undecided at
+    ``FINE_STEP``. The intervals still unsure wait on a stack and are split ``REFINED`` at a
+    time, the newest first (depth first), so that the stack holds at most about
+    4 ``REFINED`` intervals per level of splitting."""
     t = np.linspace(0.0, 1.0, count + 1)
-    owner = np.repeat(undecided, count + 1)
-    values = np.tile(t, len(undecided))
-    d = np.empty(len(owner))
-    for begin in range(0, len(owner), 50 * BATCH):
-        deadline.check()
-        rows = slice(begin, begin + 50 * BATCH)
-        q = _span_points(control[owner[rows]], values[rows])
-        d[rows] = point_distances(robot, q, obstacles, clearance + COARSE_STEP)
+    owner = np.repeat(spans, count + 1)
+    q = _span_points(control[owner], np.tile(t, len(spans)))
+    d = point_distances(robot, q, obstacles, clearance + COARSE_STEP, deadline)
     blocked[owner[d < clearance]] = True
-    d_rows = d.reshape(len(undecided), count + 1)
-    piece = np.repeat(undecided, count)
-    t_a = np.tile(t[:-1], len(undecided))
-    width = np.full(len(piece), 1.0 / count)
-    d_a, d_b = d_rows[:, :-1].ravel(), d_rows[:, 1:].ravel()
-    while piece.size:
+    d_rows = d.reshape(len(spans), count + 1)
+    stack = [(np.repeat(spans, count), np.tile(t[:-1], len(spans)), np.full(len(spans) * count, 1.0 / count),
+              d_rows[:, :-1].ravel(), d_rows[:, 1:].ravel())]
+    while stack:
         deadline.check()
+        piece, t_a, width, d_a, d_b = stack.pop()
+        if len(piece) > REFINED:  # the rest waits its turn
+            stack.append((piece[:-REFINED], t_a[:-REFINED], width[:-REFINED], d_a[:-REFINED], d_b[:-REFINED]))
+            piece, t_a, width, d_a, d_b = piece[-REFINED:], t_a[-REFINED:], width[-REFINED:], d_a[-REFINED:], d_b[-REFINED:]
         unsure = ~blocked[piece] & ((d_a + d_b - width * speed[piece]) / 2.0 < clearance)
         piece, t_a, width, d_a, d_b = piece[unsure], t_a[unsure], width[unsure], d_a[unsure], d_b[unsure]
         fine = width * speed[piece] <= FINE_STEP
         blocked[piece[fine]] = True
         piece, t_a, width, d_a, d_b = piece[~fine], t_a[~fine], width[~fine], d_a[~fine], d_b[~fine]
         if not piece.size:
-            break
+            continue
         width = width / 4.0
         inner = t_a[:, None] + width[:, None] * np.arange(1, 4)[None, :]  # (m, 3)
         q = _span_points(control[np.repeat(piece, 3)], inner.ravel())
-        new = point_distances(robot, q, obstacles, clearance + COARSE_STEP).reshape(-1, 3)
+        new = point_distances(robot, q, obstacles, clearance + COARSE_STEP, deadline).reshape(-1, 3)
         blocked[piece[(new < clearance).any(axis=1)]] = True
         ends = np.column_stack([d_a, new, d_b])  # (m, 5)
-        piece = np.repeat(piece, 4)
-        t_a = (t_a[:, None] + width[:, None] * np.arange(4)[None, :]).ravel()
-        width = np.repeat(width, 4)
-        d_a, d_b = ends[:, :-1].ravel(), ends[:, 1:].ravel()
-    keep[undecided] = ~blocked[undecided]
-    return keep, distance
+        stack.append((
+            np.repeat(piece, 4),
+            (t_a[:, None] + width[:, None] * np.arange(4)[None, :]).ravel(),
+            np.repeat(width, 4),
+            ends[:, :-1].ravel(),
+            ends[:, 1:].ravel(),
+        ))

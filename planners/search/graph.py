@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
 from robots import Robot
 
@@ -37,8 +38,14 @@ MAX_LATTICE_POINTS = 20_000
 MAX_ROADMAP_POINTS = 2_000
 #: Largest turn between two consecutive moves (degrees, in grid units) by graph kind.
 DEFAULT_MAX_TURN = {"lattice": 45.0, "roadmap": 90.0}
+#: Moves (or roadmap rows) handled between two deadline checks while building a graph.
+CHECK_EVERY = 1_024
 #: Joints beyond which ``graph = "auto"`` takes a roadmap.
 LATTICE_MAX_JOINTS = 3
+#: Default memory cap of one search, in bytes (``planners.search.memory``; the service's
+#: ``search_memory_bytes``): 2 GiB, which serves every arm's default search (the three-joint
+#: lattice's, estimated at 1.6 GiB, peaks at 1.45 GB).
+DEFAULT_SEARCH_MEMORY = 2**31
 
 
 @dataclass(frozen=True)
@@ -63,6 +70,8 @@ class SearchOptions:
         neighbors: Nearest neighbours each roadmap point is joined to.
         seed: Seed of the roadmap's random configurations.
         max_expansions: Most partial paths the branch and bound expands.
+        memory_bytes: Most bytes the search may take by its estimate
+            (``planners.search.memory``); set by the service, not by a request.
     """
 
     cells: tuple[int, ...] | None = None
@@ -76,6 +85,7 @@ class SearchOptions:
     neighbors: int = 10
     seed: int = 0
     max_expansions: int = 200_000
+    memory_bytes: int = DEFAULT_SEARCH_MEMORY
 
 
 DEFAULT_OPTIONS = SearchOptions()
@@ -110,10 +120,11 @@ class SearchGraph:
         """q_to - q_from of every edge, shape (E, n_dof)."""
         return self.points[self.edge_to] - self.points[self.edge_from]
 
-    def transitions(self, max_turn_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    def transitions(self, max_turn_deg: float, deadline: Deadline = NO_DEADLINE) -> tuple[np.ndarray, np.ndarray]:
         """Pairs (e_in, e_out) of edges meeting at a grid point that is no goal, turning by at
         most ``max_turn_deg`` degrees (in grid units) and not straight back: the edges of the
-        direction-augmented graph. Shapes (T,) each."""
+        direction-augmented graph. Shapes (T,) each. ``deadline`` is checked every
+        ``CHECK_EVERY`` edges."""
         directions = self.edge_vectors / self.scale
         directions /= np.linalg.norm(directions, axis=1, keepdims=True)
         order = np.argsort(self.edge_from, kind="stable")
@@ -122,7 +133,9 @@ class SearchGraph:
         is_goal[self.goals] = True
         cosine = math.cos(math.radians(max_turn_deg)) - 1e-9
         ins, outs = [], []
-        for e_in in np.flatnonzero(~is_goal[self.edge_to]):
+        for counted, e_in in enumerate(np.flatnonzero(~is_goal[self.edge_to])):
+            if counted % CHECK_EVERY == 0:
+                deadline.check()
             point = self.edge_to[e_in]
             candidates = order[starts[point] : starts[point + 1]]
             keep = candidates[(directions[candidates] @ directions[e_in] >= cosine) & (self.edge_to[candidates] != self.edge_from[e_in])]
@@ -208,9 +221,13 @@ def _revolution_axis(start: float, targets: np.ndarray, low: float, high: float,
     return np.sort(values[keep])
 
 
-def lattice_graph(robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool) -> SearchGraph:
-    """The tessellated position space of eq. (2.1) over the search region, each grid point joined
-    to its 3^n - 1 neighbours."""
+def goal_variants(robot: Robot, revolutions: bool) -> int:
+    """How many goal points a search has: the goal and its revolution variants."""
+    return 3 ** int(np.count_nonzero(robot.continuous)) if revolutions else 1
+
+
+def lattice_axes(robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool) -> tuple[np.ndarray, ...]:
+    """The grid values of each joint of the lattice of eq. (2.1) over the search region."""
     n = robot.dof
     goals = _goal_variants(robot, start, goal, revolutions)
     low, high = search_region(robot, start, goal, goals, options.margin)
@@ -219,10 +236,18 @@ def lattice_graph(robot: Robot, start: np.ndarray, goal: np.ndarray, options: Se
     span = np.abs(goals - start).max(axis=0)
     # a joint that does not move gets the region's typical step
     steps = np.where(steps > 0.0, steps, np.max(steps))
-    axes = tuple(
+    return tuple(
         _axis(start[j], goals[:, j], low[j], high[j], float(steps[j] if steps[j] > 0 else span[j] or 1.0), bool(robot.continuous[j]))
         for j in range(n)
     )
+
+
+def lattice_graph(robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool) -> SearchGraph:
+    """The tessellated position space of eq. (2.1) over the search region, each grid point joined
+    to its 3^n - 1 neighbours."""
+    n = robot.dof
+    goals = _goal_variants(robot, start, goal, revolutions)
+    axes = lattice_axes(robot, start, goal, options, revolutions)
     shape = tuple(len(axis) for axis in axes)
     total = math.prod(shape)
     if total > MAX_LATTICE_POINTS:
@@ -263,7 +288,8 @@ def _find(points: np.ndarray, q: np.ndarray, what: str) -> int:
 
 
 def roadmap_graph(
-    robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool, free
+    robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool, free,
+    deadline: Deadline = NO_DEADLINE,
 ) -> SearchGraph:
     """A sparse graph for arms with many joints: start, goals and ``options.roadmap_points``
     random configurations of the search region (seeded; those ``free`` refuses are drawn again,
@@ -273,6 +299,8 @@ def roadmap_graph(
     Args:
         free: ``free(q) -> mask`` for configurations (k, n_dof): whether each keeps the
             clearance from the obstacles.
+        deadline: Checked between draws and between blocks of ``CHECK_EVERY`` rows of the
+            distances, which are computed a block at a time (memory P x ``CHECK_EVERY``).
     """
     n = robot.dof
     goals = _goal_variants(robot, start, goal, revolutions)
@@ -284,6 +312,7 @@ def roadmap_graph(
     found: list[np.ndarray] = []
     drawn = 0
     while sum(len(f) for f in found) < count and drawn < 10 * count:
+        deadline.check()
         batch = low + (high - low) * rng.random((count, n))
         drawn += count
         found.append(batch[free(batch)])
@@ -292,9 +321,13 @@ def roadmap_graph(
     scale = np.where(high > low, high - low, 1.0) / max(count, 1) ** (1.0 / n)
     unit = points / scale
     k = max(1, min(int(options.neighbors), len(points) - 1))
-    squared = ((unit[:, None, :] - unit[None, :, :]) ** 2).sum(axis=2)
-    np.fill_diagonal(squared, np.inf)
-    nearest = np.argsort(squared, axis=1)[:, :k]
+    nearest = np.empty((len(points), k), dtype=int)
+    for begin in range(0, len(points), CHECK_EVERY):
+        deadline.check()
+        rows = np.arange(begin, min(begin + CHECK_EVERY, len(points)))
+        squared = ((unit[rows, None, :] - unit[None, :, :]) ** 2).sum(axis=2)
+        squared[np.arange(len(rows)), rows] = np.inf
+        nearest[rows] = np.argsort(squared, axis=1)[:, :k]
     joined = {(int(i), int(j)) for i in range(len(points)) for j in nearest[i]}
     joined |= {(j, i) for i, j in joined}
     pairs = sorted(joined)

@@ -16,6 +16,7 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
 from planners.search.branch_and_bound import branch_and_bound
 from planners.search.graph import DEFAULT_OPTIONS, SearchOptions
+from planners.search.memory import check_search_memory
 from planners.search.outcome import NoGridPath, SearchResult, SearchStatistics
 from planners.search.problem import build_problem, toward_goal
 from planners.search.shadows import obstacle_shadows
@@ -95,18 +96,23 @@ def global_search(
     the time left, each stopping at its part with the grid paths it found: that is what ends
     a variant no grid path reaches, which would otherwise run until ``max_expansions``.
 
+    Before any work, the search's memory is estimated from ``options`` and compared with
+    ``options.memory_bytes`` (``planners.search.memory``).
+
     Raises:
+        OverMemory: the estimate exceeds the cap (the detail names the largest value served).
         InvalidRequest, InfeasiblePath: see ``build_problem`` and ``branch_and_bound`` (the
             latter when no variant has a grid path).
         BudgetExceeded: ``deadline`` passed.
     """
     options = options or DEFAULT_OPTIONS
+    check_search_memory(robot, start, goal, options, revolutions)
     problem = build_problem(
         robot, limits, kinds, start, goal, options, revolutions, obstacles, clearance, deadline.within(0.0, 0.4)
     )
     # the variants by their least time to go (h2 from the start), the likeliest best first, so
     # that its t~ caps the searches of the others
-    toward = [toward_goal(problem, index) for index in range(len(problem.graph.goals))]
+    toward = [toward_goal(problem, index, deadline) for index in range(len(problem.graph.goals))]
     toward.sort(key=lambda one: float(np.min(one.h2[[state for _, state, _ in one.start_moves if state >= 0]], initial=np.inf)))
     results: list[SearchResult] = []
     failures: list[NoGridPath] = []

@@ -79,7 +79,7 @@ class SearchProblem:
     prepare_s: float
 
 
-def _graph(robot, start, goal, options: SearchOptions, revolutions, obstacles, clearance) -> SearchGraph:
+def _graph(robot, start, goal, options: SearchOptions, revolutions, obstacles, clearance, deadline: Deadline) -> SearchGraph:
     kind = options.graph
     if kind not in GRAPH_KINDS:
         raise InvalidRequest(f"timing.search.graph {kind!r} is unknown; use one of {list(GRAPH_KINDS)}")
@@ -91,9 +91,9 @@ def _graph(robot, start, goal, options: SearchOptions, revolutions, obstacles, c
     def free(q):
         if not obstacles:
             return np.ones(len(q), dtype=bool)
-        return point_distances(robot, q, obstacles) >= clearance
+        return point_distances(robot, q, obstacles, deadline=deadline) >= clearance
 
-    return roadmap_graph(robot, start, goal, options, revolutions, free)
+    return roadmap_graph(robot, start, goal, options, revolutions, free, deadline)
 
 
 def _cost_to_go(n_states: int, source: np.ndarray, target: np.ndarray, weight: np.ndarray) -> np.ndarray:
@@ -143,11 +143,11 @@ def build_problem(
                     "move it away from the obstacles or lower path.clearance"
                 )
     deadline.progress(0.0, "search: graph")
-    graph = _graph(robot, start, goal, options, revolutions, obstacle_list, clearance)
+    graph = _graph(robot, start, goal, options, revolutions, obstacle_list, clearance, deadline)
     max_turn = options.max_turn if options.max_turn is not None else DEFAULT_MAX_TURN[graph.kind]
     if not 0.0 < max_turn < 180.0:
         raise InvalidRequest(f"timing.search.max_turn must lie in (0, 180) degrees, got {max_turn}")
-    turn_in, turn_out = graph.transitions(max_turn)
+    turn_in, turn_out = graph.transitions(max_turn, deadline)
     pieces = build_pieces(graph.points, graph.edge_from, graph.edge_to, graph.start, graph.goals, turn_in, turn_out)
     deadline.check()
     usable = np.ones(len(pieces), dtype=bool)
@@ -166,22 +166,22 @@ def build_problem(
         robot=robot, limits=limits, kinds=tuple(kinds), removed=removed, points_blocked=points_blocked,
         prepare_s=0.0,
     )
-    return dataclasses.replace(_with_states(problem, graph), prepare_s=time.perf_counter() - began)
+    return dataclasses.replace(_with_states(problem, graph, deadline), prepare_s=time.perf_counter() - began)
 
 
-def toward_goal(problem: SearchProblem, goal: int) -> SearchProblem:
+def toward_goal(problem: SearchProblem, goal: int, deadline: Deadline = NO_DEADLINE) -> SearchProblem:
     """The same problem with one goal point only (``goal``, an index into the graph's goals):
     the grid paths ending at one revolution variant of the goal, a homotopy class of their
     own, searched with their own upper bound."""
     graph = dataclasses.replace(problem.graph, goals=problem.graph.goals[goal : goal + 1])
-    return _with_states(problem, graph)
+    return _with_states(problem, graph, deadline)
 
 
-def _with_states(problem: SearchProblem, graph: SearchGraph) -> SearchProblem:
+def _with_states(problem: SearchProblem, graph: SearchGraph, deadline: Deadline = NO_DEADLINE) -> SearchProblem:
     """``problem`` with the states, moves and costs to go toward ``graph.goals``."""
     bounds = problem.bounds
     successors, start_moves, state_point, h2, cut = _states(
-        graph, problem.turn_in, problem.turn_out, problem.pieces, bounds, problem.usable
+        graph, problem.turn_in, problem.turn_out, problem.pieces, bounds, problem.usable, deadline
     )
     goal_points = graph.points[graph.goals]
     straight = np.min(np.linalg.norm(cut[:, None, :] - goal_points[None, :, :], axis=2), axis=1)
@@ -191,9 +191,13 @@ def _with_states(problem: SearchProblem, graph: SearchGraph) -> SearchProblem:
     )
 
 
-def _states(graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: PieceBounds, usable):
+#: Spans handled between two deadline checks while the states are built.
+CHECK_EVERY = 4_096
+
+
+def _states(graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: PieceBounds, usable, deadline: Deadline = NO_DEADLINE):
     """The search's states and moves (``SearchProblem``), the cost-to-go h2 of each state and
-    the point where its fixed curve ends."""
+    the point where its fixed curve ends; ``deadline`` checked every ``CHECK_EVERY`` spans."""
     n_turns = len(turn_in)
     starts = np.flatnonzero(graph.edge_from == graph.start)
     goal = np.zeros(len(graph.points), dtype=bool)
@@ -207,7 +211,9 @@ def _states(graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: Piece
     direct = {int(pieces.edge[k]): int(k) for k in np.flatnonzero(usable & (pieces.kind == DIRECT))}
     successors: list[list[tuple[int, int, int]]] = [[] for _ in range(n_states)]
     source, target, weight = [], [], []
-    for k in np.flatnonzero(usable & ((pieces.kind == FIRST) | (pieces.kind == MIDDLE))):
+    for counted, k in enumerate(np.flatnonzero(usable & ((pieces.kind == FIRST) | (pieces.kind == MIDDLE)))):
+        if counted % CHECK_EVERY == 0:
+            deadline.check()
         after = int(pieces.turn_out[k])
         before = int(pieces.turn_in[k]) if pieces.kind[k] == MIDDLE else start_state[int(turn_in[after])]
         ending = int(last[after]) if goal[graph.edge_to[turn_out[after]]] else -1

@@ -26,7 +26,7 @@ import numpy as np
 from planners.constraints import LinearRows, PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.isolated import run_isolated
+from planners.isolated import LOW_PRIORITY, run_isolated
 from planners.mvc import friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
@@ -82,7 +82,7 @@ class MinCostMethod(TimingMethod):
         deadline.check()
         # cvxpy's canonicalization and Clarabel cannot check a deadline: they run in a child
         # process that is killed when the budget is spent, and whose memory is freed on exit.
-        interior, value, status = run_isolated(solve_program, program, deadline=deadline)
+        interior, value, status = run_isolated(solve_program, program, deadline=deadline, nice=LOW_PRIORITY)
         x = np.concatenate(([boundary.sd_start**2], interior, [boundary.sd_end**2]))
         return CostTimeScaling(s, np.sqrt(x), cost=value, solver_status=status)
 

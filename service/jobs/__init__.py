@@ -26,5 +26,6 @@ def job_runner(settings) -> JobRunner:
         upload_cache_size=settings.upload_cache_size,
         max_response_bytes=settings.max_response_bytes,
         ray_address=settings.ray_address,
+        search_memory_bytes=settings.search_memory_bytes,
     )
     return JobRunner(store, settings.job_workers, setup)

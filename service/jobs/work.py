@@ -20,14 +20,15 @@ import robots
 from planners import Deadline
 from planners.deadline import Progress
 from planners.errors import InvalidRequest
+from planners.search.graph import DEFAULT_SEARCH_MEMORY
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 
 @dataclass(frozen=True)
 class WorkerSetup:
-    """The server's settings a worker process needs: where uploads live (and their caps), and
-    the largest answer body served, in bytes."""
+    """The server's settings a worker process needs: where uploads live (and their caps), the
+    largest answer body served and the memory cap of a search, in bytes."""
 
     data_dir: str
     max_uploads: int
@@ -35,11 +36,12 @@ class WorkerSetup:
     upload_cache_size: int
     max_response_bytes: int
     ray_address: str | None = None
+    search_memory_bytes: int = DEFAULT_SEARCH_MEMORY
 
 
 def _trajectory(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
     body = TrajectoryRequest.model_validate_json(request)
-    return render(plan_request(body, deadline, setup.max_response_bytes), body)[0]
+    return render(plan_request(body, deadline, setup.max_response_bytes, search_memory_bytes=setup.search_memory_bytes), body)[0]
 
 
 def _compare(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:

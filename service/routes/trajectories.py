@@ -7,7 +7,7 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
-from service.planning import compare_request, encode_json, plan_request, render, worth_a_leash
+from service.planning import compare_request, encode_json, heavy_request, plan_request, render, worth_a_leash
 from service.problems import problem_responses
 from service.schemas.answers import CompareResponse, TrajectoryResponse
 from service.schemas.examples import openapi_examples
@@ -33,15 +33,19 @@ async def create_trajectory(
     """Time the path of ``body`` for its robot under the requested limits and return the
     samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit.
     The body is built and encoded by the planning, within the time budget; a small request
-    (``worth_a_leash``) is first tried on the event loop."""
+    (``worth_a_leash``) is first tried on the event loop, a heavy one (``heavy_request``) waits
+    for a heavy worker of its own."""
     settings = request.app.state.settings
 
     accept = request.headers.get("accept")
 
     def planned(deadline) -> tuple[bytes, str]:
-        return render(plan_request(body, deadline, settings.max_response_bytes, accept), body, accept)
+        return render(plan_request(body, deadline, settings.max_response_bytes, accept, settings.search_memory_bytes), body, accept)
 
-    content, media_type = await request.app.state.planning.run(planned, settings.plan_budget_s, leashed=worth_a_leash(body))
+    if heavy_request(body):  # admitted apart, so that it never holds up the short requests
+        content, media_type = await request.app.state.heavy_planning.run(planned, settings.plan_budget_s)
+    else:
+        content, media_type = await request.app.state.planning.run(planned, settings.plan_budget_s, leashed=worth_a_leash(body))
     return Response(content, media_type=media_type)
 
 
@@ -52,7 +56,6 @@ async def compare_trajectories(
     """Time one path under several methods (e.g. ``phase_plane`` against ``quintic``) and return
     each one's duration, peak utilization and solve time: what time-optimality buys."""
     settings = request.app.state.settings
-    content = await request.app.state.planning.run(
-        lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s
-    )
+    lane = request.app.state.heavy_planning if heavy_request(body) else request.app.state.planning
+    content = await lane.run(lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s)
     return Response(content, media_type="application/json")
