@@ -10,6 +10,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from planners.accuracy import accurate_solve, estimated
 from planners.constraints import PathConstraints
 from planners.errors import InfeasiblePath
 from planners.limit_check import Excess, LimitCheck, check_limits
@@ -54,9 +55,11 @@ def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
     return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
 
 
-def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline):
+def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
     """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
-    exceeded by more than ``threshold``, refine the grid there and time the path again.
+    exceeded by more than ``threshold``, refine the grid there and time the path again. The
+    first solve holds its accuracy (``planners.accuracy.accurate_solve``; ``grid_given``: the
+    request named the grid, which is kept), and every timing carries its estimated gap.
 
     Returns:
         (timing, constraints, check): the timing that holds the limits, the constraints it was
@@ -67,7 +70,7 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
             method's timing cannot be refined; says where, which joint and which limit.
     """
     deadline.progress(0.0, "timing")
-    result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+    result, constraints = accurate_solve(method, constraints, boundary, duration, deadline, grid_given)
     for round_ in range(GATE_ROUNDS + 1):
         deadline.check()
         deadline.progress(0.5 + 0.5 * round_ / (GATE_ROUNDS + 1), f"limit check, round {round_ + 1}")
@@ -90,7 +93,7 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
         if extra.size == 0:
             break
         constraints = constraints.with_points(extra)
-        result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+        result, _ = estimated(method, constraints, boundary, solve_well_scaled(method, constraints, boundary, duration, deadline), deadline)
     raise limit_exceeded(method.name, check.worst, robot, path)
 
 

@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+from planners.accuracy import answer_accuracy
 from planners.collision import Obstacle, check_clearance
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
@@ -28,6 +29,7 @@ from planners.results import Conditioning, PhasePlane, PlannedTrajectory, requir
 from planners.timed import timed_path, timed_unsynchronized, timed_via_points
 from planners.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
+from planners.timing.phase_plane import PhasePlaneMethod
 from planners.tool_speed import tool_speed_limit
 from planners.trajectory import sample_trajectory
 from planners.waypoint_checks import continuous_turns, make_path, without_repeats
@@ -222,6 +224,13 @@ def plan(
             f"the {timed.method} timing's sample at t = {samples.t[sample]:.6g} s exceeds the {what} "
             "although its dense check holds; use more grid points"
         )
+    timed_by = PhasePlaneMethod() if method.name == "search" else method  # the search's path: phase_plane
+    accuracy, warning = answer_accuracy(
+        result, timed_by, timed.method, sum(len(item.constraints.s) - 1 for item in timed.stretches), robot.dof,
+        grid_given=timing.grid_points is not None, duration_given=timing.duration is not None,
+    )
+    if warning is not None:
+        notes.append(warning)
     utilization = _utilization(timed.stretches, margin)
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
     if not np.isfinite(kappa_max):
@@ -257,6 +266,7 @@ def plan(
         switching_times=switching,
         clearance=found_clearance,
         search=timed.search,
+        accuracy=accuracy,
     )
 
 

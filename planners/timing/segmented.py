@@ -61,6 +61,25 @@ class SegmentedTiming(PathTiming):
         return Binding(binding.kind, binding.joint, float(a + w * binding.s))
 
     @property
+    def optimality_gap(self) -> float | None:
+        """The stretches' gaps weighted by their durations (of the costs, for methods that
+        report one): the relative gap of the sum; ``None`` unless every stretch has one."""
+        gaps = [part.optimality_gap for part in self.parts]
+        if any(gap is None for gap in gaps):
+            return None
+        costs = [getattr(part, "cost", None) for part in self.parts]
+        weights = costs if all(cost is not None for cost in costs) else [part.duration for part in self.parts]
+        total = float(sum(weights))
+        return float(sum(w * g for w, g in zip(weights, gaps))) / total if total > 0.0 else None
+
+    @property
+    def gap_basis(self) -> str:
+        """The stretches' bases, once each (the first stretch's reason when one has no gap)."""
+        missing = [part.gap_basis for part in self.parts if part.optimality_gap is None]
+        bases = missing[:1] if missing else list(dict.fromkeys(part.gap_basis for part in self.parts))
+        return "; ".join(basis for basis in bases if basis)
+
+    @property
     def cost(self) -> float | None:
         """The summed cost of the stretches, for methods that report one."""
         costs = [getattr(part, "cost", None) for part in self.parts]
