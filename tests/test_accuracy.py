@@ -4,13 +4,21 @@ panda and the two-link paper arms. ``benchmarks/accuracy.py`` runs the larger st
 
 from __future__ import annotations
 
+import dataclasses
+import re
+
 import numpy as np
 import pytest
 
 import robots
 from benchmarks.accuracy import KINDS, converged_duration, random_waypoints
+from benchmarks.converged import converged_duration as converged
+from benchmarks.converged import random_path
 from planners import Timing, WaypointPath, plan
 from planners.errors import InfeasiblePath
+from planners.paths import SplinePath
+from planners.timing.min_cost import MinCostMethod
+from tests.conftest import UR5_WAYPOINTS
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda", "geering_2r", "yamamoto_2r"])
@@ -30,3 +38,149 @@ def test_default_durations_are_within_a_tenth_of_a_percent_of_the_converged_opti
         assert 0.9995 <= result.duration / reference <= 1.001, (waypoints.tolist(), result.duration, reference)
         compared += 1
     assert compared >= 2
+
+
+# Every answer states its accuracy (planners/accuracy.py): the estimated relative gap to the
+# converged optimum, held within 0.1 % for time-optimal methods on their default grids.
+
+UR5_START = [0.3, -1.6, 1.7, -1.6, -1.57, 0.2]
+#: The weld seam of the README: ur5's tool along a straight line at 5 cm/s.
+WELD_LINE = {"kind": "cartesian", "start": UR5_START, "positions": [[0.413, 0.542, 0.286]]}
+
+
+def recorded_waypoints(robot, rng, count: int) -> np.ndarray:
+    """A recorded path: its first two steps are tiny next to the rest (2e-4 and 1.6e-4 of a
+    3 rad path, as in the data shipped with toppra's tests), then random steps."""
+    lower = np.where(np.isfinite(robot.limits.position_lower), robot.limits.position_lower, -np.pi)
+    upper = np.where(np.isfinite(robot.limits.position_upper), robot.limits.position_upper, np.pi)
+    middle, half = 0.5 * (lower + upper), 0.3 * (upper - lower)
+    points = [middle + rng.uniform(-1, 1, robot.dof) * half]
+    for fraction in (2e-4, 1.6e-4):
+        step = rng.normal(size=robot.dof)
+        points.append(points[-1] + 3.0 * fraction * step / np.linalg.norm(step))
+    while len(points) < count:
+        points.append(np.clip(points[-1] + rng.uniform(-1, 1, robot.dof) * half, middle - half, middle + half))
+    return np.array(points)
+
+
+def _weld(client, method: str, **timing) -> dict:
+    body = {
+        "robot": "ur5",
+        "path": WELD_LINE,
+        "timing": {"method": method, "constraints": list(KINDS), "limits": {"tool_speed": 0.05}, **timing},
+        "output": {"dt": 0.05},
+    }
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+@pytest.fixture(scope="module")
+def weld_reference(client) -> float:
+    """The weld line's converged time-optimal duration: TOPP-RA on 20,000 intervals (its own
+    discretization error there is about 1e-5)."""
+    return _weld(client, "toppra", grid_points=20_000)["duration"]
+
+
+def _gap_warnings(body: dict) -> list[str]:
+    return [text for text in body["warnings"] if "of the time-optimal one" in text]
+
+
+@pytest.mark.parametrize("method", ["toppra", "min_cost"])
+def test_the_weld_line_is_held_within_a_tenth_of_a_percent_and_says_how_close(client, weld_reference, method):
+    """Before: 1.8 % above the converged optimum on the default grid of 100 intervals, without a
+    word. Now the default answer is within 0.1 % of it, and its stated gap is the true one."""
+    body = _weld(client, method)
+    true_gap = body["duration"] / weld_reference - 1.0
+    assert true_gap <= 1e-3
+    stated = body["accuracy"]["relative_gap"]
+    assert stated is not None and "phase-plane method" in body["accuracy"]["basis"]
+    assert abs(stated - abs(true_gap)) <= 1e-4, (stated, true_gap)
+    assert not _gap_warnings(body)
+
+
+@pytest.mark.parametrize("method", ["toppra", "min_cost"])
+def test_a_named_grid_keeps_its_grid_and_warns_with_a_remedy_that_works(client, weld_reference, method):
+    """timing.grid_points 100: the request's grid, its 1.8 % stated in the accuracy and in a
+    warning, whose grid_points advice (within what the method serves) holds the 0.1 %."""
+    body = _weld(client, method, grid_points=100)
+    true_gap = body["duration"] / weld_reference - 1.0
+    assert 0.015 < true_gap < 0.021  # the grid is kept: the issue's 1.8 %
+    assert body["accuracy"]["relative_gap"] == pytest.approx(true_gap, rel=0.02)
+    (warning,) = _gap_warnings(body)
+    assert "1.8 %" in warning
+    advised = int(re.search(r"timing\.grid_points (\d+) would", warning).group(1))
+    assert 100 < advised <= MinCostMethod().max_grid_intervals(6)
+    followed = _weld(client, method, grid_points=advised)
+    assert followed["duration"] / weld_reference - 1.0 <= 1e-3
+    assert not _gap_warnings(followed)
+
+
+def test_min_cost_on_a_recorded_path_is_within_a_tenth_of_a_percent(client):
+    """A recorded ur5 path with tiny first steps: min_cost came out 0.16 % above the converged
+    optimum without a warning; now within 0.1 %, with a stated gap close to the true one."""
+    robot = robots.load("ur5")
+    waypoints = recorded_waypoints(robot, np.random.default_rng(0), 5)
+    reference, _ = converged(SplinePath(waypoints), robot)
+    body = client.post("/v1/trajectories", json={
+        "robot": "ur5",
+        "path": {"kind": "waypoints", "waypoints": waypoints.tolist()},
+        "timing": {"method": "min_cost", "constraints": list(KINDS)},
+        "output": {"dt": 0.05},
+    }).json()
+    true_gap = body["duration"] / reference - 1.0
+    assert -1e-4 <= true_gap <= 1e-3
+    assert body["accuracy"]["relative_gap"] == pytest.approx(abs(true_gap), abs=1e-4)
+
+
+@pytest.mark.parametrize("name", ["ur5", "geering_2r"])
+@pytest.mark.parametrize("method", ["phase_plane", "toppra"])
+def test_the_stated_gap_of_a_spline_matches_the_converged_reference(name, method):
+    """Seeded spline paths: the stated gap is within 1e-4 of the true one (against the
+    Richardson-converged reference of ``benchmarks/converged.py``) or above it, and no answer
+    is more than 0.1 % above the reference without a warning."""
+    robot = robots.load(name)
+    waypoints, path = random_path(robot, np.random.default_rng(3))
+    reference, _ = converged(path, robot)
+    result = plan(robot, WaypointPath(waypoints), Timing(method=method, constraints=KINDS), dt=0.01)
+    true_gap = result.duration / reference - 1.0
+    assert result.accuracy is not None and result.accuracy.relative_gap is not None
+    assert result.accuracy.relative_gap >= abs(true_gap) - 1e-4, (result.accuracy, true_gap)
+    assert result.accuracy.relative_gap <= abs(true_gap) + 6e-4, (result.accuracy, true_gap)
+    assert true_gap <= 1e-3 or any("time-optimal" in text for text in result.warnings)
+
+
+def test_min_cost_with_a_torque_weight_states_its_cost_gap():
+    """beta > 0: the cost's gap, estimated on half the grid, bounds the true one (against the
+    cost on a grid four times finer, converged within the solver's own 5e-6) without
+    overstating it more than a few times (the scheme converges faster than first order here)."""
+    robot = robots.load("geering_2r")
+    waypoints = np.array([[0.0, 0.0], [1.0, 0.6], [1.6, -0.4]])
+    timing = Timing(method="min_cost", constraints=KINDS, torque_weight=0.01)
+    result = plan(robot, WaypointPath(waypoints), timing, dt=0.01)
+    fine = plan(robot, WaypointPath(waypoints), dataclasses.replace(timing, grid_points=800), dt=0.01)
+    true_gap = result.cost / fine.cost - 1.0
+    assert result.accuracy is not None and "half the intervals" in result.accuracy.basis
+    assert 1e-5 < true_gap <= result.accuracy.relative_gap <= 5.0 * true_gap
+
+
+def test_every_answer_carries_an_accuracy_field_and_the_schema_documents_it(client):
+    """The typical request states phase_plane's own estimate; a time law says why it has none;
+    compare entries carry it; the OpenAPI schema documents it."""
+    body = client.post("/v1/trajectories", json={
+        "robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}, "output": {"dt": 0.05},
+    }).json()
+    assert 0.0 <= body["accuracy"]["relative_gap"] <= 6e-4
+    assert "midpoint" in body["accuracy"]["basis"]
+    law = client.post("/v1/trajectories", json={
+        "robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS},
+        "timing": {"method": "quintic"}, "output": {"dt": 0.05},
+    }).json()
+    assert law["accuracy"]["relative_gap"] is None and law["accuracy"]["basis"]
+    compared = client.post("/v1/trajectories/compare", json={
+        "robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}, "methods": ["phase_plane", "toppra"],
+    }).json()
+    assert all(entry["accuracy"]["relative_gap"] is not None for entry in compared["results"])
+    schema = client.get("/openapi.json").json()["components"]["schemas"]
+    assert "relative_gap" in schema["AccuracyPublic"]["properties"]
+    assert "accuracy" in schema["TrajectoryResponse"]["required"]
