@@ -65,12 +65,15 @@ class SegmentedTiming(PathTiming):
         """The stretches' gaps weighted by their durations (of the costs, for methods that
         report one): the relative gap of the sum; ``None`` unless every stretch has one."""
         gaps = [part.optimality_gap for part in self.parts]
-        if any(gap is None for gap in gaps):
+        known = [gap for gap in gaps if gap is not None]
+        if len(known) < len(gaps):
             return None
         costs = [getattr(part, "cost", None) for part in self.parts]
-        weights = costs if all(cost is not None for cost in costs) else [part.duration for part in self.parts]
-        total = float(sum(weights))
-        return float(sum(w * g for w, g in zip(weights, gaps))) / total if total > 0.0 else None
+        weights = [float(cost) for cost in costs if cost is not None]
+        if len(weights) < len(costs):
+            weights = [part.duration for part in self.parts]
+        total = sum(weights)
+        return sum(w * g for w, g in zip(weights, known)) / total if total > 0.0 else None
 
     @property
     def gap_basis(self) -> str:
