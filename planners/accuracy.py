@@ -223,15 +223,55 @@ def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid
 
 
 def answer_accuracy(
-    timing: PathTiming, method: TimingMethod, method_name: str, intervals: int, dof: int, grid_given: bool, duration_given: bool
+    timing: PathTiming,
+    method: TimingMethod,
+    method_name: str,
+    intervals: int,
+    dof: int,
+    grid_given: bool,
+    duration_given: bool,
+    law_utilization: list[tuple[float, dict[str, np.ndarray]]] | None = None,
 ) -> tuple[Accuracy, str | None]:
     """The answer's ``Accuracy`` from its timing, and the warning the policy asks for: a
     time-optimal answer (``method``: the method that timed the path) whose estimated gap still
-    exceeds ``GAP_TARGET`` after ``accurate_solve`` on its ``intervals`` grid intervals."""
+    exceeds ``GAP_TARGET`` after ``accurate_solve`` on its ``intervals`` grid intervals. Time
+    laws at their shortest (``law_utilization``: each stretch's duration and its dense check's
+    peak utilization against the limits it was timed under) are estimated from that
+    (``law_gap``), the stretches' gaps weighted by their durations."""
     gap, basis = timing.optimality_gap, timing.gap_basis
+    if gap is None and law_utilization and not duration_given:
+        gaps = [law_gap(utilization) for _, utilization in law_utilization]
+        known = [(duration, g) for (duration, _), g in zip(law_utilization, gaps) if g is not None]
+        total = sum(duration for duration, _ in known)
+        if len(known) == len(gaps) and total > 0.0:
+            gap, basis = sum(duration * g for duration, g in known) / total, LAW_BASIS
     if gap is None:
         return Accuracy(None, basis or f"not estimated for timing.method {method_name}"), None
     warning = None
     if time_optimal(method) and not duration_given and gap > GAP_TARGET:
         warning = gap_warning(method, gap, intervals, dof, grid_given)
     return Accuracy(float(gap), basis), warning
+
+
+#: How a time law's duration scales its limited quantities: velocities (and tool speeds) as
+#: 1/T, accelerations and the inertial torques as 1/T^2, jerks as 1/T^3.
+_LAW_POWERS = {"velocity": 1.0, "acceleration": 2.0, "torque": 2.0, "jerk": 3.0}
+LAW_BASIS = (
+    "the time law's peak utilization on the dense check: its shortest duration is the one at which, "
+    "sped up uniformly, its most used limit binds (velocities scale as 1/T, accelerations and torques "
+    "as 1/T^2, jerks as 1/T^3; gravity's share of a torque does not scale, so a torque-bound figure is approximate)"
+)
+
+
+def law_gap(utilization: dict[str, np.ndarray]) -> float | None:
+    """The relative gap of a time law's duration T from its own shortest T_min, from its peak
+    utilization u_k (|value| / limit, per kind and joint) on the dense check: a uniform speed-up
+    by f scales each kind by f^p (``_LAW_POWERS``; tool speeds p = 1), so
+    T_min = T max_k u_k^(1/p_k) and the gap is T / T_min - 1. ``None`` when nothing is limited."""
+    scales = [
+        float(np.max(np.asarray(peak, dtype=float))) ** (1.0 / _LAW_POWERS.get(kind, 1.0))
+        for kind, peak in utilization.items()
+        if np.size(peak) and np.isfinite(np.max(peak))
+    ]
+    largest = max(scales, default=0.0)
+    return max(1.0 / largest - 1.0, 0.0) if largest > 0.0 else None

@@ -29,6 +29,7 @@ from planners.results import Conditioning, PhasePlane, PlannedTrajectory, requir
 from planners.timed import timed_path, timed_unsynchronized, timed_via_points
 from planners.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
+from planners.timing.law_timing import LawTiming
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.tool_speed import tool_speed_limit
 from planners.trajectory import sample_trajectory
@@ -225,9 +226,11 @@ def plan(
             "although its dense check holds; use more grid points"
         )
     timed_by = PhasePlaneMethod() if method.name == "search" else method  # the search's path: phase_plane
+    laws = [(item.timing.duration, item.check.utilization) for item in timed.stretches if isinstance(item.timing, LawTiming)]
+    law = laws if len(laws) == len(timed.stretches) else None
     accuracy, warning = answer_accuracy(
         result, timed_by, timed.method, sum(len(item.constraints.s) - 1 for item in timed.stretches), robot.dof,
-        grid_given=timing.grid_points is not None, duration_given=timing.duration is not None,
+        grid_given=timing.grid_points is not None, duration_given=timing.duration is not None, law_utilization=law,
     )
     if warning is not None:
         notes.append(warning)

@@ -184,3 +184,20 @@ def test_every_answer_carries_an_accuracy_field_and_the_schema_documents_it(clie
     schema = client.get("/openapi.json").json()["components"]["schemas"]
     assert "relative_gap" in schema["AccuracyPublic"]["properties"]
     assert "accuracy" in schema["TrajectoryResponse"]["required"]
+
+
+@pytest.mark.parametrize("method", ["quintic", "cycloidal"])
+def test_a_time_law_states_its_gap_to_its_own_shortest_duration(method):
+    """A time law at its shortest: the stated gap g puts the law's own shortest duration at
+    T / (1 + g); the same law asked for that duration (plus 1e-4) holds the limits, and for
+    0.2 % less does not."""
+    robot = robots.load("ur5")
+    path = WaypointPath(np.array(UR5_WAYPOINTS))
+    result = plan(robot, path, Timing(method=method, constraints=KINDS), dt=0.01)
+    gap = result.accuracy.relative_gap
+    assert gap is not None and "peak utilization" in result.accuracy.basis
+    shortest = result.duration / (1.0 + gap)
+    held = plan(robot, path, Timing(method=method, constraints=KINDS, duration=shortest * (1 + 1e-4)), dt=0.01)
+    assert max(float(np.max(peak)) for peak in held.peak_utilization.values()) == pytest.approx(1.0, abs=1.5e-3)
+    with pytest.raises(InfeasiblePath):
+        plan(robot, path, Timing(method=method, constraints=KINDS, duration=shortest * (1 - 2e-3)), dt=0.01)
