@@ -37,6 +37,7 @@ from planners.errors import InfeasiblePath, TimingFailed
 from planners.grid import MAX_POINTS, on_points
 from planners.results import Accuracy
 from planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
+from planners.timing.phase_plane import GAP_BASIS as PHASE_PLANE_BASIS
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.scaled import solve_well_scaled
 
@@ -211,7 +212,7 @@ def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid
     figure = f"the duration is within about {100 * gap:.2g} % of the time-optimal one on this grid"
     cap = min(method.max_grid_intervals(dof), MAX_POINTS)
     wanted = math.ceil(1.25 * intervals * gap / GAP_TARGET)
-    where = "the grid given by timing.grid_points" if grid_given else "the grid the time budget allowed"
+    where = "the grid given by timing.grid_points" if grid_given else "the default grid, refined as far as the grid cap and the time budget allowed"
     if wanted <= cap and wanted > intervals:
         return f"{figure} ({where}, {intervals} intervals); timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
     if method.name != "phase_plane":
@@ -247,6 +248,9 @@ def answer_accuracy(
             gap, basis = sum(duration * g for duration, g in known) / total, LAW_BASIS
     if gap is None:
         return Accuracy(None, basis or f"not estimated for timing.method {method_name}"), None
+    if method_name == "collocation" and basis == PHASE_PLANE_BASIS:
+        # The re-timing along the collocation's path, not the free path's own optimality.
+        basis = f"the re-timing along the collocation's path only (not the path's own optimality): {basis}"
     warning = None
     if time_optimal(method) and not duration_given and gap > GAP_TARGET:
         warning = gap_warning(method, gap, intervals, dof, grid_given)
