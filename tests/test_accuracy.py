@@ -201,3 +201,16 @@ def test_a_time_law_states_its_gap_to_its_own_shortest_duration(method):
     assert max(float(np.max(peak)) for peak in held.peak_utilization.values()) == pytest.approx(1.0, abs=1.5e-3)
     with pytest.raises(InfeasiblePath):
         plan(robot, path, Timing(method=method, constraints=KINDS, duration=shortest * (1 - 2e-3)), dt=0.01)
+
+
+def test_the_typical_request_states_its_accuracy_without_a_second_solve(monkeypatch):
+    """phase_plane's estimate is its own refinement's: the typical request (4 ur5 waypoints)
+    solves once."""
+    from planners.timing.phase_plane import PhasePlaneMethod
+
+    calls = []
+    solve = PhasePlaneMethod.solve
+    monkeypatch.setattr(PhasePlaneMethod, "solve", lambda self, *args, **kwargs: calls.append(1) or solve(self, *args, **kwargs))
+    result = plan(robots.load("ur5"), WaypointPath(np.array(UR5_WAYPOINTS)), Timing(), dt=0.01)
+    assert len(calls) == 1
+    assert result.accuracy is not None and 0.0 <= result.accuracy.relative_gap <= 6e-4
