@@ -207,20 +207,23 @@ def accurate_solve(
 
 def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid_given: bool) -> str:
     """The warning of a time-optimal answer whose estimated gap exceeds ``GAP_TARGET``, with
-    a remedy the request can follow: a ``timing.grid_points`` within what the method serves
-    (first order: the gap shrinks as the intervals grow), else the phase-plane method."""
+    a remedy the request can follow. On a grid the request named: a ``timing.grid_points``
+    within what the method serves (first order: the gap shrinks as the intervals grow). On the
+    default grid, which ``accurate_solve`` refined as far as it could (the cap or the budget
+    stopped it, or the gap is not the grid's): the phase-plane method, which refines where the
+    error lies."""
     figure = f"the duration is within about {100 * gap:.2g} % of the time-optimal one on this grid"
     cap = min(method.max_grid_intervals(dof), MAX_POINTS)
     wanted = math.ceil(1.25 * intervals * gap / GAP_TARGET)
-    where = "the grid given by timing.grid_points" if grid_given else "the default grid, refined as far as the grid cap and the time budget allowed"
-    if wanted <= cap and wanted > intervals:
-        return f"{figure} ({where}, {intervals} intervals); timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
-    if method.name != "phase_plane":
+    if grid_given and intervals < wanted <= cap:
         return (
-            f"{figure} ({where}, {intervals} intervals; {method.name} serves at most {cap} on this robot): "
-            f"timing.method phase_plane refines its grid where the error lies"
+            f"{figure} (the grid given by timing.grid_points, {intervals} intervals); "
+            f"timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
         )
-    return f"{figure} ({where}, {intervals} intervals, the most phase_plane refines to within the time budget)"
+    where = "the grid given by timing.grid_points" if grid_given else "the default grid, refined as far as the grid cap and the time budget allowed"
+    if method.name != "phase_plane":
+        return f"{figure} ({where}, {intervals} intervals; {method.name} serves at most {cap} on this robot): timing.method phase_plane refines its grid where the error lies"
+    return f"{figure} ({where}, {intervals} intervals; the most phase_plane refines within its grid cap and the time budget)"
 
 
 def answer_accuracy(

@@ -214,3 +214,25 @@ def test_the_typical_request_states_its_accuracy_without_a_second_solve(monkeypa
     result = plan(robots.load("ur5"), WaypointPath(np.array(UR5_WAYPOINTS)), Timing(), dt=0.01)
     assert len(calls) == 1
     assert result.accuracy is not None and 0.0 <= result.accuracy.relative_gap <= 6e-4
+
+
+def test_the_warning_advises_only_what_the_method_serves():
+    """The remedy of a gap above 0.1 % is a timing.grid_points the method serves on the robot
+    (the gap shrinks as the intervals grow), else the phase-plane method, never a grid beyond
+    its cap."""
+    from planners.accuracy import gap_warning
+    from planners.timing.toppra_method import ToppraMethod
+
+    within = gap_warning(ToppraMethod(), 0.008, 100, 6, grid_given=True)
+    assert "0.8 %" in within and "timing.grid_points 1000 would bring it within 0.1 %" in within
+    cap = MinCostMethod().max_grid_intervals(7)
+    beyond = gap_warning(MinCostMethod(), 0.01, 2000, 7, grid_given=False)
+    assert "timing.grid_points" not in beyond.split(":")[-1] and "phase_plane" in beyond and str(cap) in beyond
+
+
+def test_the_joint_trajectory_format_carries_the_accuracy(client):
+    body = client.post("/v1/trajectories", json={
+        "robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS},
+        "output": {"dt": 0.05, "format": "joint_trajectory"},
+    }).json()
+    assert "joint_trajectory" in body and body["accuracy"]["relative_gap"] is not None
