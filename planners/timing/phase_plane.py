@@ -134,6 +134,10 @@ class PhasePlaneMethod(TimingMethod):
             is estimated to be exceeded by more than this fraction midway between them
             (``planners.refinement_kernels.row_excursions``); ``None``: the duration alone
             decides where points go, and the limits hold at the grid points only.
+
+    The answer carries the last estimate of its relative duration error as its
+    ``optimality_gap`` (``GAP_BASIS``): the one that stopped the refinement, or, when the
+    rounds ran out on a split, one more midpoint solve on the final grid.
     """
 
     name = "phase_plane"
@@ -197,10 +201,12 @@ class PhasePlaneMethod(TimingMethod):
             error = _duration_error(grid, profile, x_ends, deadline, self.tolerance)
         switches = _switch_points(grid.constraints, profile)
         if not rounds:
-            return TimeScaling(grid.s, np.sqrt(profile.x), switches, None, "not estimated (grid refinement is off)")
-        if error is None:
-            return TimeScaling(grid.s, np.sqrt(profile.x), switches, None, "not estimated: the midpoint discretization finds no motion on this grid")
-        return TimeScaling(grid.s, np.sqrt(profile.x), switches, float(error), GAP_BASIS)
+            gap, basis = None, "not estimated (grid refinement is off)"
+        elif error is None:
+            gap, basis = None, "not estimated: the midpoint discretization finds no motion on this grid"
+        else:
+            gap, basis = float(error), GAP_BASIS
+        return TimeScaling(grid.s, np.sqrt(profile.x), switches, optimality_gap=gap, gap_basis=basis)
 
 
 #: How ``PhasePlaneMethod`` estimates its duration error (``TimeScaling.gap_basis``).
