@@ -249,6 +249,8 @@ def answer_accuracy(
         total = sum(duration for duration, _ in known)
         if len(known) == len(gaps) and total > 0.0:
             gap, basis = sum(duration * g for duration, g in known) / total, LAW_BASIS
+    if gap is None and duration_given:
+        return Accuracy(None, "not estimated: timing.duration sets the duration, which is no optimum"), None
     if gap is None:
         return Accuracy(None, basis or f"not estimated for timing.method {method_name}"), None
     if method_name == "collocation" and basis == PHASE_PLANE_BASIS:
