@@ -16,10 +16,11 @@ relative error, found independently of the solve:
   kept). The scheme is first order in the interval length h, J(h) = J* + C h, so the answer's
   error J(h) - J* is about J(2h) - J(h) (the Richardson difference).
 
-The policy (``accurate_solve``): for a time-optimal method on its default grid, an estimate above
-``GAP_TARGET`` refines the grid where the phase-plane method's refinement put its points (the
-intervals that carry the error), within the method's grid cap and the time budget, and solves
-again; an explicit ``timing.grid_points`` keeps its grid. What is still above the target after
+The policy (``finer_constraints``, applied by ``planners.gate.gated``): for a time-optimal method
+on its default grid, an estimate above ``GAP_TARGET`` refines the grid where the phase-plane
+method's refinement put its points (the intervals that carry the error), within the method's grid
+cap and the time budget, and solves again; the finer answer replaces the first only when it too
+holds the limits. An explicit ``timing.grid_points`` keeps its grid. What is still above the target after
 that is said in a warning that gives the figure and a followable remedy (``gap_warning``).
 """
 
@@ -27,7 +28,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
 
 import numpy as np
 
@@ -164,45 +164,31 @@ def estimated(
     return result, None
 
 
-def accurate_solve(
+def finer_constraints(
     method: TimingMethod,
     constraints: PathConstraints,
-    boundary: Boundary,
-    duration: float | None,
+    result: PathTiming,
+    finer: np.ndarray | None,
+    spent: float,
     deadline: Deadline,
-    grid_given: bool = False,
-) -> tuple[PathTiming, PathConstraints]:
-    """``method`` on ``constraints`` (``solve_well_scaled``), with its estimated gap; for a
-    time-optimal method on a grid the request did not give, an estimate above ``GAP_TARGET``
-    refines the grid where the error lies and solves again (at most ``REFINE_ROUNDS`` times,
-    within the method's grid cap and the time budget).
-
-    Returns:
-        (timing, constraints): the timing and the constraints it was solved on.
-    """
-    started = time.perf_counter()
-    result = solve_well_scaled(method, constraints, boundary, duration, deadline)
-    spent = time.perf_counter() - started
-    result, finer = estimated(method, constraints, boundary, result, deadline, spent)
-    if duration is not None or grid_given or not time_optimal(method):
-        return result, constraints
-    cap = method.max_grid_intervals(len(constraints.joint_names))
-    for _ in range(REFINE_ROUNDS):
-        gap = result.optimality_gap
-        if gap is None or gap <= GAP_TARGET or finer is None or not constraints.can_refine:
-            break
-        extra = finer[~on_points(finer, constraints.s)]
-        intervals = len(constraints.s) - 1
-        if extra.size == 0 or intervals + extra.size > min(cap, MAX_POINTS):
-            break
-        if not _affordable(deadline, spent * (intervals + extra.size) / intervals):
-            break
-        constraints = constraints.with_points(extra)
-        started = time.perf_counter()
-        solved = solve_well_scaled(method, constraints, boundary, duration, deadline)
-        spent = time.perf_counter() - started
-        result, finer = estimated(method, constraints, boundary, solved, deadline, spent)
-    return result, constraints
+    keep_grid: bool,
+) -> PathConstraints | None:
+    """The policy: the constraints on the grid ``finer`` (where the phase-plane method's
+    refinement put its points, ``estimated``) when ``result`` is a time-optimal timing whose
+    estimated gap exceeds ``GAP_TARGET``, the grid is not to be kept (``keep_grid``: the
+    request named it, or asked for a duration), the finer grid is within the method's cap and
+    the budget left holds a solve on it (the last one took ``spent`` seconds); else ``None``."""
+    gap = result.optimality_gap
+    if keep_grid or not time_optimal(method) or gap is None or gap <= GAP_TARGET or finer is None or not constraints.can_refine:
+        return None
+    extra = finer[~on_points(finer, constraints.s)]
+    intervals = len(constraints.s) - 1
+    cap = min(method.max_grid_intervals(len(constraints.joint_names)), MAX_POINTS)
+    if extra.size == 0 or intervals + extra.size > cap:
+        return None
+    if not _affordable(deadline, spent * (intervals + extra.size) / intervals):
+        return None
+    return constraints.with_points(extra)
 
 
 def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid_given: bool) -> str:
