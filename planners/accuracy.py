@@ -206,10 +206,12 @@ def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid
             f"{figure} (the grid given by timing.grid_points, {intervals} intervals); "
             f"timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
         )
-    where = "the grid given by timing.grid_points" if grid_given else "the default grid, refined as far as the grid cap and the time budget allowed"
+    remedy = "timing.method phase_plane refines its grid where the error lies"
+    if grid_given and method.name != "phase_plane":
+        return f"{figure} (the grid given by timing.grid_points, {intervals} intervals; {method.name} serves at most {cap} on this robot): {remedy}"
     if method.name != "phase_plane":
-        return f"{figure} ({where}, {intervals} intervals; {method.name} serves at most {cap} on this robot): timing.method phase_plane refines its grid where the error lies"
-    return f"{figure} ({where}, {intervals} intervals; the most phase_plane refines within its grid cap and the time budget)"
+        return f"{figure} (the default grid, {intervals} intervals, refined as far as the limits, the grid cap and the time budget allowed): {remedy}"
+    return f"{figure} ({intervals} intervals, refined as far as phase_plane's grid cap and the time budget allowed)"
 
 
 def answer_accuracy(

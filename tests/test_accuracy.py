@@ -225,8 +225,10 @@ def test_the_warning_advises_only_what_the_method_serves():
     within = gap_warning(ToppraMethod(), 0.008, 100, 6, grid_given=True)
     assert "0.8 %" in within and "timing.grid_points 1000 would bring it within 0.1 %" in within
     cap = MinCostMethod().max_grid_intervals(7)
-    beyond = gap_warning(MinCostMethod(), 0.01, 2000, 7, grid_given=False)
+    beyond = gap_warning(MinCostMethod(), 0.01, 2000, 7, grid_given=True)
     assert "timing.grid_points" not in beyond.split(":")[-1] and "phase_plane" in beyond and str(cap) in beyond
+    refined = gap_warning(ToppraMethod(), 0.003, 400, 6, grid_given=False)
+    assert "1 %" not in refined and "0.3 %" in refined and refined.endswith("timing.method phase_plane refines its grid where the error lies")
 
 
 def test_the_joint_trajectory_format_carries_the_accuracy(client):
@@ -235,3 +237,20 @@ def test_the_joint_trajectory_format_carries_the_accuracy(client):
         "output": {"dt": 0.05, "format": "joint_trajectory"},
     }).json()
     assert "joint_trajectory" in body and body["accuracy"]["relative_gap"] is not None
+
+
+def test_a_finer_grid_that_breaks_a_limit_leaves_the_default_answer_with_a_warning():
+    """A recorded ur5 path where toppra on the refined grid exceeds an acceleration limit
+    between grid points: the answer on the default grid, which holds the limits, stands, with
+    its stated gap (close to the true 0.29 %) and a warning that gives it."""
+    robot = robots.load("ur5")
+    rng = np.random.default_rng(1)
+    for _ in range(10):
+        waypoints = recorded_waypoints(robot, rng, 5)
+    reference, _ = converged(SplinePath(waypoints), robot)
+    result = plan(robot, WaypointPath(waypoints), Timing(method="toppra", constraints=KINDS), dt=0.05)
+    true_gap = result.duration / reference - 1.0
+    assert true_gap > 1e-3
+    assert result.accuracy is not None and result.accuracy.relative_gap == pytest.approx(true_gap, abs=1e-4)
+    (warning,) = [text for text in result.warnings if "of the time-optimal one" in text]
+    assert f"{100 * result.accuracy.relative_gap:.2g} %" in warning and "phase_plane" in warning
