@@ -6,12 +6,14 @@ place, the joint and the limit.
 
 from __future__ import annotations
 
+import time
 from typing import NamedTuple
 
 import numpy as np
 
+from planners.accuracy import REFINE_ROUNDS, estimated, finer_constraints
 from planners.constraints import PathConstraints
-from planners.errors import InfeasiblePath
+from planners.errors import InfeasiblePath, TimingFailed
 from planners.limit_check import Excess, LimitCheck, check_limits
 from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
@@ -54,9 +56,13 @@ def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
     return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
 
 
-def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline):
+def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
     """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
-    exceeded by more than ``threshold``, refine the grid there and time the path again.
+    exceeded by more than ``threshold``, refine the grid there and time the path again. Every
+    timing carries its estimated gap to the converged optimum (``planners.accuracy``); a
+    time-optimal one above ``planners.accuracy.GAP_TARGET`` on a grid the request did not name
+    (``grid_given``) is timed again on a finer grid, which replaces it only when it too holds
+    the limits.
 
     Returns:
         (timing, constraints, check): the timing that holds the limits, the constraints it was
@@ -67,7 +73,33 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
             method's timing cannot be refined; says where, which joint and which limit.
     """
     deadline.progress(0.0, "timing")
+    result, finer, spent = _solved(method, constraints, boundary, duration, deadline)
+    result, constraints, check = _held(robot, path, method, constraints, result, boundary, duration, kinds, limits, threshold, deadline)
+    for _ in range(REFINE_ROUNDS):
+        refined = finer_constraints(method, constraints, result, finer, spent, deadline, grid_given or duration is not None)
+        if refined is None:
+            break
+        deadline.progress(0.5, "timing on a finer grid for accuracy")
+        try:
+            attempt, finer, spent = _solved(method, refined, boundary, duration, deadline)
+            result, constraints, check = _held(robot, path, method, refined, attempt, boundary, duration, kinds, limits, threshold, deadline)
+        except (InfeasiblePath, TimingFailed):
+            break  # the answer on the coarser grid stands, its gap stated
+    return result, constraints, check
+
+
+def _solved(method, constraints, boundary, duration, deadline):
+    """``method`` on ``constraints`` with its estimated gap: (timing, a finer grid that holds
+    the error where it lies or ``None``, the seconds the solve took)."""
+    started = time.perf_counter()
     result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+    spent = time.perf_counter() - started
+    result, finer = estimated(method, constraints, boundary, result, deadline, spent)
+    return result, finer, spent
+
+
+def _held(robot, path, method, constraints, result, boundary, duration, kinds, limits, threshold, deadline):
+    """``result`` through the dense check, refined where it exceeds a limit (``gated``)."""
     for round_ in range(GATE_ROUNDS + 1):
         deadline.check()
         deadline.progress(0.5 + 0.5 * round_ / (GATE_ROUNDS + 1), f"limit check, round {round_ + 1}")
@@ -90,7 +122,7 @@ def gated(robot, path, method, constraints, boundary, duration, kinds, limits, t
         if extra.size == 0:
             break
         constraints = constraints.with_points(extra)
-        result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+        result, _, _ = _solved(method, constraints, boundary, duration, deadline)
     raise limit_exceeded(method.name, check.worst, robot, path)
 
 

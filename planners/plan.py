@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+from planners.accuracy import answer_accuracy
 from planners.collision import Obstacle, check_clearance
 from planners.collision.obstacles import check_obstacles
 from planners.deadline import NO_DEADLINE, Deadline
@@ -30,6 +31,8 @@ from planners.results import Conditioning, PhasePlane, PlannedTrajectory, requir
 from planners.timed import timed_path, timed_unsynchronized, timed_via_points
 from planners.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
+from planners.timing.law_timing import LawTiming
+from planners.timing.phase_plane import PhasePlaneMethod
 from planners.tool_speed import tool_speed_limit
 from planners.trajectory import sample_trajectory
 from planners.waypoint_checks import continuous_turns, make_path, without_repeats
@@ -227,6 +230,15 @@ def plan(
             f"the {timed.method} timing's sample at t = {samples.t[sample]:.6g} s exceeds the {what} "
             "although its dense check holds; use more grid points"
         )
+    timed_by = PhasePlaneMethod() if method.name == "search" else method  # the search's path: phase_plane
+    laws = [(item.timing.duration, item.check.utilization) for item in timed.stretches if isinstance(item.timing, LawTiming)]
+    law = laws if len(laws) == len(timed.stretches) else None
+    accuracy, warning = answer_accuracy(
+        result, timed_by, timed.method, sum(len(item.constraints.s) - 1 for item in timed.stretches), robot.dof,
+        grid_given=timing.grid_points is not None, duration_given=timing.duration is not None, law_utilization=law,
+    )
+    if warning is not None:
+        notes.append(warning)
     utilization = _utilization(timed.stretches, margin)
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
     if not np.isfinite(kappa_max):
@@ -262,6 +274,7 @@ def plan(
         switching_times=switching,
         clearance=found_clearance,
         search=timed.search,
+        accuracy=accuracy,
     )
 
 

@@ -36,6 +36,16 @@ class Conditioning:
 
 
 @dataclass(frozen=True)
+class Accuracy:
+    """The answer's estimated relative distance from the converged optimum of its method's
+    problem (``planners.accuracy``): ``relative_gap`` (``None`` when not estimated) and how it
+    was estimated, or why not (``basis``)."""
+
+    relative_gap: float | None
+    basis: str
+
+
+@dataclass(frozen=True)
 class PlannedTrajectory:
     """What ``plan`` returns: samples and diagnostics of one timed path."""
 
@@ -57,6 +67,7 @@ class PlannedTrajectory:
     #: instants where each saturated torque changes sides.
     switching_times: dict[str, list[float]] | None = None
     search: dict | None = None
+    accuracy: Accuracy | None = None
 
 
 def require_finite(method: str, **quantities) -> None:

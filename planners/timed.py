@@ -131,7 +131,8 @@ def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, 
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
     deadline.check()
     timing, constraints, check = gated(
-        robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline.within(0.3, 1.0)
+        robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline.within(0.3, 1.0),
+        grid_given=grid_points is not None,
     )
     return TimedStretch(stretch, timing, constraints, check)
 

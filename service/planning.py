@@ -244,7 +244,7 @@ def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
             results.append({"method": method, "error": {"status": error.status, "title": error.title, "detail": error.detail}})
             continue
         body = trajectory_body(result)
-        results.append({key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms")})
+        results.append({key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")})
     return {"results": results}
 
 
@@ -302,7 +302,17 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "s": result.clearance.s,
         },
         "search": result.search,
+        "accuracy": accuracy_body(result),
     }
+
+
+def accuracy_body(result: PlannedTrajectory) -> dict:
+    """``{"relative_gap", "basis"}``: the answer's estimated relative distance from the
+    converged optimum of its method's problem (``planners.accuracy``), null when not estimated."""
+    accuracy = result.accuracy
+    if accuracy is None:
+        return {"relative_gap": None, "basis": f"not estimated for timing.method {result.method}"}
+    return {"relative_gap": accuracy.relative_gap, "basis": accuracy.basis}
 
 
 def _plain(value):

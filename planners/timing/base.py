@@ -70,6 +70,19 @@ class PathTiming(abc.ABC):
         return None
 
     @property
+    def optimality_gap(self) -> float | None:
+        """Estimated relative distance of this timing's objective from the converged optimum of
+        its method's problem (the duration for time-optimal methods, the cost for min_cost with
+        a torque weight, a time law's duration against its own shortest), found independently of
+        the solve (a second discretization, another method, a bound); ``None``: not estimated."""
+        return None
+
+    @property
+    def gap_basis(self) -> str:
+        """How ``optimality_gap`` was estimated, or why there is none; empty when unsaid."""
+        return ""
+
+    @property
     @abc.abstractmethod
     def duration(self) -> float:
         """Total time, in s."""
@@ -106,11 +119,16 @@ class TimeScaling(PathTiming):
         s: Grid, shape (K + 1,), from 0 to 1.
         sd: Path speed at the grid points, shape (K + 1,), in 1/s.
         switch_points: Optional (s, kind) pairs a method found, for the response.
+        optimality_gap: Estimated relative distance of the duration (or cost) from the
+            converged optimum (``PathTiming.optimality_gap``); ``None`` when not estimated.
+        gap_basis: How it was estimated (``PathTiming.gap_basis``).
     """
 
     s: np.ndarray
     sd: np.ndarray
     switch_points: tuple[tuple[float, str], ...] = field(default=())
+    optimality_gap: float | None = None
+    gap_basis: str = ""
 
     def __post_init__(self):
         sd = np.asarray(self.sd)

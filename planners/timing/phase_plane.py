@@ -134,6 +134,10 @@ class PhasePlaneMethod(TimingMethod):
             is estimated to be exceeded by more than this fraction midway between them
             (``planners.refinement_kernels.row_excursions``); ``None``: the duration alone
             decides where points go, and the limits hold at the grid points only.
+
+    The answer carries the last estimate of its relative duration error as its
+    ``optimality_gap`` (``GAP_BASIS``): the one that stopped the refinement, or, when the
+    rounds ran out on a split, one more midpoint solve on the final grid.
     """
 
     name = "phase_plane"
@@ -155,16 +159,24 @@ class PhasePlaneMethod(TimingMethod):
         grid = _Grid.of(constraints)
         profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False)
         kept, reference_bounds = NOTHING_KEPT, NOTHING_BEFORE
-        for _ in range(self.max_refinements if constraints.can_refine else 0):
+        # The estimated duration error of ``profile``, and whether it is the estimate on its
+        # own grid (else on the coarser grid before the last split, which only removes error).
+        error, estimated = None, False
+        rounds = self.max_refinements if constraints.can_refine else min(self.max_refinements, 1)
+        for _ in range(rounds):
             try:
                 reference = _solve_on_grid(grid, x_ends, deadline, midpoint=True, x_ref=profile.x, kept=kept, before=reference_bounds)
             except InfeasiblePath:
+                error, estimated = None, True
                 break
-            room = most_intervals - (len(grid.s) - 1)
+            room = most_intervals - (len(grid.s) - 1) if constraints.can_refine else 0
             ceiling = np.concatenate((profile.x_high, grid.x_bound[-1:]))
             wanted, priority, error = refinement(
                 grid.s, profile.x, reference.x, ceiling, profile.switch_excess, self.tolerance, _AIM, _GUARD, _MAX_PIECES, room
             )
+            estimated = True
+            if not constraints.can_refine:
+                break
             if error <= self.tolerance:
                 if self.excursion is None:
                     break
@@ -181,10 +193,40 @@ class PhasePlaneMethod(TimingMethod):
             x_ref = np.interp(grid.s, previous.s, profile.x) if grid.friction else None
             kept, reference_bounds = _kept_intervals(grid.s, previous.s), reference.bounds
             profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False, x_ref=x_ref, kept=kept, before=profile.bounds)
+            estimated = error <= self.tolerance  # within it before the split: still within it
             if error <= self.tolerance:
                 break  # split for the limits' excursions alone
+        if rounds and not estimated:
+            # The rounds ended on a split whose grid was not estimated: one more midpoint solve.
+            error = _duration_error(grid, profile, x_ends, deadline, self.tolerance)
         switches = _switch_points(grid.constraints, profile)
-        return TimeScaling(grid.s, np.sqrt(profile.x), switches)
+        if not rounds:
+            gap, basis = None, "not estimated (grid refinement is off)"
+        elif error is None:
+            gap, basis = None, "not estimated: the midpoint discretization finds no motion on this grid"
+        else:
+            gap, basis = float(error), GAP_BASIS
+        return TimeScaling(grid.s, np.sqrt(profile.x), switches, optimality_gap=gap, gap_basis=basis)
+
+
+#: How ``PhasePlaneMethod`` estimates its duration error (``TimeScaling.gap_basis``).
+GAP_BASIS = (
+    "phase_plane's error estimate on its final grid: this (conservative) discretization against the "
+    "second-order midpoint one, the time saved by switching inside an interval and the chord error "
+    "along the maximum velocity curve"
+)
+
+
+def _duration_error(grid: _Grid, profile: _Profile, x_ends, deadline, tolerance: float) -> float | None:
+    """The relative duration error of ``profile`` on ``grid``, estimated as in the refinement
+    (``planners.refinement_kernels.refinement``); ``None`` when the midpoint discretization finds
+    no motion."""
+    try:
+        reference = _solve_on_grid(grid, x_ends, deadline, midpoint=True, x_ref=profile.x)
+    except InfeasiblePath:
+        return None
+    ceiling = np.concatenate((profile.x_high, grid.x_bound[-1:]))
+    return float(refinement(grid.s, profile.x, reference.x, ceiling, profile.switch_excess, tolerance, _AIM, _GUARD, _MAX_PIECES, 0)[2])
 
 
 def midpoint_duration(constraints: PathConstraints, boundary: Boundary = AT_REST) -> float:

@@ -61,6 +61,28 @@ class SegmentedTiming(PathTiming):
         return Binding(binding.kind, binding.joint, float(a + w * binding.s))
 
     @property
+    def optimality_gap(self) -> float | None:
+        """The stretches' gaps weighted by their durations (of the costs, for methods that
+        report one): the relative gap of the sum; ``None`` unless every stretch has one."""
+        gaps = [part.optimality_gap for part in self.parts]
+        known = [gap for gap in gaps if gap is not None]
+        if len(known) < len(gaps):
+            return None
+        costs = [getattr(part, "cost", None) for part in self.parts]
+        weights = [float(cost) for cost in costs if cost is not None]
+        if len(weights) < len(costs):
+            weights = [part.duration for part in self.parts]
+        total = sum(weights)
+        return sum(w * g for w, g in zip(weights, known)) / total if total > 0.0 else None
+
+    @property
+    def gap_basis(self) -> str:
+        """The stretches' bases, once each (the first stretch's reason when one has no gap)."""
+        missing = [part.gap_basis for part in self.parts if part.optimality_gap is None]
+        bases = missing[:1] if missing else list(dict.fromkeys(part.gap_basis for part in self.parts))
+        return "; ".join(basis for basis in bases if basis)
+
+    @property
     def cost(self) -> float | None:
         """The summed cost of the stretches, for methods that report one."""
         costs = [getattr(part, "cost", None) for part in self.parts]

@@ -129,6 +129,20 @@ class SearchPublic(BaseModel):
     )
 
 
+class AccuracyPublic(BaseModel):
+    """How far the answer lies from the converged optimum of its method's problem (the limit
+    of the grid's interval going to zero), estimated independently of the solve. A
+    time-optimal answer (phase_plane, toppra, min_cost with torque_weight 0, the search's
+    timing) above 0.1 % on its default grid is refined until it holds; one that still is, or
+    whose grid the request named, says so in `warnings`, with the figure."""
+
+    relative_gap: float | None = Field(
+        description="Estimated |objective / converged optimum - 1| (the duration for time-optimal methods, "
+        "the cost for min_cost with a torque weight); null when no estimate exists (`basis` says why)."
+    )
+    basis: str = Field(description="How the estimate was obtained (a second discretization, another method), or why there is none.")
+
+
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
@@ -158,7 +172,8 @@ class TrajectoryResponse(BaseModel):
         default=None, description="With path.obstacles: the closest approach of any link to any obstacle."
     )
     search: SearchPublic | None = Field(default=None, description="timing.method `search`: what the global search did.")
-    warnings: list[str] = Field(description="What the answer should be read with: dropped waypoints, singularities, turns of continuous joints.")
+    warnings: list[str] = Field(description="What the answer should be read with: dropped waypoints, singularities, turns of continuous joints, an accuracy above 0.1 %.")
+    accuracy: AccuracyPublic = Field(description="The answer's estimated relative distance from the converged optimum of its method's problem.")
 
 
 class CompareResult(BaseModel):
@@ -170,6 +185,8 @@ class CompareResult(BaseModel):
     binding: BindingPublic | None = Field(default=None, description="The limit that set a minimal duration (time laws).")
     solve_ms: float | None = Field(default=None, description="Planning time (ms).")
     error: dict | None = Field(default=None, description="The method's problem (status, title, detail) when it failed.")
+    accuracy: AccuracyPublic | None = Field(default=None, description="The answer's estimated distance from its method's converged optimum; null when the method failed.")
+    warnings: list[str] | None = Field(default=None, description="What the answer should be read with (an accuracy above 0.1 % among them); null when the method failed.")
 
 
 class CompareResponse(BaseModel):
