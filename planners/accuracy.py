@@ -36,13 +36,11 @@ from planners.deadline import Deadline
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.grid import MAX_POINTS, on_points
 from planners.results import Accuracy
-from planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
+from planners.timing.base import GAP_TARGET, Boundary, PathTiming, TimeScaling, TimingMethod
 from planners.timing.phase_plane import GAP_BASIS as PHASE_PLANE_BASIS
 from planners.timing.phase_plane import PhasePlaneMethod
 from planners.timing.scaled import solve_well_scaled
 
-#: Largest estimated relative gap a time-optimal answer carries without a warning.
-GAP_TARGET = 1e-3
 #: Refinements of the grid for accuracy, each followed by a solve.
 REFINE_ROUNDS = 2
 #: A refinement or an estimate is started only when the budget left holds this many times its
@@ -64,8 +62,8 @@ HALF_GRID = (
 
 def time_optimal(method: TimingMethod) -> bool:
     """Whether ``method`` finds the shortest duration along the path (its objective is the
-    duration): phase_plane, toppra and min_cost without a torque weight."""
-    return method.name in ("phase_plane", "toppra") or (
+    duration): phase_plane, toppra, jerk_limited and min_cost without a torque weight."""
+    return method.name in ("phase_plane", "toppra", "jerk_limited") or (
         method.name == "min_cost" and getattr(method, "torque_weight", 0.0) == 0.0
     )
 
@@ -157,7 +155,7 @@ def estimated(
         return result, result.s
     if result.optimality_gap is not None:
         return result, None
-    if time_optimal(method):
+    if time_optimal(method) and method.name != "jerk_limited":  # the phase plane knows no jerk limit
         return _against_phase_plane(constraints, boundary, result, deadline)
     if method.name == "min_cost":
         return _cost_on_half_grid(method, constraints, boundary, result, deadline, spent), None
@@ -206,6 +204,10 @@ def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid
             f"{figure} (the grid given by timing.grid_points, {intervals} intervals); "
             f"timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
         )
+    if method.name == "jerk_limited":  # phase_plane would drop the jerk limits: no remedy there
+        if intervals < wanted <= cap:
+            return f"{figure} ({intervals} intervals); timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
+        return f"{figure} ({intervals} intervals, refined as far as jerk_limited's grid cap and the time budget allowed)"
     remedy = "timing.method phase_plane refines its grid where the error lies"
     if grid_given and method.name != "phase_plane":
         return f"{figure} (the grid given by timing.grid_points, {intervals} intervals; {method.name} serves at most {cap} on this robot): {remedy}"
@@ -231,6 +233,8 @@ def answer_accuracy(
     peak utilization against the limits it was timed under) are estimated from that
     (``law_gap``), the stretches' gaps weighted by their durations."""
     gap, basis = timing.optimality_gap, timing.gap_basis
+    if method.name == "jerk_limited" and isinstance(timing, TimeScaling):
+        intervals = len(timing.s) - 1  # the grid it refined to, not the one it started from
     if gap is None and law_utilization and not duration_given:
         gaps = [law_gap(utilization) for _, utilization in law_utilization]
         known = [(duration, g) for (duration, _), g in zip(law_utilization, gaps) if g is not None]

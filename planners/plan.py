@@ -27,7 +27,7 @@ from planners.paths.blended import MIN_BLEND, BlendedPath
 from planners.paths.cartesian import CartesianLine
 from planners.ranges import DT, check_timing
 from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
-from planners.results import Conditioning, PhasePlane, PlannedTrajectory, require_finite
+from planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
 from planners.timed import timed_path, timed_unsynchronized, timed_via_points
 from planners.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
@@ -233,10 +233,13 @@ def plan(
     timed_by = PhasePlaneMethod() if method.name == "search" else method  # the search's path: phase_plane
     laws = [(item.timing.duration, item.check.utilization) for item in timed.stretches if isinstance(item.timing, LawTiming)]
     law = laws if len(laws) == len(timed.stretches) else None
-    accuracy, warning = answer_accuracy(
-        result, timed_by, timed.method, sum(len(item.constraints.s) - 1 for item in timed.stretches), robot.dof,
-        grid_given=timing.grid_points is not None, duration_given=timing.duration is not None, law_utilization=law,
-    )
+    if timed.motion_gap is not None:  # a free path: the gap of the motion found, warned of where it is found
+        accuracy, warning = Accuracy(*timed.motion_gap), None
+    else:
+        accuracy, warning = answer_accuracy(
+            result, timed_by, timed.method, sum(len(item.constraints.s) - 1 for item in timed.stretches), robot.dof,
+            grid_given=timing.grid_points is not None, duration_given=timing.duration is not None, law_utilization=law,
+        )
     if warning is not None:
         notes.append(warning)
     utilization = _utilization(timed.stretches, margin)

@@ -100,6 +100,10 @@ class Timed(NamedTuple):
     solver: dict | None = None
     search: dict | None = None
     switching_times: dict | None = None
+    #: For a method that finds the motion itself (a free path): the estimated relative gap of
+    #: its objective to the optimum of its own problem, and how it was estimated; ``None`` when
+    #: the answer's accuracy is that of its path's timing (``planners.accuracy``).
+    motion_gap: tuple[float | None, str] | None = None
 
 
 def timing_grid(path: GeometricPath, n_intervals: int | None, method: TimingMethod, robot: Robot, s: np.ndarray | None = None) -> np.ndarray:

@@ -27,7 +27,7 @@ from planners.search.local_outcome import LocalOptimum
 from planners.search.memory import check_search_memory
 from planners.search.method import global_search
 from planners.timed import Timed, moving_velocity, path_boundary, timed_path, timing_grid
-from planners.timing.jerk_accuracy import TARGET_GAP
+from planners.timing.base import GAP_TARGET
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane import PhasePlaneMethod
 
@@ -106,7 +106,7 @@ def timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thre
         )
         solver = {**solver, **_solver_report(winner), "switching": "refined" if switching is not None else "read off the samples"}
     solver = {**solver, "optimality_gap": source.optimality_gap, "gap_basis": source.gap_basis}
-    if timing.torque_weight == 0.0 and source.optimality_gap is not None and source.optimality_gap > TARGET_GAP:
+    if timing.torque_weight == 0.0 and source.optimality_gap is not None and source.optimality_gap > GAP_TARGET:
         advice = (
             f": more timing.grid_points (collocation intervals, up to {MAX_INTERVALS}) bring it closer"
             if len(collocation.t) - 1 < MAX_INTERVALS else ""
@@ -116,7 +116,10 @@ def timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thre
             f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis}){advice}",
         )
     cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
-    return Timed(path, result, (stretch,), "collocation", notes, cost, solver, switching_times=switching)
+    return Timed(
+        path, result, (stretch,), "collocation", notes, cost, solver, switching_times=switching,
+        motion_gap=(source.optimality_gap, source.gap_basis),
+    )
 
 
 def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, deadline):

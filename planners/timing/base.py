@@ -15,6 +15,11 @@ from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import TimingFailed
 from planners.limit_kernels import grid_states
 
+#: Largest estimated relative gap to the converged optimum that a time-optimal answer carries
+#: without being refined further or, when it cannot be, without a warning that gives the figure
+#: (``PathTiming.optimality_gap``; the policy in ``planners.accuracy``).
+GAP_TARGET = 1e-3
+
 
 @dataclass(frozen=True)
 class Boundary:

@@ -17,9 +17,6 @@ import numpy as np
 
 from planners.constraints import PathConstraints
 
-#: Estimated relative gap above which a time-optimal answer is refined (or carries a warning).
-TARGET_GAP = 1e-3
-
 
 def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstraints | None:
     """``constraints`` on every other point of their grid, the ends, the points inside the first

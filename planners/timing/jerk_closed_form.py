@@ -117,12 +117,12 @@ def closed_form_timing(constraints: PathConstraints) -> JerkSegmentsTiming | Non
         return None
     durations, jerks = double_s(1.0, limits)
     timing = JerkSegmentsTiming(
-        durations, jerks, optimality_gap_estimate=0.0,
-        optimality_gap_how="exact: the closed-form double-S profile (Biagiotti & Melchiorri §3.4) of limits the same along the path",
+        durations, jerks, optimality_gap=0.0,
+        gap_basis="exact: the closed-form double-S profile (Biagiotti & Melchiorri §3.4) of limits the same along the path",
     )
     # The end state is exact up to rounding; put s = 1 exactly at the end (s is linear in the
     # jerks from rest).
     end = timing.starts[-1][0]
     return JerkSegmentsTiming(
-        durations, jerks / end, optimality_gap_estimate=timing.optimality_gap_estimate, optimality_gap_how=timing.optimality_gap_how
+        durations, jerks / end, optimality_gap=timing.optimality_gap, gap_basis=timing.gap_basis
     )

@@ -54,7 +54,7 @@ polish is a local method started from the grid solution's phases, and misses the
 
 Every answer carries an estimate of its distance from the optimum (``optimality_gap``): zero
 for the closed form, else the difference from the solution on a second grid of half as many
-points (``planners.timing.jerk_accuracy``); above ``TARGET_GAP`` the grid is doubled, at most
+points (``planners.timing.jerk_accuracy``); above ``GAP_TARGET`` the grid is doubled, at most
 ``max_refinements`` times, while the grid budget and the time left allow.
 """
 
@@ -68,8 +68,8 @@ import numpy as np
 from planners.constraints import PathConstraints
 from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
-from planners.timing.base import AT_REST, Boundary, TimingMethod
-from planners.timing.jerk_accuracy import TARGET_GAP, coarser, relative_gap
+from planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
+from planners.timing.jerk_accuracy import coarser, relative_gap
 from planners.timing.jerk_closed_form import closed_form_timing
 from planners.timing.jerk_polish import polish
 from planners.timing.jerk_program import RestrictedProgram
@@ -82,7 +82,7 @@ from planners.timing.phase_plane import PhasePlaneMethod
 FALLBACK_FIRST_INTERVAL = 1e-3
 #: Relative gain below which the LPs on a refined grid, started from the coarser solution,
 #: stop: a hundredth of the gap the refinement aims at.
-WARM_TOLERANCE = 1e-2 * TARGET_GAP
+WARM_TOLERANCE = 1e-2 * GAP_TARGET
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
 MIN_FIRST_INTERVAL = 1e-5
 
@@ -96,7 +96,7 @@ class JerkLimitedMethod(TimingMethod):
         max_iterations: Most LPs solved.
         polish: Whether to refine the grid solution in time where the limits do not change.
         max_refinements: Most doublings of the grid while the estimated gap of the answer
-            (``planners.timing.jerk_accuracy``) exceeds ``TARGET_GAP``.
+            (``planners.timing.jerk_accuracy``) exceeds ``GAP_TARGET``.
     """
 
     name = "jerk_limited"
@@ -135,12 +135,12 @@ class JerkLimitedMethod(TimingMethod):
         elapsed = time.perf_counter() - started
         gap, how = self._second_grid(constraints, original, boundary, best, deadline)
         for done in range(self.max_refinements):
-            if gap is None or gap <= TARGET_GAP or not self._affordable(constraints, elapsed, deadline):
+            if gap is None or gap <= GAP_TARGET or not self._affordable(constraints, elapsed, deadline):
                 break
             # The error about halves with each doubling (first order; the LPs cost four times
             # as much): where the doublings left would not bring it to the target, the answer
             # states its gap instead.
-            if gap / 2 ** (self.max_refinements - done) > TARGET_GAP:
+            if gap / 2 ** (self.max_refinements - done) > GAP_TARGET:
                 break
             finer = constraints.with_points(0.5 * (constraints.s[:-1] + constraints.s[1:]))
             started = time.perf_counter()
@@ -149,14 +149,14 @@ class JerkLimitedMethod(TimingMethod):
             gap = relative_gap(best.duration, finer_best.duration)
             how = f"second grid: the difference from the solution on a grid of half as many points ({len(constraints.s) - 1} intervals)"
             constraints, best = finer, finer_best
-        best = dataclasses.replace(best, optimality_gap_estimate=gap, optimality_gap_how=how)
+        best = dataclasses.replace(best, optimality_gap=gap, gap_basis=how)
         if self.polish and _uniform(constraints):
             polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
             if polished is not None:
                 # Shorter than the grid solution and feasible: no farther from the optimum.
                 return dataclasses.replace(
-                    polished, optimality_gap_estimate=gap,
-                    optimality_gap_how=f"bounded by the grid solution's estimate, which it improves on ({how})",
+                    polished, optimality_gap=gap,
+                    gap_basis=f"bounded by the grid solution's estimate, which it improves on ({how})",
                 )
         return best
 

@@ -40,28 +40,14 @@ class JerkTimeScaling(TimeScaling):
         u: Path acceleration at the grid points, shape (K + 1,), in 1/s^2.
         rest_start, rest_end: Whether the first (last) interval starts (ends) at rest with
             constant path jerk.
-        optimality_gap_estimate: Estimated relative distance of the duration from the optimum
-            of the method's problem (``optimality_gap``); ``None`` when unknown.
-        optimality_gap_how: How that estimate was obtained (``gap_basis``).
+        optimality_gap, gap_basis: (``TimeScaling``) the estimated relative distance of the
+            duration from the optimum of the method's problem, and how it was obtained.
     """
 
     # Always given; a default only because the base class's fields have defaults.
     u: np.ndarray = field(default_factory=lambda: np.zeros(0))
     rest_start: bool = False
     rest_end: bool = False
-    optimality_gap_estimate: float | None = None
-    optimality_gap_how: str = ""
-
-    @property
-    def optimality_gap(self) -> float | None:
-        """Estimated relative distance of the duration above the optimum of the method's
-        problem, obtained independently of the solve; ``None`` when unknown."""
-        return self.optimality_gap_estimate
-
-    @property
-    def gap_basis(self) -> str:
-        """How ``optimality_gap`` was obtained."""
-        return self.optimality_gap_how
 
     @property
     def _x(self) -> np.ndarray:

@@ -44,27 +44,16 @@ class JerkSegmentsTiming(PathTiming):
         durations: tau_k, shape (M,), in s.
         jerks: sigma_k, shape (M,), in 1/s^3.
         start: (s, sd, sdd) at t = 0.
-        optimality_gap_estimate: Estimated relative distance of the duration from the optimum
-            of the method's problem (``optimality_gap``); ``None`` when unknown.
-        optimality_gap_how: How that estimate was obtained (``gap_basis``).
+        optimality_gap: Estimated relative distance of the duration from the optimum
+            of the method's problem (``PathTiming.optimality_gap``); ``None`` when unknown.
+        gap_basis: How that estimate was obtained (``PathTiming.gap_basis``).
     """
 
     durations: np.ndarray
     jerks: np.ndarray
     start: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    optimality_gap_estimate: float | None = None
-    optimality_gap_how: str = ""
-
-    @property
-    def optimality_gap(self) -> float | None:
-        """Estimated relative distance of the duration above the optimum of the method's
-        problem, obtained independently of the solve; ``None`` when unknown."""
-        return self.optimality_gap_estimate
-
-    @property
-    def gap_basis(self) -> str:
-        """How ``optimality_gap`` was obtained."""
-        return self.optimality_gap_how
+    optimality_gap: float | None = None
+    gap_basis: str = ""
 
     @property
     def starts(self) -> np.ndarray:
