@@ -15,7 +15,7 @@ import pathlib
 import re
 import sys
 
-FIELD = re.compile(r"\b(timing|path|output)\.[a-z_]+")
+FIELD = re.compile(r"(?<![\w.])(timing|path|output)\.[a-z_]+")
 OPENING = re.compile(r"""f?["'](timing|path|output)\.""")
 
 
