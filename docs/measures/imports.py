@@ -1,0 +1,135 @@
+"""The import graph of robots/, planners/, service/ and client/, read from the source (ast):
+cycles between modules and between folders, imports from a lower package to a higher one, and
+the imports of planners/ that would point upward once its modules sit in the rooms of
+``docs/design.md`` (those need a change of design, not a move).
+
+Run from the repository root: ``python3 docs/measures/imports.py``.
+"""
+
+from __future__ import annotations
+
+import ast
+import collections
+import pathlib
+import sys
+
+ROOTS = ("robots", "planners", "service", "client")
+#: Layer of each top-level package: an import may point down or sideways, never up.
+PACKAGE_LAYER = {"robots": 0, "planners": 1, "service": 2, "client": 2}
+#: Today's planners module (or folder) -> its room in the target tree.
+ROOM = {
+    "planners": "runner", "planners.plan": "runner", "planners.timed": "runner", "planners.timed_free": "runner",
+    "planners.errors": "errors", "planners.diagnostics": "errors",
+    "planners.deadline": "execution", "planners.isolated": "execution", "planners.threads": "execution",
+    "planners.kinematics": "kinematics", "planners.paths": "paths", "planners.grid": "paths", "planners.collision": "collision",
+    "planners.constraints": "constraints", "planners.constraint_kernels": "constraints", "planners.mvc": "constraints",
+    "planners.kernels": "constraints", "planners.tool_speed": "constraints", "planners.torque_interpolation": "constraints",
+    "planners.timing": "timing", "planners.sweep_kernels": "timing", "planners.refinement_kernels": "timing",
+    "planners.split_kernels": "timing",
+    "planners.limit_check": "checks", "planners.limit_kernels": "checks", "planners.gate": "checks",
+    "planners.trajectory": "checks",
+    "planners.via_points": "generators", "planners.timing.unsynchronized": "generators",
+    "planners.timing.collocation_method": "generators", "planners.free_path": "generators", "planners.search": "generators",
+    "planners.requests": "problem", "planners.waypoint_checks": "problem", "planners.boundary": "problem",
+    "planners.ranges": "problem", "planners.results": "results",
+}
+#: Layer of each room (docs/design.md, "Layers"): lower numbers are imported by higher ones.
+ROOM_LAYER = {
+    "errors": 0, "execution": 1, "kinematics": 2, "paths": 3, "collision": 4, "constraints": 5, "timing": 6,
+    "checks": 7, "problem": 8, "generators": 9, "results": 10, "runner": 11,
+}
+
+
+def module_name(path: pathlib.Path) -> str:
+    parts = list(path.with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Module -> the project modules it imports (at its top or inside functions)."""
+    modules = {module_name(p): p for root in ROOTS for p in pathlib.Path(root).rglob("*.py")}
+
+    def resolve(name: str) -> str | None:
+        while name and name not in modules:
+            name = name.rpartition(".")[0]
+        return name or None
+
+    graph: dict[str, set[str]] = {}
+    for module, path in modules.items():
+        targets = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                names = [f"{node.module}.{alias.name}" for alias in node.names]
+            else:
+                continue
+            targets |= {t for t in map(resolve, names) if t is not None and t != module}
+        graph[module] = targets
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components of more than one node (Tarjan)."""
+    sys.setrecursionlimit(10_000)
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    found: list[list[str]] = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        for target in graph.get(node, ()):
+            if target not in index:
+                visit(target)
+                low[node] = min(low[node], low[target])
+            elif target in stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for node in list(graph):
+        if node not in index:
+            visit(node)
+    return found
+
+
+def folder(module: str) -> str:
+    return module if pathlib.Path(*module.split(".")).is_dir() else module.rpartition(".")[0]
+
+
+def room(module: str) -> str:
+    while module not in ROOM:
+        module = module.rpartition(".")[0]
+    return ROOM[module]
+
+
+def main() -> None:
+    graph = import_graph()
+    print(f"{len(graph)} modules, {sum(map(len, graph.values()))} imports between them")
+    print("module cycles:", cycles(graph) or "none")
+    folders: dict[str, set[str]] = collections.defaultdict(set)
+    for module, targets in graph.items():
+        folders[folder(module)] |= {folder(t) for t in targets if folder(t) != folder(module)}
+    print("folder cycles:", cycles(folders) or "none")
+    upward = [(m, t) for m, ts in graph.items() for t in ts if PACKAGE_LAYER[t.split(".")[0]] > PACKAGE_LAYER[m.split(".")[0]]]
+    print("imports from a lower top-level package to a higher one:", upward or "none")
+    against = sorted(
+        (m, t) for m, ts in graph.items() if m.startswith("planners") for t in ts
+        if t.startswith("planners") and ROOM_LAYER[room(t)] > ROOM_LAYER[room(m)]
+    )
+    print(f"planners imports pointing upward once moved to the target rooms: {len(against)}")
+    for module, target in against:
+        print(f"  {module} [{room(module)}] -> {target} [{room(target)}]")
+
+
+if __name__ == "__main__":
+    main()
