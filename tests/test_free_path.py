@@ -86,6 +86,9 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     # from the converged cost.
     assert "second grid" in cheap.solver["gap_basis"]
     assert abs(cheap.solver["cost"] - 0.5515) / 0.5515 <= cheap.solver["optimality_gap"] <= 5e-3
+    # ... and it is the answer's stated accuracy: that of the motion found, not of its re-timing
+    assert cheap.accuracy.relative_gap == cheap.solver["optimality_gap"]
+    assert cheap.accuracy.basis == cheap.solver["gap_basis"]
     assert cheap.peak_utilization["torque"].max() <= 1.005
     fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
     assert fast.duration < cheap.duration

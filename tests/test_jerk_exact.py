@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import itertools
+import re
 
 import numpy as np
 import pytest
@@ -191,3 +192,23 @@ def test_the_double_s_profile_without_a_velocity_or_an_acceleration_bound(limits
     assert durations.sum() == pytest.approx(expected, rel=1e-9)
     end = segment_starts(durations, jerks, (0.0, 0.0, 0.0))[-1]
     assert end == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)
+
+
+def test_a_coarse_grid_answer_states_its_gap_and_advises_a_grid_that_holds_a_tenth_of_a_percent():
+    """The answer of ``plan`` on a grid the request names carries the timing's own estimate
+    as its accuracy and, above 0.1 %, a warning with a grid within what jerk_limited serves
+    (never the phase-plane method, which would drop the jerk limits); that grid then holds it."""
+    arm = robots.load("ur5")
+    waypoints = np.array([[0, -1.2, 1, 0, 0, 0], [0.8, -1, 1.4, -0.5, 0.6, 0.3], [2, -1.3, 1.2, 0.2, 0.4, 1.2]])
+    kinds = ("velocity", "acceleration", "jerk")
+    coarse = plan(arm, WaypointPath(waypoints), Timing(method="jerk_limited", constraints=kinds, grid_points=20), dt=0.05)
+    assert coarse.accuracy.relative_gap > 1e-3
+    assert "second grid" in coarse.accuracy.basis
+    (warning,) = [w for w in coarse.warnings if "time-optimal one" in w]
+    assert f"{100 * coarse.accuracy.relative_gap:.2g} %" in warning
+    assert "phase_plane" not in warning
+    advised = int(re.search(r"timing\.grid_points (\d+)", warning).group(1))
+    assert advised <= JerkLimitedMethod().max_grid_intervals(arm.dof)
+    fine = plan(arm, WaypointPath(waypoints), Timing(method="jerk_limited", constraints=kinds, grid_points=advised), dt=0.05)
+    assert fine.accuracy.relative_gap <= 1e-3
+    assert not [w for w in fine.warnings if "time-optimal one" in w]

@@ -231,3 +231,5 @@ def test_at_1_74_the_switches_are_refined_to_the_type_3_optimum(arm, type_3):
     assert answer.duration == pytest.approx(reference.duration, rel=1e-6)
     assert answer.solver["optimality_gap"] <= 1e-6
     assert "second integration" in answer.solver["gap_basis"]
+    assert answer.accuracy.relative_gap == answer.solver["optimality_gap"]
+    assert "second integration" in answer.accuracy.basis
