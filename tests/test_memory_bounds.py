@@ -60,7 +60,8 @@ def test_requests_beyond_the_queue_get_503_with_retry_after():
     async def scenario():
         async with httpx.AsyncClient(transport=httpx.ASGITransport(app=app), base_url="http://toptraj") as client:
             slow = asyncio.create_task(client.post("/v1/trajectories", json=SLOW["via_points"]))
-            await asyncio.sleep(0.3)
+            while app.state.planning._admitted == 0:  # the slow planning holds the worker
+                await asyncio.sleep(0.001)
             busy = await client.post("/v1/trajectories", json=FAST)
             health = await client.get("/health")
             first = await slow
