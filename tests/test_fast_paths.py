@@ -15,7 +15,7 @@ from scipy.interpolate import CubicSpline
 import robots
 from planners.constraints import build_path_constraints
 from planners.grid import path_grid
-from planners.limit_check import INTERPOLATION_TOLERANCE, _torques, check_limits, joint_motion
+from planners.limit_check import _torques, check_limits, joint_motion
 from planners.limit_kernels import utilization_pass
 from planners.paths import SplinePath
 from planners.timing import PhasePlaneMethod, ToppraMethod
@@ -24,6 +24,9 @@ from robots.catalog import robot_from_model
 from robots.urdf_check import check_urdf
 
 KINDS = ("velocity", "acceleration", "torque")
+#: Largest error of a torque interpolated from the rows, as a fraction of the joint's torque
+#: limit (``test_torque_interpolation.py`` states the same).
+INTERPOLATION = 1e-5
 
 
 @pytest.mark.parametrize("count", [2, 3, 5, 12])
@@ -62,12 +65,12 @@ def test_dense_check_torques_from_rows_equal_rnea(name, method):
     everywhere = robot.inverse_dynamics(q, qd, qdd)
     on_grid = np.isin(states.s, constraints.s)
     assert np.abs(from_rows - everywhere)[on_grid].max() <= 1e-12 * np.abs(everywhere).max()
-    assert np.all(np.abs(from_rows - everywhere) <= INTERPOLATION_TOLERANCE * robot.limits.torque)
+    assert np.all(np.abs(from_rows - everywhere) <= INTERPOLATION * robot.limits.torque)
     fast = check_limits(path, timing, robot, robot.limits, KINDS, 1.003, constraints.s, constraints)
     slow = check_limits(path, timing, robot, robot.limits, KINDS, 1.003, constraints.s)
     for kind in ("velocity", "acceleration"):
         np.testing.assert_array_equal(fast.utilization[kind], slow.utilization[kind])
-    np.testing.assert_allclose(fast.utilization["torque"], slow.utilization["torque"], rtol=0, atol=INTERPOLATION_TOLERANCE)
+    np.testing.assert_allclose(fast.utilization["torque"], slow.utilization["torque"], rtol=0, atol=INTERPOLATION)
 
 
 def test_utilization_pass_equals_the_numpy_reduction():

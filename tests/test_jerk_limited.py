@@ -18,6 +18,8 @@ from planners.waypoint_checks import make_path
 from tests.conftest import UR5_WAYPOINTS
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")
+#: Relative agreement with ruckig on straight lines, where both are the exact optimum.
+RUCKIG_AGREEMENT = 3e-6
 
 
 @pytest.mark.parametrize(
@@ -73,8 +75,10 @@ def _ruckig_duration(arm, start, goal, limits) -> float:
 
 @pytest.mark.parametrize("seed", range(5))
 def test_straight_ur5_lines_match_ruckig(seed):
-    """Straight joint lines: jerk_limited within 1 % of ruckig's phase-synchronized duration
-    (the time-optimal motion that keeps every joint on the line) and never shorter."""
+    """Straight joint lines: jerk_limited within 3e-6 of ruckig's phase-synchronized duration
+    (the time-optimal motion that keeps every joint on the line) and never shorter. Both are
+    the exact optimum (the double-S profile in closed form or polished in time; Berscheid &
+    Kroeger's along the line), so the tolerance is the polish's accuracy, not a grid's."""
     arm = robots.load("ur5")
     rng = np.random.default_rng(seed)
     start, goal = rng.uniform(-2.0, 2.0, size=(2, arm.dof))
@@ -86,7 +90,7 @@ def test_straight_ur5_lines_match_ruckig(seed):
         dt=0.01,
     )
     reference = _ruckig_duration(arm, start, goal, arm.limits.with_request(scales={"jerk": scale}))
-    assert result.duration == pytest.approx(reference, rel=0.01)
+    assert result.duration == pytest.approx(reference, rel=RUCKIG_AGREEMENT)
     assert result.duration >= reference * (1 - 1e-9)
 
 

@@ -48,6 +48,31 @@ def _submit(client, body: dict, **fields) -> str:
     return response.json()["id"]
 
 
+class _Looks:
+    """Counts the dispatcher's looks for work in a job store: calls of ``method`` (``has_queued``,
+    made only with a free slot, or ``claim``) whose answer satisfies ``counts``."""
+
+    def __init__(self, monkeypatch, store: JobStore, method: str, counts=lambda answer: True):
+        self.calls = 0
+        original = getattr(store, method)
+
+        def counted(*args, **kwargs):
+            answer = original(*args, **kwargs)
+            if counts(answer):
+                self.calls += 1
+            return answer
+
+        monkeypatch.setattr(store, method, counted)
+
+    def wait_for(self, calls: int, hang_s: float = 60.0) -> None:
+        """Return once ``calls`` more looks are counted (a hang guard only bounds the wait)."""
+        target = self.calls + calls
+        give_up = time.monotonic() + hang_s
+        while self.calls < target:
+            assert time.monotonic() < give_up, f"{self.calls} looks for work, waiting for {target}"
+            time.sleep(0.01)
+
+
 def _wait(client, job_id: str, statuses=ENDED, timeout_s: float = 120.0, every_s: float = 0.05) -> dict:
     """The job once its status is one of ``statuses``."""
     give_up = time.monotonic() + timeout_s
@@ -166,7 +191,8 @@ def test_a_job_over_its_budget_fails_with_a_504(client):
     assert client.get(f"/v1/jobs/{job['id']}/result").status_code == 504
 
 
-def test_a_queued_job_cancelled_never_runs(client):
+def test_a_queued_job_cancelled_never_runs(client, monkeypatch):
+    looks = _Looks(monkeypatch, client.app.state.jobs.store, "has_queued")
     running = _submit(client, {"trajectory": SLOW})
     _wait(client, running, {"running"})
     queued = _submit(client, {"trajectory": QUICK})
@@ -176,7 +202,9 @@ def test_a_queued_job_cancelled_never_runs(client):
     cancelled = client.delete(f"/v1/jobs/{queued}")
     assert cancelled.status_code == 200 and cancelled.json()["status"] == "cancelled"
     assert client.delete(f"/v1/jobs/{running}").json()["status"] == "cancelled"
-    time.sleep(1.5)  # the worker is free: a queued job would have been claimed by now
+    # The worker is free: two looks for work with a free slot, the second after any claim the
+    # first could make (a queued job would have been claimed by then).
+    looks.wait_for(2)
     job = client.get(f"/v1/jobs/{queued}").json()
     assert job["status"] == "cancelled" and job["started_at"] is None and job["result"] is None
     assert client.get(f"/v1/jobs/{queued}/result").status_code == 409
@@ -261,16 +289,23 @@ def test_progress_crosses_the_worker_pipe_and_maps_onto_its_part():
 # --- several server processes on one store ---------------------------------------------------
 
 
-def test_processes_on_one_store_share_the_job_workers_and_the_cancelling(tmp_path):
+def test_processes_on_one_store_share_the_job_workers_and_the_cancelling(tmp_path, monkeypatch):
     """Two apps on one data directory, as two server processes would be: at most
     ``job_workers`` jobs run over both, and a DELETE through one stops the work of the other."""
     with TestClient(create_app(_settings(tmp_path))) as first, TestClient(create_app(_settings(tmp_path))) as second:
+        refused = [_Looks(monkeypatch, client.app.state.jobs.store, "claim", lambda job: job is None) for client in (first, second)]
         one = _submit(first, {"trajectory": SLOW})
         two = _submit(second, {"trajectory": SLOW})
         _wait(second, one, {"running"})
         workers = _job_workers()
         assert len(workers) == 1
-        time.sleep(1.5)  # both dispatchers have looked for work several times
+        # The dispatchers have looked for work three times since, and the shared limit refused
+        # them each time.
+        target = sum(looks.calls for looks in refused) + 3
+        give_up = time.monotonic() + 60.0
+        while sum(looks.calls for looks in refused) < target:
+            assert time.monotonic() < give_up, "the dispatchers stopped looking for work"
+            time.sleep(0.01)
         assert second.get(f"/v1/jobs/{two}").json()["status"] == "queued"
         clients = {id(client.app.state.jobs): client for client in (first, second)}
         (runner,) = [client.app.state.jobs for client in (first, second) if client.app.state.jobs.running_here()]

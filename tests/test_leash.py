@@ -66,15 +66,13 @@ def test_a_short_planning_runs_on_the_event_loop_under_the_leash():
 
 def test_a_planning_past_the_leash_runs_again_in_a_thread_under_the_rest_of_its_budget():
     calls: list = []
-    started = time.monotonic()
     answer = _run(PlanningWorkers(workers=1, queue=2, leash_s=0.02), _recording(calls, _checks_for(0.06)), budget_s=5.0)
-    assert answer == "answer"
+    assert answer == "answer"  # within the budget: a planning past it gets the budget error
     assert [thread is threading.main_thread() for thread, _ in calls] == [True, False]
     tried, planned = calls[0][1], calls[1][1]
     assert isinstance(tried, Leash) and not isinstance(planned, Leash)
     # The thread's deadline is the request's, counted from its arrival: the try came out of it.
     assert planned.remaining() < 5.0 - 0.02
-    assert time.monotonic() - started < 5.0
 
 
 @pytest.mark.parametrize("asks", ["remaining", "on_cancel"])
@@ -90,20 +88,36 @@ def test_work_that_sizes_itself_by_its_budget_or_waits_on_a_process_never_runs_o
         return "answer"
 
     calls: list = []
+    started = time.monotonic()
     assert _run(PlanningWorkers(workers=1, queue=2, leash_s=0.05), _recording(calls, work), budget_s=30.0) == "answer"
+    took = time.monotonic() - started
     assert [thread is threading.main_thread() for thread, _ in calls] == [True, False]
     assert len(seen) == 1  # only in the thread
-    if asks == "remaining":
-        assert 29.0 < seen[0] <= 30.0
+    if asks == "remaining":  # the whole budget but what the run took so far, however slow the machine
+        assert 30.0 - took <= seen[0] <= 30.0
 
 
 def test_a_planning_over_its_budget_after_slipping_gets_the_budget_error_at_the_budget():
+    """The budget error comes no earlier than the budget, and the planning in the thread, 10 s
+    of work checking its deadline every millisecond, is stopped by its own check (an event,
+    awaited with a hang guard only: how soon is a wall-clock figure of a loaded machine)."""
     calls: list = []
+    stopped = threading.Event()
+
+    def work(deadline):
+        try:
+            return _checks_for(10.0)(deadline)
+        except BudgetExceeded:
+            if not isinstance(deadline, Leash):
+                stopped.set()
+            raise
+
     started = time.monotonic()
     with pytest.raises(BudgetExceeded, match="time budget of 0.3 s") as raised:
-        _run(PlanningWorkers(workers=1, queue=2, leash_s=0.02), _recording(calls, _checks_for(10.0)), budget_s=0.3)
+        _run(PlanningWorkers(workers=1, queue=2, leash_s=0.02), _recording(calls, work), budget_s=0.3)
+    assert stopped.wait(30.0)
     assert not isinstance(raised.value, LeashSlipped)
-    assert 0.3 <= time.monotonic() - started < 2.0
+    assert time.monotonic() - started >= 0.3
     assert len(calls) == 2
 
 

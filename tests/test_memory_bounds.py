@@ -39,9 +39,14 @@ def test_a_grid_over_the_method_memory_cap_gets_422_with_a_value(client, robot, 
     assert f"timing.grid_points = {grid_points}" in detail and f"use timing.grid_points <= {largest}" in detail
 
 
-def test_min_cost_at_its_largest_grid_on_a_small_arm_is_served(client):
-    body = {"robot": "yamamoto_2r", "path": {"waypoints": YAMAMOTO_LINE}, "timing": {"method": "min_cost", "grid_points": 1000}}
-    assert client.post("/v1/trajectories", json=body).status_code == 200
+def test_min_cost_at_its_largest_grid_on_a_small_arm_is_served(patient_client):
+    """The largest grid the cap allows a 2-joint arm (12,000 points, one fewer than the refused
+    12,001 above) is planned, within its memory estimate, and served (a budget that a loaded
+    machine does not spend: the solve takes about 5 s on 2 busy cores)."""
+    body = {"robot": "yamamoto_2r", "path": {"waypoints": YAMAMOTO_LINE}, "timing": {"method": "min_cost", "grid_points": 12_000}}
+    response = patient_client.post("/v1/trajectories", json=body)
+    assert response.status_code == 200, response.text[:300]
+    assert response.json()["method"] == "min_cost"
 
 
 FAST = {"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS[:2]}, "timing": {"method": "phase_plane"}}
@@ -55,7 +60,8 @@ def test_requests_beyond_the_queue_get_503_with_retry_after():
     async def scenario():
         async with httpx.AsyncClient(transport=httpx.ASGITransport(app=app), base_url="http://toptraj") as client:
             slow = asyncio.create_task(client.post("/v1/trajectories", json=SLOW["via_points"]))
-            await asyncio.sleep(0.3)
+            while app.state.planning._admitted == 0:  # the slow planning holds the worker
+                await asyncio.sleep(0.001)
             busy = await client.post("/v1/trajectories", json=FAST)
             health = await client.get("/health")
             first = await slow

@@ -110,30 +110,43 @@ def test_a_path_through_an_obstacle_is_a_422_naming_link_obstacle_and_s(client):
 def test_a_clear_path_reports_its_closest_approach(client):
     box = {"kind": "box", "center": [0.6, 0.0, 0.2], "size": [0.2, 0.2, 0.2]}
     response = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [box], "clearance": 0.02}})
-    assert response.status_code == 200, response.text
+    assert response.status_code == 200, response.text[:300]
     body = response.json()
     found = body["min_clearance"]
     assert found["obstacle"] == 0 and found["distance"] >= 0.02
     # coal, at every returned sample: never closer than reported (the check is denser), and close to it
+    nearest = _coal_nearest(np.array(body["samples"]["q"]), BoxObstacle(np.array(box["center"]), np.array(box["size"])))
+    assert found["distance"] - 1e-6 <= nearest <= found["distance"] + 0.01
+
+
+def _coal_nearest(q: np.ndarray, obstacle) -> float:
+    """The smallest distance (m), by coal, between ur5's link capsules at the rows of ``q`` and
+    ``obstacle``."""
     robot = robots.load("ur5")
     capsules = robot_capsules(robot)
-    q = np.array(body["samples"]["q"])
     a, b = world_capsules(robot.model, robot.data, capsules, robot.configuration(q))
-    obstacle = BoxObstacle(np.array(box["center"]), np.array(box["size"]))
     shape, placement = _coal_obstacle(obstacle)
-    nearest = min(
+    return min(
         _coal_distance(*_coal_capsule(a[i, k], b[i, k], capsules[k].radius), shape, placement)
         for i in range(len(q))
         for k in range(len(capsules))
         if np.linalg.norm(b[i, k] - a[i, k]) > 1e-9
     )
-    assert found["distance"] - 1e-6 <= nearest <= found["distance"] + 0.01
 
 
 def test_a_lower_clearance_lets_a_close_path_through(client):
+    """The sphere the default clearance (0.01 m) refuses: with clearance 0 the path is served,
+    its closest approach is reported between 0 and 0.01 m (it grazes the ball), and coal finds
+    every returned sample apart from the ball (it never touches), no closer than reported."""
     sphere = {"kind": "sphere", "center": [0.5, 0.5, 0.5], "radius": 0.1}
-    body = {"robot": "ur5", "path": {**PATH, "obstacles": [sphere], "clearance": 0.0}}
-    assert client.post("/v1/trajectories", json=body).status_code == 200  # it grazes, but never touches
+    refused = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [sphere]}})
+    assert refused.status_code == 422, refused.text[:300]
+    response = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [sphere], "clearance": 0.0}})
+    assert response.status_code == 200, response.text[:300]
+    found = response.json()["min_clearance"]
+    assert found["obstacle"] == 0 and 0.0 < found["distance"] < 0.01
+    nearest = _coal_nearest(np.array(response.json()["samples"]["q"]), SphereObstacle(np.array(sphere["center"]), sphere["radius"]))
+    assert found["distance"] - 1e-6 <= nearest <= found["distance"] + 0.01
 
 
 def test_the_planar_paper_arm_uses_link_capsules(client):
@@ -146,7 +159,7 @@ def test_the_planar_paper_arm_uses_link_capsules(client):
     reach = 0.65 + 0.03 + 0.05 + 0.01 + 1e-3
     path["obstacles"][0]["center"] = [reach * np.cos(0.38), reach * np.sin(0.38), 0.0]
     response = client.post("/v1/trajectories", json={"robot": "geering_2r", "path": path, "timing": {"constraints": ["torque"]}})
-    assert response.status_code == 200, response.text
+    assert response.status_code == 200, response.text[:300]
     assert response.json()["min_clearance"]["distance"] == pytest.approx(0.011, abs=1e-6)
 
 
@@ -190,7 +203,7 @@ def test_obstacles_on_a_cartesian_line(client):
     aside /= np.linalg.norm(aside)
     ball["center"] = (middle + 0.1 * aside).tolist()
     response = client.post("/v1/trajectories", json={**body, "path": {**body["path"], "obstacles": [ball], "clearance": 0.01}})
-    assert response.status_code == 200, response.text
+    assert response.status_code == 200, response.text[:300]
     found = response.json()["min_clearance"]
     tips = _tool_points(robots.load("lecture_3r"), np.array(response.json()["samples"]["q"]))
     tip_distance = float(np.min(np.linalg.norm(tips - np.array(ball["center"]), axis=1))) - ball["radius"]

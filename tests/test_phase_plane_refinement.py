@@ -11,7 +11,6 @@ import robots
 from benchmarks.accuracy import KINDS, random_waypoints
 from planners.constraints import PathConstraints, build_path_constraints
 from planners.errors import InfeasiblePath
-from planners.gate import LIMIT_TOLERANCE
 from planners.grid import path_grid
 from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, zero_inertia_intervals
 from planners.limit_check import check_limits
@@ -21,6 +20,11 @@ from planners.refinement_kernels import row_excursions, switch_excess
 from planners.split_kernels import _pieces
 from planners.timing import PhasePlaneMethod
 from planners.timing.phase_plane import _kept_intervals, interval_rows, midpoint_duration, midpoint_stage_rows
+
+#: Largest |value| / limit on the dense check that the answer may reach: 0.3 % above the limit
+#: (the service promises 0.5 % on any dense resampling, and a client's samples fall between
+#: the check's states).
+HELD = 1.003
 
 
 def _random_constraints(rng, n_points: int, n_rows: int, friction: bool) -> PathConstraints:
@@ -292,8 +296,8 @@ def test_a_coarse_grid_holds_the_limits_between_its_points(name):
                 continue
             utilization = check_limits(path, timing, robot, robot.limits).utilization
             worst[label] = max(worst[label], max(value.max() for value in utilization.values()))
-    assert worst["default"] <= LIMIT_TOLERANCE
-    assert worst["duration only"] > LIMIT_TOLERANCE
+    assert worst["default"] <= HELD
+    assert worst["duration only"] > HELD
 
 
 @pytest.mark.parametrize("name", ["ur5", "yamamoto_2r"])

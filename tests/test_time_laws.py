@@ -7,7 +7,7 @@ import pytest
 
 import robots
 from planners import Timing, WaypointPath, plan
-from planners.errors import InfeasiblePath
+from planners.errors import InfeasiblePath, InvalidRequest
 from planners.timing.classical import ClassicalMethod
 from planners.timing.laws import (
     PROFILES,
@@ -105,20 +105,42 @@ def test_shortest_law_respects_every_limit_and_is_not_faster_than_optimal(law, i
     assert result.samples.q[-1] == pytest.approx(UR5_WAYPOINTS[-1], abs=1e-9)
 
 
-@pytest.mark.parametrize("interpolation", ["spline", "linear", "via"])
-@pytest.mark.parametrize("law, steps", [("cubic", [0.0, 1.0]), ("trapezoidal", [0.0, 1 / 3, 2 / 3, 1.0])])
+CUBIC_STEPS = [0.0, 1.0]
+TRAPEZOID_STEPS = [0.0, 1 / 3, 2 / 3, 1.0]
+
+
+@pytest.mark.parametrize(
+    "law, steps, interpolation",
+    [
+        ("cubic", CUBIC_STEPS, "spline"),
+        ("cubic", CUBIC_STEPS, "linear"),
+        ("cubic", CUBIC_STEPS, "via"),
+        ("trapezoidal", TRAPEZOID_STEPS, "spline"),
+        ("trapezoidal", TRAPEZOID_STEPS, "linear"),
+    ],
+)
 def test_laws_with_acceleration_steps_refuse_a_jerk_limit(law, steps, interpolation):
     """The cubic leaves rest with sigma''(0) = 6 and the trapezoid switches between constant
     accelerations: an infinite jerk at each step, whatever the duration (on 1 ms samples of
-    the unchecked law the jerk reaches 30 to 100 times ur5's limit)."""
-    if interpolation == "via" and law == "trapezoidal":
-        pytest.skip("via points take cubic or quintic segments")
+    the unchecked law the jerk reaches 30 to 100 times ur5's limit). Via points take cubic or
+    quintic segments only: the trapezoid there is refused before any limit (next test)."""
     path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
     with pytest.raises(InfeasiblePath) as refused:
         plan(UR5, path, Timing(method=law, constraints=("velocity", "acceleration", "jerk")))
     assert refused.value.limit == "jerk"
     assert "quintic" in str(refused.value)
     assert ClassicalMethod(PROFILES[law]()).profile.acceleration_steps() == pytest.approx(steps)
+
+
+@pytest.mark.parametrize("kinds", [("velocity", "acceleration"), ("velocity", "acceleration", "jerk")])
+def test_via_points_refuse_the_trapezoid_whatever_the_limits(kinds):
+    """Via points are passed by per-joint cubic or quintic segments in time: the trapezoid
+    is refused (422) naming the methods that take them, with or without a jerk limit."""
+    path = WaypointPath(np.array(UR5_WAYPOINTS), "via")
+    with pytest.raises(InvalidRequest) as refused:
+        plan(UR5, path, Timing(method="trapezoidal", constraints=kinds))
+    assert refused.value.status == 422
+    assert "'cubic' or 'quintic'" in str(refused.value) and "trapezoidal" in str(refused.value)
 
 
 def test_single_joint_closed_forms():
