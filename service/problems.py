@@ -25,6 +25,7 @@ import numpy as np
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
@@ -121,6 +122,12 @@ def _all_finite_numbers(values: list | tuple) -> bool:
     except (TypeError, ValueError):
         return False
     return array.ndim == 1 and bool(np.isfinite(array).all())
+
+
+def validation_problem(error: ValidationError) -> dict:
+    """The problem+json of a request that does not fit its schema (as the HTTP API's 422)."""
+    detail = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in error.errors())
+    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": detail}
 
 
 def problem(status: int, title: str, detail: str, headers: dict[str, str] | None = None, **extra) -> JSONResponse:
