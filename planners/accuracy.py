@@ -32,8 +32,8 @@ import math
 import numpy as np
 
 from planners.constraints import PathConstraints
-from planners.deadline import Deadline
 from planners.errors import InfeasiblePath, TimingFailed
+from planners.execution.deadline import Deadline
 from planners.grid import MAX_POINTS, on_points
 from planners.results import Accuracy
 from planners.timing.base import GAP_TARGET, Boundary, PathTiming, TimeScaling, TimingMethod

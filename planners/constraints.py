@@ -29,7 +29,7 @@ from functools import cached_property
 import numpy as np
 
 from planners.constraint_kernels import assemble_rows, velocity_bound
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.grid import on_points
 from planners.paths.base import GeometricPath
 from planners.tool_speed import tool_speed_bound

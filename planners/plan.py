@@ -15,8 +15,8 @@ import numpy as np
 from planners.accuracy import answer_accuracy
 from planners.collision import Obstacle, check_clearance
 from planners.collision.obstacles import check_obstacles
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.free_path import FreeMotion
 from planners.free_path.switching import collocation_switches, switching_times
 from planners.gate import TimedStretch, gate_threshold, samples_exceed

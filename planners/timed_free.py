@@ -11,13 +11,13 @@ import numpy as np
 
 from planners.collision import check_clearance
 from planners.constraints import build_path_constraints
-from planners.deadline import Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, OverMemory
+from planners.execution.deadline import Deadline
+from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.free_path.switching import refine_collocation, switched_path, switching_times
 from planners.gate import TimedStretch, checked, gated
 from planners.grid import path_grid
-from planners.isolated import LOW_PRIORITY, run_isolated
 from planners.paths import GeometricPath
 from planners.requests import Timing
 from planners.search.curve import GridSplinePath
@@ -156,8 +156,8 @@ def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstac
 
     The search's memory is estimated from its settings first (``planners.search.memory``,
     ``OverMemory`` beyond ``timing.search.memory_bytes``). Under a deadline the whole search
-    runs in a worker process (``planners.isolated``) at a lower CPU priority
-    (``planners.isolated.LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
+    runs in a worker process (``planners.execution.isolated``) at a lower CPU priority
+    (``planners.execution.isolated.LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
     killed when the budget is spent or the caller cancels, its memory gone with it."""
     if not isinstance(spec, FreeMotion):
         raise InvalidRequest("timing.method 'search' finds the path itself: give a free path (path.kind 'free', start and goal)")

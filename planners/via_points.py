@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath, PathPoints
 from planners.timing.base import DenseStates, PathTiming
 from planners.timing.laws import cubic_coefficients, quintic_coefficients

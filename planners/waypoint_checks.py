@@ -8,8 +8,8 @@ import dataclasses
 
 import numpy as np
 
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.paths.blended import BlendedPath
 from planners.paths.cartesian import CartesianLine, cartesian_path

@@ -11,9 +11,9 @@ from starlette.concurrency import run_in_threadpool
 
 import robots
 from planners import Timing, WaypointPath, plan
-from planners.isolated import start_worker_server
+from planners.execution.isolated import start_worker_server
+from planners.execution.threads import single_blas_thread
 from planners.kinematics.conditioning import frobenius_condition_number
-from planners.threads import single_blas_thread
 from service import stopping
 from service.body_limit import BodySizeLimit
 from service.jobs import JOB_MODULES, job_runner
@@ -47,7 +47,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
     settings = settings or Settings()
-    single_blas_thread()  # plannings run side by side; see planners.threads
+    single_blas_thread()  # plannings run side by side; see planners.execution.threads
     robots.configure_uploads(
         settings.data_dir,
         max_uploads=settings.max_uploads,

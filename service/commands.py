@@ -92,7 +92,7 @@ def _trajectory(text: str) -> bytes:
 
 
 def _compare(text: str) -> bytes:
-    from planners.deadline import NO_DEADLINE
+    from planners.execution.deadline import NO_DEADLINE
     from service.planning import compare_request, encode_json
     from service.schemas.trajectories import CompareRequest
 

@@ -14,8 +14,8 @@ import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
 from planners.boundary import finite_vector
 from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
-from planners.deadline import NO_DEADLINE
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.execution.deadline import NO_DEADLINE
 from planners.free_path import FreeMotion
 from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from planners.search import SearchOptions

@@ -8,7 +8,7 @@ import pytest
 
 import robots
 from planners import Timing, plan
-from planners.deadline import Deadline
+from planners.execution.deadline import Deadline
 from planners.free_path import FreeMotion
 
 

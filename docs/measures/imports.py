@@ -18,9 +18,10 @@ ROOTS = ("robots", "planners", "service", "client")
 PACKAGE_LAYER = {"robots": 0, "planners": 1, "service": 2, "client": 2}
 #: Today's planners module (or folder) -> its room in the target tree.
 ROOM = {
+    "planners.execution": "execution",
     "planners": "runner", "planners.plan": "runner", "planners.timed": "runner", "planners.timed_free": "runner",
     "planners.errors": "errors", "planners.diagnostics": "errors",
-    "planners.deadline": "execution", "planners.isolated": "execution", "planners.threads": "execution",
+    "planners.execution.deadline": "execution", "planners.execution.isolated": "execution", "planners.execution.threads": "execution",
     "planners.kinematics": "kinematics", "planners.paths": "paths", "planners.grid": "paths", "planners.collision": "collision",
     "planners.constraints": "constraints", "planners.constraint_kernels": "constraints", "planners.mvc": "constraints",
     "planners.kernels": "constraints", "planners.tool_speed": "constraints", "planners.torque_interpolation": "constraints",

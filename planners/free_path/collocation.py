@@ -32,12 +32,12 @@ import pinocchio as pin
 from scipy.optimize import minimize
 
 from planners.constraints import build_path_constraints
-from planners.deadline import NO_DEADLINE, Deadline, Progress
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline, Progress
+from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.free_path.motion import CollocationResult, FreeMotion
 from planners.free_path.sparse import SparseCollocation, solve_sparse
 from planners.grid import path_grid
-from planners.isolated import LOW_PRIORITY, run_isolated
 from planners.paths.waypoints import SplinePath
 from planners.timing.phase_plane import PhasePlaneMethod
 from robots import JointLimits, Robot
@@ -284,7 +284,7 @@ def optimize_motion(
 
     SLSQP holds the interpreter for seconds at a time and cannot check a deadline, so under a
     ``deadline`` the optimization runs in a worker process that is killed when it passes
-    (``planners.isolated``), at a lower CPU priority. It reports its progress to ``deadline.progress``: each initial
+    (``planners.execution.isolated``), at a lower CPU priority. It reports its progress to ``deadline.progress``: each initial
     guess ("collocation: guess 3 of 15"), then the refinement.
 
     Raises:

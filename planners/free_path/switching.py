@@ -37,7 +37,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.optimize import minimize
 
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.free_path.motion import CollocationResult, FreeMotion
 from planners.free_path.root_finding import held_newton, jacobian, newton, secant_minimum
 from planners.via_points import ConstantSpeedTiming, ViaPath

@@ -29,8 +29,8 @@ import time
 
 import numpy as np
 
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.search.bounds import forward_time, grid_path_time, path_time
 from planners.search.graph import DEFAULT_OPTIONS, SearchOptions
 from planners.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics

@@ -16,7 +16,7 @@ import numpy as np
 
 from planners.collision import Obstacle, clearance_along
 from planners.collision.distance import capsule_distance
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.search.curve import BASIS
 from planners.search.pieces import Pieces
 from robots import Robot

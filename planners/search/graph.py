@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from robots import Robot
 
 #: Grid intervals per joint across the search region when a request names none, by joint count.

@@ -52,8 +52,8 @@ from scipy.optimize import minimize
 from planners.collision.clearance import Clearance, PathInCollision, check_clearance
 from planners.collision.obstacles import Obstacle
 from planners.constraints import build_path_constraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.grid import path_grid
 from planners.paths.bspline import DEGREE, BSplinePath, clamped_knots, insert_knot
 from planners.search.free_space import joint_reaches, point_distances

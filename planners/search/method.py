@@ -12,8 +12,8 @@ import numpy as np
 
 from planners.collision import Obstacle
 from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.search.branch_and_bound import branch_and_bound
 from planners.search.graph import DEFAULT_OPTIONS, SearchOptions
 from planners.search.memory import check_search_memory

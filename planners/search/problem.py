@@ -13,8 +13,8 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from planners.collision import Obstacle
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.search.bounds import PieceBounds, piece_bounds
 from planners.search.free_space import clear_pieces, point_distances
 from planners.search.graph import (

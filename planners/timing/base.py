@@ -11,8 +11,8 @@ from functools import cached_property
 import numpy as np
 
 from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.limit_kernels import grid_states
 
 #: Largest estimated relative gap to the converged optimum that a time-optimal answer carries

@@ -24,9 +24,9 @@ from __future__ import annotations
 import numpy as np
 
 from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
 from planners.timing.law_timing import LawSegment, LawTiming
 from planners.timing.laws import (

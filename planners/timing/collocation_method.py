@@ -4,8 +4,8 @@
 from __future__ import annotations
 
 from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
 
 

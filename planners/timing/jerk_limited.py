@@ -66,8 +66,8 @@ import time
 import numpy as np
 
 from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
 from planners.timing.jerk_accuracy import coarser, relative_gap
 from planners.timing.jerk_closed_form import closed_form_timing

@@ -28,7 +28,7 @@ import numpy as np
 from scipy import sparse
 
 from planners.constraints import PathConstraints
-from planners.deadline import Deadline
+from planners.execution.deadline import Deadline
 from planners.timing.jerk_segments import JerkSegmentsTiming, segment_starts
 
 #: Most segments polished: a time-optimal motion under limits that do not change along the

@@ -22,8 +22,8 @@ import numpy as np
 from scipy import sparse
 
 from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import Boundary
 from planners.timing.jerk_scaling import JerkTimeScaling
 

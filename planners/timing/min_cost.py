@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.constraints import LinearRows, PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.isolated import LOW_PRIORITY, run_isolated
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.mvc import friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 

@@ -48,9 +48,9 @@ from typing import NamedTuple
 import numpy as np
 
 from planners.constraints import LinearRows, PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, point_bounds, zero_inertia_intervals
 from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions

@@ -15,7 +15,7 @@ import dataclasses
 import numpy as np
 
 from planners.constraints import PathConstraints
-from planners.deadline import Deadline
+from planners.execution.deadline import Deadline
 from planners.mvc import speed_scale
 from planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
 

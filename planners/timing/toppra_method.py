@@ -16,9 +16,9 @@ import logging
 import numpy as np
 
 from planners.constraints import LinearRows, PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.mvc import acceleration_bounds, admissible_set, friction_reference
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 

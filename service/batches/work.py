@@ -11,7 +11,7 @@ import orjson
 from pydantic import ValidationError
 
 import robots
-from planners.deadline import Deadline
+from planners.execution.deadline import Deadline
 from robots import ToptrajError
 from robots.upload_options import UploadOptions
 from service.batches.lines import problem_body

@@ -69,7 +69,7 @@ class Deadline:
     def ending_at(cls, end: float | None, budget_s: float | None, progress: Progress | None = None) -> Deadline:
         """A deadline that passes at ``end`` (``time.monotonic()``, the same clock in every
         process of the machine) and names ``budget_s`` when it does: the deadline of a caller,
-        carried into a worker process (``planners.isolated``)."""
+        carried into a worker process (``planners.execution.isolated``)."""
         deadline = cls(budget_s, progress)
         deadline._end = end
         return deadline
