@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.constraints import build_path_constraints
-from planners.grid import path_grid
+from planners.constraints.path_constraints import build_path_constraints
 from planners.paths import SplinePath
+from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod
 from planners.timing.phase_plane import midpoint_duration
 

@@ -1,6 +1,6 @@
 """Planners: geometric paths, path constraints, timing methods and trajectory sampling."""
 
-from planners.constraints import PathConstraints, build_path_constraints
+from planners.constraints.path_constraints import PathConstraints, build_path_constraints
 from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, TimingFailed
 from planners.execution.deadline import Deadline
 from planners.paths.cartesian import CartesianLine

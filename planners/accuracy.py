@@ -31,10 +31,10 @@ import math
 
 import numpy as np
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.execution.deadline import Deadline
-from planners.grid import MAX_POINTS, on_points
+from planners.paths.grid import MAX_POINTS, on_points
 from planners.results import Accuracy
 from planners.timing.base import GAP_TARGET, Boundary, PathTiming, TimeScaling, TimingMethod
 from planners.timing.phase_plane import GAP_BASIS as PHASE_PLANE_BASIS

@@ -12,7 +12,8 @@ from typing import NamedTuple
 import numpy as np
 
 from planners.accuracy import REFINE_ROUNDS, estimated, finer_constraints
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
+from planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.limit_check import Excess, LimitCheck, check_limits
 from planners.limit_kernels import utilization_pass
@@ -20,7 +21,6 @@ from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.timing.law_timing import LawTiming
 from planners.timing.scaled import solve_well_scaled
-from planners.tool_speed import TOOL_KINDS, tool_speeds
 from robots import JointLimits, Robot
 
 #: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is

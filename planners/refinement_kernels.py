@@ -215,7 +215,7 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
     within ``target`` (relative to the limit) of their bounds at its quarter points; ``binding``
     (N + 1,) names the joint whose velocity limit sets x_bound at each grid point, ``smooth``
     (N + 1,) marks the grid points through which the rows are smooth (no knot of the path, no
-    jump; ``planners.torque_interpolation.smooth_points``).
+    jump; ``planners.constraints.torque_interpolation.smooth_points``).
 
     The interpolation discretization holds every row ``a u + b x + c + d sd`` at both ends of
     an interval (u constant, x linear in s); between them the row departs from the chord of its

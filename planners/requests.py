@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from planners.constraints import CONSTRAINT_KINDS
+from planners.constraints.path_constraints import CONSTRAINT_KINDS
 from planners.errors import InvalidRequest
 from planners.search.graph import SearchOptions
 from planners.search.method import SearchMethod

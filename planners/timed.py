@@ -12,11 +12,11 @@ from typing import NamedTuple
 import numpy as np
 
 from planners.boundary import path_acceleration, path_speed
-from planners.constraints import build_path_constraints
+from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.gate import TimedStretch, checked, gated
-from planners.grid import path_grid
 from planners.paths import GeometricPath
+from planners.paths.grid import path_grid
 from planners.paths.stretch import Stretch, stretches
 from planners.requests import Timing, WaypointPath
 from planners.timing.base import Boundary, PathTiming, TimingMethod

@@ -10,15 +10,15 @@ import dataclasses
 import numpy as np
 
 from planners.collision import check_clearance
-from planners.constraints import build_path_constraints
+from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest, OverMemory
 from planners.execution.deadline import Deadline
 from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.free_path import FreeMotion, collocation_path, optimize_motion
 from planners.free_path.switching import refine_collocation, switched_path, switching_times
 from planners.gate import TimedStretch, checked, gated
-from planners.grid import path_grid
 from planners.paths import GeometricPath
+from planners.paths.grid import path_grid
 from planners.requests import Timing
 from planners.search.curve import GridSplinePath
 from planners.search.graph import DEFAULT_OPTIONS

@@ -23,8 +23,8 @@ from ruckig import InputParameter, Ruckig, Synchronization, Trajectory
 
 import robots
 from planners import Timing, WaypointPath, plan
-from planners.constraints import build_path_constraints
-from planners.grid import path_grid
+from planners.constraints.path_constraints import build_path_constraints
+from planners.paths.grid import path_grid
 from planners.timing.jerk_closed_form import ScalarLimits, double_s
 from planners.timing.jerk_limited import JerkLimitedMethod
 from planners.timing.jerk_segments import segment_starts

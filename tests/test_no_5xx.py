@@ -15,7 +15,7 @@ import uvicorn
 
 import robots
 from planners import Deadline, InvalidRequest, Timing, TimingFailed, WaypointPath, plan
-from planners.grid import path_grid
+from planners.paths.grid import path_grid
 from planners.results import require_finite
 from planners.timing.laws import quintic_coefficients
 from service.app import create_app

@@ -9,14 +9,14 @@ import pytest
 
 import robots
 from benchmarks.accuracy import KINDS, random_waypoints
-from planners.constraints import PathConstraints, build_path_constraints
+from planners.constraints.admissible import acceleration_bounds, admissible_set
+from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, zero_inertia_intervals
+from planners.constraints.path_constraints import PathConstraints, build_path_constraints
 from planners.errors import InfeasiblePath
 from planners.gate import LIMIT_TOLERANCE
-from planners.grid import path_grid
-from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, zero_inertia_intervals
 from planners.limit_check import check_limits
-from planners.mvc import acceleration_bounds, admissible_set
 from planners.paths import SplinePath
+from planners.paths.grid import path_grid
 from planners.refinement_kernels import row_excursions, switch_excess
 from planners.split_kernels import _pieces
 from planners.timing import PhasePlaneMethod

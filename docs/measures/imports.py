@@ -18,13 +18,14 @@ ROOTS = ("robots", "planners", "service", "client")
 PACKAGE_LAYER = {"robots": 0, "planners": 1, "service": 2, "client": 2}
 #: Today's planners module (or folder) -> its room in the target tree.
 ROOM = {
+    "planners.constraints": "constraints",
     "planners.execution": "execution",
     "planners": "runner", "planners.plan": "runner", "planners.timed": "runner", "planners.timed_free": "runner",
     "planners.errors": "errors", "planners.diagnostics": "errors",
     "planners.execution.deadline": "execution", "planners.execution.isolated": "execution", "planners.execution.threads": "execution",
-    "planners.kinematics": "kinematics", "planners.paths": "paths", "planners.grid": "paths", "planners.collision": "collision",
-    "planners.constraints": "constraints", "planners.constraint_kernels": "constraints", "planners.mvc": "constraints",
-    "planners.kernels": "constraints", "planners.tool_speed": "constraints", "planners.torque_interpolation": "constraints",
+    "planners.kinematics": "kinematics", "planners.paths": "paths", "planners.paths.grid": "paths", "planners.collision": "collision",
+    "planners.constraints.path_constraints": "constraints", "planners.constraints.assembly_kernels": "constraints", "planners.constraints.admissible": "constraints",
+    "planners.constraints.admissible_kernels": "constraints", "planners.constraints.tool_speed": "constraints", "planners.constraints.torque_interpolation": "constraints",
     "planners.timing": "timing", "planners.sweep_kernels": "timing", "planners.refinement_kernels": "timing",
     "planners.split_kernels": "timing",
     "planners.limit_check": "checks", "planners.limit_kernels": "checks", "planners.gate": "checks",

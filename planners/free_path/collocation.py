@@ -31,13 +31,13 @@ import numpy as np
 import pinocchio as pin
 from scipy.optimize import minimize
 
-from planners.constraints import build_path_constraints
+from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline, Progress
 from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.free_path.motion import CollocationResult, FreeMotion
 from planners.free_path.sparse import SparseCollocation, solve_sparse
-from planners.grid import path_grid
+from planners.paths.grid import path_grid
 from planners.paths.waypoints import SplinePath
 from planners.timing.phase_plane import PhasePlaneMethod
 from robots import JointLimits, Robot

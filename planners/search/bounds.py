@@ -15,7 +15,7 @@ Dubowsky 1991), each a bound on the next, so that t1 <= t2 <= t3 <= t4 = t_opt:
 
 All four are computed in the discretization the phase-plane method uses on the same grid (x =
 sd^2 linear in the curve's parameter over each interval, every limit row held at both ends of it;
-``planners.kernels.interval_bounds`` gives the rows of each interval as bounds on u), so each is
+``planners.constraints.admissible_kernels.interval_bounds`` gives the rows of each interval as bounds on u), so each is
 a lower bound on the discrete t4 of that grid, which ``grid_path_time`` computes with the
 phase-plane method itself. Viscous friction, which the phase-plane method linearizes, is relaxed
 to the widest bounds it can take below the first-order speed bound. t1 and t2 add up over the
@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from planners.constraints import build_path_constraints, grid_rows, speed_bound
-from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
+from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
+from planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
 from planners.search.curve import GridSplinePath
 from planners.search.pieces import INTERVALS, Pieces
 from planners.timing.phase_plane import PhasePlaneMethod
@@ -74,7 +74,7 @@ class PieceBounds:
 def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
     """Rows ``a u + b x + c in [lower, upper]`` at configurations q with parameter derivatives
     dq, ddq (each (k, n)), viscous friction relaxed below the speed bound, and that bound
-    x_bound (k,): the rows of ``planners.constraints.build_path_constraints``."""
+    x_bound (k,): the rows of ``planners.constraints.path_constraints.build_path_constraints``."""
     x_bound = np.full(len(q), _INF)
     if "velocity" in kinds:
         x_bound = speed_bound(limits, dq)[0] ** 2

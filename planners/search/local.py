@@ -51,11 +51,11 @@ from scipy.optimize import minimize
 
 from planners.collision.clearance import Clearance, PathInCollision, check_clearance
 from planners.collision.obstacles import Obstacle
-from planners.constraints import build_path_constraints
+from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.grid import path_grid
 from planners.paths.bspline import DEGREE, BSplinePath, clamped_knots, insert_knot
+from planners.paths.grid import path_grid
 from planners.search.free_space import joint_reaches, point_distances
 from planners.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
 from planners.timing.base import TimeScaling

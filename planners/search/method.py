@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planners.collision import Obstacle
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.search.branch_and_bound import branch_and_bound

@@ -10,7 +10,7 @@ from functools import cached_property
 
 import numpy as np
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.limit_kernels import grid_states

@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
+from planners.constraints.tool_speed import TOOL_KINDS
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
@@ -38,7 +39,6 @@ from planners.timing.laws import (
     cubic_coefficients,
     quintic_coefficients,
 )
-from planners.tool_speed import TOOL_KINDS
 
 #: Keeps samples strictly inside a segment, so that a corner is seen from the segment's side.
 _INSIDE = 1e-9

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod

@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 
 
 def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstraints | None:

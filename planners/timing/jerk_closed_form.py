@@ -30,7 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.timing.jerk_segments import JerkSegmentsTiming
 
 #: Relative size below which a coefficient that would make a row depend on the speed (q'' and

@@ -65,7 +65,7 @@ import time
 
 import numpy as np
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod

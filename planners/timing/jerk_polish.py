@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.execution.deadline import Deadline
 from planners.timing.jerk_segments import JerkSegmentsTiming, segment_starts
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import Boundary

@@ -24,7 +24,7 @@ collapses to one value and the sweeps take it: no chattering, no special case.
 Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
 row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
 point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
-(``planners.kernels``, ``planners.sweep_kernels``): no LP is solved anywhere; one compiled call
+(``planners.constraints.admissible_kernels``, ``planners.sweep_kernels``): no LP is solved anywhere; one compiled call
 per sweep pair builds the rows of every interval, linearizes viscous friction, finds the
 admissible intervals and runs both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
 amount, so the grid is refined where it costs time: the error of each interval is estimated from
@@ -47,12 +47,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.constraints import LinearRows, PathConstraints
+from planners.constraints.admissible import admissible_set
+from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, point_bounds, zero_inertia_intervals
+from planners.constraints.path_constraints import LinearRows, PathConstraints
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.kernels import NOTHING_BEFORE, NOTHING_KEPT, point_bounds, zero_inertia_intervals
-from planners.mvc import admissible_set
 from planners.refinement_kernels import refinement, row_excursions
 from planners.split_kernels import split_points
 from planners.sweep_kernels import sweeps
@@ -99,7 +99,7 @@ def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> L
 
 
 #: A switching point is singular where a row's u-coefficient in its interval is within this
-#: fraction of the row's scale of zero (``planners.kernels.zero_inertia_intervals``).
+#: fraction of the row's scale of zero (``planners.constraints.admissible_kernels.zero_inertia_intervals``).
 _ZERO_INERTIA_SWITCH = 1e-6
 #: Pieces into which one refinement round may split an interval at most.
 _MAX_PIECES = 8
@@ -260,7 +260,7 @@ class _Grid(NamedTuple):
     seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
     first-order bound x_bound = sd_max^2 (N + 1,), the joint whose velocity limit sets it (N + 1,,
     -1 where none or unknown), whether the rows are smooth through each grid point (N + 1,,
-    ``planners.torque_interpolation.smooth_points``) and whether any row has viscous friction."""
+    ``planners.constraints.torque_interpolation.smooth_points``) and whether any row has viscous friction."""
 
     constraints: PathConstraints
     s: np.ndarray
@@ -287,7 +287,7 @@ class _Grid(NamedTuple):
         return cls(constraints, s, rows, x_bound, binding, constraints.smooth, constraints.has_friction)
 
     def friction_reference(self) -> np.ndarray:
-        """``planners.mvc.friction_reference``: the maximum velocity curve without friction,
+        """``planners.constraints.admissible.friction_reference``: the maximum velocity curve without friction,
         capped by the first-order bound (1 where it is not positive and finite)."""
         a, b, c, _, _, _, _, _, lower, upper = self.rows
         x_max = point_bounds(a, b, c, lower, upper, self.x_bound)[4]
@@ -298,7 +298,7 @@ class _Profile(NamedTuple):
     """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
     envelope (N + 1,), the admissible upper x_i of each interval (N,), how much faster each
     interval could be crossed at its bounds (N,, ``planners.refinement_kernels.switch_excess``)
-    and the intervals' bounds (``planners.kernels.interval_bounds``' p, q, r, x_low, x_high)."""
+    and the intervals' bounds (``planners.constraints.admissible_kernels.interval_bounds``' p, q, r, x_low, x_high)."""
 
     x: np.ndarray
     capped: np.ndarray

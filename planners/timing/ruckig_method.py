@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 
-from planners.constraints import PathConstraints
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Boundary, DenseStates, PathTiming, TimingMethod
