@@ -18,7 +18,7 @@ from planners.constraints.path_constraints import build_path_constraints
 from planners.paths import SplinePath
 from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod
-from planners.timing.phase_plane import midpoint_duration
+from planners.timing.phase_plane.method import midpoint_duration
 
 KINDS = ("velocity", "acceleration", "torque")
 #: Largest disagreement of the two estimates of the converged duration.

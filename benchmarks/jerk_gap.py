@@ -26,7 +26,7 @@ from planners.constraints.path_constraints import build_path_constraints
 from planners.execution.deadline import NO_DEADLINE
 from planners.paths.grid import path_grid
 from planners.timing.base import AT_REST
-from planners.timing.jerk_limited import JerkLimitedMethod
+from planners.timing.jerk.method import JerkLimitedMethod
 from planners.waypoint_checks import make_path
 
 KINDS = ("velocity", "acceleration", "torque", "jerk")

@@ -6,7 +6,7 @@ or min_cost's cost with a torque weight) differs from the converged one (the lim
 interval goes to zero) by a discretization error. Each answer states an estimate of that
 relative error, found independently of the solve:
 
-* ``phase_plane``: its own refinement estimate (``planners.timing.phase_plane.GAP_BASIS``): the
+* ``phase_plane``: its own refinement estimate (``planners.timing.phase_plane.method.GAP_BASIS``): the
   conservative discretization against the second-order midpoint one on the same grid, plus the
   switches and chords neither sees. No extra solve.
 * ``toppra``, ``min_cost`` with beta = 0: the phase-plane method on the same constraints, a
@@ -37,8 +37,8 @@ from planners.execution.deadline import Deadline
 from planners.paths.grid import MAX_POINTS, on_points
 from planners.results import Accuracy
 from planners.timing.base import GAP_TARGET, Boundary, PathTiming, TimeScaling, TimingMethod
-from planners.timing.phase_plane import GAP_BASIS as PHASE_PLANE_BASIS
-from planners.timing.phase_plane import PhasePlaneMethod
+from planners.timing.phase_plane.method import GAP_BASIS as PHASE_PLANE_BASIS
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.timing.scaled import solve_well_scaled
 
 #: Refinements of the grid for accuracy, each followed by a solve.

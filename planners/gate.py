@@ -19,7 +19,7 @@ from planners.limit_check import Excess, LimitCheck, check_limits
 from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
-from planners.timing.law_timing import LawTiming
+from planners.timing.laws.law_timing import LawTiming
 from planners.timing.scaled import solve_well_scaled
 from robots import JointLimits, Robot
 

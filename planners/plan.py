@@ -32,8 +32,8 @@ from planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajecto
 from planners.timed import timed_path, timed_unsynchronized, timed_via_points
 from planners.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
-from planners.timing.law_timing import LawTiming
-from planners.timing.phase_plane import PhasePlaneMethod
+from planners.timing.laws.law_timing import LawTiming
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.trajectory import sample_trajectory
 from planners.waypoint_checks import continuous_turns, make_path, without_repeats
 from robots import JointLimits, Robot

@@ -14,11 +14,11 @@ from planners.search.graph import SearchOptions
 from planners.search.method import SearchMethod
 from planners.timing import METHODS
 from planners.timing.base import TimingMethod
-from planners.timing.classical import ClassicalMethod
 from planners.timing.collocation_method import CollocationMethod
-from planners.timing.laws import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
+from planners.timing.laws.method import ClassicalMethod
+from planners.timing.laws.profiles import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
+from planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
 from planners.timing.min_cost import MinCostMethod
-from planners.timing.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
 
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
 #: default path tolerance of MoveIt's time-optimal trajectory generation.
@@ -62,7 +62,7 @@ class Timing:
         trapezoid_blend: ``"linear"`` (constant acceleration, Angeles 6.1) or ``"cycloidal"``
             (cycloidal blends, Angeles 6.3) for the trapezoidal law's speed ramps.
         supporting_points: For a time law, approximate it by the cubic spline through this many
-            equally spaced points of it (Angeles 6.1 (c), ``planners.timing.splines``);
+            equally spaced points of it (Angeles 6.1 (c), ``planners.timing.laws.splines``);
             ``None``: the law itself.
         synchronization: For a time law on a straight joint move (two waypoints):
             ``"normalized"`` times the straight joint line as one, every joint starting and

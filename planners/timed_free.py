@@ -29,7 +29,7 @@ from planners.search.method import global_search
 from planners.timed import Timed, moving_velocity, path_boundary, timed_path, timing_grid
 from planners.timing.base import GAP_TARGET
 from planners.timing.min_cost import MinCostMethod
-from planners.timing.phase_plane import PhasePlaneMethod
+from planners.timing.phase_plane.method import PhasePlaneMethod
 
 #: Most collocation intervals a request may ask for (timing.grid_points).
 MAX_INTERVALS = 100

@@ -23,7 +23,7 @@ from planners.errors import InfeasiblePath, InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath, PathPoints
 from planners.timing.base import DenseStates, PathTiming
-from planners.timing.laws import cubic_coefficients, quintic_coefficients
+from planners.timing.laws.profiles import cubic_coefficients, quintic_coefficients
 from robots import JointLimits, Robot
 
 ROUNDS = 4

@@ -205,7 +205,7 @@ def test_a_time_law_states_its_gap_to_its_own_shortest_duration(method):
 def test_the_typical_request_states_its_accuracy_without_a_second_solve(monkeypatch):
     """phase_plane's estimate is its own refinement's: the typical request (4 ur5 waypoints)
     solves once."""
-    from planners.timing.phase_plane import PhasePlaneMethod
+    from planners.timing.phase_plane.method import PhasePlaneMethod
 
     calls = []
     solve = PhasePlaneMethod.solve

@@ -12,8 +12,8 @@ from ruckig import InputParameter, Ruckig, Trajectory
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import TimingFailed
-from planners.timing.jerk_limited import JerkLimitedMethod
-from planners.timing.phase_plane import PhasePlaneMethod
+from planners.timing.jerk.method import JerkLimitedMethod
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.waypoint_checks import make_path
 from tests.conftest import UR5_WAYPOINTS
 

@@ -17,10 +17,10 @@ from planners.gate import LIMIT_TOLERANCE
 from planners.limit_check import check_limits
 from planners.paths import SplinePath
 from planners.paths.grid import path_grid
-from planners.refinement_kernels import row_excursions, switch_excess
-from planners.split_kernels import _pieces
 from planners.timing import PhasePlaneMethod
-from planners.timing.phase_plane import _kept_intervals, interval_rows, midpoint_duration, midpoint_stage_rows
+from planners.timing.phase_plane.method import _kept_intervals, interval_rows, midpoint_duration, midpoint_stage_rows
+from planners.timing.phase_plane.refinement_kernels import row_excursions, switch_excess
+from planners.timing.phase_plane.split_kernels import _pieces
 
 
 def _random_constraints(rng, n_points: int, n_rows: int, friction: bool) -> PathConstraints:

@@ -18,6 +18,9 @@ ROOTS = ("robots", "planners", "service", "client")
 PACKAGE_LAYER = {"robots": 0, "planners": 1, "service": 2, "client": 2}
 #: Today's planners module (or folder) -> its room in the target tree.
 ROOM = {
+    "planners.timing.laws": "timing",
+    "planners.timing.jerk": "timing",
+    "planners.timing.phase_plane": "timing",
     "planners.constraints": "constraints",
     "planners.execution": "execution",
     "planners": "runner", "planners.plan": "runner", "planners.timed": "runner", "planners.timed_free": "runner",
@@ -26,8 +29,8 @@ ROOM = {
     "planners.kinematics": "kinematics", "planners.paths": "paths", "planners.paths.grid": "paths", "planners.collision": "collision",
     "planners.constraints.path_constraints": "constraints", "planners.constraints.assembly_kernels": "constraints", "planners.constraints.admissible": "constraints",
     "planners.constraints.admissible_kernels": "constraints", "planners.constraints.tool_speed": "constraints", "planners.constraints.torque_interpolation": "constraints",
-    "planners.timing": "timing", "planners.sweep_kernels": "timing", "planners.refinement_kernels": "timing",
-    "planners.split_kernels": "timing",
+    "planners.timing": "timing", "planners.timing.phase_plane.sweep_kernels": "timing", "planners.timing.phase_plane.refinement_kernels": "timing",
+    "planners.timing.phase_plane.split_kernels": "timing",
     "planners.limit_check": "checks", "planners.limit_kernels": "checks", "planners.gate": "checks",
     "planners.trajectory": "checks",
     "planners.via_points": "generators", "planners.timing.unsynchronized": "generators",

@@ -44,7 +44,7 @@ def smooth_points(constraints) -> np.ndarray:
     """(N + 1,): the grid points of ``constraints`` (a ``PathConstraints``) through which the
     rows are smooth, so that a polynomial through them interpolates the rows: interior, no knot
     of the path, the same rows from both sides (also where ``phase_plane``'s excursion estimate,
-    ``planners.refinement_kernels.row_excursions``, may reach across a grid point)."""
+    ``planners.timing.phase_plane.refinement_kernels.row_excursions``, may reach across a grid point)."""
     grid = constraints.s
     smooth = np.ones(len(grid), dtype=bool)
     smooth[[0, -1]] = False

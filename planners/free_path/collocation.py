@@ -39,7 +39,7 @@ from planners.free_path.motion import CollocationResult, FreeMotion
 from planners.free_path.sparse import SparseCollocation, solve_sparse
 from planners.paths.grid import path_grid
 from planners.paths.waypoints import SplinePath
-from planners.timing.phase_plane import PhasePlaneMethod
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from robots import JointLimits, Robot
 
 

@@ -11,7 +11,7 @@ Dubowsky 1991), each a bound on the next, so that t1 <= t2 <= t3 <= t4 = t_opt:
 3. maximum acceleration, velocity limit, maximum deceleration (eq. 2.8): the speed no higher
    than the maximum-acceleration curve from rest at the start, the velocity limit curve, and
    the maximum-deceleration curve into rest at the goal;
-4. t4 = t_opt: the phase-plane timing of the grid path (``planners.timing.phase_plane``).
+4. t4 = t_opt: the phase-plane timing of the grid path (``planners.timing.phase_plane.method``).
 
 All four are computed in the discretization the phase-plane method uses on the same grid (x =
 sd^2 linear in the curve's parameter over each interval, every limit row held at both ends of it;
@@ -34,7 +34,7 @@ from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT
 from planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
 from planners.search.curve import GridSplinePath
 from planners.search.pieces import INTERVALS, Pieces
-from planners.timing.phase_plane import PhasePlaneMethod
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from robots import JointLimits, Robot
 
 _INF = np.inf
@@ -241,7 +241,7 @@ def path_time(intervals, ds, p, q, r, cap_start, cap_end):  # pragma: no cover -
 
 
 def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds) -> float:
-    """t4 (s): the phase-plane method (``planners.timing.phase_plane``, without refinement) on
+    """t4 (s): the phase-plane method (``planners.timing.phase_plane.method``, without refinement) on
     the curve of the grid path through ``points`` (``planners.search.curve``), on the grid of
     its pieces (``INTERVALS`` per span)."""
     curve = GridSplinePath(points)

@@ -5,7 +5,7 @@
     J(P) = T(P) + W_obstacle * v_obstacle(P) + W_range * v_range(P)
 
 with T the path-constrained time-optimal duration along the spline, at rest at both ends
-(``planners.timing.phase_plane``, reused unchanged), and penalty functions on the obstacle
+(``planners.timing.phase_plane.method``, reused unchanged), and penalty functions on the obstacle
 distance and the joint ranges; the number of control points grows, round by round, until the
 duration stops improving.
 
@@ -59,7 +59,7 @@ from planners.paths.grid import path_grid
 from planners.search.free_space import joint_reaches, point_distances
 from planners.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
 from planners.timing.base import TimeScaling
-from planners.timing.phase_plane import PhasePlaneMethod, midpoint_duration
+from planners.timing.phase_plane.method import PhasePlaneMethod, midpoint_duration
 from robots import JointLimits, Robot
 
 #: The objective of a path no timing can follow (s): above any duration served.

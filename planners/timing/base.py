@@ -13,7 +13,7 @@ import numpy as np
 from planners.constraints.path_constraints import PathConstraints
 from planners.errors import TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.limit_kernels import grid_states
+from planners.timing.state_kernels import grid_states
 
 #: Largest estimated relative gap to the converged optimum that a time-optimal answer carries
 #: without being refined further or, when it cannot be, without a warning that gives the figure

@@ -29,7 +29,7 @@ from planners.errors import InfeasiblePath, InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.paths.base import GeometricPath, PathPoints
 from planners.timing.base import Binding
-from planners.timing.laws import NormalizedProfile
+from planners.timing.laws.profiles import NormalizedProfile
 from planners.via_points import ConstantSpeedTiming
 from robots import JointLimits, Robot
 

@@ -29,8 +29,8 @@ from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
-from planners.timing.law_timing import LawSegment, LawTiming
-from planners.timing.laws import (
+from planners.timing.laws.law_timing import LawSegment, LawTiming
+from planners.timing.laws.profiles import (
     CubicProfile,
     CycloidalProfile,
     NormalizedProfile,

@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from planners.constraints.admissible_kernels import interval_bounds
-from planners.refinement_kernels import switch_excess
+from planners.timing.phase_plane.refinement_kernels import switch_excess
 
 _INF = np.inf
 

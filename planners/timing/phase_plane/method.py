@@ -24,7 +24,7 @@ collapses to one value and the sweeps take it: no chattering, no special case.
 Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
 row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
 point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
-(``planners.constraints.admissible_kernels``, ``planners.sweep_kernels``): no LP is solved anywhere; one compiled call
+(``planners.constraints.admissible_kernels``, ``planners.timing.phase_plane.sweep_kernels``): no LP is solved anywhere; one compiled call
 per sweep pair builds the rows of every interval, linearizes viscous friction, finds the
 admissible intervals and runs both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
 amount, so the grid is refined where it costs time: the error of each interval is estimated from
@@ -36,7 +36,7 @@ estimate under the tolerance (each new piece where it removes the most error), w
 constraint rows evaluated anew at the new points (one batched evaluation per round),
 until the estimated duration error is below the tolerance. The same rounds split the intervals
 where a limit, held at both ends, bulges past itself between them by more than a small fraction
-(``planners.refinement_kernels.row_excursions``: the rows and the speed bound at the quarter
+(``planners.timing.phase_plane.refinement_kernels.row_excursions``: the rows and the speed bound at the quarter
 points from the cubic through the neighbouring grid points, no dynamics evaluated), so that on a
 coarse grid the answer holds its limits between grid points too, not only at them.
 """
@@ -53,10 +53,10 @@ from planners.constraints.path_constraints import LinearRows, PathConstraints
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath
 from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.refinement_kernels import refinement, row_excursions
-from planners.split_kernels import split_points
-from planners.sweep_kernels import sweeps
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from planners.timing.phase_plane.refinement_kernels import refinement, row_excursions
+from planners.timing.phase_plane.split_kernels import split_points
+from planners.timing.phase_plane.sweep_kernels import sweeps
 
 #: Relative slack when comparing x values computed along different routes.
 _SLACK = 1e-9
@@ -106,10 +106,10 @@ _MAX_PIECES = 8
 #: Refinement aims at this fraction of the tolerance, so that one round usually suffices.
 _AIM = 0.85
 #: Weight, in the estimated error, of the estimates that may cancel in its signed sum or
-#: estimate nothing (``planners.refinement_kernels.refinement``): a guard against their own errors.
+#: estimate nothing (``planners.timing.phase_plane.refinement_kernels.refinement``): a guard against their own errors.
 _GUARD = 0.15
 #: Relative excess of a row over its limit, midway between two grid points, above which the
-#: interval is split (``planners.refinement_kernels.row_excursions``), well within the dense
+#: interval is split (``planners.timing.phase_plane.refinement_kernels.row_excursions``), well within the dense
 #: check's ``planners.gate.LIMIT_TOLERANCE``.
 _EXCURSION = 3e-4
 #: The refined grid has at most 2^max_refinements times the intervals of the given one (what
@@ -125,14 +125,14 @@ class PhasePlaneMethod(TimingMethod):
             estimated from the midpoint discretization on the same grid (second order, so it
             stands for the exact answer), from the time each interval would save by switching
             inside it, and from the chord error along the maximum velocity curve
-            (``planners.refinement_kernels.refinement``); intervals are split where the estimates lie,
+            (``planners.timing.phase_plane.refinement_kernels.refinement``); intervals are split where the estimates lie,
             each into as many pieces as its share asks for, with the constraint rows evaluated
             anew at the new points, until the estimate falls below ``tolerance`` or
             ``max_refinements`` rounds are done.
         max_refinements: Rounds of refinement; 0 keeps the given grid.
         excursion: In each round, intervals are also split where a limit, held at both ends,
             is estimated to be exceeded by more than this fraction midway between them
-            (``planners.refinement_kernels.row_excursions``); ``None``: the duration alone
+            (``planners.timing.phase_plane.refinement_kernels.row_excursions``); ``None``: the duration alone
             decides where points go, and the limits hold at the grid points only.
 
     The answer carries the last estimate of its relative duration error as its
@@ -219,7 +219,7 @@ GAP_BASIS = (
 
 def _duration_error(grid: _Grid, profile: _Profile, x_ends, deadline, tolerance: float) -> float | None:
     """The relative duration error of ``profile`` on ``grid``, estimated as in the refinement
-    (``planners.refinement_kernels.refinement``); ``None`` when the midpoint discretization finds
+    (``planners.timing.phase_plane.refinement_kernels.refinement``); ``None`` when the midpoint discretization finds
     no motion."""
     try:
         reference = _solve_on_grid(grid, x_ends, deadline, midpoint=True, x_ref=profile.x)
@@ -297,7 +297,7 @@ class _Grid(NamedTuple):
 class _Profile(NamedTuple):
     """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
     envelope (N + 1,), the admissible upper x_i of each interval (N,), how much faster each
-    interval could be crossed at its bounds (N,, ``planners.refinement_kernels.switch_excess``)
+    interval could be crossed at its bounds (N,, ``planners.timing.phase_plane.refinement_kernels.switch_excess``)
     and the intervals' bounds (``planners.constraints.admissible_kernels.interval_bounds``' p, q, r, x_low, x_high)."""
 
     x: np.ndarray
@@ -339,7 +339,7 @@ def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoin
 
 
 def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> _Profile:
-    """One sweep pair (``planners.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
+    """One sweep pair (``planners.timing.phase_plane.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
     rows linearized around ``x_ref``."""
     x_bound, constraints = grid.x_bound, grid.constraints
     if x_end > x_bound[-1] * (1 + _SLACK) + _SLACK:

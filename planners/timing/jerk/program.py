@@ -1,10 +1,10 @@
 """The linear program of one conservative restriction of the jerk-limited timing
-(``planners.timing.jerk_limited``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
+(``planners.timing.jerk.method``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
 limit linear in (x, u) = (sd^2, sdd), the jerk limit's right-hand side J / sqrt(x) replaced by
 its tangent at the current solution, solved by HiGHS's dual simplex.
 
 Discretization (``JerkTimeScaling``): x and u at the grid points, u linear in s between them
-(x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``planners.timing.jerk_limited``'s (1), its
+(x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``planners.timing.jerk.method``'s (1), its
 right-hand side the tangent) at both ends of every interval with du/ds = (u_i+1 - u_i) / h_i,
 the second-order rows at every grid point and at the middle of
 every interval (where x = x_i + (3 u_i + u_i+1) h_i / 4), the velocity bound at its quarters
@@ -25,7 +25,7 @@ from planners.constraints.path_constraints import PathConstraints
 from planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import Boundary
-from planners.timing.jerk_scaling import JerkTimeScaling
+from planners.timing.jerk.scaling import JerkTimeScaling
 
 
 class RestrictedProgram:

@@ -1,5 +1,5 @@
 """``JerkTimeScaling``: a time scaling s(t) with continuous path acceleration, for the
-jerk-limited timing (``planners.timing.jerk_limited``).
+jerk-limited timing (``planners.timing.jerk.method``).
 
 On the grid s_0 < ... < s_N it holds x_i = sd_i^2 and u_i = sdd_i. Within an interval of width
 h_i the path acceleration is linear in s, u(s) = u_i + w_i (s - s_i) with w_i = du/ds =

@@ -2,8 +2,8 @@
 of a conservative (interpolation) profile loses, from the midpoint discretization on the same grid,
 from a switch inside the interval (``switch_excess``) and from the chord along a curved maximum
 velocity curve, and the pieces each interval is split into so that the estimated duration error
-falls to the tolerance (``refinement``, with ``planners.split_kernels``), and how far the limits
-bulge between grid points (``row_excursions``). ``planners.timing.phase_plane`` explains the
+falls to the tolerance (``refinement``, with ``planners.timing.phase_plane.split_kernels``), and how far the limits
+bulge between grid points (``row_excursions``). ``planners.timing.phase_plane.method`` explains the
 scheme; these loops hold no knowledge of paths or robots (``nogil``, cached on disk).
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from planners.split_kernels import _pieces
+from planners.timing.phase_plane.split_kernels import _pieces
 
 _INF = np.inf
 
