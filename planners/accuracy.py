@@ -16,7 +16,7 @@ relative error, found independently of the solve:
   kept). The scheme is first order in the interval length h, J(h) = J* + C h, so the answer's
   error J(h) - J* is about J(2h) - J(h) (the Richardson difference).
 
-The policy (``finer_constraints``, applied by ``planners.gate.gated``): for a time-optimal method
+The policy (``finer_constraints``, applied by ``planners.checks.gate.gated``): for a time-optimal method
 on its default grid, an estimate above ``GAP_TARGET`` refines the grid where the phase-plane
 method's refinement put its points (the intervals that carry the error), within the method's grid
 cap and the time budget, and solves again; the finer answer replaces the first only when it too

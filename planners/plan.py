@@ -13,15 +13,15 @@ import time
 import numpy as np
 
 from planners.accuracy import answer_accuracy
+from planners.checks.gate import TimedStretch, gate_threshold, samples_exceed
 from planners.collision import Obstacle, check_clearance
 from planners.collision.obstacles import check_obstacles
 from planners.constraints.admissible import admissible_set
 from planners.constraints.tool_speed import tool_speed_limit
 from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.free_path import FreeMotion
-from planners.free_path.switching import collocation_switches, switching_times
-from planners.gate import TimedStretch, gate_threshold, samples_exceed
+from planners.generators.collocation import FreeMotion
+from planners.generators.collocation.switching import collocation_switches, switching_times
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from planners.paths.blended import MIN_BLEND, BlendedPath
 from planners.paths.cartesian import CartesianLine

@@ -10,8 +10,8 @@ from numpy.typing import ArrayLike
 
 from planners.constraints.path_constraints import CONSTRAINT_KINDS
 from planners.errors import InvalidRequest
-from planners.search.graph import SearchOptions
-from planners.search.method import SearchMethod
+from planners.generators.search.graph import SearchOptions
+from planners.generators.search.method import SearchMethod
 from planners.timing import METHODS
 from planners.timing.base import TimingMethod
 from planners.timing.collocation_method import CollocationMethod
@@ -67,7 +67,7 @@ class Timing:
         synchronization: For a time law on a straight joint move (two waypoints):
             ``"normalized"`` times the straight joint line as one, every joint starting and
             stopping together; ``"none"`` runs every joint at its own full speed to its goal
-            (lecture "Trajectory Planning"; ``planners.timing.unsynchronized``).
+            (lecture "Trajectory Planning"; ``planners.generators.unsynchronized``).
         torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
             ``min_cost``.
         limit_margin: Fraction of every velocity, acceleration, jerk, torque and tool-speed
@@ -78,7 +78,7 @@ class Timing:
         tool_angular_speed: Largest angular speed of the tool frame, rad/s; ``None``: none.
         tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
         search: Options of the global search (``timing.method = "search"``); ``None``: the
-            defaults of ``planners.search.SearchOptions``.
+            defaults of ``planners.generators.search.SearchOptions``.
     """
 
     method: str = "phase_plane"

@@ -12,17 +12,17 @@ from typing import NamedTuple
 import numpy as np
 
 from planners.boundary import path_acceleration, path_speed
+from planners.checks.gate import TimedStretch, checked, gated
 from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest
-from planners.gate import TimedStretch, checked, gated
+from planners.generators.unsynchronized import unsynchronized_trajectory
+from planners.generators.via_points import via_point_trajectory
 from planners.paths import GeometricPath
 from planners.paths.grid import path_grid
 from planners.paths.stretch import Stretch, stretches
 from planners.requests import Timing, WaypointPath
 from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.segmented import SegmentedTiming
-from planners.timing.unsynchronized import unsynchronized_trajectory
-from planners.via_points import via_point_trajectory
 from planners.waypoint_checks import checked_waypoints
 from robots import Robot
 

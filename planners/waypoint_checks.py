@@ -1,6 +1,6 @@
 """Joint waypoints as a request gives them: checked against the robot, repeats dropped, and
 turned into a geometric path (spline, stop-and-go or blended; via points are timed and shaped together
-in ``planners.via_points``, Cartesian lines in ``planners.paths.cartesian``)."""
+in ``planners.generators.via_points``, Cartesian lines in ``planners.paths.cartesian``)."""
 
 from __future__ import annotations
 

@@ -16,10 +16,10 @@ from planners.boundary import finite_vector
 from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.execution.deadline import NO_DEADLINE
-from planners.free_path import FreeMotion
+from planners.generators.collocation import FreeMotion
+from planners.generators.search import SearchOptions
+from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
-from planners.search import SearchOptions
-from planners.search.graph import DEFAULT_SEARCH_MEMORY
 from robots import InvalidLimits, UnknownRobot
 from robots.catalog import catalog_robot_built
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
@@ -139,7 +139,7 @@ def plan_request(
     ``output.dt`` whose samples would not fit in a body of that size (422 naming the smallest
     ``dt`` that fits). ``accept`` (the HTTP Accept header) may choose CSV, which puts the samples
     on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
-    (``planners.search.memory``)."""
+    (``planners.generators.search.memory``)."""
     robot = robots.load(request.robot)
     timing = _timing(request)
     if timing.method == "search":

@@ -13,9 +13,9 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 import robots
+from planners.checks.limit_check import INTERPOLATION_TOLERANCE, _torques, check_limits, joint_motion
+from planners.checks.limit_kernels import utilization_pass
 from planners.constraints.path_constraints import build_path_constraints
-from planners.limit_check import INTERPOLATION_TOLERANCE, _torques, check_limits, joint_motion
-from planners.limit_kernels import utilization_pass
 from planners.paths import SplinePath
 from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod, ToppraMethod

@@ -9,7 +9,7 @@ import pytest
 import robots
 from planners import Timing, plan
 from planners.execution.deadline import Deadline
-from planners.free_path import FreeMotion
+from planners.generators.collocation import FreeMotion
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +92,7 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     assert cheap.peak_utilization["torque"].max() <= 1.005
     fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
     assert fast.duration < cheap.duration
-    # refined to exact bang-bang torques (planners.free_path.switching): never longer than the
+    # refined to exact bang-bang torques (planners.generators.collocation.switching): never longer than the
     # collocation's own duration, and at the converged minimum time (fine collocation: 0.20599 s)
     assert fast.solver["switching"] == "refined"
     assert fast.duration <= fast.solver["duration"]

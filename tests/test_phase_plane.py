@@ -9,9 +9,9 @@ from scipy.optimize import brentq
 
 import robots
 from planners import Timing, WaypointPath, plan
+from planners.checks.limit_check import check_limits
 from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath
-from planners.limit_check import check_limits
 from planners.paths import SplinePath
 from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod, ToppraMethod

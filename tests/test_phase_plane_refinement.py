@@ -9,12 +9,12 @@ import pytest
 
 import robots
 from benchmarks.accuracy import KINDS, random_waypoints
+from planners.checks.gate import LIMIT_TOLERANCE
+from planners.checks.limit_check import check_limits
 from planners.constraints.admissible import acceleration_bounds, admissible_set
 from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, zero_inertia_intervals
 from planners.constraints.path_constraints import PathConstraints, build_path_constraints
 from planners.errors import InfeasiblePath
-from planners.gate import LIMIT_TOLERANCE
-from planners.limit_check import check_limits
 from planners.paths import SplinePath
 from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod

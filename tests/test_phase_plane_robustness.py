@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import robots
+from planners.checks.limit_check import check_limits
 from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.limit_check import check_limits
 from planners.paths import SplinePath, StopAndGoPath
 from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod, ToppraMethod

@@ -17,10 +17,10 @@ import robots
 from planners import BudgetExceeded, Deadline
 from planners.collision import BoxObstacle
 from planners.errors import OverMemory
-from planners.search.graph import SearchOptions, lattice_graph, roadmap_graph
-from planners.search.memory import check_search_memory, search_spans
-from planners.search.method import global_search
-from planners.search.pieces import span_keys
+from planners.generators.search.graph import SearchOptions, lattice_graph, roadmap_graph
+from planners.generators.search.memory import check_search_memory, search_spans
+from planners.generators.search.method import global_search
+from planners.generators.search.pieces import span_keys
 from service.app import create_app
 from service.settings import Settings
 

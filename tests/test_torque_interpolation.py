@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import robots
+from planners.checks.limit_check import INTERPOLATION_TOLERANCE, _torques, joint_motion
 from planners.constraints.path_constraints import build_path_constraints
 from planners.constraints.torque_interpolation import MAX_TRAVEL
-from planners.limit_check import INTERPOLATION_TOLERANCE, _torques, joint_motion
 from planners.paths import SplinePath, StopAndGoPath
 from planners.paths.blended import BlendedPath
 from planners.paths.grid import path_grid

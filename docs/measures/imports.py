@@ -18,6 +18,8 @@ ROOTS = ("robots", "planners", "service", "client")
 PACKAGE_LAYER = {"robots": 0, "planners": 1, "service": 2, "client": 2}
 #: Today's planners module (or folder) -> its room in the target tree.
 ROOM = {
+    "planners.generators": "generators",
+    "planners.checks": "checks",
     "planners.timing.laws": "timing",
     "planners.timing.jerk": "timing",
     "planners.timing.phase_plane": "timing",
@@ -31,10 +33,10 @@ ROOM = {
     "planners.constraints.admissible_kernels": "constraints", "planners.constraints.tool_speed": "constraints", "planners.constraints.torque_interpolation": "constraints",
     "planners.timing": "timing", "planners.timing.phase_plane.sweep_kernels": "timing", "planners.timing.phase_plane.refinement_kernels": "timing",
     "planners.timing.phase_plane.split_kernels": "timing",
-    "planners.limit_check": "checks", "planners.limit_kernels": "checks", "planners.gate": "checks",
+    "planners.checks.limit_check": "checks", "planners.checks.limit_kernels": "checks", "planners.checks.gate": "checks",
     "planners.trajectory": "checks",
-    "planners.via_points": "generators", "planners.timing.unsynchronized": "generators",
-    "planners.timing.collocation_method": "generators", "planners.free_path": "generators", "planners.search": "generators",
+    "planners.generators.via_points": "generators", "planners.generators.unsynchronized": "generators",
+    "planners.timing.collocation_method": "generators", "planners.generators.collocation": "generators", "planners.generators.search": "generators",
     "planners.requests": "problem", "planners.waypoint_checks": "problem", "planners.boundary": "problem",
     "planners.ranges": "problem", "planners.results": "results",
 }

@@ -1,6 +1,6 @@
 """Joint torques between the grid points of a path's constraints, from the rows the build
 computed there with the RNEA (numba, ``nogil``, cached): the dense limit check's torques
-(``planners.limit_check``) without a dynamics evaluation per state where the interpolation is
+(``planners.checks.limit_check``) without a dynamics evaluation per state where the interpolation is
 accurate, and with one where it is not. (The rows a refining method adds at new grid points
 take the RNEA itself, ``PathConstraints.with_points``: with the compiled pass of
 ``robots.chain_dynamics`` that is as fast as interpolating them, and exact.)

@@ -57,7 +57,7 @@ PROGRESS_S = 0.1
 #: shares the cores with a server's short requests, which keep theirs.
 LOW_PRIORITY = 5
 #: Modules the fork server imports once, so that children start with them loaded.
-PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.free_path.collocation"]
+PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.generators.collocation.collocation"]
 
 _context = None
 _lock = threading.Lock()

@@ -20,7 +20,7 @@ import robots
 from planners import Deadline
 from planners.errors import InvalidRequest
 from planners.execution.deadline import Progress
-from planners.search.graph import DEFAULT_SEARCH_MEMORY
+from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 

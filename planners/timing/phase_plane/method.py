@@ -110,7 +110,7 @@ _AIM = 0.85
 _GUARD = 0.15
 #: Relative excess of a row over its limit, midway between two grid points, above which the
 #: interval is split (``planners.timing.phase_plane.refinement_kernels.row_excursions``), well within the dense
-#: check's ``planners.gate.LIMIT_TOLERANCE``.
+#: check's ``planners.checks.gate.LIMIT_TOLERANCE``.
 _EXCURSION = 3e-4
 #: The refined grid has at most 2^max_refinements times the intervals of the given one (what
 #: halving every interval in each round would give), or this many, whichever is more.

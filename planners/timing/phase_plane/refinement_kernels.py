@@ -230,7 +230,7 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
     Only limits used to within ``_NEAR`` at an end of the interval are looked at. The excursion
     falls with the square of the piece length: k pieces leave e / k^2 of an excess e, so
     k = ceil(sqrt(e / target)), at most ``max_pieces``. The dense limit check
-    (``planners.gate``) stays the judge; this only keeps the grid fine where the limits curve.
+    (``planners.checks.gate``) stays the judge; this only keeps the grid fine where the limits curve.
     """
     n_stages = s.shape[0] - 1
     n_rows = a.shape[1]

@@ -9,7 +9,7 @@ The curve has one span per edge, parameter u in [span, span + 1] for span k betw
 and s = u / L for L edges. It is C2 everywhere: no corner where the motion must stop, no jump of
 curvature. Span k depends on the control points k - 1 ... k + 2 only, that is on three
 consecutive moves of the grid path, which is what lets the search bound a partial path
-(``planners.search.pieces``).
+(``planners.generators.search.pieces``).
 """
 
 from __future__ import annotations

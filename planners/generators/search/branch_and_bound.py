@@ -31,10 +31,10 @@ import numpy as np
 
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.search.bounds import forward_time, grid_path_time, path_time
-from planners.search.graph import DEFAULT_OPTIONS, SearchOptions
-from planners.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
-from planners.search.problem import SearchProblem
+from planners.generators.search.bounds import forward_time, grid_path_time, path_time
+from planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
+from planners.generators.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
+from planners.generators.search.problem import SearchProblem
 
 #: Relative slack of a bound over t_u before it discards (float rounding between the bound's
 #: and the phase-plane method's sums of the same intervals).

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planners.checks.limit_kernels import utilization_pass
 from planners.constraints.path_constraints import PathConstraints
 from planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from planners.constraints.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel
-from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from robots import JointLimits, Robot

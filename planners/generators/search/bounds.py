@@ -32,8 +32,8 @@ from numba import njit
 
 from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
 from planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
-from planners.search.curve import GridSplinePath
-from planners.search.pieces import INTERVALS, Pieces
+from planners.generators.search.curve import GridSplinePath
+from planners.generators.search.pieces import INTERVALS, Pieces
 from planners.timing.phase_plane.method import PhasePlaneMethod
 from robots import JointLimits, Robot
 
@@ -242,7 +242,7 @@ def path_time(intervals, ds, p, q, r, cap_start, cap_end):  # pragma: no cover -
 
 def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds) -> float:
     """t4 (s): the phase-plane method (``planners.timing.phase_plane.method``, without refinement) on
-    the curve of the grid path through ``points`` (``planners.search.curve``), on the grid of
+    the curve of the grid path through ``points`` (``planners.generators.search.curve``), on the grid of
     its pieces (``INTERVALS`` per span)."""
     curve = GridSplinePath(points)
     s = np.linspace(0.0, 1.0, curve.spans * INTERVALS + 1)

@@ -17,8 +17,8 @@ import numpy as np
 from planners.collision import Obstacle, clearance_along
 from planners.collision.distance import capsule_distance
 from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.search.curve import BASIS
-from planners.search.pieces import Pieces
+from planners.generators.search.curve import BASIS
+from planners.generators.search.pieces import Pieces
 from robots import Robot
 from robots.collision import robot_capsules
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from planners.collision import Obstacle
-from planners.search.free_space import joint_placements, point_distances
+from planners.generators.search.free_space import joint_placements, point_distances
 from robots import Robot
 
 #: Grid points per joint of the occupancy grid.

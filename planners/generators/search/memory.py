@@ -1,8 +1,8 @@
 """The memory a search needs, estimated from its settings before any work, against a cap.
 
-A search's memory is that of its spans of curve (``planners.search.pieces``): per span, its
+A search's memory is that of its spans of curve (``planners.generators.search.pieces``): per span, its
 control points, its samples and their derivatives at ``INTERVALS`` intervals, and the rows of
-its bounds (``planners.search.bounds``), all proportional to the joint count n. The spans are
+its bounds (``planners.generators.search.bounds``), all proportional to the joint count n. The spans are
 the pairs of consecutive turns of the direction-augmented graph, so their count K grows with
 the cube of a node's degree:
 
@@ -45,7 +45,7 @@ import math
 import numpy as np
 
 from planners.errors import InvalidRequest, OverMemory
-from planners.search.graph import (
+from planners.generators.search.graph import (
     DEFAULT_MAX_TURN,
     LATTICE_MAX_JOINTS,
     MAX_ROADMAP_POINTS,
@@ -53,7 +53,7 @@ from planners.search.graph import (
     goal_variants,
     lattice_axes,
 )
-from planners.search.problem import GRAPH_KINDS
+from planners.generators.search.problem import GRAPH_KINDS
 from robots import Robot
 from robots.errors import excerpt
 
@@ -171,7 +171,7 @@ def check_search_memory(
     Raises:
         OverMemory: the estimate exceeds the cap; the detail names the settings and the largest
             value of one of them served with the others unchanged.
-        InvalidRequest: settings the graph refuses (``planners.search.graph``).
+        InvalidRequest: settings the graph refuses (``planners.generators.search.graph``).
     """
     cap_bytes = options.memory_bytes if cap_bytes is None else cap_bytes
     need = search_bytes(robot, start, goal, options, revolutions)

@@ -1,4 +1,4 @@
-"""The settings of the local optimization of a path among obstacles (``planners.search.local``,
+"""The settings of the local optimization of a path among obstacles (``planners.generators.search.local``,
 Jeong & Lee §2.6) and what it answers: each round's result, the statistics, and the optimum
 with its exact timing and clearance.
 """

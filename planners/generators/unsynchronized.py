@@ -27,10 +27,10 @@ import numpy as np
 
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.generators.via_points import ConstantSpeedTiming
 from planners.paths.base import GeometricPath, PathPoints
 from planners.timing.base import Binding
 from planners.timing.laws.profiles import NormalizedProfile
-from planners.via_points import ConstantSpeedTiming
 from robots import JointLimits, Robot
 
 #: Samples of tau for the law's peak derivatives (its knots are added).

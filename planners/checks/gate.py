@@ -1,5 +1,5 @@
 """The limit gate every answer passes: a timing is checked on a dense resampling
-(``planners.limit_check``); where a limit is exceeded, the grid is refined there and the path
+(``planners.checks.limit_check``); where a limit is exceeded, the grid is refined there and the path
 timed again; a timing that still exceeds a limit, or that cannot be refined, is refused with the
 place, the joint and the limit.
 """
@@ -12,11 +12,11 @@ from typing import NamedTuple
 import numpy as np
 
 from planners.accuracy import REFINE_ROUNDS, estimated, finer_constraints
+from planners.checks.limit_check import Excess, LimitCheck, check_limits
+from planners.checks.limit_kernels import utilization_pass
 from planners.constraints.path_constraints import PathConstraints
 from planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.limit_check import Excess, LimitCheck, check_limits
-from planners.limit_kernels import utilization_pass
 from planners.paths.base import GeometricPath
 from planners.timing.base import PathTiming, TimeScaling
 from planners.timing.laws.law_timing import LawTiming

@@ -54,10 +54,10 @@ from planners.collision.obstacles import Obstacle
 from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest
 from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.generators.search.free_space import joint_reaches, point_distances
+from planners.generators.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
 from planners.paths.bspline import DEGREE, BSplinePath, clamped_knots, insert_knot
 from planners.paths.grid import path_grid
-from planners.search.free_space import joint_reaches, point_distances
-from planners.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
 from planners.timing.base import TimeScaling
 from planners.timing.phase_plane.method import PhasePlaneMethod, midpoint_duration
 from robots import JointLimits, Robot
