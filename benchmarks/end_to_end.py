@@ -98,9 +98,9 @@ def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int
     first built on), over its stretches: what ``planners.plan`` times, without the sampling."""
     from planners.checks.gate import gate_threshold
     from planners.execution.deadline import NO_DEADLINE
-    from planners.requests import check_constraint_kinds, timing_method
-    from planners.timed import timed_path
-    from planners.waypoint_checks import make_path
+    from planners.problem.requests import check_constraint_kinds, timing_method
+    from planners.problem.waypoints import make_path
+    from planners.runner.given_path import timed_path
 
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)

@@ -25,9 +25,9 @@ from planners import WaypointPath
 from planners.constraints.path_constraints import build_path_constraints
 from planners.execution.deadline import NO_DEADLINE
 from planners.paths.grid import path_grid
+from planners.problem.waypoints import make_path
 from planners.timing.base import AT_REST
 from planners.timing.jerk.method import JerkLimitedMethod
-from planners.waypoint_checks import make_path
 
 KINDS = ("velocity", "acceleration", "torque", "jerk")
 

@@ -5,7 +5,7 @@ from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, Timi
 from planners.execution.deadline import Deadline
 from planners.paths.cartesian import CartesianLine
 from planners.plan import plan
-from planners.requests import Timing, WaypointPath
+from planners.problem.requests import Timing, WaypointPath
 from planners.results import PlannedTrajectory
 from planners.timing import METHODS, TimeScaling
 

@@ -12,7 +12,6 @@ import time
 
 import numpy as np
 
-from planners.accuracy import answer_accuracy
 from planners.checks.gate import TimedStretch, gate_threshold, samples_exceed
 from planners.collision import Obstacle, check_clearance
 from planners.collision.obstacles import check_obstacles
@@ -26,16 +25,17 @@ from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_a
 from planners.paths.blended import MIN_BLEND, BlendedPath
 from planners.paths.cartesian import CartesianLine
 from planners.paths.grid import MAX_POINTS, spread_indices
-from planners.ranges import DT, check_timing
-from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
+from planners.problem.ranges import DT, check_timing
+from planners.problem.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
+from planners.problem.waypoints import continuous_turns, make_path, without_repeats
 from planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
-from planners.timed import timed_path, timed_unsynchronized, timed_via_points
-from planners.timed_free import timed_free_motion, timed_search
+from planners.runner.accuracy import answer_accuracy
+from planners.runner.given_path import timed_path, timed_unsynchronized, timed_via_points
+from planners.runner.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
 from planners.timing.laws.law_timing import LawTiming
 from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.trajectory import sample_trajectory
-from planners.waypoint_checks import continuous_turns, make_path, without_repeats
 from robots import JointLimits, Robot
 
 MAX_SAMPLES = 200_000

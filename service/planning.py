@@ -12,7 +12,6 @@ import orjson
 
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
-from planners.boundary import finite_vector
 from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.execution.deadline import NO_DEADLINE
@@ -20,6 +19,7 @@ from planners.generators.collocation import FreeMotion
 from planners.generators.search import SearchOptions
 from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
+from planners.problem.boundary import finite_vector
 from robots import InvalidLimits, UnknownRobot
 from robots.catalog import catalog_robot_built
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
@@ -308,7 +308,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
 
 def accuracy_body(result: PlannedTrajectory) -> dict:
     """``{"relative_gap", "basis"}``: the answer's estimated relative distance from the
-    converged optimum of its method's problem (``planners.accuracy``), null when not estimated."""
+    converged optimum of its method's problem (``planners.runner.accuracy``), null when not estimated."""
     accuracy = result.accuracy
     if accuracy is None:
         return {"relative_gap": None, "basis": f"not estimated for timing.method {result.method}"}

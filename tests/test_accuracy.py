@@ -40,7 +40,7 @@ def test_default_durations_are_within_a_tenth_of_a_percent_of_the_converged_opti
     assert compared >= 2
 
 
-# Every answer states its accuracy (planners/accuracy.py): the estimated relative gap to the
+# Every answer states its accuracy (planners/runner/accuracy.py): the estimated relative gap to the
 # converged optimum, held within 0.1 % for time-optimal methods on their default grids.
 
 UR5_START = [0.3, -1.6, 1.7, -1.6, -1.57, 0.2]
@@ -219,7 +219,7 @@ def test_the_warning_advises_only_what_the_method_serves():
     """The remedy of a gap above 0.1 % is a timing.grid_points the method serves on the robot
     (the gap shrinks as the intervals grow), else the phase-plane method, never a grid beyond
     its cap."""
-    from planners.accuracy import gap_warning
+    from planners.runner.accuracy import gap_warning
     from planners.timing.toppra_method import ToppraMethod
 
     within = gap_warning(ToppraMethod(), 0.008, 100, 6, grid_given=True)

@@ -25,10 +25,10 @@ import robots
 from planners import Timing, WaypointPath, plan
 from planners.constraints.path_constraints import build_path_constraints
 from planners.paths.grid import path_grid
+from planners.problem.waypoints import make_path
 from planners.timing.jerk.closed_form import ScalarLimits, double_s
 from planners.timing.jerk.method import JerkLimitedMethod
 from planners.timing.jerk.segments import segment_starts
-from planners.waypoint_checks import make_path
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")
 

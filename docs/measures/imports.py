@@ -18,6 +18,8 @@ ROOTS = ("robots", "planners", "service", "client")
 PACKAGE_LAYER = {"robots": 0, "planners": 1, "service": 2, "client": 2}
 #: Today's planners module (or folder) -> its room in the target tree.
 ROOM = {
+    "planners.runner": "runner",
+    "planners.problem": "problem",
     "planners.generators": "generators",
     "planners.checks": "checks",
     "planners.timing.laws": "timing",
@@ -25,7 +27,7 @@ ROOM = {
     "planners.timing.phase_plane": "timing",
     "planners.constraints": "constraints",
     "planners.execution": "execution",
-    "planners": "runner", "planners.plan": "runner", "planners.timed": "runner", "planners.timed_free": "runner",
+    "planners": "runner", "planners.plan": "runner", "planners.runner.given_path": "runner", "planners.runner.timed_free": "runner",
     "planners.errors": "errors", "planners.diagnostics": "errors",
     "planners.execution.deadline": "execution", "planners.execution.isolated": "execution", "planners.execution.threads": "execution",
     "planners.kinematics": "kinematics", "planners.paths": "paths", "planners.paths.grid": "paths", "planners.collision": "collision",
@@ -37,8 +39,8 @@ ROOM = {
     "planners.trajectory": "checks",
     "planners.generators.via_points": "generators", "planners.generators.unsynchronized": "generators",
     "planners.timing.collocation_method": "generators", "planners.generators.collocation": "generators", "planners.generators.search": "generators",
-    "planners.requests": "problem", "planners.waypoint_checks": "problem", "planners.boundary": "problem",
-    "planners.ranges": "problem", "planners.results": "results",
+    "planners.problem.requests": "problem", "planners.problem.waypoints": "problem", "planners.problem.boundary": "problem",
+    "planners.problem.ranges": "problem", "planners.results": "results",
 }
 #: Layer of each room (docs/design.md, "Layers"): lower numbers are imported by higher ones.
 ROOM_LAYER = {

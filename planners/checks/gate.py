@@ -11,13 +11,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.accuracy import REFINE_ROUNDS, estimated, finer_constraints
 from planners.checks.limit_check import Excess, LimitCheck, check_limits
 from planners.checks.limit_kernels import utilization_pass
 from planners.constraints.path_constraints import PathConstraints
 from planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from planners.errors import InfeasiblePath, TimingFailed
 from planners.paths.base import GeometricPath
+from planners.runner.accuracy import REFINE_ROUNDS, estimated, finer_constraints
 from planners.timing.base import PathTiming, TimeScaling
 from planners.timing.laws.law_timing import LawTiming
 from planners.timing.scaled import solve_well_scaled
@@ -59,8 +59,8 @@ def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
 def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
     """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
     exceeded by more than ``threshold``, refine the grid there and time the path again. Every
-    timing carries its estimated gap to the converged optimum (``planners.accuracy``); a
-    time-optimal one above ``planners.accuracy.GAP_TARGET`` on a grid the request did not name
+    timing carries its estimated gap to the converged optimum (``planners.runner.accuracy``); a
+    time-optimal one above ``planners.runner.accuracy.GAP_TARGET`` on a grid the request did not name
     (``grid_given``) is timed again on a finer grid, which replaces it only when it too holds
     the limits.
 

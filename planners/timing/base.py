@@ -17,7 +17,7 @@ from planners.timing.state_kernels import grid_states
 
 #: Largest estimated relative gap to the converged optimum that a time-optimal answer carries
 #: without being refined further or, when it cannot be, without a warning that gives the figure
-#: (``PathTiming.optimality_gap``; the policy in ``planners.accuracy``).
+#: (``PathTiming.optimality_gap``; the policy in ``planners.runner.accuracy``).
 GAP_TARGET = 1e-3
 
 

@@ -13,8 +13,8 @@ from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from planners.paths.blended import BlendedPath
 from planners.paths.cartesian import CartesianLine, cartesian_path
-from planners.ranges import COORDINATE, MAX_DEVIATION, check
-from planners.requests import DEFAULT_MAX_DEVIATION, WaypointPath
+from planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
+from planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
 from robots import Robot
 
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath, "blend": BlendedPath}

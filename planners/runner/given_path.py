@@ -11,7 +11,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.boundary import path_acceleration, path_speed
 from planners.checks.gate import TimedStretch, checked, gated
 from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest
@@ -20,10 +19,11 @@ from planners.generators.via_points import via_point_trajectory
 from planners.paths import GeometricPath
 from planners.paths.grid import path_grid
 from planners.paths.stretch import Stretch, stretches
-from planners.requests import Timing, WaypointPath
+from planners.problem.boundary import path_acceleration, path_speed
+from planners.problem.requests import Timing, WaypointPath
+from planners.problem.waypoints import checked_waypoints
 from planners.timing.base import Boundary, PathTiming, TimingMethod
 from planners.timing.segmented import SegmentedTiming
-from planners.waypoint_checks import checked_waypoints
 from robots import Robot
 
 
@@ -102,7 +102,7 @@ class Timed(NamedTuple):
     switching_times: dict | None = None
     #: For a method that finds the motion itself (a free path): the estimated relative gap of
     #: its objective to the optimum of its own problem, and how it was estimated; ``None`` when
-    #: the answer's accuracy is that of its path's timing (``planners.accuracy``).
+    #: the answer's accuracy is that of its path's timing (``planners.runner.accuracy``).
     motion_gap: tuple[float | None, str] | None = None
 
 

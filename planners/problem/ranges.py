@@ -66,7 +66,7 @@ def check_vector(values, field: str, accepted: Range, signed: bool = False) -> N
 
 
 def check_timing(timing, dt: float) -> None:
-    """Hold every number of a ``planners.requests.Timing`` and the sample period ``dt`` to its
+    """Hold every number of a ``planners.problem.requests.Timing`` and the sample period ``dt`` to its
     range (InvalidRequest naming the field and the range otherwise)."""
     check(dt, "output.dt", DT)
     if timing.duration is not None:

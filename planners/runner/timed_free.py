@@ -25,8 +25,8 @@ from planners.generators.search.memory import check_search_memory
 from planners.generators.search.method import global_search
 from planners.paths import GeometricPath
 from planners.paths.grid import path_grid
-from planners.requests import Timing
-from planners.timed import Timed, moving_velocity, path_boundary, timed_path, timing_grid
+from planners.problem.requests import Timing
+from planners.runner.given_path import Timed, moving_velocity, path_boundary, timed_path, timing_grid
 from planners.timing.base import GAP_TARGET
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane.method import PhasePlaneMethod
