@@ -19,7 +19,7 @@ from planners.paths.grid import path_grid
 from planners.results import require_finite
 from planners.timing.laws.profiles import quintic_coefficients
 from service.app import create_app
-from service.problems import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
+from service.errors import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
 from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
 

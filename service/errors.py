@@ -1,6 +1,8 @@
 """Errors as ``application/problem+json`` (RFC 9457): one handler per family, an outermost guard
 for the unexpected, an encoder that refuses NaN and infinity, and the OpenAPI declaring all of it.
 
+* ``STATUS`` gives the HTTP status of each error class of the library (``status_of``: its own
+  class or nearest base in the table; the service's own errors carry theirs).
 * ``install_problem_handlers`` routes the error tree (``ToptrajError``), request validation and
   Starlette's HTTP errors (404, 405 with its ``Allow`` header, ...) to problem answers.
 * ``UnexpectedErrors`` (pure ASGI, outermost) answers any other exception with a problem 500
@@ -29,7 +31,9 @@ from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
+from planners.errors import BudgetExceeded
 from robots import ToptrajError
+from robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
 from service.schemas.common import Problem
 
 PROBLEM_JSON = "application/problem+json"
@@ -45,6 +49,30 @@ _TITLES = {
     500: "Internal error",
     504: "Computation over its time budget",
 }
+
+
+#: HTTP status of the library's errors by class; a class not in the table answers with its
+#: nearest base's (``ToptrajError``: 422, malformed or impossible input).
+STATUS: dict[type[ToptrajError], int] = {
+    ToptrajError: 422,
+    UnknownRobot: 404,
+    RobotConflict: 409,
+    CatalogRobotReadOnly: 409,
+    UploadStoreFull: 409,
+    UploadStoreUnavailable: 503,
+    BudgetExceeded: 504,
+}
+
+
+def status_of(error: ToptrajError) -> int:
+    """The HTTP status of ``error``: ``STATUS`` of its class or nearest base there; an error
+    class of the service itself (``service.*``: a busy queue, an unknown job) states its own."""
+    for cls in type(error).__mro__:
+        if cls in STATUS:
+            return STATUS[cls]
+        if cls.__module__.partition(".")[0] == "service" and "status" in vars(cls):
+            return vars(cls)["status"]
+    return STATUS[ToptrajError]
 
 
 class NonFiniteAnswer(ToptrajError):
@@ -157,7 +185,7 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
     retry_after = getattr(error, "retry_after", None)
     headers = None if retry_after is None else {"Retry-After": str(retry_after)}
-    return problem(error.status, error.title, error.detail, headers, **extra)
+    return problem(status_of(error), error.title, error.detail, headers, **extra)
 
 
 def _message(item: dict) -> str:
