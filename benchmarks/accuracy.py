@@ -31,13 +31,13 @@ import robots
 from benchmarks.converged import converged_duration as converged_spline
 from benchmarks.converged import random_path
 from planners import Timing, WaypointPath, plan
-from planners.accuracy import GAP_TARGET
-from planners.constraints import build_path_constraints
+from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.grid import MAX_POINTS, path_grid
 from planners.kinematics.ik import frame_pose
 from planners.paths import SplinePath
 from planners.paths.cartesian import CartesianLine
+from planners.paths.grid import MAX_POINTS, path_grid
+from planners.runner.accuracy import GAP_TARGET
 from planners.timing.toppra_method import ToppraMethod
 
 KINDS = ("velocity", "acceleration", "torque")

@@ -17,7 +17,7 @@ import pinocchio as pin
 
 import robots
 from planners.errors import TimingFailed
-from planners.grid import path_grid
+from planners.paths.grid import path_grid
 
 
 def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100) -> float:

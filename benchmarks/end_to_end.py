@@ -96,11 +96,11 @@ STAGES = (
 def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int]:
     """(points of the grids the answer was timed on, points of the grids its constraints were
     first built on), over its stretches: what ``planners.plan`` times, without the sampling."""
-    from planners.deadline import NO_DEADLINE
-    from planners.gate import gate_threshold
-    from planners.requests import check_constraint_kinds, timing_method
-    from planners.timed import timed_path
-    from planners.waypoint_checks import make_path
+    from planners.checks.gate import gate_threshold
+    from planners.execution.deadline import NO_DEADLINE
+    from planners.problem.requests import check_constraint_kinds, timing_method
+    from planners.problem.waypoints import make_path
+    from planners.runner.given_path import timed_path
 
     method = timing_method(timing)
     kinds = check_constraint_kinds(timing.constraints, method)

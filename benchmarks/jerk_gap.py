@@ -22,12 +22,12 @@ import numpy as np
 
 import robots
 from planners import WaypointPath
-from planners.constraints import build_path_constraints
-from planners.deadline import NO_DEADLINE
-from planners.grid import path_grid
+from planners.constraints.path_constraints import build_path_constraints
+from planners.execution.deadline import NO_DEADLINE
+from planners.paths.grid import path_grid
+from planners.problem.waypoints import make_path
 from planners.timing.base import AT_REST
-from planners.timing.jerk_limited import JerkLimitedMethod
-from planners.waypoint_checks import make_path
+from planners.timing.jerk.method import JerkLimitedMethod
 
 KINDS = ("velocity", "acceleration", "torque", "jerk")
 

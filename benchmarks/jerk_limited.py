@@ -25,7 +25,7 @@ import numpy as np
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.waypoint_checks import make_path
+from planners.problem.waypoints import make_path
 
 JERK_FREE = ("velocity", "acceleration", "torque")
 JERK = (*JERK_FREE, "jerk")

@@ -54,8 +54,8 @@ def _measure(count: int, repeat: int) -> dict:
             "output": {"dt": 0.01},
         })
 
-    from planners.grid import path_grid
     from planners.paths import SplinePath
+    from planners.paths.grid import path_grid
 
     encode_json(trajectory_body(plan_request(request(waypoints(4)))))  # imports, numba cache
     baseline = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

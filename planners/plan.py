@@ -12,30 +12,30 @@ import time
 
 import numpy as np
 
-from planners.accuracy import answer_accuracy
+from planners.checks.gate import TimedStretch, gate_threshold, samples_exceed
 from planners.collision import Obstacle, check_clearance
 from planners.collision.obstacles import check_obstacles
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.constraints.admissible import admissible_set
+from planners.constraints.tool_speed import tool_speed_limit
 from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
-from planners.free_path import FreeMotion
-from planners.free_path.switching import collocation_switches, switching_times
-from planners.gate import TimedStretch, gate_threshold, samples_exceed
-from planners.grid import MAX_POINTS, spread_indices
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.generators.collocation import FreeMotion
+from planners.generators.collocation.switching import collocation_switches, switching_times
 from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
-from planners.mvc import admissible_set
 from planners.paths.blended import MIN_BLEND, BlendedPath
 from planners.paths.cartesian import CartesianLine
-from planners.ranges import DT, check_timing
-from planners.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
+from planners.paths.grid import MAX_POINTS, spread_indices
+from planners.problem.ranges import DT, check_timing
+from planners.problem.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
+from planners.problem.waypoints import continuous_turns, make_path, without_repeats
 from planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
-from planners.timed import timed_path, timed_unsynchronized, timed_via_points
-from planners.timed_free import timed_free_motion, timed_search
+from planners.runner.accuracy import answer_accuracy
+from planners.runner.given_path import timed_path, timed_unsynchronized, timed_via_points
+from planners.runner.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
-from planners.timing.law_timing import LawTiming
-from planners.timing.phase_plane import PhasePlaneMethod
-from planners.tool_speed import tool_speed_limit
+from planners.timing.laws.law_timing import LawTiming
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.trajectory import sample_trajectory
-from planners.waypoint_checks import continuous_turns, make_path, without_repeats
 from robots import JointLimits, Robot
 
 MAX_SAMPLES = 200_000
@@ -45,6 +45,8 @@ MAX_SAMPLES = 200_000
 SAMPLE_SECONDS = 5e-7
 #: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
 MAX_PHASE_PLANE_POINTS = 2_000
+#: Largest number of samples whose Jacobian is conditioned (evenly spaced among them).
+CONDITIONING_POINTS = 100
 #: Share of its limit beyond which a sampled torque counts as saturated when switching times
 #: are read off the samples.
 SATURATION_READ = 0.98
@@ -243,7 +245,7 @@ def plan(
     if warning is not None:
         notes.append(warning)
     utilization = _utilization(timed.stretches, margin)
-    kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q)
+    kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
     if not np.isfinite(kappa_max):
         notes.append(
             f"the arm passes through a singularity at t = {samples.t[worst]:.4g} s: its Jacobian loses rank "

@@ -38,7 +38,7 @@ class Conditioning:
 @dataclass(frozen=True)
 class Accuracy:
     """The answer's estimated relative distance from the converged optimum of its method's
-    problem (``planners.accuracy``): ``relative_gap`` (``None`` when not estimated) and how it
+    problem (``planners.runner.accuracy``): ``relative_gap`` (``None`` when not estimated) and how it
     was estimated, or why not (``basis``)."""
 
     relative_gap: float | None

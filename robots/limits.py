@@ -34,7 +34,7 @@ LIMIT_KINDS = ("position_lower", "position_upper", "velocity", "acceleration", "
 
 @dataclass(frozen=True)
 class ToolSpeedLimit:
-    """Bounds on the speed of one frame of a robot (``planners.tool_speed``).
+    """Bounds on the speed of one frame of a robot (``planners.constraints.tool_speed``).
 
     Attributes:
         frame: The frame's name.

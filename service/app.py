@@ -11,13 +11,13 @@ from starlette.concurrency import run_in_threadpool
 
 import robots
 from planners import Timing, WaypointPath, plan
-from planners.isolated import start_worker_server
+from planners.execution.isolated import start_worker_server
+from planners.execution.threads import single_blas_thread
 from planners.kinematics.conditioning import frobenius_condition_number
-from planners.threads import single_blas_thread
 from service import stopping
 from service.body_limit import BodySizeLimit
+from service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.jobs import JOB_MODULES, job_runner
-from service.problems import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from service.routes import batches, health, jobs, trajectories, web
 from service.routes import robots as robot_routes
 from service.serving import open_connections
@@ -47,7 +47,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
     settings = settings or Settings()
-    single_blas_thread()  # plannings run side by side; see planners.threads
+    single_blas_thread()  # plannings run side by side; see planners.execution.threads
     robots.configure_uploads(
         settings.data_dir,
         max_uploads=settings.max_uploads,

@@ -48,19 +48,11 @@ def _is_compare(text: str) -> bool:
     return isinstance(body, dict) and "methods" in body
 
 
-def _validation_detail(error: ValidationError) -> str:
-    return "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in error.errors())
-
-
-def validation_problem(error: ValidationError) -> dict:
-    """The problem+json of a request that does not fit its schema (as the HTTP API's 422)."""
-    return _problem("Invalid request", 422, _validation_detail(error))
-
-
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
     from robots import ToptrajError
+    from service.errors import status_of, validation_problem
 
     try:
         content = answer(_read(source))
@@ -71,7 +63,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
         print(json.dumps(validation_problem(error)), file=sys.stderr)
         return 1
     except ToptrajError as error:
-        print(json.dumps(_problem(error.title, error.status, error.detail)), file=sys.stderr)
+        print(json.dumps(_problem(error.title, status_of(error), error.detail)), file=sys.stderr)
         return 1
     return _write(content, out)
 
@@ -100,7 +92,7 @@ def _trajectory(text: str) -> bytes:
 
 
 def _compare(text: str) -> bytes:
-    from planners.deadline import NO_DEADLINE
+    from planners.execution.deadline import NO_DEADLINE
     from service.planning import compare_request, encode_json
     from service.schemas.trajectories import CompareRequest
 

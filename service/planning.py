@@ -12,18 +12,18 @@ import orjson
 
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
-from planners.boundary import finite_vector
 from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
-from planners.deadline import NO_DEADLINE
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
-from planners.free_path import FreeMotion
+from planners.execution.deadline import NO_DEADLINE
+from planners.generators.collocation import FreeMotion
+from planners.generators.search import SearchOptions
+from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
-from planners.search import SearchOptions
-from planners.search.graph import DEFAULT_SEARCH_MEMORY
+from planners.problem.boundary import finite_vector
 from robots import InvalidLimits, UnknownRobot
 from robots.catalog import catalog_robot_built
+from service.errors import non_finite_answer, status_of
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
-from service.problems import non_finite_answer
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.
@@ -139,7 +139,7 @@ def plan_request(
     ``output.dt`` whose samples would not fit in a body of that size (422 naming the smallest
     ``dt`` that fits). ``accept`` (the HTTP Accept header) may choose CSV, which puts the samples
     on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
-    (``planners.search.memory``)."""
+    (``planners.generators.search.memory``)."""
     robot = robots.load(request.robot)
     timing = _timing(request)
     if timing.method == "search":
@@ -241,7 +241,7 @@ def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
         except UnknownRobot:
             raise
         except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:
-            results.append({"method": method, "error": {"status": error.status, "title": error.title, "detail": error.detail}})
+            results.append({"method": method, "error": {"status": status_of(error), "title": error.title, "detail": error.detail}})
             continue
         body = trajectory_body(result)
         results.append({key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")})
@@ -308,7 +308,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
 
 def accuracy_body(result: PlannedTrajectory) -> dict:
     """``{"relative_gap", "basis"}``: the answer's estimated relative distance from the
-    converged optimum of its method's problem (``planners.accuracy``), null when not estimated."""
+    converged optimum of its method's problem (``planners.runner.accuracy``), null when not estimated."""
     accuracy = result.accuracy
     if accuracy is None:
         return {"relative_gap": None, "basis": f"not estimated for timing.method {result.method}"}

@@ -14,8 +14,8 @@ from plotly.subplots import make_subplots
 
 import robots
 from planners import PlannedTrajectory
-from planners.grid import spread_indices
 from planners.kinematics.skeleton import skeleton
+from planners.paths.grid import spread_indices
 
 #: Instants of the stroboscopic picture.
 STROBE = 12

@@ -8,7 +8,7 @@ from pathlib import Path
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-from planners.search.graph import DEFAULT_SEARCH_MEMORY
+from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
 from robots.uploads import DEFAULT_CACHE_SIZE
 
@@ -43,7 +43,7 @@ class Settings(BaseSettings):
         plan_heavy_queue: Heavy plannings that may wait for a heavy worker of this process
             (within their budget); beyond, 503 with ``Retry-After``.
         search_memory_bytes: Most memory one search may take by its estimate
-            (``planners.search.memory``, 2 GiB by default): beyond, 422 naming the largest
+            (``planners.generators.search.memory``, 2 GiB by default): beyond, 422 naming the largest
             ``roadmap_points``, ``neighbors`` or ``cells`` served.
         job_workers: Jobs (``/v1/jobs``) running at once, each in a worker process, over every
             server process on the data directory (default: half the cores, at least 1).

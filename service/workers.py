@@ -5,7 +5,7 @@ that a request is refused at once with 503 and ``Retry-After``.
 Memory is bounded the same way: each planning is capped (grid, samples, body size) and at most
 ``workers`` run. A worker slot is freed when its thread really ends, not when its caller stops
 waiting: after a 504 the deadline is cancelled, the thread stops at its next check (and kills any
-worker process it waits on, ``planners.isolated``), and only then may the next planning start.
+worker process it waits on, ``planners.execution.isolated``), and only then may the next planning start.
 
 Waiting requests get a thread in the order they came (a request arriving while others wait
 queues behind them), and the thread that frees a slot wakes the first of them at once: without
@@ -22,8 +22,8 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
 from planners import Deadline
-from planners.deadline import Leash, LeashSlipped
 from planners.errors import BudgetExceeded
+from planners.execution.deadline import Leash, LeashSlipped
 from robots.errors import ToptrajError
 
 

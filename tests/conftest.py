@@ -18,7 +18,7 @@ os.environ["TOPTRAJ_DATA_DIR"] = _SESSION_DATA_DIR
 
 from fastapi.testclient import TestClient  # noqa: E402
 
-from planners.threads import single_blas_thread  # noqa: E402
+from planners.execution.threads import single_blas_thread  # noqa: E402
 from service.app import create_app  # noqa: E402
 from service.settings import Settings  # noqa: E402
 

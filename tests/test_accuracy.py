@@ -40,7 +40,7 @@ def test_default_durations_are_within_a_tenth_of_a_percent_of_the_converged_opti
     assert compared >= 2
 
 
-# Every answer states its accuracy (planners/accuracy.py): the estimated relative gap to the
+# Every answer states its accuracy (planners/runner/accuracy.py): the estimated relative gap to the
 # converged optimum, held within 0.1 % for time-optimal methods on their default grids.
 
 UR5_START = [0.3, -1.6, 1.7, -1.6, -1.57, 0.2]
@@ -205,7 +205,7 @@ def test_a_time_law_states_its_gap_to_its_own_shortest_duration(method):
 def test_the_typical_request_states_its_accuracy_without_a_second_solve(monkeypatch):
     """phase_plane's estimate is its own refinement's: the typical request (4 ur5 waypoints)
     solves once."""
-    from planners.timing.phase_plane import PhasePlaneMethod
+    from planners.timing.phase_plane.method import PhasePlaneMethod
 
     calls = []
     solve = PhasePlaneMethod.solve
@@ -219,7 +219,7 @@ def test_the_warning_advises_only_what_the_method_serves():
     """The remedy of a gap above 0.1 % is a timing.grid_points the method serves on the robot
     (the gap shrinks as the intervals grow), else the phase-plane method, never a grid beyond
     its cap."""
-    from planners.accuracy import gap_warning
+    from planners.runner.accuracy import gap_warning
     from planners.timing.toppra_method import ToppraMethod
 
     within = gap_warning(ToppraMethod(), 0.008, 100, 6, grid_given=True)

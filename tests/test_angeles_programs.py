@@ -11,8 +11,8 @@ from scipy.interpolate import CubicSpline
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import InfeasiblePath, InvalidRequest
-from planners.timing.laws import CycloidalBlendProfile, CycloidalProfile, QuinticProfile, TrapezoidalProfile
-from planners.timing.splines import SplineProfile, clamped_spline, periodic_spline, spline_from_accelerations
+from planners.timing.laws.profiles import CycloidalBlendProfile, CycloidalProfile, QuinticProfile, TrapezoidalProfile
+from planners.timing.laws.splines import SplineProfile, clamped_spline, periodic_spline, spline_from_accelerations
 from tests.conftest import UR5_WAYPOINTS
 
 TAU1, TAU2 = 0.2, 0.9

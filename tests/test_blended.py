@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planners.grid import path_grid
 from planners.paths.blended import BlendedPath
+from planners.paths.grid import path_grid
 from tests.conftest import UR5_WAYPOINTS
 
 #: MoveIt 2 TOTG test, tests "test2" and "test3": 4 joints, max_deviation 100.

@@ -130,4 +130,4 @@ def test_the_characteristic_length_is_the_reach_at_the_neutral_posture(name, rea
     robot = robots.load(name)
     assert robot.neutral_reach == pytest.approx(reach, abs=1e-15)
     assert characteristic_length(robot) == robot.neutral_reach
-    assert conditioning_along(robot, np.array([[0.3, 0.5], [0.1, -0.4]]))[2] == pytest.approx(reach, abs=1e-15)
+    assert conditioning_along(robot, np.array([[0.3, 0.5], [0.1, -0.4]]), np.arange(2))[2] == pytest.approx(reach, abs=1e-15)

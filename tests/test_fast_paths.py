@@ -13,11 +13,11 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 import robots
-from planners.constraints import build_path_constraints
-from planners.grid import path_grid
-from planners.limit_check import _torques, check_limits, joint_motion
-from planners.limit_kernels import utilization_pass
+from planners.checks.limit_check import _torques, check_limits, joint_motion
+from planners.checks.limit_kernels import utilization_pass
+from planners.constraints.path_constraints import build_path_constraints
 from planners.paths import SplinePath
+from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod, ToppraMethod
 from planners.timing.base import TimeScaling
 from robots.catalog import robot_from_model

@@ -10,8 +10,8 @@ import pinocchio as pin
 import pytest
 
 import robots
+from planners.constraints.tool_speed import frame_twists
 from planners.kinematics.frame_jacobians import frame_jacobians
-from planners.tool_speed import frame_twists
 from robots.catalog import robot_from_model
 
 DATA = Path(__file__).parent / "data"

@@ -8,8 +8,8 @@ import pytest
 
 import robots
 from planners import Timing, plan
-from planners.deadline import Deadline
-from planners.free_path import FreeMotion
+from planners.execution.deadline import Deadline
+from planners.generators.collocation import FreeMotion
 
 #: The converged optima of Yamamoto's free path (torque limits only), from its own
 #: Hermite-Simpson transcription, ``benchmarks/yamamoto_reference.py``: the same to 7 digits on
@@ -99,7 +99,7 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     assert cheap.peak_utilization["torque"].max() <= 1.005
     fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
     assert fast.duration < cheap.duration
-    # refined to exact bang-bang torques (planners.free_path.switching): never longer than the
+    # refined to exact bang-bang torques (planners.generators.collocation.switching): never longer than the
     # collocation's own duration, and within 1e-4 (the largest gap it may state) of the
     # converged minimum time (YAMAMOTO_MINIMUM_TIME; measured 2e-7)
     assert fast.solver["switching"] == "refined"

@@ -33,7 +33,7 @@ from schemathesis.generation.modes import GenerationMode
 
 import robots
 from planners import METHODS
-from planners.ranges import ACCELERATION, DURATION, SCALE, TRAPEZOID_FRACTION, VELOCITY
+from planners.problem.ranges import ACCELERATION, DURATION, SCALE, TRAPEZOID_FRACTION, VELOCITY
 from service.app import create_app
 from service.settings import Settings
 

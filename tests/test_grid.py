@@ -1,4 +1,4 @@
-"""The grid of s (``planners.grid.path_grid``): knots held, segments spaced as np.linspace
+"""The grid of s (``planners.paths.grid.path_grid``): knots held, segments spaced as np.linspace
 spaces them, bad knots refused."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from planners.errors import TimingFailed
-from planners.grid import MIN_POINTS_PER_SEGMENT, on_points, path_grid, spread_indices
+from planners.paths.grid import MIN_POINTS_PER_SEGMENT, on_points, path_grid, spread_indices
 
 
 @pytest.mark.parametrize("n_intervals", [None, 25, 100, 1000])

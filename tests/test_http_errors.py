@@ -128,3 +128,17 @@ def test_over_the_time_budget_is_504():
         )
     assert code == 504
     assert "time budget" in detail
+
+
+def test_the_service_picks_the_status_not_the_library(client, monkeypatch):
+    """The HTTP status of a library error comes from the service's table (``service.errors.STATUS``),
+    never from an attribute of the library's class: changing that attribute changes no answer."""
+    from planners.errors import BudgetExceeded
+    from robots.errors import UnknownRobot
+    from service.errors import status_of
+
+    monkeypatch.setattr(UnknownRobot, "status", 418, raising=False)
+    monkeypatch.setattr(BudgetExceeded, "status", 418, raising=False)
+    status, detail, _ = _post(client, {"robot": "nope", "path": GOOD_PATH})
+    assert (status, "no robot named 'nope'" in detail) == (404, True)
+    assert status_of(BudgetExceeded("spent")) == 504

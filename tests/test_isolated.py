@@ -1,4 +1,4 @@
-"""``planners.isolated``: a function run in a worker process returns its result or raises its
+"""``planners.execution.isolated``: a function run in a worker process returns its result or raises its
 error, and is killed when the deadline passes or is cancelled."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import pytest
 import robots
 from planners import BudgetExceeded, Deadline, InfeasiblePath
 from planners.errors import OverMemory
-from planners.isolated import run_isolated
+from planners.execution.isolated import run_isolated
 
 
 def _spin(pid_file: str) -> None:
@@ -83,9 +83,9 @@ def test_the_worker_is_killed_when_the_deadline_is_cancelled(tmp_path):
 def test_cancelling_kills_the_worker_at_once_from_the_cancelling_thread(tmp_path, monkeypatch):
     """A 504 cancels the deadline from the event loop: the worker dies then, not when the thread
     waiting for it next polls (made 5 s here), so no work runs on after the answer."""
-    import planners.isolated
+    import planners.execution.isolated
 
-    monkeypatch.setattr(planners.isolated, "POLL_S", 5.0)
+    monkeypatch.setattr(planners.execution.isolated, "POLL_S", 5.0)
     pid_file = tmp_path / "pid"
     deadline = Deadline(600)
     outcome: list[BaseException] = []

@@ -23,12 +23,12 @@ from ruckig import InputParameter, Ruckig, Synchronization, Trajectory
 
 import robots
 from planners import Timing, WaypointPath, plan
-from planners.constraints import build_path_constraints
-from planners.grid import path_grid
-from planners.timing.jerk_closed_form import ScalarLimits, double_s
-from planners.timing.jerk_limited import JerkLimitedMethod
-from planners.timing.jerk_segments import segment_starts
-from planners.waypoint_checks import make_path
+from planners.constraints.path_constraints import build_path_constraints
+from planners.paths.grid import path_grid
+from planners.problem.waypoints import make_path
+from planners.timing.jerk.closed_form import ScalarLimits, double_s
+from planners.timing.jerk.method import JerkLimitedMethod
+from planners.timing.jerk.segments import segment_starts
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")
 

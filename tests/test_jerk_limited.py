@@ -12,9 +12,9 @@ from ruckig import InputParameter, Ruckig, Trajectory
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import TimingFailed
-from planners.timing.jerk_limited import JerkLimitedMethod
-from planners.timing.phase_plane import PhasePlaneMethod
-from planners.waypoint_checks import make_path
+from planners.problem.waypoints import make_path
+from planners.timing.jerk.method import JerkLimitedMethod
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from tests.conftest import UR5_WAYPOINTS
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")

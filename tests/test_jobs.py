@@ -15,8 +15,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from planners import BudgetExceeded, Deadline
-from planners.deadline import NO_DEADLINE
-from planners.isolated import run_isolated
+from planners.execution.deadline import NO_DEADLINE
+from planners.execution.isolated import run_isolated
 from service.app import create_app
 from service.jobs.store import JobStore
 from service.settings import Settings

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from planners.deadline import Deadline, Leash, LeashSlipped
 from planners.errors import BudgetExceeded
+from planners.execution.deadline import Deadline, Leash, LeashSlipped
 from service.planning import plan_request, worth_a_leash
 from service.schemas.trajectories import TrajectoryRequest
 from service.workers import PlanningWorkers

@@ -16,7 +16,7 @@ import pytest
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import InvalidRequest
-from planners.timing.laws import QuinticProfile, polynomial_derivatives, quintic_coefficients
+from planners.timing.laws.profiles import QuinticProfile, polynomial_derivatives, quintic_coefficients
 
 ARM = robots.load("geering_2r")
 A = np.radians([20.0, 30.0])

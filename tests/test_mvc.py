@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
-from planners.constraints import LinearRows
-from planners.mvc import admissible_set
+from planners.constraints.admissible import admissible_set
+from planners.constraints.path_constraints import LinearRows
 
 RNG = np.random.default_rng(11)
 

@@ -15,11 +15,11 @@ import uvicorn
 
 import robots
 from planners import Deadline, InvalidRequest, Timing, TimingFailed, WaypointPath, plan
-from planners.grid import path_grid
+from planners.paths.grid import path_grid
 from planners.results import require_finite
-from planners.timing.laws import quintic_coefficients
+from planners.timing.laws.profiles import quintic_coefficients
 from service.app import create_app
-from service.problems import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
+from service.errors import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
 from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
 
@@ -177,7 +177,7 @@ def test_the_first_non_finite_number_is_named_wherever_it_sits(body, named):
 
 def test_a_numerical_breakdown_in_a_planner_is_a_422(client, monkeypatch):
     """Whatever overflows or turns singular inside a timing method is its failure, not a 500."""
-    import planners.timing.classical as classical
+    import planners.timing.laws.method as classical
 
     def singular(*args, **kwargs):
         raise np.linalg.LinAlgError("Singular matrix")

@@ -9,11 +9,11 @@ from scipy.optimize import brentq
 
 import robots
 from planners import Timing, WaypointPath, plan
-from planners.constraints import build_path_constraints
+from planners.checks.limit_check import check_limits
+from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath
-from planners.grid import path_grid
-from planners.limit_check import check_limits
 from planners.paths import SplinePath
+from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod, ToppraMethod
 
 UR5 = robots.load("ur5")

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 import robots
-from planners.constraints import build_path_constraints
+from planners.checks.limit_check import check_limits
+from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.grid import path_grid
-from planners.limit_check import check_limits
 from planners.paths import SplinePath, StopAndGoPath
+from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod, ToppraMethod
 
 CASES = {"ur5": 334, "panda": 333, "yamamoto_2r": 333}

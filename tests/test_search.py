@@ -1,4 +1,4 @@
-"""The global search among obstacles (Jeong & Lee section 2, ``planners.search``): branch and
+"""The global search among obstacles (Jeong & Lee section 2, ``planners.generators.search``): branch and
 bound against exhaustive enumeration, the bounds t1 <= t2 <= t3 <= t4 on every grid path, the
 Geering arm's optimum found by search and local optimization, a detour around an obstacle
 checked by an independent distance computation, and ur5 around a box."""
@@ -12,10 +12,10 @@ from fastapi.testclient import TestClient
 
 import robots
 from planners.collision import BoxObstacle, SphereObstacle
-from planners.search import branch_and_bound, build_problem, enumerate_grid_paths
-from planners.search.graph import SearchOptions
-from planners.search.outcome import NoGridPath
-from planners.search.problem import toward_goal
+from planners.generators.search import branch_and_bound, build_problem, enumerate_grid_paths
+from planners.generators.search.graph import SearchOptions
+from planners.generators.search.outcome import NoGridPath
+from planners.generators.search.problem import toward_goal
 from robots.collision import robot_capsules, world_capsules
 from service.app import create_app
 from service.settings import Settings

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import robots
-from planners.free_path import collocation
-from planners.free_path.sparse import solve_sparse
-from planners.free_path.symbolic_dynamics import inverse_dynamics_function
+from planners.generators.collocation import collocation
+from planners.generators.collocation.sparse import solve_sparse
+from planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
 from tests.test_free_path import YAMAMOTO_MINIMUM_TIME
 
 

@@ -8,8 +8,8 @@ import pytest
 import robots
 from planners import Timing, WaypointPath, plan
 from planners.errors import InfeasiblePath, InvalidRequest
-from planners.timing.classical import ClassicalMethod
-from planners.timing.laws import (
+from planners.timing.laws.method import ClassicalMethod
+from planners.timing.laws.profiles import (
     PROFILES,
     CubicProfile,
     CycloidalProfile,

@@ -13,7 +13,7 @@ import pytest
 import robots
 from planners.kinematics.ik import frame_pose
 from planners.paths.cartesian import CartesianLine
-from planners.waypoint_checks import make_path
+from planners.problem.waypoints import make_path
 from tests.conftest import UR5_WAYPOINTS
 
 UR5_START = [0.3, -1.6, 1.7, -1.6, -1.57, 0.2]

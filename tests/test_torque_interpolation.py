@@ -1,4 +1,4 @@
-"""Torques interpolated from a grid's rows (``planners.torque_interpolation``) against
+"""Torques interpolated from a grid's rows (``planners.constraints.torque_interpolation``) against
 Pinocchio's RNEA: the dense check's torques between grid points (within
 ``TOLERANCE`` of the limit where interpolated, RNEA itself where the grid does not
 resolve the rows, interpolated at most states of an ordinary request); and the rows a
@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 import robots
-from planners.constraints import build_path_constraints
-from planners.grid import path_grid
-from planners.limit_check import _torques, joint_motion
+from planners.checks.limit_check import _torques, joint_motion
+from planners.constraints.path_constraints import build_path_constraints
+from planners.constraints.torque_interpolation import MAX_TRAVEL
 from planners.paths import SplinePath, StopAndGoPath
 from planners.paths.blended import BlendedPath
+from planners.paths.grid import path_grid
 from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.torque_interpolation import MAX_TRAVEL
 from robots import Robot
 from robots.catalog import robot_from_model
 from robots.urdf_check import check_urdf
@@ -150,7 +150,7 @@ def test_refinement_rows_are_the_rows_of_a_build_on_the_refined_grid(case, monke
     refinement adds; with Coulomb friction, and on a path with corners, every interval): the
     refined constraints equal, bit for bit, those built afresh on the refined grid, with one
     RNEA per new point and none at the points already there."""
-    import planners.constraints as constraints_module
+    import planners.constraints.path_constraints as constraints_module
 
     if case == "pendulum_coulomb":
         text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()

@@ -11,7 +11,7 @@ import collections
 import json
 import sys
 
-from planners.deadline import Deadline
+from planners.execution.deadline import Deadline
 from service.planning import plan_request
 from service.schemas.trajectories import TrajectoryRequest
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from planners.collision.distance import capsule_distance
 from planners.collision.obstacles import Obstacle
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InfeasiblePath
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from robots import Robot
 from robots.collision import robot_capsules, world_capsules
 

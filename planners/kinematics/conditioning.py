@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.grid import spread_indices
 from planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
 from planners.kinematics.frame_jacobians import frame_jacobians
 from robots import Robot
@@ -81,12 +80,11 @@ def task_jacobians(robot: Robot, q: np.ndarray, frame_id: int, length: float) ->
     return jacobians
 
 
-def conditioning_along(robot: Robot, q: np.ndarray, max_points: int = 100) -> tuple[float, float, float, int]:
-    """(kappa_min, kappa_max, L, index of kappa_max in ``q``) over at most ``max_points``
-    evenly spaced rows of ``q`` (n_samples, n_dof)."""
+def conditioning_along(robot: Robot, q: np.ndarray, rows: np.ndarray) -> tuple[float, float, float, int]:
+    """(kappa_min, kappa_max, L, index of kappa_max in ``q``) over the rows ``rows`` (m,) of
+    ``q`` (n_samples, n_dof), chosen by the caller (e.g. evenly spaced)."""
     length = characteristic_length(robot)
     frame_id = robot.frame_id(robot.end_effector)
-    rows = spread_indices(len(q), max_points)
     kappas = np.atleast_1d(frobenius_condition_number(task_jacobians(robot, q[rows], frame_id, length)))
     worst = int(np.argmax(kappas))
     return float(kappas.min()), float(kappas.max()), length, int(rows[worst])

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from planners.deadline import NO_DEADLINE, Deadline
 from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.kinematics.ik import frame_pose, solve_ik
 from planners.paths.base import GeometricPath
 from planners.paths.concatenated import ConcatenatedPath

@@ -1,10 +1,10 @@
 """Timing methods: each reads ``PathConstraints`` and returns a ``TimeScaling``."""
 
 from planners.timing.base import TimeScaling, TimingMethod
-from planners.timing.classical import ClassicalMethod, classical_methods
-from planners.timing.jerk_limited import JerkLimitedMethod
+from planners.timing.jerk.method import JerkLimitedMethod
+from planners.timing.laws.method import ClassicalMethod, classical_methods
 from planners.timing.min_cost import MinCostMethod
-from planners.timing.phase_plane import PhasePlaneMethod
+from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.timing.ruckig_method import RuckigMethod
 from planners.timing.toppra_method import ToppraMethod
 

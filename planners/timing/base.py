@@ -10,14 +10,14 @@ from functools import cached_property
 
 import numpy as np
 
-from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import TimingFailed
-from planners.limit_kernels import grid_states
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.timing.state_kernels import grid_states
 
 #: Largest estimated relative gap to the converged optimum that a time-optimal answer carries
 #: without being refined further or, when it cannot be, without a warning that gives the figure
-#: (``PathTiming.optimality_gap``; the policy in ``planners.accuracy``).
+#: (``PathTiming.optimality_gap``; the policy in ``planners.runner.accuracy``).
 GAP_TARGET = 1e-3
 
 

@@ -1,16 +1,16 @@
 """``collocation``: the name under which a free motion is optimized (path and timing together,
-``planners.free_path``). It does not time a given path, so ``solve`` refuses one."""
+``planners.generators.collocation``). It does not time a given path, so ``solve`` refuses one."""
 
 from __future__ import annotations
 
-from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
 
 
 class CollocationMethod(TimingMethod):
-    """Direct collocation of path and timing from start to goal (see ``planners.free_path``)."""
+    """Direct collocation of path and timing from start to goal (see ``planners.generators.collocation``)."""
 
     name = "collocation"
     kinds = frozenset({"velocity", "acceleration", "torque"})

@@ -23,11 +23,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.constraints import LinearRows, PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.constraints.admissible import friction_reference
+from planners.constraints.path_constraints import LinearRows, PathConstraints
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.isolated import LOW_PRIORITY, run_isolated
-from planners.mvc import friction_reference
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 
-from planners.constraints import PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.constraints.path_constraints import PathConstraints
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Boundary, DenseStates, PathTiming, TimingMethod
 
 #: Stand-in for an unlimited bound (ruckig needs finite numbers).

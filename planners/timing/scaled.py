@@ -14,9 +14,9 @@ import dataclasses
 
 import numpy as np
 
-from planners.constraints import PathConstraints
-from planners.deadline import Deadline
-from planners.mvc import speed_scale
+from planners.constraints.admissible import speed_scale
+from planners.constraints.path_constraints import PathConstraints
+from planners.execution.deadline import Deadline
 from planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
 
 #: Typical x within this factor of 1 is solved as it is.

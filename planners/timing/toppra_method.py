@@ -15,11 +15,11 @@ import logging
 
 import numpy as np
 
-from planners.constraints import LinearRows, PathConstraints
-from planners.deadline import NO_DEADLINE, Deadline
+from planners.constraints.admissible import acceleration_bounds, admissible_set, friction_reference
+from planners.constraints.path_constraints import LinearRows, PathConstraints
 from planners.diagnostics import static_load
 from planners.errors import InfeasiblePath, TimingFailed
-from planners.mvc import acceleration_bounds, admissible_set, friction_reference
+from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 logging.getLogger("toppra").setLevel(logging.ERROR)

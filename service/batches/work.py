@@ -11,11 +11,11 @@ import orjson
 from pydantic import ValidationError
 
 import robots
-from planners.deadline import Deadline
+from planners.execution.deadline import Deadline
 from robots import ToptrajError
 from robots.upload_options import UploadOptions
 from service.batches.lines import problem_body
-from service.commands import validation_problem
+from service.errors import status_of, validation_problem
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
@@ -59,7 +59,8 @@ def answer(text: str, budget_s: float) -> tuple[int, bytes]:
         return 422, orjson.dumps(validation_problem(error))
     except ToptrajError as error:
         extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
-        return error.status, orjson.dumps({"type": "about:blank", "title": error.title, "status": error.status, "detail": error.detail, **extra})
+        status = status_of(error)
+        return status, orjson.dumps({"type": "about:blank", "title": error.title, "status": status, "detail": error.detail, **extra})
     except Exception as error:  # a solver's own failure: this line's answer, logged
         logger.error("a batch line failed unexpectedly", exc_info=error)
         return 500, problem_body(500, "Internal error", f"an unexpected {type(error).__name__} occurred while planning this line")

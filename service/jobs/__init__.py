@@ -7,7 +7,7 @@ from service.jobs.runner import JobRunner
 from service.jobs.store import JobStore
 from service.jobs.work import WorkerSetup
 
-#: Modules the fork server imports for the job workers (``planners.isolated.PRELOAD`` has the
+#: Modules the fork server imports for the job workers (``planners.execution.isolated.PRELOAD`` has the
 #: solver stacks), so that a job's process neither imports the web stack (1 to 2 s) nor loads
 #: the compiled kernels (0.5 s) again.
 JOB_MODULES = ("service.jobs.preload",)

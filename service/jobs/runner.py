@@ -4,7 +4,7 @@ cancelled job.
 
 * At most ``workers`` jobs run at once in all the processes sharing the store (the claim
   counts the running jobs in the same transaction); the rest wait, queued.
-* Each job runs ``work.compute`` through ``planners.isolated.run_isolated``: a process forked
+* Each job runs ``work.compute`` through ``planners.execution.isolated.run_isolated``: a process forked
   from the fork server, killed when the job is cancelled, when its budget (plus ``GRACE_S``) is
   spent, or when this server stops. The job thread of this process only waits on its pipe.
 * Progress reports come over that pipe and are written to the store at most every
@@ -28,8 +28,9 @@ from dataclasses import dataclass, field
 
 from planners import Deadline
 from planners.errors import BudgetExceeded
-from planners.isolated import run_isolated
+from planners.execution.isolated import run_isolated
 from robots.errors import ToptrajError
+from service.errors import status_of
 from service.jobs import work
 from service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
 from service.jobs.store import JobStore
@@ -67,7 +68,7 @@ def problem_of(error: BaseException) -> dict:
     """The problem+json object of a job's error: a ``ToptrajError`` with its status, title,
     detail and the ``s``, ``joint`` and ``limit`` facts it carries; anything else as a 500."""
     if isinstance(error, ToptrajError):
-        body = {"type": "about:blank", "title": error.title, "status": error.status, "detail": error.detail}
+        body = {"type": "about:blank", "title": error.title, "status": status_of(error), "detail": error.detail}
         for key in ("s", "joint", "limit"):
             if getattr(error, key, None) is not None:
                 body[key] = getattr(error, key)

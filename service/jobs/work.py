@@ -6,7 +6,7 @@ progress through ``deadline.progress`` and never knows it runs as a job. A kind 
 requests (a batch) is one more entry: it loops over its requests (or hands them to other
 workers) and reports "request k of n".
 
-``compute`` runs in a process forked from the fork server (``planners.isolated``), which shares
+``compute`` runs in a process forked from the fork server (``planners.execution.isolated``), which shares
 no module state with the server: the upload store and the body cap reach it in ``WorkerSetup``.
 """
 
@@ -18,9 +18,9 @@ import orjson
 
 import robots
 from planners import Deadline
-from planners.deadline import Progress
 from planners.errors import InvalidRequest
-from planners.search.graph import DEFAULT_SEARCH_MEMORY
+from planners.execution.deadline import Progress
+from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 

@@ -16,9 +16,9 @@ from starlette.concurrency import run_in_threadpool
 import robots
 from planners.errors import InvalidRequest
 from robots.errors import ToptrajError, excerpt
+from service.errors import PROBLEM_JSON, problem_responses
 from service.jobs.records import Job, JobEnded
 from service.jobs.store import JobStore
-from service.problems import PROBLEM_JSON, problem_responses
 from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
 
 router = APIRouter(prefix="/v1/jobs", tags=["jobs"])

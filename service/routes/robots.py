@@ -14,7 +14,7 @@ from planners.errors import InvalidRequest
 from planners.kinematics.skeleton import skeleton
 from robots.limits import LIMIT_KINDS
 from robots.upload_options import upload_options
-from service.problems import problem_responses
+from service.errors import problem_responses
 from service.schemas.robots import (
     RobotCreate,
     RobotLimits,

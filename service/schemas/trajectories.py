@@ -7,9 +7,9 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 from pydantic import Discriminator, Field, Tag
 
-from planners import ranges
+from planners.problem import ranges
 from planners.timing import METHODS
-from planners.timing.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
+from planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
 from service.schemas.common import Schema, bounded, signed
 
 MAX_WAYPOINTS = 1_000

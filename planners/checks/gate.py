@@ -1,0 +1,182 @@
+"""The limit gate every answer passes: a timing is checked on a dense resampling
+(``planners.checks.limit_check``); where a limit is exceeded, the grid is refined there and the path
+timed again; a timing that still exceeds a limit, or that cannot be refined, is refused with the
+place, the joint and the limit.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import NamedTuple
+
+import numpy as np
+
+from planners.checks.limit_check import Excess, LimitCheck, check_limits
+from planners.checks.limit_kernels import utilization_pass
+from planners.constraints.path_constraints import PathConstraints
+from planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
+from planners.errors import InfeasiblePath, TimingFailed
+from planners.paths.base import GeometricPath
+from planners.runner.accuracy import REFINE_ROUNDS, estimated, finer_constraints
+from planners.timing.base import PathTiming, TimeScaling
+from planners.timing.laws.law_timing import LawTiming
+from planners.timing.scaled import solve_well_scaled
+from robots import JointLimits, Robot
+
+#: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is
+#: 0.5 %; the gate is tighter, since a client's own resampling falls between the check's states.
+LIMIT_TOLERANCE = 1.003
+#: Rounds of grid refinement where the dense check finds a limit exceeded.
+GATE_ROUNDS = 4
+
+
+class TimedStretch(NamedTuple):
+    """One stretch of a path (or the whole path) with its timing, the constraints it was timed
+    on, and its dense limit check."""
+
+    stretch: GeometricPath
+    timing: PathTiming
+    constraints: PathConstraints
+    check: LimitCheck
+
+
+def gate_threshold(margin: float) -> float:
+    """Largest |value| / limit the gate lets through, against the limits tightened by
+    ``margin``: ``LIMIT_TOLERANCE`` without a margin; with one, never above the untightened
+    limit itself."""
+    if margin == 0.0:
+        return LIMIT_TOLERANCE
+    return min(LIMIT_TOLERANCE, (1.0 - 1e-9) / (1.0 - margin))
+
+
+def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
+    """Points that split each listed grid interval of ``timing`` in four."""
+    s = timing.s
+    quarters = np.array([0.25, 0.5, 0.75])
+    return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
+
+
+def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
+    """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
+    exceeded by more than ``threshold``, refine the grid there and time the path again. Every
+    timing carries its estimated gap to the converged optimum (``planners.runner.accuracy``); a
+    time-optimal one above ``planners.runner.accuracy.GAP_TARGET`` on a grid the request did not name
+    (``grid_given``) is timed again on a finer grid, which replaces it only when it too holds
+    the limits.
+
+    Returns:
+        (timing, constraints, check): the timing that holds the limits, the constraints it was
+        timed on, and its ``LimitCheck``.
+
+    Raises:
+        InfeasiblePath: the limits still do not hold after ``GATE_ROUNDS`` refinements, or the
+            method's timing cannot be refined; says where, which joint and which limit.
+    """
+    deadline.progress(0.0, "timing")
+    result, finer, spent = _solved(method, constraints, boundary, duration, deadline)
+    result, constraints, check = _held(robot, path, method, constraints, result, boundary, duration, kinds, limits, threshold, deadline)
+    for _ in range(REFINE_ROUNDS):
+        refined = finer_constraints(method, constraints, result, finer, spent, deadline, grid_given or duration is not None)
+        if refined is None:
+            break
+        deadline.progress(0.5, "timing on a finer grid for accuracy")
+        try:
+            attempt, finer, spent = _solved(method, refined, boundary, duration, deadline)
+            result, constraints, check = _held(robot, path, method, refined, attempt, boundary, duration, kinds, limits, threshold, deadline)
+        except (InfeasiblePath, TimingFailed):
+            break  # the answer on the coarser grid stands, its gap stated
+    return result, constraints, check
+
+
+def _solved(method, constraints, boundary, duration, deadline):
+    """``method`` on ``constraints`` with its estimated gap: (timing, a finer grid that holds
+    the error where it lies or ``None``, the seconds the solve took)."""
+    started = time.perf_counter()
+    result = solve_well_scaled(method, constraints, boundary, duration, deadline)
+    spent = time.perf_counter() - started
+    result, finer = estimated(method, constraints, boundary, result, deadline, spent)
+    return result, finer, spent
+
+
+def _held(robot, path, method, constraints, result, boundary, duration, kinds, limits, threshold, deadline):
+    """``result`` through the dense check, refined where it exceeds a limit (``gated``)."""
+    for round_ in range(GATE_ROUNDS + 1):
+        deadline.check()
+        deadline.progress(0.5 + 0.5 * round_ / (GATE_ROUNDS + 1), f"limit check, round {round_ + 1}")
+        check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s, constraints)
+        if check.worst is None or check.worst.ratio <= threshold:
+            return result, constraints, check
+        if isinstance(result, LawTiming) and duration is None:
+            # The shortest time law was found on samples of its profile; the dense check sees
+            # between them. Slowing a law down by a factor f divides velocities by f,
+            # accelerations (and the inertial part of torques) by f^2, jerks by f^3.
+            power = {"velocity": 1.0, "jerk": 3.0, **dict.fromkeys(TOOL_KINDS, 1.0)}.get(check.worst.kind, 2.0)
+            result = result.slowed(check.worst.ratio ** (1.0 / power) * (1 + 1e-6))
+            if result is None:
+                break
+            continue
+        if not (isinstance(result, TimeScaling) and constraints.can_refine and check.intervals_over.size):
+            break
+        extra = _refinement(result, check.intervals_over)
+        extra = np.unique(extra[~np.isin(extra, constraints.s)])
+        if extra.size == 0:
+            break
+        constraints = constraints.with_points(extra)
+        result, _, _ = _solved(method, constraints, boundary, duration, deadline)
+    raise limit_exceeded(method.name, check.worst, robot, path)
+
+
+def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> InfeasiblePath:
+    s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
+    joint = None if worst.joint < 0 else robot.joint_names[worst.joint]
+    what = f"{worst.kind} limit of joint {joint!r}" if joint is not None else f"{worst.kind.replace('_', ' ')} limit"
+    return InfeasiblePath(
+        f"the {method} timing exceeds the {what} by "
+        f"{100 * (worst.ratio - 1):.2f} % at s = {s:.4f}, and refining the grid there did not bring "
+        "it back within the limits; use another timing method, a lower limit scale or more grid points",
+        s=s,
+        joint=joint,
+        limit=worst.kind,
+    )
+
+
+def checked(robot, path, result, method, kinds, limits, threshold, constraints) -> TimedStretch:
+    """A timing that cannot be refined, through the limit gate: kept when it holds the limits,
+    refused (with where, which joint and which limit) when it does not."""
+    check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s)
+    if check.worst is not None and check.worst.ratio > threshold:
+        raise limit_exceeded(method, check.worst, robot, path)
+    return TimedStretch(path, result, constraints, check)
+
+
+def samples_exceed(
+    samples, limits: JointLimits, threshold: float, kinds, robot: Robot | None = None, jerk: bool = False
+) -> tuple[str, int, int] | None:
+    """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit (joint
+    -1 for a tool limit, checked when ``robot`` is given). With ``jerk`` (for timings whose
+    acceleration is continuous) and the jerk among ``kinds``, the jerk between consecutive
+    samples, by finite differences of their accelerations, is checked too: it is the mean of
+    the jerk over the step, never above its peak, so it exceeds the limit only where the
+    accelerations jump (sample index: the step's first)."""
+    checks = [(kind, values, getattr(limits, kind)) for kind, values in
+              (("velocity", samples.qd), ("acceleration", samples.qdd), ("torque", samples.tau)) if kind in kinds]
+    if jerk and "jerk" in kinds and len(samples.t) > 1:
+        steps = np.diff(samples.t)[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            between = np.where(steps > 0.0, np.diff(samples.qdd, axis=0) / steps, 0.0)
+        checks.append(("jerk", between, limits.jerk))
+    if limits.tool is not None and robot is not None:
+        speeds = tool_speeds(robot, limits.tool, samples.q, samples.qd)
+        checks.append(("tool", speeds, limits.tool.bounds))  # columns in the order of TOOL_KINDS
+    for kind, values, limit in checks:
+        if not values.size:
+            continue
+        ratio, sample, joint = utilization_pass(
+            np.ascontiguousarray(values, dtype=float), np.asarray(limit, dtype=float), np.inf,
+            np.empty(values.shape[1]), np.zeros(len(values), dtype=bool),
+        )
+        if ratio > threshold:
+            if kind == "tool":
+                return TOOL_KINDS[int(joint)], int(sample), -1
+            return kind, int(sample), int(joint)
+    return None

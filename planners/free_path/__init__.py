@@ -1,6 +1,0 @@
-"""Free-path motions: the path and its timing optimized together from start to goal."""
-
-from planners.free_path.collocation import collocation_path, optimize_motion
-from planners.free_path.motion import CollocationResult, FreeMotion
-
-__all__ = ["CollocationResult", "FreeMotion", "collocation_path", "optimize_motion"]

@@ -1,0 +1,68 @@
+"""A free motion to plan (start and goal configurations, boundary velocities, the number of
+collocation intervals) and the collocation's answer (``planners.generators.collocation.collocation``, Jeong &
+Lee section 4): the motion at its K + 1 instants with its torques, its cost and how the solver
+got there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+DEFAULT_INTERVALS = 30
+
+
+@dataclass(frozen=True)
+class FreeMotion:
+    """Start and goal configurations (n_dof,), optional boundary velocities (rad/s), the number
+    of collocation intervals, and whether continuous joints may reach their goal one revolution
+    either way (``revolutions``)."""
+
+    start: np.ndarray
+    goal: np.ndarray
+    start_velocity: np.ndarray | None = None
+    end_velocity: np.ndarray | None = None
+    intervals: int = DEFAULT_INTERVALS
+    revolutions: bool = True
+
+
+@dataclass(frozen=True)
+class CollocationResult:
+    """The optimized motion at K + 1 instants: times (K+1,), q, v, a, tau (K+1, n_dof); its cost
+    J (s), the solver's status and iteration count, and the winning initial guess; ``rivals``:
+    the fine-grid solutions to the other goals (the elbow a revolution either way) whose coarse
+    cost came close, costlier on the fine grid, for a comparison on exact terms (the bang-bang
+    refinement); the same goal's cost on the coarse grid (``coarse_intervals``), for the estimate
+    of the fine grid's error."""
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    cost: float
+    status: str
+    iterations: int
+    initial_guess: str
+    solve_s: float
+    rivals: tuple[CollocationResult, ...] = ()
+    coarse_cost: float | None = None
+    coarse_intervals: int = 0
+
+    @property
+    def optimality_gap(self) -> float | None:
+        """Estimated relative distance of the cost from the optimum of the collocation's problem
+        (its goal): the difference from the same goal's solution on the coarse grid, which
+        bounds the fine grid's error from above where the error shrinks with the interval.
+        ``None`` when unknown."""
+        if self.coarse_cost is None:
+            return None
+        return max(0.0, (self.coarse_cost - self.cost) / self.cost)
+
+    @property
+    def gap_basis(self) -> str:
+        """How ``optimality_gap`` was obtained."""
+        if self.coarse_cost is None:
+            return "none"
+        return f"second grid: the cost on {self.coarse_intervals} intervals against {len(self.t) - 1}"

@@ -1,0 +1,333 @@
+"""Local optimization of a path among obstacles (Jeong & Lee §2.6, after Shiller & Dubowsky
+1991): a seed path from start to goal becomes a clamped cubic B-spline
+(``planners.paths.bspline``) whose interior control points minimize
+
+    J(P) = T(P) + W_obstacle * v_obstacle(P) + W_range * v_range(P)
+
+with T the path-constrained time-optimal duration along the spline, at rest at both ends
+(``planners.timing.phase_plane.method``, reused unchanged), and penalty functions on the obstacle
+distance and the joint ranges; the number of control points grows, round by round, until the
+duration stops improving.
+
+How it is made fast enough. T costs one constraint evaluation (RNEA at every grid point) and
+one phase-plane integration; it dominates everything else, so:
+
+* While optimizing, T is the midpoint-discretization duration (``midpoint_duration``: second
+  order, no refinement) on a fixed uniform grid of ``LocalSettings.grid_intervals`` intervals
+  (about 1 ms on a 2-joint arm). At the end of each round the path is timed exactly: the
+  default phase-plane method with its grid refinement (relative tolerance 6e-4), on the
+  default grid, which is what the round reports and the answer returns.
+* The optimizer is derivative-free: Nelder-Mead (SciPy, adaptive coefficients) over the
+  interior control points. T along a path is continuous but only piecewise smooth in the
+  path's shape (the switching structure changes), and the exact penalty below has kinks, so
+  finite-difference gradients would be unreliable; Nelder-Mead needs no gradient and never
+  returns a point worse than its start.
+* Rounds are nested. The knots are inserted dyadically (1/2; 1/4, 3/4; 1/8, 7/8; 3/8, 5/8;
+  ...), giving 4, 5, 7, 9, 11, ... control points, and each round starts from the previous
+  optimum exactly (Boehm's knot insertion leaves the curve unchanged). The optimization grid
+  holds every dyadic knot, so it is the same grid in every round, and the objective of the
+  best point of each round is never above that of the round before.
+
+Penalties. The distance penalty acts on a lower bound of the distance between the optimization
+samples of the obstacle check (``obstacle_samples`` configurations): from the distances d_i,
+d_i+1 at the ends of an interval and a bound M on how far any point of the arm moves in it
+(sum over joints of the joint's reach times |dq_j|), the distance inside is at least
+(d_i + d_i+1 - M) / 2. Its shortfall below ``clearance + margin`` enters as an exact (L1)
+penalty: the largest shortfall times ``obstacle_weight`` (s/m) plus their mean. Joints with a
+finite range get the same on how far the samples leave it. Each round's result is then
+checked by the planner's own dense clearance check (``check_clearance``) and the joint ranges
+at the timing's grid; a round whose result fails it is not accepted.
+
+The seed (m, n_dof) is fitted first, by least squares at chord-length values of s with the end
+points fixed, by a spline of ``LocalSettings.first_control_points``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from scipy.optimize import minimize
+
+from planners.collision.clearance import Clearance, PathInCollision, check_clearance
+from planners.collision.obstacles import Obstacle
+from planners.constraints.path_constraints import build_path_constraints
+from planners.errors import InfeasiblePath, InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.generators.search.free_space import joint_reaches, point_distances
+from planners.generators.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
+from planners.paths.bspline import DEGREE, BSplinePath, clamped_knots, insert_knot
+from planners.paths.grid import path_grid
+from planners.timing.base import TimeScaling
+from planners.timing.phase_plane.method import PhasePlaneMethod, midpoint_duration
+from robots import JointLimits, Robot
+
+#: The objective of a path no timing can follow (s): above any duration served.
+_INFEASIBLE = 1e6
+
+
+def dyadic_knots(count: int) -> np.ndarray:
+    """The first ``count`` interior knots in insertion order: 1/2; 1/4, 3/4; 1/8, 7/8, 3/8,
+    5/8; 1/16, 15/16, ... (each level from the ends inwards, in symmetric pairs)."""
+    knots: list[float] = []
+    pairs: list[tuple[int, ...]]
+    level = 1
+    while len(knots) < count:
+        denominator = 2**level
+        odd = list(range(1, denominator, 2))
+        pairs = [(odd[i], odd[-1 - i]) for i in range(len(odd) // 2)] or [(odd[0],)]
+        for pair in pairs:
+            knots += [p / denominator for p in pair]
+        level += 1
+    return np.array(knots[:count])
+
+
+def _schedule(first: int, most: int) -> list[int]:
+    """Control-point counts of the rounds: ``first``, then first + 1 if that leaves the knots
+    symmetric, then two more each round, up to ``most``."""
+    counts = [first]
+    while counts[-1] < most:
+        interior = counts[-1] - DEGREE - 1
+        step = 1 if interior == 0 else 2
+        counts.append(min(counts[-1] + step, most))
+    return counts
+
+
+def fit_seed(seed: np.ndarray, interior: np.ndarray) -> np.ndarray:
+    """Control points (len(interior) + 4, n_dof) of the clamped cubic through ``seed``'s first
+    and last rows closest, in least squares at chord-length values of s, to the rest of them."""
+    lengths = np.linalg.norm(np.diff(seed, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(lengths)]) / lengths.sum()
+    s[-1] = 1.0  # exactly, whatever the rounding of the sum
+    # several points per seed segment, so a seed with few rows still fixes every control point
+    dense = np.unique(np.concatenate([s, np.linspace(0.0, 1.0, 4 * (len(interior) + 4))]))
+    points = np.column_stack([np.interp(dense, s, seed[:, j]) for j in range(seed.shape[1])])
+    from scipy.interpolate import BSpline
+
+    basis = BSpline.design_matrix(dense, clamped_knots(interior), DEGREE).toarray()
+    rhs = points - np.outer(basis[:, 0], seed[0]) - np.outer(basis[:, -1], seed[-1])
+    inner, *_ = np.linalg.lstsq(basis[:, 1:-1], rhs, rcond=None)
+    return np.vstack([seed[0], inner, seed[-1]])
+
+
+class _Objective:
+    """J(P) of the module docstring on the interior control points x (flattened (k - 2) n),
+    counting its evaluations and checking the deadline at each."""
+
+    def __init__(self, robot, limits, kinds, start, goal, obstacles, clearance, settings, deadline):
+        self.robot, self.limits, self.kinds = robot, limits, kinds
+        self.start, self.goal = start, goal
+        self.obstacles, self.clearance, self.settings = list(obstacles), clearance, settings
+        self.deadline = deadline
+        self.grid = np.linspace(0.0, 1.0, settings.grid_intervals + 1)
+        self.samples = np.linspace(0.0, 1.0, settings.obstacle_samples + 1)
+        self.reach = joint_reaches(robot) if self.obstacles else None
+        lower, upper = limits.position_lower, limits.position_upper
+        self.ranged = np.isfinite(lower) | np.isfinite(upper)
+        self.evaluations = 0
+        self.interior = np.empty(0)
+        self.stop_at = np.inf  # time.monotonic() beyond which a round ends early
+        self.best = (np.inf, None)  # (objective, x) of the round under way
+
+    def round_begins(self) -> None:
+        self.best = (np.inf, None)
+
+    def path(self, x: np.ndarray) -> BSplinePath:
+        inner = x.reshape(-1, len(self.start))
+        return BSplinePath(np.vstack([self.start, inner, self.goal]), self.interior)
+
+    def penalty(self, path: BSplinePath) -> float:
+        """The weighted penalties (s) of ``path``: obstacles and joint ranges."""
+        settings, total = self.settings, 0.0
+        if not self.obstacles and not self.ranged.any():
+            return 0.0
+        q = path(self.samples)
+        if self.obstacles:
+            distance = point_distances(self.robot, q, self.obstacles, self.clearance + 0.1)
+            motion = np.abs(np.diff(q, axis=0)) @ self.reach
+            inside = (distance[:-1] + distance[1:] - motion) / 2.0
+            shortfall = np.maximum(self.clearance + settings.margin - np.minimum(inside, distance[:-1]), 0.0)
+            total += settings.obstacle_weight * (shortfall.max() + shortfall.mean())
+        if self.ranged.any():
+            below = np.maximum(self.limits.position_lower - q, 0.0)
+            above = np.maximum(q - self.limits.position_upper, 0.0)
+            excursion = np.where(self.ranged, below + above, 0.0).max(axis=1)
+            total += settings.range_weight * (excursion.max() + excursion.mean())
+        return total
+
+    def duration(self, path: BSplinePath) -> float:
+        """Midpoint time-optimal duration (s) on the optimization grid; ``_INFEASIBLE`` when no
+        timing can follow the path."""
+        constraints = build_path_constraints(path, self.robot, self.limits, self.kinds, self.grid)
+        try:
+            return midpoint_duration(constraints)
+        except InfeasiblePath:
+            return _INFEASIBLE
+
+    def __call__(self, x: np.ndarray) -> float:
+        self.deadline.check()
+        if time.monotonic() > self.stop_at:
+            raise _AllowanceSpent
+        self.evaluations += 1
+        path = self.path(x)
+        value = self.duration(path) + self.penalty(path)
+        if value < self.best[0]:
+            self.best = (value, np.array(x, copy=True))
+        return value
+
+
+class _AllowanceSpent(Exception):
+    """The local optimization's own time allowance is spent: the round ends with its best point."""
+
+
+def _exact(path: BSplinePath, robot, limits, kinds, deadline) -> TimeScaling | None:
+    """The phase-plane timing (default tolerance and refinement) along ``path``, or ``None``
+    when no timing can follow it."""
+    constraints = build_path_constraints(path, robot, limits, kinds, path_grid(path), deadline)
+    try:
+        return PhasePlaneMethod().solve(constraints, deadline=deadline)
+    except InfeasiblePath:
+        return None
+
+
+def _clear(path, robot, limits, obstacles, clearance, deadline) -> tuple[bool, Clearance | None]:
+    """Whether ``path`` keeps ``clearance`` (the planner's dense check) and its joint ranges (at
+    the default grid); the clearance found."""
+    q = path(path_grid(path))
+    if robot.outside_position_limits(q) is not None:
+        return False, None
+    if not obstacles:
+        return True, None
+    try:
+        return True, check_clearance(path, robot, list(obstacles), clearance, deadline)
+    except PathInCollision:
+        return False, None
+
+
+def optimize_locally(
+    robot: Robot,
+    seed: np.ndarray,
+    limits: JointLimits,
+    kinds: tuple[str, ...] = ("torque",),
+    obstacles: tuple[Obstacle, ...] | list[Obstacle] = (),
+    clearance: float = 0.01,
+    deadline: Deadline = NO_DEADLINE,
+    settings: LocalSettings = LocalSettings(),
+    allowance_s: float | None = None,
+) -> LocalOptimum:
+    """The time-optimal B-spline near ``seed`` (module docstring).
+
+    Args:
+        robot: The arm.
+        seed: Joint configurations from start to goal, shape (m, n_dof), m >= 2 (a grid path,
+            or just start and goal), in joint units.
+        limits: The limits the timing holds (``kinds`` of them: "velocity", "acceleration",
+            "torque"; ``position_lower``/``upper`` become the range penalty).
+        obstacles: World-frame obstacles; every link keeps ``clearance`` (m) from them.
+        deadline: Checked at every objective evaluation and in the exact timings.
+        settings: Rounds, grid, penalties and Nelder-Mead's budget.
+        allowance_s: Seconds the rounds may take (``None``: no limit besides ``deadline``):
+            once spent, the round under way ends at its best point so far, is timed and checked
+            like any other, and no round follows (``stopped``: "allowance spent").
+
+    Returns:
+        The best round's path, its exact duration and timing, control points and statistics.
+
+    Raises:
+        InvalidRequest: a seed of the wrong shape or with non-finite values.
+        InfeasiblePath: no round gives a path that a timing can follow and that keeps the
+            clearance and the joint ranges (a ``PathInCollision`` when it is the clearance).
+        BudgetExceeded: ``deadline`` passed.
+    """
+    started = time.perf_counter()
+    seed = np.asarray(seed, dtype=float)
+    if seed.ndim != 2 or seed.shape[0] < 2 or seed.shape[1] != robot.dof or not np.all(np.isfinite(seed)):
+        raise InvalidRequest(f"the seed path must be finite joint configurations of shape (m >= 2, {robot.dof}); got shape {seed.shape}")
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(seed, axis=0), axis=1) > 1e-12])
+    seed = seed[keep]
+    if len(seed) < 2:
+        raise InvalidRequest("the seed path's start and goal coincide")
+    if settings.grid_intervals & (settings.grid_intervals - 1):
+        raise InvalidRequest(f"the optimization grid must have a power of two of intervals; got {settings.grid_intervals}")
+    objective = _Objective(robot, limits, kinds, seed[0], seed[-1], obstacles, clearance, settings, deadline)
+    counts = _schedule(max(settings.first_control_points, DEGREE + 1), settings.max_control_points)
+    if 8 * (counts[-1] - DEGREE) > settings.grid_intervals:
+        raise InvalidRequest(
+            f"{counts[-1]} control points need at least {8 * (counts[-1] - DEGREE)} grid intervals (8 per knot interval)"
+        )
+    extent = np.maximum(np.ptp(seed, axis=0) * settings.step, settings.min_step)
+
+    objective.interior = np.sort(dyadic_knots(counts[0] - DEGREE - 1))
+    control = fit_seed(seed, objective.interior)
+    seed_path = BSplinePath(control, objective.interior)
+    seed_timing = _exact(seed_path, robot, limits, kinds, deadline)
+    seed_duration = np.inf if seed_timing is None else seed_timing.duration
+
+    rounds: list[LocalRound] = []
+    best = None  # (duration, path, timing, clearance): the fitted seed first, when it passes
+    if seed_timing is not None:
+        clear, found = _clear(seed_path, robot, limits, obstacles, clearance, deadline)
+        if clear:
+            best = (seed_timing.duration, seed_path, seed_timing, found)
+    stopped, stalls = "most control points", 0
+    if allowance_s is not None:
+        objective.stop_at = time.monotonic() + allowance_s
+    for number, count in enumerate(counts):
+        deadline.progress(number / len(counts), f"local optimization: {count} control points")
+        while len(control) < count:
+            knots, control = insert_knot(clamped_knots(objective.interior), control, dyadic_knots(len(control) - DEGREE)[-1])
+            objective.interior = knots[DEGREE + 1 : -DEGREE - 1]
+        x0 = control[1:-1].ravel()
+        steps = np.tile(extent, len(control) - 2) * (1.0 if number == 0 else 0.5)
+        simplex = np.vstack([x0, x0 + np.diag(steps)])
+        before = objective.evaluations
+        objective.round_begins()
+        spent = False
+        try:
+            result = minimize(
+                objective,
+                x0,
+                method="Nelder-Mead",
+                options={
+                    "initial_simplex": simplex,
+                    "maxfev": settings.evaluations_per_variable * len(x0),
+                    "xatol": 1e-4,
+                    "fatol": 1e-6,
+                    "adaptive": len(x0) > 4,
+                },
+            )
+            x, value = result.x, float(result.fun)
+        except _AllowanceSpent:
+            spent = True
+            value, x = objective.best
+            if x is None:
+                stopped = "allowance spent"
+                break
+        path = objective.path(x)
+        control = path.control
+        timing = _exact(path, robot, limits, kinds, deadline)
+        clear, found = _clear(path, robot, limits, obstacles, clearance, deadline)
+        duration = np.inf if timing is None else timing.duration
+        rounds.append(LocalRound(count, float(value), float(duration), clear, objective.evaluations - before))
+        if timing is not None and clear:
+            if best is not None and duration > best[0] * (1.0 - settings.improvement):
+                stalls += 1
+            else:
+                stalls = 0
+            if best is None or duration < best[0]:
+                best = (duration, path, timing, found)
+        if spent:
+            stopped = "allowance spent"
+            break
+        if stalls >= settings.patience:
+            stopped = "converged"
+            break
+    if best is None:
+        raise InfeasiblePath(
+            f"the local optimization found no path that a timing can follow and that keeps the clearance "
+            f"and the joint ranges: the fitted seed and {len(rounds)} rounds of up to {counts[len(rounds) - 1] if rounds else counts[0]} "
+            "control points"
+        )
+    duration, path, timing, found = best
+    statistics = LocalStatistics(objective.evaluations, tuple(rounds), float(seed_duration), stopped, time.perf_counter() - started)
+    return LocalOptimum(path, float(duration), timing, path.control, path.interior, found, statistics)

@@ -1,0 +1,160 @@
+"""``search``: the name under which a free motion is searched globally (``planners.generators.search``). It
+does not time a given path, so ``solve`` refuses one; ``global_search`` is the search itself,
+from a free motion to its best grid paths, their statistics and, for planar arms among
+obstacles, the obstacle shadows."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from planners.collision import Obstacle
+from planners.constraints.path_constraints import PathConstraints
+from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.generators.search.branch_and_bound import branch_and_bound
+from planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
+from planners.generators.search.memory import check_search_memory
+from planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
+from planners.generators.search.problem import build_problem, toward_goal
+from planners.generators.search.shadows import obstacle_shadows
+from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
+from robots import JointLimits, Robot
+
+#: A goal variant is searched only for grid paths faster than this multiple of the best grid
+#: path of the variants searched before it (the local optimization takes a grid path down by
+#: at most about a third: 1.51 -> 0.98 s and 2.23 -> 1.00 s on the Geering arm around a sphere).
+VARIANT_CAP = 2.0
+#: Share of the time left that the branch and bound of the goal variants may take together;
+#: the rest is the local optimization's and the final timing's.
+SEARCH_SHARE = 0.25
+
+
+class SearchMethod(TimingMethod):
+    """Global search of path and timing among obstacles (see ``planners.generators.search``)."""
+
+    name = "search"
+    kinds = frozenset({"velocity", "acceleration", "torque"})
+
+    def solve(
+        self,
+        constraints: PathConstraints,
+        boundary: Boundary = AT_REST,
+        duration: float | None = None,
+        deadline: Deadline = NO_DEADLINE,
+    ) -> PathTiming:
+        raise InvalidRequest("search finds the path itself: give a free path (start and goal)")
+
+
+@dataclass(frozen=True)
+class GlobalSearch:
+    """A search's result, its region of joint space ((n_dof,) corners) and, for a planar arm
+    among obstacles, its obstacle shadows (``planners.generators.search.shadows``)."""
+
+    result: SearchResult
+    low: np.ndarray
+    high: np.ndarray
+    shadows: dict | None
+
+    def as_dict(self, chosen: int = 0) -> dict:
+        """The answer's ``search`` (JSON-ready): the statistics, the tubes' best grid paths
+        (``chosen`` the one returned), the region searched and the shadows."""
+        body = self.result.statistics.as_dict()
+        body["tube_radius"] = self.result.tube_radius
+        body["tubes"] = [
+            {"time": tube.time, "t1": tube.bounds[0], "t2": tube.bounds[1], "t3": tube.bounds[2], "points": tube.points.tolist()}
+            for tube in self.result.tubes
+        ]
+        body["chosen_tube"] = chosen
+        body["region"] = {"lower": self.low.tolist(), "upper": self.high.tolist()}
+        body["shadows"] = self.shadows
+        return body
+
+
+def global_search(
+    robot: Robot,
+    limits: JointLimits,
+    kinds: tuple[str, ...],
+    start: np.ndarray,
+    goal: np.ndarray,
+    options: SearchOptions | None = None,
+    revolutions: bool = True,
+    obstacles: tuple[Obstacle, ...] = (),
+    clearance: float = 0.01,
+    deadline: Deadline = NO_DEADLINE,
+) -> GlobalSearch:
+    """The best grid paths from ``start`` to ``goal`` at rest: the problem built once
+    (``build_problem``), then ``branch_and_bound`` toward each revolution variant of the goal
+    in turn (grid paths that end one revolution apart are never in one tube, so each variant
+    is a homotopy class with its own upper bound). The tubes are the best grid path of each
+    variant, best first, then the next tubes of the variants by time, ``options.tubes`` in all.
+    The variants are searched by their least time to go, and each after the first only for grid
+    paths faster than ``VARIANT_CAP`` times the best found before it (the cap prunes its
+    subsets from the start). With a budget, the variants' searches share ``SEARCH_SHARE`` of
+    the time left, each stopping at its part with the grid paths it found: that is what ends
+    a variant no grid path reaches, which would otherwise run until ``max_expansions``.
+
+    Before any work, the search's memory is estimated from ``options`` and compared with
+    ``options.memory_bytes`` (``planners.generators.search.memory``).
+
+    Raises:
+        OverMemory: the estimate exceeds the cap (the detail names the largest value served).
+        InvalidRequest, InfeasiblePath: see ``build_problem`` and ``branch_and_bound`` (the
+            latter when no variant has a grid path).
+        BudgetExceeded: ``deadline`` passed.
+    """
+    options = options or DEFAULT_OPTIONS
+    check_search_memory(robot, start, goal, options, revolutions)
+    problem = build_problem(
+        robot, limits, kinds, start, goal, options, revolutions, obstacles, clearance, deadline.within(0.0, 0.4)
+    )
+    # the variants by their least time to go (h2 from the start), the likeliest best first, so
+    # that its t~ caps the searches of the others
+    toward = [toward_goal(problem, index, deadline) for index in range(len(problem.graph.goals))]
+    toward.sort(key=lambda one: float(np.min(one.h2[[state for _, state, _ in one.start_moves if state >= 0]], initial=np.inf)))
+    results: list[SearchResult] = []
+    failures: list[NoGridPath] = []
+    remaining = deadline.remaining()
+    for index, variant in enumerate(toward):
+        part = deadline.within(0.4 + 0.6 * index / len(toward), 0.4 + 0.6 * (index + 1) / len(toward))
+        cap = VARIANT_CAP * min((r.tubes[0].time for r in results), default=np.inf)
+        allowance = None if remaining is None else SEARCH_SHARE * remaining / len(toward)
+        try:
+            results.append(branch_and_bound(variant, options, part, cap, allowance))
+        except NoGridPath as error:
+            failures.append(error)
+    if not results:
+        raise failures[0]
+    result = _merged(results, [f.statistics for f in failures], problem.prepare_s, options.tubes)
+    points = problem.graph.points
+    low, high = points.min(axis=0), points.max(axis=0)
+    shadows = obstacle_shadows(robot, list(obstacles), clearance, low, high) if obstacles else None
+    return GlobalSearch(result, low, high, shadows)
+
+
+def _merged(results: list[SearchResult], failed: list[SearchStatistics], prepare_s: float, count: int) -> SearchResult:
+    """One result of the searches toward each goal variant (and the statistics of those that
+    found no grid path): statistics summed (the upper bound is that of the best variant's
+    search), tubes as ``global_search`` says."""
+    firsts = sorted((r.tubes[0] for r in results), key=lambda tube: tube.time)
+    rest = sorted((tube for r in results for tube in r.tubes[1:]), key=lambda tube: tube.time)
+    tubes = tuple(sorted([*firsts, *rest][: max(1, count)], key=lambda tube: tube.time))
+    candidates = tuple(sorted((c for r in results for c in r.candidates), key=lambda c: c.time))
+    best = min(results, key=lambda r: r.tubes[0].time)
+    every = [r.statistics for r in results] + failed
+    statistics = dataclasses.replace(
+        best.statistics,
+        expanded=sum(s.expanded for s in every),
+        generated=sum(s.generated for s in every),
+        pruned={key: sum(s.pruned[key] for s in every) for key in best.statistics.pruned},
+        t4_evaluations=sum(s.t4_evaluations for s in every),
+        candidates=len(candidates),
+        best_grid_time=tubes[0].time,
+        complete=all(s.complete for s in every),
+        prepare_s=prepare_s,
+        search_s=sum(s.search_s for s in every),
+        goal_variants=len(every),
+    )
+    return SearchResult(tubes, candidates, statistics, best.tube_radius)

@@ -1,0 +1,240 @@
+"""A search problem, built once before the branch and bound: the graph (lattice or roadmap), its
+pieces of curve with the configuration-space obstacles removed, every piece's bounds, and the
+cost-to-go from each node of the direction-augmented graph under t1 and t2."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from planners.collision import Obstacle
+from planners.errors import InfeasiblePath, InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.generators.search.bounds import PieceBounds, piece_bounds
+from planners.generators.search.free_space import clear_pieces, point_distances
+from planners.generators.search.graph import (
+    DEFAULT_MAX_TURN,
+    DEFAULT_OPTIONS,
+    LATTICE_MAX_JOINTS,
+    SearchGraph,
+    SearchOptions,
+    lattice_graph,
+    roadmap_graph,
+)
+from planners.generators.search.pieces import DIRECT, FIRST, LAST, MIDDLE, Pieces, build_pieces
+from robots import JointLimits, Robot
+
+GRAPH_KINDS = ("auto", "lattice", "roadmap")
+
+
+@dataclass(frozen=True)
+class SearchProblem:
+    """Everything the branch and bound reads.
+
+    The search's states are the nodes of the direction-augmented graph seen through the
+    curve: a partial path is known by its last two moves (a turn of the graph, whose B-spline
+    span is not yet fixed), or, after one move, by that move alone (``start_states``).
+
+    Attributes:
+        graph: The grid points and moves.
+        turn_in, turn_out: The turns of the augmented graph (pairs of moves), shape (T,).
+        pieces: Every span (``planners.generators.search.pieces``).
+        bounds: Every span's bounds (``planners.generators.search.bounds``).
+        usable: Per span, whether it keeps the clearance and some motion can follow it.
+        start_moves: Per move from the start: (edge, state, direct span): the state it leads to
+            (-1 when it ends at a goal) and its usable direct span (-1 where none).
+        successors: Per state, its usable moves on: (next state, span, last span) with the last
+            span (-1 where none) when the next state's move ends at a goal.
+        state_point: The grid point each state's last move ends at, shape (S,).
+        h1, h2: Per state, lower bounds on the time from the fixed part of its curve to a goal:
+            the straight distance over V_max, and the least t2 over the graph's completions
+            (``inf`` where no goal can be reached).
+        robot, limits, kinds: What the spans were bounded for (t4 uses them too).
+        removed: Spans removed by the obstacles; ``points_blocked``: grid points closer than
+            the clearance.
+        prepare_s: Seconds spent building the problem.
+    """
+
+    graph: SearchGraph
+    turn_in: np.ndarray
+    turn_out: np.ndarray
+    pieces: Pieces
+    bounds: PieceBounds
+    usable: np.ndarray
+    start_moves: list[tuple[int, int, int]]
+    successors: list[list[tuple[int, int, int]]]
+    state_point: np.ndarray
+    h1: np.ndarray
+    h2: np.ndarray
+    robot: Robot
+    limits: JointLimits
+    kinds: tuple[str, ...]
+    removed: int
+    points_blocked: int
+    prepare_s: float
+
+
+def _graph(robot, start, goal, options: SearchOptions, revolutions, obstacles, clearance, deadline: Deadline) -> SearchGraph:
+    kind = options.graph
+    if kind not in GRAPH_KINDS:
+        raise InvalidRequest(f"timing.search.graph {kind!r} is unknown; use one of {list(GRAPH_KINDS)}")
+    if kind == "auto":
+        kind = "lattice" if robot.dof <= LATTICE_MAX_JOINTS else "roadmap"
+    if kind == "lattice":
+        return lattice_graph(robot, start, goal, options, revolutions)
+
+    def free(q):
+        if not obstacles:
+            return np.ones(len(q), dtype=bool)
+        return point_distances(robot, q, obstacles, deadline=deadline) >= clearance
+
+    return roadmap_graph(robot, start, goal, options, revolutions, free, deadline)
+
+
+def _cost_to_go(n_states: int, source: np.ndarray, target: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """Least cost from each state to a goal over arcs (source, target, weight), target -1 the
+    goal: Dijkstra from the goal over the reversed arcs."""
+    if not len(source):
+        return np.full(n_states, np.inf)
+    target = np.where(target < 0, n_states, target)
+    finite = np.isfinite(weight)
+    reversed_arcs = csr_matrix(
+        (weight[finite] + 1e-300, (target[finite], source[finite])), shape=(n_states + 1, n_states + 1)
+    )  # 1e-300: sparse matrices drop zero weights
+    return dijkstra(reversed_arcs, directed=True, indices=n_states)[:n_states]
+
+
+def build_problem(
+    robot: Robot,
+    limits: JointLimits,
+    kinds: tuple[str, ...],
+    start: np.ndarray,
+    goal: np.ndarray,
+    options: SearchOptions | None = None,
+    revolutions: bool = True,
+    obstacles: tuple[Obstacle, ...] = (),
+    clearance: float = 0.01,
+    deadline: Deadline = NO_DEADLINE,
+) -> SearchProblem:
+    """The graph between ``start`` and ``goal`` (n_dof,), its pieces kept clear of
+    ``obstacles`` by ``clearance`` (m), their bounds and the costs to go.
+
+    Raises:
+        InvalidRequest: start or goal outside the joint limits, an unknown graph kind, a grid
+            too large.
+        InfeasiblePath: start or goal closer to an obstacle than the clearance.
+    """
+    began = time.perf_counter()
+    options = options or DEFAULT_OPTIONS
+    obstacle_list = list(obstacles)
+    for name, q in (("start", start), ("goal", goal)):
+        if robot.outside_position_limits(q) is not None:
+            raise InvalidRequest(f"path.{name} is outside the joint limits")
+        if obstacle_list:
+            nearest = float(point_distances(robot, q[None, :], obstacle_list)[0])
+            if nearest < clearance:
+                raise InfeasiblePath(
+                    f"path.{name} comes within {nearest:.4g} m of an obstacle (the clearance is {clearance:g} m): "
+                    "move it away from the obstacles or lower path.clearance"
+                )
+    deadline.progress(0.0, "search: graph")
+    graph = _graph(robot, start, goal, options, revolutions, obstacle_list, clearance, deadline)
+    max_turn = options.max_turn if options.max_turn is not None else DEFAULT_MAX_TURN[graph.kind]
+    if not 0.0 < max_turn < 180.0:
+        raise InvalidRequest(f"timing.search.max_turn must lie in (0, 180) degrees, got {max_turn}")
+    turn_in, turn_out = graph.transitions(max_turn, deadline)
+    pieces = build_pieces(graph.points, graph.edge_from, graph.edge_to, graph.start, graph.goals, turn_in, turn_out)
+    deadline.check()
+    usable = np.ones(len(pieces), dtype=bool)
+    points_blocked = 0
+    if obstacle_list:
+        deadline.progress(0.1, "search: obstacles")
+        usable, distance = clear_pieces(pieces, graph.points, robot, obstacle_list, clearance, deadline)
+        points_blocked = int((distance < clearance).sum())
+    removed = int((~usable).sum())
+    deadline.progress(0.2, "search: bounds")
+    bounds = piece_bounds(pieces, robot, limits, kinds, deadline)
+    usable &= bounds.feasible
+    problem = SearchProblem(
+        graph=graph, turn_in=turn_in, turn_out=turn_out, pieces=pieces, bounds=bounds, usable=usable,
+        start_moves=[], successors=[], state_point=np.empty(0, dtype=int), h1=np.empty(0), h2=np.empty(0),
+        robot=robot, limits=limits, kinds=tuple(kinds), removed=removed, points_blocked=points_blocked,
+        prepare_s=0.0,
+    )
+    return dataclasses.replace(_with_states(problem, graph, deadline), prepare_s=time.perf_counter() - began)
+
+
+def toward_goal(problem: SearchProblem, goal: int, deadline: Deadline = NO_DEADLINE) -> SearchProblem:
+    """The same problem with one goal point only (``goal``, an index into the graph's goals):
+    the grid paths ending at one revolution variant of the goal, a homotopy class of their
+    own, searched with their own upper bound."""
+    graph = dataclasses.replace(problem.graph, goals=problem.graph.goals[goal : goal + 1])
+    return _with_states(problem, graph, deadline)
+
+
+def _with_states(problem: SearchProblem, graph: SearchGraph, deadline: Deadline = NO_DEADLINE) -> SearchProblem:
+    """``problem`` with the states, moves and costs to go toward ``graph.goals``."""
+    bounds = problem.bounds
+    successors, start_moves, state_point, h2, cut = _states(
+        graph, problem.turn_in, problem.turn_out, problem.pieces, bounds, problem.usable, deadline
+    )
+    goal_points = graph.points[graph.goals]
+    straight = np.min(np.linalg.norm(cut[:, None, :] - goal_points[None, :, :], axis=2), axis=1)
+    h1 = np.where(np.isfinite(h2), straight / bounds.v_max, np.inf)
+    return dataclasses.replace(
+        problem, graph=graph, start_moves=start_moves, successors=successors, state_point=state_point, h1=h1, h2=h2
+    )
+
+
+#: Spans handled between two deadline checks while the states are built.
+CHECK_EVERY = 4_096
+
+
+def _states(graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: PieceBounds, usable, deadline: Deadline = NO_DEADLINE):
+    """The search's states and moves (``SearchProblem``), the cost-to-go h2 of each state and
+    the point where its fixed curve ends; ``deadline`` checked every ``CHECK_EVERY`` spans."""
+    n_turns = len(turn_in)
+    starts = np.flatnonzero(graph.edge_from == graph.start)
+    goal = np.zeros(len(graph.points), dtype=bool)
+    goal[graph.goals] = True
+    start_state = {int(e): n_turns + k for k, e in enumerate(starts)}
+    n_states = n_turns + len(starts)
+    state_point = np.concatenate([graph.edge_to[turn_out], graph.edge_to[starts]])
+    last = np.full(n_turns, -1)
+    keep = usable & (pieces.kind == LAST)
+    last[pieces.turn_in[keep]] = np.flatnonzero(keep)
+    direct = {int(pieces.edge[k]): int(k) for k in np.flatnonzero(usable & (pieces.kind == DIRECT))}
+    successors: list[list[tuple[int, int, int]]] = [[] for _ in range(n_states)]
+    source, target, weight = [], [], []
+    for counted, k in enumerate(np.flatnonzero(usable & ((pieces.kind == FIRST) | (pieces.kind == MIDDLE)))):
+        if counted % CHECK_EVERY == 0:
+            deadline.check()
+        after = int(pieces.turn_out[k])
+        before = int(pieces.turn_in[k]) if pieces.kind[k] == MIDDLE else start_state[int(turn_in[after])]
+        ending = int(last[after]) if goal[graph.edge_to[turn_out[after]]] else -1
+        if goal[graph.edge_to[turn_out[after]]] and ending < 0:
+            continue  # the last span into the goal is not usable
+        successors[before].append((after, int(k), ending))
+        source.append(before)
+        target.append(after)
+        weight.append(bounds.t2[k])
+    for turn in np.flatnonzero(last >= 0):
+        source.append(int(turn))
+        target.append(-1)
+        weight.append(bounds.t2[last[turn]])
+    h2 = _cost_to_go(n_states, np.array(source, dtype=int), np.array(target, dtype=int), np.array(weight, dtype=float))
+    start_moves = []
+    for e in starts:
+        into_goal = bool(goal[graph.edge_to[e]])
+        start_moves.append((int(e), -1 if into_goal else start_state[int(e)], direct.get(int(e), -1)))
+    P = graph.points
+    cut = np.concatenate([
+        (P[graph.edge_from[turn_in]] + 4.0 * P[graph.edge_to[turn_in]] + P[graph.edge_to[turn_out]]) / 6.0,
+        P[np.full(len(starts), graph.start)],
+    ])
+    return successors, start_moves, state_point, h2, cut

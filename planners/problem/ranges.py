@@ -1,0 +1,95 @@
+"""Accepted ranges of the physical numbers a request carries (SI units).
+
+The planners raise speeds to the second and third power and divide by the fifth power of a
+duration (a quintic's coefficients), so numbers far outside what any arm does overflow to inf or
+underflow to zero and no longer describe a motion: a duration of 1e-300 s, a boundary speed of
+1e300 rad/s or a switching fraction of 5e-324 turned into infinite samples and singular
+systems. Every such number is held to a range here, the service declares the same ranges in its
+schema (OpenAPI ``minimum``/``maximum``), and ``plan`` checks them for library callers.
+
+A ``Range`` bounds a magnitude: positive quantities (limits, durations, scale factors) lie in
+[low, high]; signed ones (boundary velocities and accelerations) in [-high, high].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from planners.errors import InvalidRequest
+from robots.ranges import ACCELERATION as ACCELERATION
+from robots.ranges import JERK as JERK
+from robots.ranges import LIMITS as LIMITS
+from robots.ranges import TORQUE as TORQUE
+from robots.ranges import VELOCITY as VELOCITY
+from robots.ranges import Range as Range
+
+#: Joint coordinates (rad or m): a continuous joint may turn many times, not 1e300.
+COORDINATE = Range(0.0, 1e4, "rad or m")
+#: Duration of a time law or of the via-point motion (s).
+DURATION = Range(1e-3, 1e4, "s")
+#: Sample period of the returned trajectory (s): 1 MHz is faster than any drive's loop.
+DT = Range(1e-6, 10.0, "s")
+#: Per-joint limit overrides and the magnitude of boundary states (rad or m, per s^k) lie in
+#: the ranges of the robots' own limits: ``robots.ranges`` VELOCITY, ACCELERATION, JERK, TORQUE.
+
+#: Tool-speed limits (m/s, rad/s).
+TOOL_SPEED = Range(1e-6, 1e3, "m/s")
+TOOL_ANGULAR_SPEED = Range(1e-6, 1e3, "rad/s")
+#: Largest distance of a blended corner from its waypoint (joint-space norm, rad or m).
+MAX_DEVIATION = Range(1e-9, 1e4, "rad or m")
+#: Factors on a robot's limits.
+SCALE = Range(1e-3, 1e3, "")
+#: Switching fractions of the trapezoidal law (acceleration ends at tau1, cruise at tau2).
+TRAPEZOID_FRACTION = Range(1e-3, 1.0 - 1e-3, "")
+
+
+def check(value: float, field: str, accepted: Range) -> None:
+    """InvalidRequest unless ``value`` lies in ``accepted``."""
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and accepted.holds(value)):
+        raise InvalidRequest(f"{field} = {value!r} is outside the accepted range {accepted.describe()}")
+
+
+def check_vector(values, field: str, accepted: Range, signed: bool = False) -> None:
+    """InvalidRequest unless every entry of ``values`` lies in ``accepted`` (by magnitude, and
+    any sign, when ``signed``)."""
+    try:
+        array = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise InvalidRequest(f"{field} must be a list of numbers") from None
+    inside = (np.abs(array) <= accepted.high) if signed else ((array >= accepted.low) & (array <= accepted.high))
+    bad = np.flatnonzero(~inside)
+    if bad.size:
+        shown = f"[-{accepted.high:g}, {accepted.high:g}] {accepted.unit}".rstrip() if signed else accepted.describe()
+        raise InvalidRequest(f"{field}[{bad[0]}] = {array[bad[0]]!r} is outside the accepted range {shown}")
+
+
+def check_timing(timing, dt: float) -> None:
+    """Hold every number of a ``planners.problem.requests.Timing`` and the sample period ``dt`` to its
+    range (InvalidRequest naming the field and the range otherwise)."""
+    check(dt, "output.dt", DT)
+    if timing.duration is not None:
+        check(timing.duration, "timing.duration", DURATION)
+    if timing.method == "trapezoidal":
+        for name, value in zip(("tau1", "tau2"), timing.trapezoid_fractions):
+            check(value, f"timing.trapezoid.{name}", TRAPEZOID_FRACTION)
+    for kind, values in (timing.limit_overrides or {}).items():
+        if values is not None and kind in LIMITS:
+            check_vector(values, f"timing.limits.{kind}", LIMITS[kind])
+    for name, accepted in (("tool_speed", TOOL_SPEED), ("tool_angular_speed", TOOL_ANGULAR_SPEED)):
+        value = getattr(timing, name, None)
+        if value is not None:
+            check(value, f"timing.limits.{name}", accepted)
+    for kind, factor in (timing.limit_scales or {}).items():
+        if factor is not None:
+            check(factor, f"timing.limits.{kind}_scale", SCALE)
+    for name, accepted in (
+        ("start_velocity", VELOCITY),
+        ("end_velocity", VELOCITY),
+        ("start_acceleration", ACCELERATION),
+        ("end_acceleration", ACCELERATION),
+    ):
+        values = getattr(timing, name)
+        if values is not None:
+            check_vector(values, f"timing.boundary.{name}", accepted, signed=True)

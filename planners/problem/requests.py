@@ -1,0 +1,201 @@
+"""What a caller asks of ``plan``: the path (joint waypoints; Cartesian lines and free motions
+live with their planners) and the timing, and the timing method that a request names."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from planners.constraints.path_constraints import CONSTRAINT_KINDS
+from planners.errors import InvalidRequest
+from planners.generators.search.graph import SearchOptions
+from planners.generators.search.method import SearchMethod
+from planners.timing import METHODS
+from planners.timing.base import TimingMethod
+from planners.timing.collocation_method import CollocationMethod
+from planners.timing.laws.method import ClassicalMethod
+from planners.timing.laws.profiles import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
+from planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
+from planners.timing.min_cost import MinCostMethod
+
+#: Largest distance of a blend from its waypoint when a request names none (joint units): the
+#: default path tolerance of MoveIt's time-optimal trajectory generation.
+DEFAULT_MAX_DEVIATION = 0.1
+
+
+@dataclass(frozen=True)
+class WaypointPath:
+    """A joint path through ``waypoints`` (shape (n_waypoints, n_dof), joint units), interpolated
+    by ``"spline"`` (C2 cubic), ``"linear"`` (straight segments, stopping at each waypoint),
+    ``"blend"`` (straight segments joined by circular blends within ``max_deviation`` of each
+    waypoint, joint-space norm in joint units; default ``DEFAULT_MAX_DEVIATION``) or ``"via"``
+    (per-joint cubic or quintic segments in time through the via points, the law named by the
+    timing method). Continuous joints (no position limits) follow the numbers given
+    (``continuous = "as_given"``) or turn the short way between waypoints (``"shortest"``)."""
+
+    waypoints: np.ndarray
+    interpolation: str = "spline"
+    max_deviation: float | None = None
+    continuous: str = "as_given"
+
+
+@dataclass(frozen=True)
+class Timing:
+    """How to time the path.
+
+    Attributes:
+        method: A ``timing.method`` name (see ``planners.timing.METHODS``).
+        constraints: Which limits to respect, among velocity, acceleration and torque.
+        limit_overrides: Per-joint replacements, keys ``velocity``, ``acceleration``, ``jerk``,
+            ``torque``.
+        limit_scales: Factors on those limits, same keys.
+        grid_points: Number of grid intervals; ``None`` chooses one from the path.
+        start_velocity, end_velocity: Joint velocities at the ends (rad/s), tangent to the path;
+            ``None`` is rest.
+        start_acceleration, end_acceleration: Joint accelerations at the ends (rad/s^2), for the
+            laws that take them (quintic).
+        duration: Seconds, for the time laws; ``None`` asks for the shortest within the limits.
+        trapezoid_fractions: (tau1, tau2), the trapezoidal law's ends of acceleration and of
+            cruise as fractions of the duration.
+        trapezoid_blend: ``"linear"`` (constant acceleration, Angeles 6.1) or ``"cycloidal"``
+            (cycloidal blends, Angeles 6.3) for the trapezoidal law's speed ramps.
+        supporting_points: For a time law, approximate it by the cubic spline through this many
+            equally spaced points of it (Angeles 6.1 (c), ``planners.timing.laws.splines``);
+            ``None``: the law itself.
+        synchronization: For a time law on a straight joint move (two waypoints):
+            ``"normalized"`` times the straight joint line as one, every joint starting and
+            stopping together; ``"none"`` runs every joint at its own full speed to its goal
+            (lecture "Trajectory Planning"; ``planners.generators.unsynchronized``).
+        torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
+            ``min_cost``.
+        limit_margin: Fraction of every velocity, acceleration, jerk, torque and tool-speed
+            limit kept in reserve (0 to 0.5): the timing is planned under the limits times
+            (1 - margin), and with a positive margin no returned state exceeds the limits
+            themselves.
+        tool_speed: Largest linear speed of the tool frame's origin, m/s; ``None``: none.
+        tool_angular_speed: Largest angular speed of the tool frame, rad/s; ``None``: none.
+        tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
+        search: Options of the global search (``timing.method = "search"``); ``None``: the
+            defaults of ``planners.generators.search.SearchOptions``.
+    """
+
+    method: str = "phase_plane"
+    constraints: tuple[str, ...] = ("velocity", "acceleration", "torque")
+    limit_overrides: dict[str, list[float] | None] = field(default_factory=dict)
+    limit_scales: dict[str, float | None] = field(default_factory=dict)
+    grid_points: int | None = None
+    start_velocity: ArrayLike | None = None
+    end_velocity: ArrayLike | None = None
+    start_acceleration: ArrayLike | None = None
+    end_acceleration: ArrayLike | None = None
+    duration: float | None = None
+    trapezoid_fractions: tuple[float, float] = (1.0 / 3.0, 2.0 / 3.0)
+    trapezoid_blend: str = "linear"
+    supporting_points: int | None = None
+    synchronization: str = "normalized"
+    torque_weight: float = 0.0
+    limit_margin: float = 0.0
+    tool_speed: float | None = None
+    tool_angular_speed: float | None = None
+    tool_frame: str | None = None
+    search: SearchOptions | None = None
+
+
+def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
+    unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
+    if unknown:
+        raise InvalidRequest(f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}")
+    unsupported = [kind for kind in kinds if kind not in method.kinds]
+    if unsupported:
+        hint = " (for jerk, use jerk_limited, a time law or ruckig)" if unsupported[0] == "jerk" else ""
+        raise InvalidRequest(
+            f"timing.method {method.name!r} cannot limit {unsupported[0]}; it handles "
+            f"{sorted(method.kinds)}{hint}"
+        )
+    kinds = tuple(dict.fromkeys([*kinds, *sorted(method.required_kinds)]))
+    if not kinds:
+        raise InvalidRequest("timing.constraints is empty: without limits the time-optimal motion is instantaneous")
+    return kinds
+
+
+#: Trapezoid ramps by ``timing.trapezoid.blend``.
+BLENDS: dict[str, type[TrapezoidalProfile]] = {"linear": TrapezoidalProfile, "cycloidal": CycloidalBlendProfile}
+SYNCHRONIZATIONS = ("normalized", "none")
+
+
+def law_profile(timing: Timing) -> NormalizedProfile:
+    """The normalized profile of a time law request: the law (trapezoid fractions and blend),
+    or its spline through ``timing.supporting_points`` points."""
+    profile: NormalizedProfile
+    if timing.method == "trapezoidal":
+        tau1, tau2 = timing.trapezoid_fractions
+        if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
+            raise InvalidRequest(f"timing.trapezoid needs 0 < tau1 <= tau2 < 1, got {tau1}, {tau2}")
+        if timing.trapezoid_blend not in BLENDS:
+            raise InvalidRequest(f"timing.trapezoid.blend {timing.trapezoid_blend!r} is unknown; use one of {list(BLENDS)}")
+        profile = BLENDS[timing.trapezoid_blend](tau1, tau2)
+    else:
+        profile = PROFILES[timing.method]()
+    if timing.supporting_points is None:
+        return profile
+    points = timing.supporting_points
+    if not (isinstance(points, int) and MIN_SUPPORTING_POINTS <= points <= MAX_SUPPORTING_POINTS):
+        raise InvalidRequest(
+            f"timing.supporting_points = {points!r} is outside [{MIN_SUPPORTING_POINTS}, {MAX_SUPPORTING_POINTS}]"
+        )
+    try:
+        return SplineProfile(profile, points)
+    except ValueError as error:
+        raise InvalidRequest(f"timing.supporting_points: {error}") from None
+
+
+def _check_law_options(timing: Timing) -> None:
+    """Refuse the time-law options with a method that does not use them."""
+    law = timing.method in PROFILES
+    if timing.trapezoid_blend != "linear" and timing.method != "trapezoidal":
+        raise InvalidRequest(f"timing.trapezoid.blend is used by timing.method 'trapezoidal', not {timing.method!r}")
+    if timing.supporting_points is not None and not law:
+        raise InvalidRequest(
+            f"timing.supporting_points approximates a time law ({', '.join(PROFILES)}), not timing.method {timing.method!r}"
+        )
+    moving = [value for value in (timing.start_velocity, timing.end_velocity, timing.start_acceleration, timing.end_acceleration)
+              if value is not None and np.any(np.asarray(value) != 0.0)]
+    if timing.supporting_points is not None and moving:
+        raise InvalidRequest(
+            "timing.supporting_points gives a law from rest to rest: leave timing.boundary out, or drop "
+            "supporting_points to use cubic or quintic with boundary states"
+        )
+    if timing.synchronization not in SYNCHRONIZATIONS:
+        raise InvalidRequest(f"timing.synchronization {timing.synchronization!r} is unknown; use one of {list(SYNCHRONIZATIONS)}")
+    if timing.synchronization == "none" and not law:
+        raise InvalidRequest(
+            f"timing.synchronization 'none' runs each joint with a time law ({', '.join(PROFILES)}), not with "
+            f"timing.method {timing.method!r}"
+        )
+
+
+def timing_method(timing: Timing) -> TimingMethod:
+    """The method named by ``timing.method`` (with its per-request options)."""
+    _check_law_options(timing)
+    if timing.method == "trapezoidal" or (timing.method in PROFILES and timing.supporting_points is not None):
+        method = METHODS[timing.method]
+        boundary_law = getattr(method, "boundary_law", None) if timing.supporting_points is None else None
+        return ClassicalMethod(law_profile(timing), boundary_law=boundary_law)
+    if timing.torque_weight != 0.0 and timing.method not in ("min_cost", "collocation"):
+        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}; use min_cost")
+    if timing.method == "min_cost":
+        if not (np.isfinite(timing.torque_weight) and timing.torque_weight >= 0.0):
+            raise InvalidRequest(f"timing.cost.torque_weight must be a non-negative number, got {timing.torque_weight}")
+        return MinCostMethod(timing.torque_weight)
+    if timing.method == "collocation":
+        return CollocationMethod()
+    if timing.method == "search":
+        return SearchMethod()
+    if timing.search is not None:
+        raise InvalidRequest(f"timing.search sets up timing.method 'search', not {timing.method!r}")
+    named = METHODS.get(timing.method)
+    if named is None:
+        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted([*METHODS, 'collocation', 'search'])}")
+    return named

@@ -1,0 +1,149 @@
+"""Joint waypoints as a request gives them: checked against the robot, repeats dropped, and
+turned into a geometric path (spline, stop-and-go or blended; via points are timed and shaped together
+in ``planners.generators.via_points``, Cartesian lines in ``planners.paths.cartesian``)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from planners.errors import InvalidRequest
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.paths import GeometricPath, SplinePath, StopAndGoPath
+from planners.paths.blended import BlendedPath
+from planners.paths.cartesian import CartesianLine, cartesian_path
+from planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
+from planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
+from robots import Robot
+
+INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath, "blend": BlendedPath}
+MAX_WAYPOINTS = 1_000
+#: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
+MAX_COORDINATE = COORDINATE.high
+#: Consecutive waypoints closer than this (joint-space norm, rad or m) are one waypoint.
+COINCIDENT = 1e-12
+
+
+def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
+    """The waypoints of ``spec`` as an (n, n_dof) array, checked against the robot."""
+    if spec.interpolation not in (*INTERPOLATIONS, "via"):
+        raise InvalidRequest(
+            f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted([*INTERPOLATIONS, 'via'])}"
+        )
+    if spec.max_deviation is not None and spec.interpolation != "blend":
+        raise InvalidRequest(
+            f"path.max_deviation applies to interpolation 'blend', not {spec.interpolation!r}: leave it out or use 'blend'"
+        )
+    waypoints = np.asarray(spec.waypoints, dtype=float) if np.ndim(spec.waypoints) == 2 else None
+    if waypoints is None:
+        raise InvalidRequest("path.waypoints must be a list of joint vectors (a 2-D array)")
+    count, width = waypoints.shape
+    if count < 2:
+        raise InvalidRequest(f"path.waypoints holds {count} waypoint(s); at least 2 are needed")
+    if count > MAX_WAYPOINTS:
+        raise InvalidRequest(f"path.waypoints holds {count} waypoints; at most {MAX_WAYPOINTS} are served")
+    if width != robot.dof:
+        raise InvalidRequest(
+            f"path.waypoints[0] has {width} values; {robot.name} has {robot.dof} joints "
+            f"({', '.join(robot.joint_names)})"
+        )
+    bad = np.argwhere(~np.isfinite(waypoints) | (np.abs(waypoints) > MAX_COORDINATE))
+    if bad.size:
+        raise InvalidRequest(
+            f"path.waypoints[{bad[0][0]}][{bad[0][1]}] is {waypoints[tuple(bad[0])]:.6g}: not a finite "
+            f"number within +-{MAX_COORDINATE:g} (rad or m)"
+        )
+    lower, upper = robot.limits.position_lower, robot.limits.position_upper
+    outside = robot.outside_position_limits(waypoints)
+    if outside is not None:
+        index, joint = outside
+        raise InvalidRequest(
+            f"path.waypoints[{index}][{joint}] = {waypoints[index, joint]:.6g} is outside the limits "
+            f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
+        )
+    return waypoints
+
+
+def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
+    """``spec`` without waypoints that repeat the one before them (a recorded path that stands
+    still for a while), and a note saying which were dropped.
+
+    Raises:
+        InvalidRequest: every waypoint is the same: there is nothing to move.
+    """
+    waypoints = np.asarray(spec.waypoints, dtype=float)
+    if waypoints.ndim != 2 or len(waypoints) < 2 or not np.all(np.isfinite(waypoints)):
+        return spec, ()
+    repeats = np.flatnonzero(np.linalg.norm(np.diff(waypoints, axis=0), axis=1) <= COINCIDENT) + 1
+    if repeats.size == 0:
+        return spec, ()
+    if repeats.size == len(waypoints) - 1:
+        raise InvalidRequest(
+            f"path.waypoints[0] and path.waypoints[1] coincide, as do all {len(waypoints)} waypoints: "
+            "there is nothing to move"
+        )
+    shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
+    note = f"path.waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)"
+    return dataclasses.replace(spec, waypoints=np.delete(waypoints, repeats, axis=0)), (note,)
+
+
+CONTINUOUS = ("as_given", "shortest")
+
+
+def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
+    """The waypoints of ``spec`` with the turns of its continuous joints as ``spec.continuous``
+    asks, and notes for the caller.
+
+    * ``"shortest"``: each waypoint of a continuous joint is moved by whole turns (2 pi) to lie
+      within pi of the one before it, so the joint turns the short way (the first waypoint
+      stays as given; the others may then read as equivalent angles, e.g. 6.0 as -0.283).
+    * ``"as_given"``: the numbers are followed as they are; a note names each continuous joint
+      that turns more than pi between two waypoints (the short way is shorter).
+    """
+    if spec.continuous not in CONTINUOUS:
+        raise InvalidRequest(f"path.continuous {spec.continuous!r} is unknown; use one of {list(CONTINUOUS)}")
+    waypoints = np.asarray(spec.waypoints, dtype=float)
+    mask = np.asarray(robot.continuous, dtype=bool)
+    if waypoints.ndim != 2 or waypoints.shape[1] != mask.size or not mask.any() or not np.all(np.isfinite(waypoints)):
+        return spec, ()
+    steps = np.diff(waypoints[:, mask], axis=0)
+    if spec.continuous == "shortest":
+        wrapped = steps - 2.0 * np.pi * np.round(steps / (2.0 * np.pi))
+        if np.array_equal(wrapped, steps):
+            return spec, ()
+        shifted = waypoints.copy()
+        shifted[:, mask] = waypoints[0, mask] + np.vstack([np.zeros(mask.sum()), np.cumsum(wrapped, axis=0)])
+        moved = [robot.joint_names[j] for j, m in zip(np.flatnonzero(mask), (wrapped != steps).any(axis=0)) if m]
+        note = (
+            f"path.continuous 'shortest': continuous joint(s) {', '.join(map(repr, moved))} turn the short "
+            "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"
+        )
+        return dataclasses.replace(spec, waypoints=shifted), (note,)
+    index, column = np.nonzero(np.abs(steps) > np.pi)
+    if index.size == 0:
+        return spec, ()
+    joints = [int(j) for j in np.flatnonzero(mask)]
+    seen: dict[int, int] = {}
+    for i, c in zip(index, column):
+        seen.setdefault(joints[int(c)], int(i))
+    notes = tuple(
+        f"continuous joint {robot.joint_names[j]!r} turns {steps[i][joints.index(j)]:+.4g} rad from "
+        f"path.waypoints[{i}] to [{i + 1}], more than pi: the other way round is shorter; "
+        "path.continuous = 'shortest' takes it"
+        for j, i in seen.items()
+    )
+    return spec, notes
+
+
+def make_path(robot: Robot, spec: WaypointPath | CartesianLine, deadline: Deadline = NO_DEADLINE) -> GeometricPath:
+    """The geometric path of a Cartesian line, or of joint waypoints interpolated by spline or
+    linear segments (via points are timed and shaped together, in ``via_points``)."""
+    if isinstance(spec, CartesianLine):
+        return cartesian_path(robot, spec, deadline)
+    waypoints = checked_waypoints(robot, spec)
+    if spec.interpolation == "blend":
+        deviation = DEFAULT_MAX_DEVIATION if spec.max_deviation is None else spec.max_deviation
+        check(deviation, "path.max_deviation", MAX_DEVIATION)
+        return BlendedPath(waypoints, deviation)
+    return INTERPOLATIONS[spec.interpolation](waypoints)

@@ -1,0 +1,296 @@
+"""``jerk_limited``: time-optimal timing along the given path under velocity, acceleration,
+torque **and jerk** limits.
+
+Along q(s) the joint jerk is
+
+    qddd = q' sddd + 3 q'' sd sdd + q''' sd^3,
+
+third order in the path parameter, and with the usual variables of the phase plane, x = sd^2
+and u = sdd, it is nonconvex: with du/ds = sddd / sd it reads sd (q' du/ds + 3 q'' u + q''' x),
+so that a limit |qddd_k| <= J_k is
+
+    |q'_k du/ds + 3 q''_k u + q'''_k x| <= J_k / sqrt(x).                            (1)
+
+The literature read before choosing (DESIGN.md asks for it):
+
+* TOPP3 (Pham & Pham, "On the structure of the time-optimal path parameterization problem with
+  third-order constraints", arXiv 1609.05307, ICRA 2017) integrates profiles in the
+  (s, sd, sdd) space, bang-bang in sddd, and shows the two difficulties of that route: optimal
+  profiles in 3-D no longer meet, and singularities stop the integration. No robust
+  implementation of it exists.
+* Consolini, Locatelli et al., "A sequential approach for speed planning under jerk
+  constraints" (arXiv 2105.15095): a feasible-direction line search on a linearization of the
+  problem in x, with a structure-exploiting solver for the linearized problem; written for a
+  vehicle with scalar limits along its path.
+* Lee, Bylard, Sun & Sentis, "On the performance of jerk-constrained time-optimal trajectory
+  planning for industrial manipulators" (arXiv 2404.07889, 2024): the right-hand side of (1),
+  J / sqrt(x), is convex in x, so its tangent at any x_ref > 0 lies below it; replacing it by
+  that tangent gives a **conservative linear restriction** of (1). Every other limit is already
+  linear in (x, u), so each restricted problem is a linear program whose every solution is
+  feasible for the true limits, and the sequence of LPs, each restricted around the previous
+  solution, converges.
+
+This module implements the last: it holds every limit for manipulators with torque rows as they
+are (Lee et al. use joint limits; torque rows are linear in (x, u) too), every iterate is
+feasible, and each LP is sparse and solved by HiGHS's dual simplex, warm-started from the
+previous LP's basis.
+
+The discretization and the linear program of each restriction are
+``planners.timing.jerk.program``'s. Each LP step is followed by a line search on the true
+duration: along the segment from the current (feasible) solution to the LP's, every point lies
+in the current restriction, so the duration decreases monotonically. The first restriction is
+taken around the jerk-free time-optimal profile (``phase_plane``).
+
+The grid solution follows a phase of constant jerk only approximately (within about 0.2 % of
+the duration on the default grid). Where every limit is the same along the whole path (a
+straight joint line under velocity, acceleration and jerk limits) and the solution has at most
+nine phases, ``planners.timing.jerk.polish`` refines it in time, as segments of constant jerk
+with free switching times: the exact optimum there (Berscheid & Kroeger's profile, the same as
+ruckig's along the line). Where, moreover, the motion goes from rest to rest and every row
+reduces to a symmetric bound on sd, sdd or sddd alone, the optimum is the double-S profile in
+closed form (``planners.timing.jerk.closed_form``), returned without solving anything: the
+polish is a local method started from the grid solution's phases, and misses the optimum
+(keeping the grid solution, up to 2 % above it) where those phases differ from the profile's.
+
+Every answer carries an estimate of its distance from the optimum (``optimality_gap``): zero
+for the closed form, else the difference from the solution on a second grid of half as many
+points (``planners.timing.jerk.accuracy``); above ``GAP_TARGET`` the grid is doubled, at most
+``max_refinements`` times, while the grid budget and the time left allow.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+
+from planners.constraints.path_constraints import PathConstraints
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
+from planners.timing.jerk.accuracy import coarser, relative_gap
+from planners.timing.jerk.closed_form import closed_form_timing
+from planners.timing.jerk.polish import polish
+from planners.timing.jerk.program import RestrictedProgram
+from planners.timing.jerk.scaling import JerkTimeScaling
+from planners.timing.jerk.segments import JerkSegmentsTiming
+from planners.timing.phase_plane.method import PhasePlaneMethod
+
+#: Where the limits give no constant-jerk phase at an end at rest, the first interval is
+#: this fraction of the grid's own first interval.
+FALLBACK_FIRST_INTERVAL = 1e-3
+#: Relative gain below which the LPs on a refined grid, started from the coarser solution,
+#: stop: a hundredth of the gap the refinement aims at.
+WARM_TOLERANCE = 1e-2 * GAP_TARGET
+#: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
+MIN_FIRST_INTERVAL = 1e-5
+
+
+class JerkLimitedMethod(TimingMethod):
+    """Time-optimal timing with jerk limits by sequential linear programming over conservative
+    convex restrictions (Lee et al. 2024; see the module docstring).
+
+    Args:
+        tolerance: Relative decrease of the duration below which the iteration stops.
+        max_iterations: Most LPs solved.
+        polish: Whether to refine the grid solution in time where the limits do not change.
+        max_refinements: Most doublings of the grid while the estimated gap of the answer
+            (``planners.timing.jerk.accuracy``) exceeds ``GAP_TARGET``.
+    """
+
+    name = "jerk_limited"
+    kinds = frozenset({"velocity", "acceleration", "torque", "jerk"})
+    required_kinds = frozenset({"jerk"})
+    continuous_acceleration = True
+    #: Each LP holds some 2 (N + 1) columns and 40 rows per grid interval on a 6-joint arm:
+    #: 2,000 intervals solve in about a second per LP.
+    grid_budget = 12_000
+
+    def __init__(self, tolerance: float = 1e-7, max_iterations: int = 60, polish: bool = True, max_refinements: int = 2):
+        self.tolerance = tolerance
+        self.max_iterations = max_iterations
+        self.polish = polish
+        self.max_refinements = max_refinements
+
+    def solve(
+        self,
+        constraints: PathConstraints,
+        boundary: Boundary = AT_REST,
+        duration: float | None = None,
+        deadline: Deadline = NO_DEADLINE,
+    ) -> JerkTimeScaling | JerkSegmentsTiming:
+        if constraints.jerk is None:
+            raise InvalidRequest("timing.method 'jerk_limited' needs the jerk constraint")
+        if boundary.sdd_start or boundary.sdd_end:
+            raise InvalidRequest("timing.method 'jerk_limited' starts and ends with zero acceleration")
+        if boundary.sd_start == 0.0 and boundary.sd_end == 0.0 and _uniform(constraints):
+            exact = closed_form_timing(constraints)
+            if exact is not None:
+                return exact
+        original = constraints.s
+        constraints = _graded(constraints, boundary)
+        started = time.perf_counter()
+        best = self._grid_solution(constraints, boundary, deadline)
+        elapsed = time.perf_counter() - started
+        gap, how = self._second_grid(constraints, original, boundary, best, deadline)
+        for done in range(self.max_refinements):
+            if gap is None or gap <= GAP_TARGET or not self._affordable(constraints, elapsed, deadline):
+                break
+            # The error about halves with each doubling (first order; the LPs cost four times
+            # as much): where the doublings left would not bring it to the target, the answer
+            # states its gap instead.
+            if gap / 2 ** (self.max_refinements - done) > GAP_TARGET:
+                break
+            finer = constraints.with_points(0.5 * (constraints.s[:-1] + constraints.s[1:]))
+            started = time.perf_counter()
+            finer_best = self._grid_solution(finer, boundary, deadline, start=best, tolerance=WARM_TOLERANCE)
+            elapsed = time.perf_counter() - started
+            gap = relative_gap(best.duration, finer_best.duration)
+            how = f"second grid: the difference from the solution on a grid of half as many points ({len(constraints.s) - 1} intervals)"
+            constraints, best = finer, finer_best
+        best = dataclasses.replace(best, optimality_gap=gap, gap_basis=how)
+        if self.polish and _uniform(constraints):
+            polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
+            if polished is not None:
+                # Shorter than the grid solution and feasible: no farther from the optimum.
+                return dataclasses.replace(
+                    polished, optimality_gap=gap,
+                    gap_basis=f"bounded by the grid solution's estimate, which it improves on ({how})",
+                )
+        return best
+
+    def _grid_solution(
+        self, constraints: PathConstraints, boundary: Boundary, deadline: Deadline, start: JerkTimeScaling | None = None,
+        tolerance: float | None = None,
+    ) -> JerkTimeScaling:
+        """The sequence of restricted LPs on the grid of ``constraints`` (module docstring), the
+        first restriction taken around the jerk-free optimum, or around ``start`` (the solution
+        on a coarser grid, which saves most of the LPs), stopped at a relative gain below
+        ``tolerance`` (the method's own by default)."""
+        tolerance = self.tolerance if tolerance is None else max(tolerance, self.tolerance)
+        if start is None:
+            reference = PhasePlaneMethod(max_refinements=0).solve(constraints, boundary, None, deadline)
+        x_ref = np.maximum((reference if start is None else start).speed_at(constraints.s) ** 2, 0.0)
+        problem = RestrictedProgram(constraints, boundary, x_ref, deadline)
+        # The first restriction is taken around the jerk-free optimum, which is no feasible
+        # point itself; its LP solution is, and every later step starts from a feasible point.
+        x, u = problem.solve_restricted(x_ref)
+        best = problem.timing(x, u)
+        for _ in range(self.max_iterations):
+            deadline.check()
+            x_lp, u_lp = problem.solve_restricted(x)
+            # Line search on the true duration along the segment to the LP's solution, every
+            # point of which lies in the (convex) restriction around the current solution.
+            trials = []
+            for step in 0.5 ** np.arange(8):
+                x_step, u_step = x + step * (x_lp - x), u + step * (u_lp - u)
+                trials.append((problem.timing(x_step, u_step), x_step, u_step))
+            candidate, x_step, u_step = min(trials, key=lambda trial: trial[0].duration)
+            gain = best.duration - candidate.duration
+            if gain <= 0.0:
+                break
+            x, u, best = x_step, u_step, candidate
+            if gain <= tolerance * best.duration:
+                break
+        return best
+
+    def _second_grid(self, constraints, original, boundary, best, deadline) -> tuple[float | None, str]:
+        """The estimated relative gap of ``best`` and how it was obtained: the difference from
+        the solution on every other grid point (``planners.timing.jerk.accuracy``)."""
+        coarse = coarser(constraints, original)
+        if coarse is None:
+            return None, "none: the grid is too coarse for a second one"
+        try:
+            coarse_best = self._grid_solution(coarse, boundary, deadline)
+        except (InfeasiblePath, TimingFailed) as error:
+            return None, f"none: the second grid's solve failed ({error.detail})"
+        return (
+            relative_gap(coarse_best.duration, best.duration),
+            f"second grid: the difference from the solution on a grid of half as many points ({len(coarse.s) - 1} intervals)",
+        )
+
+    def _affordable(self, constraints: PathConstraints, elapsed: float, deadline: Deadline) -> bool:
+        """Whether a grid twice as fine fits the grid budget and (at about four times the last
+        solve's time) the time left, on constraints that can be evaluated at new points."""
+        if not constraints.can_refine or 2 * (len(constraints.s) - 1) > self.grid_budget:
+            return False
+        remaining = deadline.remaining()
+        return remaining is None or remaining > 4.0 * elapsed + 1.0
+
+
+def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:
+    """Whether every limit is the same along the whole path (a straight joint line under
+    velocity, acceleration and jerk limits): the polish's segments of constant path jerk are the
+    exact optimum there, and seldom beat the grid solution elsewhere (so it is not tried)."""
+    assert constraints.jerk is not None  # jerk_limited always builds the jerk rows
+    dq, ddq, dddq, _ = constraints.jerk
+    # Spreads are measured against the larger of each array's own magnitude and the path's
+    # (|q'|): d2q/ds2 of a straight line is rounding noise of that size, not a change.
+    reference = float(np.abs(dq).max(initial=0.0))
+    arrays = [constraints.sd_max, dq, ddq, dddq, constraints.a, constraints.b, constraints.c, constraints.d,
+              constraints.lower, constraints.upper]
+    for values in arrays:
+        values = np.asarray(values, dtype=float)
+        if values.size == 0:
+            continue
+        finite = np.isfinite(values)
+        if not np.array_equal(finite, np.broadcast_to(finite[:1], finite.shape)):
+            return False
+        spread = np.ptp(np.where(finite, values, 0.0), axis=0)
+        if np.any(spread > tolerance * max(float(np.abs(values[finite]).max(initial=0.0)), reference, 1e-300)):
+            return False
+    return True
+
+
+def _start_phase(constraints: PathConstraints, point: int) -> float:
+    """Length in s of the constant-jerk phase that starts (ends) the motion at rest at grid
+    point ``point`` (0 or -1), were the path's coefficients constant: at the largest path jerk
+    sigma = min_k J_k / |q'_k| until the largest path acceleration u_max allowed at rest,
+    s = sigma t^3 / 6 with t = u_max / sigma."""
+    assert constraints.jerk is not None  # jerk_limited always builds the jerk rows
+    dq, _, _, limit = constraints.jerk
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sigma = np.nanmin(np.where(dq[point] != 0.0, limit / np.abs(dq[point]), np.inf))
+        a, c = constraints.a[point], constraints.c[point]
+        lower, upper = constraints.lower[point], constraints.upper[point]
+        u_bound = np.where(a > 0, (upper - c) / a, np.where(a < 0, (lower - c) / a, np.inf))
+    u_max = float(np.min(u_bound, initial=np.inf))
+    if not (np.isfinite(sigma) and sigma > 0.0 and np.isfinite(u_max) and u_max > 0.0):
+        return np.inf
+    t = u_max / sigma
+    return sigma * t**3 / 6.0
+
+
+#: Grid points near an end at rest, as multiples of the length of its constant-jerk phase: the
+#: first interval holds half the phase, the points around the phase's end resolve the switch.
+_REST_POINTS = np.array([0.5, 0.7, 0.85, 1.0, 1.15, 1.3, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0])
+
+
+def _graded(constraints: PathConstraints, boundary: Boundary) -> PathConstraints:
+    """The grid with points added toward each end at rest around the end of the constant-jerk
+    phase there (``_start_phase``): the first interval, which holds the motion of constant
+    jerk from rest, then ends within that phase."""
+    if not constraints.can_refine:
+        return constraints
+    s = constraints.s
+    pieces: list[np.ndarray] = []
+    for at_rest, point, sign, room in (
+        (boundary.sd_start == 0.0, 0, 1.0, s[1] - s[0]),
+        (boundary.sd_end == 0.0, -1, -1.0, s[-1] - s[-2]),
+    ):
+        if not at_rest:
+            continue
+        # A phase shorter than the floor (a jerk limit far above what the other limits let
+        # matter) would put grid points within rounding of the end, and rows of size 1 / h^2
+        # into the program: the first interval is then the floor, over which the jerk limit
+        # does not bind.
+        phase = max(_start_phase(constraints, point), room * MIN_FIRST_INTERVAL / _REST_POINTS[0])
+        if not np.isfinite(phase):
+            phase = room * FALLBACK_FIRST_INTERVAL / _REST_POINTS[0]
+        offsets = phase * _REST_POINTS
+        offsets = offsets[offsets < 0.9 * room]
+        pieces.append(s[point] + sign * offsets)
+    points = np.concatenate(pieces) if pieces else np.empty(0)
+    extra = np.unique(points[~np.isin(points, s)])
+    return constraints.with_points(extra) if extra.size else constraints

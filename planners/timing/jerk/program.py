@@ -1,0 +1,313 @@
+"""The linear program of one conservative restriction of the jerk-limited timing
+(``planners.timing.jerk.method``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
+limit linear in (x, u) = (sd^2, sdd), the jerk limit's right-hand side J / sqrt(x) replaced by
+its tangent at the current solution, solved by HiGHS's dual simplex.
+
+Discretization (``JerkTimeScaling``): x and u at the grid points, u linear in s between them
+(x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``planners.timing.jerk.method``'s (1), its
+right-hand side the tangent) at both ends of every interval with du/ds = (u_i+1 - u_i) / h_i,
+the second-order rows at every grid point and at the middle of
+every interval (where x = x_i + (3 u_i + u_i+1) h_i / 4), the velocity bound at its quarters
+too (without them u may zigzag along a stretch of constant x). An interval that starts (ends)
+at rest holds the motion of constant path jerk from (to) rest, u = 2 x / (3 s),
+du/ds = 2 x / (9 s^2), which the linear-u interval cannot represent (it would never leave
+rest); the grid gets points around the end of that phase, as long as the limits at rest make
+it. The objective, the duration, is linearized at the current solution. Variables are scaled by a
+typical x, so that the LP sees numbers of order one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+
+from planners.constraints.path_constraints import PathConstraints
+from planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
+from planners.execution.deadline import NO_DEADLINE, Deadline
+from planners.timing.base import Boundary
+from planners.timing.jerk.scaling import JerkTimeScaling
+
+
+class RestrictedProgram:
+    """The LP of one restriction, in the scaled variables X = x / kappa, U = u / kappa (kappa a
+    typical x, so that the LP sees numbers of order one)."""
+
+    def __init__(self, constraints: PathConstraints, boundary: Boundary, x_ref: np.ndarray, deadline: Deadline = NO_DEADLINE):
+        self.constraints = constraints
+        self.deadline = deadline
+        s = constraints.s
+        self.n = n = len(s) - 1
+        self.h = np.diff(s)
+        positive = x_ref[x_ref > 0]
+        self.kappa = float(np.median(positive)) if positive.size else 1.0
+        self.x_start, self.x_end = boundary.sd_start**2, boundary.sd_end**2
+        self.rest_start, self.rest_end = self.x_start == 0.0, self.x_end == 0.0
+        if n < 2 + self.rest_start + self.rest_end:
+            raise TimingFailed("the grid is too coarse for the jerk-limited timing")
+        self._fixed_rows = self._equalities_and_rows(x_ref)
+        self._basis, self._basis_shape = None, None
+
+    # Variables: X_0..X_n at columns 0..n, U_0..U_n at columns n+1..2n+1.
+    def _x(self, i):
+        """Column of X_i."""
+        return np.asarray(i)
+
+    def _u(self, i):
+        """Column of U_i."""
+        return np.asarray(i) + self.n + 1
+
+    def _equalities_and_rows(self, x_ref):
+        """Continuity of x, the intervals at rest, and the second-order rows (which do not
+        depend on the restriction, except through friction linearized at ``x_ref``)."""
+        n, h, kappa = self.n, self.h, self.kappa
+        rows, cols, vals, lower, upper = [], [], [], [], []
+        count = 0
+
+        def add(columns, values, low, high):
+            nonlocal count
+            rows.extend([count] * len(columns))
+            cols.extend(columns)
+            vals.extend(values)
+            lower.append(low)
+            upper.append(high)
+            count += 1
+
+        for i in range(n):
+            if i == 0 and self.rest_start:
+                add([self._u(1), self._x(1)], [1.0, -2.0 / (3.0 * h[0])], 0.0, 0.0)
+            elif i == n - 1 and self.rest_end:
+                add([self._u(n - 1), self._x(n - 1)], [1.0, 2.0 / (3.0 * h[-1])], 0.0, 0.0)
+            else:
+                add([self._x(i + 1), self._x(i), self._u(i), self._u(i + 1)], [1.0, -1.0, -h[i], -h[i]], 0.0, 0.0)
+        equality = (np.array(rows), np.array(cols), np.array(vals), np.array(lower), np.array(upper), count)
+        blocks = [equality]
+        # x at the quarters of each regular interval, x_i + 2 u_i f h + (u_i+1 - u_i) f^2 h
+        # (f = 1/4, 1/2, 3/4), below the velocity bound of both ends: without them, u could
+        # zigzag (u_i+1 = -u_i) along a stretch of constant x, its x bulging between the grid
+        # points.
+        x_bound = self.constraints.sd_max**2 / kappa
+        regular = np.arange(1 if self.rest_start else 0, n - 1 if self.rest_end else n)
+        bound = np.minimum(x_bound[regular], x_bound[regular + 1])
+        keep = np.isfinite(bound)
+        bounded, bound = regular[keep], bound[keep]
+        for f in (0.25, 0.5, 0.75) if bounded.size else ():
+            hb = h[bounded]
+            blocks.append((
+                np.repeat(np.arange(bounded.size), 3),
+                np.column_stack([self._x(bounded), self._u(bounded), self._u(bounded + 1)]).ravel(),
+                np.column_stack([np.ones(bounded.size), (2.0 * f - f * f) * hb, f * f * hb]).ravel(),
+                np.full(bounded.size, -np.inf),
+                bound,
+                bounded.size,
+            ))
+
+        c = self.constraints
+        right = c.linearized(np.maximum(x_ref, 1e-12))
+        left = c.linearized(np.maximum(x_ref, 1e-12), "left")
+        differs = np.flatnonzero(
+            np.any(left.a != right.a, axis=1) | np.any(left.b != right.b, axis=1) | np.any(left.c != right.c, axis=1)
+        )
+        free = np.arange(1, n)
+        for side, points in ((right, free), (left, np.intersect1d(differs, free))):
+            if side.a.shape[1] == 0 or points.size == 0:
+                continue
+            a, b, cc = side.a[points], side.b[points], side.c[points]
+            lo, hi = side.lower[points] - cc, side.upper[points] - cc
+            scale = np.maximum(np.maximum(np.abs(a), np.abs(b)) * kappa, 1e-300)
+            m = a.shape[1]
+            point_index = np.repeat(points, m)
+            blocks.append((
+                np.repeat(np.arange(points.size * m), 2),
+                np.column_stack([self._u(point_index), self._x(point_index)]).ravel(),
+                np.column_stack([(a * kappa / scale).ravel(), (b * kappa / scale).ravel()]).ravel(),
+                (lo / scale).ravel(),
+                (hi / scale).ravel(),
+                points.size * m,
+            ))
+        if right.a.shape[1] and regular.size:
+            # The same rows at the middle of each regular interval, where u = (u_i + u_i+1) / 2
+            # and x = x_i + (3 u_i + u_i+1) h / 4 (x is quadratic in s between the grid points),
+            # with the coefficients of the two ends averaged.
+            i = regular
+            a = 0.5 * (right.a[i] + left.a[i + 1])
+            b = 0.5 * (right.b[i] + left.b[i + 1])
+            cc = 0.5 * (right.c[i] + left.c[i + 1])
+            lo, hi = right.lower[i] - cc, right.upper[i] - cc
+            hm = h[i][:, None]
+            coefficients = np.stack([0.5 * a + 0.75 * hm * b, 0.5 * a + 0.25 * hm * b, b], axis=-1) * kappa
+            scale = np.maximum(np.abs(coefficients).max(axis=-1), 1e-300)
+            m = a.shape[1]
+            index = np.repeat(i, m)
+            blocks.append((
+                np.repeat(np.arange(i.size * m), 3),
+                np.column_stack([self._u(index), self._u(index + 1), self._x(index)]).ravel(),
+                (coefficients / scale[..., None]).reshape(-1),
+                (lo / scale).ravel(),
+                (hi / scale).ravel(),
+                i.size * m,
+            ))
+        return blocks
+
+    def _jerk_rows(self, x_tangent):
+        """The jerk rows (1) at both ends of every interval, their right-hand side J / sqrt(X)
+        replaced by its tangent at ``x_tangent`` (scaled), J (alpha - beta X): two one-sided
+        rows ``+-G + J beta X <= J alpha`` each."""
+        c = self.constraints
+        dq, ddq, dddq, limit = c.jerk
+        dq_l, ddq_l, dddq_l = c.jerk_left
+        n, h, kappa = self.n, self.h, self.kappa
+        limited = np.flatnonzero(np.isfinite(limit))
+        if limited.size == 0:
+            return []
+        J = limit[limited] / kappa**1.5  # scaled: |G| <= J / sqrt(X)
+        m = limited.size
+        blocks = []
+
+        def emit(u_terms, x_coefficient, point):
+            """u_terms: (columns (k,), coefficients (k, m)) of the U part of G; x_coefficient
+            (k, m) of X at ``point`` (k,)."""
+            X = np.maximum(x_tangent[point], 1e-12)
+            alpha, beta = 1.5 / np.sqrt(X), 0.5 / X**1.5
+            k = point.size
+            x_col = np.broadcast_to(self._x(point)[:, None], (k, m))
+            columns = np.stack([*(np.broadcast_to(col[:, None], (k, m)) for col, _ in u_terms), x_col], axis=-1)
+            for sign in (1.0, -1.0):
+                values = np.stack(
+                    [*(sign * coefficient for _, coefficient in u_terms), sign * x_coefficient + J * beta[:, None]], axis=-1
+                )
+                scale = np.maximum(np.abs(values).max(axis=-1), 1e-300)
+                blocks.append((
+                    np.repeat(np.arange(k * m), columns.shape[-1]),
+                    columns.reshape(-1),
+                    (values / scale[..., None]).reshape(-1),
+                    np.full(k * m, -np.inf),
+                    (J * alpha[:, None] / scale).ravel(),
+                    k * m,
+                ))
+
+        regular = np.arange(n)
+        if self.rest_start:
+            regular = regular[1:]
+        if self.rest_end:
+            regular = regular[:-1]
+        for end, (d1, d2, d3) in ((0, (dq, ddq, dddq)), (1, (dq_l, ddq_l, dddq_l))):
+            point = regular + end
+            moving = ~(((point == 0) & self.rest_start) | ((point == n) & self.rest_end))
+            point = point[moving]
+            if point.size == 0:
+                continue
+            interval = point - end
+            hw = h[interval][:, None]
+            a1, a2, a3 = d1[point][:, limited], d2[point][:, limited], d3[point][:, limited]
+            # G = d1 (U_i+1 - U_i) / h_i + 3 d2 U_point + d3 X_point
+            emit(
+                [(self._u(interval + 1), a1 / hw), (self._u(interval), -a1 / hw), (self._u(point), 3.0 * a2)],
+                a3,
+                point,
+            )
+        for at_rest, inner, outer, sign in ((self.rest_start, 1, 0, 1.0), (self.rest_end, n - 1, n, -1.0)):
+            if not at_rest:
+                continue
+            width = h[0] if outer == 0 else h[-1]
+            d1, d2, d3 = (dq_l, ddq_l, dddq_l) if outer == 0 else (dq, ddq, dddq)
+            point = np.array([inner])
+            # At the inner point, u = sign 2 x / (3 h) and du/ds = 2 x / (9 h^2):
+            # G = X (d1 2 / (9 h^2) + sign 2 d2 / h + d3).
+            inner_g = d1[inner] * 2.0 / (9.0 * width**2) + sign * d2[inner] * 2.0 / width + d3[inner]
+            # At the rest point the jerk is q' sigma, sigma = du/ds sqrt(x): G = X d1 2 / (9 h^2).
+            outer_g = dq[outer] * 2.0 / (9.0 * width**2)
+            for g in (inner_g, outer_g):
+                emit([], g[limited][None, :], point)
+        return blocks
+
+    def solve_restricted(self, x_tangent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The LP of the restriction around ``x_tangent`` (1/s^2): x and u (unscaled)."""
+        kappa, n = self.kappa, self.n
+        X_tangent = np.asarray(x_tangent) / kappa
+        blocks = [*self._fixed_rows, *self._jerk_rows(X_tangent)]
+        offsets = np.cumsum([0] + [block[5] for block in blocks])
+        matrix = sparse.csr_matrix(
+            (
+                np.concatenate([block[2] for block in blocks]),
+                (
+                    np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)]),
+                    np.concatenate([block[1] for block in blocks]),
+                ),
+            ),
+            shape=(offsets[-1], 2 * n + 2),
+        )
+        lower = np.concatenate([block[3] for block in blocks])
+        upper = np.concatenate([block[4] for block in blocks])
+        x_high = self.constraints.sd_max**2 / kappa
+        low = np.concatenate([np.zeros(n + 1), np.full(n + 1, -np.inf)])
+        high = np.concatenate([x_high, np.full(n + 1, np.inf)])
+        for index, value in ((self._x(0), self.x_start / kappa), (self._x(n), self.x_end / kappa), (self._u(0), 0.0), (self._u(n), 0.0)):
+            low[index] = high[index] = value
+        objective = np.zeros(2 * n + 2)
+        objective[: n + 1] = self._time_gradient(np.maximum(X_tangent, 1e-12))
+        X, U = self._run(objective, matrix.tocsc(), lower, upper, low, high)
+        return np.maximum(X, 0.0) * kappa, U * kappa
+
+    def _run(self, objective, matrix, lower, upper, low, high):
+        """Solve the LP with HiGHS's dual simplex, warm-started from the previous LP's basis
+        (the restrictions of consecutive iterations differ little), stopped when the deadline
+        passes (``BudgetExceeded``)."""
+        import highspy
+
+        self.deadline.check()
+        solver = highspy.Highs()
+        solver.setOptionValue("output_flag", False)
+        # Near an end at rest the jerk rows' right-hand sides are as small as x there (1e-8 of
+        # the typical x): HiGHS's default tolerance of 1e-7 would let them be exceeded twofold.
+        solver.setOptionValue("primal_feasibility_tolerance", 1e-10)
+        remaining = self.deadline.remaining()
+        if remaining is not None:
+            solver.setOptionValue("time_limit", max(remaining, 1e-3))
+        lp = highspy.HighsLp()
+        lp.num_col_, lp.num_row_ = matrix.shape[1], matrix.shape[0]
+        lp.col_cost_, lp.col_lower_, lp.col_upper_ = objective, low, high
+        lp.row_lower_, lp.row_upper_ = lower, upper
+        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = matrix.indptr, matrix.indices, matrix.data
+        solver.passModel(lp)
+        if self._basis is not None and self._basis_shape == matrix.shape:
+            solver.setBasis(self._basis)
+        solver.run()
+        status = solver.getModelStatus()
+        if status == highspy.HighsModelStatus.kTimeLimit:
+            self.deadline.check()
+            raise BudgetExceeded(f"planning exceeded its time budget of {self.deadline.budget_s} s")
+        if status == highspy.HighsModelStatus.kInfeasible:
+            raise InfeasiblePath(
+                "no jerk-limited motion follows the path within the limits (the linear program is infeasible)"
+            )
+        if status != highspy.HighsModelStatus.kOptimal:
+            raise TimingFailed(
+                f"the jerk-limited timing's linear program ended without a solution (HiGHS: "
+                f"{solver.modelStatusToString(status).lower()}); try other timing.grid_points"
+            )
+        self._basis, self._basis_shape = solver.getBasis(), matrix.shape
+        values = np.asarray(solver.getSolution().col_value)
+        n = self.n
+        return values[: n + 1], values[n + 1 :]
+
+    def _time_gradient(self, X):
+        """d/dX of sum 2 h / (sqrt(X_i) + sqrt(X_i+1)) (3 h / sqrt(X) for an interval at rest)."""
+        root = np.sqrt(X)
+        gradient = np.zeros_like(X)
+        share = -self.h / (root[:-1] + root[1:]) ** 2
+        gradient[:-1] += share / root[:-1]
+        gradient[1:] += share / root[1:]
+        if self.rest_start:
+            gradient[0] = 0.0
+            gradient[1] += -1.5 * self.h[0] / X[1] ** 1.5 - share[0] / root[1]
+        if self.rest_end:
+            gradient[-1] = 0.0
+            gradient[-2] += -1.5 * self.h[-1] / X[-2] ** 1.5 - share[-1] / root[-2]
+        return gradient
+
+    def timing(self, x, u) -> JerkTimeScaling:
+        return JerkTimeScaling(
+            self.constraints.s, np.sqrt(np.maximum(x, 0.0)), u=np.asarray(u, dtype=float),
+            rest_start=self.rest_start, rest_end=self.rest_end,
+        )
