@@ -226,6 +226,18 @@ class LinearRows:
     lower: np.ndarray
     upper: np.ndarray
 
+    def normalized(self) -> LinearRows:
+        """The same rows, each column divided by its largest finite bound magnitude, so that
+        every bound is of order one: ``a u + b x + c in [lower, upper]`` holds exactly when
+        ``(a u + b x + c) / k in [lower / k, upper / k]`` (k > 0), but a solver with absolute
+        tolerances (toppra's LP, Clarabel; about 1e-8) cannot tell a limit of 1e-9 rad/s^2 from
+        zero. A column with no finite, nonzero bound keeps k = 1."""
+        bounds = np.concatenate([np.abs(self.lower), np.abs(self.upper)], axis=0)
+        bounds = np.where(np.isfinite(bounds), bounds, 0.0)
+        k = bounds.max(axis=0, initial=0.0)
+        k = np.where(k > 0.0, k, 1.0)
+        return LinearRows(self.a / k, self.b / k, self.c / k, self.lower / k, self.upper / k)
+
 
 def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> np.ndarray:
     """(3 n, n_dof): RNEA(q, 0, 0) = g, RNEA(q, 0, q') = M q' + g and RNEA(q, q', q'') =
