@@ -227,14 +227,16 @@ class LinearRows:
     upper: np.ndarray
 
     def normalized(self) -> LinearRows:
-        """The same rows, each column divided by its largest finite bound magnitude, so that
-        every bound is of order one: ``a u + b x + c in [lower, upper]`` holds exactly when
-        ``(a u + b x + c) / k in [lower / k, upper / k]`` (k > 0), but a solver with absolute
-        tolerances (toppra's LP, Clarabel; about 1e-8) cannot tell a limit of 1e-9 rad/s^2 from
-        zero. A column with no finite, nonzero bound keeps k = 1."""
-        bounds = np.concatenate([np.abs(self.lower), np.abs(self.upper)], axis=0)
-        bounds = np.where(np.isfinite(bounds), bounds, 0.0)
-        k = bounds.max(axis=0, initial=0.0)
+        """The same rows, each column divided by the largest magnitude of its coefficients a
+        and b over the grid (columns with neither keep their scale): ``a u + b x + c in [lower,
+        upper]`` holds exactly when the row divided by k > 0 does. A solver with absolute
+        tolerances (toppra's LP, Clarabel; about 1e-8) then sees coefficients of order one
+        whatever the limits: without it, it could not tell an acceleration limit of 1e-6 rad/s^2
+        from zero, nor use a torque row of a joint limited to 1e-6 N m next to one limited to
+        25 N m. (One factor per column: a factor per grid point made toppra's answer on a
+        blended path 29 % slower.)"""
+        k = np.maximum(np.abs(self.a), np.abs(self.b))
+        k = np.where(np.isfinite(k), k, 0.0).max(axis=0, initial=0.0)
         k = np.where(k > 0.0, k, 1.0)
         return LinearRows(self.a / k, self.b / k, self.c / k, self.lower / k, self.upper / k)
 

@@ -123,7 +123,7 @@ def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
     import cvxpy as cp
 
     ds, x_bound = program.ds, program.x_bound
-    # Bounds of order one: Clarabel's absolute tolerances cannot tell 1e-9 from zero.
+    # Rows of order one (LinearRows.normalized): Clarabel's tolerances are absolute.
     right, left = program.right.normalized(), program.left.normalized()
     n = len(ds)
     # The end values of b are data, not variables: an interior-point solver then never has
