@@ -25,7 +25,7 @@ from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_a
 from planners.paths.blended import MIN_BLEND, BlendedPath
 from planners.paths.cartesian import CartesianLine
 from planners.paths.grid import MAX_POINTS, spread_indices
-from planners.problem.ranges import DT, check_timing
+from planners.problem.ranges import DT, check_scaled_limits, check_timing
 from planners.problem.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from planners.problem.waypoints import continuous_turns, make_path, without_repeats
 from planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
@@ -155,6 +155,7 @@ def plan(
     margin = timing.limit_margin
     if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
         raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
+    check_scaled_limits(robot.limits.with_request(timing.limit_overrides), timing.limit_scales, robot.joint_names)
     requested: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
     tool = tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
     if tool is not None:

@@ -53,6 +53,21 @@ class ToptrajError(Exception):
         super().__init__(detail)
         self.detail = detail
 
+    def __reduce__(self):
+        """Pickled with its attributes, without calling ``__init__`` again: an error raised in
+        a worker process (``planners.execution.isolated``) reaches its caller whole, whatever the
+        subclass's constructor takes (``Exception``'s own pickling calls ``cls(*args)``, which
+        fails for a constructor with more required arguments than ``detail``)."""
+        return _restore_error, (type(self), self.args, self.__dict__.copy())
+
+
+def _restore_error(cls: type[ToptrajError], args: tuple, state: dict) -> ToptrajError:
+    """The unpickled ``ToptrajError`` (``ToptrajError.__reduce__``)."""
+    error = cls.__new__(cls, *args)
+    error.args = args
+    error.__dict__.update(state)
+    return error
+
 
 class UnknownRobot(ToptrajError):
     """No robot of that name is bundled, in example-robot-data, or uploaded."""

@@ -150,6 +150,7 @@ def batch(
     import threading
 
     from service.batches import run_batch
+    from service.batches.lines import ForeignOutput
     from service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
 
     if workers is not None and workers < 1:
@@ -171,6 +172,9 @@ def batch(
         report = run_batch(requests, output, workers, ray_address, progress_bar(), budget, retry_failed, stop)
     except RayMissing as error:
         print(json.dumps(_problem("Ray is not installed", 400, str(error))), file=sys.stderr)
+        return 2
+    except ForeignOutput as error:
+        print(json.dumps(_problem("Not a result file", 400, str(error))), file=sys.stderr)
         return 2
     except OSError as error:
         print(json.dumps(_problem("Cannot read or write", 400, str(error))), file=sys.stderr)

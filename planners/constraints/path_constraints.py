@@ -226,6 +226,21 @@ class LinearRows:
     lower: np.ndarray
     upper: np.ndarray
 
+    def normalized(self) -> LinearRows:
+        """The same rows, each column divided by the largest magnitude over the grid of its
+        coefficients a and b and its finite bounds (columns with none keep their scale):
+        ``a u + b x + c in [lower, upper]`` holds exactly when the row divided by k > 0 does. A
+        solver with absolute tolerances (toppra's LP, Clarabel; about 1e-8) then sees rows of
+        order one whatever the limits: without it, it could not tell an acceleration limit of
+        1e-6 rad/s^2 from zero. One factor per column: a factor per grid point made toppra's
+        answer on a blended path 29 % slower; coefficients alone, without the bounds, failed
+        limits 1e-6 and 1e5 apart on the joints of one arm."""
+        k = np.maximum.reduce([np.abs(self.a), np.abs(self.b), np.abs(self.lower), np.abs(self.upper)])
+        k = np.where(np.isfinite(k), k, np.maximum(np.abs(self.a), np.abs(self.b)))
+        k = np.where(np.isfinite(k), k, 0.0).max(axis=0, initial=0.0)
+        k = np.where(k > 0.0, k, 1.0)
+        return LinearRows(self.a / k, self.b / k, self.c / k, self.lower / k, self.upper / k)
+
 
 def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> np.ndarray:
     """(3 n, n_dof): RNEA(q, 0, 0) = g, RNEA(q, 0, q') = M q' + g and RNEA(q, q', q'') =

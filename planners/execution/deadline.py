@@ -91,7 +91,9 @@ class Deadline:
     def check(self) -> None:
         """Raise ``BudgetExceeded`` when the budget is spent or the caller cancelled."""
         if self._cancelled.is_set() or (self._end is not None and time.monotonic() > self._end):
-            raise BudgetExceeded(f"planning exceeded its time budget of {self.budget_s} s")
+            if self.budget_s is None:
+                raise BudgetExceeded("planning was stopped by its caller")
+            raise BudgetExceeded(f"planning exceeded its time budget of {self.budget_s:.3g} s")
 
     def within(self, start: float, end: float, label: str = "") -> Deadline:
         """This deadline (the same end, the same cancellation) for a part of the work spanning

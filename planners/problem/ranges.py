@@ -93,3 +93,51 @@ def check_timing(timing, dt: float) -> None:
         values = getattr(timing, name)
         if values is not None:
             check_vector(values, f"timing.boundary.{name}", accepted, signed=True)
+
+
+def _round_inward(low: float, high: float) -> tuple[float, float]:
+    """[low, high] with each end rounded to 3 significant digits, inward (so that advice shown
+    with ``:g`` lies inside the interval)."""
+
+    def rounded(value: float, up: bool) -> float:
+        if value <= 0.0 or not math.isfinite(value):
+            return value
+        step = 10.0 ** (math.floor(math.log10(value)) - 2)
+        return (math.ceil if up else math.floor)(value / step - (1e-9 if up else -1e-9)) * step
+
+    return rounded(low, True), rounded(high, False)
+
+
+def check_scaled_limits(limits, scales: dict[str, float | None] | None, joint_names: tuple[str, ...]) -> None:
+    """InvalidRequest unless every finite limit of ``limits`` (a ``JointLimits`` with the
+    request's overrides, before its scales) times its ``scales`` factor lies in the range of its
+    kind: a scale is one more source of a limit, and outside the range a limit (1e-9 rad/s^3 from
+    jerk_scale 1e-3 on 1e-6) is one the methods are not known to plan with. The message names
+    the joint, the scaled limit and the factors that keep every joint's limit in its range."""
+    for kind, factor in (scales or {}).items():
+        if factor is None or kind not in LIMITS:
+            continue
+        values = np.asarray(getattr(limits, kind), dtype=float)
+        finite = np.isfinite(values)
+        if not finite.any():
+            continue
+        accepted = LIMITS[kind]
+        scaled = values * factor
+        outside = np.flatnonzero(finite & ~((scaled >= accepted.low) & (scaled <= accepted.high)))
+        if outside.size == 0:
+            continue
+        joint = int(outside[0])
+        name = joint_names[joint] if joint < len(joint_names) else str(joint)
+        low, high = _round_inward(
+            max(SCALE.low, accepted.low / float(values[finite].min())),
+            min(SCALE.high, accepted.high / float(values[finite].max())),
+        )
+        advice = (
+            f"use timing.limits.{kind}_scale in [{low:g}, {high:g}]"
+            if low <= high
+            else f"give timing.limits.{kind} per joint instead of a scale"
+        )
+        raise InvalidRequest(
+            f"timing.limits.{kind}_scale = {factor:g} makes the {kind} limit of joint {name[:64]!r} "
+            f"{scaled[joint]:g} {accepted.unit}, outside the accepted range {accepted.describe()}; {advice}"
+        )

@@ -122,7 +122,9 @@ def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
     """
     import cvxpy as cp
 
-    ds, x_bound, right, left = program.ds, program.x_bound, program.right, program.left
+    ds, x_bound = program.ds, program.x_bound
+    # Rows of order one (LinearRows.normalized): Clarabel's tolerances are absolute.
+    right, left = program.right.normalized(), program.left.normalized()
     n = len(ds)
     # The end values of b are data, not variables: an interior-point solver then never has
     # to sit on the boundary of the cone sqrt(b) >= 0 at a motion that starts from rest.

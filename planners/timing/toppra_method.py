@@ -105,8 +105,8 @@ class ToppraMethod(TimingMethod):
         x_ref = friction_reference(constraints)
         scaling = None
         for _ in range(2 if constraints.has_friction else 1):
-            rows = constraints.linearized(x_ref)
-            left_rows = constraints.linearized(x_ref, side="left")
+            rows = constraints.linearized(x_ref).normalized()
+            left_rows = constraints.linearized(x_ref, side="left").normalized()
             deadline.check()
             instance = TOPPRA(
                 [PrecomputedRows(*_singular_rows_as_bounds(rows, x_bound), left_rows)],

@@ -30,6 +30,8 @@ from pathlib import Path
 import numpy as np
 import orjson
 
+from robots.errors import excerpt
+
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000
 #: Deepest nesting of arrays and objects in a request line (a request needs 5).
@@ -135,26 +137,41 @@ def retryable(status: int) -> bool:
     return status >= 500
 
 
+class ForeignOutput(ValueError):
+    """The output file of a batch holds lines that are no result lines (another file given
+    as ``--output``, the request file itself): it is left as it is."""
+
+
 def resume_output(path: Path, retry_failed: bool = False) -> dict[int, int]:
     """The status of each line number already answered in ``path`` (none if it does not
-    exist), with ``path`` made ready for appending: cut back before the first line that is no
-    whole result line (the last one of an interrupted run), a line number's second result
-    dropped, and with ``retry_failed`` the retryable results dropped (written to a new file
-    that replaces the old one, so an interruption leaves one or the other)."""
+    exist), with ``path`` made ready for appending: its last line cut when it has no newline
+    (the last one of an interrupted run), a line number's second result dropped, and with
+    ``retry_failed`` the retryable results dropped (written to a new file that replaces the old
+    one, so an interruption leaves one or the other).
+
+    Raises:
+        ForeignOutput: a whole line of ``path`` is no result line; nothing is changed.
+    """
     if not path.exists():
         return {}
     done: dict[int, int] = {}
     keep: list[tuple[int, int]] = []  # (offset, length) of the lines kept
     offset, dropped = 0, False
     with open(path, "rb") as handle:
-        for raw in handle:
+        for count, raw in enumerate(handle, start=1):
+            if not raw.endswith(b"\n"):
+                break  # cut short by an interruption: written again
             try:
-                if not raw.endswith(b"\n"):
-                    raise ValueError("cut short")
                 row = orjson.loads(raw)
                 number, status = int(row["line"]), int(row["status"])
-            except (ValueError, KeyError, TypeError):
-                break
+                if not isinstance(row.get("key"), str) or "body" not in row:
+                    raise KeyError("key")
+            except (ValueError, KeyError, TypeError, AttributeError):
+                raise ForeignOutput(
+                    f"{excerpt(str(path))}: line {count} is no result line of toptraj batch, so the file is no output of "
+                    "one and is left as it is; give another --output (a new file, or the output of an earlier run to "
+                    "resume it)"
+                ) from None
             if number in done or (retry_failed and retryable(status)):
                 dropped = True
             else:

@@ -33,7 +33,7 @@ import orjson
 
 import robots
 from robots.catalog import is_catalog_robot
-from service.batches.lines import problem_body, read_requests, result_line, resume_output
+from service.batches.lines import ForeignOutput, problem_body, read_requests, result_line, resume_output
 
 #: Requests per Ray task.
 CHUNK = 4
@@ -239,10 +239,14 @@ def run_batch(
     Raises:
         RayMissing: Ray is not installed (and lines need planning).
         OSError: a file cannot be read or written.
+        ForeignOutput: ``output_path`` is the request file, or holds lines that are no result
+            lines (it is left as it is).
     """
     started = time.perf_counter()
     requests_path, output_path = Path(requests_path), Path(output_path)
     stop = stop or threading.Event()
+    if output_path.exists() and requests_path.exists() and output_path.samefile(requests_path):
+        raise ForeignOutput("--output is the request file itself; give another file for the results")
     total = count_lines(requests_path)
     done = resume_output(output_path, retry_failed)
     skipped = sum(1 for number in done if number <= total)

@@ -173,10 +173,10 @@ class LimitsRequest(Schema):
     acceleration: PerJoint[Annotated[float, bounded(ranges.ACCELERATION)]] | None = Field(default=None, description="Per-joint acceleration limits replacing the robot's (rad/s^2, m/s^2).")
     jerk: PerJoint[Annotated[float, bounded(ranges.JERK)]] | None = Field(default=None, description="Per-joint jerk limits replacing the robot's (rad/s^3, m/s^3).")
     torque: PerJoint[Annotated[float, bounded(ranges.TORQUE)]] | None = Field(default=None, description="Per-joint torque limits replacing the robot's (N m, N).")
-    velocity_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every velocity limit (after overrides).")
-    acceleration_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every acceleration limit.")
-    jerk_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every jerk limit.")
-    torque_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every torque limit.")
+    velocity_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every velocity limit (after overrides); each scaled limit lies in the range of its kind, as an override does.")
+    acceleration_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every acceleration limit; each scaled limit lies in the range of its kind, as an override does.")
+    jerk_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every jerk limit; each scaled limit lies in the range of its kind, as an override does.")
+    torque_scale: Annotated[float, bounded(ranges.SCALE)] | None = Field(default=None, description="Factor on every torque limit; each scaled limit lies in the range of its kind, as an override does.")
     tool_speed: Annotated[float, bounded(ranges.TOOL_SPEED)] | None = Field(
         default=None, description="Largest linear speed of the tool frame's origin (m/s)."
     )

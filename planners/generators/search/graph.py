@@ -164,6 +164,13 @@ def search_region(robot: Robot, start: np.ndarray, goal: np.ndarray, goals: np.n
     widest = float(np.abs(goal - start).max())
     if widest <= 0.0 and len(goals) == 1:
         raise InvalidRequest("path.start and path.goal are the same configuration: there is no motion to search")
+    if np.any(np.all(np.abs(goals - start) <= 1e-9, axis=1)):
+        # Staying put reaches one of the goals allowed: every motion found would be slower.
+        raise InvalidRequest(
+            "path.goal is path.start up to whole revolutions of its continuous joints, which path.revolutions "
+            "allows: there is no motion to search; to turn a joint a full revolution, give that goal with "
+            "path.revolutions false"
+        )
     reach = margin * (widest if widest > 0.0 else 1.0)
     low = np.minimum(start, goals.min(axis=0)) - reach
     high = np.maximum(start, goals.max(axis=0)) + reach

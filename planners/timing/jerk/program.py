@@ -276,7 +276,7 @@ class RestrictedProgram:
         status = solver.getModelStatus()
         if status == highspy.HighsModelStatus.kTimeLimit:
             self.deadline.check()
-            raise BudgetExceeded(f"planning exceeded its time budget of {self.deadline.budget_s} s")
+            raise BudgetExceeded(f"planning exceeded its time budget of {self.deadline.budget_s:.3g} s")
         if status == highspy.HighsModelStatus.kInfeasible:
             raise InfeasiblePath(
                 "no jerk-limited motion follows the path within the limits (the linear program is infeasible)"
