@@ -26,6 +26,9 @@ def test_ruckig_long_move_closed_form():
     for kind in ("velocity", "acceleration", "jerk"):
         assert result.peak_utilization[kind].max() == pytest.approx(1.0, abs=2e-3)
     assert result.samples.q[-1] == pytest.approx(goal, abs=1e-9)
+    # the closed form is its method's optimum: the answer states so
+    assert result.accuracy.relative_gap == 0.0
+    assert "exact" in result.accuracy.basis
 
 
 def test_ruckig_is_never_faster_than_time_optimal():
