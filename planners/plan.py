@@ -34,6 +34,7 @@ from planners.runner.given_path import timed_path, timed_unsynchronized, timed_v
 from planners.runner.timed_free import timed_free_motion, timed_search
 from planners.timing.base import TimingMethod
 from planners.timing.laws.law_timing import LawTiming
+from planners.timing.laws.method import ClassicalMethod
 from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.trajectory import sample_trajectory
 from robots import JointLimits, Robot
@@ -234,7 +235,10 @@ def plan(
             "although its dense check holds; use more grid points"
         )
     timed_by = PhasePlaneMethod() if method.name == "search" else method  # the search's path: phase_plane
-    laws = [(item.timing.duration, item.check.utilization) for item in timed.stretches if isinstance(item.timing, LawTiming)]
+    # Time laws at their shortest, also through via points or joint by joint: every stretch
+    # timed by a law, its peak utilization read off its dense check.
+    by_law = isinstance(method, ClassicalMethod)
+    laws = [(item.timing.duration, item.check.utilization) for item in timed.stretches if by_law or isinstance(item.timing, LawTiming)]
     law = laws if len(laws) == len(timed.stretches) else None
     if timed.motion_gap is not None:  # a free path: the gap of the motion found, warned of where it is found
         accuracy, warning = Accuracy(*timed.motion_gap), None

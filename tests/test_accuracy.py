@@ -254,3 +254,24 @@ def test_a_finer_grid_that_breaks_a_limit_leaves_the_default_answer_with_a_warni
     assert result.accuracy is not None and result.accuracy.relative_gap == pytest.approx(true_gap, abs=1e-4)
     (warning,) = [text for text in result.warnings if "of the time-optimal one" in text]
     assert f"{100 * result.accuracy.relative_gap:.2g} %" in warning and "phase_plane" in warning
+
+
+@pytest.mark.parametrize(
+    "interpolation, law, synchronization",
+    [("via", "cubic", "normalized"), ("via", "quintic", "normalized"), ("linear", "trapezoidal", "none"), ("linear", "quintic", "none")],
+)
+def test_time_laws_through_via_points_or_joint_by_joint_state_their_gap(interpolation, law, synchronization):
+    """Through via points (each segment at its shortest) and joint by joint (each joint's law
+    at its shortest), the answer states its gap to the shortest uniform speed-up of its
+    profile: about zero, since its most used limit binds (peak utilization 1)."""
+    arm = robots.load("ur5")
+    waypoints = np.array(UR5_WAYPOINTS[:3] if interpolation == "via" else UR5_WAYPOINTS[:2])
+    result = plan(
+        arm, WaypointPath(waypoints, interpolation),
+        Timing(method=law, constraints=("velocity", "acceleration"), synchronization=synchronization), dt=0.05,
+    )
+    assert result.accuracy.relative_gap is not None
+    assert result.accuracy.relative_gap <= 1e-6
+    assert "peak utilization" in result.accuracy.basis
+    binding = max(float(result.peak_utilization[kind].max()) for kind in ("velocity", "acceleration"))
+    assert binding == pytest.approx(1.0, abs=1e-3)
