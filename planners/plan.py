@@ -97,6 +97,25 @@ def _utilization(stretches_, margin: float) -> dict[str, np.ndarray]:
     }
 
 
+def _unasked_limits(utilization: dict[str, np.ndarray], kinds: tuple[str, ...], method: TimingMethod, joint_names: tuple[str, ...]) -> list[str]:
+    """A note for each joint limit the answer exceeds by more than ``UNASKED_EXCESS`` where
+    that kind of limit was not among the constraints (``kinds``): the answer is right, but a
+    reader of its peak utilization must not take it for a broken promise."""
+    notes = []
+    for kind, peak in utilization.items():
+        peak = np.atleast_1d(np.asarray(peak, dtype=float))
+        if kind in kinds or kind.startswith("tool") or not peak.size or not np.nanmax(peak) > UNASKED_EXCESS:
+            continue
+        joint = int(np.nanargmax(peak))
+        name = joint_names[joint] if peak.size == len(joint_names) else f"joint {joint}"
+        remedy = f"add {kind!r} to the constraints to hold it" if kind in method.kinds else f"{method.name} cannot hold {kind} limits"
+        notes.append(f"the {kind} of joint {name!r} reaches {peak[joint]:.4g} times its limit, which was not asked for: {remedy}")
+    return notes
+
+
+#: Peak utilization of a limit kind not among the constraints above which the answer says so.
+UNASKED_EXCESS = 1.005
+
 #: Distance (m) every link keeps from the obstacles unless a request says otherwise.
 DEFAULT_CLEARANCE = 0.01
 
@@ -238,7 +257,11 @@ def plan(
     # Time laws at their shortest, also through via points or joint by joint: every stretch
     # timed by a law, its peak utilization read off its dense check.
     by_law = isinstance(method, ClassicalMethod)
-    laws = [(item.timing.duration, item.check.utilization) for item in timed.stretches if by_law or isinstance(item.timing, LawTiming)]
+    laws = [
+        (item.timing.duration, {kind: peak for kind, peak in item.check.utilization.items() if kind in kinds or kind.startswith("tool")})
+        for item in timed.stretches
+        if by_law or isinstance(item.timing, LawTiming)
+    ]
     law = laws if len(laws) == len(timed.stretches) else None
     if timed.motion_gap is not None:  # a free path: the gap of the motion found, warned of where it is found
         accuracy, warning = Accuracy(*timed.motion_gap), None
@@ -250,6 +273,7 @@ def plan(
     if warning is not None:
         notes.append(warning)
     utilization = _utilization(timed.stretches, margin)
+    notes.extend(_unasked_limits(utilization, kinds, method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
     if not np.isfinite(kappa_max):
         notes.append(

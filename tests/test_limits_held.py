@@ -14,6 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import robots
+from planners import Timing, WaypointPath
+from planners import plan as plan_library
+from tests.conftest import UR5_WAYPOINTS
+
 DATA = Path(__file__).parent / "data"
 KINDS = ("velocity", "acceleration", "torque")
 METHODS = ("phase_plane", "toppra", "min_cost", "quintic", "trapezoidal", "jerk_limited")
@@ -197,3 +202,19 @@ def test_a_recorded_path_that_stands_still_drops_its_repeated_waypoints(client):
         response = plan(client, "ur5", chosen, method, **({"constraints": ["velocity", "acceleration"]} if method == "ruckig" else {}))
         assert response.status_code == 200, response.text
         assert any("were dropped" in warning for warning in response.json()["warnings"])
+
+
+def test_a_limit_not_asked_for_that_the_answer_exceeds_is_said():
+    """Torque is not among the constraints, and its limit (1e-3 N m) is far below what the
+    motion needs: the answer holds what was asked and says which joint's torque exceeds its
+    limit, by how much, and how to hold it."""
+    arm = robots.load("ur5")
+    timing = Timing(method="phase_plane", constraints=("velocity", "acceleration"), limit_overrides={"torque": [1e-3] * 6})
+    result = plan_library(arm, WaypointPath(np.array(UR5_WAYPOINTS[:2])), timing, dt=0.05)
+    worst = int(np.argmax(result.peak_utilization["torque"]))
+    (note,) = [w for w in result.warnings if "not asked for" in w]
+    assert f"torque of joint {arm.joint_names[worst]!r}" in note
+    assert f"{result.peak_utilization['torque'][worst]:.4g} times its limit" in note
+    assert "add 'torque' to the constraints" in note
+    asked = plan_library(arm, WaypointPath(np.array(UR5_WAYPOINTS[:2])), Timing(method="phase_plane", constraints=("velocity", "acceleration")), dt=0.05)
+    assert not [w for w in asked.warnings if "not asked for" in w]
