@@ -234,12 +234,22 @@ class LinearRows:
         order one whatever the limits: without it, it could not tell an acceleration limit of
         1e-6 rad/s^2 from zero. One factor per column: a factor per grid point made toppra's
         answer on a blended path 29 % slower; coefficients alone, without the bounds, failed
-        limits 1e-6 and 1e5 apart on the joints of one arm."""
+        limits 1e-6 and 1e5 apart on the joints of one arm. Only columns whose scale lies outside
+        ``ROW_SCALES`` are divided: on rows of ordinary size the solvers' own conditioning is
+        the better one (dividing every column made toppra fail on torque-limited paths of the
+        Yamamoto arm that it solves as given)."""
         k = np.maximum.reduce([np.abs(self.a), np.abs(self.b), np.abs(self.lower), np.abs(self.upper)])
         k = np.where(np.isfinite(k), k, np.maximum(np.abs(self.a), np.abs(self.b)))
         k = np.where(np.isfinite(k), k, 0.0).max(axis=0, initial=0.0)
-        k = np.where(k > 0.0, k, 1.0)
+        low, high = ROW_SCALES
+        k = np.where((k > 0.0) & ((k < low) | (k > high)), k, 1.0)
         return LinearRows(self.a / k, self.b / k, self.c / k, self.lower / k, self.upper / k)
+
+
+#: Scales of a row's column (its largest coefficient or finite bound over the grid) that
+#: ``LinearRows.normalized`` leaves as they are: within them, a solver's absolute tolerance
+#: (about 1e-8) is small against the row.
+ROW_SCALES = (1e-2, 1e4)
 
 
 def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> np.ndarray:
