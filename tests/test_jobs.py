@@ -466,18 +466,20 @@ def test_the_geering_free_path_example_runs_as_a_job_while_requests_are_served(c
     served, stages, next_request = 0, set(), time.monotonic()
     while (job := client.get(f"/v1/jobs/{job_id}").json())["status"] not in ENDED:
         stages.add(job["progress"]["stage"])
-        seen_collocation = any(stage.startswith("collocation") for stage in stages)
-        if job["status"] == "running" and seen_collocation and time.monotonic() >= next_request:
+        if job["status"] == "running" and time.monotonic() >= next_request:
             # Now and then only: on two busy cores, requests in a row would halve the job's share.
-            # Only once the collocation was seen: on a loaded machine a request can outlast it.
             response = client.post("/v1/trajectories", json=QUICK)
             assert response.status_code == 200, response.text
             served += 1
             next_request = time.monotonic() + 2.0
-        time.sleep(0.2)
+        time.sleep(0.05)
     assert job["status"] == "done", job["error"]
-    assert served >= 1 and any(stage.startswith("collocation") for stage in stages), (served, stages)
-    # Jeong & Lee's type-3 motion: T = 0.9755 s with the elbow turning a full revolution.
+    # progress by stage: the collocation's guesses, its path re-timed, its switching times refined
+    # (how many of them a poll sees depends on the machine's speed; at least one past the start)
+    worked = {stage for stage in stages if stage.startswith(("collocation", "re-timing", "refining"))}
+    assert served >= 1 and worked, (served, stages)
+    # Jeong & Lee's type-3 motion, T = 0.9755 s in the paper; with the elbow free the faster of
+    # the goals one revolution apart is answered (the elbow returning, 0.974963 s)
     assert job["result"]["duration"] == pytest.approx(0.9755, rel=1e-2)
     assert job["result"]["solver"]["duration"] == pytest.approx(0.9755, rel=1e-2)
 
