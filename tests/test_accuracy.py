@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import robots
-from benchmarks.accuracy import KINDS, converged_duration, random_waypoints
+from benchmarks.accuracy import KINDS, converged_duration, random_waypoints, recorded_waypoints
 from benchmarks.converged import converged_duration as converged
 from benchmarks.converged import random_path
 from planners import Timing, WaypointPath, plan
@@ -46,21 +46,6 @@ def test_default_durations_are_within_a_tenth_of_a_percent_of_the_converged_opti
 UR5_START = [0.3, -1.6, 1.7, -1.6, -1.57, 0.2]
 #: The weld seam of the README: ur5's tool along a straight line at 5 cm/s.
 WELD_LINE = {"kind": "cartesian", "start": UR5_START, "positions": [[0.413, 0.542, 0.286]]}
-
-
-def recorded_waypoints(robot, rng, count: int) -> np.ndarray:
-    """A recorded path: its first two steps are tiny next to the rest (2e-4 and 1.6e-4 of a
-    3 rad path, as in the data shipped with toppra's tests), then random steps."""
-    lower = np.where(np.isfinite(robot.limits.position_lower), robot.limits.position_lower, -np.pi)
-    upper = np.where(np.isfinite(robot.limits.position_upper), robot.limits.position_upper, np.pi)
-    middle, half = 0.5 * (lower + upper), 0.3 * (upper - lower)
-    points = [middle + rng.uniform(-1, 1, robot.dof) * half]
-    for fraction in (2e-4, 1.6e-4):
-        step = rng.normal(size=robot.dof)
-        points.append(points[-1] + 3.0 * fraction * step / np.linalg.norm(step))
-    while len(points) < count:
-        points.append(np.clip(points[-1] + rng.uniform(-1, 1, robot.dof) * half, middle - half, middle + half))
-    return np.array(points)
 
 
 def _weld(client, method: str, **timing) -> dict:
