@@ -17,9 +17,9 @@ from pathlib import Path
 
 from fastapi.testclient import TestClient
 
-from robots.catalog import example_urdf_path
-from service.app import create_app
-from service.settings import Settings
+from toptraj.robots.catalog import example_urdf_path
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 UR5 = Path(example_urdf_path("ur5")).read_text()
 

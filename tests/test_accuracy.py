@@ -10,15 +10,15 @@ import re
 import numpy as np
 import pytest
 
-import robots
 from benchmarks.accuracy import KINDS, converged_duration, random_waypoints, recorded_waypoints
 from benchmarks.converged import converged_duration as converged
 from benchmarks.converged import random_path
-from planners import Timing, WaypointPath, plan
-from planners.errors import InfeasiblePath
-from planners.paths import SplinePath
-from planners.timing.min_cost import MinCostMethod
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.paths import SplinePath
+from toptraj.planners.timing.min_cost import MinCostMethod
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda", "geering_2r", "yamamoto_2r"])
@@ -190,7 +190,7 @@ def test_a_time_law_states_its_gap_to_its_own_shortest_duration(method):
 def test_the_typical_request_states_its_accuracy_without_a_second_solve(monkeypatch):
     """phase_plane's estimate is its own refinement's: the typical request (4 ur5 waypoints)
     solves once."""
-    from planners.timing.phase_plane.method import PhasePlaneMethod
+    from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
     calls = []
     solve = PhasePlaneMethod.solve
@@ -204,8 +204,8 @@ def test_the_warning_advises_only_what_the_method_serves():
     """The remedy of a gap above 0.1 % is a timing.grid_points the method serves on the robot
     (the gap shrinks as the intervals grow), else the phase-plane method, never a grid beyond
     its cap."""
-    from planners.runner.accuracy import gap_warning
-    from planners.timing.toppra_method import ToppraMethod
+    from toptraj.planners.runner.accuracy import gap_warning
+    from toptraj.planners.timing.toppra_method import ToppraMethod
 
     within = gap_warning(ToppraMethod(), 0.008, 100, 6, grid_given=True)
     assert "0.8 %" in within and "timing.grid_points 1000 would bring it within 0.1 %" in within

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.errors import InfeasiblePath, InvalidRequest
-from planners.timing.laws.profiles import CycloidalBlendProfile, CycloidalProfile, QuinticProfile, TrapezoidalProfile
-from planners.timing.laws.splines import SplineProfile, clamped_spline, periodic_spline, spline_from_accelerations
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.timing.laws.profiles import CycloidalBlendProfile, CycloidalProfile, QuinticProfile, TrapezoidalProfile
+from toptraj.planners.timing.laws.splines import SplineProfile, clamped_spline, periodic_spline, spline_from_accelerations
 
 TAU1, TAU2 = 0.2, 0.9
 TRAPEZOID = TrapezoidalProfile(TAU1, TAU2)

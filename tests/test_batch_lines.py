@@ -21,14 +21,14 @@ import orjson
 import psutil
 import pytest
 
-import service.batches.work as batch_work
-from planners import Deadline
-from service.batches import lines as lines_
-from service.batches import run_batch, runner
-from service.batches.lines import MAX_DEPTH, nesting_depth, request_key
-from service.batches.work import answer, answer_chunk
-from service.cli import main
-from service.jobs.work import WorkerSetup, _batch
+import toptraj.service.batches.work as batch_work
+from toptraj.planners import Deadline
+from toptraj.service.batches import lines as lines_
+from toptraj.service.batches import run_batch, runner
+from toptraj.service.batches.lines import MAX_DEPTH, nesting_depth, request_key
+from toptraj.service.batches.work import answer, answer_chunk
+from toptraj.service.cli import main
+from toptraj.service.jobs.work import WorkerSetup, _batch
 
 ROOT = Path(__file__).resolve().parents[1]
 GOOD = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.4, 0.3, -0.2, 0.1, 0.2, 0.3]]}}
@@ -310,7 +310,7 @@ def test_sigint_stops_a_ray_batch_within_seconds_and_leaves_no_process(tmp_path)
     requests.write_text("".join(json.dumps({**GOOD, "output": {"dt": 0.001 + 1e-6 * k}}) + "\n" for k in range(3000)))
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     driver = subprocess.Popen(
-        [sys.executable, "-m", "service.cli", "batch", str(requests), "-o", str(output), "--workers", "2"],
+        [sys.executable, "-m", "toptraj.service.cli", "batch", str(requests), "-o", str(output), "--workers", "2"],
         stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path, start_new_session=True,
     )
     try:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from service.batches.lines import ForeignOutput, resume_output
+from toptraj.service.batches.lines import ForeignOutput, resume_output
 
 REQUEST = json.dumps({"robot": "geering_2r", "path": {"kind": "waypoints", "waypoints": [[0.0, 0.0], [0.5, 0.3]]}})
 RESULT = json.dumps({"line": 1, "key": "ab" * 32, "status": 200, "body": {"duration": 1.0}})
@@ -43,7 +43,7 @@ def test_the_request_file_as_output_is_refused_and_kept(tmp_path):
     requests = tmp_path / "requests.jsonl"
     requests.write_text(REQUEST + "\n")
     done = subprocess.run(
-        [sys.executable, "-m", "service.cli", "batch", str(requests), "-o", str(requests)],
+        [sys.executable, "-m", "toptraj.service.cli", "batch", str(requests), "-o", str(requests)],
         capture_output=True, text=True, timeout=60, cwd=Path(__file__).parent.parent,
     )
     assert done.returncode == 2, done.stderr

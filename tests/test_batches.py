@@ -10,12 +10,12 @@ import numpy as np
 import orjson
 import pytest
 
-import robots
-from service.batches import run_batch
-from service.batches.lines import request_key, resume_output
-from service.planning import plan_request, render
-from service.schemas.trajectories import TrajectoryRequest
 from tests.test_upload_store import PLAN, arm
+from toptraj import robots
+from toptraj.service.batches import run_batch
+from toptraj.service.batches.lines import request_key, resume_output
+from toptraj.service.planning import plan_request, render
+from toptraj.service.schemas.trajectories import TrajectoryRequest
 
 #: The directories of Ray's sessions on this machine (its default temporary directory), named
 #: session_<date>_<time>_<pid of the process that started it>.
@@ -151,8 +151,8 @@ def test_a_batch_over_http_runs_on_ray_when_the_server_has_an_address(tmp_path):
     import psutil
     from fastapi.testclient import TestClient
 
-    from service.app import create_app
-    from service.settings import Settings
+    from toptraj.service.app import create_app
+    from toptraj.service.settings import Settings
 
     good = json.loads(_requests(2)[1])
     before = set(glob.glob(RAY_SESSIONS))

@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planners.paths.blended import BlendedPath
-from planners.paths.grid import path_grid
 from tests.conftest import UR5_WAYPOINTS
+from toptraj.planners.paths.blended import BlendedPath
+from toptraj.planners.paths.grid import path_grid
 
 #: MoveIt 2 TOTG test, tests "test2" and "test3": 4 joints, max_deviation 100.
 TOTG_WAYPOINTS = [

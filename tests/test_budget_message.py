@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from planners import BudgetExceeded, Deadline
+from toptraj.planners import BudgetExceeded, Deadline
 
 
 def test_the_budget_is_shown_to_three_digits():

@@ -6,8 +6,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from planners.kinematics.ik import frame_pose, solve_ik
+from toptraj import robots
+from toptraj.planners.kinematics.ik import frame_pose, solve_ik
 
 INCH = 0.0254
 LECTURE_TABLE = np.array(

@@ -1,4 +1,4 @@
-"""The compiled inverse dynamics (``robots.chain_dynamics``, behind ``Robot.rnea``) against
+"""The compiled inverse dynamics (``toptraj.robots.chain_dynamics``, behind ``Robot.rnea``) against
 Pinocchio's ``rnea``, one state at a time."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from robots.catalog import robot_from_model
 from tests.test_frame_jacobians import SKEWED
+from toptraj import robots
+from toptraj.robots.catalog import robot_from_model
 
 DATA = Path(__file__).parent / "data"
 

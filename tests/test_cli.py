@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from service.cli import main
 from tests.conftest import UR5_WAYPOINTS
+from toptraj.service.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -65,7 +65,7 @@ def test_csv_format_prints_csv(tmp_path, capsys):
 def test_a_closed_pipe_ends_quietly(tmp_path):
     request = tmp_path / "request.json"  # an answer of about 1 MB, far more than a pipe holds
     request.write_text(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}, "output": {"dt": 0.001}}))
-    command = f"{sys.executable} -m service.cli plan - < {request} | head -c 20"
+    command = f"{sys.executable} -m toptraj.service.cli plan - < {request} | head -c 20"
     done = subprocess.run(["bash", "-c", command], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.stdout == '{"robot":"ur5","meth'
     assert done.stderr == ""
@@ -76,7 +76,7 @@ def test_a_reader_gone_is_no_error(tmp_path, monkeypatch, capsys):
         def write(self, data):
             raise BrokenPipeError(32, "Broken pipe")
 
-    from service import commands
+    from toptraj.service import commands
 
     request = tmp_path / "request.json"
     request.write_text(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}}))

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from client import Client, ProblemError
 from tests.conftest import UR5_WAYPOINTS
+from toptraj.client import Client, ProblemError
 
 
 @pytest.fixture(scope="module")

@@ -8,9 +8,9 @@ import pinocchio as pin
 import pytest
 from scipy.optimize import minimize
 
-import robots
-from planners.kinematics.conditioning import frobenius_condition_number, task_jacobian
-from robots.catalog import robot_from_model
+from toptraj import robots
+from toptraj.planners.kinematics.conditioning import frobenius_condition_number, task_jacobian
+from toptraj.robots.catalog import robot_from_model
 
 LINK = '<link name="{name}"><inertial><origin xyz="{com} 0 0"/><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
 
@@ -125,7 +125,7 @@ def test_the_gram_matrix_route_equals_the_singular_values(shape):
 def test_the_characteristic_length_is_the_reach_at_the_neutral_posture(name, reach):
     """L of the two-link arms of the papers, stretched out at q = 0: the sum of their link
     lengths (the URDFs' joint and tip offsets), the same at every call."""
-    from planners.kinematics.conditioning import characteristic_length, conditioning_along
+    from toptraj.planners.kinematics.conditioning import characteristic_length, conditioning_along
 
     robot = robots.load(name)
     assert robot.neutral_reach == pytest.approx(reach, abs=1e-15)

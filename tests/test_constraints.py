@@ -6,10 +6,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from planners.constraints.path_constraints import build_path_constraints
-from planners.paths import SplinePath, StopAndGoPath
-from planners.paths.grid import path_grid
+from toptraj import robots
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.paths import SplinePath, StopAndGoPath
+from toptraj.planners.paths.grid import path_grid
 
 RNG = np.random.default_rng(3)
 
@@ -69,7 +69,7 @@ def test_rows_of_finite_limits_only_in_chunks(monkeypatch):
     computing the torque rows a few points at a time gives the same numbers."""
     import dataclasses
 
-    from planners.constraints import path_constraints as module
+    from toptraj.planners.constraints import path_constraints as module
 
     robot = robots.load("ur5")
     waypoints = RNG.uniform(-1, 1, (4, 6))
@@ -116,7 +116,7 @@ def test_refined_constraints_know_their_smooth_points(make):
     """``with_points`` hands the refined grid the smooth points (``PathConstraints.smooth``) it
     derives from the coarse grid's: the same as computing them afresh, at corners (rows that
     differ from the two sides) and where a new point falls on a knot the grid did not hold."""
-    from planners.constraints.torque_interpolation import smooth_points
+    from toptraj.planners.constraints.torque_interpolation import smooth_points
 
     robot = robots.load("ur5")
     kinds = ("velocity", "acceleration", "torque")

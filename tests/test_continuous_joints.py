@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, WaypointPath, plan
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
 
 TURN = np.array([[0.0, 0.2], [0.3, 6.0]])  # psi: 0.2 -> 6.0 rad, 5.8 rad as given, 0.483 the short way
 

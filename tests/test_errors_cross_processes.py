@@ -1,4 +1,4 @@
-"""Errors raised in a worker process (``planners.execution.isolated.run_isolated``: the search, min_cost,
+"""Errors raised in a worker process (``toptraj.planners.execution.isolated.run_isolated``: the search, min_cost,
 collocation) cross back to the caller by pickling. An error whose constructor takes more than
 its detail (the search's NoGridPath, with its statistics) failed to unpickle, and the request
 became a 500 ("an unexpected TypeError"): ur5 with a roadmap of 2 points. Every ToptrajError
@@ -10,9 +10,9 @@ import pickle
 
 import pytest
 
-from planners.errors import InfeasiblePath, OverMemory
-from planners.generators.search.outcome import NoGridPath
-from robots.errors import UnknownRobot
+from toptraj.planners.errors import InfeasiblePath, OverMemory
+from toptraj.planners.generators.search.outcome import NoGridPath
+from toptraj.robots.errors import UnknownRobot
 
 UR5_START = [-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]
 UR5_GOAL = [1.0, -1.2, 1.5, -1.9, -1.57, 0.0]

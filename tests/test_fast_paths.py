@@ -12,16 +12,16 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
-import robots
-from planners.checks.limit_check import _torques, check_limits, joint_motion
-from planners.checks.limit_kernels import utilization_pass
-from planners.constraints.path_constraints import build_path_constraints
-from planners.paths import SplinePath
-from planners.paths.grid import path_grid
-from planners.timing import PhasePlaneMethod, ToppraMethod
-from planners.timing.base import TimeScaling
-from robots.catalog import robot_from_model
-from robots.urdf_check import check_urdf
+from toptraj import robots
+from toptraj.planners.checks.limit_check import _torques, check_limits, joint_motion
+from toptraj.planners.checks.limit_kernels import utilization_pass
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.paths import SplinePath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing import PhasePlaneMethod, ToppraMethod
+from toptraj.planners.timing.base import TimeScaling
+from toptraj.robots.catalog import robot_from_model
+from toptraj.robots.urdf_check import check_urdf
 
 KINDS = ("velocity", "acceleration", "torque")
 #: Largest error of a torque interpolated from the rows, as a fraction of the joint's torque

@@ -1,4 +1,4 @@
-"""The compiled frame Jacobians (``planners.kinematics.frame_jacobians``) against Pinocchio's
+"""The compiled frame Jacobians (``toptraj.planners.kinematics.frame_jacobians``) against Pinocchio's
 ``computeFrameJacobian`` and ``getFrameVelocity``, in ``LOCAL_WORLD_ALIGNED``."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from planners.constraints.tool_speed import frame_twists
-from planners.kinematics.frame_jacobians import frame_jacobians
-from robots.catalog import robot_from_model
+from toptraj import robots
+from toptraj.planners.constraints.tool_speed import frame_twists
+from toptraj.planners.kinematics.frame_jacobians import frame_jacobians
+from toptraj.robots.catalog import robot_from_model
 
 DATA = Path(__file__).parent / "data"
 LINK = '<link name="{name}"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'

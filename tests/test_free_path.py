@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, plan
-from planners.execution.deadline import Deadline
-from planners.generators.collocation import FreeMotion
+from toptraj import robots
+from toptraj.planners import Timing, plan
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.generators.collocation import FreeMotion
 
 #: The converged optima of Yamamoto's free path (torque limits only), from its own
 #: Hermite-Simpson transcription, ``benchmarks/yamamoto_reference.py``: the same to 7 digits on
@@ -99,7 +99,7 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     assert cheap.peak_utilization["torque"].max() <= 1.005
     fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
     assert fast.duration < cheap.duration
-    # refined to exact bang-bang torques (planners.generators.collocation.switching): never longer than the
+    # refined to exact bang-bang torques (toptraj.planners.generators.collocation.switching): never longer than the
     # collocation's own duration, and within 1e-4 (the largest gap it may state) of the
     # converged minimum time (YAMAMOTO_MINIMUM_TIME; measured 2e-7)
     assert fast.solver["switching"] == "refined"
@@ -114,8 +114,8 @@ def test_ur5_smoke():
     it quick, tests/test_sparse_collocation.py solves 30)."""
     from fastapi.testclient import TestClient
 
-    from service.app import create_app
-    from service.settings import Settings
+    from toptraj.service.app import create_app
+    from toptraj.service.settings import Settings
 
     body = {
         "robot": "ur5",

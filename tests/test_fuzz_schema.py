@@ -31,11 +31,11 @@ from fastapi.testclient import TestClient
 from hypothesis import HealthCheck, given, settings
 from schemathesis.generation.modes import GenerationMode
 
-import robots
-from planners import METHODS
-from planners.problem.ranges import ACCELERATION, DURATION, SCALE, TRAPEZOID_FRACTION, VELOCITY
-from service.app import create_app
-from service.settings import Settings
+from toptraj import robots
+from toptraj.planners import METHODS
+from toptraj.planners.problem.ranges import ACCELERATION, DURATION, SCALE, TRAPEZOID_FRACTION, VELOCITY
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 #: A budget that small requests meet with room to spare even on a busy machine: a 504 here is a
 #: finding too. schemathesis waits longer than the budget (``request_timeout``), so a request

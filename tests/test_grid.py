@@ -1,4 +1,4 @@
-"""The grid of s (``planners.paths.grid.path_grid``): knots held, segments spaced as np.linspace
+"""The grid of s (``toptraj.planners.paths.grid.path_grid``): knots held, segments spaced as np.linspace
 spaces them, bad knots refused."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from planners.errors import TimingFailed
-from planners.paths.grid import MIN_POINTS_PER_SEGMENT, on_points, path_grid, spread_indices
+from toptraj.planners.errors import TimingFailed
+from toptraj.planners.paths.grid import MIN_POINTS_PER_SEGMENT, on_points, path_grid, spread_indices
 
 
 @pytest.mark.parametrize("n_intervals", [None, 25, 100, 1000])

@@ -1,4 +1,4 @@
-"""Heavy plannings (``service.planning.heavy``) are admitted apart from the short ones: while
+"""Heavy plannings (``toptraj.service.planning.heavy``) are admitted apart from the short ones: while
 searches run over their budget, the typical request keeps its latency, and once they end the
 server is idle again and holds the memory it held before."""
 
@@ -13,12 +13,12 @@ import numpy as np
 import psutil
 import pytest
 
-from service.app import create_app
-from service.planning import heavy, heavy_request
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
-from service.settings import Settings
 from tests.live_server import LiveServer
 from tests.test_search_budget import UR5_BOX, UR5_GOAL, UR5_START
+from toptraj.service.app import create_app
+from toptraj.service.planning import heavy, heavy_request
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.settings import Settings
 
 #: The typical request (``benchmarks/end_to_end.py``): ur5, 4 spline waypoints, phase_plane.
 TYPICAL = {

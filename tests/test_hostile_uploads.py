@@ -11,12 +11,12 @@ from pathlib import Path
 
 import pytest
 
-import robots
-from robots.bounded_yaml import MAX_ALIASES, MAX_CHARS, MAX_DEPTH, MAX_NODES
-from robots.catalog import example_urdf_path
-from robots.errors import MAX_DETAIL_CHARS, InvalidURDF, excerpt
-from robots.ranges import LIMITS
-from robots.upload_options import UploadOptions
+from toptraj import robots
+from toptraj.robots.bounded_yaml import MAX_ALIASES, MAX_CHARS, MAX_DEPTH, MAX_NODES
+from toptraj.robots.catalog import example_urdf_path
+from toptraj.robots.errors import MAX_DETAIL_CHARS, InvalidURDF, excerpt
+from toptraj.robots.ranges import LIMITS
+from toptraj.robots.upload_options import UploadOptions
 
 UR5 = Path(example_urdf_path("ur5")).read_text()
 KEYS = {"velocity": "max_velocity", "acceleration": "max_acceleration", "jerk": "max_jerk", "torque": "max_effort"}

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from service.app import create_app
-from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 GOOD_PATH = {"kind": "waypoints", "waypoints": UR5_WAYPOINTS[:2]}
 
@@ -131,11 +131,11 @@ def test_over_the_time_budget_is_504():
 
 
 def test_the_service_picks_the_status_not_the_library(client, monkeypatch):
-    """The HTTP status of a library error comes from the service's table (``service.errors.STATUS``),
+    """The HTTP status of a library error comes from the service's table (``toptraj.service.errors.STATUS``),
     never from an attribute of the library's class: changing that attribute changes no answer."""
-    from planners.errors import BudgetExceeded
-    from robots.errors import UnknownRobot
-    from service.errors import status_of
+    from toptraj.planners.errors import BudgetExceeded
+    from toptraj.robots.errors import UnknownRobot
+    from toptraj.service.errors import status_of
 
     monkeypatch.setattr(UnknownRobot, "status", 418, raising=False)
     monkeypatch.setattr(BudgetExceeded, "status", 418, raising=False)

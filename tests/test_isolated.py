@@ -1,4 +1,4 @@
-"""``planners.execution.isolated``: a function run in a worker process returns its result or raises its
+"""``toptraj.planners.execution.isolated``: a function run in a worker process returns its result or raises its
 error, and is killed when the deadline passes or is cancelled."""
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import numpy as np
 import psutil
 import pytest
 
-import robots
-from planners import BudgetExceeded, Deadline, InfeasiblePath
-from planners.errors import OverMemory
-from planners.execution.isolated import run_isolated
+from toptraj import robots
+from toptraj.planners import BudgetExceeded, Deadline, InfeasiblePath
+from toptraj.planners.errors import OverMemory
+from toptraj.planners.execution.isolated import run_isolated
 
 
 def _spin(pid_file: str) -> None:
@@ -83,9 +83,9 @@ def test_the_worker_is_killed_when_the_deadline_is_cancelled(tmp_path):
 def test_cancelling_kills_the_worker_at_once_from_the_cancelling_thread(tmp_path, monkeypatch):
     """A 504 cancels the deadline from the event loop: the worker dies then, not when the thread
     waiting for it next polls (made 5 s here), so no work runs on after the answer."""
-    import planners.execution.isolated
+    import toptraj.planners.execution.isolated
 
-    monkeypatch.setattr(planners.execution.isolated, "POLL_S", 5.0)
+    monkeypatch.setattr(toptraj.planners.execution.isolated, "POLL_S", 5.0)
     pid_file = tmp_path / "pid"
     deadline = Deadline(600)
     outcome: list[BaseException] = []
@@ -133,8 +133,8 @@ def test_the_worker_process_keeps_to_one_blas_thread():
 
 @pytest.mark.skipif(os.cpu_count() < 2, reason="a one-core machine gives BLAS one thread anyway")
 def test_the_service_process_keeps_to_one_blas_thread():
-    from service.app import create_app
-    from service.settings import Settings
+    from toptraj.service.app import create_app
+    from toptraj.service.settings import Settings
 
     create_app(Settings(preload_robots=False))
     assert _blas_threads() == 1

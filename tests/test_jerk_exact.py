@@ -21,14 +21,14 @@ import numpy as np
 import pytest
 from ruckig import InputParameter, Ruckig, Synchronization, Trajectory
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.constraints.path_constraints import build_path_constraints
-from planners.paths.grid import path_grid
-from planners.problem.waypoints import make_path
-from planners.timing.jerk.closed_form import ScalarLimits, double_s
-from planners.timing.jerk.method import JerkLimitedMethod
-from planners.timing.jerk.segments import segment_starts
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.timing.jerk.closed_form import ScalarLimits, double_s
+from toptraj.planners.timing.jerk.method import JerkLimitedMethod
+from toptraj.planners.timing.jerk.segments import segment_starts
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")
 

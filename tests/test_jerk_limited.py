@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 from ruckig import InputParameter, Ruckig, Trajectory
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.errors import TimingFailed
-from planners.problem.waypoints import make_path
-from planners.timing.jerk.method import JerkLimitedMethod
-from planners.timing.phase_plane.method import PhasePlaneMethod
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import TimingFailed
+from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.timing.jerk.method import JerkLimitedMethod
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")
 #: Relative agreement with ruckig on straight lines, where both are the exact optimum.

@@ -14,14 +14,14 @@ import psutil
 import pytest
 from fastapi.testclient import TestClient
 
-from planners import BudgetExceeded, Deadline
-from planners.execution.deadline import NO_DEADLINE
-from planners.execution.isolated import run_isolated
-from service.app import create_app
-from service.jobs.store import JobStore
-from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
 from tests.live_server import LiveServer
+from toptraj.planners import BudgetExceeded, Deadline
+from toptraj.planners.execution.deadline import NO_DEADLINE
+from toptraj.planners.execution.isolated import run_isolated
+from toptraj.service.app import create_app
+from toptraj.service.jobs.store import JobStore
+from toptraj.service.settings import Settings
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 DATA = Path(__file__).resolve().parent / "data"

@@ -14,11 +14,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from planners.errors import BudgetExceeded
-from planners.execution.deadline import Deadline, Leash, LeashSlipped
-from service.planning import plan_request, worth_a_leash
-from service.schemas.trajectories import TrajectoryRequest
-from service.workers import PlanningWorkers
+from toptraj.planners.errors import BudgetExceeded
+from toptraj.planners.execution.deadline import Deadline, Leash, LeashSlipped
+from toptraj.service.planning import plan_request, worth_a_leash
+from toptraj.service.schemas.trajectories import TrajectoryRequest
+from toptraj.service.workers import PlanningWorkers
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -246,7 +246,7 @@ def _example(name: str) -> dict:
 
 
 def test_only_small_waypoint_requests_on_a_checking_method_are_worth_a_leash():
-    import robots
+    from toptraj import robots
 
     robots.load("ur5")
     typical = _example("ur5_spline.json")

@@ -13,10 +13,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.errors import InvalidRequest
-from planners.timing.laws.profiles import QuinticProfile, polynomial_derivatives, quintic_coefficients
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.timing.laws.profiles import QuinticProfile, polynomial_derivatives, quintic_coefficients
 
 ARM = robots.load("geering_2r")
 A = np.radians([20.0, 30.0])

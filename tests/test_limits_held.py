@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, WaypointPath
-from planners import plan as plan_library
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath
+from toptraj.planners import plan as plan_library
 
 DATA = Path(__file__).parent / "data"
 KINDS = ("velocity", "acceleration", "torque")

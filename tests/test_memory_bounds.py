@@ -10,10 +10,10 @@ import httpx
 import pytest
 from fastapi.testclient import TestClient
 
-from service.app import create_app
-from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
 from tests.test_budget_stops_work import SLOW
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 YAMAMOTO_LINE = [[0.0, 0.0], [0.5, 0.3]]
 

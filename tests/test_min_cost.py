@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-import robots
-from planners import Timing, WaypointPath, plan
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
 
 YAMAMOTO_LINE = np.radians([[45.0, -90.0], [-90.0, 0.0]])
 BETA = 0.03

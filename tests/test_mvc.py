@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
-from planners.constraints.admissible import admissible_set
-from planners.constraints.path_constraints import LinearRows
+from toptraj.planners.constraints.admissible import admissible_set
+from toptraj.planners.constraints.path_constraints import LinearRows
 
 RNG = np.random.default_rng(11)
 

@@ -13,15 +13,15 @@ import numpy as np
 import pytest
 import uvicorn
 
-import robots
-from planners import Deadline, InvalidRequest, Timing, TimingFailed, WaypointPath, plan
-from planners.paths.grid import path_grid
-from planners.results import require_finite
-from planners.timing.laws.profiles import quintic_coefficients
-from service.app import create_app
-from service.errors import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
-from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import Deadline, InvalidRequest, Timing, TimingFailed, WaypointPath, plan
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.results import require_finite
+from toptraj.planners.timing.laws.profiles import quintic_coefficients
+from toptraj.service.app import create_app
+from toptraj.service.errors import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
+from toptraj.service.settings import Settings
 
 DIRECTION = [0.8, 0.2, 0.4, -0.5, 0.6, 0.3]
 TWO = UR5_WAYPOINTS[:2]
@@ -177,7 +177,7 @@ def test_the_first_non_finite_number_is_named_wherever_it_sits(body, named):
 
 def test_a_numerical_breakdown_in_a_planner_is_a_422(client, monkeypatch):
     """Whatever overflows or turns singular inside a timing method is its failure, not a 500."""
-    import planners.timing.laws.method as classical
+    import toptraj.planners.timing.laws.method as classical
 
     def singular(*args, **kwargs):
         raise np.linalg.LinAlgError("Singular matrix")
@@ -194,7 +194,7 @@ def test_a_numerical_breakdown_in_a_planner_is_a_422(client, monkeypatch):
 @pytest.fixture
 def live_server(monkeypatch):
     """A uvicorn server in a thread whose trajectory planning raises an unexpected error."""
-    import service.routes.trajectories as routes
+    import toptraj.service.routes.trajectories as routes
 
     def broken(*args, **kwargs):
         raise RuntimeError("a planner bug")

@@ -9,11 +9,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from planners.collision import BoxObstacle, CapsuleObstacle, SphereObstacle
-from planners.collision.distance import capsule_distance
-from robots.collision import robot_capsules, world_capsules
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, SphereObstacle
+from toptraj.planners.collision.distance import capsule_distance
+from toptraj.robots.collision import robot_capsules, world_capsules
 
 RNG = np.random.default_rng(7)
 
@@ -70,7 +70,7 @@ def test_the_link_capsules_contain_ur5s_collision_meshes():
     """Conservative: a capsule is never farther from a sphere than the mesh it wraps (coal's
     mesh-to-sphere distance)."""
     robot = robots.load("ur5")
-    from robots.catalog import example_urdf_path
+    from toptraj.robots.catalog import example_urdf_path
 
     path = example_urdf_path("ur5")
     model = pin.buildModelFromUrdf(path)

@@ -9,9 +9,9 @@ import io
 import numpy as np
 import pytest
 
-import robots
-from service.formats import chosen_format, time_from_start
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.service.formats import chosen_format, time_from_start
 
 PATH = {"kind": "waypoints", "waypoints": UR5_WAYPOINTS, "interpolation": "spline"}
 

@@ -6,7 +6,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
+from toptraj import robots
 
 RNG = np.random.default_rng(20240531)
 

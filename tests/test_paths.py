@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planners.errors import InvalidRequest
-from planners.paths import SplinePath, StopAndGoPath
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.paths import SplinePath, StopAndGoPath
 
 WAYPOINTS = np.array([[0.0, 0.0], [1.0, 0.5], [1.5, 2.0], [3.0, 2.5]])
 

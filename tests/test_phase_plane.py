@@ -7,14 +7,14 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.checks.limit_check import check_limits
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath
-from planners.paths import SplinePath
-from planners.paths.grid import path_grid
-from planners.timing import PhasePlaneMethod, ToppraMethod
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.checks.limit_check import check_limits
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.paths import SplinePath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing import PhasePlaneMethod, ToppraMethod
 
 UR5 = robots.load("ur5")
 START = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])

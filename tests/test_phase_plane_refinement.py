@@ -7,19 +7,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
 from benchmarks.accuracy import KINDS, random_waypoints
-from planners.checks.limit_check import check_limits
-from planners.constraints.admissible import acceleration_bounds, admissible_set
-from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, zero_inertia_intervals
-from planners.constraints.path_constraints import PathConstraints, build_path_constraints
-from planners.errors import InfeasiblePath
-from planners.paths import SplinePath
-from planners.paths.grid import path_grid
-from planners.timing import PhasePlaneMethod
-from planners.timing.phase_plane.method import _kept_intervals, interval_rows, midpoint_duration, midpoint_stage_rows
-from planners.timing.phase_plane.refinement_kernels import row_excursions, switch_excess
-from planners.timing.phase_plane.split_kernels import _pieces
+from toptraj import robots
+from toptraj.planners.checks.limit_check import check_limits
+from toptraj.planners.constraints.admissible import acceleration_bounds, admissible_set
+from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, zero_inertia_intervals
+from toptraj.planners.constraints.path_constraints import PathConstraints, build_path_constraints
+from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.paths import SplinePath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing import PhasePlaneMethod
+from toptraj.planners.timing.phase_plane.method import _kept_intervals, interval_rows, midpoint_duration, midpoint_stage_rows
+from toptraj.planners.timing.phase_plane.refinement_kernels import row_excursions, switch_excess
+from toptraj.planners.timing.phase_plane.split_kernels import _pieces
 
 #: Largest |value| / limit on the dense check that the answer may reach: 0.3 % above the limit
 #: (the service promises 0.5 % on any dense resampling, and a client's samples fall between

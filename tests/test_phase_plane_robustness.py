@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners.checks.limit_check import check_limits
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.paths import SplinePath, StopAndGoPath
-from planners.paths.grid import path_grid
-from planners.timing import PhasePlaneMethod, ToppraMethod
+from toptraj import robots
+from toptraj.planners.checks.limit_check import check_limits
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.paths import SplinePath, StopAndGoPath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing import PhasePlaneMethod, ToppraMethod
 
 CASES = {"ur5": 334, "panda": 333, "yamamoto_2r": 333}
 

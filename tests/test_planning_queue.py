@@ -7,7 +7,7 @@ import asyncio
 import threading
 import time
 
-from service.workers import PlanningWorkers
+from toptraj.service.workers import PlanningWorkers
 
 
 async def _order_of_service() -> list[str]:

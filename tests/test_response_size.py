@@ -12,9 +12,9 @@ import httpx
 import pytest
 from fastapi.testclient import TestClient
 
-from service.app import create_app
-from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 CAP = 1_000_000
 REQUEST = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}, "timing": {"method": "phase_plane"}}
@@ -61,11 +61,11 @@ def _health_while_rendering(monkeypatch, body: dict):
     answer's body) first waits until a ``/health`` sent once it started is answered: the
     answer, and whether ``render`` ran at all. Were the body built on the event loop, the
     loop could not answer ``/health`` and the wait would end in its hang guard (a 500)."""
-    import service.planning
-    import service.routes.trajectories as routes
+    import toptraj.service.planning
+    import toptraj.service.routes.trajectories as routes
 
     rendering, health_answered = threading.Event(), threading.Event()
-    original = service.planning.render
+    original = toptraj.service.planning.render
 
     def watched(*args, **kwargs):
         rendering.set()

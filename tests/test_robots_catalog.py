@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from robots.catalog import EXAMPLE_ARMS
+from toptraj import robots
+from toptraj.robots.catalog import EXAMPLE_ARMS
 
 
 @pytest.mark.parametrize("name", list(robots.catalog_names()))

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, WaypointPath, plan
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
 
 UR5 = robots.load("ur5")
 START = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])

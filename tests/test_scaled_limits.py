@@ -1,5 +1,5 @@
 """A scale factor is one more source of a limit: the limit it makes lies in the range of its
-kind, like an override, an upload's or a URDF's (``robots.ranges``). Outside, a jerk limit of
+kind, like an override, an upload's or a URDF's (``toptraj.robots.ranges``). Outside, a jerk limit of
 1e-9 rad/s^3 (jerk_scale 1e-3 on 1e-6) made jerk_limited answer "the linear program is
 infeasible" for a motion that exists; the request is refused before planning, with the factors
 that are accepted, and following that advice plans."""
@@ -11,9 +11,9 @@ import re
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.errors import InvalidRequest
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import InvalidRequest
 
 UR5 = robots.load("ur5")
 TWO = WaypointPath(np.array([[0.0, -1.2, 1.0, 0.0, 0.3, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3]]))

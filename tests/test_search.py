@@ -1,4 +1,4 @@
-"""The global search among obstacles (Jeong & Lee section 2, ``planners.generators.search``): branch and
+"""The global search among obstacles (Jeong & Lee section 2, ``toptraj.planners.generators.search``): branch and
 bound against exhaustive enumeration, the bounds t1 <= t2 <= t3 <= t4 on every grid path, the
 Geering arm's optimum found by search and local optimization, a detour around an obstacle
 checked by an independent distance computation, and ur5 around a box."""
@@ -10,16 +10,16 @@ import pinocchio as pin
 import pytest
 from fastapi.testclient import TestClient
 
-import robots
-from planners.collision import BoxObstacle, SphereObstacle
-from planners.generators.search import branch_and_bound, build_problem, enumerate_grid_paths
-from planners.generators.search.graph import SearchOptions
-from planners.generators.search.outcome import NoGridPath
-from planners.generators.search.problem import toward_goal
-from robots.collision import robot_capsules, world_capsules
-from service.app import create_app
-from service.settings import Settings
 from tests.test_obstacles import _coal_capsule, _coal_distance, _coal_obstacle
+from toptraj import robots
+from toptraj.planners.collision import BoxObstacle, SphereObstacle
+from toptraj.planners.generators.search import branch_and_bound, build_problem, enumerate_grid_paths
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.outcome import NoGridPath
+from toptraj.planners.generators.search.problem import toward_goal
+from toptraj.robots.collision import robot_capsules, world_capsules
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 #: Jeong & Lee, Fig. 3 caption: the free motion phi 0 -> 0.76 rad of the Geering arm.
 GEERING_OPTIMUM = 0.9755

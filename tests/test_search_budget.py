@@ -13,16 +13,16 @@ import psutil
 import pytest
 from fastapi.testclient import TestClient
 
-import robots
-from planners import BudgetExceeded, Deadline
-from planners.collision import BoxObstacle
-from planners.errors import OverMemory
-from planners.generators.search.graph import SearchOptions, lattice_graph, roadmap_graph
-from planners.generators.search.memory import check_search_memory, search_spans
-from planners.generators.search.method import global_search
-from planners.generators.search.pieces import span_keys
-from service.app import create_app
-from service.settings import Settings
+from toptraj import robots
+from toptraj.planners import BudgetExceeded, Deadline
+from toptraj.planners.collision import BoxObstacle
+from toptraj.planners.errors import OverMemory
+from toptraj.planners.generators.search.graph import SearchOptions, lattice_graph, roadmap_graph
+from toptraj.planners.generators.search.memory import check_search_memory, search_spans
+from toptraj.planners.generators.search.method import global_search
+from toptraj.planners.generators.search.pieces import span_keys
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 UR5_START = [-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]
 UR5_GOAL = [1.0, -1.2, 1.5, -1.9, -1.57, 0.0]
@@ -155,7 +155,7 @@ def test_a_search_job_obeys_the_same_memory_cap(tmp_path):
 def test_an_estimate_too_low_is_a_clear_error_not_the_system_killing_a_process(monkeypatch):
     # as if the estimate said 1 byte: the search's worker process gets 64 MB of room, runs out
     # while it builds its spans (about 0.5 GB), and the answer says so
-    import planners.runner.timed_free as timed_free
+    import toptraj.planners.runner.timed_free as timed_free
 
     monkeypatch.setattr(timed_free, "check_search_memory", lambda *args, **kwargs: 1)
     monkeypatch.setattr(timed_free, "SEARCH_MEMORY_SLACK", 64 * 2**20)

@@ -11,10 +11,10 @@ import math
 import numpy as np
 import pytest
 
-import robots
-from planners.errors import InvalidRequest
-from planners.generators.search import build_problem
-from planners.generators.search.graph import SearchOptions
+from toptraj import robots
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.generators.search import build_problem
+from toptraj.planners.generators.search.graph import SearchOptions
 
 GEERING = robots.load("geering_2r")  # phi revolute (+-2 pi), psi continuous
 OPTIONS = SearchOptions(tubes=1)

@@ -1,7 +1,7 @@
 """``toptraj serve --workers 2`` stopped by SIGTERM at any moment: just started, while its
 processes are still starting (importing, warming up, the fork server importing the solver
 stacks), and warm with a job running: every process it started, and every process those
-started, is gone within 5 s (``service.stopping``)."""
+started, is gone within 5 s (``toptraj.service.stopping``)."""
 
 from __future__ import annotations
 
@@ -18,10 +18,10 @@ import uuid
 import psutil
 import pytest
 
-from service.jobs.store import JobStore
-from service.stopping import descendants
 from tests.live_server import ROOT, _free_port
 from tests.test_jobs import SLOW
+from toptraj.service.jobs.store import JobStore
+from toptraj.service.stopping import descendants
 
 #: Seconds within which every process must be gone.
 GONE_S = 5.0
@@ -35,7 +35,7 @@ def _describe(process: psutil.Process) -> str:
 
 
 class _Server:
-    """``python -m service.cli serve --workers 2`` whose every process carries a marker in its
+    """``python -m toptraj.service.cli serve --workers 2`` whose every process carries a marker in its
     environment (inherited by spawned and forked processes alike), so that a process left
     behind is found even once its parent is gone."""
 
@@ -50,7 +50,7 @@ class _Server:
             **settings,
         }
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--workers", "2"],
+            [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(self.port), "--workers", "2"],
             cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
         )
         self.log: list[str] = []

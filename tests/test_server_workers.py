@@ -15,11 +15,11 @@ import sys
 import psutil
 import pytest
 
-from robots.store import UploadStore
-from service.cli import APP_FACTORY, main, plan_threads_per_process
-from service.serving import LOOP, SWITCH_INTERVAL_S, BalancedEventLoop, new_event_loop, open_connections
 from tests.live_server import LiveServer
 from tests.test_upload_store import PLAN, app_client, arm
+from toptraj.robots.store import UploadStore
+from toptraj.service.cli import APP_FACTORY, main, plan_threads_per_process
+from toptraj.service.serving import LOOP, SWITCH_INTERVAL_S, BalancedEventLoop, new_event_loop, open_connections
 
 
 def test_serve_runs_the_app_factory_in_one_process_per_core_by_default(monkeypatch):
@@ -28,8 +28,8 @@ def test_serve_runs_the_app_factory_in_one_process_per_core_by_default(monkeypat
     monkeypatch.delenv("TOPTRAJ_PLAN_WORKERS", raising=False)
     assert main(["serve"]) == 0
     app, options = calls[-1]
-    assert app == APP_FACTORY == "service.app:create_app" and options["factory"] is True
-    assert options["loop"] == LOOP == "service.serving:new_server_loop"
+    assert app == APP_FACTORY == "toptraj.service.app:create_app" and options["factory"] is True
+    assert options["loop"] == LOOP == "toptraj.service.serving:new_server_loop"
     assert (options["host"], options["port"], options["workers"]) == ("127.0.0.1", 8000, os.cpu_count())
     assert os.environ["TOPTRAJ_PLAN_WORKERS"] == str(plan_threads_per_process(os.cpu_count()))
 
@@ -232,6 +232,6 @@ def _burst(server: LiveServer, clients: int) -> list[int]:
 def test_connections_opened_at_once_spread_over_the_processes(two_workers):
     """Four clients connecting together keep both processes (both cores) busy: the event
     loop's own accept loop gave all four to one process in 14 to 19 of 30 such bursts on a
-    loaded 2-core machine, the balanced loop (``service.serving``) in none of 60."""
+    loaded 2-core machine, the balanced loop (``toptraj.service.serving``) in none of 60."""
     spread = [len(set(_burst(two_workers, 4))) == 2 for _ in range(5)]
     assert sum(spread) >= 4, spread

@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners.generators.collocation import collocation
-from planners.generators.collocation.sparse import solve_sparse
-from planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
 from tests.test_free_path import YAMAMOTO_MINIMUM_TIME
+from toptraj import robots
+from toptraj.planners.generators.collocation import collocation
+from toptraj.planners.generators.collocation.sparse import solve_sparse
+from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda", "kinova", "geering_2r", "yamamoto_2r", "lecture_3r"])

@@ -3,7 +3,7 @@ captions (section 4.3, Figs. 1 to 4), from the free-path answer's ``switching_ti
 
 The collocation (30 intervals, h = T / 30, 32.5 to 42 ms) places each switch within one
 interval; read off its torques they are up to 1.9 ms from the refined ones on Type 3. The answer's switching
-times come from the bang-bang refinement (``planners.generators.collocation.switching``), exact to the
+times come from the bang-bang refinement (``toptraj.planners.generators.collocation.switching``), exact to the
 integration (1 ms Runge-Kutta steps, goal error below 1e-8): the captions are matched within
 5 ms, the durations within the caption's last printed digit (Type 3: 0.97564 s against
 0.9755, 0.14 ms).
@@ -21,10 +21,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, plan
-from planners.generators.collocation import FreeMotion
-from planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching
+from toptraj import robots
+from toptraj.planners import Timing, plan
+from toptraj.planners.generators.collocation import FreeMotion
+from toptraj.planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching
 
 CAPTION_TOLERANCE = 5e-3  # s
 
@@ -131,7 +131,7 @@ def test_type_4_caption(arm, type_4):
 def test_collocation_alone_places_switches_within_its_step(arm, type_3):
     """Without the refinement, the switches read off the collocation's own instants (h = T / 30)
     lie within one step of the refined ones but not within a millisecond."""
-    from planners.generators.collocation.collocation import _optimize_motion
+    from toptraj.planners.generators.collocation.collocation import _optimize_motion
 
     motion = FreeMotion(np.zeros(2), np.array([0.76, -2 * np.pi]), revolutions=False, intervals=30)
     collocation = _optimize_motion(arm, arm.limits, motion, 0.0, 1000)
@@ -158,7 +158,7 @@ def type_1(arm):
 
 
 def _family(arm, answer, phi_b):
-    from planners.generators.collocation.optimality_map import Family
+    from toptraj.planners.generators.collocation.optimality_map import Family
 
     controls = _controls(answer, arm)
     elbow = 2 * np.pi * round(answer.samples.q[-1][1] / (2 * np.pi))
@@ -166,7 +166,7 @@ def _family(arm, answer, phi_b):
 
 
 def test_type_1_to_type_3_crossover(arm, type_1, type_3):
-    from planners.generators.collocation.optimality_map import boundary
+    from toptraj.planners.generators.collocation.optimality_map import boundary
 
     one, three = _family(arm, type_1, 0.5), _family(arm, type_3, 0.76)
     assert (one.elbow, three.elbow) == (0.0, -2 * np.pi)
@@ -179,7 +179,7 @@ def test_type_1_to_type_3_crossover(arm, type_1, type_3):
 
 
 def test_type_3_to_type_4_boundary(arm, type_3, type_4):
-    from planners.generators.collocation.optimality_map import boundary
+    from toptraj.planners.generators.collocation.optimality_map import boundary
 
     three, four = _family(arm, type_3, 0.76), _family(arm, type_4, np.pi)
     lower, upper = boundary([three, four], three, 1.71, 1.81, BOUNDARY_WIDTH)
@@ -191,10 +191,10 @@ def test_type_3_to_type_4_boundary(arm, type_3, type_4):
 
 def test_switching_times_in_the_answer_schema(type_3):
     """The answer carries switching_times per joint name (s), declared in the OpenAPI."""
-    from service.app import create_app
-    from service.planning import trajectory_body
-    from service.schemas.answers import TrajectoryResponse
-    from service.settings import Settings
+    from toptraj.service.app import create_app
+    from toptraj.service.planning import trajectory_body
+    from toptraj.service.schemas.answers import TrajectoryResponse
+    from toptraj.service.settings import Settings
 
     body = TrajectoryResponse.model_validate(trajectory_body(type_3)).model_dump()
     assert set(body["switching_times"]) == {"phi", "psi"}

@@ -3,8 +3,8 @@ service sets up no provider, and the instrumentation's checks would cost every r
 
 from __future__ import annotations
 
-from service.app import create_app
-from service.settings import Settings
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 
 def _instrumentation(settings: Settings) -> dict:

@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.errors import InfeasiblePath, InvalidRequest
-from planners.timing.laws.method import ClassicalMethod
-from planners.timing.laws.profiles import (
+from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.timing.laws.method import ClassicalMethod
+from toptraj.planners.timing.laws.profiles import (
     PROFILES,
     CubicProfile,
     CycloidalProfile,
@@ -19,7 +20,6 @@ from planners.timing.laws.profiles import (
     polynomial_derivatives,
     quintic_coefficients,
 )
-from tests.conftest import UR5_WAYPOINTS
 
 
 def test_lecture_example_1_cubic():

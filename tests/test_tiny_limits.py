@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, WaypointPath, plan
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
 
 UR5 = robots.load("ur5")
 SPLINE = WaypointPath(

@@ -10,11 +10,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from planners.kinematics.ik import frame_pose
-from planners.paths.cartesian import CartesianLine
-from planners.problem.waypoints import make_path
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners.kinematics.ik import frame_pose
+from toptraj.planners.paths.cartesian import CartesianLine
+from toptraj.planners.problem.waypoints import make_path
 
 UR5_START = [0.3, -1.6, 1.7, -1.6, -1.57, 0.2]
 

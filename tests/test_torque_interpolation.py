@@ -1,4 +1,4 @@
-"""Torques interpolated from a grid's rows (``planners.constraints.torque_interpolation``) against
+"""Torques interpolated from a grid's rows (``toptraj.planners.constraints.torque_interpolation``) against
 Pinocchio's RNEA: the dense check's torques between grid points (within
 ``TOLERANCE`` of the limit where interpolated, RNEA itself where the grid does not
 resolve the rows, interpolated at most states of an ordinary request); and the rows a
@@ -11,17 +11,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import robots
-from planners.checks.limit_check import _torques, joint_motion
-from planners.constraints.path_constraints import build_path_constraints
-from planners.constraints.torque_interpolation import MAX_TRAVEL
-from planners.paths import SplinePath, StopAndGoPath
-from planners.paths.blended import BlendedPath
-from planners.paths.grid import path_grid
-from planners.timing import PhasePlaneMethod, ToppraMethod
-from robots import Robot
-from robots.catalog import robot_from_model
-from robots.urdf_check import check_urdf
+from toptraj import robots
+from toptraj.planners.checks.limit_check import _torques, joint_motion
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.constraints.torque_interpolation import MAX_TRAVEL
+from toptraj.planners.paths import SplinePath, StopAndGoPath
+from toptraj.planners.paths.blended import BlendedPath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing import PhasePlaneMethod, ToppraMethod
+from toptraj.robots import Robot
+from toptraj.robots.catalog import robot_from_model
+from toptraj.robots.urdf_check import check_urdf
 
 KINDS = ("velocity", "acceleration", "torque")
 #: Largest error of an interpolated torque, as a fraction of the joint's torque limit: 1e-5, a
@@ -150,7 +150,7 @@ def test_refinement_rows_are_the_rows_of_a_build_on_the_refined_grid(case, monke
     refinement adds; with Coulomb friction, and on a path with corners, every interval): the
     refined constraints equal, bit for bit, those built afresh on the refined grid, with one
     RNEA per new point and none at the points already there."""
-    import planners.constraints.path_constraints as constraints_module
+    import toptraj.planners.constraints.path_constraints as constraints_module
 
     if case == "pendulum_coulomb":
         text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()

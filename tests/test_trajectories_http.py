@@ -6,8 +6,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
 from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
 
 DT = 0.0005
 
@@ -116,7 +116,7 @@ def test_request_models_are_frozen_and_share_their_defaults():
     validating a deep copy of each."""
     from pydantic import ValidationError
 
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     body = {"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS[:2]}, "timing": {"method": "phase_plane"}}
     first, second = TrajectoryRequest.model_validate(body), TrajectoryRequest.model_validate(body)

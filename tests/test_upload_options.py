@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import robots
-from robots.catalog import example_urdf_path
-from robots.upload_options import InvalidUpload, upload_options
+from toptraj import robots
+from toptraj.robots.catalog import example_urdf_path
+from toptraj.robots.upload_options import InvalidUpload, upload_options
 
 PANDA = Path(example_urdf_path("panda")).read_text()
 UR5 = Path(example_urdf_path("ur5")).read_text()

@@ -17,11 +17,11 @@ import httpx
 import pytest
 from fastapi.testclient import TestClient
 
-import robots
-from robots.store import UploadStore
-from robots.uploads import cached_upload_count
-from service.app import create_app
-from service.settings import Settings
+from toptraj import robots
+from toptraj.robots.store import UploadStore
+from toptraj.robots.uploads import cached_upload_count
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -187,7 +187,7 @@ def _start_server(data_dir: Path, port: int, log: Path) -> subprocess.Popen:
     env = {**os.environ, "TOPTRAJ_DATA_DIR": str(data_dir), "TOPTRAJ_PRELOAD_ROBOTS": "false", "PYTHONPATH": str(REPO)}
     with open(log, "wb") as output:
         process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(port), "--workers", "1"],
+            [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(port), "--workers", "1"],
             env=env,
             stdout=output,
             stderr=subprocess.STDOUT,

@@ -8,8 +8,8 @@ from importlib import resources
 
 import pytest
 
-from robots.catalog import BUNDLED, EXAMPLE_ARMS, example_urdf_path
-from robots.urdf_check import check_urdf
+from toptraj.robots.catalog import BUNDLED, EXAMPLE_ARMS, example_urdf_path
+from toptraj.robots.urdf_check import check_urdf
 
 INERTIA = 'ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"'
 

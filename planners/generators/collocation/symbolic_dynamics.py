@@ -1,5 +1,5 @@
 """Inverse dynamics of a Pinocchio model as a CasADi expression, for sparse nonlinear programs
-(``planners.generators.collocation.sparse``).
+(``toptraj.planners.generators.collocation.sparse``).
 
 The recursive Newton-Euler algorithm (Featherstone, *Rigid Body Dynamics Algorithms*, 2008,
 Table 5.1) in Pinocchio's conventions: spatial motions [v; w] and forces [f; n] in each joint's
@@ -21,7 +21,7 @@ import casadi as ca
 import numpy as np
 import pinocchio as pin
 
-from robots import Robot
+from toptraj.robots import Robot
 
 
 def _skew(w):
