@@ -8,7 +8,7 @@ latency alone and under the searches (p50, p99, max) with its statuses, the serv
 tree CPU time in the 2 s after both 504s, and its resident memory warm, at its peak during the
 searches and when it came back within 200 MB of the warm figure. The targets (issue "Trust for
 the heavy half"): p99 under 1 s, under 0.5 CPU-s, back within 200 MB within 5 s;
-``tests/test_heavy_admission.py`` asserts them once.
+``tests/service/test_heavy_admission.py`` asserts them once.
 """
 
 from __future__ import annotations

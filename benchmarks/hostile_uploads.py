@@ -6,7 +6,7 @@ mixed types, and the largest text the bounds accept.
 
 Prints one line per case: the status, the time and the start of the detail. Before the bounded
 loader (``robots/bounded_yaml.py``) the depth-8 bomb froze a process for 27 s and the others were
-500s; ``tests/test_hostile_uploads.py`` asserts the statuses.
+500s; ``tests/robots/test_hostile_uploads.py`` asserts the statuses.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ For each type: the caption's switching times of u1 and u2 and T, ours (the answe
 ``switching_times``, from the bang-bang refinement, in the caption's orientation: a
 time-reversed motion is as fast on this arm, ``toptraj.planners.generators.collocation.switching.mirrored``), and
 the differences in ms. Type 1 is solved with its structure (Type 2 without u1's last arc),
-seeded by the Type 2 answer, as ``tests/test_switching_times.py`` does: at phi_b = 0.979 the
+seeded by the Type 2 answer, as ``tests/planners/generators/test_switching_times.py`` does: at phi_b = 0.979 the
 answer itself is Type 2. Then the switches read off the collocation's own instants (30
 intervals), without the refinement, against the refined ones of Type 3.
 """

@@ -1,5 +1,5 @@
 """The converged optima of Yamamoto's free path, by a transcription of its own: the references
-of ``tests/test_free_path.py`` and ``tests/test_sparse_collocation.py``.
+of ``tests/planners/generators/test_free_path.py`` and ``tests/planners/generators/test_sparse_collocation.py``.
 
     python benchmarks/yamamoto_reference.py [--intervals 200,400,800,1600]
 
@@ -16,7 +16,7 @@ midpoint, and with h = T / K
     x_mid = (x_k + x_k+1) / 2 + h (f_k - f_k+1) / 8,    x_k+1 - x_k = h (f_k + 4 f_mid + f_k+1) / 6;
 
 the torque tau = RNEA(q, v, a) (the robot's model, ``toptraj.planners.generators.collocation.symbolic_dynamics``,
-checked against Pinocchio in ``tests/test_sparse_collocation.py``) within its limits at every
+checked against Pinocchio in ``tests/planners/generators/test_sparse_collocation.py``) within its limits at every
 node and midpoint, and the cost integrated by Simpson's rule. Solved by IPOPT (CasADi) from the
 straight joint line under a quintic time law. Its error falls as h^4 where the solution is
 smooth (the torques switch, so less at the switches): successive halvings of the grid agree

@@ -18,7 +18,7 @@ R^T w), X_j^* moves a force back, (f; n) -> (R f; R n + p x R f), the cross prod
 (v; w) x (u; z) = (w x u + v x z; w x z) and (v; w) x* (f; n) = (w x f; w x n + v x f), and
 the spatial inertia of mass m, centre of mass c and rotational inertia I_c about it maps (v; w)
 to (h; I_c w + c x h) with h = m (v - c x w). Pinocchio's ``rnea`` computes the same sum,
-armature included; the two agree to rounding (``tests/test_chain_dynamics.py``).
+armature included; the two agree to rounding (``tests/robots/test_chain_dynamics.py``).
 
 Shapes: q (n, n_dof) in rad or m; qd, qdd, tau (n_sets, n, n_dof) in rad/s, rad/s^2 and N m
 (m/s, m/s^2 and N for a prismatic joint).

@@ -1,6 +1,6 @@
 """The request examples of ``examples/`` (kept in ``service/examples`` so that they ship with
 the package), as OpenAPI examples of the endpoints they are bodies of: each is answered by the
-tests (``tests/test_examples.py``), so every example in ``/docs`` works."""
+tests (``tests/service/test_examples.py``), so every example in ``/docs`` works."""
 
 from __future__ import annotations
 

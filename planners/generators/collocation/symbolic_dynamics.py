@@ -11,7 +11,7 @@ For joint i with parent p, placement M_i in its parent and motion subspace S_i (
     tau_i = S_i^T f_i,     f_p += X_i f_i (children first).
 
 Joints served: 1-DoF revolute (bounded or continuous, any axis) and prismatic joints, the joints
-of every arm the service loads; ``tests/test_sparse_collocation.py`` checks the expression
+of every arm the service loads; ``tests/planners/generators/test_sparse_collocation.py`` checks the expression
 against ``pinocchio.rnea`` at random states. Units: rad (m), rad/s, rad/s^2 in; N m (N) out.
 """
 

@@ -11,7 +11,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from tests.conftest import UR5_WAYPOINTS
-from tests.test_budget_stops_work import SLOW
+from tests.planners.execution.test_budget_stops_work import SLOW
 from toptraj.service.app import create_app
 from toptraj.service.settings import Settings
 

@@ -22,6 +22,7 @@ import psutil
 import pytest
 
 import toptraj.service.batches.work as batch_work
+from tests.paths import ROOT
 from toptraj.planners import Deadline
 from toptraj.service.batches import lines as lines_
 from toptraj.service.batches import run_batch, runner
@@ -30,7 +31,6 @@ from toptraj.service.batches.work import answer, answer_chunk
 from toptraj.service.cli import main
 from toptraj.service.jobs.work import WorkerSetup, _batch
 
-ROOT = Path(__file__).resolve().parents[1]
 GOOD = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.4, 0.3, -0.2, 0.1, 0.2, 0.3]]}}
 OTHER = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [-0.3, 0.2, 0.2, -0.1, 0.1, 0.2]]}}
 

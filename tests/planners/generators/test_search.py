@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 from fastapi.testclient import TestClient
 
-from tests.test_obstacles import _coal_capsule, _coal_distance, _coal_obstacle
+from tests.planners.collision.test_obstacles import _coal_capsule, _coal_distance, _coal_obstacle
 from toptraj import robots
 from toptraj.planners.collision import BoxObstacle, SphereObstacle
 from toptraj.planners.generators.search import branch_and_bound, build_problem, enumerate_grid_paths

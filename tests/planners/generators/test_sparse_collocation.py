@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.test_free_path import YAMAMOTO_MINIMUM_TIME
+from tests.planners.generators.test_free_path import YAMAMOTO_MINIMUM_TIME
 from toptraj import robots
 from toptraj.planners.generators.collocation import collocation
 from toptraj.planners.generators.collocation.sparse import solve_sparse

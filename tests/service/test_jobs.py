@@ -8,7 +8,6 @@ import json
 import os
 import signal
 import time
-from pathlib import Path
 
 import psutil
 import pytest
@@ -16,6 +15,7 @@ from fastapi.testclient import TestClient
 
 from tests.conftest import UR5_WAYPOINTS
 from tests.live_server import LiveServer
+from tests.paths import DATA, ROOT
 from toptraj.planners import BudgetExceeded, Deadline
 from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.execution.isolated import run_isolated
@@ -23,8 +23,7 @@ from toptraj.service.app import create_app
 from toptraj.service.jobs.store import JobStore
 from toptraj.service.settings import Settings
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-DATA = Path(__file__).resolve().parent / "data"
+EXAMPLES = ROOT / "examples"
 
 QUICK = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}}
 #: A free-path collocation of a six-joint arm on a fine grid: minutes of SLSQP in its worker

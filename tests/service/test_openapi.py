@@ -4,11 +4,12 @@ endpoint, the methods are enums, and every field says what it is."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pytest
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+from tests.paths import ROOT
+
+EXAMPLES = ROOT / "examples"
 
 
 @pytest.fixture(scope="module")

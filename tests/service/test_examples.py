@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pytest
 
-EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.json"))
+from tests.paths import ROOT
+
+EXAMPLES = sorted((ROOT / "examples").glob("*.json"))
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,7 @@ import psutil
 import pytest
 
 from tests.live_server import LiveServer
-from tests.test_upload_store import PLAN, app_client, arm
+from tests.service.test_upload_store import PLAN, app_client, arm
 from toptraj.robots.store import UploadStore
 from toptraj.service.cli import APP_FACTORY, main, plan_threads_per_process
 from toptraj.service.serving import LOOP, SWITCH_INTERVAL_S, BalancedEventLoop, new_event_loop, open_connections

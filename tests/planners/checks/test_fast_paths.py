@@ -6,12 +6,11 @@ state (friction included); more on the rows' interpolation between grid points i
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
+from tests.paths import DATA
 from toptraj import robots
 from toptraj.planners.checks.limit_check import _torques, check_limits, joint_motion
 from toptraj.planners.checks.limit_kernels import utilization_pass
@@ -42,7 +41,7 @@ def test_spline_evaluation_matches_scipy(count):
 
 
 def _friction_pendulum():
-    text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()
+    text = (DATA / "pendulum_1r.urdf").read_text()
     return robot_from_model("pendulum_1r", check_urdf(text), "upload", None)
 
 

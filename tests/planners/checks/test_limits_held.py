@@ -9,17 +9,15 @@ accelerations again as finite differences of the returned velocities.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from tests.conftest import UR5_WAYPOINTS
+from tests.paths import DATA
 from toptraj import robots
 from toptraj.planners import Timing, WaypointPath
 from toptraj.planners import plan as plan_library
 
-DATA = Path(__file__).parent / "data"
 KINDS = ("velocity", "acceleration", "torque")
 METHODS = ("phase_plane", "toppra", "min_cost", "quintic", "trapezoidal", "jerk_limited")
 

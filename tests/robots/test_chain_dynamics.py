@@ -3,17 +3,14 @@ Pinocchio's ``rnea``, one state at a time."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from tests.test_frame_jacobians import SKEWED
+from tests.paths import DATA
+from tests.planners.kinematics.test_frame_jacobians import SKEWED
 from toptraj import robots
 from toptraj.robots.catalog import robot_from_model
-
-DATA = Path(__file__).parent / "data"
 
 
 def _lopsided(model: pin.Model, seed: int) -> pin.Model:

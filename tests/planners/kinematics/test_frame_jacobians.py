@@ -3,18 +3,16 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pinocchio as pin
 import pytest
 
+from tests.paths import DATA
 from toptraj import robots
 from toptraj.planners.constraints.tool_speed import frame_twists
 from toptraj.planners.kinematics.frame_jacobians import frame_jacobians
 from toptraj.robots.catalog import robot_from_model
 
-DATA = Path(__file__).parent / "data"
 LINK = '<link name="{name}"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
 #: Joint origins turned by rpy and axes along no coordinate axis: Pinocchio makes them its
 #: unaligned revolute and prismatic joints, and a continuous joint its unbounded form.

@@ -6,11 +6,10 @@ refinement adds, which are the RNEA's own."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.paths import DATA
 from toptraj import robots
 from toptraj.planners.checks.limit_check import _torques, joint_motion
 from toptraj.planners.constraints.path_constraints import build_path_constraints
@@ -94,7 +93,7 @@ def test_with_coulomb_friction_the_states_between_grid_points_get_rnea(monkeypat
     """Coulomb friction sits in c with its sign at each grid point: on the friction pendulum
     every state off the grid (or at rest) goes to RNEA, and every torque is RNEA's (with the
     URDF's friction) to rounding, on a grid fine enough to be interpolated without it."""
-    text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()
+    text = (DATA / "pendulum_1r.urdf").read_text()
     pendulum = robot_from_model("pendulum_1r", check_urdf(text), "upload", None)
     assert np.any(pendulum.coulomb_friction)
     path = SplinePath(np.array([[-0.5], [0.4], [1.0]]))
@@ -153,7 +152,7 @@ def test_refinement_rows_are_the_rows_of_a_build_on_the_refined_grid(case, monke
     import toptraj.planners.constraints.path_constraints as constraints_module
 
     if case == "pendulum_coulomb":
-        text = (Path(__file__).parent / "data" / "pendulum_1r.urdf").read_text()
+        text = (DATA / "pendulum_1r.urdf").read_text()
         robot = robot_from_model("pendulum_1r", check_urdf(text), "upload", None)
         assert np.any(robot.coulomb_friction)
         path = SplinePath(np.array([[-0.5], [0.4], [1.0]]))

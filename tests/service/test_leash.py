@@ -9,18 +9,18 @@ import asyncio
 import json
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.paths import ROOT
 from toptraj.planners.errors import BudgetExceeded
 from toptraj.planners.execution.deadline import Deadline, Leash, LeashSlipped
 from toptraj.service.planning import plan_request, worth_a_leash
 from toptraj.service.schemas.trajectories import TrajectoryRequest
 from toptraj.service.workers import PlanningWorkers
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = ROOT / "examples"
 
 
 def _run(pool: PlanningWorkers, function, budget_s: float = 60.0, leashed: bool = True):

@@ -10,7 +10,7 @@ import numpy as np
 import orjson
 import pytest
 
-from tests.test_upload_store import PLAN, arm
+from tests.service.test_upload_store import PLAN, arm
 from toptraj import robots
 from toptraj.service.batches import run_batch
 from toptraj.service.batches.lines import request_key, resume_output

@@ -8,14 +8,12 @@ import json
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from tests.conftest import UR5_WAYPOINTS
+from tests.paths import ROOT
 from toptraj.service.cli import main
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_plan_prints_the_response(tmp_path, capsys):

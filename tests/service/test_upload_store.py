@@ -17,13 +17,14 @@ import httpx
 import pytest
 from fastapi.testclient import TestClient
 
+from tests.paths import ROOT
 from toptraj import robots
 from toptraj.robots.store import UploadStore
 from toptraj.robots.uploads import cached_upload_count
 from toptraj.service.app import create_app
 from toptraj.service.settings import Settings
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = ROOT
 
 
 def arm(effort: float = 5.0, mass: float = 1.0) -> str:

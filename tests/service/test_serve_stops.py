@@ -18,8 +18,9 @@ import uuid
 import psutil
 import pytest
 
-from tests.live_server import ROOT, _free_port
-from tests.test_jobs import SLOW
+from tests.live_server import _free_port
+from tests.paths import ROOT
+from tests.service.test_jobs import SLOW
 from toptraj.service.jobs.store import JobStore
 from toptraj.service.stopping import descendants
 

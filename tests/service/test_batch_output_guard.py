@@ -9,10 +9,10 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
+from tests.paths import ROOT
 from toptraj.service.batches.lines import ForeignOutput, resume_output
 
 REQUEST = json.dumps({"robot": "geering_2r", "path": {"kind": "waypoints", "waypoints": [[0.0, 0.0], [0.5, 0.3]]}})
@@ -44,7 +44,7 @@ def test_the_request_file_as_output_is_refused_and_kept(tmp_path):
     requests.write_text(REQUEST + "\n")
     done = subprocess.run(
         [sys.executable, "-m", "toptraj.service.cli", "batch", str(requests), "-o", str(requests)],
-        capture_output=True, text=True, timeout=60, cwd=Path(__file__).parent.parent,
+        capture_output=True, text=True, timeout=60, cwd=ROOT,
     )
     assert done.returncode == 2, done.stderr
     problem = json.loads(done.stderr.strip().splitlines()[-1])

@@ -14,7 +14,7 @@ import psutil
 import pytest
 
 from tests.live_server import LiveServer
-from tests.test_search_budget import UR5_BOX, UR5_GOAL, UR5_START
+from tests.planners.generators.test_search_budget import UR5_BOX, UR5_GOAL, UR5_START
 from toptraj.service.app import create_app
 from toptraj.service.planning import heavy, heavy_request
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
