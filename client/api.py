@@ -39,6 +39,13 @@ def _text(value: str | os.PathLike[str]) -> str:
     return Path(value).read_text() if isinstance(value, os.PathLike) else value
 
 
+def _alone(body: dict, **arguments: Any) -> None:
+    """Refuse the arguments that would be lost beside a whole request ``body``."""
+    given = [name for name, value in arguments.items() if value is not None]
+    if given:
+        raise ValueError(f"a whole request is sent as it is: put {', '.join(given)} into it instead of passing them")
+
+
 class Client(JobCalls):
     """The toptraj service at ``base_url``.
 
@@ -176,6 +183,8 @@ class Client(JobCalls):
                 ``limit`` say where a limit cannot be met); 503 busy; 504 over the budget.
         """
         if isinstance(robot, dict):
+            _alone(robot, waypoints=waypoints, path=path, method=method, constraints=constraints, limits=limits,
+                   duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period)
             body = robot
         else:
             body = trajectory_request(
@@ -214,6 +223,7 @@ class Client(JobCalls):
             its ``error`` (not raised).
         """
         if isinstance(robot, dict):
+            _alone(robot, waypoints=waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing)
             body = robot
         else:
             if not methods:

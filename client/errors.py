@@ -46,6 +46,9 @@ class ProblemError(Exception):
         self.retry_after = retry_after
         super().__init__(f"{self.status} {self.title}: {self.detail}")
 
+    def __reduce__(self) -> tuple:
+        return (ProblemError, (self.problem, self.retry_after))
+
     @classmethod
     def from_response(cls, response: httpx.Response) -> ProblemError:
         """The problem an error ``response`` carries; a body that is not a problem (a proxy's

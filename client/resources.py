@@ -31,7 +31,7 @@ def _limit(values: list, unlimited: float) -> np.ndarray:
     return np.array([unlimited if v is None else v for v in values], dtype=float)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Limits:
     """A robot's per-joint limits, shape (n_dof,) each, SI units; ``inf`` where a joint has no
     such limit (``-inf`` for a missing lower position limit, e.g. a continuous joint).
@@ -107,7 +107,7 @@ class Robot:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Skeleton:
     """The arm as a stick figure: ``positions[k, i]`` is the world position (m) of point
     ``points[i]`` (the joints' origins, then the end effector) in configuration k; shape

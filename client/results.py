@@ -28,7 +28,7 @@ def _optional(kind: Any, value: dict | None) -> Any:
     return None if value is None else kind.from_body(value)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Utilization:
     """Peak |value| / limit per joint on a dense resampling of the answer (1.0: the limit binds;
     the service holds every limit within 0.5 %).
@@ -72,7 +72,7 @@ class SwitchPoint:
     kind: str
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PhasePlane:
     """The timing in the phase plane.
 
@@ -167,7 +167,7 @@ def joint_trajectory_arrays(message: dict) -> dict[str, np.ndarray]:
     return {"t": t, **{name: _rows([p[key] for p in points], n_dof) for name, key in fields.items()}}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Trajectory:
     """A planned trajectory (a JSON answer: ``output.format`` ``samples`` or
     ``joint_trajectory``).
@@ -265,7 +265,7 @@ class Trajectory:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CsvTrajectory:
     """A trajectory served as CSV (``output.format = "csv"``): the columns as arrays.
 
@@ -277,7 +277,7 @@ class CsvTrajectory:
         qdd: Joint accelerations (rad/s^2, m/s^2), shape (n, n_dof).
         tau: Joint torques (N m) or forces (N), shape (n, n_dof).
         comments: The text of the lines starting with ``#`` (without the ``#``), in order.
-        metadata: The comment lines of the form ``name: value`` or ``name = value``, by name.
+        metadata: The comment lines of the form ``name: value`` (or ``name = value``), by name.
         headers: The response's HTTP headers (lower-case names).
         text: The CSV as the service sent it.
     """
@@ -312,7 +312,7 @@ class CsvTrajectory:
         for comment in comments:
             for separator in (":", "="):
                 name, found, value = comment.partition(separator)
-                if found and name.strip() and " " not in name.strip():
+                if found and name.strip() and "," not in name:
                     metadata[name.strip()] = value.strip()
                     break
         return cls(joints, columns["t"], comments=comments, metadata=metadata, headers=dict(headers or {}), text=text, **arrays)

@@ -6,6 +6,7 @@ is checked against the service's own JSON, read apart from the client."""
 from __future__ import annotations
 
 import json
+import pickle
 import time
 from pathlib import Path
 
@@ -251,3 +252,45 @@ def test_a_batch_is_followed_and_read_request_by_request(toptraj, server):
     with pytest.raises(ProblemError) as caught:
         toptraj.submit_batch([QUICK, {"robot": "ur5"}])
     assert caught.value.status == 422 and any(e["field"].startswith("requests[1]") for e in caught.value.errors), caught.value.problem
+
+
+# --- without a server ---------------------------------------------------------------------------
+
+
+def test_a_problem_is_read_from_any_error_answer():
+    """A problem+json with a fact the client does not know yet, a 503's Retry-After, a proxy's
+    page that is no problem at all; the exception survives pickling (a worker process's)."""
+    busy = httpx.Response(
+        503,
+        headers={"retry-after": "2", "content-type": "application/problem+json"},
+        json={"type": "about:blank", "title": "Busy", "status": 503, "detail": "the queue is full", "queue": 8},
+    )
+    problem = ProblemError.from_response(busy)
+    assert (problem.status, problem.title, problem.retry_after, problem.extras) == (503, "Busy", 2.0, {"queue": 8})
+    assert problem.s is None and problem.joint is None and problem.errors == []
+    copy = pickle.loads(pickle.dumps(problem))
+    assert (copy.status, copy.detail, copy.retry_after, copy.extras) == (503, "the queue is full", 2.0, {"queue": 8})
+    page = ProblemError.from_response(httpx.Response(502, text="<html>Bad Gateway</html>"))
+    assert (page.status, page.title, page.detail) == (502, "Bad Gateway", "<html>Bad Gateway</html>")
+
+
+def test_arguments_beside_a_whole_request_are_refused():
+    with Client("http://127.0.0.1:9") as offline:
+        with pytest.raises(ValueError, match="dt"):
+            offline.plan(QUICK, dt=0.1)
+        with pytest.raises(ValueError, match="methods"):
+            offline.compare({**QUICK, "methods": ["quintic"]}, methods=["cubic"])
+        with pytest.raises(ValueError, match="waypoints"):
+            offline.plan("ur5")
+
+
+def test_csv_comments_and_columns_are_read():
+    text = "# method: phase_plane\n# duration = 0.5\n# a note\nt,q.a,q.b,qd.a,qd.b,qdd.a,qdd.b,tau.a,tau.b\n" + "\n".join(
+        ",".join(repr(k + 0.1 * c) for c in range(9)) for k in range(3)
+    ) + "\n"
+    table = CsvTrajectory.from_text(text, {"content-type": "text/csv"})
+    assert table.joint_names == ["a", "b"] and table.metadata == {"method": "phase_plane", "duration": "0.5"}
+    assert table.comments == ["method: phase_plane", "duration = 0.5", "a note"]
+    np.testing.assert_array_equal(table.t, [0.0, 1.0, 2.0])
+    np.testing.assert_array_equal(table.tau[:, 1], [0.8, 1.8, 2.8])
+    assert table.q.shape == table.qd.shape == table.qdd.shape == (3, 2)
