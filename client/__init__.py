@@ -5,7 +5,7 @@ reachable, without the planning libraries.
 
 Example:
     ```python
-    from client import Client, ProblemError
+    from toptraj.client import Client, ProblemError
 
     with Client("http://127.0.0.1:8000", timeout=60) as toptraj:
         waypoints = [[0, -1.2, 1, 0, 0, 0], [2, -1.3, 1.2, 0.2, 0.4, 1.2]]
@@ -25,12 +25,12 @@ Example:
     ```
 """
 
-from client.api import ENDPOINTS, Client
-from client.bodies import compare_request, trajectory_request
-from client.errors import ProblemError
-from client.jobs import Progress
-from client.resources import BatchItem, Job, JobPage, Limits, Robot, RobotSummary, Skeleton
-from client.results import (
+from toptraj.client.api import ENDPOINTS, Client
+from toptraj.client.bodies import compare_request, trajectory_request
+from toptraj.client.errors import ProblemError
+from toptraj.client.jobs import Progress
+from toptraj.client.resources import BatchItem, Job, JobPage, Limits, Robot, RobotSummary, Skeleton
+from toptraj.client.results import (
     Accuracy,
     Binding,
     Clearance,

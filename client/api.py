@@ -1,5 +1,5 @@
 """``Client``: the toptraj HTTP API as Python calls, over one keep-alive connection (httpx):
-the service, robots and trajectories here, jobs and batches from ``client.jobs.JobCalls``."""
+the service, robots and trajectories here, jobs and batches from ``toptraj.client.jobs.JobCalls``."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ from typing import Any
 
 import numpy as np
 
-from client.bodies import compare_request, trajectory_request
-from client.jobs import JobCalls
-from client.resources import Robot, RobotSummary, Skeleton
-from client.results import Comparison, CsvTrajectory, Trajectory, comparisons
+from toptraj.client.bodies import compare_request, trajectory_request
+from toptraj.client.jobs import JobCalls
+from toptraj.client.resources import Robot, RobotSummary, Skeleton
+from toptraj.client.results import Comparison, CsvTrajectory, Trajectory, comparisons
 
 #: Every operation of the service's OpenAPI, by method and path, and the ``Client`` method that
 #: calls it.

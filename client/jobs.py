@@ -7,10 +7,10 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from client.errors import ProblemError
-from client.resources import BatchItem, Job, JobPage, answer_of
-from client.results import Comparison, CsvTrajectory, Trajectory
-from client.transport import CSV, Transport
+from toptraj.client.errors import ProblemError
+from toptraj.client.resources import BatchItem, Job, JobPage, answer_of
+from toptraj.client.results import Comparison, CsvTrajectory, Trajectory
+from toptraj.client.transport import CSV, Transport
 
 #: ``progress(fraction, stage)``: called while a job is followed, each time its progress changes;
 #: ``fraction`` in [0, 1] never goes back, ``stage`` says what is under way.

@@ -10,8 +10,8 @@ from typing import Any, cast
 
 import numpy as np
 
-from client.errors import ProblemError
-from client.results import Comparison, Trajectory, comparisons
+from toptraj.client.errors import ProblemError
+from toptraj.client.results import Comparison, Trajectory, comparisons
 
 #: Job statuses after which nothing changes any more.
 ENDED = frozenset({"done", "failed", "cancelled", "interrupted"})

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from client.errors import ProblemError
+from toptraj.client.errors import ProblemError
 
 
 def _floats(values: Any) -> np.ndarray:

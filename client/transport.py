@@ -7,8 +7,8 @@ from typing import Any, Self
 
 import httpx
 
-from client.errors import ProblemError
-from client.results import CsvTrajectory
+from toptraj.client.errors import ProblemError
+from toptraj.client.results import CsvTrajectory
 
 CSV = "text/csv"
 

@@ -31,10 +31,10 @@ from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
-from planners.errors import BudgetExceeded
-from robots import ToptrajError
-from robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
-from service.schemas.common import Problem
+from toptraj.planners.errors import BudgetExceeded
+from toptraj.robots import ToptrajError
+from toptraj.robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
+from toptraj.service.schemas.common import Problem
 
 PROBLEM_JSON = "application/problem+json"
 logger = logging.getLogger("toptraj")
