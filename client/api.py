@@ -1,168 +1,232 @@
-"""``Client``: the toptraj HTTP API as Python calls (see the package docstring)."""
+"""``Client``: the toptraj HTTP API as Python calls, over one keep-alive connection (httpx):
+the service, robots and trajectories here, jobs and batches from ``toptraj.client.jobs.JobCalls``."""
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, field
+import os
+from pathlib import Path
 from typing import Any
 
-import httpx
 import numpy as np
 
+from toptraj.client.bodies import compare_request, trajectory_request
+from toptraj.client.jobs import JobCalls
+from toptraj.client.resources import Robot, RobotSummary, Skeleton
+from toptraj.client.results import Comparison, CsvTrajectory, Trajectory, comparisons
 
-class ProblemError(Exception):
-    """An answer that is not a success: the problem+json's ``status``, ``title`` and ``detail``
-    (and, for a path that cannot be followed, ``s``, ``joint`` and ``limit`` in ``problem``)."""
-
-    def __init__(self, problem: dict):
-        self.problem = problem
-        self.status = int(problem.get("status", 0))
-        self.title = str(problem.get("title", ""))
-        self.detail = str(problem.get("detail", ""))
-        super().__init__(f"{self.status} {self.title}: {self.detail}")
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """A planned trajectory: ``duration`` (s), samples ``t`` (n,) and ``q``, ``qd``, ``qdd``,
-    ``tau`` (n, n_dof) in SI units, the peak utilization of each limit per joint, the warnings,
-    and the whole answer as the service sent it (``body``)."""
-
-    robot: str
-    method: str
-    joint_names: list[str]
-    duration: float
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    tau: np.ndarray
-    peak_utilization: dict[str, Any]
-    warnings: list[str]
-    body: dict = field(repr=False)
-
-    @classmethod
-    def from_body(cls, body: dict) -> Trajectory:
-        samples = body["samples"]
-        return cls(
-            robot=body["robot"],
-            method=body["method"],
-            joint_names=list(body["joint_names"]),
-            duration=float(body["duration"]),
-            t=np.asarray(samples["t"], dtype=float),
-            q=np.asarray(samples["q"], dtype=float),
-            qd=np.asarray(samples["qd"], dtype=float),
-            qdd=np.asarray(samples["qdd"], dtype=float),
-            tau=np.asarray(samples["tau"], dtype=float),
-            peak_utilization=body["peak_utilization"],
-            warnings=list(body["warnings"]),
-            body=body,
-        )
+#: Every operation of the service's OpenAPI, by method and path, and the ``Client`` method that
+#: calls it.
+ENDPOINTS: dict[tuple[str, str], str] = {
+    ("GET", "/health"): "health",
+    ("GET", "/v1/robots"): "robots",
+    ("GET", "/v1/robots/{name}"): "robot",
+    ("POST", "/v1/robots"): "upload",
+    ("DELETE", "/v1/robots/{name}"): "delete_robot",
+    ("POST", "/v1/robots/{name}/skeleton"): "skeleton",
+    ("POST", "/v1/trajectories"): "plan",
+    ("POST", "/v1/trajectories/compare"): "compare",
+    ("POST", "/v1/jobs"): "submit",
+    ("GET", "/v1/jobs"): "jobs",
+    ("GET", "/v1/jobs/{job_id}"): "job",
+    ("GET", "/v1/jobs/{job_id}/result"): "job_result",
+    ("DELETE", "/v1/jobs/{job_id}"): "cancel_job",
+    ("POST", "/v1/batches"): "submit_batch",
+}
 
 
-@dataclass(frozen=True)
-class Comparison:
-    """One method's result of a compare: its duration (s) and solve time (ms), or its error."""
-
-    method: str
-    duration: float | None
-    solve_ms: float | None
-    error: dict | None
+def _text(value: str | os.PathLike[str]) -> str:
+    """A file's text for a path (``pathlib.Path``), the string itself otherwise."""
+    return Path(value).read_text() if isinstance(value, os.PathLike) else value
 
 
-class Client:
-    """The toptraj API at ``base_url`` (or through a given ``httpx.Client``, e.g. a test client)."""
+def _alone(body: dict, **arguments: Any) -> None:
+    """Refuse the arguments that would be lost beside a whole request ``body``."""
+    given = [name for name, value in arguments.items() if value is not None]
+    if given:
+        raise ValueError(f"a whole request is sent as it is: put {', '.join(given)} into it instead of passing them")
 
-    def __init__(self, base_url: str = "http://127.0.0.1:8000", timeout: float = 60.0, http: httpx.Client | None = None):
-        self._http = http or httpx.Client(base_url=base_url, timeout=timeout)
-        self._owned = http is None
 
-    def __enter__(self) -> Client:
-        return self
+class Client(JobCalls):
+    """The toptraj service at ``base_url``.
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    Every call goes over one ``httpx.Client`` whose connections are kept alive and reused;
+    close it with ``close()`` or use the client as a context manager. An answer that is not a
+    success raises ``ProblemError``; a connection that fails or a read that times out raises
+    httpx's ``TransportError`` (``httpx.TimeoutException`` among them).
 
-    def close(self) -> None:
-        if self._owned:
-            self._http.close()
+    Args:
+        base_url: Where the service listens, e.g. ``"http://127.0.0.1:8000"``.
+        timeout: Seconds to wait for an answer (reading, writing, a free connection of the
+            pool); a synchronous plan may take up to the server's budget (20 s by default).
+            An ``httpx.Timeout`` sets each phase.
+        connect_timeout: Seconds to wait for a connection to the service.
+        headers: Headers sent with every request (e.g. an ``Authorization`` of a proxy).
+        http: An ``httpx.Client`` to use instead (e.g. FastAPI's ``TestClient``); it is not
+            closed by ``close()``.
+    """
 
-    def _call(self, method: str, path: str, body: dict | None = None) -> Any:
-        response = self._http.request(method, path, json=body)
-        if response.status_code >= 400:
-            try:
-                problem = response.json()
-            except ValueError:
-                problem = {"status": response.status_code, "title": response.reason_phrase, "detail": response.text[:500]}
-            raise ProblemError(problem)
-        return response.json() if response.content else None
+    # --- the service -----------------------------------------------------------------------
 
-    def robots(self) -> list[dict]:
-        """The catalog and the uploads: ``{name, dof, source}`` each."""
-        return self._call("GET", "/v1/robots")
+    def health(self) -> str:
+        """``GET /health``: ``"ok"`` while the service runs."""
+        return str(self._call("GET", "/health")["status"])
 
-    def robot(self, name: str) -> dict:
-        """One robot's joints, end effector and limits."""
-        return self._call("GET", f"/v1/robots/{name}")
+    def openapi(self) -> dict:
+        """``GET /openapi.json``: the service's OpenAPI document."""
+        return self._call("GET", "/openapi.json")
 
-    def upload(self, urdf: str, name: str | None = None) -> dict:
-        """Upload a URDF; returns the robot's description (its ``name`` among it)."""
-        return self._call("POST", "/v1/robots", {"urdf": urdf, **({"name": name} if name else {})})
+    # --- robots ----------------------------------------------------------------------------
 
-    @staticmethod
-    def _request(robot: str, path: dict | None, waypoints, timing: dict | None, **timing_fields) -> dict:
-        if (path is None) == (waypoints is None):
-            raise ValueError("give either path (a request's path object) or waypoints")
-        if path is None:
-            path = {"kind": "waypoints", "waypoints": np.asarray(waypoints, dtype=float).tolist()}
-        timing = {**(timing or {}), **{k: v for k, v in timing_fields.items() if v is not None}}
-        return {"robot": robot, "path": path, "timing": timing}
+    def robots(self) -> list[RobotSummary]:
+        """``GET /v1/robots``: the catalog and the uploads."""
+        return [RobotSummary(r["name"], int(r["dof"]), r["source"]) for r in self._call("GET", "/v1/robots")]
+
+    def robot(self, name: str) -> Robot:
+        """``GET /v1/robots/{name}``: one robot's joints, end effector and limits.
+
+        Raises:
+            ProblemError: 404 when no robot has that name.
+        """
+        return Robot.from_body(self._call("GET", f"/v1/robots/{name}"))
+
+    def upload(
+        self,
+        urdf: str | os.PathLike[str],
+        name: str | None = None,
+        *,
+        locked_joints: dict[str, float] | None = None,
+        joint_limits: str | os.PathLike[str] | dict | None = None,
+        timeout: float | None = None,
+    ) -> Robot:
+        """``POST /v1/robots``: check, build and store a fixed-base arm's URDF.
+
+        Args:
+            urdf: The URDF text, or a ``pathlib.Path`` to read it from.
+            name: The name to keep it under (default ``urdf-`` and a content hash).
+            locked_joints: Joints to fix at a value (rad, m), e.g. a gripper's fingers
+                ``{"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}``.
+            joint_limits: Limits in the form of MoveIt's ``joint_limits.yaml``: its text, a
+                ``pathlib.Path`` to it, or the same structure as a dict. Acceleration and jerk
+                limits are taken as given, velocity and effort limits only tighten the URDF's.
+            timeout: Seconds to wait for this answer instead of the client's.
+
+        Returns:
+            The robot; ``limit_sources`` and ``notes`` say what was applied.
+
+        Raises:
+            ProblemError: 422 naming the link, joint or limit at fault; 409 a name taken.
+        """
+        body: dict[str, Any] = {"urdf": _text(urdf)}
+        if name is not None:
+            body["name"] = name
+        if locked_joints is not None:
+            body["locked_joints"] = dict(locked_joints)
+        if joint_limits is not None:
+            body["joint_limits"] = joint_limits if isinstance(joint_limits, dict) else _text(joint_limits)
+        return Robot.from_body(self._call("POST", "/v1/robots", body, timeout=timeout))
+
+    def delete_robot(self, name: str) -> None:
+        """``DELETE /v1/robots/{name}``: remove an upload; planning for it answers 404 after.
+
+        Raises:
+            ProblemError: 404 when no upload has that name; 409 for a catalog robot.
+        """
+        self.request("DELETE", f"/v1/robots/{name}")
+
+    def skeleton(self, name: str, q: Any) -> Skeleton:
+        """``POST /v1/robots/{name}/skeleton``: the arm as a stick figure in configurations
+        ``q`` (rad, m; shape (n_configurations, n_dof), at most 1,000 rows)."""
+        rows = np.atleast_2d(np.asarray(q, dtype=float)).tolist()
+        body = self._call("POST", f"/v1/robots/{name}/skeleton", {"q": rows})
+        return Skeleton(list(body["points"]), np.asarray(body["positions"], dtype=float).reshape(len(rows), -1, 3))
+
+    # --- trajectories ----------------------------------------------------------------------
 
     def plan(
         self,
-        robot: str,
-        waypoints=None,
+        robot: str | dict,
+        waypoints: Any = None,
         *,
         path: dict | None = None,
         method: str | None = None,
         constraints: list[str] | None = None,
+        limits: dict | None = None,
+        duration: float | None = None,
         timing: dict | None = None,
-        dt: float = 0.01,
-    ) -> Trajectory:
-        """``POST /v1/trajectories``: time the path (``waypoints``, or a whole ``path`` object)
-        under ``constraints`` with ``method`` (the service's defaults otherwise)."""
-        body = self._request(robot, path, waypoints, timing, method=method, constraints=constraints)
-        body["output"] = {"dt": dt}
-        return Trajectory.from_body(self._call("POST", "/v1/trajectories", body))
+        dt: float | None = None,
+        format: str | None = None,
+        exact_period: bool | None = None,
+        timeout: float | None = None,
+    ) -> Trajectory | CsvTrajectory:
+        """``POST /v1/trajectories``: time a path.
+
+        Args:
+            robot: A robot's name, or a whole request body (a dict, e.g. an example file's
+                JSON), sent as it is; the other arguments then must be left out.
+            waypoints: Joint configurations (rad, m), shape (n_waypoints, n_dof).
+            path: A whole ``path`` object instead (cartesian, free, obstacles, ...).
+            method: ``timing.method``, e.g. ``"phase_plane"`` or ``"quintic"``.
+            constraints: ``timing.constraints``.
+            limits: ``timing.limits`` (overrides, scale factors, tool speeds).
+            duration: ``timing.duration`` (s), for the classical time laws.
+            timing: Other ``timing`` fields (``boundary``, ``cost``, ``grid_points``, ...).
+            dt: ``output.dt``, the sample period (s).
+            format: ``output.format``: ``samples`` (default), ``joint_trajectory`` or ``csv``.
+            exact_period: ``output.exact_period``: samples on whole periods of ``dt``.
+            timeout: Seconds to wait for this answer instead of the client's.
+
+        Returns:
+            A ``Trajectory`` for the JSON formats; a ``CsvTrajectory`` for ``csv``.
+
+        Raises:
+            ProblemError: 404 unknown robot; 422 malformed or impossible (``s``, ``joint`` and
+                ``limit`` say where a limit cannot be met); 503 busy; 504 over the budget.
+        """
+        if isinstance(robot, dict):
+            _alone(robot, waypoints=waypoints, path=path, method=method, constraints=constraints, limits=limits,
+                   duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period)
+            body = robot
+        else:
+            body = trajectory_request(
+                robot, waypoints, path=path, method=method, constraints=constraints, limits=limits,
+                duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period,
+            )
+        answer = self._answer(self.request("POST", "/v1/trajectories", body, timeout=timeout))
+        return answer if isinstance(answer, CsvTrajectory) else Trajectory.from_body(answer)
 
     def compare(
         self,
-        robot: str,
-        waypoints=None,
+        robot: str | dict,
+        waypoints: Any = None,
         *,
-        methods: list[str],
+        methods: list[str] | None = None,
         path: dict | None = None,
         constraints: list[str] | None = None,
+        limits: dict | None = None,
         timing: dict | None = None,
+        timeout: float | None = None,
     ) -> list[Comparison]:
-        """``POST /v1/trajectories/compare``: the same path under each of ``methods``."""
-        body = self._request(robot, path, waypoints, timing, constraints=constraints)
-        body["methods"] = list(methods)
-        results = self._call("POST", "/v1/trajectories/compare", body)["results"]
-        return [Comparison(r["method"], r.get("duration"), r.get("solve_ms"), r.get("error")) for r in results]
+        """``POST /v1/trajectories/compare``: the same path under each of ``methods``.
 
-    def plan_in_background(self, request: dict, budget_s: float | None = None, poll_s: float = 0.5, timeout_s: float = 3600.0) -> Trajectory:
-        """A long request (a free path) as a job: submitted, waited for, and returned."""
-        job = self._call("POST", "/v1/jobs", {"trajectory": request, **({"budget_s": budget_s} if budget_s else {})})
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            state = self._call("GET", f"/v1/jobs/{job['id']}")
-            if state["status"] == "done":
-                return Trajectory.from_body(state["result"])
-            if state["status"] == "failed":
-                raise ProblemError(state["error"])
-            if state["status"] in ("cancelled", "interrupted"):
-                raise ProblemError({"status": 409, "title": "Job ended", "detail": f"the job was {state['status']}"})
-            time.sleep(poll_s)
-        self._call("DELETE", f"/v1/jobs/{job['id']}")
-        raise TimeoutError(f"the job did not end within {timeout_s} s; it was cancelled")
+        Args:
+            robot: A robot's name, or a whole compare body (a dict) sent as it is.
+            waypoints: Joint configurations (rad, m), shape (n_waypoints, n_dof).
+            methods: Timing methods, e.g. ``["phase_plane", "toppra", "quintic"]``.
+            path: A whole ``path`` object instead of ``waypoints``.
+            constraints: ``timing.constraints`` shared by every method.
+            limits: ``timing.limits`` shared by every method.
+            timing: Other ``timing`` fields.
+            timeout: Seconds to wait for this answer instead of the client's.
+
+        Returns:
+            One ``Comparison`` per method, in the order asked; a method that failed carries
+            its ``error`` (not raised).
+        """
+        if isinstance(robot, dict):
+            _alone(robot, waypoints=waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing)
+            body = robot
+        else:
+            if not methods:
+                raise ValueError("give methods, e.g. ['phase_plane', 'quintic']")
+            body = compare_request(robot, waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing)
+        return comparisons(self._call("POST", "/v1/trajectories/compare", body, timeout=timeout))

@@ -1,0 +1,95 @@
+"""Request bodies of ``POST /v1/trajectories`` and ``POST /v1/trajectories/compare`` from Python
+values, for ``Client.plan``, ``Client.compare``, jobs and batches. The service checks them (a
+malformed one is a ``ProblemError`` with status 422 naming the field)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+OUTPUT_FORMATS = ("samples", "joint_trajectory", "csv")
+
+
+def _path(path: dict | None, waypoints: Any) -> dict:
+    if (path is None) == (waypoints is None):
+        raise ValueError("give either waypoints (joint configurations, one row each) or path (a request's path object)")
+    if path is not None:
+        return dict(path)
+    return {"kind": "waypoints", "waypoints": np.asarray(waypoints, dtype=float).tolist()}
+
+
+def _timing(timing: dict | None, fields: dict[str, Any]) -> dict:
+    return {**(timing or {}), **{key: value for key, value in fields.items() if value is not None}}
+
+
+def trajectory_request(
+    robot: str,
+    waypoints: Any = None,
+    *,
+    path: dict | None = None,
+    method: str | None = None,
+    constraints: list[str] | None = None,
+    limits: dict | None = None,
+    duration: float | None = None,
+    timing: dict | None = None,
+    dt: float | None = None,
+    format: str | None = None,
+    exact_period: bool | None = None,
+) -> dict:
+    """The body of ``POST /v1/trajectories``.
+
+    Args:
+        robot: A catalog or uploaded robot's name, e.g. ``"ur5"``.
+        waypoints: Joint configurations (rad, m), shape (n_waypoints, n_dof), joined by a C2
+            cubic spline; or give ``path``.
+        path: A whole ``path`` object instead: ``{"kind": "waypoints", ...}``,
+            ``{"kind": "cartesian", ...}`` or ``{"kind": "free", "start", "goal", ...}``.
+        method: ``timing.method`` (``phase_plane`` by default on the service).
+        constraints: ``timing.constraints``, e.g. ``["velocity", "acceleration", "torque"]``.
+        limits: ``timing.limits``: per-joint overrides, ``*_scale`` factors, tool speeds.
+        duration: ``timing.duration`` (s), for the classical time laws.
+        timing: Any other ``timing`` fields (``boundary``, ``cost``, ``grid_points``, ...); the
+            arguments above take precedence.
+        dt: ``output.dt``, the sample period (s); 0.01 on the service.
+        format: ``output.format``: ``samples``, ``joint_trajectory`` or ``csv``.
+        exact_period: ``output.exact_period``: samples on whole periods of ``dt``.
+
+    Returns:
+        The request as a JSON-ready dict.
+
+    Raises:
+        ValueError: Neither or both of ``waypoints`` and ``path``, or an unknown ``format``.
+    """
+    if format is not None and format not in OUTPUT_FORMATS:
+        raise ValueError(f"format {format!r} is not one of {', '.join(OUTPUT_FORMATS)}")
+    body: dict[str, Any] = {
+        "robot": robot,
+        "path": _path(path, waypoints),
+        "timing": _timing(timing, {"method": method, "constraints": constraints, "limits": limits, "duration": duration}),
+    }
+    output = {key: value for key, value in {"dt": dt, "format": format, "exact_period": exact_period}.items() if value is not None}
+    if output:
+        body["output"] = output
+    return body
+
+
+def compare_request(
+    robot: str,
+    waypoints: Any = None,
+    *,
+    methods: list[str],
+    path: dict | None = None,
+    constraints: list[str] | None = None,
+    limits: dict | None = None,
+    timing: dict | None = None,
+) -> dict:
+    """The body of ``POST /v1/trajectories/compare``: one path under each of ``methods`` (e.g.
+    ``["phase_plane", "quintic"]``), with the constraints and limits every method shares; the
+    other arguments are those of ``trajectory_request``."""
+    return {
+        "robot": robot,
+        "path": _path(path, waypoints),
+        "methods": list(methods),
+        "timing": _timing(timing, {"constraints": constraints, "limits": limits}),
+    }
