@@ -117,7 +117,7 @@ def catalog_robot_built(name: str) -> bool:
 def _build(name: str) -> Robot:
     """Build the catalog robot ``name`` from its URDF."""
     if name in BUNDLED:
-        urdf = resources.files("robots").joinpath(f"urdf/{name}.urdf").read_text()
+        urdf = resources.files("toptraj.robots").joinpath(f"urdf/{name}.urdf").read_text()
         return robot_from_model(name, pin.buildModelFromXML(urdf), "bundled", BUNDLED[name])
     arm = EXAMPLE_ARMS[name]
     model = pin.buildModelFromUrdf(example_urdf_path(arm.loader))

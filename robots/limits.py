@@ -132,7 +132,7 @@ class JointLimits:
 
 @cache
 def _limit_table() -> dict:
-    text = resources.files("robots").joinpath("data/limits.toml").read_text()
+    text = resources.files("toptraj.robots").joinpath("data/limits.toml").read_text()
     return tomllib.loads(text)
 
 

@@ -66,11 +66,11 @@ STATUS: dict[type[ToptrajError], int] = {
 
 def status_of(error: ToptrajError) -> int:
     """The HTTP status of ``error``: ``STATUS`` of its class or nearest base there; an error
-    class of the service itself (``service.*``: a busy queue, an unknown job) states its own."""
+    class of the service itself (``toptraj.service.*``: a busy queue, an unknown job) states its own."""
     for cls in type(error).__mro__:
         if cls in STATUS:
             return STATUS[cls]
-        if cls.__module__.partition(".")[0] == "service" and "status" in vars(cls):
+        if cls.__module__.startswith("toptraj.service.") and "status" in vars(cls):
             return vars(cls)["status"]
     return STATUS[ToptrajError]
 

@@ -6,7 +6,7 @@ from importlib import resources
 
 import pytest
 
-GEERING = resources.files("robots").joinpath("urdf/geering_2r.urdf").read_text()
+GEERING = resources.files("toptraj.robots").joinpath("urdf/geering_2r.urdf").read_text()
 
 MINIMAL = """<robot name="one">
   <link name="base"/>

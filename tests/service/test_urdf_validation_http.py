@@ -158,7 +158,7 @@ def test_physically_valid_limits_cases_upload():
 @pytest.mark.parametrize("name", [*BUNDLED, *EXAMPLE_ARMS])
 def test_every_catalog_urdf_passes_the_checks(name):
     if name in BUNDLED:
-        urdf = resources.files("robots").joinpath(f"urdf/{name}.urdf").read_text()
+        urdf = resources.files("toptraj.robots").joinpath(f"urdf/{name}.urdf").read_text()
     else:
         with open(example_urdf_path(EXAMPLE_ARMS[name].loader)) as handle:
             urdf = handle.read()
