@@ -162,3 +162,40 @@ def test_an_absent_site_is_a_404_that_says_how_to_build_it(tmp_path):
 def test_the_page_and_the_api_docs_link_to_the_guide(client):
     assert 'href="/guide/"' in client.get("/").text
     assert "/guide/" in client.get("/openapi.json").json()["info"]["description"]
+
+
+def test_the_guide_works_in_a_browser_with_no_other_host(site):
+    """Material's pages, styles, scripts and search in Debian's chromium against a real server,
+    every other host refused: nothing is fetched from elsewhere, and the search finds a method."""
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    if not chromium:
+        pytest.skip("no chromium: apt-get install chromium (make test does it)")
+    from playwright.sync_api import sync_playwright
+
+    from tests.live_server import LiveServer
+
+    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false", TOPTRAJ_GUIDE_DIR=str(site)) as server, sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=chromium, args=["--no-sandbox", "--disable-dev-shm-usage"])
+        page = browser.new_page(viewport={"width": 1300, "height": 900})
+        base = f"http://127.0.0.1:{server.port}"
+        outside: list[str] = []
+
+        def offline(route):
+            if route.request.url.startswith(base):
+                return route.continue_()
+            outside.append(route.request.url)
+            return route.abort()
+
+        page.route("**/*", offline)
+        page.goto(base + "/")
+        page.click("a[href='/guide/']")
+        page.wait_for_url(base + "/guide/")
+        # the theme's style sheet applied: its header bar is laid out at the top
+        assert page.locator("header.md-header").bounding_box()["height"] > 20
+        page.click("text=Methods")
+        page.wait_for_url(base + "/guide/methods/")
+        page.fill("input.md-search__input", "jerk_limited")
+        page.wait_for_selector(".md-search-result__item", timeout=15_000)
+        assert "jerk_limited" in page.inner_text(".md-search-result")
+        browser.close()
+        assert outside == []
