@@ -61,7 +61,7 @@ USER 10001:10001
 # The compiled kernels (numba) in the image: two server processes compiling them at start took
 # 88 s before /health answered; with the cache in the image, seconds. (-P: the installed
 # package, which the server imports, not /app: numba keys its cache by source file.)
-RUN python -P -c "from service.app import _warm_up; _warm_up()"
+RUN python -P -c "from toptraj.service.app import _warm_up; _warm_up()"
 
 EXPOSE 8000
 

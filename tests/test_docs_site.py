@@ -16,8 +16,8 @@ import pytest
 import yaml
 from fastapi.testclient import TestClient
 
-from service.app import create_app
-from service.settings import Settings
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -86,7 +86,7 @@ def test_every_page_is_built_with_its_content(site):
 def test_the_reference_comes_from_the_docstrings(site):
     html = (site / "reference" / "planners" / "index.html").read_text()
     # plan's own docstring and its signature, rendered by mkdocstrings
-    assert 'id="planners.plan.plan"' in html and 'id="planners.Timing"' in html
+    assert 'id="toptraj.planners.plan.plan"' in html and 'id="planners.Timing"' in html
     assert "Plan the timed trajectory of" in html
     robots_html = (site / "reference" / "robots" / "index.html").read_text()
     assert 'id="robots.Robot"' in robots_html and 'id="robots.load"' in robots_html
