@@ -86,12 +86,12 @@ def test_every_page_is_built_with_its_content(site):
 def test_the_reference_comes_from_the_docstrings(site):
     html = (site / "reference" / "planners" / "index.html").read_text()
     # plan's own docstring and its signature, rendered by mkdocstrings
-    assert 'id="toptraj.planners.plan.plan"' in html and 'id="planners.Timing"' in html
+    assert 'id="toptraj.planners.plan.plan"' in html and 'id="toptraj.planners.Timing"' in html
     assert "Plan the timed trajectory of" in html
     robots_html = (site / "reference" / "robots" / "index.html").read_text()
-    assert 'id="robots.Robot"' in robots_html and 'id="robots.load"' in robots_html
+    assert 'id="toptraj.robots.Robot"' in robots_html and 'id="toptraj.robots.load"' in robots_html
     client_html = (site / "client" / "index.html").read_text()
-    assert 'id="client.Client"' in client_html
+    assert 'id="toptraj.client.Client"' in client_html
 
 
 def test_no_page_loads_anything_from_another_host(site):
@@ -116,10 +116,10 @@ def test_a_broken_link_or_anchor_fails_the_build(tmp_path):
 
 def test_a_missing_reference_fails_the_build(tmp_path):
     config = _config_copy(tmp_path)
-    (tmp_path / "docs" / "client.md").write_text("# Python client\n\n::: client.NoSuchThing\n")
+    (tmp_path / "docs" / "client.md").write_text("# Python client\n\n::: toptraj.client.NoSuchThing\n")
     result = _build(config, tmp_path / "site")
     assert result.returncode != 0
-    assert "client.NoSuchThing" in result.stderr
+    assert "toptraj.client.NoSuchThing" in result.stderr
 
 
 def _guide_client(guide_dir: Path, tmp_path: Path) -> TestClient:
