@@ -47,9 +47,12 @@ WORKDIR /app
 COPY requirements.lock ./
 RUN pip install --require-hashes -r requirements.lock
 
-# The code (and tests/), then the package itself without touching the dependencies.
+# The code (and tests/), the documentation site served at /guide/ (built from docs/ into
+# service/web/guide, shipped with the package), then the package itself without touching the
+# dependencies.
 COPY . .
-RUN pip install --no-deps . \
+RUN NO_MKDOCS_2_WARNING=1 python -m mkdocs build --strict --quiet -d service/web/guide \
+    && pip install --no-deps . \
     && pip check \
     && rm -rf build ./*.egg-info
 

@@ -1,4 +1,5 @@
 # The two commands of the README: `make serve` and `make test`. Both set up .venv on first use.
+# `make guide` builds the documentation site (docs/, mkdocs.yml) that the service serves at /guide/.
 PYTHON ?= python3
 HOST ?= 127.0.0.1
 PORT ?= 8000
@@ -6,7 +7,10 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: serve test install browser lock clean
+.PHONY: serve test install guide browser lock clean
+
+GUIDE := service/web/guide
+GUIDE_SOURCES := mkdocs.yml $(shell find docs robots planners client -name '*.md' -o -name '*.py' -o -name '*.png' 2>/dev/null)
 
 # Exact versions with their hashes from requirements.lock (the runtime dependencies and the
 # test extra, resolved from the ranges in pyproject.toml), then the project itself on top;
@@ -26,9 +30,16 @@ lock: $(STAMP)
 	$(BIN)/uv pip compile pyproject.toml --extra test --python-version 3.11 \
 	  --python-platform x86_64-manylinux_2_28 --generate-hashes --quiet -o requirements.lock
 
-install: $(STAMP)
+install: $(STAMP) guide
 
-serve: $(STAMP)
+# The site, offline (no web fonts, no CDN), with the library's reference from its docstrings;
+# --strict: a broken link, anchor or reference fails the build.
+guide: $(GUIDE)/index.html
+
+$(GUIDE)/index.html: $(STAMP) $(GUIDE_SOURCES)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict --quiet -d $(GUIDE)
+
+serve: $(STAMP) guide
 	$(BIN)/toptraj serve --host $(HOST) --port $(PORT)
 
 # The web page's tests drive a real browser: Debian's chromium, installed with apt when missing
@@ -43,4 +54,4 @@ test: $(STAMP) browser
 	$(BIN)/python -m pytest
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build *.egg-info $(GUIDE)

@@ -18,7 +18,7 @@ from toptraj.service import stopping
 from toptraj.service.body_limit import BodySizeLimit
 from toptraj.service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from toptraj.service.jobs import JOB_MODULES, job_runner
-from toptraj.service.routes import batches, health, jobs, trajectories, web
+from toptraj.service.routes import batches, guide, health, jobs, trajectories, web
 from toptraj.service.routes import robots as robot_routes
 from toptraj.service.serving import open_connections
 from toptraj.service.settings import Settings
@@ -76,6 +76,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app = FastAPIOffline(
         title="toptraj",
         summary="Time-optimal trajectories with torques for URDF robot arms.",
+        description="The guide: [/guide/](/guide/) (concepts, methods, errors, jobs, the Python client). The web page: [/](/).",
         version="0.1.0",
         lifespan=lifespan,
         default_response_class=FiniteJSONResponse,
@@ -94,4 +95,5 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(jobs.router)
     app.include_router(batches.router)
     app.include_router(web.router)
+    app.include_router(guide.router)
     return app

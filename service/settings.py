@@ -11,6 +11,7 @@ from pydantic_settings import BaseSettings, SettingsConfigDict
 from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from toptraj.robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
 from toptraj.robots.uploads import DEFAULT_CACHE_SIZE
+from toptraj.service.web import GUIDE
 
 
 class Settings(BaseSettings):
@@ -60,6 +61,8 @@ class Settings(BaseSettings):
         ray_address: A Ray cluster for batches (``POST /v1/batches``): ``auto``,
             ``ray://host:port`` or ``local`` (a Ray started in the job's process); none: a batch
             runs in the server's own job worker process.
+        guide_dir: The built documentation site served at ``/guide/`` (``make guide`` builds it
+            into ``service/web/guide``).
     """
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")
@@ -87,3 +90,4 @@ class Settings(BaseSettings):
     max_job_store_bytes: int = Field(default=1_000_000_000, ge=1_000_000)
     telemetry: bool = False
     ray_address: str | None = None
+    guide_dir: Path = GUIDE

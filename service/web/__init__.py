@@ -5,3 +5,5 @@ service itself with Plotly's JavaScript from the installed ``plotly`` wheel: no 
 from pathlib import Path
 
 STATIC = Path(__file__).parent / "static"
+#: The documentation site built from docs/ (``make guide``; git-ignored), served at /guide/.
+GUIDE = Path(__file__).parent / "guide"
