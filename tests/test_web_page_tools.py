@@ -192,7 +192,7 @@ def _overlap(a: dict, b: dict) -> bool:
 @pytest.mark.parametrize("width", [390, 1400])
 def test_the_page_fits_its_screen(browser_page, width):
     """No horizontal overflow, the example list inside its card, the phase plane's `s` title
-    clear of its legend."""
+    clear of its legend and of its tick labels."""
     page, base, _, outside = browser_page
     narrow = offline_page(page.context.browser, base, outside, viewport={"width": width, "height": 844})
     try:
@@ -202,6 +202,8 @@ def test_the_page_fits_its_screen(browser_page, width):
         assert card["x"] <= select["x"] and select["x"] + select["width"] <= card["x"] + card["width"]
         title, legend = narrow.locator("#phase-plane .g-xtitle").bounding_box(), narrow.locator("#phase-plane .legend").bounding_box()
         assert title and legend and not _overlap(title, legend)
+        ticks = narrow.locator("#phase-plane .xtick text")
+        assert ticks.count() >= 3 and not any(_overlap(title, ticks.nth(k).bounding_box()) for k in range(ticks.count()))
         assert outside == []
     finally:
         narrow.close()

@@ -113,6 +113,8 @@ async function init() {
   applyPreset(Object.keys(PRESETS)[0]);
   $("plan").addEventListener("click", plan);
   $("cancel").addEventListener("click", cancel);
+  // a link pasted over this page's own (the page only ever replaces its fragment itself)
+  window.addEventListener("hashchange", () => location.reload());
   let shared = null;
   try {
     shared = await requestInURL();

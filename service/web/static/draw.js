@@ -32,7 +32,7 @@ function drawPhasePlane(answer) {
   const yaxis = {title: {text: "ṡ (1/s)"}, rangemode: "tozero"};
   if (Math.max(...plane.sd_max.filter((v) => v != null)) > 2 * top) yaxis.range = [0, 1.6 * top];
   const margin = {...LAYOUT.margin, b: legendMargin(traces.length, $("phase-plane").clientWidth)};
-  Plotly.newPlot("phase-plane", traces, {...LAYOUT, margin, title: {text: "Phase plane"}, xaxis: {title: {text: "s"}}, yaxis}, {responsive: true});
+  Plotly.newPlot("phase-plane", traces, {...LAYOUT, margin, title: {text: "Phase plane"}, xaxis: {title: {text: "s", standoff: 4}, automargin: true}, yaxis}, {responsive: true});
 }
 
 function interpolate(xs, ys, x) {
@@ -90,7 +90,7 @@ function drawJoints(answer, limits) {
       }
     });
     layout[`yaxis${axis}`] = {title: {text: row.label}};
-    layout[`xaxis${axis}`] = {title: {text: index === rows.length - 1 ? "t (s)" : ""}};
+    layout[`xaxis${axis}`] = {title: {text: index === rows.length - 1 ? "t (s)" : "", standoff: 4}, automargin: true};
   });
   $("joints").style.minHeight = `${height}px`;
   Plotly.newPlot("joints", traces, layout, {responsive: true});
@@ -118,9 +118,10 @@ async function drawArm(answer, path) {
     return {...trace, type: "scatter3d", x: points.map((p) => p[0]), y: points.map((p) => p[1]), z: points.map((p) => p[2])};
   });
   if (plane && plane[0] === 0 && plane[1] === 1) traces.unshift(...obstacleTraces(answer, path));
-  const layout = {...LAYOUT, title: {text: "The arm, stroboscopically (light: start, dark: end)"}};
-  if (plane) Object.assign(layout, {xaxis: {title: {text: names[plane[0]]}}, yaxis: {title: {text: names[plane[1]]}, scaleanchor: "x"}});
-  else layout.scene = {aspectmode: "data", camera: {eye: {x: 1.8, y: 1.8, z: 1.2}}, xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}}, zaxis: {title: {text: "z (m)"}}};
+  const shown = traces.filter((trace) => trace.showlegend !== false).length;
+  const layout = {...LAYOUT, title: {text: "The arm, stroboscopically (light: start, dark: end)"}, margin: {...LAYOUT.margin, b: legendMargin(shown, $("arm").clientWidth)}};
+  if (plane) Object.assign(layout, {xaxis: {title: {text: names[plane[0]], standoff: 4}, automargin: true}, yaxis: {title: {text: names[plane[1]]}, scaleanchor: "x"}});
+  else layout.scene = {aspectmode: "data", camera: {eye: {x: 1.6, y: 1.6, z: 1.1}}, xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}}, zaxis: {title: {text: "z (m)"}}};
   Plotly.newPlot("arm", traces, layout, {responsive: true});
 }
 
