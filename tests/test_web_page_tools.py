@@ -119,7 +119,7 @@ def test_the_peak_utilization_table_marks_each_joints_binding_limit(browser_page
         assert values == [answer["peak_utilization"][kind][joint] for kind in kinds]
         marked = [kind for kind in kinds if "binding" in (row.locator(f"td[data-kind={kind}]").get_attribute("class") or "")]
         assert marked == [kinds[values.index(max(values))]]
-    caption = page.inner_text("#utilization caption")
+    caption = page.inner_text("#utilization-note")
     assert "0.5 %" in caption and "1.0000019" in caption and "dense resampling" in caption
 
 
@@ -160,7 +160,7 @@ def test_the_page_downloads_as_one_html_file_that_opens_offline(browser_page, tm
         for plot, traces in shown.items():
             copy.wait_for_function(f"() => document.getElementById('{plot}').data && document.getElementById('{plot}').querySelector('.main-svg')", timeout=30_000)
             assert copy.evaluate(f"() => document.getElementById('{plot}').data.length") == traces
-        assert copy.inner_text("#duration") == page.inner_text("#duration")
+        assert copy.inner_text("#duration") == page.inner_text("#duration") and copy.title().endswith(page.inner_text("#duration"))
         assert copy.locator("#utilization tbody tr").count() == 6 and copy.locator("#durations tbody tr").count() == 3
         assert refused == []  # nothing from elsewhere
     finally:

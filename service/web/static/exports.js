@@ -8,9 +8,11 @@ const KINDS = ["velocity", "acceleration", "jerk", "torque"];
 const TOLERANCE = 0.005;
 
 function showUtilization(answer, constraints) {
-  // one row per joint, a column per limit kind the answer reports; in each row the largest
-  // utilization (the limit that binds that joint) is marked
-  const kinds = KINDS.filter((kind) => answer.peak_utilization[kind]);
+  // one row per joint, a column per limit kind the answer reports (a kind left out of the
+  // constraints only where some joint uses its limit: an infinite limit reads 0); in each row the
+  // largest utilization (the limit that binds that joint) is marked
+  const used = (kind) => constraints.includes(kind) || answer.peak_utilization[kind].some((value) => value > 0);
+  const kinds = KINDS.filter((kind) => answer.peak_utilization[kind] && used(kind));
   const head = $("utilization").querySelector("thead tr");
   head.replaceChildren(...["joint", ...kinds].map((kind) => {
     const cell = document.createElement("th");
@@ -85,7 +87,8 @@ async function pageHTML() {
   const data = JSON.stringify(plots).replace(/</g, "\\u003c");
   const draw = `const plots = ${data};\nfor (const [id, plot] of Object.entries(plots)) Plotly.newPlot(id, plot.data, plot.layout, {responsive: true});`;
   const escape = (text) => text.replace(/<\/script/gi, "<\\/script");
-  return `<!doctype html>\n<html lang="en"><head><meta charset="utf-8"><title>${document.title}: ${$("duration").textContent}</title>`
+  const title = `${document.title}: ${$("duration").textContent}`.replace(/&/g, "&amp;").replace(/</g, "&lt;");
+  return `<!doctype html>\n<html lang="en"><head><meta charset="utf-8"><title>${title}</title>`
     + `<meta name="viewport" content="width=device-width, initial-scale=1"><style>${style}</style><script>${escape(plotly)}</script></head>`
     + `<body><main class="saved">${results.outerHTML}</main><script>${escape(draw)}</script></body></html>`;
 }
