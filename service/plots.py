@@ -42,14 +42,15 @@ def phase_plane_figure(result: PlannedTrajectory) -> go.Figure:
 def _joint_rows(result: PlannedTrajectory, limits) -> list[tuple[str, np.ndarray, np.ndarray, str, np.ndarray, np.ndarray]]:
     """Each plotted quantity: its kind, times (s, shape (n,)), values (shape (n, n_dof)), axis
     label, and each joint's lower and upper limit (shape (n_dof,); not finite: none). The jerk,
-    for timings with a finite one, is the difference of consecutive accelerations over their
+    for timings with a finite one measured against a finite limit, is the difference of consecutive accelerations over their
     interval, at its midpoint."""
     samples = result.samples
     t = np.asarray(samples.t)
     rows = [("position", t, samples.q, "q (rad)", limits.position_lower, limits.position_upper),
             ("velocity", t, samples.qd, "q̇ (rad/s)", -limits.velocity, limits.velocity),
             ("acceleration", t, samples.qdd, "q̈ (rad/s²)", -limits.acceleration, limits.acceleration)]
-    if result.peak_utilization.get("jerk") is not None and len(t) > 1:
+    jerk_utilization = result.peak_utilization.get("jerk")
+    if jerk_utilization is not None and np.any(np.asarray(jerk_utilization) > 0) and len(t) > 1:
         step = np.diff(t)
         keep = step > 0
         jerk = np.diff(samples.qdd, axis=0)[keep] / step[keep, None]

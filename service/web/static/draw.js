@@ -63,7 +63,8 @@ function jointRows(answer, limits) {
     {kind: "velocity", t: samples.t, values: samples.qd, label: "q̇ (rad/s)", bounds: symmetric(limits.velocity)},
     {kind: "acceleration", t: samples.t, values: samples.qdd, label: "q̈ (rad/s²)", bounds: symmetric(limits.acceleration)},
   ];
-  if (answer.peak_utilization.jerk) {
+  // the jerk where the answer reports it against a finite limit (an infinite one reads 0)
+  if (answer.peak_utilization.jerk && answer.peak_utilization.jerk.some((value) => value > 0)) {
     const jerk = jerkSamples(samples);
     rows.push({kind: "jerk", t: jerk.t, values: jerk.values, label: "jerk (rad/s³)", bounds: symmetric(limits.jerk)});
   }
