@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import io
 import shutil
 
 from tests.live_server import LiveServer
@@ -44,3 +45,20 @@ def serve_page():
         page = offline_page(browser, base, outside, viewport={"width": 1400, "height": 1300}, accept_downloads=True)
         yield page, base, server, outside
         browser.close()
+
+
+def drawn_to_the_edge(png: bytes, box: dict) -> dict[str, int]:
+    """Pixels of each edge of ``box`` (the 3-D scene's viewport) that are not the page's white:
+    a picture that reaches its viewport's edge is cut there."""
+    from PIL import Image
+
+    image = Image.open(io.BytesIO(png)).convert("RGB")
+    x, y, w, h = (round(box[key]) for key in ("x", "y", "width", "height"))
+    pixels = image.crop((x, y, x + w, y + h)).load()
+    edges = {
+        "top": [pixels[i, 1] for i in range(w)],
+        "bottom": [pixels[i, h - 2] for i in range(w)],
+        "left": [pixels[1, j] for j in range(h)],
+        "right": [pixels[w - 2, j] for j in range(h)],
+    }
+    return {edge: sum(min(colour) < 235 for colour in colours) for edge, colours in edges.items()}

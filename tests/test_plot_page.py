@@ -4,13 +4,12 @@ joint's plots carry all of its limits."""
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import pytest
 
 from service.cli import main
-from tests.browser_page import launch, offline_page
+from tests.browser_page import drawn_to_the_edge, launch, offline_page
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -34,23 +33,6 @@ def plot_page(tmp_path_factory):
         browser.close()
 
 
-def _drawn_to_the_edge(png: bytes, box: dict) -> dict[str, int]:
-    """Pixels of each edge of ``box`` (the 3-D scene's viewport) that are not the page's white:
-    a picture that reaches its viewport's edge is cut there."""
-    from PIL import Image
-
-    image = Image.open(io.BytesIO(png)).convert("RGB")
-    x, y, w, h = (round(box[key]) for key in ("x", "y", "width", "height"))
-    pixels = image.crop((x, y, x + w, y + h)).load()
-    edges = {
-        "top": [pixels[i, 1] for i in range(w)],
-        "bottom": [pixels[i, h - 2] for i in range(w)],
-        "left": [pixels[1, j] for j in range(h)],
-        "right": [pixels[w - 2, j] for j in range(h)],
-    }
-    return {edge: sum(min(colour) < 235 for colour in colours) for edge, colours in edges.items()}
-
-
 def test_the_plot_page_draws_the_whole_arm(plot_page):
     """The ur5's scene (the arm at 12 instants, its axes and box) lies within its viewport: a
     scene stretched across the page's width was cut at its bottom."""
@@ -59,7 +41,7 @@ def test_the_plot_page_draws_the_whole_arm(plot_page):
     assert arm.evaluate("(d) => d.data.filter((t) => t.type === 'scatter3d').length") == 12
     scene = arm.locator("#scene").bounding_box()
     box = {**scene, "y": scene["y"] + page.evaluate("() => scrollY")}
-    assert _drawn_to_the_edge(page.screenshot(full_page=True), box) == {"top": 0, "bottom": 0, "left": 0, "right": 0}
+    assert drawn_to_the_edge(page.screenshot(full_page=True), box) == {"top": 0, "bottom": 0, "left": 0, "right": 0}
     assert refused == []
 
 

@@ -13,7 +13,7 @@ import zlib
 
 import pytest
 
-from tests.browser_page import offline_page, serve_page
+from tests.browser_page import drawn_to_the_edge, offline_page, serve_page
 
 browser_page = pytest.fixture(scope="module")(serve_page)
 
@@ -183,6 +183,16 @@ def test_a_running_job_can_be_cancelled(browser_page):
     assert not page.is_visible("#error") and not page.is_visible("#cancel") and page.is_enabled("#plan")
     status, _, raw = server.request("GET", f"/v1/jobs/{page.get_attribute('body', 'data-job')}")
     assert status == 200 and json.loads(raw)["status"] == "cancelled"
+
+
+def test_the_arm_is_drawn_whole(browser_page):
+    """The ur5's 3-D scene (the arm at 12 instants, its axes and box) lies within its viewport."""
+    page, base, _, _ = browser_page
+    _plan(page, base)
+    page.wait_for_timeout(1000)  # the WebGL scene's first frames
+    scene = page.locator("#arm #scene").bounding_box()
+    box = {**scene, "y": scene["y"] + page.evaluate("() => scrollY")}
+    assert drawn_to_the_edge(page.screenshot(full_page=True), box) == {"top": 0, "bottom": 0, "left": 0, "right": 0}
 
 
 def _overlap(a: dict, b: dict) -> bool:
