@@ -159,7 +159,11 @@ async function runJob(request) {
   try {
     for (;;) {
       await new Promise((resolve) => setTimeout(resolve, 400));
-      const state = await getJSON(`/v1/jobs/${job.id}`);
+      const state = await getJSON(`/v1/jobs/${job.id}`).catch((error) => {
+        // a job that ended as it was cancelled is deleted with its answer (DELETE of an ended job)
+        if (running.cancelling && error.problem && error.problem.status === 404) throw new Cancelled("Cancelled: the job ended as it was cancelled, and its answer was deleted.");
+        throw error;
+      });
       if (!running.cancelling) $("status").textContent = `job ${state.status}: ${Math.round(100 * state.progress.fraction)} % ${state.progress.stage}`;
       if (state.status === "done") return state.result;
       if (state.status === "failed") throw new Error(`${state.error.title} (${state.error.status}): ${state.error.detail}`);
