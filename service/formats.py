@@ -13,7 +13,7 @@
 
 Controllers consume points at a fixed period, so ``joint_trajectory`` and ``csv`` put the
 samples on whole periods by default (``output.exact_period``, see
-``planners.trajectory.sample_trajectory``).
+``toptraj.planners.trajectory.sample_trajectory``).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import io
 
 import numpy as np
 
-from planners import PlannedTrajectory
+from toptraj.planners import PlannedTrajectory
 
 FORMATS = ("samples", "joint_trajectory", "csv")
 CSV_MEDIA_TYPE = "text/csv; charset=utf-8"

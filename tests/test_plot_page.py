@@ -1,4 +1,4 @@
-"""The page ``toptraj plot`` writes (``service.plots``), opened in a real browser (Playwright driving
+"""The page ``toptraj plot`` writes (``toptraj.service.plots``), opened in a real browser (Playwright driving
 Debian's chromium, every other host refused): the arm's 3-D scene is drawn whole, and each
 joint's plots carry all of its limits."""
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from service.cli import main
+from toptraj.service.cli import main
 from tests.browser_page import drawn_to_the_edge, launch, offline_page
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,7 +48,7 @@ def test_the_plot_page_draws_the_whole_arm(plot_page):
 def test_the_plot_page_draws_every_limit_of_every_joint(plot_page):
     """Dashed lines at each joint's position range and at ± its velocity, acceleration and
     torque limits (the ur5's, from its URDF and limits.toml), whatever its utilization."""
-    import robots
+    from toptraj import robots
 
     page, _ = plot_page
     robot = robots.load("ur5")

@@ -8,7 +8,7 @@ from importlib import resources
 from fastapi import APIRouter, HTTPException
 from fastapi.responses import FileResponse, HTMLResponse
 
-from service.web import STATIC
+from toptraj.service.web import STATIC
 
 router = APIRouter(include_in_schema=False)
 
