@@ -5,38 +5,12 @@ renders its operations offline too."""
 from __future__ import annotations
 
 import json
-import shutil
 
 import pytest
 
-from tests.live_server import LiveServer
+from tests.browser_page import serve_page
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-
-
-@pytest.fixture(scope="module")
-def browser_page():
-    """A chromium page that can reach nothing but the service (every other host is refused)."""
-    from playwright.sync_api import sync_playwright
-
-    assert CHROMIUM, "a real browser is needed: apt-get install chromium (make test does it)"
-    # a job's default budget of 30 s: the page's search runs as a job, which then returns the best
-    # curve its local optimization reached in that time
-    with LiveServer(TOPTRAJ_PRELOAD_ROBOTS="false", TOPTRAJ_JOB_BUDGET_S="30") as server, sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
-        page = browser.new_page(viewport={"width": 1400, "height": 1300})
-        base = f"http://127.0.0.1:{server.port}"
-        outside: list[str] = []
-
-        def offline(route):
-            if route.request.url.startswith(base):
-                return route.continue_()
-            outside.append(route.request.url)
-            return route.abort()
-
-        page.route("**/*", offline)
-        yield page, base, server, outside
-        browser.close()
+browser_page = pytest.fixture(scope="module")(serve_page)
 
 
 def _plotted(page, element: str) -> int:

@@ -1,5 +1,6 @@
 // The toptraj page: builds a request from the form, plans it through the service's own HTTP API
-// (POST /v1/trajectories, /compare, or a job for free paths) and draws the answer with Plotly.
+// (POST /v1/trajectories, /compare, or a job for free paths, which can be cancelled) and shows
+// the answer (draw.js: the plots; exports.js: the utilization table, downloads, the URL).
 "use strict";
 
 const FALLBACK_METHODS = ["phase_plane", "toppra", "min_cost", "quintic", "cubic", "trapezoidal", "cycloidal", "ruckig", "collocation", "search"];
@@ -37,6 +38,10 @@ const PRESETS = {
 
 const $ = (id) => document.getElementById(id);
 const robotLimits = {};
+// the job being planned: its id, and whether the page asked to cancel it
+let running = null;
+
+class Cancelled extends Error {}
 
 async function getJSON(url, options) {
   const response = await fetch(url, options);
@@ -75,6 +80,7 @@ function checked(container) {
 
 function applyPreset(name) {
   const preset = PRESETS[name];
+  if (!preset) return;
   $("robot").value = preset.robot;
   $("path").value = formatPath(preset.path);
   const methods = [...$("methods").querySelectorAll("input")].map((box) => box.value);
@@ -106,7 +112,33 @@ async function init() {
   $("preset").addEventListener("change", () => applyPreset($("preset").value));
   applyPreset(Object.keys(PRESETS)[0]);
   $("plan").addEventListener("click", plan);
+  $("cancel").addEventListener("click", cancel);
+  // a link pasted over this page's own (the page only ever replaces its fragment itself)
+  window.addEventListener("hashchange", () => location.reload());
+  let shared = null;
+  try {
+    shared = await requestInURL();
+  } catch (error) {
+    showError(`The link's request was not opened: ${error.message}`);
+  }
+  if (shared) applyForm(shared);
   document.body.dataset.ready = "true";
+  // a shared waypoint or Cartesian path is planned at once; a free path (a job that may run for
+  // minutes) waits for Plan
+  if (shared && shared.path.kind !== "free") await plan();
+  else if (shared) $("status").textContent = "The link's request is in the form: press Plan to plan it.";
+}
+
+function applyForm(form) {
+  if (![...$("robot").options].some((option) => option.value === form.robot)) $("robot").append(new Option(form.robot, form.robot));
+  $("preset").prepend(new Option("(the link's request)", ""));
+  $("preset").value = "";
+  $("robot").value = form.robot;
+  $("path").value = formatPath(form.path);
+  const methods = [...$("methods").querySelectorAll("input")].map((box) => box.value);
+  checkboxes($("methods"), [...methods, ...form.methods.filter((name) => !methods.includes(name))], form.methods);
+  checkboxes($("constraints"), CONSTRAINTS, form.constraints);
+  $("dt").value = String(form.dt);
 }
 
 function showError(message) {
@@ -121,13 +153,43 @@ async function limitsOf(robot) {
 
 async function runJob(request) {
   const job = await postJSON("/v1/jobs", {trajectory: request});
-  for (;;) {
-    await new Promise((resolve) => setTimeout(resolve, 400));
-    const state = await getJSON(`/v1/jobs/${job.id}`);
-    $("status").textContent = `job ${state.status}: ${Math.round(100 * state.progress.fraction)} % ${state.progress.stage}`;
-    if (state.status === "done") return state.result;
-    if (state.status === "failed") throw new Error(`${state.error.title} (${state.error.status}): ${state.error.detail}`);
-    if (state.status === "cancelled" || state.status === "interrupted") throw new Error(`the job was ${state.status}`);
+  running = {id: job.id, cancelling: false, started: Date.now()};
+  document.body.dataset.job = job.id;
+  $("cancel").hidden = false;
+  try {
+    for (;;) {
+      await new Promise((resolve) => setTimeout(resolve, 400));
+      const state = await getJSON(`/v1/jobs/${job.id}`).catch((error) => {
+        // a job that ended as it was cancelled is deleted with its answer (DELETE of an ended job)
+        if (running.cancelling && error.problem && error.problem.status === 404) throw new Cancelled("Cancelled: the job ended as it was cancelled, and its answer was deleted.");
+        throw error;
+      });
+      if (!running.cancelling) $("status").textContent = `job ${state.status}: ${Math.round(100 * state.progress.fraction)} % ${state.progress.stage}`;
+      if (state.status === "done") return state.result;
+      if (state.status === "failed") throw new Error(`${state.error.title} (${state.error.status}): ${state.error.detail}`);
+      if (state.status === "cancelled") throw new Cancelled(`Cancelled: the job ran ${((Date.now() - running.started) / 1000).toFixed(1)} s and was stopped; nothing was planned.`);
+      if (state.status === "interrupted") throw new Error("the job was interrupted (the server stopped); plan again");
+    }
+  } finally {
+    running = null;
+    $("cancel").hidden = true;
+    $("cancel").disabled = false;
+  }
+}
+
+async function cancel() {
+  // DELETE /v1/jobs/{id}: a running job's worker is stopped; the polling loop then sees it
+  // cancelled
+  if (!running || running.cancelling) return;
+  running.cancelling = true;
+  $("cancel").disabled = true;
+  $("status").textContent = "cancelling the job…";
+  try {
+    await getJSON(`/v1/jobs/${running.id}`, {method: "DELETE"});
+  } catch (error) {
+    if (running) running.cancelling = false;
+    $("cancel").disabled = false;
+    showError(`The job could not be cancelled: ${error.message}`);
   }
 }
 
@@ -153,18 +215,19 @@ async function plan() {
   $("plan").disabled = true;
   $("status").textContent = "planning…";
   try {
+    $("link-note").textContent = await keepInURL({robot, path, methods, constraints: timing.constraints, dt: request.output.dt});
     const answer = path.kind === "free" ? await runJob(request) : await postJSON("/v1/trajectories", request);
     let compared = null;
     if (methods.length > 1) {
       const body = {robot, path, methods, timing: {constraints: timing.constraints}};
       compared = await postJSON("/v1/trajectories/compare", body);
     }
-    await show(answer, compared, await limitsOf(robot), path);
+    await show(answer, compared, await limitsOf(robot), path, timing.constraints);
     $("status").textContent = `planned in ${answer.solve_ms.toFixed(1)} ms`;
     document.body.dataset.planned = "true";
   } catch (error) {
-    $("status").textContent = "";
-    showError(error.message);
+    $("status").textContent = error instanceof Cancelled ? error.message : "";
+    if (!(error instanceof Cancelled)) showError(error.message);
   } finally {
     $("plan").disabled = false;
   }
@@ -188,111 +251,18 @@ function showDurations(compared) {
   table.hidden = false;
 }
 
-async function show(answer, compared, limits, path) {
+async function show(answer, compared, limits, path, constraints) {
   $("results").hidden = false;
   $("duration").textContent = `${answer.method}: ${answer.duration.toFixed(4)} s`;
   $("duration").dataset.duration = String(answer.duration);
   $("binding").textContent = answer.binding ? `(binding: ${answer.binding.kind} of ${answer.binding.joint || "the path"} at s = ${answer.binding.s.toFixed(3)})` : "";
   $("warnings").replaceChildren(...answer.warnings.map((text) => Object.assign(document.createElement("li"), {textContent: text})));
   showDurations(compared);
+  showUtilization(answer, constraints);
+  offerDownloads(answer);
   drawPhasePlane(answer);
   drawJoints(answer, limits);
   await drawArm(answer, path);
-}
-
-const LAYOUT = {margin: {l: 55, r: 15, t: 40, b: 45}, font: {size: 11}, legend: {orientation: "h"}};
-
-function drawPhasePlane(answer) {
-  const plane = answer.phase_plane;
-  const traces = [
-    {x: plane.s, y: plane.sd_max, name: "maximum velocity curve", mode: "lines", line: {dash: "dot", color: "#c0392b"}},
-    {x: plane.s, y: plane.sd, name: "path speed ṡ", mode: "lines", line: {color: "#1f5fbf"}},
-  ];
-  const kinds = [...new Set(plane.switch_points.map((point) => point.kind))];
-  const symbols = ["circle", "diamond", "square", "triangle-up", "x"];
-  kinds.forEach((kind, index) => {
-    const points = plane.switch_points.filter((point) => point.kind === kind);
-    const speed = points.map((point) => interpolate(plane.s, plane.sd, point.s));
-    traces.push({x: points.map((p) => p.s), y: speed, name: `switch: ${kind}`, mode: "markers", marker: {symbol: symbols[index % symbols.length], size: 9}});
-  });
-  // the maximum velocity curve may soar where the path nearly stops (a free path's ends): keep
-  // the path speed readable
-  const top = Math.max(...plane.sd);
-  const yaxis = {title: {text: "ṡ (1/s)"}, rangemode: "tozero"};
-  if (Math.max(...plane.sd_max.filter((v) => v != null)) > 2 * top) yaxis.range = [0, 1.6 * top];
-  Plotly.newPlot("phase-plane", traces, {...LAYOUT, title: {text: "Phase plane"}, xaxis: {title: {text: "s"}}, yaxis}, {responsive: true});
-}
-
-function interpolate(xs, ys, x) {
-  let i = 1;
-  while (i < xs.length - 1 && xs[i] < x) i += 1;
-  const t = xs[i] === xs[i - 1] ? 0 : (x - xs[i - 1]) / (xs[i] - xs[i - 1]);
-  return ys[i - 1] + t * (ys[i] - ys[i - 1]);
-}
-
-function drawJoints(answer, limits) {
-  const samples = answer.samples;
-  const rows = [["q", "q (rad)", null], ["qd", "q̇ (rad/s)", limits.velocity], ["qdd", "q̈ (rad/s²)", limits.acceleration], ["tau", "τ (N m)", limits.torque]];
-  const colors = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22"];
-  const traces = [];
-  const layout = {...LAYOUT, title: {text: "Joints against their limits (dashed)"}, grid: {rows: 4, columns: 1, pattern: "independent"}, height: 640, showlegend: true};
-  rows.forEach(([key, label, limit], row) => {
-    const axis = row === 0 ? "" : String(row + 1);
-    answer.joint_names.forEach((name, joint) => {
-      const color = colors[joint % colors.length];
-      traces.push({x: samples.t, y: samples[key].map((values) => values[joint]), name, legendgroup: name, showlegend: row === 0,
-                   mode: "lines", line: {color}, xaxis: `x${axis}`, yaxis: `y${axis}`});
-      if (limit && limit[joint] != null && answer.peak_utilization[{qd: "velocity", qdd: "acceleration", tau: "torque"}[key]][joint] > 0.5) {
-        for (const sign of [1, -1]) {
-          traces.push({x: [samples.t[0], samples.t[samples.t.length - 1]], y: [sign * limit[joint], sign * limit[joint]], mode: "lines",
-                       line: {color, dash: "dash", width: 1}, legendgroup: name, showlegend: false, hoverinfo: "skip", xaxis: `x${axis}`, yaxis: `y${axis}`});
-        }
-      }
-    });
-    layout[`yaxis${axis}`] = {title: {text: label}};
-    layout[`xaxis${axis}`] = {title: {text: row === 3 ? "t (s)" : ""}};
-  });
-  Plotly.newPlot("joints", traces, layout, {responsive: true});
-}
-
-async function drawArm(answer, path) {
-  const count = Math.min(12, answer.samples.t.length);
-  const indices = [...Array(count).keys()].map((k) => Math.round((k * (answer.samples.t.length - 1)) / Math.max(1, count - 1)));
-  const figure = await postJSON(`/v1/robots/${encodeURIComponent(answer.robot)}/skeleton`, {q: indices.map((i) => answer.samples.q[i])});
-  const all = figure.positions.flat();
-  const planar = all.every((p) => Math.abs(p[2] - all[0][2]) < 1e-9);
-  const traces = figure.positions.map((points, k) => {
-    const shade = count > 1 ? k / (count - 1) : 1;
-    const color = `rgba(31, 95, 191, ${0.15 + 0.85 * shade})`;
-    const trace = {x: points.map((p) => p[0]), y: points.map((p) => p[1]), mode: "lines+markers", line: {color, width: 3}, marker: {size: 4, color},
-                   name: `t = ${answer.samples.t[indices[k]].toFixed(3)} s`, showlegend: k === 0 || k === count - 1};
-    if (!planar) Object.assign(trace, {type: "scatter3d", z: points.map((p) => p[2])});
-    return trace;
-  });
-  if (planar) traces.unshift(...obstacleTraces(answer, path));
-  const layout = {...LAYOUT, title: {text: "The arm, stroboscopically (light: start, dark: end)"}};
-  if (planar) Object.assign(layout, {xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}, scaleanchor: "x"}});
-  else layout.scene = {aspectmode: "data", xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}}, zaxis: {title: {text: "z (m)"}}};
-  Plotly.newPlot("arm", traces, layout, {responsive: true});
-}
-
-function obstacleTraces(answer, path) {
-  // a planar arm's picture: the obstacle shadows of the search (the tip positions where a link
-  // would meet an obstacle, per elbow branch; Jeong & Lee §2.2) and the spheres themselves
-  const traces = [];
-  const shadows = answer.search && answer.search.shadows;
-  const colors = ["rgba(230, 126, 34, 0.25)", "rgba(142, 68, 173, 0.25)"];
-  if (shadows) {
-    shadows.shadows.forEach((branch, k) => traces.push({x: branch.points.map((p) => p[0]), y: branch.points.map((p) => p[1]), mode: "markers",
-      marker: {size: 3, color: colors[k % colors.length]}, name: `obstacle shadow, ${branch.branch}`, hoverinfo: "skip"}));
-  }
-  for (const obstacle of (path && path.obstacles) || []) {
-    if (obstacle.kind !== "sphere") continue;
-    const angles = [...Array(49).keys()].map((k) => (2 * Math.PI * k) / 48);
-    traces.push({x: angles.map((a) => obstacle.center[0] + obstacle.radius * Math.cos(a)), y: angles.map((a) => obstacle.center[1] + obstacle.radius * Math.sin(a)),
-                 mode: "lines", fill: "toself", line: {color: "#555"}, fillcolor: "rgba(85, 85, 85, 0.5)", name: "obstacle"});
-  }
-  return traces;
 }
 
 init().catch((error) => showError(`The page could not start: ${error.message}`));
