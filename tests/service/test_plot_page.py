@@ -4,14 +4,11 @@ joint's plots carry all of its limits."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
-from toptraj.service.cli import main
 from tests.browser_page import drawn_to_the_edge, launch, offline_page
-
-ROOT = Path(__file__).resolve().parents[1]
+from tests.paths import ROOT
+from toptraj.service.cli import main
 
 
 @pytest.fixture(scope="module")

@@ -16,10 +16,9 @@ import pytest
 import yaml
 from fastapi.testclient import TestClient
 
+from tests.paths import ROOT
 from toptraj.service.app import create_app
 from toptraj.service.settings import Settings
-
-ROOT = Path(__file__).resolve().parent.parent
 
 for _module in ("mkdocs", "material", "mkdocstrings", "mkdocstrings_handlers.python"):
     pytest.importorskip(_module, reason="the docs extra (mkdocs, mkdocs-material, mkdocstrings) is not installed")
