@@ -178,9 +178,9 @@ def _obstacles(specs) -> tuple:
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
     """The answer's bytes and media type in the format asked (``service.formats``)."""
     format_ = chosen_format(request.output.format, accept)
-    if format_ == "csv":
-        return csv_bytes(result), CSV_MEDIA_TYPE
     body = trajectory_body(result)
+    if format_ == "csv":
+        return csv_bytes(body), CSV_MEDIA_TYPE
     if format_ == "joint_trajectory":
         del body["samples"]
         body["joint_trajectory"] = joint_trajectory(result)
