@@ -30,6 +30,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from planners import PlannedTrajectory
+from planners.checks.gate import LIMIT_TOLERANCE
 
 FORMATS = ("samples", "joint_trajectory", "csv")
 CSV_MEDIA_TYPE = "text/csv; charset=utf-8"
@@ -109,7 +110,8 @@ def csv_metadata(body: Mapping) -> list[str]:
         f"method: {body['method']}",
         f"duration: {float(body['duration'])!r} s",
         f"sampled_duration: {float(body['sampled_duration'])!r} s",
-        "peak_utilization: peak |value| / limit per joint on a dense resampling, 1 at the limit",
+        "peak_utilization: peak |value| / limit per joint on a dense resampling; 1 is at the limit, and the "
+        f"limits asked are held within {round((LIMIT_TOLERANCE - 1.0) * 100, 6):g} %",
     ]
     for kind, values in body["peak_utilization"].items():
         lines.append(f"peak_utilization.{kind}: " + ",".join(repr(float(v)) for v in values))
