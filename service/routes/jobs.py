@@ -262,7 +262,7 @@ def _answer(job: Job, result: bytes, request_json: str | None, accept: str | Non
 )
 def cancel_job(job_id: str, request: Request) -> Response:
     """Cancel a queued or running job (200, the job cancelled): a queued one never runs; a
-    running one's worker process is killed. A job that has ended (done, failed, cancelled,
+    running one stops computing at once. A job that has ended (done, failed, cancelled,
     interrupted) is deleted with its stored answer (204); GET answers 404 for it afterwards."""
     store = _store(request)
     if _job(store, job_id).status in ("queued", "running"):
