@@ -61,32 +61,8 @@ def _methods(text: str) -> list[str]:
     return names
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the console script."""
-    parser = argparse.ArgumentParser(
-        prog="toptraj",
-        description="Time-optimal trajectories for robot arms: serve the HTTP service, or plan, compare and\n"
-        "plot requests (JSON files shaped like the service's request bodies) in this process.",
-        epilog="examples:\n"
-        "  toptraj serve --port 8000\n"
-        "  toptraj plan examples/ur5_spline.json > answer.json\n"
-        "  toptraj compare examples/ur5_spline.json --methods phase_plane,toppra,quintic\n"
-        "  toptraj plot examples/compare_methods.json -o compare.html\n\n"
-        "toptraj COMMAND --help describes each command.",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    serve = commands.add_parser("serve", help="run the HTTP service", description="Run the HTTP service (the API, its documentation at /docs and the web page at /).")
-    serve.add_argument("--host", default="127.0.0.1", help="the address to listen on (default: 127.0.0.1; 0.0.0.0 for every interface)")
-    serve.add_argument("--port", type=int, default=8000, help="the port to listen on (default: 8000)")
-    serve.add_argument(
-        "--workers",
-        type=int,
-        default=os.cpu_count() or 1,
-        help="server processes on the port, each planning on its own core (default: the number of cores)",
-    )
-    serve.add_argument("--access-log", action="store_true", help="log a line per request (uvicorn's access log; default off)")
-    serve.set_defaults(run=_serve)
+def _request_commands(commands) -> None:
+    """``toptraj plan``, ``toptraj compare`` and ``toptraj plot``: one request each."""
     exits = "Exit status: 0 answered, 1 answered with an error (printed on stderr as problem+json), 2 the request could not be read."
     plan = commands.add_parser(
         "plan",
@@ -126,6 +102,35 @@ def main(argv: list[str] | None = None) -> int:
     plot.add_argument("-o", "--output", required=True, help="the HTML file to write")
     plot.add_argument("--methods", type=_methods, default=None, help="compare these timing methods, comma-separated, e.g. phase_plane,toppra")
     plot.set_defaults(run=lambda args: commands_.plot(args.request, args.output, args.methods))
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the console script."""
+    parser = argparse.ArgumentParser(
+        prog="toptraj",
+        description="Time-optimal trajectories for robot arms: serve the HTTP service, or plan, compare and\n"
+        "plot requests (JSON files shaped like the service's request bodies) in this process.",
+        epilog="examples:\n"
+        "  toptraj serve --port 8000\n"
+        "  toptraj plan examples/ur5_spline.json > answer.json\n"
+        "  toptraj compare examples/ur5_spline.json --methods phase_plane,toppra,quintic\n"
+        "  toptraj plot examples/compare_methods.json -o compare.html\n\n"
+        "toptraj COMMAND --help describes each command.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    serve = commands.add_parser("serve", help="run the HTTP service", description="Run the HTTP service (the API, its documentation at /docs and the web page at /).")
+    serve.add_argument("--host", default="127.0.0.1", help="the address to listen on (default: 127.0.0.1; 0.0.0.0 for every interface)")
+    serve.add_argument("--port", type=int, default=8000, help="the port to listen on (default: 8000)")
+    serve.add_argument(
+        "--workers",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="server processes on the port, each planning on its own core (default: the number of cores)",
+    )
+    serve.add_argument("--access-log", action="store_true", help="log a line per request (uvicorn's access log; default off)")
+    serve.set_defaults(run=_serve)
+    _request_commands(commands)
     batch = commands.add_parser("batch", help="plan a file of requests (JSON Lines) on Ray, resumably")
     batch.add_argument("requests", help="a JSON Lines file: a POST /v1/trajectories (or compare) body per line")
     batch.add_argument("-o", "--output", required=True, help="the JSON Lines file of results (appended; resumed)")
