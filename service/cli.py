@@ -88,7 +88,7 @@ def _request_commands(commands) -> None:
         type=_methods,
         default=None,
         help="timing methods, comma-separated, e.g. phase_plane,toppra (default: the request's own; for a trajectory "
-        "request, its method then phase_plane, toppra and quintic)",
+        "request, its method then phase_plane, toppra and quintic, or on a free path collocation and search)",
     )
     compare.add_argument("--json", action="store_true", help="print JSON even on a terminal")
     compare.set_defaults(run=lambda args: commands_.compare(args.request, args.methods, True if args.json else None))

@@ -54,14 +54,16 @@ def _is_compare(text: str) -> bool:
 
 
 #: Methods ``toptraj compare`` runs on a trajectory body given without ``--methods``, after
-#: the body's own ``timing.method``.
+#: the body's own ``timing.method``; on a free path (start and goal only), ``FREE_METHODS``.
 DEFAULT_METHODS = ("phase_plane", "toppra", "quintic")
+FREE_METHODS = ("collocation", "search")
 
 
 def compare_body(text: str, methods: list[str] | None = None) -> str:
     """The compare body (JSON) of ``text``: a compare body, its ``methods`` replaced by
     ``methods`` when given; or a trajectory body's robot, path and timing (its ``output`` left
-    out) under ``methods``, by default its own method then ``DEFAULT_METHODS``."""
+    out) under ``methods``, by default its own method then ``DEFAULT_METHODS`` (``FREE_METHODS``
+    on a free path)."""
     body = _json(text)
     if not isinstance(body, dict):
         return text  # refused by the schema, which says what it expects
@@ -69,7 +71,9 @@ def compare_body(text: str, methods: list[str] | None = None) -> str:
         return text if methods is None else json.dumps({**body, "methods": methods})
     timing = body.get("timing")
     own = timing.get("method", "phase_plane") if isinstance(timing, dict) else "phase_plane"
-    chosen = methods or list(dict.fromkeys([own, *DEFAULT_METHODS] if isinstance(own, str) else DEFAULT_METHODS))
+    path = body.get("path")
+    defaults = FREE_METHODS if isinstance(path, dict) and path.get("kind") == "free" else DEFAULT_METHODS
+    chosen = methods or list(dict.fromkeys([own, *defaults] if isinstance(own, str) else defaults))
     return json.dumps({**{key: value for key, value in body.items() if key != "output"}, "methods": chosen})
 
 

@@ -148,6 +148,10 @@ def test_compare_without_methods_runs_the_bodys_method_and_the_defaults(capsys, 
     request = tmp_path / "cubic.json"
     request.write_text(json.dumps(body))
     assert [r["method"] for r in _compared(capsys, str(request))] == ["cubic", "phase_plane", "toppra", "quintic"]
+    from service.commands import compare_body
+
+    free = json.loads(compare_body((ROOT / "examples" / "geering_free_motion.json").read_text()))
+    assert free["methods"] == ["collocation", "search"] and "output" not in free and free["path"]["kind"] == "free"
 
 
 def test_methods_replace_those_of_a_compare_body(capsys):
