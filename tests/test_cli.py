@@ -185,6 +185,7 @@ def test_the_table_shows_each_method_against_the_fastest():
 
 def test_compare_prints_a_table_on_a_terminal_and_json_when_piped_or_asked(monkeypatch, capsys):
     import pty
+    import select
 
     command = [sys.executable, "-m", "service.cli", "compare", str(SPLINE), "--methods", "phase_plane,quintic"]
     leader, follower = pty.openpty()
@@ -192,6 +193,7 @@ def test_compare_prints_a_table_on_a_terminal_and_json_when_piped_or_asked(monke
         os.close(follower)
         printed = b""
         while True:
+            assert select.select([leader], [], [], 120)[0], "no output for 120 s"
             try:
                 chunk = os.read(leader, 65536)
             except OSError:  # the terminal closed with the process
@@ -204,8 +206,8 @@ def test_compare_prints_a_table_on_a_terminal_and_json_when_piped_or_asked(monke
     lines = printed.decode().splitlines()
     assert lines[0].split()[:3] == ["method", "duration", "(s)"]
     assert lines[1].split()[0] == "phase_plane" and lines[2].split()[0] == "quintic" and lines[1].split()[2] == "1.000"
-    piped = subprocess.run(command, cwd=ROOT, capture_output=True, timeout=120)
-    assert [r["method"] for r in json.loads(piped.stdout)["results"]] == ["phase_plane", "quintic"]
+    assert main(["compare", str(SPLINE), "--methods", "quintic"]) == 0  # JSON into a pipe or a file (the capture)
+    assert json.loads(capsys.readouterr().out)["results"][0]["method"] == "quintic"
     monkeypatch.setattr("sys.stdout.isatty", lambda: True)
     assert main(["compare", str(SPLINE), "--methods", "quintic", "--json"]) == 0  # JSON when asked, on a terminal too
     assert json.loads(capsys.readouterr().out)["results"][0]["method"] == "quintic"

@@ -23,7 +23,7 @@ _ERRORS = problem_responses(404, 413, 422, 503, 504)
     summary="Plan a timed trajectory",
     response_model=TrajectoryResponse,
     responses={
-        200: {"content": {"text/csv": {"schema": {"type": "string"}, "example": "t,q.shoulder,…\n0.0,0.0,…\n"}}},
+        200: {"content": {"text/csv": {"schema": {"type": "string"}, "example": "t,q.shoulder,…\n# robot: ur5\n# method: phase_plane\n…\n0.0,0.0,…\n"}}},
         **_ERRORS,
     },
 )
