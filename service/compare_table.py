@@ -9,10 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from planners.checks.gate import LIMIT_TOLERANCE
-
-#: How far past a limit asked an answer may go, in percent of the limit.
-TOLERANCE_PERCENT = round((LIMIT_TOLERANCE - 1.0) * 100, 6)
+from service.formats import TOLERANCE_PERCENT
 
 #: The table's columns: header and alignment (``<`` left, ``>`` right).
 COLUMNS = (("method", "<"), ("duration (s)", ">"), ("× fastest", ">"), ("peak utilization", "<"), ("warnings", ">"), ("solve (ms)", ">"))

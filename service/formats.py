@@ -34,6 +34,8 @@ from planners.checks.gate import LIMIT_TOLERANCE
 
 FORMATS = ("samples", "joint_trajectory", "csv")
 CSV_MEDIA_TYPE = "text/csv; charset=utf-8"
+#: How far past a limit asked an answer may go on a dense resampling, in percent of the limit.
+TOLERANCE_PERCENT = round((LIMIT_TOLERANCE - 1.0) * 100, 6)
 
 
 def _quality(accept: str, media: str) -> float:
@@ -111,7 +113,7 @@ def csv_metadata(body: Mapping) -> list[str]:
         f"duration: {float(body['duration'])!r} s",
         f"sampled_duration: {float(body['sampled_duration'])!r} s",
         "peak_utilization: peak |value| / limit per joint on a dense resampling; 1 is at the limit, and the "
-        f"limits asked are held within {round((LIMIT_TOLERANCE - 1.0) * 100, 6):g} %",
+        f"limits asked are held within {TOLERANCE_PERCENT:g} %",
     ]
     for kind, values in body["peak_utilization"].items():
         lines.append(f"peak_utilization.{kind}: " + ",".join(repr(float(v)) for v in values))
