@@ -1,7 +1,7 @@
 """What ``toptraj plan``, ``toptraj compare`` and ``toptraj plot`` do: one request read from a
 file or standard input (``-``), planned in this process by the service's own code path
-(``service.planning``), its answer on standard output (a comparison as a table on a terminal,
-``service.compare_table``; or a page of plots in a file), its error as problem+json on standard
+(``toptraj.service.planning``), its answer on standard output (a comparison as a table on a terminal,
+``toptraj.service.compare_table``; or a page of plots in a file), its error as problem+json on standard
 error with a non-zero exit status:
 
 * 0: answered;
@@ -80,8 +80,8 @@ def compare_body(text: str, methods: list[str] | None = None) -> str:
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
-    from robots import ToptrajError
-    from service.errors import status_of, validation_problem
+    from toptraj.robots import ToptrajError
+    from toptraj.service.errors import status_of, validation_problem
 
     try:
         content = answer(_read(source))
@@ -113,21 +113,21 @@ def _write(content: bytes, out=None) -> int:
 
 
 def _trajectory(text: str) -> bytes:
-    from service.planning import plan_request, render
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.planning import plan_request, render
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     request = TrajectoryRequest.model_validate_json(text)
     return render(plan_request(request), request)[0]
 
 
 def _compare(text: str, as_table: bool = False) -> bytes:
-    from planners.execution.deadline import NO_DEADLINE
-    from service.planning import compare_request, encode_json
-    from service.schemas.trajectories import CompareRequest
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.service.planning import compare_request, encode_json
+    from toptraj.service.schemas.trajectories import CompareRequest
 
     answer = compare_request(CompareRequest.model_validate_json(text), NO_DEADLINE)
     if as_table:
-        from service.compare_table import compare_table
+        from toptraj.service.compare_table import compare_table
 
         return compare_table(answer).encode()
     return encode_json(answer)
@@ -151,14 +151,14 @@ def plot(source: str, output: str, methods: list[str] | None = None) -> int:
     request, or of every method of a compare body drawn over each other (``--methods`` turns a
     trajectory body into one), in a self-contained HTML file (Plotly's JavaScript inlined: it
     opens offline)."""
-    from planners.execution.deadline import NO_DEADLINE
-    from service.planning import plan_request
-    from service.plots import figures_html
-    from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.service.planning import plan_request
+    from toptraj.service.plots import figures_html
+    from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
     def page(text: str) -> bytes:
         if methods is not None or _is_compare(text):
-            from service.compare_plots import compare_html
+            from toptraj.service.compare_plots import compare_html
 
             return compare_html(CompareRequest.model_validate_json(compare_body(text, methods)), NO_DEADLINE).encode()
         return figures_html(plan_request(TrajectoryRequest.model_validate_json(text))).encode()
@@ -185,15 +185,15 @@ def batch(
     retry_failed: bool = False,
 ) -> int:
     """``toptraj batch FILE -o OUT``: every request line planned (on Ray), one result line per
-    line, resumable (``service.batches``). Ctrl-C stops within seconds, keeps what finished,
+    line, resumable (``toptraj.service.batches``). Ctrl-C stops within seconds, keeps what finished,
     prints the command that resumes and exits with 130; a second Ctrl-C changes nothing."""
     import shlex
     import signal
     import threading
 
-    from service.batches import run_batch
-    from service.batches.lines import ForeignOutput
-    from service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
+    from toptraj.service.batches import run_batch
+    from toptraj.service.batches.lines import ForeignOutput
+    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
 
     if workers is not None and workers < 1:
         print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)

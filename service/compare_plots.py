@@ -1,7 +1,7 @@
 """The page of ``toptraj plot`` for a comparison: every method of one path timed, and drawn
 over the others: the phase plane (path speed ṡ over s under the maximum velocity curve) and
 the use of each limit over time (at each instant, the largest |value| / limit over the
-joints; 1 is at the limit), with the comparison's table (``service.compare_table``). Plotly's
+joints; 1 is at the limit), with the comparison's table (``toptraj.service.compare_table``). Plotly's
 JavaScript is inlined once, so the file opens offline."""
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ import plotly.graph_objects as go
 from plotly.io import to_html
 from plotly.subplots import make_subplots
 
-import robots
-from planners import Deadline, PlannedTrajectory
-from service.compare_table import compare_table
-from service.planning import compare_results, requested_limits
-from service.schemas.trajectories import CompareRequest
+from toptraj import robots
+from toptraj.planners import Deadline, PlannedTrajectory
+from toptraj.service.compare_table import compare_table
+from toptraj.service.planning import compare_results, requested_limits
+from toptraj.service.schemas.trajectories import CompareRequest
 
 #: One color per method, in the order of ``methods``.
 PALETTE = ("#1f5fbf", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf")

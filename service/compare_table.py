@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from service.formats import TOLERANCE_PERCENT
+from toptraj.service.formats import TOLERANCE_PERCENT
 
 #: The table's columns: header and alignment (``<`` left, ``>`` right).
 COLUMNS = (("method", "<"), ("duration (s)", ">"), ("× fastest", ">"), ("peak utilization", "<"), ("warnings", ">"), ("solve (ms)", ">"))

@@ -19,7 +19,7 @@
 
 Controllers consume points at a fixed period, so ``joint_trajectory`` and ``csv`` put the
 samples on whole periods by default (``output.exact_period``, see
-``planners.trajectory.sample_trajectory``).
+``toptraj.planners.trajectory.sample_trajectory``).
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from planners import PlannedTrajectory
-from planners.checks.gate import LIMIT_TOLERANCE
+from toptraj.planners import PlannedTrajectory
+from toptraj.planners.checks.gate import LIMIT_TOLERANCE
 
 FORMATS = ("samples", "joint_trajectory", "csv")
 CSV_MEDIA_TYPE = "text/csv; charset=utf-8"
@@ -103,7 +103,7 @@ def joint_trajectory(result: PlannedTrajectory) -> dict:
 
 def csv_metadata(body: Mapping) -> list[str]:
     """The ``# key: value`` lines of a trajectory body's CSV (``body`` as
-    ``service.planning.trajectory_body`` builds it, or as its JSON decodes): robot, method,
+    ``toptraj.service.planning.trajectory_body`` builds it, or as its JSON decodes): robot, method,
     durations (s), peak utilization per limit (one value per joint, in the columns' order),
     the binding limit and the warnings, one line each. Line breaks within a value become
     spaces, so that every line stays a comment."""

@@ -28,8 +28,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from robots.errors import excerpt
-from service.jobs.records import ClaimedJob, Job, JobEnded, JobQueueFull, JobStoreUnavailable, owner_is_gone
+from toptraj.robots.errors import excerpt
+from toptraj.service.jobs.records import ClaimedJob, Job, JobEnded, JobQueueFull, JobStoreUnavailable, owner_is_gone
 
 DATABASE = "jobs.sqlite3"
 STATUSES = ("queued", "running", "done", "failed", "cancelled", "interrupted")

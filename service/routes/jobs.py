@@ -13,14 +13,14 @@ from fastapi.responses import Response
 from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners.errors import InvalidRequest
-from robots.errors import ToptrajError, excerpt
-from service.errors import PROBLEM_JSON, problem_responses
-from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes
-from service.jobs.records import Job, JobEnded
-from service.jobs.store import JobStore
-from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
+from toptraj import robots
+from toptraj.planners.errors import InvalidRequest
+from toptraj.robots.errors import ToptrajError, excerpt
+from toptraj.service.errors import PROBLEM_JSON, problem_responses
+from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes
+from toptraj.service.jobs.records import Job, JobEnded
+from toptraj.service.jobs.store import JobStore
+from toptraj.service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
 
 router = APIRouter(prefix="/v1/jobs", tags=["jobs"])
 

@@ -1,5 +1,5 @@
 """Schemas of the answers of ``POST /v1/trajectories`` and ``POST /v1/trajectories/compare``
-(DESIGN.md, HTTP contract); the requests are ``service.schemas.trajectories``."""
+(DESIGN.md, HTTP contract); the requests are ``toptraj.service.schemas.trajectories``."""
 
 from __future__ import annotations
 

@@ -8,9 +8,9 @@ from typing import Literal
 
 from pydantic import BaseModel, Field, model_validator
 
-from service.schemas.answers import CompareResponse, TrajectoryResponse
-from service.schemas.common import Problem, Schema
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.schemas.answers import CompareResponse, TrajectoryResponse
+from toptraj.service.schemas.common import Problem, Schema
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 JobKind = Literal["trajectory", "compare", "batch"]
 JobStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]

@@ -4,11 +4,11 @@ configuration-space obstacles removed from it (``free_space``), lower bounds on 
 along grid paths (``bounds``) on their B-spline curves (``curve``), and branch and bound over the grid paths (``branch_and_bound``),
 whose best grid path of each tube is the start of the local optimization (section 2.6)."""
 
-from planners.generators.search.branch_and_bound import branch_and_bound, enumerate_grid_paths
-from planners.generators.search.curve import GridSplinePath
-from planners.generators.search.graph import SearchOptions
-from planners.generators.search.outcome import GridPath, SearchResult, SearchStatistics
-from planners.generators.search.problem import SearchProblem, build_problem
+from toptraj.planners.generators.search.branch_and_bound import branch_and_bound, enumerate_grid_paths
+from toptraj.planners.generators.search.curve import GridSplinePath
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.outcome import GridPath, SearchResult, SearchStatistics
+from toptraj.planners.generators.search.problem import SearchProblem, build_problem
 
 __all__ = [
     "GridPath",
