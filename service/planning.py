@@ -178,9 +178,9 @@ def _obstacles(specs) -> tuple:
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
     """The answer's bytes and media type in the format asked (``toptraj.service.formats``)."""
     format_ = chosen_format(request.output.format, accept)
-    if format_ == "csv":
-        return csv_bytes(result), CSV_MEDIA_TYPE
     body = trajectory_body(result)
+    if format_ == "csv":
+        return csv_bytes(body), CSV_MEDIA_TYPE
     if format_ == "joint_trajectory":
         del body["samples"]
         body["joint_trajectory"] = joint_trajectory(result)
@@ -223,29 +223,48 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
     return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous)
 
 
-def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
-    """Run every method of ``request`` on the same path and limits; a method's own failure is
-    reported in its entry instead of failing the comparison."""
-    results = []
+def method_request(request: CompareRequest, method: str, dt: float = 1.0) -> TrajectoryRequest:
+    """The trajectory request of one method of a comparison, sampled every ``dt`` seconds."""
+    return TrajectoryRequest(
+        robot=request.robot,
+        path=request.path,
+        timing=request.timing.model_copy(update={"method": method}),
+        output=OutputRequest(dt=dt),
+    )
+
+
+def requested_limits(request: TrajectoryRequest | CompareRequest, robot: robots.Robot) -> robots.JointLimits:
+    """The robot's limits with the request's overrides and scale factors applied."""
+    limits = request.timing.limits
+    kinds = ("velocity", "acceleration", "jerk", "torque")
+    return robot.limits.with_request({kind: getattr(limits, kind) for kind in kinds}, {kind: getattr(limits, f"{kind}_scale") for kind in kinds})
+
+
+def compare_results(request: CompareRequest, deadline: Deadline, dt: float = 1.0) -> list[tuple[dict, PlannedTrajectory | None]]:
+    """Run every method of ``request`` on the same path and limits, sampled every ``dt``
+    seconds: each method's entry of the comparison with its trajectory, or, when the method
+    itself fails, an entry naming its error and ``None``."""
+    results: list[tuple[dict, PlannedTrajectory | None]] = []
+    count = len(request.methods)
     for index, method in enumerate(request.methods):
-        single = TrajectoryRequest(
-            robot=request.robot,
-            path=request.path,
-            timing=request.timing.model_copy(update={"method": method}),
-            output=OutputRequest(dt=1.0),
-        )
-        count = len(request.methods)
         part = deadline.within(index / count, (index + 1) / count, f"{method} ({index + 1} of {count})")
         try:
-            result = plan_request(single, part)
+            result = plan_request(method_request(request, method, dt), part)
         except UnknownRobot:
             raise
         except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:
-            results.append({"method": method, "error": {"status": status_of(error), "title": error.title, "detail": error.detail}})
+            results.append(({"method": method, "error": {"status": status_of(error), "title": error.title, "detail": error.detail}}, None))
             continue
         body = trajectory_body(result)
-        results.append({key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")})
-    return {"results": results}
+        entry = {key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")}
+        results.append((entry, result))
+    return results
+
+
+def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
+    """Run every method of ``request`` on the same path and limits; a method's own failure is
+    reported in its entry instead of failing the comparison."""
+    return {"results": [entry for entry, _ in compare_results(request, deadline)]}
 
 
 def _finite_or_none(values) -> np.ndarray | list[float | None]:

@@ -172,6 +172,14 @@ class JobStore:
             row = connection.execute("SELECT result FROM jobs WHERE id = ? AND status = 'done'", (job_id,)).fetchone()
         return None if row is None else bytes(row[0])
 
+    def request(self, job_id: str) -> str | None:
+        """The validated request (JSON) of job ``job_id``, ``None`` when there is none."""
+        with self._connect(write=False) as connection:
+            if connection is None:
+                return None
+            row = connection.execute("SELECT request FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return None if row is None else str(row[0])
+
     def jobs(self, limit: int, before: int | None = None, status: str | None = None) -> list[Job]:
         """At most ``limit`` jobs, newest first, submitted before the job of sequence number
         ``before`` (when given), with ``status`` (when given)."""

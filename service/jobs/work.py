@@ -40,8 +40,14 @@ class WorkerSetup:
 
 
 def _trajectory(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
+    """The answer as JSON, in the format asked; a job asking CSV keeps its samples as JSON (a
+    job's answer is part of ``GET /v1/jobs/{id}``), planned as CSV is (on whole periods), and
+    ``GET /v1/jobs/{id}/result`` writes them as CSV."""
     body = TrajectoryRequest.model_validate_json(request)
-    return render(plan_request(body, deadline, setup.max_response_bytes, search_memory_bytes=setup.search_memory_bytes), body)[0]
+    result = plan_request(body, deadline, setup.max_response_bytes, search_memory_bytes=setup.search_memory_bytes)
+    if body.output.format == "csv":
+        body = body.model_copy(update={"output": body.output.model_copy(update={"format": "samples"})})
+    return render(result, body)[0]
 
 
 def _compare(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:

@@ -52,7 +52,9 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
 @router.get("", summary="List the robots")
 def list_robots() -> list[RobotSummary]:
     """Every robot the service can plan for: the bundled paper arms, the fixed-base arms of
-    example-robot-data and the uploaded URDFs (from the store, without building their models)."""
+    example-robot-data and the uploaded URDFs.
+    \f
+    Uploads are listed from the store, without building their models."""
     catalog = [
         RobotSummary(name=robot.name, dof=robot.dof, source=cast(Source, robot.source))
         for robot in map(robots.load, robots.catalog_names())

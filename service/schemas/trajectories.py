@@ -329,7 +329,9 @@ class OutputRequest(Schema):
             "`samples`: arrays t, q, qd, qdd, tau; `joint_trajectory`: ROS's "
             "trajectory_msgs/JointTrajectory as JSON (joint_names, points with positions, "
             "velocities, accelerations, effort, time_from_start {sec, nanosec}); `csv`: text/csv, "
-            "a header and a row per sample (also chosen by `Accept: text/csv`)."
+            "a header, then the answer's robot, method, durations, peak utilization, binding limit and "
+            "warnings as `# key: value` lines, then a row per sample (also chosen by `Accept: text/csv`; "
+            "read it with pandas' `read_csv(f, comment=\"#\")` or numpy's `loadtxt(f, delimiter=\",\", skiprows=1)`)."
         ),
     )
     exact_period: bool | None = Field(

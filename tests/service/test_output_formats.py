@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import io
+import time
 
 import numpy as np
 import pytest
@@ -52,7 +53,7 @@ def test_the_csv_parses_to_the_same_numbers(client):
     samples = _post(client, _request(exact_period=True)).json()
     response = _post(client, _request(format="csv"))
     assert response.headers["content-type"].startswith("text/csv")
-    rows = list(csv.reader(io.StringIO(response.text)))
+    rows = list(csv.reader(line for line in io.StringIO(response.text) if not line.startswith("#")))
     names = samples["joint_names"]
     assert rows[0] == ["t"] + [f"{k}.{n}" for k in ("q", "qd", "qdd", "tau") for n in names]
     table = np.array(rows[1:], dtype=float)
@@ -116,7 +117,62 @@ def test_exact_period_with_moving_ends_is_refused(client):
     assert response.status_code == 422 and "exact_period" in response.json()["detail"]
 
 
-def test_a_job_asking_csv_is_refused_with_the_way_out(client):
-    response = client.post("/v1/jobs", json={"trajectory": _request(format="csv")})
-    assert response.status_code == 422
-    assert "joint_trajectory" in response.text and "POST /v1/trajectories" in response.text
+def _metadata(text: str) -> dict[str, list[str]]:
+    """The ``# key: value`` lines of a CSV answer, each key with its values in order."""
+    found: dict[str, list[str]] = {}
+    for line in text.splitlines():
+        if line.startswith("# "):
+            key, value = line[2:].split(": ", 1)
+            found.setdefault(key, []).append(value)
+    return found
+
+
+def test_the_csv_carries_its_metadata_and_numpy_reads_it(client):
+    """Method, durations, peak utilization and warnings in ``#`` lines after the header: the
+    JSON answer's values, and numpy's readers (as pandas' ``comment="#"``) skip them."""
+    body = _request(exact_period=True)
+    body["path"]["waypoints"] = [[0.0, -1.2, 1.0, 0.0, 0.0, 0.0], *UR5_WAYPOINTS[1:]]  # starts in a singularity: a warning
+    answer = _post(client, body).json()
+    assert answer["warnings"]
+    text = _post(client, {**body, "output": {"dt": 0.01, "format": "csv"}}).text
+    meta = _metadata(text)
+    assert meta["robot"] == ["ur5"] and meta["method"] == ["phase_plane"]
+    assert meta["duration"] == [f"{answer['duration']!r} s"] and meta["sampled_duration"] == [f"{answer['sampled_duration']!r} s"]
+    assert meta["warnings"] == [str(len(answer["warnings"]))] and meta["warning"] == answer["warnings"]
+    for kind, values in answer["peak_utilization"].items():
+        assert [float(v) for v in meta[f"peak_utilization.{kind}"][0].split(",")] == values
+    table = np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1)
+    np.testing.assert_array_equal(table[:, 0], answer["samples"]["t"])
+    np.testing.assert_array_equal(table[:, 1:7], answer["samples"]["q"])
+    named = np.genfromtxt(io.StringIO(text), delimiter=",", names=True, deletechars="")
+    np.testing.assert_array_equal(named["tau.wrist_3_joint"], np.array(answer["samples"]["tau"])[:, 5])
+
+
+def test_a_binding_limit_is_in_the_csv(client):
+    body = {**_request(format="csv"), "timing": {"method": "quintic"}}
+    answer = _post(client, {**body, "output": {"dt": 0.01}}).json()
+    binding = answer["binding"]
+    assert _metadata(_post(client, body).text)["binding"] == [f"{binding['kind']}, joint {binding['joint']}, s = {binding['s']!r}"]
+
+
+def _job_answer(client, job: dict, **headers):
+    response = client.post("/v1/jobs", json=job)
+    assert response.status_code == 202, response.text
+    job_id, give_up = response.json()["id"], time.monotonic() + 120.0
+    while client.get(f"/v1/jobs/{job_id}").json()["status"] in ("queued", "running"):
+        assert time.monotonic() < give_up, f"job {job_id} still running"
+        time.sleep(0.05)
+    return client.get(f"/v1/jobs/{job_id}/result", headers=headers)
+
+
+def test_a_job_answers_in_the_format_asked_as_the_synchronous_endpoint(client):
+    synchronous = _post(client, _request(format="csv"))
+    asked = _job_answer(client, {"trajectory": _request(format="csv")}, accept="application/json")
+    assert asked.headers["content-type"] == synchronous.headers["content-type"] and asked.text == synchronous.text
+    accepted = _job_answer(client, {"trajectory": _request(exact_period=True)}, accept="text/csv")
+    assert accepted.headers["content-type"].startswith("text/csv") and accepted.text == synchronous.text
+    assert _job_answer(client, {"trajectory": _request(exact_period=True)}).headers["content-type"] == "application/json"
+    ros = _job_answer(client, {"trajectory": _request(format="joint_trajectory")}, accept="text/csv")  # the format asked wins
+    assert ros.json()["joint_trajectory"] == _post(client, _request(format="joint_trajectory")).json()["joint_trajectory"]
+    compared = _job_answer(client, {"compare": {"robot": "ur5", "path": PATH, "methods": ["quintic"]}}, accept="text/csv")
+    assert compared.headers["content-type"] == "application/json" and compared.json()["results"][0]["method"] == "quintic"
