@@ -4,6 +4,9 @@ to ``MAX_NODE_BYTES``, and the counters read back into the search's statistics."
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from planners.generators.search import search_kernels as kernels
@@ -24,6 +27,10 @@ MAX_NODE_BYTES = 2**27
 ROW_BYTES = 11 * 8 + 3 * 8
 #: Rows allocated at first.
 FIRST_ROWS = 4_096
+# the compiled kernels, called with the table's arrays unpacked
+_child: Callable[..., Any] = kernels.child
+_run_chunk: Callable[..., Any] = kernels.run_chunk
+_settle_t4: Callable[..., Any] = kernels.settle_t4
 
 
 class NodeTable:
@@ -68,18 +75,18 @@ class NodeTable:
 
     def child(self, parent: int, state: int, edge: int, piece: int, ending: int) -> None:
         """A first move from the root (``kernels.child`` with no parent key)."""
-        kernels.child(*self._queue(), parent, state, edge, piece, ending, 0.0, *self.bounds)
+        _child(*self._queue(), parent, state, edge, piece, ending, 0.0, *self.bounds)
 
     def chunk(self, max_expansions: int) -> tuple[int, int]:
         """``kernels.run_chunk``: what stopped it and the node concerned."""
-        status, index = kernels.run_chunk(
+        status, index = _run_chunk(
             *self._queue(), CHUNK_POPS, max_expansions, self.room, self.out_key, *self.moves, *self.bounds
         )
         return int(status), int(index)
 
     def settle(self, index: int, t4: float, upper_margin: float) -> None:
         """Node ``index``, popped at ``out_key``, timed at ``t4`` (``kernels.settle_t4``)."""
-        kernels.settle_t4(*self._queue(), upper_margin, index, float(self.out_key[0]), t4)
+        _settle_t4(*self._queue(), upper_margin, index, float(self.out_key[0]), t4)
 
     def grow(self) -> bool:
         """Twice the rows (node table and heap); False when that passes ``MAX_NODE_BYTES``."""
