@@ -8,7 +8,9 @@ Each case is planned as the service plans it (``service.planning.plan_request``,
 its isolated worker) under its budget; each round times the case between two sets of five bare
 toppra solves (``anchors.bare_toppra`` on the typical request's path), and the ratio is the
 case's wall time over the median of those solves. Printed per case: the median wall time, the
-ratio, the duration found and the search's own figures (graph build, branch and bound, local
+ratio, the median duration found (and each round's: under a budget, the local optimization
+stops when its share is spent, so the duration depends on the machine's speed at the time) and
+the last round's search figures (graph build, branch and bound, local
 optimization's evaluations), beside the figures measured before the search was compiled
 (``BEFORE``: same machine, same command, on the commit before).
 """
@@ -94,12 +96,13 @@ def main() -> int:
             plan_request(request, Deadline(10.0 * budget))
         except ToptrajError as error:  # compiling may take the budget's share of the search
             print(f"{name:<8} warm-up: {type(error).__name__}", flush=True)
-        walls, anchors, answer = [], [], None
+        walls, anchors, answer, durations = [], [], None, []
         for _ in range(args.rounds):
             anchors += _anchor(ur5, waypoints)
             began = time.perf_counter()
             try:
                 answer = plan_request(request, Deadline(budget))
+                durations.append(answer.duration)
             except ToptrajError as error:
                 print(f"{name:<8} {type(error).__name__} after {time.perf_counter() - began:.2f} s: {error}", flush=True)
                 continue
@@ -113,7 +116,7 @@ def main() -> int:
         local = search.get("local") or [{}]
         print(
             f"{name:<8} wall {wall:7.3f} s  ratio {wall / anchor:7.0f}x (goal <= {goal}x; toppra {1e3 * anchor:.2f} ms)  "
-            f"duration {answer.duration:.5f} s  build {search.get('prepare_s', 0.0):.3f} s  "
+            f"duration {statistics.median(durations):.5f} s (rounds {', '.join(f'{d:.5f}' for d in durations)})  build {search.get('prepare_s', 0.0):.3f} s  "
             f"B&B {search.get('search_s', 0.0):.3f} s  expanded {search.get('expanded')}  "
             f"local evaluations {local[0].get('evaluations')} ({local[0].get('stopped')}, {local[0].get('wall_s') or 0.0:.2f} s)",
             flush=True,
