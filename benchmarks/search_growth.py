@@ -23,12 +23,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import robots  # noqa: E402
-from planners.collision import BoxObstacle, SphereObstacle  # noqa: E402
-from planners.errors import InfeasiblePath  # noqa: E402
-from planners.generators.search.graph import SearchOptions  # noqa: E402
-from planners.generators.search.method import global_search  # noqa: E402
-from planners.generators.search.problem import build_problem  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.planners.collision import BoxObstacle, SphereObstacle  # noqa: E402
+from toptraj.planners.errors import InfeasiblePath  # noqa: E402
+from toptraj.planners.generators.search.graph import SearchOptions  # noqa: E402
+from toptraj.planners.generators.search.method import global_search  # noqa: E402
+from toptraj.planners.generators.search.problem import build_problem  # noqa: E402
 
 KINDS = {
     "geering_2r": ("torque",),

@@ -4,7 +4,7 @@ panda around a box <= 2,000x, durations no worse than before).
 
     python benchmarks/search_speed.py [--rounds 2] [--cases geering ur5 panda]
 
-Each case is planned as the service plans it (``service.planning.plan_request``, the search in
+Each case is planned as the service plans it (``toptraj.service.planning.plan_request``, the search in
 its isolated worker) under its budget; each round times the case between two sets of five bare
 toppra solves (``anchors.bare_toppra`` on the typical request's path), and the ratio is the
 case's wall time over the median of those solves. Printed per case: the median wall time, the
@@ -33,11 +33,11 @@ sys.path.insert(0, str(ROOT))
 from anchors import bare_toppra  # noqa: E402
 from end_to_end import WAYPOINTS  # noqa: E402
 
-import robots  # noqa: E402
-from planners.errors import ToptrajError  # noqa: E402
-from planners.execution.deadline import Deadline  # noqa: E402
-from service.planning import plan_request  # noqa: E402
-from service.schemas.trajectories import TrajectoryRequest  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.planners.errors import ToptrajError  # noqa: E402
+from toptraj.planners.execution.deadline import Deadline  # noqa: E402
+from toptraj.service.planning import plan_request  # noqa: E402
+from toptraj.service.schemas.trajectories import TrajectoryRequest  # noqa: E402
 
 UR5_START, UR5_GOAL = [-1.0, -1.2, 1.5, -1.9, -1.57, 0.0], [1.0, -1.2, 1.5, -1.9, -1.57, 0.0]
 PANDA_START, PANDA_GOAL = [-0.8, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8], [0.8, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8]

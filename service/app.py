@@ -9,20 +9,20 @@ from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.execution.isolated import start_worker_server
-from planners.execution.threads import single_blas_thread
-from planners.kinematics.conditioning import frobenius_condition_number
-from service import stopping
-from service.body_limit import BodySizeLimit
-from service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
-from service.jobs import JOB_MODULES, job_runner
-from service.routes import batches, health, jobs, trajectories, web
-from service.routes import robots as robot_routes
-from service.serving import open_connections
-from service.settings import Settings
-from service.workers import PlanningWorkers
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.execution.isolated import start_worker_server
+from toptraj.planners.execution.threads import single_blas_thread
+from toptraj.planners.kinematics.conditioning import frobenius_condition_number
+from toptraj.service import stopping
+from toptraj.service.body_limit import BodySizeLimit
+from toptraj.service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
+from toptraj.service.jobs import JOB_MODULES, job_runner
+from toptraj.service.routes import batches, guide, health, jobs, trajectories, web
+from toptraj.service.routes import robots as robot_routes
+from toptraj.service.serving import open_connections
+from toptraj.service.settings import Settings
+from toptraj.service.workers import PlanningWorkers
 
 
 def _warm_up() -> None:
@@ -47,7 +47,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
     settings = settings or Settings()
-    single_blas_thread()  # plannings run side by side; see planners.execution.threads
+    single_blas_thread()  # plannings run side by side; see toptraj.planners.execution.threads
     robots.configure_uploads(
         settings.data_dir,
         max_uploads=settings.max_uploads,
@@ -76,6 +76,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app = FastAPIOffline(
         title="toptraj",
         summary="Time-optimal trajectories with torques for URDF robot arms.",
+        description="The guide: [/guide/](/guide/) (concepts, methods, errors, jobs, the Python client). The web page: [/](/).",
         version="0.1.0",
         lifespan=lifespan,
         default_response_class=FiniteJSONResponse,
@@ -94,4 +95,5 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(jobs.router)
     app.include_router(batches.router)
     app.include_router(web.router)
+    app.include_router(guide.router)
     return app

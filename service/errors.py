@@ -31,10 +31,10 @@ from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
-from planners.errors import BudgetExceeded
-from robots import ToptrajError
-from robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
-from service.schemas.common import Problem
+from toptraj.planners.errors import BudgetExceeded
+from toptraj.robots import ToptrajError
+from toptraj.robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
+from toptraj.service.schemas.common import Problem
 
 PROBLEM_JSON = "application/problem+json"
 logger = logging.getLogger("toptraj")
@@ -66,11 +66,11 @@ STATUS: dict[type[ToptrajError], int] = {
 
 def status_of(error: ToptrajError) -> int:
     """The HTTP status of ``error``: ``STATUS`` of its class or nearest base there; an error
-    class of the service itself (``service.*``: a busy queue, an unknown job) states its own."""
+    class of the service itself (``toptraj.service.*``: a busy queue, an unknown job) states its own."""
     for cls in type(error).__mro__:
         if cls in STATUS:
             return STATUS[cls]
-        if cls.__module__.partition(".")[0] == "service" and "status" in vars(cls):
+        if cls.__module__.startswith("toptraj.service.") and "status" in vars(cls):
             return vars(cls)["status"]
     return STATUS[ToptrajError]
 

@@ -1,5 +1,5 @@
 """The branch and bound's loop as it was in pure Python (objects and ``heapq``), kept as the
-reference the compiled loop (``planners.generators.search.search_kernels``) must agree with:
+reference the compiled loop (``toptraj.planners.generators.search.search_kernels``) must agree with:
 same subsets expanded in the same order, same grid paths found, same counts."""
 
 from __future__ import annotations
@@ -8,10 +8,10 @@ import heapq
 
 import numpy as np
 
-from planners.generators.search.bounds import forward_time
-from planners.generators.search.branch_and_bound import _Node, _Search
-from planners.generators.search.graph import DEFAULT_OPTIONS
-from planners.generators.search.outcome import GridPath
+from toptraj.planners.generators.search.bounds import forward_time
+from toptraj.planners.generators.search.branch_and_bound import _Node, _Search
+from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS
+from toptraj.planners.generators.search.outcome import GridPath
 
 SLACK = 1e-9
 
@@ -105,6 +105,6 @@ def reference_search(problem, options=DEFAULT_OPTIONS, cap: float = np.inf) -> R
 
 
 def _no_deadline():
-    from planners.execution.deadline import NO_DEADLINE
+    from toptraj.planners.execution.deadline import NO_DEADLINE
 
     return NO_DEADLINE

@@ -1,6 +1,6 @@
-"""The search's compiled arm-to-obstacle distances (``planners.generators.search.distance_kernels``,
+"""The search's compiled arm-to-obstacle distances (``toptraj.planners.generators.search.distance_kernels``,
 used by ``free_space.point_distances``) against the numpy computation they replaced: the joint
-frames of ``free_space.joint_placements`` and ``planners.collision.distance.capsule_distance``,
+frames of ``free_space.joint_placements`` and ``toptraj.planners.collision.distance.capsule_distance``,
 on random configurations of three arms, for spheres, capsules and boxes (exact everywhere, and
 exact only below a threshold, where the same configurations get the same lower bounds)."""
 
@@ -9,11 +9,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners.collision import BoxObstacle, CapsuleObstacle, SphereObstacle
-from planners.collision.distance import capsule_distance
-from planners.generators.search.free_space import joint_placements, point_distances
-from robots.collision import robot_capsules
+from toptraj import robots
+from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, SphereObstacle
+from toptraj.planners.collision.distance import capsule_distance
+from toptraj.planners.generators.search.free_space import joint_placements, point_distances
+from toptraj.robots.collision import robot_capsules
 
 OBSTACLES = (
     SphereObstacle(np.array([0.45, 0.2, 0.3]), 0.08),
@@ -50,8 +50,8 @@ def test_compiled_distances_equal_the_numpy_ones(arm, exact_below):
 
 
 def test_compiled_capsule_ends_equal_the_numpy_frames():
-    from planners.generators.search.distance_kernels import capsule_ends
-    from planners.generators.search.free_space import _chain_tables
+    from toptraj.planners.generators.search.distance_kernels import capsule_ends
+    from toptraj.planners.generators.search.free_space import _chain_tables
 
     robot = robots.load("panda")
     q = np.random.default_rng(3).uniform(-2.0, 2.0, (50, robot.dof))

@@ -1,4 +1,4 @@
-"""The compiled branch and bound (``planners.generators.search.search_kernels``) against the
+"""The compiled branch and bound (``toptraj.planners.generators.search.search_kernels``) against the
 pure-Python loop it replaced (``tests.search_reference``): on the Geering arm's lattices, with
 and without an obstacle, every revolution variant of the goal, an upper margin and a cap, the
 same grid paths are found with the same times and bounds, after the same subsets were
@@ -9,13 +9,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import robots
-from planners.collision import SphereObstacle
-from planners.execution.deadline import NO_DEADLINE
-from planners.generators.search import build_problem
-from planners.generators.search.branch_and_bound import _Search
-from planners.generators.search.graph import SearchOptions
-from planners.generators.search.problem import toward_goal
+from toptraj import robots
+from toptraj.planners.collision import SphereObstacle
+from toptraj.planners.execution.deadline import NO_DEADLINE
+from toptraj.planners.generators.search import build_problem
+from toptraj.planners.generators.search.branch_and_bound import _Search
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.problem import toward_goal
 from tests.search_reference import reference_search
 
 SPHERE = SphereObstacle(np.array([0.52, 0.28, 0.0]), 0.05)
@@ -58,7 +58,7 @@ def test_the_compiled_search_expands_and_finds_what_the_python_loop_did(cells, o
 def test_the_node_table_stops_growing_at_its_most_bytes(monkeypatch):
     """A variant no grid path reaches, searched without a cap, fills the node table: at
     ``MAX_NODE_BYTES`` the search stops, incomplete, before ``max_expansions``."""
-    import planners.generators.search.node_table as node_table
+    import toptraj.planners.generators.search.node_table as node_table
 
     monkeypatch.setattr(node_table, "MAX_NODE_BYTES", 2**20)
     robot = robots.load("geering_2r")

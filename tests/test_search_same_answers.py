@@ -9,10 +9,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import robots
-from planners.collision import BoxObstacle, SphereObstacle
-from planners.generators.search.graph import SearchOptions
-from planners.generators.search.method import global_search
+from toptraj import robots
+from toptraj.planners.collision import BoxObstacle, SphereObstacle
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.method import global_search
 
 
 def test_the_geering_example_finds_the_same_grid_path_after_the_same_expansions():

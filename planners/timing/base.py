@@ -10,14 +10,14 @@ from functools import cached_property
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.state_kernels import grid_states
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.state_kernels import grid_states
 
 #: Largest estimated relative gap to the converged optimum that a time-optimal answer carries
 #: without being refined further or, when it cannot be, without a warning that gives the figure
-#: (``PathTiming.optimality_gap``; the policy in ``planners.runner.accuracy``).
+#: (``PathTiming.optimality_gap``; the policy in ``toptraj.planners.runner.accuracy``).
 GAP_TARGET = 1e-3
 
 
@@ -215,7 +215,7 @@ class TimingMethod(abc.ABC):
         continuous_acceleration: Whether the method's path acceleration is continuous, so that
             the jerk of its samples (by finite differences) is checked against a jerk limit too.
         absolute_tolerances: Whether the method's solver works with absolute tolerances, so
-            that it needs path speeds of order one (``planners.timing.scaled``).
+            that it needs path speeds of order one (``toptraj.planners.timing.scaled``).
         grid_budget: The largest grid the method serves, in grid intervals times joints: its
             memory grows with both (about 1.3 kB per interval and joint for phase_plane,
             2.3 kB for toppra, 9 kB for min_cost; ``benchmarks/budgets.py``). 140,000 is

@@ -1,5 +1,5 @@
 """A free motion to plan (start and goal configurations, boundary velocities, the number of
-collocation intervals) and the collocation's answer (``planners.generators.collocation.collocation``, Jeong &
+collocation intervals) and the collocation's answer (``toptraj.planners.generators.collocation.collocation``, Jeong &
 Lee section 4): the motion at its K + 1 instants with its torques, its cost and how the solver
 got there.
 """

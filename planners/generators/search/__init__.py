@@ -20,11 +20,11 @@ timings (``local``; about 2 ms each on the Geering arm, 10 ms on ur5, on that ma
 it converges or its share of the budget is spent.
 """
 
-from planners.generators.search.branch_and_bound import branch_and_bound, enumerate_grid_paths
-from planners.generators.search.curve import GridSplinePath
-from planners.generators.search.graph import SearchOptions
-from planners.generators.search.outcome import GridPath, SearchResult, SearchStatistics
-from planners.generators.search.problem import SearchProblem, build_problem
+from toptraj.planners.generators.search.branch_and_bound import branch_and_bound, enumerate_grid_paths
+from toptraj.planners.generators.search.curve import GridSplinePath
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.outcome import GridPath, SearchResult, SearchStatistics
+from toptraj.planners.generators.search.problem import SearchProblem, build_problem
 
 __all__ = [
     "GridPath",

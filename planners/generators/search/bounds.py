@@ -11,11 +11,11 @@ Dubowsky 1991), each a bound on the next, so that t1 <= t2 <= t3 <= t4 = t_opt:
 3. maximum acceleration, velocity limit, maximum deceleration (eq. 2.8): the speed no higher
    than the maximum-acceleration curve from rest at the start, the velocity limit curve, and
    the maximum-deceleration curve into rest at the goal;
-4. t4 = t_opt: the phase-plane timing of the grid path (``planners.timing.phase_plane.method``).
+4. t4 = t_opt: the phase-plane timing of the grid path (``toptraj.planners.timing.phase_plane.method``).
 
 All four are computed in the discretization the phase-plane method uses on the same grid (x =
 sd^2 linear in the curve's parameter over each interval, every limit row held at both ends of it;
-``planners.constraints.admissible_kernels.interval_bounds`` gives the rows of each interval as bounds on u), so each is
+``toptraj.planners.constraints.admissible_kernels.interval_bounds`` gives the rows of each interval as bounds on u), so each is
 a lower bound on the discrete t4 of that grid, which ``grid_path_time`` computes with the
 phase-plane method itself. Viscous friction, which the phase-plane method linearizes, is relaxed
 to the widest bounds it can take below the first-order speed bound. t1 and t2 add up over the
@@ -30,12 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
-from planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
-from planners.generators.search.curve import GridSplinePath
-from planners.generators.search.pieces import INTERVALS, Pieces
-from planners.timing.phase_plane.method import PhasePlaneMethod
-from robots import JointLimits, Robot
+from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
+from toptraj.planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
+from toptraj.planners.generators.search.curve import GridSplinePath
+from toptraj.planners.generators.search.pieces import INTERVALS, Pieces
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.robots import JointLimits, Robot
 
 _INF = np.inf
 #: Rows of limits evaluated between two deadline checks.
@@ -74,7 +74,7 @@ class PieceBounds:
 def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
     """Rows ``a u + b x + c in [lower, upper]`` at configurations q with parameter derivatives
     dq, ddq (each (k, n)), viscous friction relaxed below the speed bound, and that bound
-    x_bound (k,): the rows of ``planners.constraints.path_constraints.build_path_constraints``."""
+    x_bound (k,): the rows of ``toptraj.planners.constraints.path_constraints.build_path_constraints``."""
     x_bound = np.full(len(q), _INF)
     if "velocity" in kinds:
         x_bound = speed_bound(limits, dq)[0] ** 2
@@ -244,8 +244,8 @@ def path_time(intervals, ds, p, q, r, cap_start, cap_end):  # pragma: no cover -
 
 
 def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds) -> float:
-    """t4 (s): the phase-plane method (``planners.timing.phase_plane.method``, without refinement) on
-    the curve of the grid path through ``points`` (``planners.generators.search.curve``), on the grid of
+    """t4 (s): the phase-plane method (``toptraj.planners.timing.phase_plane.method``, without refinement) on
+    the curve of the grid path through ``points`` (``toptraj.planners.generators.search.curve``), on the grid of
     its pieces (``INTERVALS`` per span)."""
     curve = GridSplinePath(points)
     s = np.linspace(0.0, 1.0, curve.spans * INTERVALS + 1)

@@ -28,14 +28,14 @@ import time
 
 import numpy as np
 
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search import search_kernels as kernels
-from planners.generators.search.bounds import grid_path_time, path_time
-from planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
-from planners.generators.search.node_table import NodeTable
-from planners.generators.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
-from planners.generators.search.problem import SearchProblem
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search import search_kernels as kernels
+from toptraj.planners.generators.search.bounds import grid_path_time, path_time
+from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
+from toptraj.planners.generators.search.node_table import NodeTable
+from toptraj.planners.generators.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
+from toptraj.planners.generators.search.problem import SearchProblem
 
 
 class _Node:

@@ -1,7 +1,7 @@
 """Compiled arm-to-obstacle distances for the search (``free_space.point_distances``): the link
 capsules' end points at many configurations (the forward kinematics of a chain of revolute and
 prismatic joints, Rodrigues' formula per joint) and their signed distances to one obstacle, the
-same computations as ``free_space.joint_placements`` and ``planners.collision.distance`` in
+same computations as ``free_space.joint_placements`` and ``toptraj.planners.collision.distance`` in
 numpy (sphere: point to segment; capsule: segment to segment, Ericson §5.1.9; box: golden
 section along the segment of the convex signed distance, exact where the ball bound cannot
 decide), one configuration at a time without temporaries.
@@ -16,10 +16,10 @@ import math
 import numpy as np
 from numba import njit
 
-from planners.collision.obstacles import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
+from toptraj.planners.collision.obstacles import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 
 SPHERE, CAPSULE, BOX = 0, 1, 2
-#: Steps of the golden-section search along a segment (as ``planners.collision.distance``).
+#: Steps of the golden-section search along a segment (as ``toptraj.planners.collision.distance``).
 GOLDEN_STEPS = 28
 _RATIO = (math.sqrt(5.0) - 1.0) / 2.0
 _TINY = 1e-18

@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.collision import Obstacle, clearance_along
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.curve import BASIS
-from planners.generators.search.distance_kernels import capsule_ends, lower_distances, obstacle_row
-from planners.generators.search.pieces import Pieces
-from robots import Robot
-from robots.collision import robot_capsules
+from toptraj.planners.collision import Obstacle, clearance_along
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search.curve import BASIS
+from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, obstacle_row
+from toptraj.planners.generators.search.pieces import Pieces
+from toptraj.robots import Robot
+from toptraj.robots.collision import robot_capsules
 
 #: Largest arm motion (m) between the samples of a piece near an obstacle.
 COARSE_STEP = 0.02
@@ -117,9 +117,9 @@ _TABLES: dict[int, tuple] = {}
 def point_distances(
     robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exact_below: float = np.inf, deadline: Deadline = NO_DEADLINE
 ) -> np.ndarray:
-    """Smallest signed distance (m) of the arm's link capsules (``robots.collision``) to any
+    """Smallest signed distance (m) of the arm's link capsules (``toptraj.robots.collision``) to any
     obstacle at each configuration (k, n_dof); distances above ``exact_below`` may be lower
-    bounds (``planners.collision.distance.capsule_distance``), computed by the compiled
+    bounds (``toptraj.planners.collision.distance.capsule_distance``), computed by the compiled
     ``distance_kernels``. ``deadline`` is checked before each obstacle of each ``BATCH`` of
     configurations."""
     out = np.empty(len(q))

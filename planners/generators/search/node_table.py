@@ -1,4 +1,4 @@
-"""The branch and bound's subsets and queue as arrays (``planners.generators.search.search_kernels``):
+"""The branch and bound's subsets and queue as arrays (``toptraj.planners.generators.search.search_kernels``):
 the problem's moves laid out for the compiled loop, the node table and heap grown by doubling up
 to ``MAX_NODE_BYTES``, and the counters read back into the search's statistics."""
 
@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from planners.generators.search import search_kernels as kernels
-from planners.generators.search.outcome import SearchStatistics
-from planners.generators.search.problem import SearchProblem
+from toptraj.planners.generators.search import search_kernels as kernels
+from toptraj.planners.generators.search.outcome import SearchStatistics
+from toptraj.planners.generators.search.problem import SearchProblem
 
 #: Relative slack of a bound over t_u before it discards (float rounding between the bound's
 #: and the phase-plane method's sums of the same intervals).
@@ -21,7 +21,7 @@ SLACK = 1e-9
 CHUNK_POPS = 1_024
 #: Most bytes of the node table and heap together (112 bytes a subset: about 1.2 million
 #: subsets): beyond, the search stops as at ``max_expansions``. The isolated worker's memory
-#: cap allows 1 GiB above the search's estimate (``planners.generators.search.memory``).
+#: cap allows 1 GiB above the search's estimate (``toptraj.planners.generators.search.memory``).
 MAX_NODE_BYTES = 2**27
 #: Bytes per row: five 8-byte ints and six 8-byte floats of the node, and a heap entry.
 ROW_BYTES = 11 * 8 + 3 * 8

@@ -1,4 +1,4 @@
-"""The compiled inner loop of the branch and bound (``planners.generators.search.branch_and_bound``):
+"""The compiled inner loop of the branch and bound (``toptraj.planners.generators.search.branch_and_bound``):
 best-first over subsets of grid paths with the tests t1, t2, t3 of Jeong & Lee section 2.4
 (eqs. 2.6 to 2.8), in flat arrays instead of Python objects.
 
@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from planners.generators.search.bounds import forward_time, path_time
+from toptraj.planners.generators.search.bounds import forward_time, path_time
 
 # node columns
 STATE, EDGE, PARENT, PIECE, COMPLETE = 0, 1, 2, 3, 4
