@@ -92,14 +92,17 @@ def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
 def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds, deadline) -> PieceBounds:
     """The bounds of every piece (t1, t2 and the arrays t3 runs on)."""
     count = len(pieces.ds)
-    parts = []
+    p = q = r = np.empty((count, 0))
+    cap_start, cap_end = np.empty(count), np.empty(count)
     for begin in range(0, count, CHUNK):
         deadline.check()
         rows = slice(begin, begin + CHUNK)
         start = _rows(robot, limits, kinds, pieces.q0[rows], pieces.dq0[rows], pieces.ddq0[rows])
         end = _rows(robot, limits, kinds, pieces.q1[rows], pieces.dq1[rows], pieces.ddq1[rows])
-        parts.append(_interval_arrays(pieces.ds[rows], start, end))
-    p, q, r, cap_start, cap_end = (np.concatenate([part[i] for part in parts]) for i in range(5))
+        part = _interval_arrays(pieces.ds[rows], start, end)
+        if begin == 0:  # the rows' count is known now: the arrays filled in place, chunk by chunk
+            p, q, r = (np.empty((count, part[0].shape[1])) for _ in range(3))
+        p[rows], q[rows], r[rows], cap_start[rows], cap_end[rows] = part
     owner = np.repeat(np.arange(len(pieces)), np.diff(pieces.first))
     last = np.zeros(count, dtype=bool)
     last[pieces.first[1:] - 1] = True
@@ -153,7 +156,7 @@ def _interval_arrays(ds, start, end):
         np.ascontiguousarray(a1), np.ascontiguousarray(b1), np.ascontiguousarray(c1),
         np.ascontiguousarray(lo1), np.ascontiguousarray(up1), np.ascontiguousarray(xb1),
     )[4]
-    return p[0::2].copy(), q[0::2].copy(), r[0::2].copy(), x_high[0::2].copy(), cap_end
+    return p[0::2], q[0::2], r[0::2], x_high[0::2], cap_end
 
 
 @njit(cache=True, nogil=True)

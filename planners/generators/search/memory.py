@@ -34,6 +34,10 @@ it starts (``check_search_memory``: ``OverMemory`` naming the setting and the la
 served with the others unchanged); a worker process running one is also capped by the system
 (``toptraj.planners.runner.timed_free``: twice the estimate and 1 GiB), so that an estimate that is too low
 is a clear error rather than the system killing a process.
+
+The branch and bound's subsets (``toptraj.planners.generators.search.node_table``, 112 bytes each) are
+not in the estimate: their table stops growing at ``MAX_NODE_BYTES`` (128 MiB), which the
+worker's 1 GiB above the estimate holds, and the search then stops as at ``max_expansions``.
 """
 
 from __future__ import annotations

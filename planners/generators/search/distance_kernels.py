@@ -1,0 +1,184 @@
+"""Compiled arm-to-obstacle distances for the search (``free_space.point_distances``): the link
+capsules' end points at many configurations (the forward kinematics of a chain of revolute and
+prismatic joints, Rodrigues' formula per joint) and their signed distances to one obstacle, the
+same computations as ``free_space.joint_placements`` and ``toptraj.planners.collision.distance`` in
+numpy (sphere: point to segment; capsule: segment to segment, Ericson §5.1.9; box: golden
+section along the segment of the convex signed distance, exact where the ball bound cannot
+decide), one configuration at a time without temporaries.
+
+Shapes: q (k, n_dof) in rad or m; capsule ends (k, C, 3) in m; distances (k,) in m.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from toptraj.planners.collision.obstacles import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
+
+SPHERE, CAPSULE, BOX = 0, 1, 2
+#: Steps of the golden-section search along a segment (as ``toptraj.planners.collision.distance``).
+GOLDEN_STEPS = 28
+_RATIO = (math.sqrt(5.0) - 1.0) / 2.0
+_TINY = 1e-18
+
+
+def obstacle_row(obstacle: Obstacle) -> tuple[int, np.ndarray]:
+    """The obstacle as (kind, parameters (18,)): center or a (3), b (3), radius, half sizes
+    (3), rotation (9, row-major)."""
+    row = np.zeros(19)
+    if isinstance(obstacle, SphereObstacle):
+        row[0:3], row[6] = obstacle.center, obstacle.radius
+        return SPHERE, row
+    if isinstance(obstacle, CapsuleObstacle):
+        row[0:3], row[3:6], row[6] = obstacle.a, obstacle.b, obstacle.radius
+        return CAPSULE, row
+    if isinstance(obstacle, BoxObstacle):
+        row[0:3], row[7:10] = obstacle.center, np.asarray(obstacle.size, dtype=float) / 2.0
+        row[10:19] = np.asarray(obstacle.rotation, dtype=float).ravel()
+        row[6] = float(np.linalg.norm(obstacle.size)) / 2.0
+        return BOX, row
+    raise TypeError(f"unknown obstacle {obstacle!r}")
+
+
+@njit(cache=True, nogil=True)
+def capsule_ends(q, parent, rotation0, translation0, prismatic, axis, index, joint, local_a, local_b):  # pragma: no cover - compiled
+    """End points a, b (k, C, 3) of the capsules (attached to ``joint`` (C,), local ends
+    ``local_a``, ``local_b`` (C, 3)) at configurations q (k, n): joint j's frame is its
+    parent's times its placement (``rotation0`` (J, 3, 3), ``translation0`` (J, 3)) times its
+    motion about or along ``axis`` (J, 3) by q[:, index[j]]."""
+    k, n_joints, n_caps = q.shape[0], parent.shape[0], joint.shape[0]
+    a = np.empty((k, n_caps, 3))
+    b = np.empty((k, n_caps, 3))
+    rot = np.zeros((n_joints, 3, 3))
+    trans = np.zeros((n_joints, 3))
+    base = np.empty((3, 3))
+    turn = np.empty((3, 3))
+    for row in range(k):
+        for i in range(3):
+            for m in range(3):
+                rot[0, i, m] = 1.0 if i == m else 0.0
+            trans[0, i] = 0.0
+        for j in range(1, n_joints):
+            p = parent[j]
+            for i in range(3):
+                trans[j, i] = trans[p, i]
+                for m in range(3):
+                    trans[j, i] += rot[p, i, m] * translation0[j, m]
+                    total = 0.0
+                    for w in range(3):
+                        total += rot[p, i, w] * rotation0[j, w, m]
+                    base[i, m] = total
+            value = q[row, index[j]]
+            x, y, z = axis[j, 0], axis[j, 1], axis[j, 2]
+            if prismatic[j]:
+                for i in range(3):
+                    trans[j, i] += value * (base[i, 0] * x + base[i, 1] * y + base[i, 2] * z)
+                    for m in range(3):
+                        rot[j, i, m] = base[i, m]
+                continue
+            s, c = math.sin(value), 1.0 - math.cos(value)
+            # I + s K + c K^2 with K the cross-product matrix of the axis
+            turn[0, 0], turn[0, 1], turn[0, 2] = 1.0 - c * (y * y + z * z), -s * z + c * x * y, s * y + c * x * z
+            turn[1, 0], turn[1, 1], turn[1, 2] = s * z + c * x * y, 1.0 - c * (x * x + z * z), -s * x + c * y * z
+            turn[2, 0], turn[2, 1], turn[2, 2] = -s * y + c * x * z, s * x + c * y * z, 1.0 - c * (x * x + y * y)
+            for i in range(3):
+                for m in range(3):
+                    rot[j, i, m] = base[i, 0] * turn[0, m] + base[i, 1] * turn[1, m] + base[i, 2] * turn[2, m]
+        for cap in range(n_caps):
+            j = joint[cap]
+            for i in range(3):
+                a[row, cap, i] = trans[j, i] + rot[j, i, 0] * local_a[cap, 0] + rot[j, i, 1] * local_a[cap, 1] + rot[j, i, 2] * local_a[cap, 2]
+                b[row, cap, i] = trans[j, i] + rot[j, i, 0] * local_b[cap, 0] + rot[j, i, 1] * local_b[cap, 1] + rot[j, i, 2] * local_b[cap, 2]
+    return a, b
+
+
+@njit(cache=True, nogil=True)
+def _point_segment(p, a, b):  # pragma: no cover - compiled
+    ab0, ab1, ab2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    length2 = ab0 * ab0 + ab1 * ab1 + ab2 * ab2
+    t = 0.0
+    if length2 > 0.0:
+        t = ((p[0] - a[0]) * ab0 + (p[1] - a[1]) * ab1 + (p[2] - a[2]) * ab2) / length2
+        t = min(max(t, 0.0), 1.0)
+    d0, d1, d2 = p[0] - (a[0] + t * ab0), p[1] - (a[1] + t * ab1), p[2] - (a[2] + t * ab2)
+    return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
+@njit(cache=True, nogil=True)
+def _segment_segment(p1, q1, p2, q2):  # pragma: no cover - compiled
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e, f = np.dot(d1, d1), np.dot(d2, d2), np.dot(d2, r)
+    c, b = np.dot(d1, r), np.dot(d1, d2)
+    denom = a * e - b * b
+    s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > _TINY else 0.0
+    t = (b * s + f) / e if e > _TINY else 0.0
+    if t < 0.0:
+        s = min(max(-c / a, 0.0), 1.0) if a > _TINY else 0.0
+    elif t > 1.0:
+        s = min(max((b - c) / a, 0.0), 1.0) if a > _TINY else 0.0
+    t = min(max(t, 0.0), 1.0)
+    return np.linalg.norm(p1 + s * d1 - (p2 + t * d2))
+
+
+@njit(cache=True, nogil=True)
+def _box_at(la, lb, half, t):  # pragma: no cover - compiled
+    outside, inside = 0.0, -np.inf
+    for i in range(3):
+        excess = abs(la[i] + t * (lb[i] - la[i])) - half[i]
+        if excess > 0.0:
+            outside += excess * excess
+        inside = max(inside, excess)
+    return math.sqrt(outside) + min(inside, 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _segment_box(a, b, row):  # pragma: no cover - compiled
+    la, lb = np.empty(3), np.empty(3)
+    for i in range(3):
+        la[i] = (a[0] - row[0]) * row[10 + i] + (a[1] - row[1]) * row[13 + i] + (a[2] - row[2]) * row[16 + i]
+        lb[i] = (b[0] - row[0]) * row[10 + i] + (b[1] - row[1]) * row[13 + i] + (b[2] - row[2]) * row[16 + i]
+    half = row[7:10]
+    lo, hi = 0.0, 1.0
+    for _ in range(GOLDEN_STEPS):
+        c, d = hi - _RATIO * (hi - lo), lo + _RATIO * (hi - lo)
+        if _box_at(la, lb, half, c) < _box_at(la, lb, half, d):
+            hi = d
+        else:
+            lo = c
+    return min(_box_at(la, lb, half, (lo + hi) / 2.0), _box_at(la, lb, half, 0.0), _box_at(la, lb, half, 1.0))
+
+
+@njit(cache=True, nogil=True)
+def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: no cover - compiled
+    """``nearest`` (k,) lowered to each configuration's least signed distance of its capsules
+    (a, b (k, C, 3), ``radius`` (C,)) to the obstacle (``obstacle_row``). For a box, the
+    distance is exact where its ball bound is below ``exact_below`` or below the least
+    distance to its center over all the configurations given, a lower bound elsewhere."""
+    k, n_caps = a.shape[0], a.shape[1]
+    center = row[0:3]
+    if kind == SPHERE:
+        for i in range(k):
+            for c in range(n_caps):
+                nearest[i] = min(nearest[i], _point_segment(center, a[i, c], b[i, c]) - radius[c] - row[6])
+        return
+    if kind == CAPSULE:
+        for i in range(k):
+            for c in range(n_caps):
+                nearest[i] = min(nearest[i], _segment_segment(a[i, c], b[i, c], row[0:3], row[3:6]) - radius[c] - row[6])
+        return
+    to_center = np.empty((k, n_caps))
+    least = np.inf
+    for i in range(k):
+        for c in range(n_caps):
+            to_center[i, c] = _point_segment(center, a[i, c], b[i, c]) - radius[c]
+            least = min(least, to_center[i, c])
+    threshold = max(exact_below, least)
+    for i in range(k):
+        for c in range(n_caps):
+            lower = to_center[i, c] - row[6]
+            if lower < threshold:
+                lower = _segment_box(a[i, c], b[i, c], row) - radius[c]
+            nearest[i] = min(nearest[i], lower)

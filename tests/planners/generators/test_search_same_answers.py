@@ -1,0 +1,45 @@
+"""The compiled search answers what the search answered before it was compiled, on the cases of
+``tests/test_search.py`` and ``benchmarks/search_growth.py``: the same best grid path time, the
+same pieces removed by the obstacles and the same count of subsets expanded (figures recorded
+from the pure-Python search on the same cases)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from toptraj import robots
+from toptraj.planners.collision import BoxObstacle, SphereObstacle
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.method import global_search
+
+
+def test_the_geering_example_finds_the_same_grid_path_after_the_same_expansions():
+    """examples/geering_search_obstacle.json's search: the elbow's -2 pi turn at 1.5107 s, after
+    220,891 subsets expanded over the three goal variants (200,000 of them in the variant no grid
+    path reaches, stopped by ``max_expansions``)."""
+    robot = robots.load("geering_2r")
+    sphere = SphereObstacle(np.array([0.52, 0.28, 0.0]), 0.05)
+    found = global_search(robot, robot.limits, ("torque",), np.zeros(2), np.array([0.76, 0.0]), SearchOptions(tubes=1), True, (sphere,), 0.01)
+    stats = found.result.statistics
+    assert found.result.tubes[0].time == pytest.approx(1.5107493207030294, rel=1e-12)
+    assert stats.expanded == 220_891 and stats.generated == 518_482
+    assert stats.pruned == {"t1": 75_639, "t2": 37_146, "t3": 72_152, "t4": 0, "t_u": 20_500}
+    assert not stats.complete  # the unreachable variant stopped at max_expansions
+
+
+def test_ur5_around_a_box_finds_the_same_roadmap_path():
+    """benchmarks/search_growth.py's ur5 at 100 roadmap points: a 10 cm box where the tool is
+    halfway along the straight joint line; best grid path 1.5796 s, 8 subsets expanded."""
+    robot = robots.load("ur5")
+    start, goal = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]), np.array([1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    pin.framesForwardKinematics(robot.model, robot.data, robot.configuration(((start + goal) / 2.0)[None])[0])
+    tool = np.array(robot.data.oMf[robot.frame_id(robot.end_effector)].translation)
+    box = BoxObstacle(tool, np.array([0.1, 0.1, 0.1]))
+    found = global_search(
+        robot, robot.limits, ("velocity", "acceleration", "torque"), start, goal, SearchOptions(roadmap_points=100, tubes=1), True, (box,), 0.01
+    )
+    stats = found.result.statistics
+    assert stats.best_grid_time == pytest.approx(1.5796, abs=1e-4)
+    assert stats.expanded == 8 and stats.removed_by_obstacles > 0
