@@ -96,15 +96,12 @@ STAGES = (
 def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int]:
     """(points of the grids the answer was timed on, points of the grids its constraints were
     first built on), over its stretches: what ``toptraj.planners.plan`` times, without the sampling."""
-    from toptraj.planners.checks.gate import gate_threshold
-    from toptraj.planners.execution.deadline import NO_DEADLINE
-    from toptraj.planners.problem.requests import check_constraint_kinds, timing_method
-    from toptraj.planners.problem.waypoints import make_path
-    from toptraj.planners.runner.given_path import timed_path
+    from toptraj.planners.problem.build import build_problem
+    from toptraj.planners.runner.choice import method_for
+    from toptraj.planners.runner.run import _given_path
 
-    method = timing_method(timing)
-    kinds = check_constraint_kinds(timing.constraints, method)
-    timed = timed_path(robot, make_path(robot, path_spec), method, timing, kinds, robot.limits, NO_DEADLINE, gate_threshold(0.0))
+    problem = build_problem(robot, path_spec, method_for(timing, path_spec), timing)
+    timed, _ = _given_path(problem, problem.deadline)
     return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 

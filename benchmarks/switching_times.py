@@ -23,9 +23,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from toptraj import robots  # noqa: E402
 from toptraj.planners import Timing, plan  # noqa: E402
-from toptraj.planners.generators.collocation import FreeMotion  # noqa: E402
 from toptraj.planners.generators.collocation.collocation import _optimize_motion  # noqa: E402
 from toptraj.planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching  # noqa: E402
+from toptraj.planners.problem.free_motion import FreeMotion  # noqa: E402
 
 
 def answer(arm, phi_b: float, revolutions: bool):

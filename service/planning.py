@@ -15,11 +15,11 @@ from toptraj.planners import CartesianLine, Deadline, PlannedTrajectory, Timing,
 from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE
-from toptraj.planners.generators.collocation import FreeMotion
 from toptraj.planners.generators.search import SearchOptions
 from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-from toptraj.planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from toptraj.planners.problem.boundary import finite_vector
+from toptraj.planners.problem.build import DEFAULT_CLEARANCE, MAX_SAMPLES
+from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
 from toptraj.service.errors import non_finite_answer, status_of

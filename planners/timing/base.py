@@ -7,6 +7,7 @@ from __future__ import annotations
 import abc
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import ClassVar, Literal
 
 import numpy as np
 
@@ -206,6 +207,8 @@ class TimingMethod(abc.ABC):
     """A way to time a path: reads ``PathConstraints``, returns a ``PathTiming``.
 
     Attributes:
+        family: ``"timing"``: the family of methods that time a given path (the other,
+            ``"generator"``, finds the motion itself: ``toptraj.planners.problem.methods``).
         name: The ``timing.method`` name.
         kinds: The limit kinds the method can respect.
         takes_duration: Whether a requested duration is honoured.
@@ -222,6 +225,7 @@ class TimingMethod(abc.ABC):
             20,000 intervals on a 7-joint arm, about 300 MB at most.
     """
 
+    family: ClassVar[Literal["timing"]] = "timing"
     name: str
     kinds: frozenset[str] = frozenset({"velocity", "acceleration", "torque"})
     required_kinds: frozenset[str] = frozenset()

@@ -35,10 +35,11 @@ from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline, Progress
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
-from toptraj.planners.generators.collocation.motion import CollocationResult, FreeMotion
+from toptraj.planners.generators.collocation.motion import CollocationResult
 from toptraj.planners.generators.collocation.sparse import SparseCollocation, solve_sparse
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.waypoints import SplinePath
+from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.robots import JointLimits, Robot
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from toptraj.planners.generators.collocation.collocation import _optimize_motion
-from toptraj.planners.generators.collocation.motion import FreeMotion
 from toptraj.planners.generators.collocation.switching import BangBang, refine_collocation, refine_switching
+from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.robots import Robot
 
 #: Largest step (rad) of phi_b between a family's solution and the next one solved from it.

@@ -38,9 +38,10 @@ import pinocchio as pin
 from scipy.optimize import minimize
 
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
-from toptraj.planners.generators.collocation.motion import CollocationResult, FreeMotion
+from toptraj.planners.generators.collocation.motion import CollocationResult
 from toptraj.planners.generators.collocation.root_finding import held_newton, jacobian, newton, secant_minimum
 from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
+from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.robots import JointLimits, Robot
 
 #: Longest Runge-Kutta step (s) while the switching times are solved for, and of the final

@@ -32,7 +32,7 @@ The estimate is conservative: ur5's default search (150 points, 10 neighbours) i
 1.45 GB. A search estimated above its cap (``DEFAULT_SEARCH_MEMORY``, 2 GiB) is refused before
 it starts (``check_search_memory``: ``OverMemory`` naming the setting and the largest value
 served with the others unchanged); a worker process running one is also capped by the system
-(``toptraj.planners.runner.timed_free``: twice the estimate and 1 GiB), so that an estimate that is too low
+(``toptraj.planners.generators.search.generator``: twice the estimate and 1 GiB), so that an estimate that is too low
 is a clear error rather than the system killing a process.
 
 The branch and bound's subsets (``toptraj.planners.generators.search.node_table``, 112 bytes each) are

@@ -1,7 +1,6 @@
-"""``search``: the name under which a free motion is searched globally (``toptraj.planners.generators.search``). It
-does not time a given path, so ``solve`` refuses one; ``global_search`` is the search itself,
-from a free motion to its best grid paths, their statistics and, for planar arms among
-obstacles, the obstacle shadows."""
+"""``global_search``: the search itself (``toptraj.planners.generators.search``), from a free
+motion to its best grid paths, their statistics and, for planar arms among obstacles, the
+obstacle shadows."""
 
 from __future__ import annotations
 
@@ -11,8 +10,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.collision import Obstacle
-from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.branch_and_bound import branch_and_bound
 from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
@@ -20,7 +17,6 @@ from toptraj.planners.generators.search.memory import check_search_memory
 from toptraj.planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
 from toptraj.planners.generators.search.problem import build_problem, toward_goal
 from toptraj.planners.generators.search.shadows import obstacle_shadows
-from toptraj.planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
 from toptraj.robots import JointLimits, Robot
 
 #: A goal variant is searched only for grid paths faster than this multiple of the best grid
@@ -30,22 +26,6 @@ VARIANT_CAP = 2.0
 #: Share of the time left that the branch and bound of the goal variants may take together;
 #: the rest is the local optimization's and the final timing's.
 SEARCH_SHARE = 0.25
-
-
-class SearchMethod(TimingMethod):
-    """Global search of path and timing among obstacles (see ``toptraj.planners.generators.search``)."""
-
-    name = "search"
-    kinds = frozenset({"velocity", "acceleration", "torque"})
-
-    def solve(
-        self,
-        constraints: PathConstraints,
-        boundary: Boundary = AT_REST,
-        duration: float | None = None,
-        deadline: Deadline = NO_DEADLINE,
-    ) -> PathTiming:
-        raise InvalidRequest("search finds the path itself: give a free path (start and goal)")
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ import pytest
 from toptraj import robots
 from toptraj.planners import Timing, plan
 from toptraj.planners.execution.deadline import Deadline
-from toptraj.planners.generators.collocation import FreeMotion
+from toptraj.planners.problem.free_motion import FreeMotion
 
 #: The converged optima of Yamamoto's free path (torque limits only), from its own
 #: Hermite-Simpson transcription, ``benchmarks/yamamoto_reference.py``: the same to 7 digits on

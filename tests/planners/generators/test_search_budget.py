@@ -155,7 +155,7 @@ def test_a_search_job_obeys_the_same_memory_cap(tmp_path):
 def test_an_estimate_too_low_is_a_clear_error_not_the_system_killing_a_process(monkeypatch):
     # as if the estimate said 1 byte: the search's worker process gets 64 MB of room, runs out
     # while it builds its spans (about 0.5 GB), and the answer says so
-    import toptraj.planners.runner.timed_free as timed_free
+    import toptraj.planners.generators.search.generator as timed_free
 
     monkeypatch.setattr(timed_free, "check_search_memory", lambda *args, **kwargs: 1)
     monkeypatch.setattr(timed_free, "SEARCH_MEMORY_SLACK", 64 * 2**20)

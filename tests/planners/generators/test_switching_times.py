@@ -23,8 +23,8 @@ import pytest
 
 from toptraj import robots
 from toptraj.planners import Timing, plan
-from toptraj.planners.generators.collocation import FreeMotion
 from toptraj.planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching
+from toptraj.planners.problem.free_motion import FreeMotion
 
 CAPTION_TOLERANCE = 5e-3  # s
 

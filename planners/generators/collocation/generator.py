@@ -1,0 +1,165 @@
+"""``Collocation``, the motion generator of a free path (Jeong & Lee section 4): the path and its
+timing optimized together by direct collocation, then the path re-timed exactly along itself
+(phase_plane, or min_cost for beta > 0) so that every limit holds between the collocation
+instants too, and, for minimum time, the bang-bang torques refined to exact switching times
+(``toptraj.planners.generators.collocation.switching``)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from toptraj.planners.checks.gate import TimedStretch, checked, gated
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.generators.collocation import collocation_path, optimize_motion
+from toptraj.planners.generators.collocation.switching import refine_collocation, switched_path, switching_times
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
+from toptraj.planners.problem.path_checks import moving_velocity, path_boundary, timing_grid
+from toptraj.planners.problem.problem import MotionSpec, Problem
+from toptraj.planners.problem.requests import Timing
+from toptraj.planners.timing.base import GAP_TARGET, TimingMethod
+from toptraj.planners.timing.min_cost import MinCostMethod
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.robots import JointLimits, Robot
+
+#: Most collocation intervals a request may ask for (timing.grid_points).
+MAX_INTERVALS = 100
+
+
+class Collocation(MotionGenerator):
+    """Direct collocation of path and timing from start to goal, minimizing T or the integral
+    of (1 + beta |tau|^2) dt (``torque_weight`` beta, 1/(N m)^2)."""
+
+    name = "collocation"
+    kinds = frozenset({"velocity", "acceleration", "torque"})
+    required_kinds = frozenset({"torque"})
+
+    def __init__(self, torque_weight: float = 0.0):
+        self.torque_weight = torque_weight
+
+    @property
+    def timed_by(self) -> TimingMethod:
+        return PhasePlaneMethod() if self.torque_weight == 0.0 else MinCostMethod(self.torque_weight)
+
+    def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
+        if not isinstance(motion, FreeMotion):
+            raise InvalidRequest(
+                "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
+            )
+        if options.grid_points is not None and not 4 <= options.grid_points <= MAX_INTERVALS:
+            raise InvalidRequest(f"timing.grid_points sets the collocation intervals, 4 to {MAX_INTERVALS}; got {options.grid_points}")
+
+    def generate(self, problem: Problem, execution: Execution) -> Timed:
+        """The collocation's path, re-timed exactly along itself, its switching times refined."""
+        deadline = execution.deadline
+        assert isinstance(problem.motion, FreeMotion)  # validated
+        robot, spec, kinds, limits, threshold = problem.robot, problem.motion, problem.kinds, problem.limits, problem.threshold
+        collocation = _optimized(problem, deadline.within(0.0, 0.8))
+        path, collocation_timing = collocation_path(collocation)
+        solver = _solver_report(collocation)
+        retimer = self.timed_by
+        retiming = deadline.within(0.8, 0.9, "re-timing along the collocation's path")
+        retiming.progress(0.0, "constraints")
+        constraints = build_path_constraints(path, robot, limits, kinds, timing_grid(path, None, retimer, robot), deadline)
+        moving = dataclasses.replace(
+            problem.options, start_velocity=moving_velocity(spec.start_velocity), end_velocity=moving_velocity(spec.end_velocity),
+            duration=None,
+        )
+        notes: tuple[str, ...] = ()
+        try:
+            result, constraints, check = gated(
+                robot, path, retimer, constraints, path_boundary(path, moving, retimer), None, kinds, limits, threshold,
+                retiming.within(0.1, 1.0),
+            )
+            stretch = TimedStretch(path, result, constraints, check)
+        except InfeasiblePath as error:
+            # A boundary state right at a limit may be out of reach of the conservative re-timing;
+            # the collocation's own timing is then returned, if it holds the limits.
+            result = collocation_timing
+            stretch = checked(robot, path, result, "collocation", kinds, limits, threshold, constraints)
+            notes = (f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})",)
+        switching, source = None, collocation
+        if self.torque_weight == 0.0:
+            deadline.progress(0.9, "refining the switching times")
+            path, result, stretch, switching, notes, winner, source = _switched(
+                problem, collocation, (path, result, stretch), notes, deadline
+            )
+            solver = {**solver, **_solver_report(winner), "switching": "refined" if switching is not None else "read off the samples"}
+        solver = {**solver, "optimality_gap": source.optimality_gap, "gap_basis": source.gap_basis}
+        notes = (*notes, *self._gap_note(source, collocation))
+        cost = getattr(result, "cost", None) if self.torque_weight else result.duration
+        return Timed(
+            path, result, (stretch,), "collocation", notes, cost, solver, switching_times=switching,
+            motion_gap=(source.optimality_gap, source.gap_basis),
+        )
+
+    def _gap_note(self, source, collocation) -> tuple[str, ...]:
+        """A note when the minimum time found may lie farther than ``GAP_TARGET`` above the
+        optimum, with the advice that brings it closer where there is one."""
+        if self.torque_weight != 0.0 or source.optimality_gap is None or source.optimality_gap <= GAP_TARGET:
+            return ()
+        advice = (
+            f": more timing.grid_points (collocation intervals, up to {MAX_INTERVALS}) bring it closer"
+            if len(collocation.t) - 1 < MAX_INTERVALS else ""
+        )
+        return (f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis}){advice}",)
+
+
+def _optimized(problem: Problem, deadline):
+    """The collocation's optimum on the requested intervals, under the velocity and acceleration
+    limits only when they are asked for."""
+    spec, options, robot, limits = problem.motion, problem.options, problem.robot, problem.limits
+    assert isinstance(spec, FreeMotion)
+    if options.grid_points is not None:
+        spec = dataclasses.replace(spec, intervals=options.grid_points)
+    unlimited = np.full(robot.dof, np.inf)
+    limits = dataclasses.replace(
+        limits,
+        velocity=limits.velocity if "velocity" in options.constraints else unlimited,
+        acceleration=limits.acceleration if "acceleration" in options.constraints else unlimited,
+    )
+    return optimize_motion(robot, limits, spec, options.torque_weight, deadline)
+
+
+def _solver_report(result) -> dict:
+    """The collocation's figures for the answer's ``solver``."""
+    return {
+        "cost": result.cost,
+        "duration": float(result.t[-1]),
+        "status": result.status,
+        "iterations": result.iterations,
+        "initial_guess": result.initial_guess,
+        "solve_s": result.solve_s,
+    }
+
+
+def _switched(problem: Problem, collocation, timed, notes, deadline):
+    """The time-optimal free motion with exact bang-bang torques in place of ``timed`` (path,
+    timing, stretch) when it reaches the goal, is not longer and passes the limit gate; with its
+    switching times (else ``None``). The collocation's rivals (``CollocationResult.rivals``) are
+    refined too and the shortest refined motion wins; the collocation result it came from is
+    returned, and the result whose ``optimality_gap`` the answer states (the refined motion, or
+    else the collocation)."""
+    robot, spec, kinds, limits, threshold = problem.robot, problem.motion, problem.kinds, problem.limits, problem.threshold
+    assert isinstance(spec, FreeMotion)
+    path, result, stretch = timed
+    refined, winner = None, collocation
+    # The rivals (other goals the fine grid found close) are compared on exact terms too: the
+    # collocation's grid error can exceed their difference.
+    for candidate in (collocation, *collocation.rivals):
+        motion = refine_collocation(robot, limits, spec, candidate, deadline)
+        if motion is not None and (refined is None or motion.duration < refined.duration):
+            refined, winner = motion, candidate
+    if refined is None or (winner is collocation and refined.duration > result.duration):
+        return path, result, stretch, None, notes, collocation, collocation
+    switched, timing = switched_path(refined)
+    constraints = build_path_constraints(switched, robot, limits, kinds, path_grid(switched), deadline)
+    try:
+        stretch = checked(robot, switched, timing, "collocation", kinds, limits, threshold, constraints)
+    except InfeasiblePath as error:
+        return path, result, stretch, None, (*notes, f"the bang-bang refinement is not returned: {error.detail}"), collocation, collocation
+    return switched, timing, stretch, switching_times(refined.controls, robot.joint_names), notes, winner, refined

@@ -1,0 +1,98 @@
+"""The second family of methods: motion generators, which find the motion itself (via points,
+joints moving on their own, the collocation, the global search) and return a path with its
+timing; and ``Timed``, what both families hand the runner.
+
+Timing methods (``toptraj.planners.timing.base.TimingMethod``, ``family = "timing"``) time a
+given path from its ``PathConstraints``; the runner builds the path, its stretches and their
+constraints for them. A generator (``family = "generator"``) gets the whole ``Problem`` and an
+``Execution``: its share of the deadline, and the runner's own given-path pipeline
+(``time_path``: stretches, constraints, the limit gate) for the paths it finds, so that no
+generator calls the gate's pipeline or the runner itself.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar, Literal, NamedTuple
+
+from toptraj.planners.checks.gate import TimedStretch
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.paths import GeometricPath
+from toptraj.planners.timing.base import PathTiming, TimingMethod
+from toptraj.robots import JointLimits, Robot
+
+if TYPE_CHECKING:
+    from toptraj.planners.problem.problem import MotionSpec, Problem
+    from toptraj.planners.problem.requests import Timing
+
+
+class Timed(NamedTuple):
+    """A path with its timing, its stretches as they were timed and checked, and what to tell
+    about it: what either family of methods hands the runner."""
+
+    path: GeometricPath
+    timing: PathTiming
+    stretches: tuple[TimedStretch, ...]
+    method: str
+    notes: tuple[str, ...] = ()
+    cost: float | None = None
+    solver: dict | None = None
+    search: dict | None = None
+    switching_times: dict | None = None
+    #: For a method that finds the motion itself (a free path): the estimated relative gap of
+    #: its objective to the optimum of its own problem, and how it was estimated; ``None`` when
+    #: the answer's accuracy is that of its path's timing (``toptraj.planners.runner.accuracy``).
+    motion_gap: tuple[float | None, str] | None = None
+
+
+#: The runner's given-path pipeline: (robot, path, method, options, kinds, limits, deadline,
+#: threshold) -> Timed, each stretch between corners timed and passed through the limit gate.
+TimePath = Callable[[Robot, GeometricPath, TimingMethod, "Timing", tuple, JointLimits, Deadline, float], Timed]
+
+
+@dataclass(frozen=True)
+class Execution:
+    """What the runner lends a generator: its share of the deadline (budget, cancellation,
+    progress) and the given-path pipeline for the paths it finds. ``time_path`` is a module-level
+    function, so an ``Execution`` crosses into a worker process."""
+
+    deadline: Deadline
+    time_path: TimePath
+
+
+class MotionGenerator(abc.ABC):
+    """A method that finds the motion itself and returns it timed.
+
+    Its capabilities are read as a timing method's are (``kinds``, ``required_kinds``,
+    ``two_waypoints_only``, ``continuous_acceleration``, ``max_grid_intervals``); ``timed_by``
+    is the timing method whose accuracy the answer states when the generator states none of its
+    own (``Timed.motion_gap``).
+    """
+
+    family: ClassVar[Literal["generator"]] = "generator"
+    name: str
+    kinds: frozenset[str] = frozenset({"velocity", "acceleration", "torque"})
+    required_kinds: frozenset[str] = frozenset()
+    two_waypoints_only: bool = False
+    continuous_acceleration: bool = False
+    grid_budget: int = 140_000
+
+    def max_grid_intervals(self, n_dof: int) -> int:
+        """The most grid intervals the generator's paths are timed on, on ``n_dof`` joints."""
+        return self.grid_budget // max(n_dof, 1)
+
+    @property
+    @abc.abstractmethod
+    def timed_by(self) -> TimingMethod:
+        """The timing method that times the motion's path (for the answer's accuracy)."""
+
+    @abc.abstractmethod
+    def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
+        """Refuse a motion or options the generator does not serve (``InvalidRequest``), before
+        any work."""
+
+    @abc.abstractmethod
+    def generate(self, problem: Problem, execution: Execution) -> Timed:
+        """The motion of ``problem``, timed and through the limit gate."""

@@ -1,0 +1,84 @@
+"""What a path built from a problem must satisfy before it is timed, and the grid and boundary
+it is timed with: within the joint range, a finite jerk where jerk is limited, the boundary
+velocities tangent to the path (as path speeds), a grid within the method's memory."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.paths import GeometricPath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.problem.boundary import path_acceleration, path_speed
+from toptraj.planners.problem.requests import Timing
+from toptraj.planners.timing.base import Boundary, TimingMethod
+from toptraj.robots import Robot
+
+
+def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:
+    """Splines may overshoot between waypoints: refuse a path that leaves the joint range (where
+    it lies farthest outside on a spline; elsewhere, the first of 4 points per interval of the
+    grid ``s`` that does)."""
+    lower, upper = robot.limits.position_lower, robot.limits.position_upper
+    outside = path.outside_range(lower, upper, 4 * len(s) + 1)
+    if outside is not None:
+        at, joint, value = outside
+        raise InfeasiblePath(
+            f"the interpolated path leaves the range [{lower[joint]:.6g}, {upper[joint]:.6g}] of joint "
+            f"{robot.joint_names[joint]!r} at s = {at:.4f} (q = {value:.6g}); "
+            "add waypoints or use interpolation 'linear'",
+            s=at,
+            joint=robot.joint_names[joint],
+        )
+
+
+def check_jerk_finite(path: GeometricPath, kinds) -> None:
+    """A jerk limit needs a path whose d2q/ds2 is continuous where the motion goes on: at a
+    break (a straight segment meeting a circular blend) the joint acceleration q'' sd^2 jumps
+    unless the motion stops there, an infinite jerk."""
+    if "jerk" not in kinds or not len(path.breaks):
+        return
+    s = float(path.breaks[0])
+    raise InfeasiblePath(
+        f"the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend), "
+        "so the joint accelerations jump there and no motion that passes it has a finite jerk: use "
+        "interpolation 'spline' with a jerk limit, or leave 'jerk' out of timing.constraints",
+        s=s,
+        limit="jerk",
+    )
+
+
+def moving_velocity(velocity):
+    """A boundary velocity, or ``None`` for rest (a zero vector included)."""
+    if velocity is None or not np.any(np.asarray(velocity) != 0.0):
+        return None
+    return velocity
+
+
+def path_boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
+    if (timing.start_acceleration is not None or timing.end_acceleration is not None) and not method.takes_acceleration_boundary:
+        raise InvalidRequest(
+            f"timing.boundary accelerations are not used by timing.method {method.name!r}; use quintic"
+        )
+    if timing.duration is not None and not method.takes_duration:
+        raise InvalidRequest(
+            f"timing.duration is not used by timing.method {method.name!r}, which finds the shortest "
+            "duration itself; leave it out or use a time law"
+        )
+    sd_start = path_speed(path, timing.start_velocity, 0.0, "timing.boundary.start_velocity")
+    sd_end = path_speed(path, timing.end_velocity, 1.0, "timing.boundary.end_velocity")
+    return Boundary(
+        sd_start=sd_start,
+        sd_end=sd_end,
+        sdd_start=path_acceleration(path, timing.start_acceleration, sd_start, 0.0, "timing.boundary.start_acceleration"),
+        sdd_end=path_acceleration(path, timing.end_acceleration, sd_end, 1.0, "timing.boundary.end_acceleration"),
+    )
+
+
+def timing_grid(path: GeometricPath, n_intervals: int | None, method: TimingMethod, robot: Robot, s: np.ndarray | None = None) -> np.ndarray:
+    """The grid of ``path`` (``n_intervals``, else the default; ``s``: that grid, already
+    built), within what ``method`` serves on ``robot``: a long path's default grid is thinned to
+    ``method.max_grid_intervals``."""
+    s = path_grid(path, n_intervals) if s is None else s
+    cap = method.max_grid_intervals(robot.dof)
+    return s if len(s) - 1 <= cap else path_grid(path, cap)

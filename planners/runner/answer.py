@@ -1,0 +1,223 @@
+"""From a timed motion to the answer, the same for every method: the samples (checked against
+the limits once more), the stated accuracy, the peak utilization, the conditioning, the switching
+times, the phase plane, and the notes that tell what the numbers alone do not."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from toptraj.planners.checks.gate import TimedStretch, samples_exceed
+from toptraj.planners.collision import check_clearance
+from toptraj.planners.collision.clearance import Clearance
+from toptraj.planners.constraints.admissible import admissible_set
+from toptraj.planners.errors import InvalidRequest, TimingFailed
+from toptraj.planners.generators.collocation.switching import collocation_switches, switching_times
+from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
+from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
+from toptraj.planners.paths.grid import spread_indices
+from toptraj.planners.problem.methods import MotionGenerator, Timed
+from toptraj.planners.problem.problem import Problem
+from toptraj.planners.problem.ranges import DT
+from toptraj.planners.problem.requests import Timing
+from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
+from toptraj.planners.runner.accuracy import answer_accuracy
+from toptraj.planners.timing.base import TimingMethod
+from toptraj.planners.timing.laws.law_timing import LawTiming
+from toptraj.planners.timing.laws.method import ClassicalMethod
+from toptraj.planners.trajectory import Samples, sample_trajectory
+
+#: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
+#: encoding of the answer that follow it (measured about 0.3 us on ur5 at 236 to 23,409
+#: samples; twice that, for slower machines): what ``Deadline.expect`` is told before it.
+SAMPLE_SECONDS = 5e-7
+#: Largest number of phase-plane points returned (the grid is thinned evenly beyond it).
+MAX_PHASE_PLANE_POINTS = 2_000
+#: Largest number of samples whose Jacobian is conditioned (evenly spaced among them).
+CONDITIONING_POINTS = 100
+#: Share of its limit beyond which a sampled torque counts as saturated when switching times
+#: are read off the samples.
+SATURATION_READ = 0.98
+#: Peak utilization of a limit kind not among the constraints above which the answer says so.
+UNASKED_EXCESS = 1.005
+
+
+def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, started: float) -> PlannedTrajectory:
+    """The answer to ``problem`` from its timed motion (``checked_first``: the clearance of a
+    given path, found before its timing; ``started``: ``time.perf_counter()`` at the start)."""
+    robot, deadline, result = problem.robot, problem.deadline, timed.timing
+    notes = [*problem.notes, *timed.notes, *_blend_notes(timed.path)]
+    deadline.check()
+    found_clearance = None
+    if problem.obstacles:
+        # a given path was checked before its timing; a path shaped with its timing (via points) now
+        found_clearance = checked_first or check_clearance(timed.path, robot, list(problem.obstacles), problem.clearance, deadline)
+    deadline.progress(0.9, "sampling")
+    samples = _samples(problem, timed)
+    accuracy, warning = _accuracy(problem, timed)
+    if warning is not None:
+        notes.append(warning)
+    utilization = _utilization(timed.stretches, problem.margin)
+    notes.extend(_unasked_limits(utilization, problem.kinds, problem.method, robot.joint_names))
+    kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
+    notes.extend(_singularity_notes(kappa_max, samples.t[worst]))
+    switching = timed.switching_times
+    if switching is None and timed.method == "collocation" and problem.options.torque_weight == 0.0:
+        read = collocation_switches(samples.t, samples.tau, problem.limits.torque, level=SATURATION_READ)
+        switching = switching_times(read, robot.joint_names)
+    s, sd, mvc = _phase_plane(timed.stretches)
+    require_finite(timed.method, path_speed=sd, cost=timed.cost)
+    return PlannedTrajectory(
+        robot=robot.name, method=timed.method, joint_names=robot.joint_names, duration=result.duration, samples=samples,
+        phase_plane=PhasePlane(s, sd, mvc, result.switch_points), peak_utilization=utilization,
+        solve_ms=(time.perf_counter() - started) * 1e3, warnings=tuple(notes), binding=result.binding,
+        conditioning=Conditioning(kappa_min, kappa_max, length), cost=timed.cost, solver=timed.solver,
+        switching_times=switching, clearance=found_clearance, search=timed.search, accuracy=accuracy,
+    )
+
+
+def _blend_notes(path) -> list[str]:
+    """Corners a blend could not round within the path's deviation: the motion stops there."""
+    if not (isinstance(path, BlendedPath) and path.tight_corners):
+        return []
+    return [
+        f"path.max_deviation = {path.max_deviation:g} is too small to blend the corners at waypoints "
+        f"{', '.join(map(str, path.tight_corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
+        "stops there"
+    ]
+
+
+def _samples(problem: Problem, timed: Timed) -> Samples:
+    """The motion sampled every ``dt``, every sample checked against the limits (the gate's
+    threshold; a continuous acceleration's jerk too)."""
+    robot, result, sampling, method = problem.robot, timed.timing, problem.sampling, problem.method
+    require_finite(timed.method, duration=result.duration)
+    if result.duration / sampling.dt > sampling.max_samples - 2:
+        raise InvalidRequest(_too_many_samples(result.duration, sampling.dt, sampling.max_samples, problem.options))
+    problem.deadline.expect((result.duration / sampling.dt + 2) * robot.dof * SAMPLE_SECONDS)
+    samples = sample_trajectory(timed.path, result, robot, sampling.dt, sampling.exact_period)
+    require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
+    beyond = samples_exceed(samples, problem.limits, problem.threshold, problem.kinds, robot, jerk=method.continuous_acceleration)
+    if beyond is None:
+        return samples
+    kind, sample, joint = beyond
+    what = f"{kind} limit of joint {robot.joint_names[joint]!r}" if joint >= 0 else f"{kind.replace('_', ' ')} limit"
+    if kind == "jerk":
+        raise TimingFailed(
+            f"the {timed.method} timing's accelerations jump between the samples at t = "
+            f"{samples.t[sample]:.6g} s and {samples.t[sample + 1]:.6g} s: the jerk from the samples "
+            f"exceeds the {what}"
+        )
+    raise TimingFailed(
+        f"the {timed.method} timing's sample at t = {samples.t[sample]:.6g} s exceeds the {what} "
+        "although its dense check holds; use more grid points"
+    )
+
+
+def _accuracy(problem: Problem, timed: Timed) -> tuple[Accuracy, str | None]:
+    """The answer's stated accuracy (``toptraj.planners.runner.accuracy``) and a warning when it
+    is short of the target: a free path's own gap, else the timing's."""
+    if timed.motion_gap is not None:  # a free path: the gap of the motion found, warned of where it is found
+        return Accuracy(*timed.motion_gap), None
+    method = problem.method
+    timed_by = method.timed_by if isinstance(method, MotionGenerator) else method
+    # Time laws at their shortest, also through via points or joint by joint: every stretch
+    # timed by a law, its peak utilization read off its dense check.
+    by_law = isinstance(timed_by, ClassicalMethod)
+    laws = [
+        (item.timing.duration, {kind: peak for kind, peak in item.check.utilization.items() if kind in problem.kinds or kind.startswith("tool")})
+        for item in timed.stretches
+        if by_law or isinstance(item.timing, LawTiming)
+    ]
+    intervals = sum(len(item.constraints.s) - 1 for item in timed.stretches)
+    return answer_accuracy(
+        timed.timing, timed_by, timed.method, intervals, problem.robot.dof, grid_given=problem.options.grid_points is not None,
+        duration_given=problem.options.duration is not None, law_utilization=laws if len(laws) == len(timed.stretches) else None,
+    )
+
+
+def _singularity_notes(kappa_max: float, at: float) -> list[str]:
+    """A note when the arm passes through or near a singularity (at ``at``, s)."""
+    if not np.isfinite(kappa_max):
+        return [
+            f"the arm passes through a singularity at t = {at:.4g} s: its Jacobian loses rank "
+            "there (the condition number is infinite)"
+        ]
+    if kappa_max > NEAR_SINGULAR_KAPPA:
+        return [f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} at t = {at:.4g} s"]
+    return []
+
+
+def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """s, sd and the maximum velocity curve (1/s) over the grids the stretches were timed on,
+    in the path's own s."""
+    pieces = []
+    for item in stretches_:
+        constraints = item.constraints
+        sd = item.timing.speed_at(constraints.s)
+        mvc = admissible_set(constraints.linearized(sd**2), constraints.sd_max**2).sd_max
+        start, width = getattr(item.stretch, "start", 0.0), getattr(item.stretch, "width", 1.0)
+        pieces.append((start + width * constraints.s, width * sd, width * mvc))
+    s, sd, mvc = (np.concatenate([piece[i] for piece in pieces]) for i in range(3))
+    keep = spread_indices(len(s), MAX_PHASE_PLANE_POINTS)
+    return s[keep], sd[keep], mvc[keep]
+
+
+def _utilization(stretches_: tuple[TimedStretch, ...], margin: float) -> dict[str, np.ndarray]:
+    """Peak |value| / limit per kind and joint over every stretch, against the limits as
+    requested (before any margin)."""
+    kinds = stretches_[0].check.utilization.keys()
+    if len(stretches_) == 1:
+        return {kind: (1.0 - margin) * peak for kind, peak in stretches_[0].check.utilization.items()}
+    return {
+        kind: (1.0 - margin) * np.max([item.check.utilization[kind] for item in stretches_], axis=0)
+        for kind in kinds
+    }
+
+
+def _unasked_limits(
+    utilization: dict[str, np.ndarray], kinds: tuple[str, ...], method: TimingMethod | MotionGenerator, joint_names: tuple[str, ...]
+) -> list[str]:
+    """A note for each joint limit the answer exceeds by more than ``UNASKED_EXCESS`` where
+    that kind of limit was not among the constraints (``kinds``): the answer is right, but a
+    reader of its peak utilization must not take it for a broken promise."""
+    notes = []
+    for kind, peak in utilization.items():
+        peak = np.atleast_1d(np.asarray(peak, dtype=float))
+        if kind in kinds or kind.startswith("tool") or not peak.size or not np.nanmax(peak) > UNASKED_EXCESS:
+            continue
+        joint = int(np.nanargmax(peak))
+        name = joint_names[joint] if peak.size == len(joint_names) else f"joint {joint}"
+        remedy = f"add {kind!r} to the constraints to hold it" if kind in method.kinds else f"{method.name} cannot hold {kind} limits"
+        notes.append(f"the {kind} of joint {name!r} reaches {peak[joint]:.4g} times its limit, which was not asked for: {remedy}")
+    return notes
+
+
+def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> str:
+    """Why ``duration`` (s) sampled every ``dt`` (s) is not served, and advice that can be
+    followed: the smallest ``output.dt`` that fits when it lies in ``DT``, else the limits that
+    make the motion this slow (no ``output.dt`` beyond its own range is ever advised)."""
+    given = f"output.dt = {dt:g} s gives {math.ceil(duration / dt) + 1} samples over the {duration:.4g} s motion; at most {max_samples} are served"
+    needed = _round_up(duration / (max_samples - 2))
+    if needed <= DT.high:
+        return f"{given}: use output.dt >= {needed:g} s"
+    slowing = [f"timing.limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None]
+    slowing += ["the velocity and acceleration limits (timing.limits and their scales)"]
+    return (
+        f"{given}, and even the largest output.dt ({DT.high:g} s) serves at most {_round_down(DT.high * (max_samples - 2)):g} s "
+        f"of motion: the limits make this motion too slow to serve; raise {' or '.join(slowing)}"
+    )
+
+
+def _round_down(value: float, digits: int = 3) -> float:
+    """``value`` rounded down to ``digits`` significant digits."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.floor(value / scale) * scale
+
+
+def _round_up(value: float, digits: int = 3) -> float:
+    """``value`` rounded up to ``digits`` significant digits."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return math.ceil(value / scale) * scale

@@ -1,0 +1,64 @@
+"""The runner: a ``Problem`` solved by its method, whichever family it belongs to, through the
+same deadline, limit gate and answer.
+
+A timing method times the given path (built here, checked for clearance, each stretch through
+the gate: ``toptraj.planners.runner.given_path``); a motion generator finds and times the
+motion itself, with the given-path pipeline lent to it (``Execution``). Then both go the same
+way (``toptraj.planners.runner.answer``): sampled, the samples checked against the limits, the
+accuracy stated, the phase plane and the peak utilization read off.
+"""
+
+from __future__ import annotations
+
+import time
+
+from toptraj.planners.collision import check_clearance
+from toptraj.planners.collision.clearance import Clearance
+from toptraj.planners.errors import numerical_breakdown_is_failure
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
+from toptraj.planners.problem.problem import Problem
+from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.results import PlannedTrajectory
+from toptraj.planners.runner.answer import answer
+from toptraj.planners.runner.given_path import timed_path
+
+
+def run(problem: Problem) -> PlannedTrajectory:
+    """The timed trajectory of ``problem``, sampled, checked and with its stated accuracy.
+
+    Raises:
+        InvalidRequest: a ``dt`` that gives more samples than the problem allows (the message
+            names the smallest that fits), or what only the built path shows.
+        InfeasiblePath: no timing can follow the path within the limits (says where, which
+            joint and which limit).
+        TimingFailed: the method failed.
+        BudgetExceeded: the problem's deadline passed.
+    """
+    started = time.perf_counter()
+    method, part = problem.method, problem.deadline.within(0.0, 0.9)
+    checked_first = None
+    with numerical_breakdown_is_failure(method.name):
+        if isinstance(method, MotionGenerator):
+            timed = method.generate(problem, Execution(part, timed_path))
+        else:
+            timed, checked_first = _given_path(problem, part)
+    return answer(problem, timed, checked_first, started)
+
+
+def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | None]:
+    """The given path built, kept clear of the obstacles, and timed by the problem's timing
+    method; with the clearance found, when there are obstacles."""
+    part.progress(0.0, "path")
+    assert not isinstance(problem.motion, FreeMotion)  # build_problem gives free motions to generators
+    path = make_path(problem.robot, problem.motion, problem.deadline)
+    checked = None
+    if problem.obstacles:
+        part.progress(0.05, "clearance")
+        checked = check_clearance(path, problem.robot, list(problem.obstacles), problem.clearance, problem.deadline)
+    timed = timed_path(
+        problem.robot, path, problem.method, problem.options, problem.kinds, problem.limits, part.within(0.1, 1.0),
+        problem.threshold,
+    )
+    return timed, checked
