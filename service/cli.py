@@ -8,8 +8,6 @@ import os
 import sys
 
 from service import commands as commands_
-from service.serving import LOOP
-from service.stopping import GRACEFUL_S
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
 APP_FACTORY = "service.app:create_app"
@@ -25,7 +23,10 @@ def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
 
 
 def _serve(args) -> int:
-    import uvicorn
+    import uvicorn  # here, as the server's own modules: ``toptraj plan`` needs none of them
+
+    from service.serving import LOOP
+    from service.stopping import GRACEFUL_S
 
     if args.workers < 1:
         print(f"toptraj serve: --workers must be at least 1, not {args.workers}", file=sys.stderr)

@@ -52,7 +52,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
     from robots import ToptrajError
-    from service.errors import status_of, validation_problem
+    from service.problems import status_of, validation_problem
 
     try:
         content = answer(_read(source))

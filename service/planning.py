@@ -22,8 +22,8 @@ from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from planners.problem.boundary import finite_vector
 from robots import InvalidLimits, UnknownRobot
 from robots.catalog import catalog_robot_built
-from service.errors import non_finite_answer, status_of
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
+from service.problems import non_finite_answer, status_of
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.

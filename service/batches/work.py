@@ -15,8 +15,8 @@ from planners.execution.deadline import Deadline
 from robots import ToptrajError
 from robots.upload_options import UploadOptions
 from service.batches.lines import problem_body
-from service.errors import status_of, validation_problem
 from service.planning import compare_request, encode_json, plan_request, render
+from service.problems import status_of, validation_problem
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 logger = logging.getLogger("toptraj.batches")

@@ -30,10 +30,10 @@ from planners import Deadline
 from planners.errors import BudgetExceeded
 from planners.execution.isolated import run_isolated
 from robots.errors import ToptrajError
-from service.errors import status_of
 from service.jobs import work
 from service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
 from service.jobs.store import JobStore
+from service.problems import status_of
 
 logger = logging.getLogger("toptraj.jobs")
 

@@ -29,14 +29,12 @@ import time
 
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import minimize
 
 from planners.constraints.path_constraints import build_path_constraints
 from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline, Progress
 from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.generators.collocation.motion import CollocationResult, FreeMotion
-from planners.generators.collocation.sparse import SparseCollocation, solve_sparse
 from planners.paths.grid import path_grid
 from planners.paths.waypoints import SplinePath
 from planners.timing.phase_plane.method import PhasePlaneMethod
@@ -250,6 +248,8 @@ def _bends(n_dof: int) -> list[tuple[str, np.ndarray]]:
 
 
 def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int):
+    from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
+
     result = minimize(
         problem.cost,
         z0,
@@ -306,6 +306,9 @@ def _optimize_motion(
     max_iterations: int,
     progress: Progress = NO_DEADLINE.progress,
 ) -> CollocationResult:
+    # here: casadi and its solvers take a second to import, for this method only
+    from planners.generators.collocation.sparse import SparseCollocation, solve_sparse
+
     if robot.outside_position_limits(motion.start) is not None:
         raise InvalidRequest("path.start is outside the joint limits")
     if robot.outside_position_limits(motion.goal) is not None:
