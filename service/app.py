@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import os
 from contextlib import asynccontextmanager
 
 from fastapi import FastAPI
@@ -30,7 +31,8 @@ def _warm_up() -> None:
     """Build every catalog robot and load the compiled phase-plane and conditioning kernels
     once (``service.warmup.server_steps``), each step logged, so that first requests are fast.
     The solver stacks of the other methods are imported where those run, when they first do."""
-    warmup.run_steps(warmup.server_steps(), lambda line: _log.info("toptraj start-up: %s", line))
+    process = os.getpid()
+    warmup.run_steps(warmup.server_steps(), lambda line: _log.info("toptraj start-up [%d]: %s", process, line))
 
 
 #: FastAPI's telemetry options with every part off (``Settings.telemetry``).

@@ -41,6 +41,14 @@ def _serve(args) -> int:
     # either way.
     # A stop (SIGTERM, Ctrl-C) ends every process within seconds (service.stopping): open
     # requests get GRACEFUL_S to finish.
+    # Said before the seconds each process spends importing, which print nothing themselves;
+    # each then logs its start-up steps (service.warmup).
+    print(
+        f"toptraj serve: {args.workers} server process(es) on http://{args.host}:{args.port}, each importing the planners, "
+        "then loading its compiled kernels (a line per step)",
+        file=sys.stderr,
+        flush=True,
+    )
     uvicorn.run(
         APP_FACTORY,
         factory=True,

@@ -102,7 +102,7 @@ def test_a_server_with_a_warm_cache_starts_without_compiling_or_heavy_imports(tm
     assert started["health"] == 200
     assert started["compiled"] == 0
     assert _loaded(started["modules"], ("cvxpy", "clarabel", "casadi", "toppra", "matplotlib", "ray", "plotly", "scipy.optimize")) == []
-    steps = [line for line in started["lines"] if line.startswith("toptraj start-up:")]
+    steps = [line for line in started["lines"] if line.startswith("toptraj start-up [")]
     assert any("phase-plane kernels: done" in line and "nothing to compile" in line for line in steps), started["lines"]
     assert len(steps) >= 6  # a line as each of the three steps begins and one as it ends
 
