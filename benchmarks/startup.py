@@ -15,7 +15,10 @@ Printed beside each goal of the issue:
   as after a fresh clone) and then the first start ready within 15 s (<= 3,000x), with the
   longest silence of either.
 
-    python benchmarks/startup.py [--rounds 5] [--restart-every 1] [--fresh]
+With ``--baseline DIR`` (another checkout, e.g. ``git archive main | tar -x -C DIR``, its
+kernels compiled once), the same ``toptraj plan`` and restart of that tree, interleaved.
+
+    python benchmarks/startup.py [--rounds 5] [--restart-every 1] [--fresh] [--baseline DIR]
 """
 
 from __future__ import annotations
@@ -43,8 +46,6 @@ from anchors import bare_toppra  # noqa: E402
 import robots  # noqa: E402
 from service.warmup import TYPICAL  # noqa: E402
 
-ENV = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-
 
 def _free_port() -> int:
     with socket.socket() as probe:
@@ -52,10 +53,14 @@ def _free_port() -> int:
         return probe.getsockname()[1]
 
 
-def _cli_plan(request_file: str, env: dict) -> float:
+def _env(root: Path) -> dict:
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(root), os.environ.get("PYTHONPATH")]))}
+
+
+def _cli_plan(request_file: str, env: dict, root: Path = ROOT) -> float:
     """Wall seconds of ``toptraj plan FILE`` (a new interpreter), its answer checked."""
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "service.cli", "plan", request_file], cwd=ROOT, env=env, capture_output=True)
+    done = subprocess.run([sys.executable, "-m", "service.cli", "plan", request_file], cwd=root, env=env, capture_output=True)
     seconds = time.perf_counter() - started
     if done.returncode != 0 or not done.stdout.startswith(b'{"robot":"ur5"'):
         raise RuntimeError(f"toptraj plan failed: {done.stderr[-500:]!r}")
@@ -66,13 +71,13 @@ class _Server:
     """``toptraj serve --workers 1`` on a free port: seconds until ``/health`` answers, the
     longest gap between two lines of its log until then, and the resident memory at idle."""
 
-    def __init__(self, env: dict):
+    def __init__(self, env: dict, root: Path = ROOT):
         self.port = _free_port()
         self.lines: list[tuple[float, str]] = []
         self.started = time.perf_counter()
         self.process = subprocess.Popen(
             [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--workers", "1"],
-            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+            cwd=root, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         )
         threading.Thread(target=self._read, daemon=True).start()
         self.ready_s = self._wait_ready()
@@ -147,7 +152,7 @@ def _goal(label: str, value: float, goal: float, unit: str = "x") -> None:
 def _fresh(anchor_s: float) -> None:
     """The install's warm-up into an empty numba cache, then the first start on it."""
     with tempfile.TemporaryDirectory(prefix="toptraj-numba-") as cache:
-        env = {**ENV, "NUMBA_CACHE_DIR": cache}
+        env = {**_env(ROOT), "NUMBA_CACHE_DIR": cache}
         started = time.perf_counter()
         install = subprocess.Popen([sys.executable, "-m", "service.warmup"], cwd=ROOT, env=env, stdout=subprocess.PIPE, text=True)
         assert install.stdout is not None
@@ -173,7 +178,9 @@ def main() -> int:
     parser.add_argument("--solves", type=int, default=20, help="bare toppra solves per anchor (their median)")
     parser.add_argument("--restart-every", type=int, default=1, help="a server restart every this many rounds")
     parser.add_argument("--fresh", action="store_true", help="also the install step into an empty cache and the first start")
+    parser.add_argument("--baseline", type=Path, default=None, help="another checkout timed alike, interleaved")
     args = parser.parse_args()
+    trees = {"this tree": ROOT, **({"baseline": args.baseline.resolve()} if args.baseline else {})}
 
     import toppra
 
@@ -184,34 +191,42 @@ def main() -> int:
         bare_toppra(robot, waypoints)
     with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as handle:
         json.dump(TYPICAL, handle)
-    _cli_plan(handle.name, ENV)  # numba's cache and the bytecode written, if they were not
-    anchors, plans, restarts, silences, memory = [], [], [], [], []
+    for root in trees.values():
+        _cli_plan(handle.name, _env(root), root)  # numba's cache and the bytecode written, if they were not
+    anchors: list[float] = []
+    plans: dict[str, list[float]] = {name: [] for name in trees}
+    restarts: dict[str, list[float]] = {name: [] for name in trees}
+    silences: dict[str, list[float]] = {name: [] for name in trees}
+    memory: dict[str, tuple[float, float]] = {}
     try:
         for round_ in range(args.rounds):
             anchors.append(_anchor(robot, waypoints, args.solves))
-            plans.append(_cli_plan(handle.name, ENV))
-            if round_ % args.restart_every == 0:
-                server = _Server(ENV)
-                try:
-                    restarts.append(server.ready_s)
-                    silences.append(server.longest_silence())
-                    if not memory:
-                        memory.append(server.idle_rss_mb())
-                finally:
-                    server.stop()
+            for name, root in trees.items():
+                plans[name].append(_cli_plan(handle.name, _env(root), root))
+                if round_ % args.restart_every == 0:
+                    server = _Server(_env(root), root)
+                    try:
+                        restarts[name].append(server.ready_s)
+                        silences[name].append(server.longest_silence())
+                        if name not in memory:
+                            memory[name] = server.idle_rss_mb()
+                    finally:
+                        server.stop()
     finally:
         os.unlink(handle.name)
     anchor = float(np.median(anchors))
     print(f"typical request (ur5, 4 spline waypoints, velocity + acceleration + torque, phase_plane, dt 0.01); "
           f"{args.rounds} interleaved rounds; bare toppra {1e3 * anchor:.2f} ms (median)")
-    print(f"  toptraj plan: {np.median(plans):.3f} s median ({', '.join(f'{s:.2f}' for s in plans)})")
-    print(f"  restart to /health: {np.median(restarts):.2f} s median ({', '.join(f'{s:.2f}' for s in restarts)}); "
-          f"longest silence {max(silences):.2f} s")
-    _goal("toptraj plan / bare toppra", float(np.median(plans)) / anchor, 100)
-    _goal("restart ready / bare toppra", float(np.median(restarts)) / anchor, 600)
-    server_mb, fork_mb = memory[0]
-    _goal("server process resident at idle", server_mb, 300, " MB")
-    print(f"  {'its fork server (children share its pages)':44s} {fork_mb:9.1f} MB")
+    for name, root in trees.items():
+        print(f"{name} ({root}):")
+        print(f"  toptraj plan: {np.median(plans[name]):.3f} s median ({', '.join(f'{s:.2f}' for s in plans[name])})")
+        print(f"  restart to /health: {np.median(restarts[name]):.2f} s median ({', '.join(f'{s:.2f}' for s in restarts[name])}); "
+              f"longest silence {max(silences[name]):.2f} s")
+        _goal("toptraj plan / bare toppra", float(np.median(plans[name])) / anchor, 100)
+        _goal("restart ready / bare toppra", float(np.median(restarts[name])) / anchor, 600)
+        server_mb, fork_mb = memory[name]
+        _goal("server process resident at idle", server_mb, 300, " MB")
+        print(f"  {'its fork server (children share its pages)':44s} {fork_mb:9.1f} MB")
     if args.fresh:
         _fresh(anchor)
     return 0

@@ -8,6 +8,7 @@ import os
 import sys
 
 from service import commands as commands_
+from service import warmup
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
 APP_FACTORY = "service.app:create_app"
@@ -41,14 +42,13 @@ def _serve(args) -> int:
     # either way.
     # A stop (SIGTERM, Ctrl-C) ends every process within seconds (service.stopping): open
     # requests get GRACEFUL_S to finish.
-    # Said before the seconds each process spends importing, which print nothing themselves;
-    # each then logs its start-up steps (service.warmup).
-    print(
-        f"toptraj serve: {args.workers} server process(es) on http://{args.host}:{args.port}, each importing the planners, "
-        "then loading its compiled kernels (a line per step)",
-        file=sys.stderr,
-        flush=True,
-    )
+    # Said before the seconds each process spends importing, and every few seconds while it
+    # does (service.warmup); each then logs its start-up steps. A single process imports the app
+    # here, before uvicorn configures its logging; more import it in their own processes.
+    print(f"toptraj serve: {args.workers} server process(es) on http://{args.host}:{args.port}", file=sys.stderr, flush=True)
+    if args.workers == 1:
+        process = os.getpid()
+        warmup.say_while_importing(lambda line: print(f"INFO:     toptraj start-up [{process}]: {line}", file=sys.stderr, flush=True))
     uvicorn.run(
         APP_FACTORY,
         factory=True,

@@ -47,6 +47,30 @@ TYPICAL = {
 Report = Callable[[str], None]
 Step = tuple[str, Callable[[], None]]
 
+_imported = threading.Event()
+
+
+def say_while_importing(report: Report) -> None:
+    """``report`` that this process imports the service now, and again every ``HEARTBEAT_S``
+    until ``imports_done``: the seconds a server process spends importing before its app exists
+    (its event loop factory calls this, before uvicorn imports the app; ``toptraj serve`` with
+    one process, where uvicorn imports it before it makes the loop). Nothing once imported."""
+    if _imported.is_set():
+        return
+    started = time.monotonic()
+    report("importing the service (the planners, the web framework) ...")
+
+    def beat() -> None:
+        while not _imported.wait(HEARTBEAT_S):
+            report(f"still importing the service: {time.monotonic() - started:.0f} s")
+
+    threading.Thread(target=beat, name="toptraj-import-heartbeat", daemon=True).start()
+
+
+def imports_done() -> None:
+    """The service is imported (its app is being made): ``say_while_importing`` stops."""
+    _imported.set()
+
 
 def _catalog_robots() -> None:
     import robots
