@@ -7,7 +7,9 @@ run, interleaved: each round times the anchor (the median of ``--solves`` solves
 
 Printed beside each goal of the issue:
 
-* ``toptraj plan`` of the typical request <= 100x;
+* ``toptraj plan`` of the typical request <= 100x, beside its floor: a new interpreter that
+  imports numpy, Pinocchio and pydantic and calls one kernel from numba's cache (numba's own
+  start, which every process that runs a kernel pays);
 * a restart ready within 3 s (<= 600x), the longest silence of its log before ``/health``;
 * each server process <= 300 MB resident at idle, with its fork server's (which preloads the
   stacks of its children: ``planners.execution.isolated.PRELOAD``);
@@ -27,6 +29,7 @@ import argparse
 import http.client
 import json
 import os
+import shutil
 import socket
 import subprocess
 import sys
@@ -55,6 +58,29 @@ def _free_port() -> int:
 
 def _env(root: Path) -> dict:
     return {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(root), os.environ.get("PYTHONPATH")]))}
+
+
+#: The floor's kernel: one cached numba function, in a module of its own.
+_FLOOR_KERNEL = """
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def kernel(x):
+    return np.sqrt(x) + 1.0
+"""
+
+
+def _floor(folder: str) -> float:
+    """Wall seconds of a new interpreter importing numpy, Pinocchio and pydantic and calling one
+    cached numba kernel (``_FLOOR_KERNEL`` in ``folder``)."""
+    started = time.perf_counter()
+    subprocess.run(
+        [sys.executable, "-c", "import numpy, pinocchio, pydantic, floor_kernel; floor_kernel.kernel(numpy.ones(3))"],
+        cwd=folder, check=True,
+    )
+    return time.perf_counter() - started
 
 
 def _cli_plan(request_file: str, env: dict, root: Path = ROOT) -> float:
@@ -193,6 +219,10 @@ def main() -> int:
         json.dump(TYPICAL, handle)
     for root in trees.values():
         _cli_plan(handle.name, _env(root), root)  # numba's cache and the bytecode written, if they were not
+    floor_folder = tempfile.mkdtemp(prefix="toptraj-floor-")
+    Path(floor_folder, "floor_kernel.py").write_text(_FLOOR_KERNEL)
+    _floor(floor_folder)  # compiled into its cache
+    floors: list[float] = []
     anchors: list[float] = []
     plans: dict[str, list[float]] = {name: [] for name in trees}
     restarts: dict[str, list[float]] = {name: [] for name in trees}
@@ -201,6 +231,7 @@ def main() -> int:
     try:
         for round_ in range(args.rounds):
             anchors.append(_anchor(robot, waypoints, args.solves))
+            floors.append(_floor(floor_folder))
             for name, root in trees.items():
                 plans[name].append(_cli_plan(handle.name, _env(root), root))
                 if round_ % args.restart_every == 0:
@@ -214,9 +245,12 @@ def main() -> int:
                         server.stop()
     finally:
         os.unlink(handle.name)
+        shutil.rmtree(floor_folder, ignore_errors=True)
     anchor = float(np.median(anchors))
     print(f"typical request (ur5, 4 spline waypoints, velocity + acceleration + torque, phase_plane, dt 0.01); "
           f"{args.rounds} interleaved rounds; bare toppra {1e3 * anchor:.2f} ms (median)")
+    print(f"  floor (interpreter, numpy, pinocchio, pydantic, one cached numba kernel): {np.median(floors):.3f} s median, "
+          f"{np.median(floors) / anchor:.1f}x bare toppra")
     for name, root in trees.items():
         print(f"{name} ({root}):")
         print(f"  toptraj plan: {np.median(plans[name]):.3f} s median ({', '.join(f'{s:.2f}' for s in plans[name])})")
