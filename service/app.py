@@ -42,6 +42,7 @@ _NO_TELEMETRY = {"tracing": False, "metrics": False, "logs": False, "operation_s
 def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
+    warmup.imports_done()
     settings = settings or Settings()
     single_blas_thread()  # plannings run side by side; see planners.execution.threads
     robots.configure_uploads(
