@@ -133,3 +133,29 @@ def test_warm_start_up_does_not_change_any_answer():
     warm = json.loads(_python(_ANSWERS, "warm", requests).stdout.strip().splitlines()[-1])
     assert set(cold) == {"typical", "toppra", "cubic"}
     assert warm == cold
+
+
+def test_a_long_start_up_step_is_said_again_until_it_ends(monkeypatch):
+    """Never silent: a step that lasts is reported as it begins, again every ``HEARTBEAT_S``
+    while it lasts (here it ends only once two such lines came), and as it ends."""
+    import threading
+
+    from service import warmup
+
+    monkeypatch.setattr(warmup, "HEARTBEAT_S", 0.01)
+    lines: list[str] = []
+    two_said = threading.Event()
+
+    def report(line: str) -> None:
+        lines.append(line)
+        if sum(line.startswith("still loading") for line in lines) >= 2:
+            two_said.set()
+
+    def long_step() -> None:
+        assert two_said.wait(60), lines
+
+    assert warmup.run_steps([("loading", long_step)], report) == 0
+    assert lines[0] == "loading ..." and lines[1].startswith("still loading") and lines[-1].startswith("loading: done in")
+    said = len(lines)
+    threading.Event().wait(0.1)  # the heartbeat ended with the step
+    assert len(lines) == said
