@@ -59,7 +59,7 @@ USER 10001:10001
 # them at start took 88 s before /health answered; with the cache in the image, seconds. (-P:
 # the installed package, which the server imports, not /app: numba keys its cache by source
 # file.)
-RUN python -P -m service.warmup
+RUN python -P -m toptraj.service.warmup
 
 EXPOSE 8000
 

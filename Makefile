@@ -19,7 +19,7 @@ $(STAMP): pyproject.toml requirements.lock
 	$(BIN)/python -m pip install --quiet --require-hashes -r requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
 	$(BIN)/python -m pip check
-	$(BIN)/python -m service.warmup
+	$(BIN)/python -m toptraj.service.warmup
 	touch $(STAMP)
 
 # Re-resolve requirements.lock after a change of the ranges in pyproject.toml (uv's resolver,

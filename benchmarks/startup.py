@@ -12,8 +12,8 @@ Printed beside each goal of the issue:
   start, which every process that runs a kernel pays);
 * a restart ready within 3 s (<= 600x), the longest silence of its log before ``/health``;
 * each server process <= 300 MB resident at idle, with its fork server's (which preloads the
-  stacks of its children: ``planners.execution.isolated.PRELOAD``);
-* with ``--fresh``: the install's step (``python -m service.warmup`` into an empty numba cache,
+  stacks of its children: ``toptraj.planners.execution.isolated.PRELOAD``);
+* with ``--fresh``: the install's step (``python -m toptraj.service.warmup`` into an empty numba cache,
   as after a fresh clone) and then the first start ready within 15 s (<= 3,000x), with the
   longest silence of either.
 
@@ -46,8 +46,8 @@ sys.path.insert(0, str(ROOT))
 
 from anchors import bare_toppra  # noqa: E402
 
-import robots  # noqa: E402
-from service.warmup import TYPICAL  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.service.warmup import TYPICAL  # noqa: E402
 
 
 def _free_port() -> int:
@@ -86,7 +86,7 @@ def _floor(folder: str) -> float:
 def _cli_plan(request_file: str, env: dict, root: Path = ROOT) -> float:
     """Wall seconds of ``toptraj plan FILE`` (a new interpreter), its answer checked."""
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "service.cli", "plan", request_file], cwd=root, env=env, capture_output=True)
+    done = subprocess.run([sys.executable, "-m", "toptraj.service.cli", "plan", request_file], cwd=root, env=env, capture_output=True)
     seconds = time.perf_counter() - started
     if done.returncode != 0 or not done.stdout.startswith(b'{"robot":"ur5"'):
         raise RuntimeError(f"toptraj plan failed: {done.stderr[-500:]!r}")
@@ -102,7 +102,7 @@ class _Server:
         self.lines: list[tuple[float, str]] = []
         self.started = time.perf_counter()
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--workers", "1"],
+            [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(self.port), "--workers", "1"],
             cwd=root, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         )
         threading.Thread(target=self._read, daemon=True).start()
@@ -180,7 +180,7 @@ def _fresh(anchor_s: float) -> None:
     with tempfile.TemporaryDirectory(prefix="toptraj-numba-") as cache:
         env = {**_env(ROOT), "NUMBA_CACHE_DIR": cache}
         started = time.perf_counter()
-        install = subprocess.Popen([sys.executable, "-m", "service.warmup"], cwd=ROOT, env=env, stdout=subprocess.PIPE, text=True)
+        install = subprocess.Popen([sys.executable, "-m", "toptraj.service.warmup"], cwd=ROOT, env=env, stdout=subprocess.PIPE, text=True)
         assert install.stdout is not None
         stamps = [started]
         for line in install.stdout:
@@ -188,7 +188,7 @@ def _fresh(anchor_s: float) -> None:
             print(f"    {stamps[-1] - started:6.1f} s  {line.rstrip()}")
         install.wait()
         install_s = time.perf_counter() - started
-        print(f"  install step (python -m service.warmup, empty cache): {install_s:.1f} s, "
+        print(f"  install step (python -m toptraj.service.warmup, empty cache): {install_s:.1f} s, "
               f"longest silence {np.max(np.diff(stamps)):.1f} s")
         server = _Server(env)
         try:

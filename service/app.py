@@ -10,18 +10,18 @@ from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners.execution.isolated import start_worker_server
-from planners.execution.threads import single_blas_thread
-from service import stopping, warmup
-from service.body_limit import BodySizeLimit
-from service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
-from service.jobs import JOB_MODULES, job_runner
-from service.routes import batches, health, jobs, trajectories, web
-from service.routes import robots as robot_routes
-from service.serving import open_connections
-from service.settings import Settings
-from service.workers import PlanningWorkers
+from toptraj import robots
+from toptraj.planners.execution.isolated import start_worker_server
+from toptraj.planners.execution.threads import single_blas_thread
+from toptraj.service import stopping, warmup
+from toptraj.service.body_limit import BodySizeLimit
+from toptraj.service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
+from toptraj.service.jobs import JOB_MODULES, job_runner
+from toptraj.service.routes import batches, health, jobs, trajectories, web
+from toptraj.service.routes import robots as robot_routes
+from toptraj.service.serving import open_connections
+from toptraj.service.settings import Settings
+from toptraj.service.workers import PlanningWorkers
 
 #: Where a server process says what it does while it starts (uvicorn's own log).
 _log = logging.getLogger("uvicorn.error")
@@ -29,7 +29,7 @@ _log = logging.getLogger("uvicorn.error")
 
 def _warm_up() -> None:
     """Build every catalog robot and load the compiled phase-plane and conditioning kernels
-    once (``service.warmup.server_steps``), each step logged, so that first requests are fast.
+    once (``toptraj.service.warmup.server_steps``), each step logged, so that first requests are fast.
     The solver stacks of the other methods are imported where those run, when they first do."""
     process = os.getpid()
     warmup.run_steps(warmup.server_steps(), lambda line: _log.info("toptraj start-up [%d]: %s", process, line))
@@ -44,7 +44,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     (``robots.configure_uploads``): one upload store per process, the last app's."""
     warmup.imports_done()
     settings = settings or Settings()
-    single_blas_thread()  # plannings run side by side; see planners.execution.threads
+    single_blas_thread()  # plannings run side by side; see toptraj.planners.execution.threads
     robots.configure_uploads(
         settings.data_dir,
         max_uploads=settings.max_uploads,

@@ -1,5 +1,5 @@
 """The ``toptraj`` command: ``toptraj serve [--host H] [--port P] [--workers N] [--access-log]``, and
-``toptraj plan|compare FILE|-`` and ``toptraj plot FILE|- -o OUT.html`` (``service.commands``)."""
+``toptraj plan|compare FILE|-`` and ``toptraj plot FILE|- -o OUT.html`` (``toptraj.service.commands``)."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import argparse
 import os
 import sys
 
-from service import commands as commands_
-from service import warmup
+from toptraj.service import commands as commands_
+from toptraj.service import warmup
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
-APP_FACTORY = "service.app:create_app"
+APP_FACTORY = "toptraj.service.app:create_app"
 
 
 def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
@@ -26,8 +26,8 @@ def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
 def _serve(args) -> int:
     import uvicorn  # here, as the server's own modules: ``toptraj plan`` needs none of them
 
-    from service.serving import LOOP
-    from service.stopping import GRACEFUL_S
+    from toptraj.service.serving import LOOP
+    from toptraj.service.stopping import GRACEFUL_S
 
     if args.workers < 1:
         print(f"toptraj serve: --workers must be at least 1, not {args.workers}", file=sys.stderr)
@@ -36,14 +36,14 @@ def _serve(args) -> int:
     os.environ.setdefault("TOPTRAJ_PLAN_WORKERS", str(plan_threads_per_process(args.workers)))
     # One process (workers=1) serves in this process; more are spawned processes sharing this
     # process's listening socket, each with its own app, planning threads and model caches,
-    # restarted by uvicorn's supervisor if one dies, taking connections in turns (service.serving).
+    # restarted by uvicorn's supervisor if one dies, taking connections in turns (toptraj.service.serving).
     # A line per request costs the event loop about 0.2 ms of a 7 ms request (uvicorn's access
     # formatter and a write per line), so it is asked for, as gunicorn's is; errors are logged
     # either way.
-    # A stop (SIGTERM, Ctrl-C) ends every process within seconds (service.stopping): open
+    # A stop (SIGTERM, Ctrl-C) ends every process within seconds (toptraj.service.stopping): open
     # requests get GRACEFUL_S to finish.
     # Said before the seconds each process spends importing, and every few seconds while it
-    # does (service.warmup); each then logs its start-up steps. A single process imports the app
+    # does (toptraj.service.warmup); each then logs its start-up steps. A single process imports the app
     # here, before uvicorn configures its logging; more import it in their own processes.
     print(f"toptraj serve: {args.workers} server process(es) on http://{args.host}:{args.port}", file=sys.stderr, flush=True)
     if args.workers == 1:

@@ -3,7 +3,7 @@ for the unexpected, an encoder that refuses NaN and infinity, and the OpenAPI de
 
 * ``STATUS`` gives the HTTP status of each error class of the library (``status_of``: its own
   class or nearest base in the table; the service's own errors carry theirs); it lives in
-  ``service.problems`` with the rest that needs no web framework, and is re-exported here.
+  ``toptraj.service.problems`` with the rest that needs no web framework, and is re-exported here.
 * ``install_problem_handlers`` routes the error tree (``ToptrajError``), request validation and
   Starlette's HTTP errors (404, 405 with its ``Allow`` header, ...) to problem answers.
 * ``UnexpectedErrors`` (pure ASGI, outermost) answers any other exception with a problem 500
@@ -28,9 +28,9 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
-from robots import ToptrajError
-from service.problems import STATUS, NonFiniteAnswer, non_finite_answer, status_of, validation_problem
-from service.schemas.common import Problem
+from toptraj.robots import ToptrajError
+from toptraj.service.problems import STATUS, NonFiniteAnswer, non_finite_answer, status_of, validation_problem
+from toptraj.service.schemas.common import Problem
 
 __all__ = ["PROBLEM_JSON", "STATUS", "FiniteJSONResponse", "NonFiniteAnswer", "non_finite_answer", "status_of", "validation_problem"]
 

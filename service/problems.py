@@ -1,7 +1,7 @@
 """Errors as ``application/problem+json`` (RFC 9457) without the web framework: the HTTP status
 of each error class of the library, the problem of a request that does not fit its schema and the
 search for a NaN or infinity in an answer. ``toptraj plan`` and the batch workers answer with
-these, without importing FastAPI; ``service.errors`` serves them over HTTP.
+these, without importing FastAPI; ``toptraj.service.errors`` serves them over HTTP.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ from typing import Any
 import numpy as np
 from pydantic import ValidationError
 
-from planners.errors import BudgetExceeded
-from robots import ToptrajError
-from robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
+from toptraj.planners.errors import BudgetExceeded
+from toptraj.robots import ToptrajError
+from toptraj.robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
 
 #: HTTP status of the library's errors by class; a class not in the table answers with its
 #: nearest base's (``ToptrajError``: 422, malformed or impossible input).

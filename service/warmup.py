@@ -3,7 +3,7 @@ built, and the compiled kernels (numba, ``cache=True``) compiled into numba's ca
 from it.
 
 Compiling the kernels takes a minute or more on two cores; loading them from the cache, a
-second or two. So the install compiles them (``python -m service.warmup``: ``make install``, the
+second or two. So the install compiles them (``python -m toptraj.service.warmup``: ``make install``, the
 Dockerfile's build), each server process then only loads them (``server_steps``, from the app's
 lifespan), and neither is silent meanwhile: a line when a step begins, one every ``HEARTBEAT_S``
 while it lasts, and one when it ends with its seconds and how many kernels it compiled (0 when
@@ -11,9 +11,9 @@ the cache held them all).
 
 The solver stacks that only some methods use (cvxpy, casadi, toppra, scipy's optimizers) are
 not imported here: each method imports its own when it first runs (in the fork server's
-children for cvxpy and casadi, ``planners.execution.isolated.PRELOAD``).
+children for cvxpy and casadi, ``toptraj.planners.execution.isolated.PRELOAD``).
 
-    python -m service.warmup     # what the install runs: every step, a line per step
+    python -m toptraj.service.warmup     # what the install runs: every step, a line per step
 """
 
 from __future__ import annotations
@@ -73,7 +73,7 @@ def imports_done() -> None:
 
 
 def _catalog_robots() -> None:
-    import robots
+    from toptraj import robots
 
     for name in robots.catalog_names():
         robots.load(name)
@@ -82,8 +82,8 @@ def _catalog_robots() -> None:
 def _phase_plane() -> None:
     import numpy as np
 
-    import robots
-    from planners import Timing, WaypointPath, plan
+    from toptraj import robots
+    from toptraj.planners import Timing, WaypointPath, plan
 
     arm = robots.load("yamamoto_2r")
     plan(arm, WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
@@ -93,14 +93,14 @@ def _conditioning() -> None:
     """Conditioning's singular-value kernel, on a singular Jacobian."""
     import numpy as np
 
-    from planners.kinematics.conditioning import frobenius_condition_number
+    from toptraj.planners.kinematics.conditioning import frobenius_condition_number
 
     frobenius_condition_number(np.zeros((6, 6)))
 
 
 def _typical() -> None:
-    from service.planning import plan_request, render
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.planning import plan_request, render
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     request = TrajectoryRequest.model_validate(TYPICAL)
     render(plan_request(request), request)
@@ -173,7 +173,7 @@ def run_steps(steps: list[Step], report: Report) -> int:
 
 
 def main() -> int:
-    """``python -m service.warmup``: every install step, a line each on standard output."""
+    """``python -m toptraj.service.warmup``: every install step, a line each on standard output."""
 
     def report(line: str) -> None:
         print(f"toptraj warm-up: {line}", flush=True)

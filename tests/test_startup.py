@@ -31,10 +31,10 @@ TYPICAL = {
 TOPPRA = {**TYPICAL, "timing": {"method": "toppra", "constraints": ["velocity", "acceleration", "torque"]}}
 CUBIC = {"robot": "panda", "path": {"kind": "waypoints", "waypoints": [[0, -0.5, 0, -2, 0, 1.5, 0.7], [0.6, -0.2, 0.3, -1.6, 0.2, 1.8, 0.9]]},
          "timing": {"method": "cubic", "constraints": ["velocity", "acceleration"]}}
-#: A fresh interpreter: ``toptraj plan FILE`` (service.cli.main), then the modules it holds.
+#: A fresh interpreter: ``toptraj plan FILE`` (toptraj.service.cli.main), then the modules it holds.
 _PLAN = """
 import json, sys
-from service.cli import main
+from toptraj.service.cli import main
 status = main(["plan", sys.argv[1]])
 sys.stdout.flush()
 print(json.dumps(sorted(sys.modules)), file=sys.stderr)
@@ -77,8 +77,8 @@ _START = """
 import json, logging, sys
 from numba.core import event
 from fastapi.testclient import TestClient
-from service.app import create_app
-from service.settings import Settings
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 lines = []
 handler = logging.Handler()
@@ -97,7 +97,7 @@ def test_a_server_with_a_warm_cache_starts_without_compiling_or_heavy_imports(tm
     """The bound is in events: once the install's step has run (here: the server's steps, in a
     process of their own), a start compiles no kernel, imports none of the stacks that run in
     the fork server's children or in methods not yet asked for, and says each step."""
-    _python("from service.warmup import run_steps, server_steps; run_steps(server_steps(), print)")
+    _python("from toptraj.service.warmup import run_steps, server_steps; run_steps(server_steps(), print)")
     started = json.loads(_python(_START, str(tmp_path)).stdout.strip().splitlines()[-1])
     assert started["health"] == 200
     assert started["compiled"] == 0
@@ -113,10 +113,10 @@ def test_a_server_with_a_warm_cache_starts_without_compiling_or_heavy_imports(tm
 _ANSWERS = """
 import hashlib, json, sys
 if sys.argv[1] == "warm":
-    from service.warmup import run_steps, server_steps
+    from toptraj.service.warmup import run_steps, server_steps
     run_steps(server_steps(), lambda line: None)
-from service.planning import plan_request, render
-from service.schemas.trajectories import TrajectoryRequest
+from toptraj.service.planning import plan_request, render
+from toptraj.service.schemas.trajectories import TrajectoryRequest
 answers = {}
 for name, body in json.loads(sys.argv[2]).items():
     request = TrajectoryRequest.model_validate(body)
@@ -140,7 +140,7 @@ def test_a_long_start_up_step_is_said_again_until_it_ends(monkeypatch):
     while it lasts (here it ends only once two such lines came), and as it ends."""
     import threading
 
-    from service import warmup
+    from toptraj.service import warmup
 
     monkeypatch.setattr(warmup, "HEARTBEAT_S", 0.01)
     lines: list[str] = []

@@ -3,7 +3,7 @@ parameterization (Jeong & Lee section 4.3, after Geering et al. 1986: the time-o
 of the two-link arm are bang-bang, each torque at one bound or the other between its switching
 times, and the paper's figure captions print those times).
 
-A collocation (``planners.generators.collocation.collocation``) places a switch only between two of its
+A collocation (``toptraj.planners.generators.collocation.collocation``) places a switch only between two of its
 instants: it changes sides somewhere within one interval h = T / K (36 ms at K = 30 on the
 Geering arm), and reading the instant where the interpolated torque crosses zero leaves errors
 of a good part of h. Here the controls are instead exactly bang-bang,
@@ -36,11 +36,11 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.collocation.motion import CollocationResult, FreeMotion
-from planners.generators.collocation.root_finding import held_newton, jacobian, newton, secant_minimum
-from planners.generators.via_points import ConstantSpeedTiming, ViaPath
-from robots import JointLimits, Robot
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.collocation.motion import CollocationResult, FreeMotion
+from toptraj.planners.generators.collocation.root_finding import held_newton, jacobian, newton, secant_minimum
+from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
+from toptraj.robots import JointLimits, Robot
 
 #: Longest Runge-Kutta step (s) while the switching times are solved for, and of the final
 #: integration of the refined motion.
