@@ -58,10 +58,11 @@ RUN NO_MKDOCS_2_WARNING=1 python -m mkdocs build --strict --quiet -d service/web
 
 USER 10001:10001
 
-# The compiled kernels (numba) in the image: two server processes compiling them at start took
-# 88 s before /health answered; with the cache in the image, seconds. (-P: the installed
-# package, which the server imports, not /app: numba keys its cache by source file.)
-RUN python -P -c "from toptraj.service.app import _warm_up; _warm_up()"
+# The compiled kernels (numba) in the image, a line per step: two server processes compiling
+# them at start took 88 s before /health answered; with the cache in the image, seconds. (-P:
+# the installed package, which the server imports, not /app: numba keys its cache by source
+# file.)
+RUN python -P -m toptraj.service.warmup
 
 EXPOSE 8000
 

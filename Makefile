@@ -15,12 +15,15 @@ GUIDE_SOURCES := mkdocs.yml $(shell find docs robots planners client -name '*.md
 # Exact versions with their hashes from requirements.lock (the runtime dependencies and the
 # test extra, resolved from the ranges in pyproject.toml), then the project itself on top;
 # pip check fails when the lock no longer holds a dependency pyproject.toml asks for (make lock).
+# Last, the compiled kernels into numba's cache (a line per step; a minute or more on two
+# cores), so that the first `make serve` is ready in seconds rather than compiling them.
 $(STAMP): pyproject.toml requirements.lock
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet --require-hashes -r requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
 	$(BIN)/python -m pip check
+	$(BIN)/python -m toptraj.service.warmup
 	touch $(STAMP)
 
 # Re-resolve requirements.lock after a change of the ranges in pyproject.toml (uv's resolver,

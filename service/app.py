@@ -2,19 +2,18 @@
 
 from __future__ import annotations
 
+import logging
+import os
 from contextlib import asynccontextmanager
 
-import numpy as np
 from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 from starlette.concurrency import run_in_threadpool
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
 from toptraj.planners.execution.isolated import start_worker_server
 from toptraj.planners.execution.threads import single_blas_thread
-from toptraj.planners.kinematics.conditioning import frobenius_condition_number
-from toptraj.service import stopping
+from toptraj.service import stopping, warmup
 from toptraj.service.body_limit import BodySizeLimit
 from toptraj.service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
 from toptraj.service.jobs import JOB_MODULES, job_runner
@@ -24,19 +23,16 @@ from toptraj.service.serving import open_connections
 from toptraj.service.settings import Settings
 from toptraj.service.workers import PlanningWorkers
 
+#: Where a server process says what it does while it starts (uvicorn's own log).
+_log = logging.getLogger("uvicorn.error")
+
 
 def _warm_up() -> None:
-    """Build every catalog robot, import toppra and cvxpy, and load the compiled phase-plane
-    kernels once (and conditioning's singular-value kernel, on a singular Jacobian), so that
-    first requests are fast."""
-    for name in robots.catalog_names():
-        robots.load(name)
-    import cvxpy  # noqa: F401
-    import toppra  # noqa: F401
-
-    arm = robots.load("yamamoto_2r")
-    plan(arm, WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
-    frobenius_condition_number(np.zeros((6, 6)))
+    """Build every catalog robot and load the compiled phase-plane and conditioning kernels
+    once (``toptraj.service.warmup.server_steps``), each step logged, so that first requests are fast.
+    The solver stacks of the other methods are imported where those run, when they first do."""
+    process = os.getpid()
+    warmup.run_steps(warmup.server_steps(), lambda line: _log.info("toptraj start-up [%d]: %s", process, line))
 
 
 #: FastAPI's telemetry options with every part off (``Settings.telemetry``).
@@ -46,6 +42,7 @@ _NO_TELEMETRY = {"tracing": False, "metrics": False, "logs": False, "operation_s
 def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
+    warmup.imports_done()
     settings = settings or Settings()
     single_blas_thread()  # plannings run side by side; see toptraj.planners.execution.threads
     robots.configure_uploads(
@@ -57,9 +54,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        await run_in_threadpool(start_worker_server, JOB_MODULES)
         if settings.preload_robots:
             await run_in_threadpool(_warm_up)
+        # After the warm-up: the fork server's imports (its own process) then do not compete
+        # for the cores with this process's, and it is ready a second or two after this one.
+        await run_in_threadpool(start_worker_server, JOB_MODULES)
         await run_in_threadpool(app.state.jobs.start)
         stopping.serving()  # a stop is graceful from here on
         yield

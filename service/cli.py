@@ -8,8 +8,7 @@ import os
 import sys
 
 from toptraj.service import commands as commands_
-from toptraj.service.serving import LOOP
-from toptraj.service.stopping import GRACEFUL_S
+from toptraj.service import warmup
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
 APP_FACTORY = "toptraj.service.app:create_app"
@@ -25,7 +24,10 @@ def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
 
 
 def _serve(args) -> int:
-    import uvicorn
+    import uvicorn  # here, as the server's own modules: ``toptraj plan`` needs none of them
+
+    from toptraj.service.serving import LOOP
+    from toptraj.service.stopping import GRACEFUL_S
 
     if args.workers < 1:
         print(f"toptraj serve: --workers must be at least 1, not {args.workers}", file=sys.stderr)
@@ -40,6 +42,13 @@ def _serve(args) -> int:
     # either way.
     # A stop (SIGTERM, Ctrl-C) ends every process within seconds (toptraj.service.stopping): open
     # requests get GRACEFUL_S to finish.
+    # Said before the seconds each process spends importing, and every few seconds while it
+    # does (toptraj.service.warmup); each then logs its start-up steps. A single process imports the app
+    # here, before uvicorn configures its logging; more import it in their own processes.
+    print(f"toptraj serve: {args.workers} server process(es) on http://{args.host}:{args.port}", file=sys.stderr, flush=True)
+    if args.workers == 1:
+        process = os.getpid()
+        warmup.say_while_importing(lambda line: print(f"INFO:     toptraj start-up [{process}]: {line}", file=sys.stderr, flush=True))
     uvicorn.run(
         APP_FACTORY,
         factory=True,

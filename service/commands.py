@@ -81,7 +81,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
     from toptraj.robots import ToptrajError
-    from toptraj.service.errors import status_of, validation_problem
+    from toptraj.service.problems import status_of, validation_problem
 
     try:
         content = answer(_read(source))

@@ -22,8 +22,8 @@ from toptraj.planners.problem.build import DEFAULT_CLEARANCE, MAX_SAMPLES
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
-from toptraj.service.errors import non_finite_answer, status_of
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
+from toptraj.service.problems import non_finite_answer, status_of
 from toptraj.service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.

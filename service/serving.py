@@ -35,6 +35,7 @@ from __future__ import annotations
 import asyncio
 import errno
 import logging
+import os
 import socket
 import sys
 import weakref
@@ -86,10 +87,14 @@ class BalancedEventLoop(_BaseLoop):
 def new_server_loop() -> asyncio.AbstractEventLoop:
     """The event loop of a ``toptraj serve`` process (uvicorn's ``loop`` setting, ``LOOP``):
     ``new_event_loop``'s, once the process's stop watch runs (``toptraj.service.stopping``; uvicorn
-    makes the loop before it installs its signal handlers and before it loads the app)."""
-    from toptraj.service import stopping
+    makes the loop before it installs its signal handlers and before it loads the app) and
+    while it says, every few seconds, that it is importing the app (``toptraj.service.warmup``)."""
+    from toptraj.service import stopping, warmup
 
     stopping.watch()
+    if "toptraj.service.app" not in sys.modules:  # one process: uvicorn imported it before (toptraj serve says so)
+        process = os.getpid()
+        warmup.say_while_importing(lambda line: _log.info("toptraj start-up [%d]: %s", process, line))
     return new_event_loop()
 
 

@@ -27,7 +27,7 @@ ROOM = {
     "toptraj.planners.timing.phase_plane": "timing",
     "toptraj.planners.constraints": "constraints",
     "toptraj.planners.execution": "execution",
-    "planners": "runner", "toptraj.planners.plan": "runner", "toptraj.planners.runner.given_path": "runner", "toptraj.planners.runner.timed_free": "runner",
+    "planners": "runner", "toptraj.planners.plan": "runner", "toptraj.planners.runner.given_path": "runner", "toptraj.planners.runner.run": "runner", "toptraj.planners.runner.answer": "runner",
     "toptraj.planners.errors": "errors", "toptraj.planners.diagnostics": "errors",
     "toptraj.planners.execution.deadline": "execution", "toptraj.planners.execution.isolated": "execution", "toptraj.planners.execution.threads": "execution",
     "toptraj.planners.kinematics": "kinematics", "toptraj.planners.paths": "paths", "toptraj.planners.paths.grid": "paths", "toptraj.planners.collision": "collision",

@@ -56,8 +56,24 @@ PROGRESS_S = 0.1
 #: How much lower the CPU priority of a heavy planning's worker process is (``nice``): it
 #: shares the cores with a server's short requests, which keep theirs.
 LOW_PRIORITY = 5
-#: Modules the fork server imports once, so that children start with them loaded.
-PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "toptraj.planners.timing.min_cost", "toptraj.planners.generators.collocation.collocation"]
+#: Modules the fork server imports once, so that children start with them loaded: the stacks of
+#: the computations that run in children, which their modules import only where they run
+#: (``min_cost``: cvxpy and Clarabel; the collocation: casadi and scipy's optimizers; the
+#: search: scipy's sparse graphs, optimizers and B-splines). The server process imports none.
+PRELOAD = [
+    "numpy",
+    "threadpoolctl",
+    "pinocchio",
+    "scipy.optimize",
+    "scipy.sparse.csgraph",
+    "scipy.interpolate",
+    "cvxpy",
+    "clarabel",
+    "toptraj.planners.timing.min_cost",
+    "toptraj.planners.generators.collocation.collocation",
+    "toptraj.planners.generators.collocation.sparse",
+    "toptraj.planners.generators.search.generator",
+]
 
 _context = None
 _lock = threading.Lock()

@@ -15,8 +15,8 @@ from toptraj.planners.execution.deadline import Deadline
 from toptraj.robots import ToptrajError
 from toptraj.robots.upload_options import UploadOptions
 from toptraj.service.batches.lines import problem_body
-from toptraj.service.errors import status_of, validation_problem
 from toptraj.service.planning import compare_request, encode_json, plan_request, render
+from toptraj.service.problems import status_of, validation_problem
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 logger = logging.getLogger("toptraj.batches")

@@ -30,10 +30,10 @@ from toptraj.planners import Deadline
 from toptraj.planners.errors import BudgetExceeded
 from toptraj.planners.execution.isolated import run_isolated
 from toptraj.robots.errors import ToptrajError
-from toptraj.service.errors import status_of
 from toptraj.service.jobs import work
 from toptraj.service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
 from toptraj.service.jobs.store import JobStore
+from toptraj.service.problems import status_of
 
 logger = logging.getLogger("toptraj.jobs")
 

@@ -135,7 +135,7 @@ def test_the_service_picks_the_status_not_the_library(client, monkeypatch):
     never from an attribute of the library's class: changing that attribute changes no answer."""
     from toptraj.planners.errors import BudgetExceeded
     from toptraj.robots.errors import UnknownRobot
-    from toptraj.service.errors import status_of
+    from toptraj.service.problems import status_of
 
     monkeypatch.setattr(UnknownRobot, "status", 418, raising=False)
     monkeypatch.setattr(BudgetExceeded, "status", 418, raising=False)

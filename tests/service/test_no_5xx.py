@@ -20,7 +20,8 @@ from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.results import require_finite
 from toptraj.planners.timing.laws.profiles import quintic_coefficients
 from toptraj.service.app import create_app
-from toptraj.service.errors import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
+from toptraj.service.errors import FiniteJSONResponse
+from toptraj.service.problems import NonFiniteAnswer, non_finite_answer
 from toptraj.service.settings import Settings
 
 DIRECTION = [0.8, 0.2, 0.4, -0.5, 0.6, 0.3]

@@ -29,14 +29,12 @@ import time
 
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import minimize
 
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline, Progress
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.generators.collocation.motion import CollocationResult
-from toptraj.planners.generators.collocation.sparse import SparseCollocation, solve_sparse
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.waypoints import SplinePath
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -251,6 +249,8 @@ def _bends(n_dof: int) -> list[tuple[str, np.ndarray]]:
 
 
 def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int):
+    from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
+
     result = minimize(
         problem.cost,
         z0,
@@ -307,6 +307,9 @@ def _optimize_motion(
     max_iterations: int,
     progress: Progress = NO_DEADLINE.progress,
 ) -> CollocationResult:
+    # here: casadi and its solvers take a second to import, for this method only
+    from toptraj.planners.generators.collocation.sparse import SparseCollocation, solve_sparse
+
     if robot.outside_position_limits(motion.start) is not None:
         raise InvalidRequest("path.start is outside the joint limits")
     if robot.outside_position_limits(motion.goal) is not None:

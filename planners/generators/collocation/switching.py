@@ -35,7 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import minimize
 
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.collocation.motion import CollocationResult
@@ -260,6 +259,8 @@ def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> tuple[Ba
     if free == 1:
         theta, held = secant_minimum(residual, theta)
     elif free > 1:
+        from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
+
         theta = minimize(
             lambda x: x[-1],
             theta,

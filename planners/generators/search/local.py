@@ -47,7 +47,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.optimize import minimize
 
 from toptraj.planners.collision.clearance import Clearance, PathInCollision, check_clearance
 from toptraj.planners.collision.obstacles import Obstacle
@@ -239,6 +238,8 @@ def optimize_locally(
             clearance and the joint ranges (a ``PathInCollision`` when it is the clearance).
         BudgetExceeded: ``deadline`` passed.
     """
+    from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
+
     started = time.perf_counter()
     seed = np.asarray(seed, dtype=float)
     if seed.ndim != 2 or seed.shape[0] < 2 or seed.shape[1] != robot.dof or not np.all(np.isfinite(seed)):

@@ -9,8 +9,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from toptraj.planners.collision import Obstacle
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest
@@ -101,6 +99,9 @@ def _cost_to_go(n_states: int, source: np.ndarray, target: np.ndarray, weight: n
     goal: Dijkstra from the goal over the reversed arcs."""
     if not len(source):
         return np.full(n_states, np.inf)
+    from scipy.sparse import csr_matrix  # here: scipy.sparse is imported by the searches only
+    from scipy.sparse.csgraph import dijkstra
+
     target = np.where(target < 0, n_states, target)
     finite = np.isfinite(weight)
     reversed_arcs = csr_matrix(

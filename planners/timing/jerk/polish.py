@@ -25,7 +25,6 @@ solution; for limits constant along the path it is the exact optimum.
 from __future__ import annotations
 
 import numpy as np
-from scipy import sparse
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.execution.deadline import Deadline
@@ -280,6 +279,7 @@ def _solve(z, evaluate, M, deadline=None):
     (a jerk row along a segment whose limits do not change, a limit at the state two segments
     share) are kept once. ``None`` when it does not end at a feasible point."""
     import highspy
+    from scipy import sparse  # here: scipy.sparse is imported by jerk_limited only
 
     h, H, g, G = evaluate(z)
     keep = _distinct_rows(np.column_stack([g, G]))

@@ -19,7 +19,6 @@ typical x, so that the LP sees numbers of order one.
 from __future__ import annotations
 
 import numpy as np
-from scipy import sparse
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
@@ -222,6 +221,8 @@ class RestrictedProgram:
 
     def solve_restricted(self, x_tangent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The LP of the restriction around ``x_tangent`` (1/s^2): x and u (unscaled)."""
+        from scipy import sparse  # here: scipy.sparse is imported by jerk_limited only
+
         kappa, n = self.kappa, self.n
         X_tangent = np.asarray(x_tangent) / kappa
         blocks = [*self._fixed_rows, *self._jerk_rows(X_tangent)]

@@ -155,10 +155,10 @@ def test_a_search_job_obeys_the_same_memory_cap(tmp_path):
 def test_an_estimate_too_low_is_a_clear_error_not_the_system_killing_a_process(monkeypatch):
     # as if the estimate said 1 byte: the search's worker process gets 64 MB of room, runs out
     # while it builds its spans (about 0.5 GB), and the answer says so
-    import toptraj.planners.generators.search.generator as timed_free
+    import toptraj.planners.generators.search.generator as search_generator
 
-    monkeypatch.setattr(timed_free, "check_search_memory", lambda *args, **kwargs: 1)
-    monkeypatch.setattr(timed_free, "SEARCH_MEMORY_SLACK", 64 * 2**20)
+    monkeypatch.setattr(search_generator, "check_search_memory", lambda *args, **kwargs: 1)
+    monkeypatch.setattr(search_generator, "SEARCH_MEMORY_SLACK", 64 * 2**20)
     with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=30.0))) as client:
         response = client.post("/v1/trajectories", json=_ur5_search({}, 30.0, ()))
     assert response.status_code == 422, response.text[:300]

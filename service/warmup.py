@@ -1,0 +1,188 @@
+"""The work a server does before it answers, step by step and said aloud: the catalog robots
+built, and the compiled kernels (numba, ``cache=True``) compiled into numba's cache or loaded
+from it.
+
+Compiling the kernels takes a minute or more on two cores; loading them from the cache, a
+second or two. So the install compiles them (``python -m toptraj.service.warmup``: ``make install``, the
+Dockerfile's build), each server process then only loads them (``server_steps``, from the app's
+lifespan), and neither is silent meanwhile: a line when a step begins, one every ``HEARTBEAT_S``
+while it lasts, and one when it ends with its seconds and how many kernels it compiled (0 when
+the cache held them all).
+
+The solver stacks that only some methods use (cvxpy, casadi, toppra, scipy's optimizers) are
+not imported here: each method imports its own when it first runs (in the fork server's
+children for cvxpy and casadi, ``toptraj.planners.execution.isolated.PRELOAD``).
+
+    python -m toptraj.service.warmup     # what the install runs: every step, a line per step
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+
+#: Seconds between two lines while a step lasts.
+HEARTBEAT_S = 3.0
+#: The typical request (``benchmarks/end_to_end.py``): ur5, 4 spline waypoints, velocity,
+#: acceleration and torque limits, ``phase_plane``, samples every 10 ms.
+TYPICAL = {
+    "robot": "ur5",
+    "path": {
+        "kind": "waypoints",
+        "waypoints": [
+            [0.0, -1.2, 1.0, 0.0, 0.0, 0.0],
+            [0.8, -1.0, 1.4, -0.5, 0.6, 0.3],
+            [1.5, -0.5, 0.8, -1.0, 1.0, 0.8],
+            [2.0, -1.3, 1.2, 0.2, 0.4, 1.2],
+        ],
+        "interpolation": "spline",
+    },
+    "timing": {"method": "phase_plane", "constraints": ["velocity", "acceleration", "torque"]},
+    "output": {"dt": 0.01},
+}
+
+Report = Callable[[str], None]
+Step = tuple[str, Callable[[], None]]
+
+_imported = threading.Event()
+
+
+def say_while_importing(report: Report) -> None:
+    """``report`` that this process imports the service now, and again every ``HEARTBEAT_S``
+    until ``imports_done``: the seconds a server process spends importing before its app exists
+    (its event loop factory calls this, before uvicorn imports the app; ``toptraj serve`` with
+    one process, where uvicorn imports it before it makes the loop). Nothing once imported."""
+    if _imported.is_set():
+        return
+    started = time.monotonic()
+    report("importing the service (the planners, the web framework) ...")
+
+    def beat() -> None:
+        while not _imported.wait(HEARTBEAT_S):
+            report(f"still importing the service: {time.monotonic() - started:.0f} s")
+
+    threading.Thread(target=beat, name="toptraj-import-heartbeat", daemon=True).start()
+
+
+def imports_done() -> None:
+    """The service is imported (its app is being made): ``say_while_importing`` stops."""
+    _imported.set()
+
+
+def _catalog_robots() -> None:
+    from toptraj import robots
+
+    for name in robots.catalog_names():
+        robots.load(name)
+
+
+def _phase_plane() -> None:
+    import numpy as np
+
+    from toptraj import robots
+    from toptraj.planners import Timing, WaypointPath, plan
+
+    arm = robots.load("yamamoto_2r")
+    plan(arm, WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
+
+
+def _conditioning() -> None:
+    """Conditioning's singular-value kernel, on a singular Jacobian."""
+    import numpy as np
+
+    from toptraj.planners.kinematics.conditioning import frobenius_condition_number
+
+    frobenius_condition_number(np.zeros((6, 6)))
+
+
+def _typical() -> None:
+    from toptraj.service.planning import plan_request, render
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
+
+    request = TrajectoryRequest.model_validate(TYPICAL)
+    render(plan_request(request), request)
+
+
+def server_steps() -> list[Step]:
+    """What each server process does before it answers (kernels loaded from the cache)."""
+    return [
+        ("building the catalog robots", _catalog_robots),
+        ("compiling or loading the phase-plane kernels", _phase_plane),
+        ("compiling or loading the conditioning kernel", _conditioning),
+    ]
+
+
+def install_steps() -> list[Step]:
+    """What the install does: the server's steps, then the kernels of the typical request
+    (velocity and acceleration rows, sampling, dense checks), compiled into the cache."""
+    return [*server_steps(), ("compiling the typical request's kernels (ur5, spline, velocity, acceleration, torque)", _typical)]
+
+
+@contextmanager
+def _compilations() -> Iterator[list]:
+    """The numba compilations (not cache loads) that happen inside the block, as events."""
+    from numba.core import event
+
+    with event.install_recorder("numba:compile") as recorder:
+        yield recorder.buffer
+
+
+def _compiled(events: list) -> int:
+    """Kernels compiled among numba's compile ``events`` (a start and an end each)."""
+    return sum(1 for _, item in list(events) if item.is_end)
+
+
+@contextmanager
+def _heartbeat(label: str, events: list, report: Report) -> Iterator[None]:
+    """``report`` a line every ``HEARTBEAT_S`` while the block runs, with the kernels compiled
+    so far (``events``: numba's compile events)."""
+    done = threading.Event()
+    started = time.monotonic()
+
+    def beat() -> None:
+        while not done.wait(HEARTBEAT_S):
+            report(f"still {label}: {time.monotonic() - started:.0f} s, {_compiled(events)} functions compiled so far "
+                   "(a minute or more the first time; seconds once numba's cache holds them)")
+
+    thread = threading.Thread(target=beat, name="toptraj-warm-up-heartbeat", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join()
+
+
+def run_steps(steps: list[Step], report: Report) -> int:
+    """Run ``steps`` in order, ``report``-ing each (module docstring); the number of kernels
+    compiled (0: every kernel came from the cache)."""
+    compiled = 0
+    for label, step in steps:
+        report(f"{label} ...")
+        started = time.monotonic()
+        with _compilations() as events, _heartbeat(label, events, report):
+            step()
+        count = _compiled(events)
+        compiled += count
+        source = f"compiled {count} functions" if count else "nothing to compile"
+        report(f"{label}: done in {time.monotonic() - started:.1f} s ({source})")
+    return compiled
+
+
+def main() -> int:
+    """``python -m toptraj.service.warmup``: every install step, a line each on standard output."""
+
+    def report(line: str) -> None:
+        print(f"toptraj warm-up: {line}", flush=True)
+
+    started = time.monotonic()
+    compiled = run_steps(install_steps(), report)
+    report(f"ready in {time.monotonic() - started:.1f} s ({compiled} functions compiled into numba's cache)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
