@@ -54,8 +54,12 @@ polish is a local method started from the grid solution's phases, and misses the
 
 Every answer carries an estimate of its distance from the optimum (``optimality_gap``): zero
 for the closed form, else the difference from the solution on a second grid of half as many
-points (``planners.timing.jerk.accuracy``); above ``GAP_TARGET`` the grid is doubled, at most
-``max_refinements`` times, while the grid budget and the time left allow.
+points (``planners.timing.jerk.accuracy``), which is solved first and starts the LPs of the
+answer's grid; above ``GAP_TARGET`` the grid is doubled, at most ``max_refinements`` times,
+while the grid budget and the time left allow.
+
+Each LP is solved over a working set of its rows (``planners.timing.jerk.working_set``): of
+some 50 rows per interval only about two per point are active at the optimum.
 """
 
 from __future__ import annotations
@@ -130,10 +134,14 @@ class JerkLimitedMethod(TimingMethod):
                 return exact
         original = constraints.s
         constraints = _graded(constraints, boundary)
+        # The second grid first: its solution starts the LPs on the answer's grid, which then
+        # need few iterations over few rows (``planners.timing.jerk.working_set``).
+        coarse, gap, how = self._second_grid(constraints, original, boundary, deadline)
         started = time.perf_counter()
-        best = self._grid_solution(constraints, boundary, deadline)
+        best = self._grid_solution(constraints, boundary, deadline, start=coarse)
         elapsed = time.perf_counter() - started
-        gap, how = self._second_grid(constraints, original, boundary, best, deadline)
+        if coarse is not None:
+            gap = relative_gap(coarse.duration, best.duration)
         for done in range(self.max_refinements):
             if gap is None or gap <= GAP_TARGET or not self._affordable(constraints, elapsed, deadline):
                 break
@@ -175,7 +183,8 @@ class JerkLimitedMethod(TimingMethod):
         problem = RestrictedProgram(constraints, boundary, x_ref, deadline)
         # The first restriction is taken around the jerk-free optimum, which is no feasible
         # point itself; its LP solution is, and every later step starts from a feasible point.
-        x, u = problem.solve_restricted(x_ref)
+        # Its rows start from those near a bound at x_ref (u from dx/ds = 2 u).
+        x, u = problem.solve_restricted(x_ref, seed=(x_ref, 0.5 * np.gradient(x_ref, constraints.s)))
         best = problem.timing(x, u)
         for _ in range(self.max_iterations):
             deadline.check()
@@ -195,18 +204,19 @@ class JerkLimitedMethod(TimingMethod):
                 break
         return best
 
-    def _second_grid(self, constraints, original, boundary, best, deadline) -> tuple[float | None, str]:
-        """The estimated relative gap of ``best`` and how it was obtained: the difference from
-        the solution on every other grid point (``planners.timing.jerk.accuracy``)."""
+    def _second_grid(self, constraints, original, boundary, deadline) -> tuple[JerkTimeScaling | None, float | None, str]:
+        """The solution on every other grid point (``planners.timing.jerk.accuracy``), which
+        estimates the gap of the answer's grid, and how: (``None``, ``None``, why) when there is
+        none."""
         coarse = coarser(constraints, original)
         if coarse is None:
-            return None, "none: the grid is too coarse for a second one"
+            return None, None, "none: the grid is too coarse for a second one"
         try:
             coarse_best = self._grid_solution(coarse, boundary, deadline)
         except (InfeasiblePath, TimingFailed) as error:
-            return None, f"none: the second grid's solve failed ({error.detail})"
+            return None, None, f"none: the second grid's solve failed ({error.detail})"
         return (
-            relative_gap(coarse_best.duration, best.duration),
+            coarse_best, None,
             f"second grid: the difference from the solution on a grid of half as many points ({len(coarse.s) - 1} intervals)",
         )
 

@@ -1,0 +1,125 @@
+"""The heavy methods against one bare toppra solve of the typical request, interleaved in one run.
+
+Probes, timed in a shuffled order each round (medians kept):
+
+* **bare toppra**: the anchor, one solve of the typical request's path (ur5, 4 spline waypoints,
+  velocity + acceleration + torque) through toppra's own public API (``anchors.bare_toppra``);
+* **jerk_limited**: ``examples/ur5_jerk_limited.json`` through ``service.planning.plan_request``
+  (the library call the server makes, limit gate and sampling included), with a 20 s budget;
+* **jerk_limited_2000**: the same request on ``timing.grid_points`` 2,000 (a fine grid such as
+  a weld path asks for);
+* **collocation**: the ur5 free motion of ``benchmarks/free_path.py`` (velocity + acceleration +
+  torque, the default grid) with a 20 s budget, so that, as in the server, the optimization runs
+  in a worker process forked for it (``planners.execution.isolated``), at its lower CPU
+  priority;
+* **collocation_inline**: the same without a budget, in the calling thread (no worker).
+
+Prints each probe's median and its ratio to the anchor beside the goal of issue 35 (jerk_limited
+<= 10x, collocation <= 200x), and each answer's duration and stated gap.
+
+    python benchmarks/heavy_speed.py [--rounds 7] [--probes jerk_limited,collocation]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from anchors import bare_toppra  # noqa: E402
+
+import robots  # noqa: E402
+from planners.errors import BudgetExceeded  # noqa: E402
+from planners.execution.deadline import NO_DEADLINE, Deadline  # noqa: E402
+from service.planning import plan_request  # noqa: E402
+from service.schemas.trajectories import TrajectoryRequest  # noqa: E402
+
+TYPICAL_WAYPOINTS = np.array([
+    [0.0, -1.2, 1.0, 0.0, 0.0, 0.0],
+    [0.8, -1.0, 1.4, -0.5, 0.6, 0.3],
+    [1.5, -0.5, 0.8, -1.0, 1.0, 0.8],
+    [2.0, -1.3, 1.2, 0.2, 0.4, 1.2],
+])
+JERK = json.loads((ROOT / "examples" / "ur5_jerk_limited.json").read_text())
+JERK_FINE = {**JERK, "timing": {**JERK["timing"], "grid_points": 2000}}
+COLLOCATION = {
+    "robot": "ur5",
+    "path": {"kind": "free", "start": [0.0, -1.2, 1.0, 0.0, 0.3, 0.0], "goal": [0.8, -1.0, 1.4, -0.5, 0.6, 0.3]},
+    "timing": {"method": "collocation", "constraints": ["velocity", "acceleration", "torque"]},
+    "output": {"dt": 0.01},
+}
+#: Probe name: (request body, goal as a multiple of bare toppra or None, whether under a budget).
+PROBES = {
+    "jerk_limited": (JERK, 10.0, True),
+    "jerk_limited_2000": (JERK_FINE, None, True),
+    "collocation": (COLLOCATION, 200.0, True),
+    "collocation_inline": (COLLOCATION, None, False),
+}
+BUDGET_S = 20.0
+
+
+def _timed(function) -> float:
+    started = time.perf_counter()
+    function()
+    return time.perf_counter() - started
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--rounds", type=int, default=7)
+    parser.add_argument("--probes", default=",".join(PROBES), help="comma-separated, of: " + ", ".join(PROBES))
+    args = parser.parse_args()
+    import toppra
+
+    toppra.setup_logging("WARNING")
+    ur5 = robots.load("ur5")
+    chosen = [name for name in args.probes.split(",") if name]
+    requests = {name: TrajectoryRequest.model_validate(PROBES[name][0]) for name in chosen}
+    probes = {"bare toppra": lambda: bare_toppra(ur5, TYPICAL_WAYPOINTS)}
+    answers, over = {}, []
+    plan_request(TrajectoryRequest.model_validate(JERK))  # the first call compiles the kernels
+    for name, request in requests.items():
+        budgeted = PROBES[name][2]
+        try:
+            answers[name] = plan_request(request, Deadline(BUDGET_S) if budgeted else NO_DEADLINE)  # warm-up, and the answer
+        except BudgetExceeded:
+            over.append(name)
+            continue
+        probes[name] = lambda request=request, budgeted=budgeted: plan_request(request, Deadline(BUDGET_S) if budgeted else NO_DEADLINE)
+    for _ in range(3):
+        probes["bare toppra"]()
+    times: dict[str, list[float]] = {name: [] for name in probes}
+    order = list(probes)
+    shuffle = random.Random(1)
+    for _ in range(args.rounds):
+        shuffle.shuffle(order)
+        for name in order:
+            times[name].append(_timed(probes[name]))
+    anchor = float(np.median(times["bare toppra"]))
+    print(f"{args.rounds} interleaved rounds; bare toppra (typical request) p50 {1e3 * anchor:.2f} ms")
+    for name in over:
+        print(f"  {name:20s} exceeded its budget of {BUDGET_S:g} s")
+    for name in answers:
+        median = float(np.median(times[name]))
+        ratio = median / anchor
+        goal = PROBES[name][1]
+        verdict = "" if goal is None else f"   goal <= {goal:g}x   {'met' if ratio <= goal else 'MISSED'}"
+        answer = answers[name]
+        gap = answer.solver.get("optimality_gap") if isinstance(answer.solver, dict) else None
+        print(
+            f"  {name:20s} p50 {1e3 * median:9.1f} ms  {ratio:7.1f}x bare toppra{verdict}   "
+            f"(duration {answer.duration:.6f} s, stated gap {gap if gap is None else f'{gap:.2e}'})"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
