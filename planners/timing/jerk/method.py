@@ -191,11 +191,11 @@ class JerkLimitedMethod(TimingMethod):
             x_lp, u_lp = problem.solve_restricted(x)
             # Line search on the true duration along the segment to the LP's solution, every
             # point of which lies in the (convex) restriction around the current solution.
-            trials = []
-            for step in 0.5 ** np.arange(8):
-                x_step, u_step = x + step * (x_lp - x), u + step * (u_lp - u)
-                trials.append((problem.timing(x_step, u_step), x_step, u_step))
-            candidate, x_step, u_step = min(trials, key=lambda trial: trial[0].duration)
+            steps = 0.5 ** np.arange(8)[:, None]
+            x_steps, u_steps = x + steps * (x_lp - x), u + steps * (u_lp - u)
+            chosen = int(np.argmin(problem.durations(x_steps, u_steps)))
+            x_step, u_step = x_steps[chosen], u_steps[chosen]
+            candidate = problem.timing(x_step, u_step)
             gain = best.duration - candidate.duration
             if gain <= 0.0:
                 break

@@ -26,7 +26,7 @@ from planners.constraints.path_constraints import PathConstraints
 from planners.errors import TimingFailed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import Boundary
-from planners.timing.jerk.scaling import JerkTimeScaling
+from planners.timing.jerk.scaling import JerkTimeScaling, interval_times
 from planners.timing.jerk.working_set import WorkingSetLP
 
 
@@ -268,6 +268,10 @@ class RestrictedProgram:
             gradient[-1] = 0.0
             gradient[-2] += -1.5 * self.h[-1] / X[-2] ** 1.5 - share[-1] / root[-2]
         return gradient
+
+    def durations(self, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Durations (M,) in s of the motions x, u (M, N + 1) on this grid."""
+        return interval_times(self.constraints.s, np.maximum(x, 0.0), u, self.rest_start, self.rest_end).sum(axis=1)
 
     def timing(self, x, u) -> JerkTimeScaling:
         return JerkTimeScaling(

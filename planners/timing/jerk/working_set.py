@@ -29,9 +29,13 @@ from planners.execution.deadline import Deadline
 #: end at rest the jerk rows' right-hand sides are as small as x there (1e-8 of the typical
 #: x): HiGHS's default of 1e-7 would let them be exceeded twofold.
 FEASIBILITY = 1e-10
-#: Most rounds of adding violated rows to one LP (each round adds every violated row, so that
-#: a few rounds suffice; the cap only guards against cycling on rounding noise).
-MAX_ROUNDS = 50
+#: Rounds that add only the most violated row of each grid point (the rows of a point mostly
+#: cut the same corner off, and most never bind); later rounds add every row violated or
+#: within ``SEED_MARGIN`` of a bound.
+SELECTIVE_ROUNDS = 10
+#: Most rounds of adding violated rows to one LP before the whole LP is solved instead (a
+#: guard against cycling on rounding noise).
+MAX_ROUNDS = 40
 #: Distance from a bound (the rows are scaled to a largest coefficient of one, the columns to
 #: values of order one) within which a row is active enough at a seed to start in W.
 SEED_MARGIN = 1e-2
@@ -83,12 +87,15 @@ class WorkingSetLP:
         solver = self._model(objective, matrix, lower, upper, low, high, presolve)
         in_set = np.zeros(matrix.shape[0], dtype=bool)
         in_set[self.rows] = True
-        for _ in range(MAX_ROUNDS):
+        for round_ in range(MAX_ROUNDS):
             if self._run(solver):
                 values = np.asarray(solver.getSolution().col_value)
                 activity = matrix @ values
                 violated = np.flatnonzero(~in_set & ((activity > upper + FEASIBILITY) | (activity < lower - FEASIBILITY)))
-                violated = _worst_per_point(violated, np.maximum(activity - upper, lower - activity)[violated], matrix)
+                if round_ < SELECTIVE_ROUNDS:
+                    violated = _worst_per_point(violated, np.maximum(activity - upper, lower - activity)[violated], matrix)
+                elif violated.size:  # slow progress: the rows near a bound join too
+                    violated = np.flatnonzero(~in_set & ((activity > upper - SEED_MARGIN) | (activity < lower + SEED_MARGIN)))
             else:  # a relaxation without a bound in some direction: every row joins
                 violated = np.flatnonzero(~in_set)
             if violated.size == 0:
@@ -101,7 +108,7 @@ class WorkingSetLP:
             in_set[violated] = True
             self.rows = np.concatenate([self.rows, violated])
         else:
-            raise TimingFailed("the jerk-limited timing's linear program kept finding violated rows; try other timing.grid_points")
+            raise _Unsettled
         self.basis = solver.getBasis()
         return values
 
