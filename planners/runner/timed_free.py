@@ -37,6 +37,9 @@ MAX_INTERVALS = 100
 #: estimate, plus ``SEARCH_MEMORY_SLACK`` (the solver stacks' arenas and libraries' own
 #: mappings): beyond, ``MemoryError`` there, answered as ``OverMemory``.
 SEARCH_MEMORY_ROOM = 2
+#: Fraction of its torque limit that every joint's collocation torque must reach somewhere for
+#: the motion to be refined to bang-bang torques (``_switched``).
+REFINED_ABOVE = 0.9
 SEARCH_MEMORY_SLACK = 2**30
 
 
@@ -134,6 +137,11 @@ def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, 
     # The rivals (other goals the fine grid found close) are compared on exact terms too: the
     # collocation's grid error can exceed their difference.
     for candidate in (collocation, *collocation.rivals):
+        if np.any(np.abs(candidate.tau).max(axis=0) < REFINED_ABOVE * limits.torque):
+            # A bang-bang motion holds every joint's torque at a limit throughout; one near the
+            # collocation's optimum cannot have a joint whose torque stays well below its
+            # limit there (velocity or acceleration limits shape such a motion).
+            continue
         motion = refine_collocation(robot, limits, spec, candidate, deadline)
         if motion is not None and (refined is None or motion.duration < refined.duration):
             refined, winner = motion, candidate

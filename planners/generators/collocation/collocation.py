@@ -37,6 +37,7 @@ from planners.execution.deadline import NO_DEADLINE, Deadline, Progress
 from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.generators.collocation.motion import CollocationResult, FreeMotion
 from planners.generators.collocation.sparse import SparseCollocation, solve_sparse
+from planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
 from planners.paths.grid import path_grid
 from planners.paths.waypoints import SplinePath
 from planners.timing.phase_plane.method import PhasePlaneMethod
@@ -313,6 +314,7 @@ def _optimize_motion(
     started = time.perf_counter()
     tried: list[str] = []
     coarse_solver = None
+    dynamics = None
     coarse_motion = FreeMotion(
         motion.start, motion.goal, motion.start_velocity, motion.end_velocity, min(COARSE_INTERVALS, motion.intervals)
     )
@@ -332,7 +334,8 @@ def _optimize_motion(
             tried.append(f"{label}: {error.detail}")
             continue
         if coarse_solver is None:  # one sparse solver for every guess: they differ in bounds only
-            coarse_solver = SparseCollocation(coarse, max_iterations)
+            dynamics = inverse_dynamics_function(robot)
+            coarse_solver = SparseCollocation(coarse, max_iterations, dynamics)
         result = coarse_solver.solve(coarse, z0)
         feasible = _feasible(coarse, result.x)
         tried.append(f"{label}: {result.message} (cost {result.fun:.6g})")
@@ -352,7 +355,7 @@ def _optimize_motion(
         progress((len(guesses) + rank / len(contenders)) * share, "collocation: refining the best guess")
         problem = _Problem(robot, limits, motion, goal, torque_weight)
         z0 = _refined(coarse, coarse_result.x, problem)
-        result = solve_sparse(problem, z0, max_iterations)
+        result = solve_sparse(problem, z0, max_iterations, dynamics)
         feasible = _feasible(problem, result.x)
         if not feasible:  # the dense SQP, from the same start
             result, feasible = _solve(problem, z0, max_iterations)
