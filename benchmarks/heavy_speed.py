@@ -113,7 +113,7 @@ def main() -> int:
         goal = PROBES[name][1]
         verdict = "" if goal is None else f"   goal <= {goal:g}x   {'met' if ratio <= goal else 'MISSED'}"
         answer = answers[name]
-        gap = answer.solver.get("optimality_gap") if isinstance(answer.solver, dict) else None
+        gap = answer.accuracy.relative_gap if answer.accuracy is not None else None
         print(
             f"  {name:20s} p50 {1e3 * median:9.1f} ms  {ratio:7.1f}x bare toppra{verdict}   "
             f"(duration {answer.duration:.6f} s, stated gap {gap if gap is None else f'{gap:.2e}'})"

@@ -155,3 +155,32 @@ def test_a_straight_ur5_line_from_motion_is_ruckig_through_the_lps_and_the_polis
     assert result.duration == pytest.approx(trajectory.duration, rel=3e-6)
     assert result.duration >= trajectory.duration * (1 - 1e-9)
 
+
+
+def test_a_fine_grid_starts_from_the_grids_below_it(monkeypatch):
+    """ur5's example path on 800 intervals: the LPs of every grid start from the solution on
+    every other point of it, down to the coarsest (at most twice ``SEED_INTERVALS``), which
+    alone starts from the jerk-free optimum; the answer's gap is the difference from its second
+    grid's duration, each sequence converged from its own start."""
+    from planners.timing.jerk import method as jerk_method
+
+    calls = []
+    grid_solution = jerk_method.JerkLimitedMethod._grid_solution
+
+    def spy(self, constraints, boundary, deadline, start=None, tolerance=None):
+        result = grid_solution(self, constraints, boundary, deadline, start=start, tolerance=tolerance)
+        calls.append((len(constraints.s) - 1, None if start is None else len(start.s) - 1, result.duration))
+        return result
+
+    monkeypatch.setattr(jerk_method.JerkLimitedMethod, "_grid_solution", spy)
+    arm = robots.load("ur5")
+    path = make_path(arm, WaypointPath(EXAMPLE_WAYPOINTS))
+    limits = arm.limits.with_request(scales={"jerk": 0.5})
+    constraints = build_path_constraints(path, arm, limits, KINDS, path_grid(path, 800))
+    answer = jerk_method.JerkLimitedMethod(max_refinements=0, polish=False).solve(constraints)
+    sizes = [size for size, _, _ in calls]
+    assert sizes == sorted(sizes) and len(sizes) >= 4
+    assert calls[0][1] is None and sizes[0] <= 2 * jerk_method.SEED_INTERVALS
+    for (size, start, _), (below, _, _) in zip(calls[1:], calls[:-1]):
+        assert start == below and size > 1.8 * below
+    assert answer.optimality_gap == pytest.approx((calls[-2][2] - calls[-1][2]) / calls[-1][2], rel=1e-12)

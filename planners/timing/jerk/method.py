@@ -59,7 +59,10 @@ answer's grid; above ``GAP_TARGET`` the grid is doubled, at most ``max_refinemen
 while the grid budget and the time left allow.
 
 Each LP is solved over a working set of its rows (``planners.timing.jerk.working_set``): of
-some 50 rows per interval only about two per point are active at the optimum.
+some 50 rows per interval only about two per point are active at the optimum. On fine grids the
+second grid is itself started from the grid coarser still, down to ``SEED_INTERVALS`` (a
+multigrid start): each level's LPs begin near their optimum, over the rows that bind there, and
+only the coarsest level starts from the jerk-free optimum.
 """
 
 from __future__ import annotations
@@ -87,6 +90,12 @@ FALLBACK_FIRST_INTERVAL = 1e-3
 #: Relative gain below which the LPs on a refined grid, started from the coarser solution,
 #: stop: a hundredth of the gap the refinement aims at.
 WARM_TOLERANCE = 1e-2 * GAP_TARGET
+#: Time of the LPs on a grid twice as fine as the last, as a multiple of the last's: the first
+#: LP starts from no basis, its simplex iterations and their cost each about doubling (ur5,
+#: 2,000 to 4,000 intervals: 9 times).
+REFINEMENT_COST = 10.0
+#: Fewest intervals of a grid that starts the LPs of a finer one (``JerkLimitedMethod._seed``).
+SEED_INTERVALS = 60
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
 MIN_FIRST_INTERVAL = 1e-5
 
@@ -145,7 +154,7 @@ class JerkLimitedMethod(TimingMethod):
         for done in range(self.max_refinements):
             if gap is None or gap <= GAP_TARGET or not self._affordable(constraints, elapsed, deadline):
                 break
-            # The error about halves with each doubling (first order; the LPs cost four times
+            # The error about halves with each doubling (first order; the LPs cost ten times
             # as much): where the doublings left would not bring it to the target, the answer
             # states its gap instead.
             if gap / 2 ** (self.max_refinements - done) > GAP_TARGET:
@@ -212,7 +221,7 @@ class JerkLimitedMethod(TimingMethod):
         if coarse is None:
             return None, None, "none: the grid is too coarse for a second one"
         try:
-            coarse_best = self._grid_solution(coarse, boundary, deadline)
+            coarse_best = self._grid_solution(coarse, boundary, deadline, start=self._seed(coarse, original, boundary, deadline))
         except (InfeasiblePath, TimingFailed) as error:
             return None, None, f"none: the second grid's solve failed ({error.detail})"
         return (
@@ -220,13 +229,29 @@ class JerkLimitedMethod(TimingMethod):
             f"second grid: the difference from the solution on a grid of half as many points ({len(coarse.s) - 1} intervals)",
         )
 
+    def _seed(self, constraints, original, boundary, deadline) -> JerkTimeScaling | None:
+        """Where the LPs on ``constraints`` start: the solution on every other point of their
+        grid, itself started from the grid coarser still, down to ``SEED_INTERVALS``; ``None``
+        (the jerk-free optimum) below. Each level's LPs then begin near their optimum and over
+        the rows that bind there, the cold start paid on a small grid only; the levels below
+        the second grid stop at a gain of ``WARM_TOLERANCE``, being starts only."""
+        coarse = coarser(constraints, original) if len(constraints.s) - 1 > 2 * SEED_INTERVALS else None
+        if coarse is None:
+            return None
+        try:
+            return self._grid_solution(
+                coarse, boundary, deadline, start=self._seed(coarse, original, boundary, deadline), tolerance=WARM_TOLERANCE,
+            )
+        except (InfeasiblePath, TimingFailed):
+            return None
+
     def _affordable(self, constraints: PathConstraints, elapsed: float, deadline: Deadline) -> bool:
-        """Whether a grid twice as fine fits the grid budget and (at about four times the last
-        solve's time) the time left, on constraints that can be evaluated at new points."""
+        """Whether a grid twice as fine fits the grid budget and (at ``REFINEMENT_COST`` times the
+        last solve's time) the time left, on constraints that can be evaluated at new points."""
         if not constraints.can_refine or 2 * (len(constraints.s) - 1) > self.grid_budget:
             return False
         remaining = deadline.remaining()
-        return remaining is None or remaining > 4.0 * elapsed + 1.0
+        return remaining is None or remaining > REFINEMENT_COST * elapsed + 1.0
 
 
 def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:

@@ -48,6 +48,7 @@ class RestrictedProgram:
             raise TimingFailed("the grid is too coarse for the jerk-limited timing")
         self._fixed_rows = self._equalities_and_rows(x_ref)
         self._lp = WorkingSetLP(deadline)
+        self._fixed: tuple[sparse.csr_matrix, np.ndarray, np.ndarray] | None = None
 
     # Variables: X_0..X_n at columns 0..n, U_0..U_n at columns n+1..2n+1.
     def _x(self, i):
@@ -228,20 +229,12 @@ class RestrictedProgram:
         (``planners.timing.jerk.working_set``)."""
         kappa, n = self.kappa, self.n
         X_tangent = np.asarray(x_tangent) / kappa
-        blocks = [*self._fixed_rows, *self._jerk_rows(X_tangent)]
-        offsets = np.cumsum([0] + [block[5] for block in blocks])
-        matrix = sparse.csr_matrix(
-            (
-                np.concatenate([block[2] for block in blocks]),
-                (
-                    np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)]),
-                    np.concatenate([block[1] for block in blocks]),
-                ),
-            ),
-            shape=(offsets[-1], 2 * n + 2),
-        )
-        lower = np.concatenate([block[3] for block in blocks])
-        upper = np.concatenate([block[4] for block in blocks])
+        if self._fixed is None:  # the rows that do not depend on the restriction, built once
+            self._fixed = _stacked(self._fixed_rows, 2 * n + 2)
+        jerk, jerk_lower, jerk_upper = _stacked(self._jerk_rows(X_tangent), 2 * n + 2)
+        matrix = sparse.vstack([self._fixed[0], jerk], format="csr")
+        lower = np.concatenate([self._fixed[1], jerk_lower])
+        upper = np.concatenate([self._fixed[2], jerk_upper])
         x_high = self.constraints.sd_max**2 / kappa
         low = np.concatenate([np.zeros(n + 1), np.full(n + 1, -np.inf)])
         high = np.concatenate([x_high, np.full(n + 1, np.inf)])
@@ -278,3 +271,22 @@ class RestrictedProgram:
             self.constraints.s, np.sqrt(np.maximum(x, 0.0)), u=np.asarray(u, dtype=float),
             rest_start=self.rest_start, rest_end=self.rest_end,
         )
+
+
+def _stacked(blocks, columns: int) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:
+    """The rows of ``blocks`` (row, column, value, lower, upper, count; rows numbered within each
+    block) one under the other: the matrix (CSR, ``columns`` wide) and its bounds."""
+    if not blocks:
+        return sparse.csr_matrix((0, columns)), np.zeros(0), np.zeros(0)
+    offsets = np.cumsum([0] + [block[5] for block in blocks])
+    matrix = sparse.csr_matrix(
+        (
+            np.concatenate([block[2] for block in blocks]),
+            (
+                np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)]),
+                np.concatenate([block[1] for block in blocks]),
+            ),
+        ),
+        shape=(offsets[-1], columns),
+    )
+    return matrix, np.concatenate([block[3] for block in blocks]), np.concatenate([block[4] for block in blocks])
