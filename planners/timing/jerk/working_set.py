@@ -6,11 +6,13 @@ and the middles, jerk rows at both ends, the velocity bound at the quarters) for
 and at its optimum only about two of them per point are active. The dual simplex solves the LP
 restricted to a working set W of rows; the solution is then checked against every row (one
 sparse product), the rows it violates join W, and the simplex continues from its basis, which
-stays dual feasible when rows are added (Dantzig & Thapa, *Linear Programming 2*, Springer 2003,
-§1.5 "cutting planes"; the classic constraint-generation loop). It ends when no row outside W
-is violated by more than the solver's own feasibility tolerance: the solution of the relaxation
-is then feasible for the whole LP, hence its optimum (the same vertex the full LP has, up to
-that tolerance).
+stays dual feasible when rows are added (row generation, as in Dantzig, Fulkerson & Johnson,
+"Solution of a large-scale traveling-salesman problem", J. Oper. Res. Soc. Am. 2(4), 1954). A
+round adds the most violated row of each grid point (``SELECTIVE_ROUNDS`` rounds), then every
+row violated or near a bound; past ``MAX_ROUNDS``, or where HiGHS gives up on a relaxation, the
+whole LP is solved from scratch. It ends when no row outside W is violated by more than the
+solver's own feasibility tolerance: the solution of the relaxation is then feasible for the
+whole LP, hence optimal for it (its objective that of the whole LP, up to that tolerance).
 
 The rows of consecutive restrictions keep their order, so W and the basis carry over from one
 LP to the next: the rows active at one restriction's optimum are those likely active at the
@@ -36,6 +38,8 @@ SELECTIVE_ROUNDS = 10
 #: Most rounds of adding violated rows to one LP before the whole LP is solved instead (a
 #: guard against cycling on rounding noise).
 MAX_ROUNDS = 40
+#: HiGHS's value of ``simplex_dual_edge_weight_strategy`` for Devex pricing.
+DEVEX = 1
 #: Distance from a bound (the rows are scaled to a largest coefficient of one, the columns to
 #: values of order one) within which a row is active enough at a seed to start in W.
 SEED_MARGIN = 1e-2
@@ -120,6 +124,10 @@ class WorkingSetLP:
         solver = highspy.Highs()
         solver.setOptionValue("output_flag", False)
         solver.setOptionValue("primal_feasibility_tolerance", FEASIBILITY)
+        # Devex pricing: the dual steepest-edge weights HiGHS computes by default, anew for every
+        # warm start, cost more than they save on these LPs (a third of the LP time of the ur5
+        # example; the same optima).
+        solver.setOptionValue("simplex_dual_edge_weight_strategy", DEVEX)
         if not presolve:  # a warm start skips it anyway; a relaxation gains nothing from it
             solver.setOptionValue("presolve", "off")
         remaining = self.deadline.remaining()
