@@ -61,3 +61,19 @@ def test_a_motion_shaped_by_its_acceleration_limits_is_not_refined_to_bang_bang(
     assert result.solver["switching"] == "read off the samples"
     assert max(result.peak_utilization["torque"]) < 0.5
     assert max(result.peak_utilization["acceleration"]) <= 1.005
+
+
+def _loaded_phase_plane_signatures() -> int:
+    from planners.timing.phase_plane.sweep_kernels import sweeps
+
+    return len(sweeps.signatures)
+
+
+def test_a_worker_starts_with_the_first_guess_kernels_loaded():
+    """A worker process (``planners.execution.isolated``) starts with the phase-plane kernels
+    of the collocation's first guess already loaded, before calling any: its fork server ran
+    them once (``planners.generators.collocation.warm``)."""
+    from planners.execution.deadline import Deadline
+    from planners.execution.isolated import run_isolated
+
+    assert run_isolated(_loaded_phase_plane_signatures, deadline=Deadline(120)) >= 1
