@@ -90,10 +90,11 @@ FALLBACK_FIRST_INTERVAL = 1e-3
 #: Relative gain below which the LPs on a refined grid, started from the coarser solution,
 #: stop: a hundredth of the gap the refinement aims at.
 WARM_TOLERANCE = 1e-2 * GAP_TARGET
-#: Time of the LPs on a grid twice as fine as the last, as a multiple of the last's: the first
-#: LP starts from no basis, its simplex iterations and their cost each about doubling (ur5,
-#: 2,000 to 4,000 intervals: 9 times).
-REFINEMENT_COST = 10.0
+#: Time of the LPs on a grid twice as fine as the last, as a multiple of the last's, with room:
+#: the first LP starts from no basis, its simplex iterations and their cost each about doubling
+#: (ur5, 2,000 to 4,000 intervals: 9 to 12 times the last grid's sequence, itself started from
+#: the grids below it), and a refinement begun but not finished costs the whole answer.
+REFINEMENT_COST = 20.0
 #: Fewest intervals of a grid that starts the LPs of a finer one (``JerkLimitedMethod._seed``).
 SEED_INTERVALS = 60
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
@@ -154,7 +155,7 @@ class JerkLimitedMethod(TimingMethod):
         for done in range(self.max_refinements):
             if gap is None or gap <= GAP_TARGET or not self._affordable(constraints, elapsed, deadline):
                 break
-            # The error about halves with each doubling (first order; the LPs cost ten times
+            # The error about halves with each doubling (first order; the LPs cost ten times or more
             # as much): where the doublings left would not bring it to the target, the answer
             # states its gap instead.
             if gap / 2 ** (self.max_refinements - done) > GAP_TARGET:
