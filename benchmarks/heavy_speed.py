@@ -67,6 +67,32 @@ def _timed(function) -> tuple[float, float]:
     return time.perf_counter() - started, time.process_time() - cpu
 
 
+def _report(times, failed, answers, over, rounds: int) -> None:
+    """Each probe's medians and ratios to the anchor's (module docstring)."""
+    anchor, anchor_cpu = (float(value) for value in np.median(times["bare toppra"], axis=0))
+    print(f"{rounds} interleaved rounds; bare toppra (typical request) p50 {1e3 * anchor:.2f} ms wall, "
+          f"{1e3 * anchor_cpu:.2f} ms CPU")
+    for name in over:
+        print(f"  {name:20s} exceeded its budget of {BUDGET_S:g} s")
+    for name in answers:
+        if not times[name]:
+            print(f"  {name:20s} exceeded its budget of {BUDGET_S:g} s in every round")
+            continue
+        median, median_cpu = (float(value) for value in np.median(times[name], axis=0))
+        ratio = median / anchor
+        goal = PROBES[name][1]
+        verdict = "" if goal is None else f"   goal <= {goal:g}x   {'met' if ratio <= goal else 'MISSED'}"
+        # A worker process's CPU time is not this process's: only the wall time compares.
+        cpu = f"{median_cpu / anchor_cpu:7.1f}x by CPU time" if not PROBES[name][2] or name.startswith("jerk") else "  (CPU in a worker)"
+        answer = answers[name]
+        gap = answer.accuracy.relative_gap if answer.accuracy is not None else None
+        print(
+            f"  {name:20s} p50 {1e3 * median:9.1f} ms  {ratio:7.1f}x bare toppra{verdict}; {cpu}   "
+            f"(duration {answer.duration:.6f} s, stated gap {gap if gap is None else f'{gap:.2e}'})"
+            + (f"; exceeded its budget in {failed[name]} of {rounds} rounds" if failed[name] else "")
+        )
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--rounds", type=int, default=7)
@@ -111,28 +137,7 @@ def main() -> int:
                 times[name].append(_timed(probes[name]))
             except BudgetExceeded:
                 failed[name] += 1
-    anchor, anchor_cpu = (float(value) for value in np.median(times["bare toppra"], axis=0))
-    print(f"{args.rounds} interleaved rounds; bare toppra (typical request) p50 {1e3 * anchor:.2f} ms wall, "
-          f"{1e3 * anchor_cpu:.2f} ms CPU")
-    for name in over:
-        print(f"  {name:20s} exceeded its budget of {BUDGET_S:g} s")
-    for name in answers:
-        if not times[name]:
-            print(f"  {name:20s} exceeded its budget of {BUDGET_S:g} s in every round")
-            continue
-        median, median_cpu = (float(value) for value in np.median(times[name], axis=0))
-        ratio = median / anchor
-        goal = PROBES[name][1]
-        verdict = "" if goal is None else f"   goal <= {goal:g}x   {'met' if ratio <= goal else 'MISSED'}"
-        # A worker process's CPU time is not this process's: only the wall time compares.
-        cpu = f"{median_cpu / anchor_cpu:7.1f}x by CPU time" if not PROBES[name][2] or name.startswith("jerk") else "  (CPU in a worker)"
-        answer = answers[name]
-        gap = answer.accuracy.relative_gap if answer.accuracy is not None else None
-        print(
-            f"  {name:20s} p50 {1e3 * median:9.1f} ms  {ratio:7.1f}x bare toppra{verdict}; {cpu}   "
-            f"(duration {answer.duration:.6f} s, stated gap {gap if gap is None else f'{gap:.2e}'})"
-            + (f"; exceeded its budget in {failed[name]} of {args.rounds} rounds" if failed[name] else "")
-        )
+    _report(times, failed, answers, over, args.rounds)
     return 0
 
 
