@@ -4,13 +4,13 @@ Probes, timed in a shuffled order each round (medians kept):
 
 * **bare toppra**: the anchor, one solve of the typical request's path (ur5, 4 spline waypoints,
   velocity + acceleration + torque) through toppra's own public API (``anchors.bare_toppra``);
-* **jerk_limited**: ``examples/ur5_jerk_limited.json`` through ``service.planning.plan_request``
+* **jerk_limited**: ``examples/ur5_jerk_limited.json`` through ``toptraj.service.planning.plan_request``
   (the library call the server makes, limit gate and sampling included), with a 20 s budget;
 * **jerk_limited_2000**: the same request on ``timing.grid_points`` 2,000 (a fine grid such as
   a weld path asks for);
 * **collocation**: the ur5 free motion of ``benchmarks/free_path.py`` (velocity + acceleration +
   torque, the default grid) with a 20 s budget, so that, as in the server, the optimization runs
-  in a worker process forked for it (``planners.execution.isolated``), at its lower CPU
+  in a worker process forked for it (``toptraj.planners.execution.isolated``), at its lower CPU
   priority;
 * **collocation_inline**: the same without a budget, in the calling thread (no worker).
 
@@ -103,11 +103,11 @@ def main() -> int:
     import toppra
     from anchors import bare_toppra
 
-    import robots
-    from planners.errors import BudgetExceeded
-    from planners.execution.deadline import NO_DEADLINE, Deadline
-    from service.planning import plan_request
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj import robots
+    from toptraj.planners.errors import BudgetExceeded
+    from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+    from toptraj.service.planning import plan_request
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     toppra.setup_logging("WARNING")
     ur5 = robots.load("ur5")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.constraints.path_constraints import PathConstraints
 
 
 def static_load(constraints: PathConstraints, point: int) -> tuple[str, str | None, str | None]:

@@ -6,7 +6,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from robots.errors import ToptrajError
+from toptraj.robots.errors import ToptrajError
 
 
 class InvalidRequest(ToptrajError):

@@ -2,41 +2,37 @@
 
 from __future__ import annotations
 
+import logging
+import os
 from contextlib import asynccontextmanager
 
-import numpy as np
 from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.execution.isolated import start_worker_server
-from planners.execution.threads import single_blas_thread
-from planners.kinematics.conditioning import frobenius_condition_number
-from service import stopping
-from service.body_limit import BodySizeLimit
-from service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
-from service.jobs import JOB_MODULES, job_runner
-from service.routes import batches, health, jobs, trajectories, web
-from service.routes import robots as robot_routes
-from service.serving import open_connections
-from service.settings import Settings
-from service.workers import PlanningWorkers
+from toptraj import robots
+from toptraj.planners.execution.isolated import start_worker_server
+from toptraj.planners.execution.threads import single_blas_thread
+from toptraj.service import stopping, warmup
+from toptraj.service.body_limit import BodySizeLimit
+from toptraj.service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
+from toptraj.service.jobs import JOB_MODULES, job_runner
+from toptraj.service.routes import batches, guide, health, jobs, trajectories, web
+from toptraj.service.routes import robots as robot_routes
+from toptraj.service.serving import open_connections
+from toptraj.service.settings import Settings
+from toptraj.service.workers import PlanningWorkers
+
+#: Where a server process says what it does while it starts (uvicorn's own log).
+_log = logging.getLogger("uvicorn.error")
 
 
 def _warm_up() -> None:
-    """Build every catalog robot, import toppra and cvxpy, and load the compiled phase-plane
-    kernels once (and conditioning's singular-value kernel, on a singular Jacobian), so that
-    first requests are fast."""
-    for name in robots.catalog_names():
-        robots.load(name)
-    import cvxpy  # noqa: F401
-    import toppra  # noqa: F401
-
-    arm = robots.load("yamamoto_2r")
-    plan(arm, WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
-    frobenius_condition_number(np.zeros((6, 6)))
+    """Build every catalog robot and load the compiled phase-plane and conditioning kernels
+    once (``toptraj.service.warmup.server_steps``), each step logged, so that first requests are fast.
+    The solver stacks of the other methods are imported where those run, when they first do."""
+    process = os.getpid()
+    warmup.run_steps(warmup.server_steps(), lambda line: _log.info("toptraj start-up [%d]: %s", process, line))
 
 
 #: FastAPI's telemetry options with every part off (``Settings.telemetry``).
@@ -46,8 +42,9 @@ _NO_TELEMETRY = {"tracing": False, "metrics": False, "logs": False, "operation_s
 def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
+    warmup.imports_done()
     settings = settings or Settings()
-    single_blas_thread()  # plannings run side by side; see planners.execution.threads
+    single_blas_thread()  # plannings run side by side; see toptraj.planners.execution.threads
     robots.configure_uploads(
         settings.data_dir,
         max_uploads=settings.max_uploads,
@@ -57,9 +54,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        await run_in_threadpool(start_worker_server, JOB_MODULES)
         if settings.preload_robots:
             await run_in_threadpool(_warm_up)
+        # After the warm-up: the fork server's imports (its own process) then do not compete
+        # for the cores with this process's, and it is ready a second or two after this one.
+        await run_in_threadpool(start_worker_server, JOB_MODULES)
         await run_in_threadpool(app.state.jobs.start)
         stopping.serving()  # a stop is graceful from here on
         yield
@@ -76,6 +75,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app = FastAPIOffline(
         title="toptraj",
         summary="Time-optimal trajectories with torques for URDF robot arms.",
+        description="The guide: [/guide/](/guide/) (concepts, methods, errors, jobs, the Python client). The web page: [/](/).",
         version="0.1.0",
         lifespan=lifespan,
         default_response_class=FiniteJSONResponse,
@@ -94,4 +94,5 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(jobs.router)
     app.include_router(batches.router)
     app.include_router(web.router)
+    app.include_router(guide.router)
     return app

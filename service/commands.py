@@ -1,7 +1,8 @@
 """What ``toptraj plan``, ``toptraj compare`` and ``toptraj plot`` do: one request read from a
 file or standard input (``-``), planned in this process by the service's own code path
-(``service.planning``), its answer on standard output (or a page of plots in a file), its error
-as problem+json on standard error with a non-zero exit status:
+(``toptraj.service.planning``), its answer on standard output (a comparison as a table on a terminal,
+``toptraj.service.compare_table``; or a page of plots in a file), its error as problem+json on standard
+error with a non-zero exit status:
 
 * 0: answered;
 * 1: the request was answered with an error (422 malformed or impossible, 404 unknown robot, …);
@@ -39,20 +40,48 @@ def _read(source: str) -> str:
         raise _Unreadable(f"cannot read the request {source!r}: {error}") from None
 
 
-def _is_compare(text: str) -> bool:
-    """A compare body names its ``methods``."""
+def _json(text: str):
     try:
-        body = json.loads(text)
+        return json.loads(text)
     except ValueError:
         raise _Unreadable("the request is not JSON") from None
+
+
+def _is_compare(text: str) -> bool:
+    """A compare body names its ``methods``."""
+    body = _json(text)
     return isinstance(body, dict) and "methods" in body
+
+
+#: Methods ``toptraj compare`` runs on a trajectory body given without ``--methods``, after
+#: the body's own ``timing.method``; on a free path (start and goal only), ``FREE_METHODS``.
+DEFAULT_METHODS = ("phase_plane", "toppra", "quintic")
+FREE_METHODS = ("collocation", "search")
+
+
+def compare_body(text: str, methods: list[str] | None = None) -> str:
+    """The compare body (JSON) of ``text``: a compare body, its ``methods`` replaced by
+    ``methods`` when given; or a trajectory body's robot, path and timing (its ``output`` left
+    out) under ``methods``, by default its own method then ``DEFAULT_METHODS`` (``FREE_METHODS``
+    on a free path)."""
+    body = _json(text)
+    if not isinstance(body, dict):
+        return text  # refused by the schema, which says what it expects
+    if "methods" in body:
+        return text if methods is None else json.dumps({**body, "methods": methods})
+    timing = body.get("timing")
+    own = timing.get("method", "phase_plane") if isinstance(timing, dict) else "phase_plane"
+    path = body.get("path")
+    defaults = FREE_METHODS if isinstance(path, dict) and path.get("kind") == "free" else DEFAULT_METHODS
+    chosen = methods or list(dict.fromkeys([own, *defaults] if isinstance(own, str) else defaults))
+    return json.dumps({**{key: value for key, value in body.items() if key != "output"}, "methods": chosen})
 
 
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
-    from robots import ToptrajError
-    from service.errors import status_of, validation_problem
+    from toptraj.robots import ToptrajError
+    from toptraj.service.problems import status_of, validation_problem
 
     try:
         content = answer(_read(source))
@@ -84,19 +113,24 @@ def _write(content: bytes, out=None) -> int:
 
 
 def _trajectory(text: str) -> bytes:
-    from service.planning import plan_request, render
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.planning import plan_request, render
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     request = TrajectoryRequest.model_validate_json(text)
     return render(plan_request(request), request)[0]
 
 
-def _compare(text: str) -> bytes:
-    from planners.execution.deadline import NO_DEADLINE
-    from service.planning import compare_request, encode_json
-    from service.schemas.trajectories import CompareRequest
+def _compare(text: str, as_table: bool = False) -> bytes:
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.service.planning import compare_request, encode_json
+    from toptraj.service.schemas.trajectories import CompareRequest
 
-    return encode_json(compare_request(CompareRequest.model_validate_json(text), NO_DEADLINE))
+    answer = compare_request(CompareRequest.model_validate_json(text), NO_DEADLINE)
+    if as_table:
+        from toptraj.service.compare_table import compare_table
+
+        return compare_table(answer).encode()
+    return encode_json(answer)
 
 
 def plan(source: str) -> int:
@@ -104,21 +138,29 @@ def plan(source: str) -> int:
     return _run(source, lambda text: _compare(text) if _is_compare(text) else _trajectory(text))
 
 
-def compare(source: str) -> int:
-    """``toptraj compare FILE|-``: a compare body."""
-    return _run(source, _compare)
+def compare(source: str, methods: list[str] | None = None, as_json: bool | None = None) -> int:
+    """``toptraj compare FILE|- [--methods a,b] [--json]``: a compare body, or a trajectory body
+    compared under ``methods`` (``compare_body``); a table on a terminal, JSON when piped or
+    when ``as_json``."""
+    as_table = sys.stdout.isatty() if as_json is None else not as_json
+    return _run(source, lambda text: _compare(compare_body(text, methods), as_table))
 
 
-def plot(source: str, output: str) -> int:
-    """``toptraj plot FILE|- -o OUT.html``: the page's plots of one trajectory request, in a
-    self-contained HTML file (Plotly's JavaScript inlined: it opens offline)."""
-    from service.planning import plan_request
-    from service.plots import figures_html
-    from service.schemas.trajectories import TrajectoryRequest
+def plot(source: str, output: str, methods: list[str] | None = None) -> int:
+    """``toptraj plot FILE|- -o OUT.html [--methods a,b]``: the page's plots of one trajectory
+    request, or of every method of a compare body drawn over each other (``--methods`` turns a
+    trajectory body into one), in a self-contained HTML file (Plotly's JavaScript inlined: it
+    opens offline)."""
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.service.planning import plan_request
+    from toptraj.service.plots import figures_html
+    from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
     def page(text: str) -> bytes:
-        if _is_compare(text):
-            raise _Unreadable("toptraj plot draws one trajectory request, not a compare body (it names methods)")
+        if methods is not None or _is_compare(text):
+            from toptraj.service.compare_plots import compare_html
+
+            return compare_html(CompareRequest.model_validate_json(compare_body(text, methods)), NO_DEADLINE).encode()
         return figures_html(plan_request(TrajectoryRequest.model_validate_json(text))).encode()
 
     buffer = io.BytesIO()
@@ -143,15 +185,15 @@ def batch(
     retry_failed: bool = False,
 ) -> int:
     """``toptraj batch FILE -o OUT``: every request line planned (on Ray), one result line per
-    line, resumable (``service.batches``). Ctrl-C stops within seconds, keeps what finished,
+    line, resumable (``toptraj.service.batches``). Ctrl-C stops within seconds, keeps what finished,
     prints the command that resumes and exits with 130; a second Ctrl-C changes nothing."""
     import shlex
     import signal
     import threading
 
-    from service.batches import run_batch
-    from service.batches.lines import ForeignOutput
-    from service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
+    from toptraj.service.batches import run_batch
+    from toptraj.service.batches.lines import ForeignOutput
+    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
 
     if workers is not None and workers < 1:
         print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)

@@ -1,4 +1,4 @@
-"""The bridge between the HTTP schemas and ``planners.plan``: request -> library call ->
+"""The bridge between the HTTP schemas and ``toptraj.planners.plan``: request -> library call ->
 response body, encoded to JSON bytes by the planning (in a planning thread, or on the event
 loop under a short leash for a small request: ``worth_a_leash``)."""
 
@@ -10,21 +10,21 @@ import math
 import numpy as np
 import orjson
 
-import robots
-from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
-from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
-from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
-from planners.execution.deadline import NO_DEADLINE
-from planners.generators.collocation import FreeMotion
-from planners.generators.search import SearchOptions
-from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
-from planners.problem.boundary import finite_vector
-from robots import InvalidLimits, UnknownRobot
-from robots.catalog import catalog_robot_built
-from service.errors import non_finite_answer, status_of
-from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
-from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
+from toptraj import robots
+from toptraj.planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
+from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE
+from toptraj.planners.generators.search import SearchOptions
+from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.planners.problem.boundary import finite_vector
+from toptraj.planners.problem.build import DEFAULT_CLEARANCE, MAX_SAMPLES
+from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.robots import InvalidLimits, UnknownRobot
+from toptraj.robots.catalog import catalog_robot_built
+from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
+from toptraj.service.problems import non_finite_answer, status_of
+from toptraj.service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.
 NUMBER_BYTES = 25
@@ -73,7 +73,7 @@ def heavy(method: str, path_kind: str, grid_points: int | None) -> bool:
     """Whether a planning is heavy: it takes seconds of CPU and up to a gigabyte (a search, a
     collocation or any free path, jerk_limited's linear programs, min_cost's convex program on
     more than ``HEAVY_MIN_COST_POINTS`` intervals or on its default grid). Heavy plannings are
-    admitted apart from the others (``service.workers``: ``plan_heavy_workers`` at once per
+    admitted apart from the others (``toptraj.service.workers``: ``plan_heavy_workers`` at once per
     process, ``plan_heavy_queue`` waiting), so that the short requests keep their threads and
     their latency while heavy ones run."""
     if method in HEAVY_METHODS or path_kind == "free":
@@ -139,7 +139,7 @@ def plan_request(
     ``output.dt`` whose samples would not fit in a body of that size (422 naming the smallest
     ``dt`` that fits). ``accept`` (the HTTP Accept header) may choose CSV, which puts the samples
     on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
-    (``planners.generators.search.memory``)."""
+    (``toptraj.planners.generators.search.memory``)."""
     robot = robots.load(request.robot)
     timing = _timing(request)
     if timing.method == "search":
@@ -176,11 +176,11 @@ def _obstacles(specs) -> tuple:
 
 
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
-    """The answer's bytes and media type in the format asked (``service.formats``)."""
+    """The answer's bytes and media type in the format asked (``toptraj.service.formats``)."""
     format_ = chosen_format(request.output.format, accept)
-    if format_ == "csv":
-        return csv_bytes(result), CSV_MEDIA_TYPE
     body = trajectory_body(result)
+    if format_ == "csv":
+        return csv_bytes(body), CSV_MEDIA_TYPE
     if format_ == "joint_trajectory":
         del body["samples"]
         body["joint_trajectory"] = joint_trajectory(result)
@@ -223,29 +223,48 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
     return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous)
 
 
-def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
-    """Run every method of ``request`` on the same path and limits; a method's own failure is
-    reported in its entry instead of failing the comparison."""
-    results = []
+def method_request(request: CompareRequest, method: str, dt: float = 1.0) -> TrajectoryRequest:
+    """The trajectory request of one method of a comparison, sampled every ``dt`` seconds."""
+    return TrajectoryRequest(
+        robot=request.robot,
+        path=request.path,
+        timing=request.timing.model_copy(update={"method": method}),
+        output=OutputRequest(dt=dt),
+    )
+
+
+def requested_limits(request: TrajectoryRequest | CompareRequest, robot: robots.Robot) -> robots.JointLimits:
+    """The robot's limits with the request's overrides and scale factors applied."""
+    limits = request.timing.limits
+    kinds = ("velocity", "acceleration", "jerk", "torque")
+    return robot.limits.with_request({kind: getattr(limits, kind) for kind in kinds}, {kind: getattr(limits, f"{kind}_scale") for kind in kinds})
+
+
+def compare_results(request: CompareRequest, deadline: Deadline, dt: float = 1.0) -> list[tuple[dict, PlannedTrajectory | None]]:
+    """Run every method of ``request`` on the same path and limits, sampled every ``dt``
+    seconds: each method's entry of the comparison with its trajectory, or, when the method
+    itself fails, an entry naming its error and ``None``."""
+    results: list[tuple[dict, PlannedTrajectory | None]] = []
+    count = len(request.methods)
     for index, method in enumerate(request.methods):
-        single = TrajectoryRequest(
-            robot=request.robot,
-            path=request.path,
-            timing=request.timing.model_copy(update={"method": method}),
-            output=OutputRequest(dt=1.0),
-        )
-        count = len(request.methods)
         part = deadline.within(index / count, (index + 1) / count, f"{method} ({index + 1} of {count})")
         try:
-            result = plan_request(single, part)
+            result = plan_request(method_request(request, method, dt), part)
         except UnknownRobot:
             raise
         except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:
-            results.append({"method": method, "error": {"status": status_of(error), "title": error.title, "detail": error.detail}})
+            results.append(({"method": method, "error": {"status": status_of(error), "title": error.title, "detail": error.detail}}, None))
             continue
         body = trajectory_body(result)
-        results.append({key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")})
-    return {"results": results}
+        entry = {key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")}
+        results.append((entry, result))
+    return results
+
+
+def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
+    """Run every method of ``request`` on the same path and limits; a method's own failure is
+    reported in its entry instead of failing the comparison."""
+    return {"results": [entry for entry, _ in compare_results(request, deadline)]}
 
 
 def _finite_or_none(values) -> np.ndarray | list[float | None]:
@@ -308,7 +327,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
 
 def accuracy_body(result: PlannedTrajectory) -> dict:
     """``{"relative_gap", "basis"}``: the answer's estimated relative distance from the
-    converged optimum of its method's problem (``planners.runner.accuracy``), null when not estimated."""
+    converged optimum of its method's problem (``toptraj.planners.runner.accuracy``), null when not estimated."""
     accuracy = result.accuracy
     if accuracy is None:
         return {"relative_gap": None, "basis": f"not estimated for timing.method {result.method}"}

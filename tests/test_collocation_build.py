@@ -1,20 +1,20 @@
-"""The free-path collocation's IPOPT problem (``planners.generators.collocation.sparse``) holds one
+"""The free-path collocation's IPOPT problem (``toptraj.planners.generators.collocation.sparse``) holds one
 inverse-dynamics graph whatever the number of intervals, and reaches the optimum the dense
 solver (SLSQP on Pinocchio's RNEA and its analytical derivatives) reaches from the same start;
 a motion that its velocity or acceleration limits shape is not sent to the bang-bang
-refinement (``planners.runner.timed_free``)."""
+refinement (``toptraj.planners.runner.timed_free``)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-import robots
-from planners import Timing, plan
-from planners.generators.collocation import collocation
-from planners.generators.collocation.motion import FreeMotion
-from planners.generators.collocation.sparse import SparseCollocation
-from planners.runner import timed_free
+from toptraj import robots
+from toptraj.planners import Timing, plan
+from toptraj.planners.generators.collocation import collocation
+from toptraj.planners.generators.collocation.motion import FreeMotion
+from toptraj.planners.generators.collocation.sparse import SparseCollocation
+from toptraj.planners.runner import timed_free
 
 START = np.array([0.0, -1.2, 1.0, 0.0, 0.3, 0.0])
 GOAL = np.array([0.8, -1.0, 1.4, -0.5, 0.6, 0.3])
@@ -64,16 +64,16 @@ def test_a_motion_shaped_by_its_acceleration_limits_is_not_refined_to_bang_bang(
 
 
 def _loaded_phase_plane_signatures() -> int:
-    from planners.timing.phase_plane.sweep_kernels import sweeps
+    from toptraj.planners.timing.phase_plane.sweep_kernels import sweeps
 
     return len(sweeps.signatures)
 
 
 def test_a_worker_starts_with_the_first_guess_kernels_loaded():
-    """A worker process (``planners.execution.isolated``) starts with the phase-plane kernels
+    """A worker process (``toptraj.planners.execution.isolated``) starts with the phase-plane kernels
     of the collocation's first guess already loaded, before calling any: its fork server ran
-    them once (``planners.generators.collocation.warm``)."""
-    from planners.execution.deadline import Deadline
-    from planners.execution.isolated import run_isolated
+    them once (``toptraj.planners.generators.collocation.warm``)."""
+    from toptraj.planners.execution.deadline import Deadline
+    from toptraj.planners.execution.isolated import run_isolated
 
     assert run_isolated(_loaded_phase_plane_signatures, deadline=Deadline(120)) >= 1

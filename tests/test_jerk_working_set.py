@@ -1,6 +1,6 @@
 """The jerk-limited timing's linear programs over a working set of their rows
-(``planners.timing.jerk.working_set``) and its batched durations
-(``planners.timing.jerk.scaling.interval_times``), each against an independent computation: the
+(``toptraj.planners.timing.jerk.working_set``) and its batched durations
+(``toptraj.planners.timing.jerk.scaling.interval_times``), each against an independent computation: the
 whole LP solved by HiGHS from scratch, and the time integral of ds / sd by adaptive quadrature."""
 
 from __future__ import annotations
@@ -9,17 +9,17 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.constraints.path_constraints import build_path_constraints
-from planners.paths.grid import path_grid
-from planners.problem.waypoints import make_path
-from planners.timing.base import AT_REST
-from planners.timing.jerk import working_set
-from planners.timing.jerk.method import _graded
-from planners.timing.jerk.program import RestrictedProgram
-from planners.timing.jerk.scaling import JerkTimeScaling, interval_times
-from planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.timing.base import AT_REST
+from toptraj.planners.timing.jerk import working_set
+from toptraj.planners.timing.jerk.method import _graded
+from toptraj.planners.timing.jerk.program import RestrictedProgram
+from toptraj.planners.timing.jerk.scaling import JerkTimeScaling, interval_times
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
 #: The path of examples/ur5_jerk_limited.json.
 EXAMPLE_WAYPOINTS = np.array([[0.0, -1.2, 1.0, 0.0, 0.3, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3], [1.5, -0.5, 0.8, -1.0, 1.0, 0.8]])
@@ -162,7 +162,7 @@ def test_a_fine_grid_starts_from_the_grids_below_it(monkeypatch):
     every other point of it, down to the coarsest (at most twice ``SEED_INTERVALS``), which
     alone starts from the jerk-free optimum; the answer's gap is the difference from its second
     grid's duration, each sequence converged from its own start."""
-    from planners.timing.jerk import method as jerk_method
+    from toptraj.planners.timing.jerk import method as jerk_method
 
     calls = []
     grid_solution = jerk_method.JerkLimitedMethod._grid_solution

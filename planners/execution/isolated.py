@@ -28,7 +28,7 @@ Children are forked from a fork server (``multiprocessing``'s ``forkserver`` con
 single-threaded process started once, which has imported the solver stacks (``PRELOAD``), so a
 child starts in milliseconds without copying the threads of the server. Where ``forkserver`` is
 not available, children are spawned (a fresh interpreter each). A child keeps to one BLAS
-thread (``planners.execution.threads``). As with any ``multiprocessing``
+thread (``toptraj.planners.execution.threads``). As with any ``multiprocessing``
 code, a script that plans with a deadline must guard its entry point with
 ``if __name__ == "__main__":`` (a child imports the main script as ``__mp_main__``).
 """
@@ -45,9 +45,9 @@ import threading
 import time
 from collections.abc import Sequence
 
-from planners.errors import OverMemory, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.execution.threads import single_blas_thread
+from toptraj.planners.errors import OverMemory, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.execution.threads import single_blas_thread
 
 #: Seconds between two deadline checks while waiting for the child.
 POLL_S = 0.02
@@ -60,8 +60,8 @@ LOW_PRIORITY = 5
 #: The last loads the compiled kernels the collocation's first guess calls (each worker would
 #: otherwise load them from numba's disk cache itself: 0.36 s a ur5 free motion).
 PRELOAD = [
-    "numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost",
-    "planners.generators.collocation.collocation", "planners.generators.collocation.warm",
+    "numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "toptraj.planners.timing.min_cost",
+    "toptraj.planners.generators.collocation.collocation", "toptraj.planners.generators.collocation.warm",
 ]
 
 _context = None

@@ -11,11 +11,10 @@ on successively refined knot vectors are nested.
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import BSpline
 
-from planners.errors import InvalidRequest
-from planners.paths.base import GeometricPath, PathPoints
-from planners.paths.waypoints import cubic_pieces
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.paths.waypoints import cubic_pieces
 
 DEGREE = 3
 
@@ -74,6 +73,8 @@ class BSplinePath(GeometricPath):
         self.knots = np.concatenate([[0.0], interior, [1.0]])
         self.kinks = np.empty(0)
         self.breaks = np.empty(0)
+        from scipy.interpolate import BSpline  # here: the searches' paths only, not every request
+
         self._spline = BSpline(clamped_knots(interior), control, DEGREE)
         # Power-basis coefficients per knot interval, (4, pieces, n_dof), for ``cubic_pieces``.
         left = self.knots[:-1]

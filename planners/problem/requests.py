@@ -4,21 +4,23 @@ live with their planners) and the timing, and the timing method that a request n
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from planners.constraints.path_constraints import CONSTRAINT_KINDS
-from planners.errors import InvalidRequest
-from planners.generators.search.graph import SearchOptions
-from planners.generators.search.method import SearchMethod
-from planners.timing import METHODS
-from planners.timing.base import TimingMethod
-from planners.timing.collocation_method import CollocationMethod
-from planners.timing.laws.method import ClassicalMethod
-from planners.timing.laws.profiles import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
-from planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
-from planners.timing.min_cost import MinCostMethod
+from toptraj.planners.constraints.path_constraints import CONSTRAINT_KINDS
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.timing import METHODS
+from toptraj.planners.timing.base import TimingMethod
+from toptraj.planners.timing.laws.method import ClassicalMethod
+from toptraj.planners.timing.laws.profiles import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
+from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
+from toptraj.planners.timing.min_cost import MinCostMethod
+
+if TYPE_CHECKING:
+    from toptraj.planners.problem.methods import MotionGenerator
 
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
 #: default path tolerance of MoveIt's time-optimal trajectory generation.
@@ -46,7 +48,7 @@ class Timing:
     """How to time the path.
 
     Attributes:
-        method: A ``timing.method`` name (see ``planners.timing.METHODS``).
+        method: A ``timing.method`` name (see ``toptraj.planners.timing.METHODS``).
         constraints: Which limits to respect, among velocity, acceleration and torque.
         limit_overrides: Per-joint replacements, keys ``velocity``, ``acceleration``, ``jerk``,
             ``torque``.
@@ -62,12 +64,12 @@ class Timing:
         trapezoid_blend: ``"linear"`` (constant acceleration, Angeles 6.1) or ``"cycloidal"``
             (cycloidal blends, Angeles 6.3) for the trapezoidal law's speed ramps.
         supporting_points: For a time law, approximate it by the cubic spline through this many
-            equally spaced points of it (Angeles 6.1 (c), ``planners.timing.laws.splines``);
+            equally spaced points of it (Angeles 6.1 (c), ``toptraj.planners.timing.laws.splines``);
             ``None``: the law itself.
         synchronization: For a time law on a straight joint move (two waypoints):
             ``"normalized"`` times the straight joint line as one, every joint starting and
             stopping together; ``"none"`` runs every joint at its own full speed to its goal
-            (lecture "Trajectory Planning"; ``planners.generators.unsynchronized``).
+            (lecture "Trajectory Planning"; ``toptraj.planners.generators.unsynchronized``).
         torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
             ``min_cost``.
         limit_margin: Fraction of every velocity, acceleration, jerk, torque and tool-speed
@@ -78,7 +80,7 @@ class Timing:
         tool_angular_speed: Largest angular speed of the tool frame, rad/s; ``None``: none.
         tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
         search: Options of the global search (``timing.method = "search"``); ``None``: the
-            defaults of ``planners.generators.search.SearchOptions``.
+            defaults of ``toptraj.planners.generators.search.SearchOptions``.
     """
 
     method: str = "phase_plane"
@@ -103,7 +105,7 @@ class Timing:
     search: SearchOptions | None = None
 
 
-def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
+def check_constraint_kinds(kinds, method: TimingMethod | MotionGenerator) -> tuple[str, ...]:
     unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
     if unknown:
         raise InvalidRequest(f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}")
@@ -123,6 +125,8 @@ def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
 #: Trapezoid ramps by ``timing.trapezoid.blend``.
 BLENDS: dict[str, type[TrapezoidalProfile]] = {"linear": TrapezoidalProfile, "cycloidal": CycloidalBlendProfile}
 SYNCHRONIZATIONS = ("normalized", "none")
+#: Method names of the motion generators that find a free path themselves.
+GENERATORS = ("collocation", "search")
 
 
 def law_profile(timing: Timing) -> NormalizedProfile:
@@ -176,8 +180,10 @@ def _check_law_options(timing: Timing) -> None:
         )
 
 
-def timing_method(timing: Timing) -> TimingMethod:
-    """The method named by ``timing.method`` (with its per-request options)."""
+def timing_method(timing: Timing) -> TimingMethod | None:
+    """The timing method named by ``timing.method`` (with its per-request options), after the
+    checks of the options every method shares; ``None`` for the names of motion generators
+    (``collocation``, ``search``), which the caller builds."""
     _check_law_options(timing)
     if timing.method == "trapezoidal" or (timing.method in PROFILES and timing.supporting_points is not None):
         method = METHODS[timing.method]
@@ -189,10 +195,8 @@ def timing_method(timing: Timing) -> TimingMethod:
         if not (np.isfinite(timing.torque_weight) and timing.torque_weight >= 0.0):
             raise InvalidRequest(f"timing.cost.torque_weight must be a non-negative number, got {timing.torque_weight}")
         return MinCostMethod(timing.torque_weight)
-    if timing.method == "collocation":
-        return CollocationMethod()
-    if timing.method == "search":
-        return SearchMethod()
+    if timing.method in GENERATORS:
+        return None
     if timing.search is not None:
         raise InvalidRequest(f"timing.search sets up timing.method 'search', not {timing.method!r}")
     named = METHODS.get(timing.method)

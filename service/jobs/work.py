@@ -6,7 +6,7 @@ progress through ``deadline.progress`` and never knows it runs as a job. A kind 
 requests (a batch) is one more entry: it loops over its requests (or hands them to other
 workers) and reports "request k of n".
 
-``compute`` runs in a process forked from the fork server (``planners.execution.isolated``), which shares
+``compute`` runs in a process forked from the fork server (``toptraj.planners.execution.isolated``), which shares
 no module state with the server: the upload store and the body cap reach it in ``WorkerSetup``.
 """
 
@@ -16,13 +16,13 @@ from dataclasses import dataclass
 
 import orjson
 
-import robots
-from planners import Deadline
-from planners.errors import InvalidRequest
-from planners.execution.deadline import Progress
-from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-from service.planning import compare_request, encode_json, plan_request, render
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj import robots
+from toptraj.planners import Deadline
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.execution.deadline import Progress
+from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.service.planning import compare_request, encode_json, plan_request, render
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 
 @dataclass(frozen=True)
@@ -40,8 +40,14 @@ class WorkerSetup:
 
 
 def _trajectory(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
+    """The answer as JSON, in the format asked; a job asking CSV keeps its samples as JSON (a
+    job's answer is part of ``GET /v1/jobs/{id}``), planned as CSV is (on whole periods), and
+    ``GET /v1/jobs/{id}/result`` writes them as CSV."""
     body = TrajectoryRequest.model_validate_json(request)
-    return render(plan_request(body, deadline, setup.max_response_bytes, search_memory_bytes=setup.search_memory_bytes), body)[0]
+    result = plan_request(body, deadline, setup.max_response_bytes, search_memory_bytes=setup.search_memory_bytes)
+    if body.output.format == "csv":
+        body = body.model_copy(update={"output": body.output.model_copy(update={"format": "samples"})})
+    return render(result, body)[0]
 
 
 def _compare(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
@@ -63,7 +69,7 @@ def _batch(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
 
 
 def _not_reached(budget_s: float | None) -> tuple[int, bytes]:
-    from service.batches.lines import problem_body
+    from toptraj.service.batches.lines import problem_body
 
     detail = f"the batch's time budget of {budget_s:g} s was spent before this request was planned; submit it again, or the batch with a larger budget_s"
     return 504, problem_body(504, "Time budget exceeded", detail)
@@ -76,7 +82,7 @@ def _line_budget(deadline: Deadline) -> float:
 
 
 def _here(texts: list[str], deadline: Deadline) -> list[tuple[int, bytes]]:
-    from service.batches.work import answer
+    from toptraj.service.batches.work import answer
 
     answers = []
     for k, text in enumerate(texts):
@@ -89,8 +95,8 @@ def _here(texts: list[str], deadline: Deadline) -> list[tuple[int, bytes]]:
 def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tuple[int, bytes]]:
     import ray
 
-    from service.batches.runner import _uploads_named
-    from service.batches.work import answer_chunk
+    from toptraj.service.batches.runner import _uploads_named
+    from toptraj.service.batches.work import answer_chunk
 
     if not ray.is_initialized():
         ray.init(address=None if setup.ray_address == "local" else setup.ray_address, log_to_driver=False, configure_logging=False)
@@ -116,7 +122,7 @@ def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tu
 
 
 def _worker_failed(error: BaseException) -> bytes:
-    from service.batches.lines import problem_body
+    from toptraj.service.batches.lines import problem_body
 
     return problem_body(500, "Worker failed", f"the worker planning this request failed ({type(error).__name__}); submit it again")
 

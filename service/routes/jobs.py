@@ -13,13 +13,14 @@ from fastapi.responses import Response
 from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners.errors import InvalidRequest
-from robots.errors import ToptrajError, excerpt
-from service.errors import PROBLEM_JSON, problem_responses
-from service.jobs.records import Job, JobEnded
-from service.jobs.store import JobStore
-from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
+from toptraj import robots
+from toptraj.planners.errors import InvalidRequest
+from toptraj.robots.errors import ToptrajError, excerpt
+from toptraj.service.errors import PROBLEM_JSON, problem_responses
+from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes
+from toptraj.service.jobs.records import Job, JobEnded
+from toptraj.service.jobs.store import JobStore
+from toptraj.service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
 
 router = APIRouter(prefix="/v1/jobs", tags=["jobs"])
 
@@ -211,8 +212,11 @@ def get_job(job_id: str, request: Request) -> Response:
     summary="A job's answer alone",
     response_model=None,
     responses={
-        200: {"description": "The body of the synchronous endpoint (`TrajectoryResponse` or `CompareResponse`).",
-              "content": {"application/json": {"schema": {"type": "object"}}}},
+        200: {"description": "The body of the synchronous endpoint (`TrajectoryResponse` or `CompareResponse`), in "
+                             "the trajectory's `output.format`: CSV when it asked `csv`, or when it asked the default "
+                             "and the `Accept` header prefers `text/csv`.",
+              "content": {"application/json": {"schema": {"type": "object"}},
+                          "text/csv": {"schema": {"type": "string"}, "example": "t,q.shoulder,…\n# robot: ur5\n…\n0.0,0.0,…\n"}}},
         404: _problem(404, "No job has that id."),
         409: _problem(409, "The job has not ended, or ended without an answer (cancelled, interrupted)."),
         422: _problem(422, "The job failed: its own error, with the status it carries (e.g. 422)."),
@@ -220,17 +224,31 @@ def get_job(job_id: str, request: Request) -> Response:
     },
 )
 def get_job_result(job_id: str, request: Request) -> Response:
-    """Exactly what the synchronous endpoint would have answered: the body once `done`, the
-    job's problem+json (with its own status) once `failed`."""
+    """Exactly what the synchronous endpoint would have answered: the body once `done`, in the
+    format the trajectory asked (`output.format`; CSV also when `Accept` prefers `text/csv`),
+    the job's problem+json (with its own status) once `failed`."""
     store = _store(request)
     job = _job(store, job_id)
     if job.status == "done":
         result = store.result(job_id)
         if result is not None:
-            return Response(result, media_type="application/json")
+            return _answer(job, result, store.request(job_id), request.headers.get("accept"))
     if job.status == "failed" and job.error is not None:
         return Response(orjson.dumps(job.error), status_code=int(job.error.get("status", 500)), media_type=PROBLEM_JSON)
     raise JobNotDone(f"job {job_id} is {job.status}; GET /v1/jobs/{job_id} shows its progress")
+
+
+def _answer(job: Job, result: bytes, request_json: str | None, accept: str | None) -> Response:
+    """The stored answer (JSON) in the format the job asked or, when it asked the default, the
+    one its Accept header prefers, as ``POST /v1/trajectories`` chooses: CSV is written from
+    the stored samples."""
+    if job.kind == "trajectory" and request_json is not None:
+        requested = orjson.loads(request_json)["output"]["format"]
+        if chosen_format(requested, accept) == "csv":
+            body = orjson.loads(result)
+            if "samples" in body:
+                return Response(csv_bytes(body), media_type=CSV_MEDIA_TYPE)
+    return Response(result, media_type="application/json")
 
 
 @router.delete(
@@ -244,7 +262,7 @@ def get_job_result(job_id: str, request: Request) -> Response:
 )
 def cancel_job(job_id: str, request: Request) -> Response:
     """Cancel a queued or running job (200, the job cancelled): a queued one never runs; a
-    running one's worker process is killed. A job that has ended (done, failed, cancelled,
+    running one stops computing at once. A job that has ended (done, failed, cancelled,
     interrupted) is deleted with its stored answer (204); GET answers 404 for it afterwards."""
     store = _store(request)
     if _job(store, job_id).status in ("queued", "running"):

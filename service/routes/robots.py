@@ -9,13 +9,13 @@ import numpy as np
 from fastapi import APIRouter, Response
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners.errors import InvalidRequest
-from planners.kinematics.skeleton import skeleton
-from robots.limits import LIMIT_KINDS
-from robots.upload_options import upload_options
-from service.errors import problem_responses
-from service.schemas.robots import (
+from toptraj import robots
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.kinematics.skeleton import skeleton
+from toptraj.robots.limits import LIMIT_KINDS
+from toptraj.robots.upload_options import upload_options
+from toptraj.service.errors import problem_responses
+from toptraj.service.schemas.robots import (
     RobotCreate,
     RobotLimits,
     RobotLimitSources,
@@ -52,7 +52,9 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
 @router.get("", summary="List the robots")
 def list_robots() -> list[RobotSummary]:
     """Every robot the service can plan for: the bundled paper arms, the fixed-base arms of
-    example-robot-data and the uploaded URDFs (from the store, without building their models)."""
+    example-robot-data and the uploaded URDFs.
+    \f
+    Uploads are listed from the store, without building their models."""
     catalog = [
         RobotSummary(name=robot.name, dof=robot.dof, source=cast(Source, robot.source))
         for robot in map(robots.load, robots.catalog_names())

@@ -7,11 +7,11 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
-from service.errors import problem_responses
-from service.planning import compare_request, encode_json, heavy_request, plan_request, render, worth_a_leash
-from service.schemas.answers import CompareResponse, TrajectoryResponse
-from service.schemas.examples import openapi_examples
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.errors import problem_responses
+from toptraj.service.planning import compare_request, encode_json, heavy_request, plan_request, render, worth_a_leash
+from toptraj.service.schemas.answers import CompareResponse, TrajectoryResponse
+from toptraj.service.schemas.examples import openapi_examples
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
 
@@ -23,15 +23,21 @@ _ERRORS = problem_responses(404, 413, 422, 503, 504)
     summary="Plan a timed trajectory",
     response_model=TrajectoryResponse,
     responses={
-        200: {"content": {"text/csv": {"schema": {"type": "string"}, "example": "t,q.shoulder,…\n0.0,0.0,…\n"}}},
+        200: {"content": {"text/csv": {"schema": {"type": "string"}, "example": "t,q.shoulder,…\n# robot: ur5\n# method: phase_plane\n…\n0.0,0.0,…\n"}}},
         **_ERRORS,
     },
 )
 async def create_trajectory(
     body: Annotated[TrajectoryRequest, Body(openapi_examples=openapi_examples(compare=False))], request: Request
 ) -> Response:
-    """Time the path of ``body`` for its robot under the requested limits and return the
-    samples ``t, q, qd, qdd, tau``, the phase plane and the peak utilization of each limit.
+    """Time the path of the request for its robot under the requested limits and return the
+    samples `t, q, qd, qdd, tau`, the phase plane and the peak utilization of each limit, in
+    the format asked (`output.format`; CSV also when `Accept` prefers `text/csv`). Planning has
+    a time budget (504 past it; `POST /v1/jobs` runs longer ones in the background). Heavy
+    plannings (`search`, `collocation`, `jerk_limited`, any free path, `min_cost` on its
+    default grid or on more than 100 intervals) wait for capacity of their own, so that short
+    requests never queue behind them.
+    \f
     The body is built and encoded by the planning, within the time budget; a small request
     (``worth_a_leash``) is first tried on the event loop, a heavy one (``heavy_request``) waits
     for a heavy worker of its own."""

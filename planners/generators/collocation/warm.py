@@ -1,4 +1,4 @@
-"""Imported by the fork server of ``planners.execution.isolated`` (its ``PRELOAD``): the
+"""Imported by the fork server of ``toptraj.planners.execution.isolated`` (its ``PRELOAD``): the
 collocation's first guess (``collocation._timed_guess``: a spline, its constraint rows, the
 phase-plane solve and its sampling) computed once on the two-link Geering arm, so that the
 compiled kernels it calls are in the fork server's memory and in every worker forked from it.
@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-import robots
-from planners.generators.collocation.collocation import _Problem, _timed_guess
-from planners.generators.collocation.motion import FreeMotion
+from toptraj import robots
+from toptraj.planners.generators.collocation.collocation import _Problem, _timed_guess
+from toptraj.planners.generators.collocation.motion import FreeMotion
 
 
 def warm() -> None:

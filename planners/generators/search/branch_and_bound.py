@@ -24,23 +24,18 @@ tube of radius D_max around the best of them gives one candidate for the local o
 
 from __future__ import annotations
 
-import heapq
 import time
 
 import numpy as np
 
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.bounds import forward_time, grid_path_time, path_time
-from planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
-from planners.generators.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
-from planners.generators.search.problem import SearchProblem
-
-#: Relative slack of a bound over t_u before it discards (float rounding between the bound's
-#: and the phase-plane method's sums of the same intervals).
-SLACK = 1e-9
-#: Pops between two deadline checks and progress reports.
-CHECK_EVERY = 64
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search import search_kernels as kernels
+from toptraj.planners.generators.search.bounds import grid_path_time, path_time
+from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
+from toptraj.planners.generators.search.node_table import NodeTable
+from toptraj.planners.generators.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
+from toptraj.planners.generators.search.problem import SearchProblem
 
 
 class _Node:
@@ -79,8 +74,6 @@ class _Search:
         self.goal_points = set(int(g) for g in graph.goals)
         self.t_u = cap
         self.stop_at = stop_at
-        self.heap: list = []
-        self.count = 0
         self.found: list[GridPath] = []
         self.stats = SearchStatistics(
             graph=graph.kind,
@@ -100,80 +93,28 @@ class _Search:
         return np.concatenate([np.arange(first[p], first[p + 1]) for p in pieces])
 
     def points(self, node: _Node) -> np.ndarray:
+        return self.points_of(node.edges())
+
+    def points_of(self, edges: list[int]) -> np.ndarray:
+        """The grid points (k, n_dof) of the path made of ``edges`` from the start."""
         graph = self.problem.graph
-        return graph.points[np.concatenate(([graph.start], graph.edge_to[node.edges()]))]
+        return graph.points[np.concatenate(([graph.start], graph.edge_to[np.asarray(edges, dtype=int)]))]
 
     def t3_of(self, node: _Node) -> float:
         b = self.problem.bounds
         return float(path_time(self._intervals(node.pieces()), b.ds, b.p, b.q, b.r, b.cap_start, b.cap_end))
 
-    def t4_of(self, node: _Node) -> float:
+    def t4_of(self, points: np.ndarray) -> float:
+        """t4 (s) of the grid path through ``points``; ``inf`` where no timing follows it."""
         self.stats.t4_evaluations += 1
         problem = self.problem
         try:
-            return grid_path_time(self.points(node), problem.robot, problem.limits, problem.kinds)
+            return grid_path_time(points, problem.robot, problem.limits, problem.kinds)
         except (InfeasiblePath, TimingFailed):
             return np.inf
 
-    def _above(self, value: float) -> bool:
-        return not value <= self.t_u * (1.0 + SLACK)
-
     def _lower_t_u(self, t4: float) -> None:
         self.t_u = min(self.t_u, (1.0 + self.options.upper_margin) * t4)
-
-    # branching --------------------------------------------------------------------------------
-    def child(self, parent: _Node, state: int, edge: int, piece: int, ending: int, parent_key: float) -> None:
-        """Make the subset ``parent`` + ``edge`` (fixing ``piece``, and completing the path with
-        ``ending`` when its move reaches a goal; -1 where none), test it, queue it."""
-        problem, b = self.problem, self.problem.bounds
-        self.stats.generated += 1
-        point = int(problem.graph.edge_to[edge])
-        visited = parent.visited | (1 << point)
-        complete = ending >= 0
-        g1 = parent.g1 + (b.t1[piece] if piece >= 0 else 0.0)
-        g2 = parent.g2 + (b.t2[piece] if piece >= 0 else 0.0)
-        if complete:
-            f1, f2 = g1 + b.t1[ending], g2 + b.t2[ending]
-        else:
-            f1, f2 = g1 + problem.h1[state], g2 + problem.h2[state]
-        f1 = max(f1, parent_key)
-        if self._above(f1):
-            self.stats.pruned["t1"] += 1
-            return
-        f2 = max(f2, f1)
-        if self._above(f2):
-            self.stats.pruned["t2"] += 1
-            return
-        g3, x = parent.g3, parent.x
-        if piece >= 0:
-            first = problem.pieces.first
-            span, x = forward_time(first[piece], first[piece + 1], b.ds, b.q, b.r, b.cap_start, b.cap_end, x)
-            g3 += span
-        node = _Node(state, edge, g1, g2, g3, x, visited, parent, piece)
-        if complete:
-            node = _Node(state, -1, f1, f2, g3, x, visited, node, ending, complete=True)
-            node.t3 = self.t3_of(node)
-            f3 = max(f2, node.t3)
-        else:
-            f3 = max(f2, g3 + problem.h2[state])
-        if self._above(f3):
-            self.stats.pruned["t3"] += 1
-            return
-        self.push(f3, node)
-
-    def push(self, key: float, node: _Node) -> None:
-        self.count += 1
-        heapq.heappush(self.heap, (key, self.count, node))
-
-    def expand(self, node: _Node, key: float) -> None:
-        self.stats.expanded += 1
-        problem = self.problem
-        turn_out, edge_to = problem.turn_out, problem.graph.edge_to
-        for state, piece, ending in problem.successors[node.state]:
-            edge = int(turn_out[state])
-            if node.visited >> int(edge_to[edge]) & 1:
-                continue  # a loop
-            self.child(node, state, edge, piece, ending, key)
 
     def root(self) -> _Node:
         return _Node(-1, -1, 0.0, 0.0, 0.0, 0.0, 1 << int(self.problem.graph.start), None, -1)
@@ -199,7 +140,7 @@ class _Search:
             node = _Node(state, edge, 0.0, 0.0, 0.0, 0.0, node.visited | 1 << int(problem.graph.edge_to[edge]), node, piece)
             if ending >= 0:
                 node = _Node(state, -1, 0.0, 0.0, 0.0, 0.0, node.visited, node, ending, complete=True)
-                self._lower_t_u(self.t4_of(node))
+                self._lower_t_u(self.t4_of(self.points(node)))
                 return
             options = [
                 ((b.t2[p] + (b.t2[end] if end >= 0 else problem.h2[s])), s, int(problem.turn_out[s]), p, end)
@@ -209,40 +150,37 @@ class _Search:
     def run(self) -> None:
         began = time.perf_counter()
         self.dive()
-        root = self.root()
+        tables = NodeTable(self.problem, self.t_u)
         for state, edge, piece, ending in self.starts():
-            self.child(root, state, edge, piece, ending, 0.0)
-        pops = 0
-        while self.heap:
-            key, _, node = heapq.heappop(self.heap)
-            if self._above(key):
-                self.stats.pruned["t_u"] += 1 + len(self.heap)
-                self.heap.clear()
-                break
-            pops += 1
-            if pops % CHECK_EVERY == 0:
-                self.deadline.check()
-                if time.monotonic() > self.stop_at:
-                    self.stats.complete = False
+            tables.child(0, state, edge, piece, ending)
+        while True:
+            status, index = tables.chunk(self.options.max_expansions)
+            if status == kernels.FULL:
+                if not tables.grow():
+                    self.stats.complete = False  # the node table is at its most bytes
                     break
-                if np.isfinite(self.t_u):
-                    best = self.t_u / (1.0 + self.options.upper_margin)
-                    self.deadline.progress(min(key / self.t_u, 1.0), f"search: branch and bound, {self.stats.expanded} expanded, t~ {best:.4g} s")
-            if node.complete:
-                if node.t4 is None:
-                    node.t4 = self.t4_of(node)
-                    if self._above(node.t4):
-                        self.stats.pruned["t4"] += 1
-                        continue
-                    self._lower_t_u(node.t4)
-                    self.push(max(key, node.t4), node)
-                    continue
-                self.found.append(GridPath(self.points(node), float(node.t4), (float(node.g1), float(node.g2), float(node.t3))))
-                continue
-            if self.stats.expanded >= self.options.max_expansions:
+            elif status == kernels.NEED_T4:
+                tables.settle(index, self.t4_of(self.points_of(tables.edges(index))), self.options.upper_margin)
+            elif status == kernels.FOUND:
+                g1, g2, _, _, t3, t4 = tables.floats[index]
+                self.found.append(GridPath(self.points_of(tables.edges(index)), float(t4), (float(g1), float(g2), float(t3))))
+            elif status in (kernels.CHUNK, kernels.MAX_EXPANSIONS):
+                self.stats.complete = status == kernels.CHUNK
+            if status == kernels.DONE or not self.stats.complete:
+                break
+            self.deadline.check()
+            if time.monotonic() > self.stop_at:
                 self.stats.complete = False
                 break
-            self.expand(node, key)
+            if status == kernels.CHUNK and np.isfinite(tables.upper[0]):
+                t_u = float(tables.upper[0])
+                self.deadline.progress(
+                    min(float(tables.out_key[0]) / t_u, 1.0),
+                    f"search: branch and bound, {tables.counters[kernels.EXPANDED]} expanded, "
+                    f"t~ {t_u / (1.0 + self.options.upper_margin):.4g} s",
+                )
+        tables.count_into(self.stats)
+        self.t_u = float(tables.upper[0])
         self.stats.candidates = len(self.found)
         self.stats.best_grid_time = self.found[0].time if self.found else None
         self.stats.upper_bound = self.t_u
@@ -339,7 +277,7 @@ def enumerate_grid_paths(problem: SearchProblem, deadline: Deadline = NO_DEADLIN
         node = _Node(state, edge, g1, g2, 0.0, 0.0, node.visited | 1 << int(edge_to[edge]), node, piece)
         if ending >= 0:
             complete = _Node(state, -1, g1 + b.t1[ending], g2 + b.t2[ending], 0.0, 0.0, node.visited, node, ending, complete=True)
-            out.append(GridPath(search.points(complete), search.t4_of(complete), (float(complete.g1), float(complete.g2), search.t3_of(complete))))
+            out.append(GridPath(search.points(complete), search.t4_of(search.points(complete)), (float(complete.g1), float(complete.g2), search.t3_of(complete))))
             return
         deadline.check()
         for after, span, end in problem.successors[state]:

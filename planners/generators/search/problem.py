@@ -9,15 +9,13 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
-from planners.collision import Obstacle
-from planners.errors import InfeasiblePath, InvalidRequest
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.bounds import PieceBounds, piece_bounds
-from planners.generators.search.free_space import clear_pieces, point_distances
-from planners.generators.search.graph import (
+from toptraj.planners.collision import Obstacle
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search.bounds import PieceBounds, piece_bounds
+from toptraj.planners.generators.search.free_space import clear_pieces, point_distances
+from toptraj.planners.generators.search.graph import (
     DEFAULT_MAX_TURN,
     DEFAULT_OPTIONS,
     LATTICE_MAX_JOINTS,
@@ -26,8 +24,8 @@ from planners.generators.search.graph import (
     lattice_graph,
     roadmap_graph,
 )
-from planners.generators.search.pieces import DIRECT, FIRST, LAST, MIDDLE, Pieces, build_pieces
-from robots import JointLimits, Robot
+from toptraj.planners.generators.search.pieces import DIRECT, FIRST, LAST, MIDDLE, Pieces, build_pieces
+from toptraj.robots import JointLimits, Robot
 
 GRAPH_KINDS = ("auto", "lattice", "roadmap")
 
@@ -43,8 +41,8 @@ class SearchProblem:
     Attributes:
         graph: The grid points and moves.
         turn_in, turn_out: The turns of the augmented graph (pairs of moves), shape (T,).
-        pieces: Every span (``planners.generators.search.pieces``).
-        bounds: Every span's bounds (``planners.generators.search.bounds``).
+        pieces: Every span (``toptraj.planners.generators.search.pieces``).
+        bounds: Every span's bounds (``toptraj.planners.generators.search.bounds``).
         usable: Per span, whether it keeps the clearance and some motion can follow it.
         start_moves: Per move from the start: (edge, state, direct span): the state it leads to
             (-1 when it ends at a goal) and its usable direct span (-1 where none).
@@ -101,6 +99,9 @@ def _cost_to_go(n_states: int, source: np.ndarray, target: np.ndarray, weight: n
     goal: Dijkstra from the goal over the reversed arcs."""
     if not len(source):
         return np.full(n_states, np.inf)
+    from scipy.sparse import csr_matrix  # here: scipy.sparse is imported by the searches only
+    from scipy.sparse.csgraph import dijkstra
+
     target = np.where(target < 0, n_states, target)
     finite = np.isfinite(weight)
     reversed_arcs = csr_matrix(

@@ -1,11 +1,11 @@
 """The linear program of one conservative restriction of the jerk-limited timing
-(``planners.timing.jerk.method``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
+(``toptraj.planners.timing.jerk.method``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
 limit linear in (x, u) = (sd^2, sdd), the jerk limit's right-hand side J / sqrt(x) replaced by
 its tangent at the current solution, solved by HiGHS's dual simplex over a working set of its
-rows (``planners.timing.jerk.working_set``).
+rows (``toptraj.planners.timing.jerk.working_set``).
 
 Discretization (``JerkTimeScaling``): x and u at the grid points, u linear in s between them
-(x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``planners.timing.jerk.method``'s (1), its
+(x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``toptraj.planners.timing.jerk.method``'s (1), its
 right-hand side the tangent) at both ends of every interval with du/ds = (u_i+1 - u_i) / h_i,
 the second-order rows at every grid point and at the middle of
 every interval (where x = x_i + (3 u_i + u_i+1) h_i / 4), the velocity bound at its quarters
@@ -22,12 +22,12 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.base import Boundary
-from planners.timing.jerk.scaling import JerkTimeScaling, interval_times
-from planners.timing.jerk.working_set import WorkingSetLP
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import Boundary
+from toptraj.planners.timing.jerk.scaling import JerkTimeScaling, interval_times
+from toptraj.planners.timing.jerk.working_set import WorkingSetLP
 
 
 class RestrictedProgram:
@@ -226,7 +226,7 @@ class RestrictedProgram:
     def solve_restricted(self, x_tangent: np.ndarray, seed: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The LP of the restriction around ``x_tangent`` (1/s^2): x and u (unscaled). ``seed``,
         x and u near the optimum (unscaled), chooses the rows the first LP starts with
-        (``planners.timing.jerk.working_set``)."""
+        (``toptraj.planners.timing.jerk.working_set``)."""
         kappa, n = self.kappa, self.n
         X_tangent = np.asarray(x_tangent) / kappa
         if self._fixed is None:  # the rows that do not depend on the restriction, built once

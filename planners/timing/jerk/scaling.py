@@ -1,5 +1,5 @@
 """``JerkTimeScaling``: a time scaling s(t) with continuous path acceleration, for the
-jerk-limited timing (``planners.timing.jerk.method``).
+jerk-limited timing (``toptraj.planners.timing.jerk.method``).
 
 On the grid s_0 < ... < s_N it holds x_i = sd_i^2 and u_i = sdd_i. Within an interval of width
 h_i the path acceleration is linear in s, u(s) = u_i + w_i (s - s_i) with w_i = du/ds =
@@ -25,7 +25,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.timing.base import DenseStates, TimeScaling
+from toptraj.planners.timing.base import DenseStates, TimeScaling
 
 #: Gauss-Legendre nodes and weights on [0, 1] for the time of an interval.
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(12)
@@ -47,7 +47,7 @@ def interval_times(s: np.ndarray, x: np.ndarray, u: np.ndarray, rest_start: bool
     """Time spent in each interval by each of several motions on one grid (module docstring):
     ``s`` (K + 1,), x = sd^2 and u = sdd at its points, (M, K + 1) each; returns (M, K) in s.
     The quadrature of ``JerkTimeScaling._times_to`` over whole intervals, for M motions at once
-    (the line search of ``planners.timing.jerk.method`` times eight)."""
+    (the line search of ``toptraj.planners.timing.jerk.method`` times eight)."""
     h = np.diff(s)
     w = np.diff(u, axis=1) / h
     sigma_start = (2.0 / 9.0) * x[:, 1] ** 1.5 / h[0] ** 2

@@ -1,4 +1,4 @@
-"""The linear programs of the jerk-limited timing (``planners.timing.jerk.program``) solved over
+"""The linear programs of the jerk-limited timing (``toptraj.planners.timing.jerk.program``) solved over
 a working set of their rows: a cutting-plane loop around HiGHS's dual simplex.
 
 Each LP holds some 50 rows per grid interval on a 6-joint arm (second-order rows at the points
@@ -24,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
-from planners.execution.deadline import Deadline
+from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
+from toptraj.planners.execution.deadline import Deadline
 
 #: HiGHS's primal feasibility tolerance, and the violation above which a row joins W. Near an
 #: end at rest the jerk rows' right-hand sides are as small as x there (1e-8 of the typical
