@@ -309,6 +309,7 @@ def _optimize_motion(
 ) -> CollocationResult:
     # here: casadi and its solvers take a second to import, for this method only
     from toptraj.planners.generators.collocation.sparse import SparseCollocation, solve_sparse
+    from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
 
     if robot.outside_position_limits(motion.start) is not None:
         raise InvalidRequest("path.start is outside the joint limits")
@@ -317,6 +318,7 @@ def _optimize_motion(
     started = time.perf_counter()
     tried: list[str] = []
     coarse_solver = None
+    dynamics = None
     coarse_motion = FreeMotion(
         motion.start, motion.goal, motion.start_velocity, motion.end_velocity, min(COARSE_INTERVALS, motion.intervals)
     )
@@ -336,7 +338,8 @@ def _optimize_motion(
             tried.append(f"{label}: {error.detail}")
             continue
         if coarse_solver is None:  # one sparse solver for every guess: they differ in bounds only
-            coarse_solver = SparseCollocation(coarse, max_iterations)
+            dynamics = inverse_dynamics_function(robot)
+            coarse_solver = SparseCollocation(coarse, max_iterations, dynamics)
         result = coarse_solver.solve(coarse, z0)
         feasible = _feasible(coarse, result.x)
         tried.append(f"{label}: {result.message} (cost {result.fun:.6g})")
@@ -356,7 +359,7 @@ def _optimize_motion(
         progress((len(guesses) + rank / len(contenders)) * share, "collocation: refining the best guess")
         problem = _Problem(robot, limits, motion, goal, torque_weight)
         z0 = _refined(coarse, coarse_result.x, problem)
-        result = solve_sparse(problem, z0, max_iterations)
+        result = solve_sparse(problem, z0, max_iterations, dynamics)
         feasible = _feasible(problem, result.x)
         if not feasible:  # the dense SQP, from the same start
             result, feasible = _solve(problem, z0, max_iterations)

@@ -28,6 +28,9 @@ from toptraj.robots import JointLimits, Robot
 
 #: Most collocation intervals a request may ask for (timing.grid_points).
 MAX_INTERVALS = 100
+#: Fraction of its torque limit that every joint's collocation torque must reach somewhere for
+#: the motion to be refined to bang-bang torques (``_switched``).
+REFINED_ABOVE = 0.9
 
 
 class Collocation(MotionGenerator):
@@ -151,6 +154,11 @@ def _switched(problem: Problem, collocation, timed, notes, deadline):
     # The rivals (other goals the fine grid found close) are compared on exact terms too: the
     # collocation's grid error can exceed their difference.
     for candidate in (collocation, *collocation.rivals):
+        if np.any(np.abs(candidate.tau).max(axis=0) < REFINED_ABOVE * limits.torque):
+            # A bang-bang motion holds every joint's torque at a limit throughout; one near the
+            # collocation's optimum cannot have a joint whose torque stays well below its
+            # limit there (velocity or acceleration limits shape such a motion).
+            continue
         motion = refine_collocation(robot, limits, spec, candidate, deadline)
         if motion is not None and (refined is None or motion.duration < refined.duration):
             refined, winner = motion, candidate

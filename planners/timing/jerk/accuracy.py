@@ -6,7 +6,11 @@ durations on two nested grids, T_coarse - T_fine, estimates the fine grid's erro
 wherever the error shrinks at least linearly with the interval (T_coarse - T* = 2 (T_fine - T*)
 for first order, 4 times for second). The coarse grid is every other point of the fine one (the
 points toward an end at rest, which resolve its constant-jerk phase, and the path's knots all
-kept), so that the two solves share nothing but the problem.
+kept). The coarse grid is solved first, from the jerk-free optimum; its solution is where the
+fine grid's first restriction is taken, which saves most of the fine grid's LPs. Both sequences
+run until their gain per LP falls below the method's tolerance, so that each ends at its own
+grid's fixed point; ``benchmarks/jerk_gap.py`` checks the stated gap against a reference
+extrapolated from grids four and eight times finer.
 """
 
 from __future__ import annotations

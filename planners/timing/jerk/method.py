@@ -54,8 +54,15 @@ polish is a local method started from the grid solution's phases, and misses the
 
 Every answer carries an estimate of its distance from the optimum (``optimality_gap``): zero
 for the closed form, else the difference from the solution on a second grid of half as many
-points (``toptraj.planners.timing.jerk.accuracy``); above ``GAP_TARGET`` the grid is doubled, at most
-``max_refinements`` times, while the grid budget and the time left allow.
+points (``toptraj.planners.timing.jerk.accuracy``), which is solved first and starts the LPs of the
+answer's grid; above ``GAP_TARGET`` the grid is doubled, at most ``max_refinements`` times,
+while the grid budget and the time left allow.
+
+Each LP is solved over a working set of its rows (``toptraj.planners.timing.jerk.working_set``): of
+some 50 rows per interval only about two per point are active at the optimum. On fine grids the
+second grid is itself started from the grid coarser still, down to ``SEED_INTERVALS`` (a
+multigrid start): each level's LPs begin near their optimum, over the rows that bind there, and
+only the coarsest level starts from the jerk-free optimum.
 """
 
 from __future__ import annotations
@@ -83,6 +90,13 @@ FALLBACK_FIRST_INTERVAL = 1e-3
 #: Relative gain below which the LPs on a refined grid, started from the coarser solution,
 #: stop: a hundredth of the gap the refinement aims at.
 WARM_TOLERANCE = 1e-2 * GAP_TARGET
+#: Time of the LPs on a grid twice as fine as the last, as a multiple of the last's, with room:
+#: the first LP starts from no basis, its simplex iterations and their cost each about doubling
+#: (ur5, 2,000 to 4,000 intervals: 9 to 12 times the last grid's sequence, itself started from
+#: the grids below it), and a refinement begun but not finished costs the whole answer.
+REFINEMENT_COST = 20.0
+#: Fewest intervals of a grid that starts the LPs of a finer one (``JerkLimitedMethod._seed``).
+SEED_INTERVALS = 60
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
 MIN_FIRST_INTERVAL = 1e-5
 
@@ -130,14 +144,18 @@ class JerkLimitedMethod(TimingMethod):
                 return exact
         original = constraints.s
         constraints = _graded(constraints, boundary)
+        # The second grid first: its solution starts the LPs on the answer's grid, which then
+        # need few iterations over few rows (``toptraj.planners.timing.jerk.working_set``).
+        coarse, gap, how = self._second_grid(constraints, original, boundary, deadline)
         started = time.perf_counter()
-        best = self._grid_solution(constraints, boundary, deadline)
+        best = self._grid_solution(constraints, boundary, deadline, start=coarse)
         elapsed = time.perf_counter() - started
-        gap, how = self._second_grid(constraints, original, boundary, best, deadline)
+        if coarse is not None:
+            gap = relative_gap(coarse.duration, best.duration)
         for done in range(self.max_refinements):
             if gap is None or gap <= GAP_TARGET or not self._affordable(constraints, elapsed, deadline):
                 break
-            # The error about halves with each doubling (first order; the LPs cost four times
+            # The error about halves with each doubling (first order; the LPs cost ten times or more
             # as much): where the doublings left would not bring it to the target, the answer
             # states its gap instead.
             if gap / 2 ** (self.max_refinements - done) > GAP_TARGET:
@@ -175,18 +193,19 @@ class JerkLimitedMethod(TimingMethod):
         problem = RestrictedProgram(constraints, boundary, x_ref, deadline)
         # The first restriction is taken around the jerk-free optimum, which is no feasible
         # point itself; its LP solution is, and every later step starts from a feasible point.
-        x, u = problem.solve_restricted(x_ref)
+        # Its rows start from those near a bound at x_ref (u from dx/ds = 2 u).
+        x, u = problem.solve_restricted(x_ref, seed=(x_ref, 0.5 * np.gradient(x_ref, constraints.s)))
         best = problem.timing(x, u)
         for _ in range(self.max_iterations):
             deadline.check()
             x_lp, u_lp = problem.solve_restricted(x)
             # Line search on the true duration along the segment to the LP's solution, every
             # point of which lies in the (convex) restriction around the current solution.
-            trials = []
-            for step in 0.5 ** np.arange(8):
-                x_step, u_step = x + step * (x_lp - x), u + step * (u_lp - u)
-                trials.append((problem.timing(x_step, u_step), x_step, u_step))
-            candidate, x_step, u_step = min(trials, key=lambda trial: trial[0].duration)
+            steps = 0.5 ** np.arange(8)[:, None]
+            x_steps, u_steps = x + steps * (x_lp - x), u + steps * (u_lp - u)
+            chosen = int(np.argmin(problem.durations(x_steps, u_steps)))
+            x_step, u_step = x_steps[chosen], u_steps[chosen]
+            candidate = problem.timing(x_step, u_step)
             gain = best.duration - candidate.duration
             if gain <= 0.0:
                 break
@@ -195,28 +214,45 @@ class JerkLimitedMethod(TimingMethod):
                 break
         return best
 
-    def _second_grid(self, constraints, original, boundary, best, deadline) -> tuple[float | None, str]:
-        """The estimated relative gap of ``best`` and how it was obtained: the difference from
-        the solution on every other grid point (``toptraj.planners.timing.jerk.accuracy``)."""
+    def _second_grid(self, constraints, original, boundary, deadline) -> tuple[JerkTimeScaling | None, float | None, str]:
+        """The solution on every other grid point (``toptraj.planners.timing.jerk.accuracy``), which
+        estimates the gap of the answer's grid, and how: (``None``, ``None``, why) when there is
+        none."""
         coarse = coarser(constraints, original)
         if coarse is None:
-            return None, "none: the grid is too coarse for a second one"
+            return None, None, "none: the grid is too coarse for a second one"
         try:
-            coarse_best = self._grid_solution(coarse, boundary, deadline)
+            coarse_best = self._grid_solution(coarse, boundary, deadline, start=self._seed(coarse, original, boundary, deadline))
         except (InfeasiblePath, TimingFailed) as error:
-            return None, f"none: the second grid's solve failed ({error.detail})"
+            return None, None, f"none: the second grid's solve failed ({error.detail})"
         return (
-            relative_gap(coarse_best.duration, best.duration),
+            coarse_best, None,
             f"second grid: the difference from the solution on a grid of half as many points ({len(coarse.s) - 1} intervals)",
         )
 
+    def _seed(self, constraints, original, boundary, deadline) -> JerkTimeScaling | None:
+        """Where the LPs on ``constraints`` start: the solution on every other point of their
+        grid, itself started from the grid coarser still, down to ``SEED_INTERVALS``; ``None``
+        (the jerk-free optimum) below. Each level's LPs then begin near their optimum and over
+        the rows that bind there, the cold start paid on a small grid only; the levels below
+        the second grid stop at a gain of ``WARM_TOLERANCE``, being starts only."""
+        coarse = coarser(constraints, original) if len(constraints.s) - 1 > 2 * SEED_INTERVALS else None
+        if coarse is None:
+            return None
+        try:
+            return self._grid_solution(
+                coarse, boundary, deadline, start=self._seed(coarse, original, boundary, deadline), tolerance=WARM_TOLERANCE,
+            )
+        except (InfeasiblePath, TimingFailed):
+            return None
+
     def _affordable(self, constraints: PathConstraints, elapsed: float, deadline: Deadline) -> bool:
-        """Whether a grid twice as fine fits the grid budget and (at about four times the last
-        solve's time) the time left, on constraints that can be evaluated at new points."""
+        """Whether a grid twice as fine fits the grid budget and (at ``REFINEMENT_COST`` times the
+        last solve's time) the time left, on constraints that can be evaluated at new points."""
         if not constraints.can_refine or 2 * (len(constraints.s) - 1) > self.grid_budget:
             return False
         remaining = deadline.remaining()
-        return remaining is None or remaining > 4.0 * elapsed + 1.0
+        return remaining is None or remaining > REFINEMENT_COST * elapsed + 1.0
 
 
 def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:

@@ -1,7 +1,8 @@
 """The linear program of one conservative restriction of the jerk-limited timing
 (``toptraj.planners.timing.jerk.method``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
 limit linear in (x, u) = (sd^2, sdd), the jerk limit's right-hand side J / sqrt(x) replaced by
-its tangent at the current solution, solved by HiGHS's dual simplex.
+its tangent at the current solution, solved by HiGHS's dual simplex over a working set of its
+rows (``toptraj.planners.timing.jerk.working_set``).
 
 Discretization (``JerkTimeScaling``): x and u at the grid points, u linear in s between them
 (x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``toptraj.planners.timing.jerk.method``'s (1), its
@@ -18,13 +19,18 @@ typical x, so that the LP sees numbers of order one.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
+from toptraj.planners.errors import TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import Boundary
-from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
+from toptraj.planners.timing.jerk.scaling import JerkTimeScaling, interval_times
+
+if TYPE_CHECKING:
+    from scipy import sparse
 
 
 class RestrictedProgram:
@@ -44,7 +50,11 @@ class RestrictedProgram:
         if n < 2 + self.rest_start + self.rest_end:
             raise TimingFailed("the grid is too coarse for the jerk-limited timing")
         self._fixed_rows = self._equalities_and_rows(x_ref)
-        self._basis, self._basis_shape = None, None
+        # here: scipy.sparse is imported by jerk_limited only
+        from toptraj.planners.timing.jerk.working_set import WorkingSetLP
+
+        self._lp = WorkingSetLP(deadline)
+        self._fixed: tuple[sparse.csr_matrix, np.ndarray, np.ndarray] | None = None
 
     # Variables: X_0..X_n at columns 0..n, U_0..U_n at columns n+1..2n+1.
     def _x(self, i):
@@ -219,26 +229,20 @@ class RestrictedProgram:
                 emit([], g[limited][None, :], point)
         return blocks
 
-    def solve_restricted(self, x_tangent: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The LP of the restriction around ``x_tangent`` (1/s^2): x and u (unscaled)."""
-        from scipy import sparse  # here: scipy.sparse is imported by jerk_limited only
-
+    def solve_restricted(self, x_tangent: np.ndarray, seed: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The LP of the restriction around ``x_tangent`` (1/s^2): x and u (unscaled). ``seed``,
+        x and u near the optimum (unscaled), chooses the rows the first LP starts with
+        (``toptraj.planners.timing.jerk.working_set``)."""
         kappa, n = self.kappa, self.n
         X_tangent = np.asarray(x_tangent) / kappa
-        blocks = [*self._fixed_rows, *self._jerk_rows(X_tangent)]
-        offsets = np.cumsum([0] + [block[5] for block in blocks])
-        matrix = sparse.csr_matrix(
-            (
-                np.concatenate([block[2] for block in blocks]),
-                (
-                    np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)]),
-                    np.concatenate([block[1] for block in blocks]),
-                ),
-            ),
-            shape=(offsets[-1], 2 * n + 2),
-        )
-        lower = np.concatenate([block[3] for block in blocks])
-        upper = np.concatenate([block[4] for block in blocks])
+        if self._fixed is None:  # the rows that do not depend on the restriction, built once
+            self._fixed = _stacked(self._fixed_rows, 2 * n + 2)
+        jerk, jerk_lower, jerk_upper = _stacked(self._jerk_rows(X_tangent), 2 * n + 2)
+        from scipy import sparse
+
+        matrix = sparse.vstack([self._fixed[0], jerk], format="csr")
+        lower = np.concatenate([self._fixed[1], jerk_lower])
+        upper = np.concatenate([self._fixed[2], jerk_upper])
         x_high = self.constraints.sd_max**2 / kappa
         low = np.concatenate([np.zeros(n + 1), np.full(n + 1, -np.inf)])
         high = np.concatenate([x_high, np.full(n + 1, np.inf)])
@@ -246,51 +250,10 @@ class RestrictedProgram:
             low[index] = high[index] = value
         objective = np.zeros(2 * n + 2)
         objective[: n + 1] = self._time_gradient(np.maximum(X_tangent, 1e-12))
-        X, U = self._run(objective, matrix.tocsc(), lower, upper, low, high)
+        scaled = None if seed is None else np.concatenate(seed) / kappa
+        values = self._lp.solve(objective, matrix, lower, upper, low, high, scaled)
+        X, U = values[: n + 1], values[n + 1 :]
         return np.maximum(X, 0.0) * kappa, U * kappa
-
-    def _run(self, objective, matrix, lower, upper, low, high):
-        """Solve the LP with HiGHS's dual simplex, warm-started from the previous LP's basis
-        (the restrictions of consecutive iterations differ little), stopped when the deadline
-        passes (``BudgetExceeded``)."""
-        import highspy
-
-        self.deadline.check()
-        solver = highspy.Highs()
-        solver.setOptionValue("output_flag", False)
-        # Near an end at rest the jerk rows' right-hand sides are as small as x there (1e-8 of
-        # the typical x): HiGHS's default tolerance of 1e-7 would let them be exceeded twofold.
-        solver.setOptionValue("primal_feasibility_tolerance", 1e-10)
-        remaining = self.deadline.remaining()
-        if remaining is not None:
-            solver.setOptionValue("time_limit", max(remaining, 1e-3))
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = matrix.shape[1], matrix.shape[0]
-        lp.col_cost_, lp.col_lower_, lp.col_upper_ = objective, low, high
-        lp.row_lower_, lp.row_upper_ = lower, upper
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = matrix.indptr, matrix.indices, matrix.data
-        solver.passModel(lp)
-        if self._basis is not None and self._basis_shape == matrix.shape:
-            solver.setBasis(self._basis)
-        solver.run()
-        status = solver.getModelStatus()
-        if status == highspy.HighsModelStatus.kTimeLimit:
-            self.deadline.check()
-            raise BudgetExceeded(f"planning exceeded its time budget of {self.deadline.budget_s:.3g} s")
-        if status == highspy.HighsModelStatus.kInfeasible:
-            raise InfeasiblePath(
-                "no jerk-limited motion follows the path within the limits (the linear program is infeasible)"
-            )
-        if status != highspy.HighsModelStatus.kOptimal:
-            raise TimingFailed(
-                f"the jerk-limited timing's linear program ended without a solution (HiGHS: "
-                f"{solver.modelStatusToString(status).lower()}); try other timing.grid_points"
-            )
-        self._basis, self._basis_shape = solver.getBasis(), matrix.shape
-        values = np.asarray(solver.getSolution().col_value)
-        n = self.n
-        return values[: n + 1], values[n + 1 :]
 
     def _time_gradient(self, X):
         """d/dX of sum 2 h / (sqrt(X_i) + sqrt(X_i+1)) (3 h / sqrt(X) for an interval at rest)."""
@@ -307,8 +270,33 @@ class RestrictedProgram:
             gradient[-2] += -1.5 * self.h[-1] / X[-2] ** 1.5 - share[-1] / root[-2]
         return gradient
 
+    def durations(self, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Durations (M,) in s of the motions x, u (M, N + 1) on this grid."""
+        return interval_times(self.constraints.s, np.maximum(x, 0.0), u, self.rest_start, self.rest_end).sum(axis=1)
+
     def timing(self, x, u) -> JerkTimeScaling:
         return JerkTimeScaling(
             self.constraints.s, np.sqrt(np.maximum(x, 0.0)), u=np.asarray(u, dtype=float),
             rest_start=self.rest_start, rest_end=self.rest_end,
         )
+
+
+def _stacked(blocks, columns: int) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:
+    """The rows of ``blocks`` (row, column, value, lower, upper, count; rows numbered within each
+    block) one under the other: the matrix (CSR, ``columns`` wide) and its bounds."""
+    from scipy import sparse
+
+    if not blocks:
+        return sparse.csr_matrix((0, columns)), np.zeros(0), np.zeros(0)
+    offsets = np.cumsum([0] + [block[5] for block in blocks])
+    matrix = sparse.csr_matrix(
+        (
+            np.concatenate([block[2] for block in blocks]),
+            (
+                np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)]),
+                np.concatenate([block[1] for block in blocks]),
+            ),
+        ),
+        shape=(offsets[-1], columns),
+    )
+    return matrix, np.concatenate([block[3] for block in blocks]), np.concatenate([block[4] for block in blocks])

@@ -20,6 +20,8 @@ along which u = 2 x / (3 s) and du/ds = 2 / t^2 = 2 x / (9 s^2) (mirrored at an 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -28,6 +30,44 @@ from toptraj.planners.timing.base import DenseStates, TimeScaling
 #: Gauss-Legendre nodes and weights on [0, 1] for the time of an interval.
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(12)
 _NODES, _WEIGHTS = 0.5 * (_NODES + 1.0), 0.5 * _WEIGHTS
+
+
+class _Grid(NamedTuple):
+    """Per-interval arrays of a ``JerkTimeScaling``: widths h (K,), x = sd^2 at the points
+    (K + 1,), du/ds w (K,), and the path jerk of the intervals at rest (0 where none)."""
+
+    h: np.ndarray
+    x: np.ndarray
+    w: np.ndarray
+    sigma_start: float
+    sigma_end: float
+
+
+def interval_times(s: np.ndarray, x: np.ndarray, u: np.ndarray, rest_start: bool, rest_end: bool) -> np.ndarray:
+    """Time spent in each interval by each of several motions on one grid (module docstring):
+    ``s`` (K + 1,), x = sd^2 and u = sdd at its points, (M, K + 1) each; returns (M, K) in s.
+    The quadrature of ``JerkTimeScaling._times_to`` over whole intervals, for M motions at once
+    (the line search of ``toptraj.planners.timing.jerk.method`` times eight)."""
+    h = np.diff(s)
+    w = np.diff(u, axis=1) / h
+    sigma_start = (2.0 / 9.0) * x[:, 1] ** 1.5 / h[0] ** 2
+    sigma_end = (2.0 / 9.0) * x[:, -2] ** 1.5 / h[-1] ** 2
+    if rest_start:
+        w[:, 0] = 2.0 * x[:, 1] / (9.0 * h[0] ** 2)
+    if rest_end:
+        w[:, -1] = 2.0 * x[:, -2] / (9.0 * h[-1] ** 2)
+    x0, u0 = x[:, :-1], u[:, :-1]
+    x_end = np.maximum(x0 + 2.0 * u0 * h + w * h**2, 0.0)
+    from_start = (x0 <= x_end)[..., None]
+    nodes = h[None, :, None] * np.where(from_start, _NODES**2, 1.0 - _NODES**2)
+    inside = np.maximum(x0[..., None] + 2.0 * u0[..., None] * nodes + w[..., None] * nodes**2, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        times = h * (_WEIGHTS * 2.0 * _NODES / np.sqrt(inside)).sum(axis=-1)
+        if rest_start:
+            times[:, 0] = np.cbrt(6.0 * h[0] / sigma_start)
+        if rest_end:
+            times[:, -1] = np.cbrt(6.0 * h[-1] / sigma_end)
+    return times
 
 
 @dataclass(frozen=True)
@@ -49,70 +89,73 @@ class JerkTimeScaling(TimeScaling):
     rest_start: bool = False
     rest_end: bool = False
 
+    @cached_property
+    def _grid(self) -> _Grid:
+        """The arrays every evaluation reads, computed once per timing."""
+        h = np.diff(self.s)
+        x = self.sd**2
+        w = np.diff(self.u) / h
+        sigma_start = sigma_end = 0.0
+        if self.rest_start:
+            w[0] = 2.0 * x[1] / (9.0 * h[0] ** 2)
+            sigma_start = (2.0 / 9.0) * x[1] ** 1.5 / h[0] ** 2
+        if self.rest_end:
+            w[-1] = 2.0 * x[-2] / (9.0 * h[-1] ** 2)
+            sigma_end = (2.0 / 9.0) * x[-2] ** 1.5 / h[-1] ** 2
+        return _Grid(h, x, w, sigma_start, sigma_end)
+
     @property
     def _x(self) -> np.ndarray:
-        return self.sd**2
+        return self._grid.x
 
     @property
     def _w(self) -> np.ndarray:
         """du/ds of each interval (K,); for an interval at rest, its value at the other end."""
-        h = np.diff(self.s)
-        w = np.diff(self.u) / h
-        x = self._x
-        if self.rest_start:
-            w[0] = 2.0 * x[1] / (9.0 * h[0] ** 2)
-        if self.rest_end:
-            w[-1] = 2.0 * x[-2] / (9.0 * h[-1] ** 2)
-        return w
+        return self._grid.w
 
     def _sigma(self, end: bool) -> float:
         """Path jerk of the interval at rest at the start (``end`` False) or the end."""
-        h = np.diff(self.s)
-        x = self._x[-2] if end else self._x[1]
-        width = h[-1] if end else h[0]
-        return (2.0 / 9.0) * x**1.5 / width**2
+        return self._grid.sigma_end if end else self._grid.sigma_start
 
-    def _rest_flags(self) -> tuple[np.ndarray, np.ndarray]:
-        n = len(self.s) - 1
-        first = np.zeros(n, dtype=bool)
-        last = np.zeros(n, dtype=bool)
-        first[0] = self.rest_start
-        last[-1] = self.rest_end
-        return first, last
+    def _rest_masks(self, interval: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Where ``interval`` is the interval at rest at the start, at the end (``None``: nowhere)."""
+        first = interval == 0 if self.rest_start else None
+        last = interval == len(self.s) - 2 if self.rest_end else None
+        return (first if first is not None and first.any() else None), (last if last is not None and last.any() else None)
 
     def _state(self, interval: np.ndarray, offset: np.ndarray):
         """x, u and sddd at ``offset`` = s - s_i into ``interval`` (arrays of equal shape)."""
-        h = np.diff(self.s)[interval]
-        x0, u0 = self._x[interval], self.u[interval]
-        w = self._w[interval]
-        first, last = (flag[interval] for flag in self._rest_flags())
+        grid = self._grid
+        h = grid.h[interval]
+        x0, u0 = grid.x[interval], self.u[interval]
+        w = grid.w[interval]
         x = np.maximum(x0 + 2.0 * u0 * offset + w * offset**2, 0.0)
         u = u0 + w * offset
         sddd = w * np.sqrt(x)
-        if first.any() or last.any():
-            for mask, end in ((first, False), (last, True)):
-                if not mask.any():
-                    continue
-                sigma = self._sigma(end)
-                # Distance from the rest point, and the time from (or to) it.
-                gap = offset[mask] if not end else h[mask] - offset[mask]
-                tau = np.cbrt(6.0 * np.maximum(gap, 0.0) / sigma)
-                x[mask] = (0.5 * sigma * tau**2) ** 2
-                u[mask] = sigma * tau if not end else -sigma * tau
-                sddd[mask] = sigma
+        for mask, end in zip(self._rest_masks(interval), (False, True)):
+            if mask is None:
+                continue
+            sigma = self._sigma(end)
+            # Distance from the rest point, and the time from (or to) it.
+            gap = offset[mask] if not end else h[mask] - offset[mask]
+            tau = np.cbrt(6.0 * np.maximum(gap, 0.0) / sigma)
+            x[mask] = (0.5 * sigma * tau**2) ** 2
+            u[mask] = sigma * tau if not end else -sigma * tau
+            sddd[mask] = sigma
         return x, u, sddd
 
-    @property
+    @cached_property
     def interval_times(self) -> np.ndarray:
         """Time spent in each interval, shape (K,), in s."""
-        return self._times_to(np.arange(len(self.s) - 1), np.diff(self.s))
+        return interval_times(self.s, self._x[None, :], self.u[None, :], self.rest_start, self.rest_end)[0]
 
     def _times_to(self, interval: np.ndarray, offset: np.ndarray) -> np.ndarray:
         """Time from the start of ``interval`` to ``offset`` into it."""
         offset = np.asarray(offset, dtype=float)
         # With h = offset tau^2 from the end where x is smaller, dh / sqrt(x) = 2 offset tau
         # dtau / sqrt(x) stays smooth where x nears zero (x grows linearly from there).
-        x_start, _, _ = self._state(interval, np.zeros_like(offset))
+        grid = self._grid
+        x_start = grid.x[interval]
         x_end, _, _ = self._state(interval, offset)
         from_start = x_start <= x_end
         tau = _NODES[None, :]
@@ -120,17 +163,15 @@ class JerkTimeScaling(TimeScaling):
         x, _, _ = self._state(np.repeat(interval[:, None], len(_NODES), axis=1), nodes)
         with np.errstate(divide="ignore", invalid="ignore"):
             times = offset * (_WEIGHTS * 2.0 * tau / np.sqrt(x)).sum(axis=1)
-        first, last = (flag[interval] for flag in self._rest_flags())
-        h = np.diff(self.s)[interval]
-        if first.any():
-            sigma = self._sigma(False)
-            times[first] = np.cbrt(6.0 * offset[first] / sigma)
-        if last.any():
-            sigma = self._sigma(True)
-            times[last] = np.cbrt(6.0 * h[last] / sigma) - np.cbrt(6.0 * np.maximum(h[last] - offset[last], 0.0) / sigma)
+        first, last = self._rest_masks(interval)
+        if first is not None:
+            times[first] = np.cbrt(6.0 * offset[first] / self._sigma(False))
+        if last is not None:
+            sigma, h = self._sigma(True), grid.h[interval[last]]
+            times[last] = np.cbrt(6.0 * h / sigma) - np.cbrt(6.0 * np.maximum(h - offset[last], 0.0) / sigma)
         return np.where(offset > 0.0, times, 0.0)
 
-    @property
+    @cached_property
     def t(self) -> np.ndarray:
         """Time at each grid point, shape (K + 1,), in s."""
         return np.concatenate(([0.0], np.cumsum(self.interval_times)))
