@@ -12,8 +12,8 @@ import pytest
 from toptraj import robots
 from toptraj.planners import Timing, plan
 from toptraj.planners.generators.collocation import collocation
-from toptraj.planners.generators.collocation.motion import FreeMotion
 from toptraj.planners.generators.collocation.sparse import SparseCollocation
+from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.runner import timed_free
 
 START = np.array([0.0, -1.2, 1.0, 0.0, 0.3, 0.0])
