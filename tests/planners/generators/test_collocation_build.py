@@ -2,7 +2,7 @@
 inverse-dynamics graph whatever the number of intervals, and reaches the optimum the dense
 solver (SLSQP on Pinocchio's RNEA and its analytical derivatives) reaches from the same start;
 a motion that its velocity or acceleration limits shape is not sent to the bang-bang
-refinement (``toptraj.planners.runner.timed_free``)."""
+refinement (``toptraj.planners.generators.collocation.generator``)."""
 
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ import pytest
 from toptraj import robots
 from toptraj.planners import Timing, plan
 from toptraj.planners.generators.collocation import collocation
+from toptraj.planners.generators.collocation import generator as collocation_generator
 from toptraj.planners.generators.collocation.sparse import SparseCollocation
 from toptraj.planners.problem.free_motion import FreeMotion
-from toptraj.planners.runner import timed_free
 
 START = np.array([0.0, -1.2, 1.0, 0.0, 0.3, 0.0])
 GOAL = np.array([0.8, -1.0, 1.4, -0.5, 0.6, 0.3])
@@ -53,7 +53,7 @@ def test_a_motion_shaped_by_its_acceleration_limits_is_not_refined_to_bang_bang(
     below a third of their limits (the acceleration limits shape it), so no refinement to
     bang-bang torques is tried; the answer is the collocation's path re-timed, within its limits."""
     calls = []
-    monkeypatch.setattr(timed_free, "refine_collocation", lambda *args, **kwargs: calls.append(args))
+    monkeypatch.setattr(collocation_generator, "refine_collocation", lambda *args, **kwargs: calls.append(args))
     arm = robots.load("ur5")
     result = plan(arm, FreeMotion(START, GOAL, intervals=12, revolutions=False),
                   Timing(method="collocation", constraints=("velocity", "acceleration", "torque")), dt=0.01)
