@@ -17,7 +17,7 @@ from planners.collision import Obstacle, check_clearance
 from planners.collision.obstacles import check_obstacles
 from planners.constraints.admissible import admissible_set
 from planners.constraints.tool_speed import tool_speed_limit
-from planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
+from planners.errors import Conflicting, NotServed, OutOfRange, TimingFailed, TooLarge, numerical_breakdown_is_failure
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.generators.collocation import FreeMotion
 from planners.generators.collocation.switching import collocation_switches, switching_times
@@ -59,15 +59,9 @@ def _check_tool_limit_served(path_spec, method: TimingMethod) -> None:
     """Tool-speed limits bound the path speed of a given path: refuse them where the path is
     shaped by the timing (free motions, via points)."""
     if isinstance(path_spec, FreeMotion) or method.name == "collocation":
-        raise InvalidRequest(
-            "timing.limits.tool_speed and tool_angular_speed are not served by collocation on a free path; "
-            "give the path (waypoints or a cartesian line) and a method such as phase_plane"
-        )
+        raise NotServed("limits.tool_speed", None, method.name, rule="tool_speed_on_free_path", alternatives=("phase_plane",))
     if isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via":
-        raise InvalidRequest(
-            "timing.limits.tool_speed and tool_angular_speed are not served with interpolation 'via' "
-            "(its segments are shaped by their time laws); use 'spline' or 'linear'"
-        )
+        raise NotServed("limits.tool_speed", None, method.name, rule="tool_speed_through_via", alternatives=("spline", "linear"))
 
 
 def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -159,22 +153,16 @@ def plan(
     if exact_period and any(
         v is not None and np.any(np.asarray(v) != 0.0) for v in (timing.start_velocity, timing.end_velocity)
     ):
-        raise InvalidRequest(
-            "output.exact_period slows the motion uniformly, which would change the nonzero "
-            "timing.boundary velocities: set output.exact_period to false (samples every dt "
-            "plus the final instant) or plan from and to rest"
-        )
+        raise Conflicting("sampling.exact_period", exact_period, ("boundary",), rule="exact_period_with_moving_ends")
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
-        raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
+        raise OutOfRange("grid.intervals", timing.grid_points, 2, MAX_POINTS, rule="grid_out_of_range")
     if timing.grid_points is not None and timing.grid_points > method.max_grid_intervals(robot.dof):
-        raise InvalidRequest(
-            f"timing.grid_points = {timing.grid_points} is more than {method.name} serves on a "
-            f"{robot.dof}-joint robot (its memory grows with grid intervals times joints): use "
-            f"timing.grid_points <= {method.max_grid_intervals(robot.dof)}"
-        )
+        cap = method.max_grid_intervals(robot.dof)
+        raise TooLarge("grid.intervals", timing.grid_points, timing.grid_points, cap, "intervals", largest=cap,
+                       rule="grid_over_method_cap", method=method.name, dof=robot.dof)
     margin = timing.limit_margin
     if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
-        raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
+        raise OutOfRange("limits.margin", margin, 0.0, MAX_LIMIT_MARGIN, rule="margin_out_of_range")
     check_scaled_limits(robot.limits.with_request(timing.limit_overrides), timing.limit_scales, robot.joint_names)
     requested: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
     tool = tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
@@ -189,19 +177,12 @@ def plan(
         path_spec, dropped = without_repeats(path_spec)
         dropped = (*turns, *dropped)
     if method.two_waypoints_only and (not isinstance(path_spec, WaypointPath) or len(path_spec.waypoints) != 2):
-        given = f"{len(path_spec.waypoints)} waypoints" if isinstance(path_spec, WaypointPath) else "a cartesian path"
-        raise InvalidRequest(
-            f"timing.method {method.name!r} plans state-to-state motions: give exactly 2 waypoints, not "
-            f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
-            "law through several waypoints"
-        )
+        count = len(path_spec.waypoints) if isinstance(path_spec, WaypointPath) else None
+        raise NotServed("waypoints", count, method.name, rule="needs_two_waypoints", alternatives=("phase_plane",))
     timing_part = deadline.within(0.0, 0.9)
     checked_first = None
     if obstacles and isinstance(path_spec, FreeMotion) and method.name != "search":
-        raise InvalidRequest(
-            "path.obstacles on a free path are served by timing.method 'search' (the global search among obstacles); "
-            "collocation does not see obstacles"
-        )
+        raise NotServed("obstacles", len(obstacles), method.name, rule="obstacles_need_search", alternatives=("search",))
     with numerical_breakdown_is_failure(method.name):
         if method.name == "search":
             timed = timed_search(robot, path_spec, timing, kinds, limits, timing_part, threshold, obstacles, clearance)
@@ -235,7 +216,7 @@ def plan(
     deadline.progress(0.9, "sampling")
     require_finite(timed.method, duration=result.duration)
     if result.duration / dt > max_samples - 2:
-        raise InvalidRequest(_too_many_samples(result.duration, dt, max_samples, timing))
+        raise _too_many_samples(result.duration, dt, max_samples, timing)
     deadline.expect((result.duration / dt + 2) * robot.dof * SAMPLE_SECONDS)
     samples = sample_trajectory(path, result, robot, dt, exact_period)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
@@ -312,19 +293,18 @@ def plan(
     )
 
 
-def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> str:
-    """Why ``duration`` (s) sampled every ``dt`` (s) is not served, and advice that can be
-    followed: the smallest ``output.dt`` that fits when it lies in ``DT``, else the limits that
-    make the motion this slow (no ``output.dt`` beyond its own range is ever advised)."""
-    given = f"output.dt = {dt:g} s gives {math.ceil(duration / dt) + 1} samples over the {duration:.4g} s motion; at most {max_samples} are served"
+def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> TooLarge:
+    """Why ``duration`` (s) sampled every ``dt`` (s) is not served, with advice that can be
+    followed: ``smallest_dt``, the smallest sample period that fits when it lies in ``DT`` (else
+    ``None``, and ``longest_s``, the longest motion the largest period serves, with the tool
+    limits given, ``fields``, among what makes the motion this slow): no period beyond its own
+    range is ever advised."""
     needed = _round_up(duration / (max_samples - 2))
-    if needed <= DT.high:
-        return f"{given}: use output.dt >= {needed:g} s"
-    slowing = [f"timing.limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None]
-    slowing += ["the velocity and acceleration limits (timing.limits and their scales)"]
-    return (
-        f"{given}, and even the largest output.dt ({DT.high:g} s) serves at most {_round_down(DT.high * (max_samples - 2)):g} s "
-        f"of motion: the limits make this motion too slow to serve; raise {' or '.join(slowing)}"
+    return TooLarge(
+        "sampling.dt", dt, math.ceil(duration / dt) + 1, max_samples, "samples", rule="too_many_samples",
+        duration=duration, smallest_dt=needed if needed <= DT.high else None, largest_dt=DT.high,
+        longest_s=_round_down(DT.high * (max_samples - 2)),
+        fields=tuple(f"limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None),
     )
 
 

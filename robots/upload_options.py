@@ -58,8 +58,6 @@ MAX_LIMITS_CHARS = bounded_yaml.MAX_CHARS
 class InvalidUpload(ToptrajError):
     """The options of an upload do not fit its URDF or are malformed."""
 
-    title = "Invalid upload options"
-
 
 @dataclass(frozen=True)
 class UploadOptions:

@@ -1,8 +1,11 @@
 """Errors as ``application/problem+json`` (RFC 9457): one handler per family, an outermost guard
 for the unexpected, an encoder that refuses NaN and infinity, and the OpenAPI declaring all of it.
 
-* ``STATUS`` gives the HTTP status of each error class of the library (``status_of``: its own
-  class or nearest base in the table; the service's own errors carry theirs).
+* ``STATUS`` and ``TITLE`` give the HTTP status and title of each error class of the library
+  (``status_of``, ``title_of``: its own class or nearest base in the table; the service's own
+  errors carry theirs); ``detail`` words an error in the request's vocabulary
+  (``REQUEST_FIELD`` maps the library's fields to the request's; ``service.wordings`` holds one
+  wording per rule). The HTTP answers, jobs, batches and the CLI all use these.
 * ``install_problem_handlers`` routes the error tree (``ToptrajError``), request validation and
   Starlette's HTTP errors (404, 405 with its ``Allow`` header, ...) to problem answers.
 * ``UnexpectedErrors`` (pure ASGI, outermost) answers any other exception with a problem 500
@@ -20,6 +23,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import string
 from collections.abc import Iterable
 from typing import Any
 
@@ -31,10 +35,24 @@ from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
-from planners.errors import BudgetExceeded
+from planners.collision.clearance import PathInCollision
+from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
 from robots import ToptrajError
-from robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
+from robots.errors import (
+    MAX_DETAIL_CHARS,
+    CatalogRobotReadOnly,
+    InvalidLimits,
+    InvalidRobotName,
+    InvalidURDF,
+    RobotConflict,
+    UnknownRobot,
+    UploadStoreFull,
+    UploadStoreUnavailable,
+    excerpt,
+)
+from robots.upload_options import InvalidUpload
 from service.schemas.common import Problem
+from service.wordings import WORDING
 
 PROBLEM_JSON = "application/problem+json"
 logger = logging.getLogger("toptraj")
@@ -62,6 +80,125 @@ STATUS: dict[type[ToptrajError], int] = {
     UploadStoreUnavailable: 503,
     BudgetExceeded: 504,
 }
+
+
+#: Title of the library's errors by class (nearest base, as ``STATUS``).
+TITLE: dict[type[ToptrajError], str] = {
+    ToptrajError: "Unprocessable request",
+    UnknownRobot: "Unknown robot",
+    InvalidURDF: "Invalid URDF",
+    RobotConflict: "Robot name taken",
+    InvalidRobotName: "Invalid robot name",
+    CatalogRobotReadOnly: "Catalog robot cannot be deleted",
+    UploadStoreFull: "Upload store full",
+    UploadStoreUnavailable: "Upload store unavailable",
+    InvalidLimits: "Invalid limits",
+    InvalidUpload: "Invalid upload options",
+    InvalidRequest: "Invalid request",
+    InfeasiblePath: "Path cannot be followed within the limits",
+    PathInCollision: "Path comes too close to an obstacle",
+    TimingFailed: "Timing method failed",
+    OverMemory: "Computation over its memory cap",
+    BudgetExceeded: "Computation over its time budget",
+}
+
+#: The request's field of each of the library's (``InvalidInput.field``); a library field
+#: ``name[i]...`` or ``name.part`` maps by its longest listed prefix (``waypoints[2][4]`` ->
+#: ``path.waypoints[2][4]``).
+REQUEST_FIELD: dict[str, str] = {
+    "method": "timing.method",
+    "constraints": "timing.constraints",
+    "grid.intervals": "timing.grid_points",
+    "duration": "timing.duration",
+    "boundary": "timing.boundary",
+    "boundary.start_velocity": "timing.boundary.start_velocity",
+    "boundary.end_velocity": "timing.boundary.end_velocity",
+    "boundary.start_acceleration": "timing.boundary.start_acceleration",
+    "boundary.end_acceleration": "timing.boundary.end_acceleration",
+    "method.torque_weight": "timing.cost.torque_weight",
+    "law.trapezoid": "timing.trapezoid",
+    "law.blend": "timing.trapezoid.blend",
+    "law.supporting_points": "timing.supporting_points",
+    "law.synchronization": "timing.synchronization",
+    "limits": "timing.limits",
+    "limits.margin": "timing.limit_margin",
+    "tool.frame": "timing.limits.tool_frame",
+    "search": "timing.search",
+    "sampling.dt": "output.dt",
+    "sampling.exact_period": "output.exact_period",
+    "sampling.samples": "output.dt",
+    "waypoints": "path.waypoints",
+    "interpolation": "path.interpolation",
+    "max_deviation": "path.max_deviation",
+    "continuous": "path.continuous",
+    "start": "path.start",
+    "goal": "path.goal",
+    "revolutions": "path.revolutions",
+    "obstacles": "path.obstacles",
+    "clearance": "path.clearance",
+    "frame": "path.frame",
+    "positions": "path.positions",
+    "poses": "path.poses",
+}
+
+
+def request_field(field: str) -> str:
+    """The request's name of the library's ``field`` (``REQUEST_FIELD`` by its longest prefix
+    ending before a ``[`` or ``.``; a field not listed is shown as it is)."""
+    for end in range(len(field), 0, -1):
+        if end < len(field) and field[end] not in "[.":
+            continue
+        head = REQUEST_FIELD.get(field[:end])
+        if head is not None:
+            return head + field[end:]
+    return field
+
+
+class _Words(string.Formatter):
+    """``str.format`` with ``!j`` (join a sequence with ", "), ``!e`` (excerpt) and ``!f`` (a
+    library field as the request's)."""
+
+    def convert_field(self, value, conversion):
+        if conversion == "j":
+            return ", ".join(map(str, value))
+        if conversion == "e":
+            return excerpt(value)
+        if conversion == "f":
+            return request_field(value)
+        return super().convert_field(value, conversion)
+
+
+_WORDS = _Words()
+
+
+def detail(error: ToptrajError) -> str:
+    """``error`` in the request's words: the wording of its rule (``service.wordings``) over its
+    facts, with its ``field`` as the request's; an error without a rule worded here is shown by
+    its own sentence (the service's errors, and the library's that name no request field)."""
+    rule = getattr(error, "rule", None)
+    wording = WORDING.get(rule) if isinstance(rule, str) else None
+    if wording is None:
+        return error.detail
+    facts = dict(vars(error))
+    if isinstance(facts.get("field"), str):
+        facts["field"] = request_field(facts["field"])
+    if isinstance(facts.get("fields"), tuple):
+        facts["fields"] = tuple(request_field(name) for name in facts["fields"])
+    text = wording(facts) if callable(wording) else _WORDS.format(wording, **facts)
+    if len(text) > MAX_DETAIL_CHARS:
+        text = text[: MAX_DETAIL_CHARS - 20] + " ... (detail cut)"
+    return text
+
+
+def title_of(error: ToptrajError) -> str:
+    """The title of ``error``'s answer: ``TITLE`` of its class or nearest base there; an error
+    class of the service itself states its own."""
+    for cls in type(error).__mro__:
+        if cls in TITLE:
+            return TITLE[cls]
+        if cls.__module__.partition(".")[0] == "service" and "title" in vars(cls):
+            return vars(cls)["title"]
+    return TITLE[ToptrajError]
 
 
 def status_of(error: ToptrajError) -> int:
@@ -185,7 +322,7 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
     retry_after = getattr(error, "retry_after", None)
     headers = None if retry_after is None else {"Retry-After": str(retry_after)}
-    return problem(status_of(error), error.title, error.detail, headers, **extra)
+    return problem(status_of(error), title_of(error), detail(error), headers, **extra)
 
 
 def _message(item: dict) -> str:

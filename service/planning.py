@@ -13,7 +13,7 @@ import orjson
 import robots
 from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
 from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
-from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, WrongLength
 from planners.execution.deadline import NO_DEADLINE
 from planners.generators.collocation import FreeMotion
 from planners.generators.search import SearchOptions
@@ -22,7 +22,7 @@ from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from planners.problem.boundary import finite_vector
 from robots import InvalidLimits, UnknownRobot
 from robots.catalog import catalog_robot_built
-from service.errors import non_finite_answer, status_of
+from service.errors import detail, non_finite_answer, status_of, title_of
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
@@ -191,12 +191,12 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
     if spec.kind == "free":
         for name in ("start", "goal"):
             if len(getattr(spec, name)) != robot.dof:
-                raise InvalidRequest(f"path.{name} has {len(getattr(spec, name))} values; {robot.name} has {robot.dof} joints")
+                raise WrongLength(name, getattr(spec, name), len(getattr(spec, name)), robot.dof, robot=robot.name)
         boundary = request.timing.boundary
 
         def velocity(name):
             value = getattr(boundary, name)
-            return None if value is None else finite_vector(value, f"timing.boundary.{name}", robot.dof)
+            return None if value is None else finite_vector(value, f"boundary.{name}", robot.dof)
 
         return FreeMotion(
             start=np.asarray(spec.start, dtype=float),
@@ -207,7 +207,7 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
         )
     if spec.kind == "cartesian":
         if len(spec.start) != robot.dof:
-            raise InvalidRequest(f"path.start has {len(spec.start)} values; {robot.name} has {robot.dof} joints")
+            raise WrongLength("start", spec.start, len(spec.start), robot.dof, robot=robot.name)
         return CartesianLine(
             start=np.asarray(spec.start, dtype=float),
             positions=None if spec.positions is None else np.asarray(spec.positions, dtype=float),
@@ -216,10 +216,7 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
         )
     for index, row in enumerate(spec.waypoints):
         if len(row) != robot.dof:
-            raise InvalidRequest(
-                f"path.waypoints[{index}] has {len(row)} values; {robot.name} has {robot.dof} joints "
-                f"({', '.join(robot.joint_names)})"
-            )
+            raise WrongLength(f"waypoints[{index}]", row, len(row), robot.dof, robot=robot.name, joint_names=robot.joint_names)
     return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous)
 
 
@@ -241,7 +238,7 @@ def compare_request(request: CompareRequest, deadline: Deadline) -> dict:
         except UnknownRobot:
             raise
         except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:
-            results.append({"method": method, "error": {"status": status_of(error), "title": error.title, "detail": error.detail}})
+            results.append({"method": method, "error": {"status": status_of(error), "title": title_of(error), "detail": detail(error)}})
             continue
         body = trajectory_body(result)
         results.append({key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")})

@@ -14,12 +14,13 @@ import pytest
 import uvicorn
 
 import robots
-from planners import Deadline, InvalidRequest, Timing, TimingFailed, WaypointPath, plan
+from planners import Deadline, Timing, TimingFailed, WaypointPath, plan
+from planners.errors import OutOfRange
 from planners.paths.grid import path_grid
 from planners.results import require_finite
 from planners.timing.laws.profiles import quintic_coefficients
 from service.app import create_app
-from service.errors import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
+from service.errors import FiniteJSONResponse, NonFiniteAnswer, detail, non_finite_answer
 from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
 
@@ -86,16 +87,18 @@ def test_the_library_holds_the_same_ranges():
     """``plan`` called without the service checks the ranges too."""
     arm = robots.load("geering_2r")
     path = WaypointPath(np.array([[0.0, 0.0], [1.0, 1.0]]))
-    for timing, dt, words in [
-        (Timing(method="cubic", duration=1e-300), 0.01, "timing.duration = 1e-300"),
-        (Timing(method="trapezoidal", trapezoid_fractions=(5e-324, 0.5)), 0.01, "timing.trapezoid.tau1"),
-        (Timing(method="quintic", start_acceleration=np.array([1e308, 1e308])), 0.01, "timing.boundary.start_acceleration[0]"),
-        (Timing(limit_scales={"torque": 1e-300}), 0.01, "timing.limits.torque_scale"),
-        (Timing(), 5e-324, "output.dt"),
+    for timing, dt, field, words in [
+        (Timing(method="cubic", duration=1e-300), 0.01, "duration", "timing.duration = 1e-300"),
+        (Timing(method="trapezoidal", trapezoid_fractions=(5e-324, 0.5)), 0.01, "law.trapezoid.tau1", "timing.trapezoid.tau1"),
+        (Timing(method="quintic", start_acceleration=np.array([1e308, 1e308])), 0.01, "boundary.start_acceleration[0]",
+         "timing.boundary.start_acceleration[0]"),
+        (Timing(limit_scales={"torque": 1e-300}), 0.01, "limits.torque_scale", "timing.limits.torque_scale"),
+        (Timing(), 5e-324, "sampling.dt", "output.dt"),
     ]:
-        with pytest.raises(InvalidRequest, match="accepted range") as caught:
+        with pytest.raises(OutOfRange) as caught:
             plan(arm, path, timing, dt, Deadline())
-        assert words in caught.value.detail
+        assert caught.value.field == field and not caught.value.low <= abs(caught.value.value) <= caught.value.high
+        assert words in detail(caught.value) and "accepted range" in detail(caught.value)
 
 
 def test_extreme_numbers_inside_the_ranges_plan_or_fail_cleanly(client):

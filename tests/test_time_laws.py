@@ -19,6 +19,7 @@ from planners.timing.laws.profiles import (
     polynomial_derivatives,
     quintic_coefficients,
 )
+from service.errors import detail, status_of
 from tests.conftest import UR5_WAYPOINTS
 
 
@@ -139,8 +140,9 @@ def test_via_points_refuse_the_trapezoid_whatever_the_limits(kinds):
     path = WaypointPath(np.array(UR5_WAYPOINTS), "via")
     with pytest.raises(InvalidRequest) as refused:
         plan(UR5, path, Timing(method="trapezoidal", constraints=kinds))
-    assert refused.value.status == 422
-    assert "'cubic' or 'quintic'" in str(refused.value) and "trapezoidal" in str(refused.value)
+    assert status_of(refused.value) == 422
+    assert (refused.value.field, refused.value.value, refused.value.alternatives) == ("method", "trapezoidal", ("cubic", "quintic"))
+    assert "'cubic' or 'quintic'" in detail(refused.value) and "trapezoidal" in detail(refused.value)
 
 
 def test_single_joint_closed_forms():

@@ -37,8 +37,6 @@ class PathInCollision(InfeasiblePath):
     """The path comes closer to an obstacle than the clearance: ``link``, ``obstacle`` (its
     index in ``path.obstacles``) and ``s`` say where."""
 
-    title = "Path comes too close to an obstacle"
-
     def __init__(self, detail: str, s: float, link: str, obstacle: int):
         super().__init__(detail, s=s)
         self.link = link

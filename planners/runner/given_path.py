@@ -13,7 +13,7 @@ import numpy as np
 
 from planners.checks.gate import TimedStretch, checked, gated
 from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath, InvalidRequest
+from planners.errors import Conflicting, InfeasiblePath, NotServed
 from planners.generators.unsynchronized import unsynchronized_trajectory
 from planners.generators.via_points import via_point_trajectory
 from planners.paths import GeometricPath
@@ -52,11 +52,11 @@ def check_jerk_finite(path: GeometricPath, kinds) -> None:
         return
     s = float(path.breaks[0])
     raise InfeasiblePath(
-        f"the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend), "
-        "so the joint accelerations jump there and no motion that passes it has a finite jerk: use "
-        "interpolation 'spline' with a jerk limit, or leave 'jerk' out of timing.constraints",
+        f"the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend): "
+        "no motion that passes it has a finite jerk",
         s=s,
         limit="jerk",
+        rule="curvature_jump",
     )
 
 
@@ -69,21 +69,16 @@ def moving_velocity(velocity):
 
 def path_boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
     if (timing.start_acceleration is not None or timing.end_acceleration is not None) and not method.takes_acceleration_boundary:
-        raise InvalidRequest(
-            f"timing.boundary accelerations are not used by timing.method {method.name!r}; use quintic"
-        )
+        raise NotServed("boundary", None, method.name, rule="boundary_accelerations_not_used", alternatives=("quintic",))
     if timing.duration is not None and not method.takes_duration:
-        raise InvalidRequest(
-            f"timing.duration is not used by timing.method {method.name!r}, which finds the shortest "
-            "duration itself; leave it out or use a time law"
-        )
-    sd_start = path_speed(path, timing.start_velocity, 0.0, "timing.boundary.start_velocity")
-    sd_end = path_speed(path, timing.end_velocity, 1.0, "timing.boundary.end_velocity")
+        raise NotServed("duration", timing.duration, method.name, rule="duration_not_used")
+    sd_start = path_speed(path, timing.start_velocity, 0.0, "boundary.start_velocity")
+    sd_end = path_speed(path, timing.end_velocity, 1.0, "boundary.end_velocity")
     return Boundary(
         sd_start=sd_start,
         sd_end=sd_end,
-        sdd_start=path_acceleration(path, timing.start_acceleration, sd_start, 0.0, "timing.boundary.start_acceleration"),
-        sdd_end=path_acceleration(path, timing.end_acceleration, sd_end, 1.0, "timing.boundary.end_acceleration"),
+        sdd_start=path_acceleration(path, timing.start_acceleration, sd_start, 0.0, "boundary.start_acceleration"),
+        sdd_end=path_acceleration(path, timing.end_acceleration, sd_end, 1.0, "boundary.end_acceleration"),
     )
 
 
@@ -182,9 +177,9 @@ def timed_path(robot, path, method, timing, kinds, limits, deadline, threshold) 
 def timed_via_points(robot, spec, method, timing, kinds, limits, deadline, threshold) -> Timed:
     """Via points: segments shaped and timed together by the limits."""
     if timing.start_velocity is not None or timing.end_velocity is not None:
-        raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
+        raise Conflicting("boundary", None, ("interpolation",), rule="via_points_from_rest")
     if timing.supporting_points is not None:
-        raise InvalidRequest("via-point segments are polynomials: leave timing.supporting_points out, or use 'spline' or 'linear'")
+        raise Conflicting("law.supporting_points", timing.supporting_points, ("interpolation",), rule="via_points_are_polynomials")
     if "jerk" in kinds and method.name in ("cubic", "quintic"):
         method.refuse_jerk_limit()
     path, result = via_point_trajectory(robot, checked_waypoints(robot, spec), method.name, limits, kinds, timing.duration, deadline)
@@ -198,16 +193,11 @@ def timed_via_points(robot, spec, method, timing, kinds, limits, deadline, thres
 def timed_unsynchronized(robot, spec, method, timing, kinds, limits, deadline, threshold) -> Timed:
     """Every joint at its own full speed to its goal (``timing.synchronization = "none"``)."""
     if not isinstance(spec, WaypointPath) or spec.interpolation == "via" or len(spec.waypoints) != 2:
-        raise InvalidRequest(
-            "timing.synchronization 'none' moves every joint on its own from a start to a goal: give "
-            "exactly 2 waypoints (interpolation 'spline' or 'linear'), or use 'normalized'"
-        )
+        raise Conflicting("law.synchronization", timing.synchronization, ("waypoints",), rule="unsynchronized_needs_two_waypoints")
     boundary = (timing.start_velocity, timing.end_velocity, timing.start_acceleration, timing.end_acceleration)
     if any(value is not None for value in boundary) or limits.tool is not None:
-        raise InvalidRequest(
-            "timing.synchronization 'none' moves every joint from rest to rest on its own: leave "
-            "timing.boundary and the tool-speed limits out, or use 'normalized'"
-        )
+        raise Conflicting("law.synchronization", timing.synchronization, ("boundary", "limits.tool_speed"),
+                          rule="unsynchronized_from_rest")
     if "jerk" in kinds:
         method.refuse_jerk_limit()
     waypoints = checked_waypoints(robot, spec)

@@ -12,7 +12,7 @@ import numpy as np
 from planners.checks.gate import TimedStretch, checked, gated
 from planners.collision import check_clearance
 from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath, InvalidRequest, OverMemory
+from planners.errors import Conflicting, InfeasiblePath, NotServed, OutOfRange, OverMemory
 from planners.execution.deadline import Deadline
 from planners.execution.isolated import LOW_PRIORITY, run_isolated
 from planners.generators.collocation import FreeMotion, collocation_path, optimize_motion
@@ -43,11 +43,9 @@ SEARCH_MEMORY_SLACK = 2**30
 def _free_motion(robot, path_spec, method, timing: Timing, limits, deadline):
     """Path and timing optimized together (``path.kind = "free"`` with ``collocation``)."""
     if not isinstance(path_spec, FreeMotion) or method.name != "collocation":
-        raise InvalidRequest(
-            "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
-        )
+        raise NotServed("method", method.name, method.name, rule="free_path_needs_collocation", alternatives=("collocation", "search"))
     if timing.grid_points is not None and not 4 <= timing.grid_points <= MAX_INTERVALS:
-        raise InvalidRequest(f"timing.grid_points sets the collocation intervals, 4 to {MAX_INTERVALS}; got {timing.grid_points}")
+        raise OutOfRange("grid.intervals", timing.grid_points, 4, MAX_INTERVALS, rule="collocation_intervals")
     if timing.grid_points is not None:
         path_spec = dataclasses.replace(path_spec, intervals=timing.grid_points)
     unlimited = np.full(robot.dof, np.inf)
@@ -160,9 +158,9 @@ def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstac
     (``planners.execution.isolated.LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
     killed when the budget is spent or the caller cancels, its memory gone with it."""
     if not isinstance(spec, FreeMotion):
-        raise InvalidRequest("timing.method 'search' finds the path itself: give a free path (path.kind 'free', start and goal)")
+        raise NotServed("method", "search", "search", rule="search_needs_free_path")
     if moving_velocity(spec.start_velocity) is not None or moving_velocity(spec.end_velocity) is not None or timing.duration is not None:
-        raise InvalidRequest("the search plans the fastest motion from rest to rest: leave timing.boundary and timing.duration out")
+        raise Conflicting("method", "search", ("boundary", "duration"), rule="search_from_rest")
     options = timing.search or DEFAULT_OPTIONS
     if robot.outside_position_limits(spec.start) is None and robot.outside_position_limits(spec.goal) is None:
         need = check_search_memory(robot, spec.start, spec.goal, options, spec.revolutions)
@@ -175,8 +173,8 @@ def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstac
         )
     except OverMemory as error:
         raise OverMemory(
-            f"the search needed more memory than its estimate of {need / 2**30:.3g} GiB allowed ({error.detail}): "
-            "lower timing.search.roadmap_points or neighbors (cells on a lattice)"
+            f"the search needed more memory than its estimate of {need / 2**30:.3g} GiB allowed ({error.detail})",
+            rule="search_over_estimate", estimate=need, cause=error.detail,
         ) from None
 
 

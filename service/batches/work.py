@@ -15,7 +15,7 @@ from planners.execution.deadline import Deadline
 from robots import ToptrajError
 from robots.upload_options import UploadOptions
 from service.batches.lines import problem_body
-from service.errors import status_of, validation_problem
+from service.errors import detail, status_of, title_of, validation_problem
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
@@ -60,7 +60,7 @@ def answer(text: str, budget_s: float) -> tuple[int, bytes]:
     except ToptrajError as error:
         extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
         status = status_of(error)
-        return status, orjson.dumps({"type": "about:blank", "title": error.title, "status": status, "detail": error.detail, **extra})
+        return status, orjson.dumps({"type": "about:blank", "title": title_of(error), "status": status, "detail": detail(error), **extra})
     except Exception as error:  # a solver's own failure: this line's answer, logged
         logger.error("a batch line failed unexpectedly", exc_info=error)
         return 500, problem_body(500, "Internal error", f"an unexpected {type(error).__name__} occurred while planning this line")

@@ -30,7 +30,7 @@ from planners import Deadline
 from planners.errors import BudgetExceeded
 from planners.execution.isolated import run_isolated
 from robots.errors import ToptrajError
-from service.errors import status_of
+from service.errors import detail, status_of, title_of
 from service.jobs import work
 from service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
 from service.jobs.store import JobStore
@@ -68,7 +68,7 @@ def problem_of(error: BaseException) -> dict:
     """The problem+json object of a job's error: a ``ToptrajError`` with its status, title,
     detail and the ``s``, ``joint`` and ``limit`` facts it carries; anything else as a 500."""
     if isinstance(error, ToptrajError):
-        body = {"type": "about:blank", "title": error.title, "status": status_of(error), "detail": error.detail}
+        body = {"type": "about:blank", "title": title_of(error), "status": status_of(error), "detail": detail(error)}
         for key in ("s", "joint", "limit"):
             if getattr(error, key, None) is not None:
                 body[key] = getattr(error, key)
