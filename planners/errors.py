@@ -53,16 +53,12 @@ class NotServed(InvalidRequest):
     """An input ``method`` does not serve (``rule`` says what it needs instead; ``alternatives``
     the methods or settings that do)."""
 
-    rule_of_class = "not_served"
-
     def __init__(self, field: str, value: object, method: str, *, rule: str, alternatives: tuple = (), **facts: Any):
         super().__init__(field, value, method=method, rule=rule, alternatives=tuple(alternatives), **facts)
 
 
 class Conflicting(InvalidRequest):
     """Inputs that cannot be given together (``fields``; ``rule`` says why)."""
-
-    rule_of_class = "conflicting"
 
     def __init__(self, field: str, value: object, fields: tuple[str, ...], *, rule: str, **facts: Any):
         super().__init__(field, value, fields=tuple(fields), rule=rule, **facts)
@@ -87,6 +83,8 @@ class InfeasiblePath(ToptrajError):
         joint: Name of the joint whose limit cannot be met there, if one is to blame.
         limit: The kind of limit that cannot be met ("velocity", "acceleration", "torque",
             "jerk"), when one is to blame.
+        held: A ``planners.diagnostics.HeldLoad`` when holding still there already needs more
+            torque than a joint's limit (gravity and friction), else ``None``.
     """
 
     def __init__(self, detail: str = "", s: float | None = None, joint: str | None = None, limit: str | None = None,

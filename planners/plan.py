@@ -38,6 +38,7 @@ from planners.timing.laws.method import ClassicalMethod
 from planners.timing.phase_plane.method import PhasePlaneMethod
 from planners.trajectory import sample_trajectory
 from robots import JointLimits, Robot
+from robots.notes import Note
 
 MAX_SAMPLES = 200_000
 #: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
@@ -203,11 +204,13 @@ def plan(
             timed = timed_path(robot, path, method, timing, kinds, limits, timing_part.within(0.1, 1.0), threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
     if isinstance(path, BlendedPath) and path.tight_corners:
-        notes.append(
-            f"path.max_deviation = {path.max_deviation:g} is too small to blend the corners at waypoints "
+        notes.append(Note(
+            f"the largest deviation {path.max_deviation:g} is too small to blend the corners at waypoints "
             f"{', '.join(map(str, path.tight_corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
-            "stops there"
-        )
+            "stops there",
+            "corners_not_blended", field="max_deviation", value=path.max_deviation, corners=tuple(path.tight_corners),
+            min_blend=MIN_BLEND,
+        ))
     deadline.check()
     found_clearance = None
     if obstacles:

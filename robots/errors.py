@@ -87,6 +87,8 @@ class InvalidInput(ToptrajError):
         value: What was given (shown only through ``excerpt``).
         rule: The rule it breaks, a short key (``out_of_range``, ``needs_rest``, ...); further
             facts by rule, as keywords.
+
+    ``detail``, when given, is the library's sentence (else one is made from the facts).
     """
 
     field: str
@@ -94,8 +96,8 @@ class InvalidInput(ToptrajError):
     rule: str
     rule_of_class = "invalid_input"
 
-    def __init__(self, field: str, value: object = None, *, rule: str = "", **facts: Any):
-        super().__init__(field=field, value=value, rule=rule or self.rule_of_class, **facts)
+    def __init__(self, field: str, value: object = None, *, rule: str = "", detail: str = "", **facts: Any):
+        super().__init__(detail, field=field, value=value, rule=rule or self.rule_of_class, **facts)
 
     def sentence(self) -> str:
         """``field = value`` and the rule it breaks, with the other facts."""
@@ -108,7 +110,9 @@ class UnknownRobot(ToptrajError):
     catalog's robots: ``known``)."""
 
     def __init__(self, name: str, known: list[str]):
-        super().__init__(f"no robot named {excerpt(name)}; catalog robots: {', '.join(known)}", name=name, known=tuple(known))
+        super().__init__(
+            f"no robot named {excerpt(name)}; catalog robots: {', '.join(known)}", name=name, known=tuple(known), rule="unknown_robot"
+        )
 
 
 class InvalidURDF(ToptrajError):

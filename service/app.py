@@ -16,7 +16,8 @@ from planners.execution.threads import single_blas_thread
 from planners.kinematics.conditioning import frobenius_condition_number
 from service import stopping
 from service.body_limit import BodySizeLimit
-from service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
+from service.errors import UnexpectedErrors, install_problem_handlers
+from service.finite import FiniteJSONResponse
 from service.jobs import JOB_MODULES, job_runner
 from service.routes import batches, health, jobs, trajectories, web
 from service.routes import robots as robot_routes

@@ -1,5 +1,5 @@
-"""Errors as ``application/problem+json`` (RFC 9457): one handler per family, an outermost guard
-for the unexpected, an encoder that refuses NaN and infinity, and the OpenAPI declaring all of it.
+"""Errors as ``application/problem+json`` (RFC 9457): the status, title and words of each
+error, one handler per family and an outermost guard for the unexpected.
 
 * ``STATUS`` and ``TITLE`` give the HTTP status and title of each error class of the library
   (``status_of``, ``title_of``: its own class or nearest base in the table; the service's own
@@ -12,22 +12,16 @@ for the unexpected, an encoder that refuses NaN and infinity, and the OpenAPI de
   and lets the server keep the connection: Starlette's own last-resort handler re-raises after
   answering, and uvicorn then drops the keep-alive connection without ``Connection: close``,
   so a client's next request on it fails.
-* ``FiniteJSONResponse`` refuses NaN and infinity (JSON has no such numbers) with a 422 that
-  says where the answer held one, instead of an encoder crash.
-* ``problem_responses`` and ``declare_problems`` make the OpenAPI say what the service answers:
-  problem+json bodies for 400, 404, 409, 413, 422 and 504, in place of FastAPI's default 422.
+* ``service.finite.FiniteJSONResponse`` refuses NaN and infinity (JSON has no such numbers)
+  with a 422 that says where the answer held one, instead of an encoder crash.
+* ``service.problem_docs`` makes the OpenAPI declare these answers.
 """
 
 from __future__ import annotations
 
-import json
 import logging
-import math
 import string
-from collections.abc import Iterable
-from typing import Any
 
-import numpy as np
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
@@ -50,11 +44,11 @@ from robots.errors import (
     UploadStoreUnavailable,
     excerpt,
 )
+from robots.notes import Note
 from robots.upload_options import InvalidUpload
-from service.schemas.common import Problem
+from service.problem_docs import PROBLEM_JSON, declare_problems
 from service.wordings import WORDING
 
-PROBLEM_JSON = "application/problem+json"
 logger = logging.getLogger("toptraj")
 
 _TITLES = {
@@ -176,15 +170,39 @@ def detail(error: ToptrajError) -> str:
     facts, with its ``field`` as the request's; an error without a rule worded here is shown by
     its own sentence (the service's errors, and the library's that name no request field)."""
     rule = getattr(error, "rule", None)
+    text = _worded(rule, dict(vars(error)), error.detail)
+    held = getattr(error, "held", None)
+    if held is not None:
+        text += (
+            f": holding still at s = {held.s:.4f} needs {held.torque:.4g} N m on joint {held.joint!r}, "
+            f"above its limit of {held.limit:.4g} N m"
+        )
+    return _cut(text)
+
+
+def note_text(note: str) -> str:
+    """A note of an answer (``robots.notes.Note``) in the request's words, as ``detail`` words
+    an error; a plain string as it is."""
+    if not isinstance(note, Note):
+        return note
+    return _worded(note.rule, dict(note.facts), str(note))
+
+
+def _worded(rule: object, facts: dict, sentence: str) -> str:
+    """The wording of ``rule`` over ``facts`` (fields mapped to the request's), or ``sentence``
+    when the rule has none."""
     wording = WORDING.get(rule) if isinstance(rule, str) else None
     if wording is None:
-        return error.detail
-    facts = dict(vars(error))
+        return sentence
     if isinstance(facts.get("field"), str):
         facts["field"] = request_field(facts["field"])
     if isinstance(facts.get("fields"), tuple):
         facts["fields"] = tuple(request_field(name) for name in facts["fields"])
-    text = wording(facts) if callable(wording) else _WORDS.format(wording, **facts)
+    return _cut(wording(facts) if callable(wording) else _WORDS.format(wording, **facts))
+
+
+def _cut(text: str) -> str:
+    """``text`` within ``MAX_DETAIL_CHARS`` (a detail never echoes a large request back)."""
     if len(text) > MAX_DETAIL_CHARS:
         text = text[: MAX_DETAIL_CHARS - 20] + " ... (detail cut)"
     return text
@@ -212,81 +230,11 @@ def status_of(error: ToptrajError) -> int:
     return STATUS[ToptrajError]
 
 
-class NonFiniteAnswer(ToptrajError):
-    """A computed answer holds NaN or infinity, which JSON cannot carry: the request's numbers
-    drove a computation out of the floating-point range."""
+class RequestRefused(ToptrajError):
+    """A request the service refuses by its own rules (a job's kind, a cursor, a budget above the
+    server's cap, a skeleton's configurations), in the service's words."""
 
-    title = "Answer not representable"
-
-
-class FiniteJSONResponse(JSONResponse):
-    """JSON that never carries NaN or infinity: such a number is a ``NonFiniteAnswer`` (422)
-    naming where it is, never invalid JSON and never an encoder crash."""
-
-    def render(self, content: Any) -> bytes:
-        try:
-            return json.dumps(content, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode("utf-8")
-        except ValueError:
-            error = non_finite_answer(content)
-            if error is None:
-                raise
-            raise error from None
-
-
-def non_finite_answer(content: Any) -> NonFiniteAnswer | None:
-    """The ``NonFiniteAnswer`` naming the first NaN or infinity in ``content`` (dicts, lists
-    and numpy arrays), or ``None`` when every number is finite."""
-    where, value = _first_non_finite(content, "")
-    if where is None:
-        return None
-    return NonFiniteAnswer(
-        f"the computed answer holds {value} at {where or 'its top level'}, which JSON cannot "
-        "carry; the request's numbers lie too far apart (durations, limits, boundary states)"
-    )
-
-
-def _first_non_finite(value: Any, where: str) -> tuple[str | None, float | None]:
-    """(place, value) of the first NaN or infinity in ``value`` at ``where``, or (None, None).
-    Strings, integers and ``None`` inside a container are passed over and floats tested in
-    place, without a call each; arrays in one numpy pass."""
-    if isinstance(value, float):
-        return (None, None) if math.isfinite(value) else (where, value)
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind != "f" or np.isfinite(value).all():
-            return None, None
-        bad = np.argwhere(~np.isfinite(value))[0]
-        return where + "".join(f"[{i}]" for i in bad), float(value[tuple(bad)])
-    if isinstance(value, dict):
-        items: Iterable[tuple[Any, Any]] = value.items()
-        dotted = True
-    elif isinstance(value, (list, tuple)):
-        if _all_finite_numbers(value):
-            return None, None
-        items, dotted = enumerate(value), False
-    else:
-        return None, None
-    for key, item in items:
-        if item is None or isinstance(item, (str, int)):
-            continue
-        if isinstance(item, float) and math.isfinite(item):
-            continue
-        place = (f"{where}.{key}" if where else str(key)) if dotted else f"{where}[{key}]"
-        found = _first_non_finite(item, place)
-        if found[0] is not None:
-            return found
-    return None, None
-
-
-def _all_finite_numbers(values: list | tuple) -> bool:
-    """Whether ``values`` is a flat sequence of finite numbers, checked in one numpy pass (a
-    sequence holding anything else is walked item by item instead)."""
-    if not values or not isinstance(values[0], (int, float)):
-        return False
-    try:
-        array = np.asarray(values, dtype=float)
-    except (TypeError, ValueError):
-        return False
-    return array.ndim == 1 and bool(np.isfinite(array).all())
+    title = "Invalid request"
 
 
 def validation_problem(error: ValidationError) -> dict:
@@ -409,65 +357,3 @@ def install_problem_handlers(app: FastAPI) -> None:
     app.add_exception_handler(RequestValidationError, _validation_error)  # type: ignore[arg-type]
     app.add_exception_handler(StarletteHTTPException, _http_error)  # type: ignore[arg-type]
     declare_problems(app)
-
-
-# --- OpenAPI -------------------------------------------------------------------------------
-
-_REF = "#/components/schemas/"
-_DESCRIPTIONS = {
-    400: "The request body cannot be read.",
-    404: "No such resource (e.g. an unknown robot).",
-    409: "The name is taken.",
-    413: "The request body exceeds the size cap.",
-    422: "Malformed or impossible input: a field out of range, wrong lengths, NaN/inf, a path "
-    "that no timing can follow (the detail says where).",
-    503: "The service cannot do this now (e.g. its data directory cannot be written).",
-    504: "The computation ran past its time budget.",
-}
-#: What every operation with a body may answer, whatever it declares (FastAPI itself adds a
-#: 422 to operations with parameters; its content is replaced below).
-_WITH_BODY = (400, 413, 422)
-
-
-def _problem_content() -> dict:
-    return {PROBLEM_JSON: {"schema": {"$ref": _REF + "Problem"}}}
-
-
-def problem_responses(*statuses: int) -> dict[int | str, dict[str, Any]]:
-    """``responses=`` of a route: each status answered with a problem+json body."""
-    return {status: {"description": _DESCRIPTIONS[status], "content": _problem_content()} for status in statuses}
-
-
-def _problem_schemas() -> dict[str, dict]:
-    schema = Problem.model_json_schema(ref_template=_REF + "{model}")
-    definitions = schema.pop("$defs", {})
-    return {"Problem": schema, **definitions}
-
-
-def _declare(openapi: dict) -> dict:
-    components = openapi.setdefault("components", {}).setdefault("schemas", {})
-    components.update(_problem_schemas())
-    for operations in openapi.get("paths", {}).values():
-        for operation in operations.values():
-            if not isinstance(operation, dict) or "responses" not in operation:
-                continue
-            responses = operation["responses"]
-            for status in _WITH_BODY if "requestBody" in operation else ():
-                responses[str(status)] = problem_responses(status)[status]
-            for status, response in responses.items():
-                if status.isdigit() and int(status) >= 400:
-                    response["content"] = _problem_content()
-    for name in ("HTTPValidationError", "ValidationError"):
-        if f'"{_REF}{name}"' not in json.dumps(openapi):
-            components.pop(name, None)
-    return openapi
-
-
-def declare_problems(app: FastAPI) -> None:
-    """Make ``app``'s OpenAPI declare its error answers as problem+json (``Problem``), with
-    FastAPI's default 422 schema replaced."""
-
-    def openapi() -> dict:
-        return _declare(FastAPI.openapi(app))
-
-    app.openapi = openapi  # type: ignore[method-assign]  # FastAPI's way to extend its schema

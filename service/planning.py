@@ -22,7 +22,8 @@ from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
 from planners.problem.boundary import finite_vector
 from robots import InvalidLimits, UnknownRobot
 from robots.catalog import catalog_robot_built
-from service.errors import detail, non_finite_answer, status_of, title_of
+from service.errors import detail, note_text, status_of, title_of
+from service.finite import non_finite_answer
 from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
 from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
@@ -291,7 +292,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         "solver": result.solver,
         "switching_times": result.switching_times,
         "solve_ms": result.solve_ms,
-        "warnings": list(result.warnings),
+        "warnings": [note_text(note) for note in result.warnings],
         "min_clearance": None if result.clearance is None else {
             "distance": result.clearance.distance,
             "link": result.clearance.link,
@@ -309,7 +310,7 @@ def accuracy_body(result: PlannedTrajectory) -> dict:
     accuracy = result.accuracy
     if accuracy is None:
         return {"relative_gap": None, "basis": f"not estimated for timing.method {result.method}"}
-    return {"relative_gap": accuracy.relative_gap, "basis": accuracy.basis}
+    return {"relative_gap": accuracy.relative_gap, "basis": note_text(accuracy.basis)}
 
 
 def _plain(value):

@@ -9,6 +9,7 @@ to the request's; or a function of the facts for what a template cannot say.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from robots.ranges import Range
@@ -78,6 +79,121 @@ def _needs_two_waypoints(facts: dict) -> str:
     )
 
 
+def _where(facts: dict) -> str:
+    """Where along a Cartesian line: the point's field, the next point, how far along."""
+    return (
+        f"{facts['field']} on the way to point {facts['index'] + 1}, {100 * facts['fraction']:.1f} % along "
+        f"(at {facts['position']} m)"
+    )
+
+
+def _about(facts: dict) -> str:
+    return f"about {facts['estimate'] / 2**30:.3g} GiB, above the cap of {facts['cap'] / 2**30:.3g} GiB per search"
+
+
+def _lattice_over_memory(facts: dict) -> str:
+    cells = facts["largest"]
+    advice = f"at most {cells} cells per joint are served" if cells is not None else "no lattice fits: use timing.search.graph 'roadmap'"
+    return (
+        f"{facts['field']} gives a lattice of {facts['shape']} grid points on a {facts['dof']}-joint arm, which needs "
+        f"{_about(facts)}; {advice}"
+    )
+
+
+def _roadmap_over_memory(facts: dict) -> str:
+    points, neighbors = facts["points"], facts["neighbors"]
+    served = []
+    if facts["most_points"] is not None:
+        served.append(f"at most {facts['most_points']} roadmap points are served with {neighbors} neighbors")
+    if facts["most_neighbors"] is not None:
+        served.append(f"at most {facts['most_neighbors']} neighbors with {points} roadmap points")
+    return (
+        f"{facts['field']} {points} with neighbors {neighbors} on a {facts['dof']}-joint arm needs {_about(facts)}; "
+        + ("; ".join(served) if served else "lower timing.search.neighbors and roadmap_points")
+    )
+
+
+def _search_incomplete(facts: dict) -> str:
+    smaller = "timing.search.roadmap_points or timing.search.neighbors" if facts["graph"] == "roadmap" else "timing.search.cells"
+    return (
+        f"the search found no grid path within its share of the time budget or its max_expansions "
+        f"({facts['statistics'].expanded} partial paths expanded): give it a larger budget (a job's budget_s), fewer "
+        f"{smaller} or more timing.search.max_expansions"
+    )
+
+
+def _no_grid_path(facts: dict) -> str:
+    stats = facts["statistics"]
+    finer = (
+        "raise timing.search.roadmap_points or timing.search.neighbors (within the memory cap), try another "
+        "timing.search.seed"
+        if facts["graph"] == "roadmap"
+        else "refine timing.search.cells"
+    )
+    below = f" faster than {facts['cap']:.4g} s" if math.isfinite(facts["cap"]) else ""
+    return (
+        f"the search found no grid path from start to goal{below} that keeps the clearance and the limits "
+        f"({stats.grid_points} grid points, {stats.removed_by_obstacles} pieces of path removed by obstacles, "
+        f"{stats.points_blocked} grid points blocked): {finer}, widen timing.search.margin, or move the obstacles"
+    )
+
+
+def _law_acceleration_steps(facts: dict) -> str:
+    where = ", ".join(f"{tau:.4g}" for tau in facts["steps"])
+    return (
+        f"the {facts['law']}'s acceleration jumps at tau = {where} (as a fraction of each stretch's "
+        "duration), so its jerk is infinite there and no duration holds a jerk limit: use quintic, "
+        "cycloidal, trapezoidal with blend 'cycloidal' or jerk_limited, or leave 'jerk' out of "
+        "timing.constraints"
+    )
+
+
+def _path_in_collision(facts: dict) -> str:
+    index, distance = facts["obstacle"], facts["distance"]
+    how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of path.obstacles[{index}]"
+    closest = "" if facts["closest"] is None else f"; the closest approach is {facts['closest'][0]:.4g} m at s = {facts['closest'][1]:.4g}"
+    return (
+        f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): "
+        "move the waypoints away from the obstacle or lower path.clearance"
+    )
+
+
+def _unknown_tool_frame(facts: dict) -> str:
+    frames = facts["allowed"]
+    shown = ", ".join(repr(item) for item in frames[:60]) + (", ..." if len(frames) > 60 else "")
+    return f"{facts['field']} {facts['value'][:100]!r} is not a frame of {facts['robot']}; its frames are {shown}"
+
+
+def _gap_above_target(facts: dict) -> str:
+    gap, intervals, method = facts["gap"], facts["intervals"], facts["method"]
+    figure = f"the duration is within about {100 * gap:.2g} % of the time-optimal one on this grid"
+    within = f"timing.grid_points {facts['wanted']} would bring it within {100 * facts['target']:g} %"
+    phase_plane = "timing.method phase_plane refines its grid where the error lies"
+    if facts["remedy"] == "grid.intervals":
+        if facts["grid_given"]:
+            return f"{figure} (the grid given by timing.grid_points, {intervals} intervals); {within}"
+        return f"{figure} ({intervals} intervals); {within}"
+    if facts["remedy"] == "method" and facts["grid_given"]:
+        return f"{figure} (the grid given by timing.grid_points, {intervals} intervals; {method} serves at most {facts['cap']} on this robot): {phase_plane}"
+    if facts["remedy"] == "method":
+        return f"{figure} (the default grid, {intervals} intervals, refined as far as the limits, the grid cap and the time budget allowed): {phase_plane}"
+    return f"{figure} ({intervals} intervals, refined as far as {method}'s grid cap and the time budget allowed)"
+
+
+def _waypoints_dropped(facts: dict) -> str:
+    repeats = facts["indices"]
+    shown = ", ".join(map(str, repeats[:10])) + (", ..." if len(repeats) > 10 else "")
+    return f"{facts['field']} [{shown}] repeat the waypoint before them and were dropped ({len(repeats)} in all)"
+
+
+def _collocation_gap(facts: dict) -> str:
+    advice = (
+        f": more timing.grid_points (collocation intervals, up to {facts['most_intervals']}) bring it closer"
+        if facts["most_intervals"] is not None else ""
+    )
+    return f"the duration may lie up to {100 * facts['gap']:.2g} % above the optimum ({facts['basis']}){advice}"
+
+
 Wording = str | Callable[[dict], str]
 
 #: Wording by rule.
@@ -86,6 +202,7 @@ WORDING: dict[str, Wording] = {
     "scaled_limit_out_of_range": _scaled_limit,
     "not_numbers": "{field} must be a list of numbers",
     "wrong_length": _wrong_length,
+    "too_large": "{field} asks for {estimate} {unit}; at most {cap} are served",
     "not_one_of": "{field} {value!r} is unknown; use one of {allowed}",
     "deviation_needs_blend": "{field} applies to interpolation 'blend', not {interpolation!r}: leave it out or use 'blend'",
     "not_joint_vectors": "{field} must be a list of joint vectors (a 2-D array)",
@@ -181,5 +298,94 @@ WORDING: dict[str, Wording] = {
         "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
     ),
     "collocation_intervals": "{field} sets the collocation intervals, {low} to {high}; got {value}",
+    "positions_or_poses": "a cartesian path needs exactly one of path.positions and path.poses",
+    "not_cartesian_rows": lambda facts: (
+        f"{facts['field']} must be a list of [{'x, y, z' if facts['width'] == 3 else 'x, y, z, qx, qy, qz, qw'}] rows"
+    ),
+    "not_finite_number": "{field} is not a finite number",
+    "quaternion_not_unit": "{field} has a quaternion of norm {norm:.6g}, not 1",
+    "only_the_start_pose": "{field} holds only the start pose: give at least one more point",
+    "unknown_frame": "{field} {value!r} is not a frame of {robot}",
+    "not_finite_joint_values": "{field} must hold {expected} finite joint values",
+    "outside_joint_limits": "{field} = {value:.6g} is outside the limits of joint {joint_name!r}",
+    "line_too_long": "the line to {field} is {length:.4g} m long: it leaves the workspace of {robot}",
+    "repeated_point": "{field} repeats the previous point",
+    "point_out_of_reach": lambda facts: (
+        f"the line leaves the workspace of {facts['robot']}: no joint solution reaches the point {_where(facts)}"
+    ),
+    "line_crosses_singularity": lambda facts: f"the line crosses a singularity of {facts['robot']} near the point {_where(facts)}",
+    "joint_jump": lambda facts: (
+        f"the line needs a joint jump of {facts['jump']:.3g} rad on joint {facts['joint_name']!r} near the point {_where(facts)}"
+    ),
+    "joint_path_strays": lambda facts: (
+        f"the joint path strays {facts['deviation'] * 1e3:.3g} mm from the line after {facts['field']} "
+        f"(tolerance {facts['tolerance'] * 1e3:g} mm): the line passes too close to a singularity"
+    ),
+    "goal_is_start": "path.start and {field} are the same configuration: there is no motion to search",
+    "goal_is_start_turned": (
+        "{field} is path.start up to whole revolutions of its continuous joints, which path.revolutions "
+        "allows: there is no motion to search; to turn a joint a full revolution, give that goal with "
+        "path.revolutions false"
+    ),
+    "search_cells_length": "{field} has {given} values; give one, or one per joint ({expected})",
+    "search_cells_out_of_range": "{field} must lie in [{low}, {high}], got {value}",
+    "lattice_too_large": lambda facts: (
+        f"{facts['field']} gives a lattice of {facts['estimate']} grid points ({' x '.join(map(str, facts['shape']))}); "
+        f"at most {facts['cap']} are searched: use fewer cells, or timing.search.graph 'roadmap'"
+    ),
+    "unknown_graph": "{field} {value!e} is unknown; use one of {allowed}",
+    "lattice_over_memory": _lattice_over_memory,
+    "roadmap_over_memory": _roadmap_over_memory,
+    "outside_the_joint_limits": "{field} is outside the joint limits",
+    "end_too_close": lambda facts: (
+        f"path.{facts['field']} comes within {facts['distance']:.4g} m of an obstacle (the clearance is {facts['clearance']:g} m): "
+        "move it away from the obstacles or lower path.clearance"
+    ),
+    "max_turn_out_of_range": "{field} must lie in (0, 180) degrees, got {value}",
+    "search_incomplete": _search_incomplete,
+    "no_grid_path": _no_grid_path,
+    "frame_without_speed": "{field} is given without timing.limits.tool_speed or tool_angular_speed",
+    "unknown_tool_frame": _unknown_tool_frame,
+    "jerk_limited_needs_jerk": "timing.method 'jerk_limited' needs the jerk constraint",
+    "jerk_limited_from_zero_acceleration": "timing.method 'jerk_limited' starts and ends with zero acceleration",
+    "law_acceleration_steps": _law_acceleration_steps,
+    "law_from_rest_only": "timing.method {method!r} starts and ends at rest; use cubic or quintic for non-zero boundary velocities",
+    "law_unbounded": "no requested limit bounds the {law} law's speed: add a velocity or acceleration limit",
+    "orientation_not_unit": (
+        "{field} has norm {norm:.6g}; a box's orientation is a unit quaternion "
+        "[qx, qy, qz, qw] (norm 1 within 1e-3), e.g. [0, 0, 0, 1] for a box along the world's axes"
+    ),
+    "path_in_collision": _path_in_collision,
+    "jerk_program_unsolved": (
+        "the jerk-limited timing's linear program ended without a solution (HiGHS: {solver_status}); "
+        "try other timing.grid_points"
+    ),
+    "limit_not_positive": "{field} must be positive, got {value}",
+    "scale_not_positive": "{field} must be positive and finite, got {value}",
+    "unknown_robot": "no robot named {name!e}; catalog robots: {known!j}; uploaded robots are listed by GET /v1/robots",
+    # notes of an answer
+    "gap_above_target": _gap_above_target,
+    "duration_given": "not estimated: timing.duration sets the duration, which is no optimum",
+    "not_estimated": "not estimated for timing.method {method}",
+    "waypoints_dropped": _waypoints_dropped,
+    "turned_the_short_way": lambda facts: (
+        f"{facts['field']} 'shortest': continuous joint(s) {', '.join(map(repr, facts['joints']))} turn the short "
+        "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"
+    ),
+    "turns_the_long_way": lambda facts: (
+        f"continuous joint {facts['joint_name']!r} turns {facts['turn']:+.4g} rad from "
+        f"{facts['field']} to [{facts['index'] + 1}], more than pi: the other way round is shorter; "
+        "path.continuous = 'shortest' takes it"
+    ),
+    "corners_not_blended": lambda facts: (
+        f"{facts['field']} = {facts['value']:g} is too small to blend the corners at waypoints "
+        f"{', '.join(map(str, facts['corners']))} (a blend shorter than {facts['min_blend']:g} of the path): the motion "
+        "stops there"
+    ),
+    "collocation_gap": _collocation_gap,
+    "urdf_limit_out_of_range": (
+        "{where}: {kind} limit {value:g} {unit} in the URDF is outside the accepted range "
+        "[{low:g}, {high:g}] (the range of every {kind} limit, a request's timing.limits too)"
+    ),
     "all_waypoints_coincide": "path.waypoints[0] and path.waypoints[1] coincide, as do all {count} waypoints: there is nothing to move",
 }

@@ -20,7 +20,8 @@ from planners.paths.grid import path_grid
 from planners.results import require_finite
 from planners.timing.laws.profiles import quintic_coefficients
 from service.app import create_app
-from service.errors import FiniteJSONResponse, NonFiniteAnswer, detail, non_finite_answer
+from service.errors import detail
+from service.finite import FiniteJSONResponse, NonFiniteAnswer, non_finite_answer
 from service.settings import Settings
 from tests.conftest import UR5_WAYPOINTS
 

@@ -128,8 +128,9 @@ def test_laws_with_acceleration_steps_refuse_a_jerk_limit(law, steps, interpolat
     path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
     with pytest.raises(InfeasiblePath) as refused:
         plan(UR5, path, Timing(method=law, constraints=("velocity", "acceleration", "jerk")))
-    assert refused.value.limit == "jerk"
-    assert "quintic" in str(refused.value)
+    assert (refused.value.limit, refused.value.rule) == ("jerk", "law_acceleration_steps")
+    assert refused.value.steps == pytest.approx(ClassicalMethod(PROFILES[law]()).profile.acceleration_steps())
+    assert "quintic" in detail(refused.value)
     assert ClassicalMethod(PROFILES[law]()).profile.acceleration_steps() == pytest.approx(steps)
 
 

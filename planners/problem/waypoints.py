@@ -16,6 +16,7 @@ from planners.paths.cartesian import CartesianLine, cartesian_path
 from planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
 from planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
 from robots import Robot
+from robots.notes import Note
 
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath, "blend": BlendedPath}
 MAX_WAYPOINTS = 1_000
@@ -71,7 +72,10 @@ def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
     if repeats.size == len(waypoints) - 1:
         raise InvalidRequest("waypoints", waypoints, rule="all_waypoints_coincide", count=len(waypoints))
     shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
-    note = f"path.waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)"
+    note = Note(
+        f"waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)",
+        "waypoints_dropped", field="waypoints", indices=tuple(int(i) for i in repeats),
+    )
     return dataclasses.replace(spec, waypoints=np.delete(waypoints, repeats, axis=0)), (note,)
 
 
@@ -102,9 +106,10 @@ def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tu
         shifted = waypoints.copy()
         shifted[:, mask] = waypoints[0, mask] + np.vstack([np.zeros(mask.sum()), np.cumsum(wrapped, axis=0)])
         moved = [robot.joint_names[j] for j, m in zip(np.flatnonzero(mask), (wrapped != steps).any(axis=0)) if m]
-        note = (
-            f"path.continuous 'shortest': continuous joint(s) {', '.join(map(repr, moved))} turn the short "
-            "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"
+        note = Note(
+            f"continuous joint(s) {', '.join(map(repr, moved))} turn the short way; their waypoints after "
+            "the first are reached as equivalent angles (whole turns apart)",
+            "turned_the_short_way", field="continuous", joints=tuple(moved),
         )
         return dataclasses.replace(spec, waypoints=shifted), (note,)
     index, column = np.nonzero(np.abs(steps) > np.pi)
@@ -115,9 +120,12 @@ def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tu
     for i, c in zip(index, column):
         seen.setdefault(joints[int(c)], int(i))
     notes = tuple(
-        f"continuous joint {robot.joint_names[j]!r} turns {steps[i][joints.index(j)]:+.4g} rad from "
-        f"path.waypoints[{i}] to [{i + 1}], more than pi: the other way round is shorter; "
-        "path.continuous = 'shortest' takes it"
+        Note(
+            f"continuous joint {robot.joint_names[j]!r} turns {steps[i][joints.index(j)]:+.4g} rad from "
+            f"waypoint {i} to {i + 1}, more than pi: the other way round is shorter",
+            "turns_the_long_way", field=f"waypoints[{i}]", joint_name=robot.joint_names[j],
+            turn=float(steps[i][joints.index(j)]), index=i,
+        )
         for j, i in seen.items()
     )
     return spec, notes

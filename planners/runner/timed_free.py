@@ -30,6 +30,7 @@ from planners.runner.given_path import Timed, moving_velocity, path_boundary, ti
 from planners.timing.base import GAP_TARGET
 from planners.timing.min_cost import MinCostMethod
 from planners.timing.phase_plane.method import PhasePlaneMethod
+from robots.notes import Note
 
 #: Most collocation intervals a request may ask for (timing.grid_points).
 MAX_INTERVALS = 100
@@ -105,13 +106,13 @@ def timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thre
         solver = {**solver, **_solver_report(winner), "switching": "refined" if switching is not None else "read off the samples"}
     solver = {**solver, "optimality_gap": source.optimality_gap, "gap_basis": source.gap_basis}
     if timing.torque_weight == 0.0 and source.optimality_gap is not None and source.optimality_gap > GAP_TARGET:
-        advice = (
-            f": more timing.grid_points (collocation intervals, up to {MAX_INTERVALS}) bring it closer"
-            if len(collocation.t) - 1 < MAX_INTERVALS else ""
-        )
         notes = (
             *notes,
-            f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis}){advice}",
+            Note(
+                f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis})",
+                "collocation_gap", gap=source.optimality_gap, basis=source.gap_basis,
+                most_intervals=MAX_INTERVALS if len(collocation.t) - 1 < MAX_INTERVALS else None,
+            ),
         )
     cost = getattr(result, "cost", None) if timing.torque_weight else result.duration
     return Timed(

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from planners.constraints.path_constraints import PathConstraints
-from planners.errors import InvalidRequest
+from planners.errors import NotServed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
 
@@ -23,4 +23,5 @@ class CollocationMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> PathTiming:
-        raise InvalidRequest("collocation optimizes the path itself: give a free path (start and goal)")
+        raise NotServed("method", "collocation", "collocation", rule="collocation_needs_free_path",
+                        detail="collocation optimizes the path itself: give a free path (start and goal)")

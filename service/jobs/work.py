@@ -18,9 +18,9 @@ import orjson
 
 import robots
 from planners import Deadline
-from planners.errors import InvalidRequest
 from planners.execution.deadline import Progress
 from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from service.errors import RequestRefused
 from service.planning import compare_request, encode_json, plan_request, render
 from service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
@@ -138,7 +138,7 @@ def compute(kind: str, request: str, budget_s: float, setup: WorkerSetup, progre
             ``InfeasiblePath``, ``BudgetExceeded``).
     """
     if kind not in KINDS:
-        raise InvalidRequest(f"unknown job kind {kind!r}; known: {', '.join(KINDS)}")
+        raise RequestRefused(f"unknown job kind {kind!r}; known: {', '.join(KINDS)}")
     robots.configure_uploads(
         setup.data_dir,
         max_uploads=setup.max_uploads,

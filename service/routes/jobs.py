@@ -14,11 +14,11 @@ from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 import robots
-from planners.errors import InvalidRequest
 from robots.errors import ToptrajError, excerpt
-from service.errors import PROBLEM_JSON, problem_responses
+from service.errors import RequestRefused
 from service.jobs.records import Job, JobEnded
 from service.jobs.store import JobStore
+from service.problem_docs import PROBLEM_JSON, problem_responses
 from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
 
 router = APIRouter(prefix="/v1/jobs", tags=["jobs"])
@@ -161,7 +161,7 @@ async def create_job(body: Annotated[JobCreate, Body(openapi_examples=EXAMPLES)]
     settings = request.app.state.settings
     budget_s = min(settings.job_budget_s, settings.job_max_budget_s) if body.budget_s is None else body.budget_s
     if budget_s > settings.job_max_budget_s:
-        raise InvalidRequest(
+        raise RequestRefused(
             f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= "
             f"{settings.job_max_budget_s:g} (setting TOPTRAJ_JOB_MAX_BUDGET_S)"
         )
@@ -184,7 +184,7 @@ def list_jobs(
     before = None
     if cursor is not None:
         if not cursor.isdigit():
-            raise InvalidRequest(f"cursor {excerpt(cursor)} is not a next_cursor of GET /v1/jobs")
+            raise RequestRefused(f"cursor {excerpt(cursor)} is not a next_cursor of GET /v1/jobs")
         before = int(cursor)
     jobs = _store(request).jobs(limit + 1, before, status)
     page = jobs[:limit]

@@ -12,7 +12,7 @@ import numpy as np
 
 from planners.collision import Obstacle
 from planners.constraints.path_constraints import PathConstraints
-from planners.errors import InvalidRequest
+from planners.errors import NotServed
 from planners.execution.deadline import NO_DEADLINE, Deadline
 from planners.generators.search.branch_and_bound import branch_and_bound
 from planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
@@ -45,7 +45,7 @@ class SearchMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> PathTiming:
-        raise InvalidRequest("search finds the path itself: give a free path (start and goal)")
+        raise NotServed("method", "search", "search", rule="search_needs_free_path")
 
 
 @dataclass(frozen=True)
