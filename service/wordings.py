@@ -363,6 +363,12 @@ WORDING: dict[str, Wording] = {
     "limit_not_positive": "{field} must be positive, got {value}",
     "scale_not_positive": "{field} must be positive and finite, got {value}",
     "unknown_robot": "no robot named {name!e}; catalog robots: {known!j}; uploaded robots are listed by GET /v1/robots",
+    "name_taken": "name {name!e} already holds a different {what}; choose another name, or DELETE /v1/robots/{{name}} first",
+    "store_full": (
+        "the upload store holds {count} uploads and {size} bytes; its caps are {max_uploads} uploads and "
+        "{max_bytes} bytes, and this upload adds {added} bytes. Free space with DELETE /v1/robots/{{name}} "
+        "(GET /v1/robots lists the uploads)."
+    ),
     # notes of an answer
     "gap_above_target": _gap_above_target,
     "duration_given": "not estimated: timing.duration sets the duration, which is no optimum",
