@@ -92,6 +92,16 @@ class InfeasiblePath(ToptrajError):
         super().__init__(detail, s=s, joint=joint, limit=limit, **facts)
 
 
+class LimitExceeded(InfeasiblePath):
+    """A timing that still exceeds a limit by the factor ``ratio`` (> 1) at ``s`` after the
+    gate's rounds of refinement (``planners.checks.gate``)."""
+
+
+class OutsideJointRange(InfeasiblePath):
+    """The interpolated path leaves the range [``lower``, ``upper``] of ``joint`` at ``s``,
+    where the joint's coordinate is ``value``."""
+
+
 class TimingFailed(ToptrajError):
     """A timing method's solver failed on a problem that is feasible at its grid points
     (``method``, when known; ``solver_status``: the solver's own word)."""

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import ast
 import pathlib
+import pickle
 import subprocess
 import sys
 
@@ -21,22 +22,28 @@ import pytest
 
 import robots
 from planners import Deadline, Timing, WaypointPath, plan
+from planners.checks.gate import limit_exceeded
+from planners.checks.limit_check import Excess
 from planners.errors import (
     BudgetExceeded,
     Conflicting,
     InfeasiblePath,
     InvalidRequest,
+    LimitExceeded,
     NotOneOf,
     NotServed,
     OutOfRange,
+    OutsideJointRange,
     TooLarge,
     WrongLength,
 )
+from planners.paths import SplinePath
 from planners.paths.grid import MAX_POINTS
 from planners.problem.ranges import DT, SCALE
 from planners.timing import METHODS
 from robots.errors import InvalidInput, ToptrajError, UnknownRobot
-from service.errors import REQUEST_FIELD, STATUS, detail, request_field, status_of
+from robots.notes import Note
+from service.errors import REQUEST_FIELD, STATUS, detail, note_text, request_field, status_of
 from service.wordings import WORDING
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -247,3 +254,27 @@ def test_the_library_holds_no_request_vocabulary_and_no_status():
     ).stdout
     assert "\n0 strings naming a request field" in "\n" + output, output
     assert "0 HTTP statuses" in output, output
+
+
+def test_a_spline_leaving_the_joint_range_says_where_and_by_how_much():
+    waypoints = np.array([[0, 0, 0, 0, 0, 0], [0, 0, 3.1, 0, 0, 0], [0, 0, 3.14, 0, 0, 0], [0, 0, 0, 0, 0, 0]], dtype=float)
+    error = _refused(WaypointPath(waypoints), Timing())
+    assert isinstance(error, OutsideJointRange) and isinstance(error, InfeasiblePath)
+    assert error.joint == "elbow_joint" and 0.0 < error.s < 1.0
+    assert (error.lower, error.upper) == pytest.approx((-np.pi, np.pi))
+    assert not error.lower <= error.value <= error.upper
+
+
+def test_limit_exceeded_carries_the_ratio():
+    excess = Excess(ratio=1.0123, kind="acceleration", joint=2, s=0.25)
+    error = limit_exceeded("toppra", excess, UR5, SplinePath(np.array([START, START + 0.4])))
+    assert isinstance(error, LimitExceeded) and isinstance(error, InfeasiblePath)
+    assert (error.ratio, error.joint, error.limit, error.method) == (1.0123, "elbow_joint", "acceleration", "toppra")
+    assert "by 1.23 %" in detail(error)
+
+
+def test_a_note_crosses_processes_with_its_facts():
+    note = Note("waypoints [2] repeat the waypoint before them", "waypoints_dropped", field="waypoints", indices=(2,))
+    copy = pickle.loads(pickle.dumps(note))
+    assert (str(copy), copy.rule, copy.facts) == (str(note), "waypoints_dropped", {"field": "waypoints", "indices": (2,)})
+    assert note_text(copy) == "path.waypoints [2] repeat the waypoint before them and were dropped (1 in all)"

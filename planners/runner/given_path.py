@@ -13,7 +13,7 @@ import numpy as np
 
 from planners.checks.gate import TimedStretch, checked, gated
 from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import Conflicting, InfeasiblePath, NotServed
+from planners.errors import Conflicting, InfeasiblePath, NotServed, OutsideJointRange
 from planners.generators.unsynchronized import unsynchronized_trajectory
 from planners.generators.via_points import via_point_trajectory
 from planners.paths import GeometricPath
@@ -35,12 +35,15 @@ def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -
     outside = path.outside_range(lower, upper, 4 * len(s) + 1)
     if outside is not None:
         at, joint, value = outside
-        raise InfeasiblePath(
+        raise OutsideJointRange(
             f"the interpolated path leaves the range [{lower[joint]:.6g}, {upper[joint]:.6g}] of joint "
             f"{robot.joint_names[joint]!r} at s = {at:.4f} (q = {value:.6g}); "
             "add waypoints or use interpolation 'linear'",
             s=at,
             joint=robot.joint_names[joint],
+            value=float(value),
+            lower=float(lower[joint]),
+            upper=float(upper[joint]),
         )
 
 
