@@ -47,18 +47,22 @@ WORKDIR /app
 COPY requirements.lock ./
 RUN pip install --require-hashes -r requirements.lock
 
-# The code (and tests/), then the package itself without touching the dependencies.
+# The code (and tests/), the documentation site served at /guide/ (built from docs/ into
+# service/web/guide, shipped with the package), then the package itself without touching the
+# dependencies.
 COPY . .
-RUN pip install --no-deps . \
+RUN NO_MKDOCS_2_WARNING=1 python -m mkdocs build --strict --quiet -d service/web/guide \
+    && pip install --no-deps . \
     && pip check \
     && rm -rf build ./*.egg-info
 
 USER 10001:10001
 
-# The compiled kernels (numba) in the image: two server processes compiling them at start took
-# 88 s before /health answered; with the cache in the image, seconds. (-P: the installed
-# package, which the server imports, not /app: numba keys its cache by source file.)
-RUN python -P -c "from service.app import _warm_up; _warm_up()"
+# The compiled kernels (numba) in the image, a line per step: two server processes compiling
+# them at start took 88 s before /health answered; with the cache in the image, seconds. (-P:
+# the installed package, which the server imports, not /app: numba keys its cache by source
+# file.)
+RUN python -P -m toptraj.service.warmup
 
 EXPOSE 8000
 

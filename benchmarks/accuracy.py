@@ -27,18 +27,18 @@ import time
 
 import numpy as np
 
-import robots
 from benchmarks.converged import converged_duration as converged_spline
 from benchmarks.converged import random_path
-from planners import Timing, WaypointPath, plan
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.kinematics.ik import frame_pose
-from planners.paths import SplinePath
-from planners.paths.cartesian import CartesianLine
-from planners.paths.grid import MAX_POINTS, path_grid
-from planners.runner.accuracy import GAP_TARGET
-from planners.timing.toppra_method import ToppraMethod
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.kinematics.ik import frame_pose
+from toptraj.planners.paths import SplinePath
+from toptraj.planners.paths.cartesian import CartesianLine
+from toptraj.planners.paths.grid import MAX_POINTS, path_grid
+from toptraj.planners.runner.accuracy import GAP_TARGET
+from toptraj.planners.timing.toppra_method import ToppraMethod
 
 KINDS = ("velocity", "acceleration", "torque")
 UR5_START = np.array([0.3, -1.6, 1.7, -1.6, -1.57, 0.2])

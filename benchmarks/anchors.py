@@ -15,9 +15,9 @@ import re
 import numpy as np
 import pinocchio as pin
 
-import robots
-from planners.errors import TimingFailed
-from planners.paths.grid import path_grid
+from toptraj import robots
+from toptraj.planners.errors import TimingFailed
+from toptraj.planners.paths.grid import path_grid
 
 
 def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100) -> float:
@@ -129,7 +129,7 @@ def drake_plant(robot):
         from pydrake.multibody.plant import MultibodyPlant
     except ImportError:
         return None
-    from robots.catalog import EXAMPLE_ARMS, example_urdf_path
+    from toptraj.robots.catalog import EXAMPLE_ARMS, example_urdf_path
 
     with open(example_urdf_path(EXAMPLE_ARMS[robot.name].loader)) as handle:
         text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)

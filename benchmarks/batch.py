@@ -24,10 +24,10 @@ import orjson
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import robots  # noqa: E402
-from service.batches import run_batch  # noqa: E402
-from service.planning import plan_request, render  # noqa: E402
-from service.schemas.trajectories import TrajectoryRequest  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.service.batches import run_batch  # noqa: E402
+from toptraj.service.planning import plan_request, render  # noqa: E402
+from toptraj.service.schemas.trajectories import TrajectoryRequest  # noqa: E402
 
 
 def requests(count: int, seed: int = 2026) -> list[str]:

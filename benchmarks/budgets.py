@@ -74,7 +74,7 @@ class Server:
             probe.bind(("127.0.0.1", 0))
             self.port = probe.getsockname()[1]
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--workers", "1"],
+            [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(self.port), "--workers", "1"],
             cwd=ROOT,
             env={**os.environ, **env},
             stdout=subprocess.DEVNULL,
@@ -158,7 +158,7 @@ def idle_after_504(budget_s: float) -> None:
 
 _PEAK = """
 import resource, sys, numpy as np, robots
-from planners import plan, Timing, WaypointPath
+from toptraj.planners import plan, Timing, WaypointPath
 robot, path = robots.load("ur5"), WaypointPath(np.array({waypoints}))
 plan(robot, path, Timing(method="min_cost", grid_points=100))
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.constraints.path_constraints import build_path_constraints
-from planners.paths import SplinePath
-from planners.paths.grid import path_grid
-from planners.timing import PhasePlaneMethod
-from planners.timing.phase_plane.method import midpoint_duration
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.paths import SplinePath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing import PhasePlaneMethod
+from toptraj.planners.timing.phase_plane.method import midpoint_duration
 
 KINDS = ("velocity", "acceleration", "torque")
 #: Largest disagreement of the two estimates of the converged duration.

@@ -17,7 +17,7 @@ samples every 10 ms. Each round times, in a shuffled order:
   build grid and the points the phase-plane refinement added), in one batched call of
   Pinocchio's ``rneaInParallel`` on one thread (an anchor outside our code: ``Robot.rnea``
   takes toptraj's own compiled pass);
-* **library**: ``planners.plan`` for the request (no HTTP, no JSON);
+* **library**: ``toptraj.planners.plan`` for the request (no HTTP, no JSON);
 * **planning thread**: what a server's planning thread does: the request's schema object to
   JSON bytes (``plan_request``, ``trajectory_body``, ``encode_json``);
 * **HTTP**: ``POST /v1/trajectories`` to ``toptraj serve --workers 1`` over one keep-alive
@@ -60,9 +60,9 @@ sys.path.insert(0, str(ROOT))
 
 from anchors import bare_toppra, drake_solver  # noqa: E402
 
-import robots  # noqa: E402
-from service.planning import encode_json, plan_request, trajectory_body  # noqa: E402
-from service.schemas.trajectories import TrajectoryRequest  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.service.planning import encode_json, plan_request, trajectory_body  # noqa: E402
+from toptraj.service.schemas.trajectories import TrajectoryRequest  # noqa: E402
 
 WAYPOINTS = [
     [0.0, -1.2, 1.0, 0.0, 0.0, 0.0],
@@ -95,16 +95,13 @@ STAGES = (
 
 def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int]:
     """(points of the grids the answer was timed on, points of the grids its constraints were
-    first built on), over its stretches: what ``planners.plan`` times, without the sampling."""
-    from planners.checks.gate import gate_threshold
-    from planners.execution.deadline import NO_DEADLINE
-    from planners.problem.requests import check_constraint_kinds, timing_method
-    from planners.problem.waypoints import make_path
-    from planners.runner.given_path import timed_path
+    first built on), over its stretches: what ``toptraj.planners.plan`` times, without the sampling."""
+    from toptraj.planners.problem.build import build_problem
+    from toptraj.planners.runner.choice import method_for
+    from toptraj.planners.runner.run import _given_path
 
-    method = timing_method(timing)
-    kinds = check_constraint_kinds(timing.constraints, method)
-    timed = timed_path(robot, make_path(robot, path_spec), method, timing, kinds, robot.limits, NO_DEADLINE, gate_threshold(0.0))
+    problem = build_problem(robot, path_spec, method_for(timing, path_spec), timing)
+    timed, _ = _given_path(problem, problem.deadline)
     return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 
@@ -122,7 +119,7 @@ def _free_port() -> int:
 
 def _serve(port: int) -> subprocess.Popen:
     server = subprocess.Popen(
-        [sys.executable, "-m", "service.cli", "serve", "--port", str(port), "--workers", "1"],
+        [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(port), "--workers", "1"],
         cwd=ROOT,
         env={**os.environ, "PYTHONPATH": str(ROOT)},
         stdout=subprocess.DEVNULL,
@@ -195,8 +192,8 @@ def main() -> int:
     waypoints = np.array(WAYPOINTS)
     request = TrajectoryRequest.model_validate(TYPICAL)
     payload = json.dumps(TYPICAL).encode()
-    from planners import plan
-    from service.planning import _path, _timing
+    from toptraj.planners import plan
+    from toptraj.service.planning import _path, _timing
 
     timing, path_spec = _timing(request), _path(request.path, robot, request)
     answer = plan(robot, path_spec, timing, 0.01)

@@ -20,9 +20,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import robots  # noqa: E402
-from planners.generators.collocation import collocation  # noqa: E402
-from planners.generators.collocation.sparse import solve_sparse  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.planners.generators.collocation import collocation  # noqa: E402
+from toptraj.planners.generators.collocation.sparse import solve_sparse  # noqa: E402
 
 MOTIONS = {
     "yamamoto_2r": (np.radians([45.0, -90.0]), np.radians([-90.0, 0.0])),

@@ -6,7 +6,7 @@ mixed types, and the largest text the bounds accept.
 
 Prints one line per case: the status, the time and the start of the detail. Before the bounded
 loader (``robots/bounded_yaml.py``) the depth-8 bomb froze a process for 27 s and the others were
-500s; ``tests/test_hostile_uploads.py`` asserts the statuses.
+500s; ``tests/robots/test_hostile_uploads.py`` asserts the statuses.
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from pathlib import Path
 
 from fastapi.testclient import TestClient
 
-from robots.catalog import example_urdf_path
-from service.app import create_app
-from service.settings import Settings
+from toptraj.robots.catalog import example_urdf_path
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
 
 UR5 = Path(example_urdf_path("ur5")).read_text()
 

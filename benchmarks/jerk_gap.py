@@ -20,14 +20,14 @@ import time
 
 import numpy as np
 
-import robots
-from planners import WaypointPath
-from planners.constraints.path_constraints import build_path_constraints
-from planners.execution.deadline import NO_DEADLINE
-from planners.paths.grid import path_grid
-from planners.problem.waypoints import make_path
-from planners.timing.base import AT_REST
-from planners.timing.jerk.method import JerkLimitedMethod
+from toptraj import robots
+from toptraj.planners import WaypointPath
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.execution.deadline import NO_DEADLINE
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.timing.base import AT_REST
+from toptraj.planners.timing.jerk.method import JerkLimitedMethod
 
 KINDS = ("velocity", "acceleration", "torque", "jerk")
 

@@ -4,7 +4,7 @@ one interleaved run.
 For each of ``--paths`` seeded random spline paths (half ur5, half panda; 2 to 5 waypoints,
 within the joint ranges), with velocity, acceleration and torque limits (the torque scaled down
 until holding the arm still along the path takes 1 / 1.3 of it somewhere, so that it shapes the
-motion), and jerk limits for ``jerk_limited``: both methods time the path through ``planners.plan`` (the library call the
+motion), and jerk limits for ``jerk_limited``: both methods time the path through ``toptraj.planners.plan`` (the library call the
 service makes, limit gate included), alternately, ``--repeats`` times each; the median solve
 time of each is kept. Every answer's limits are recomputed from 1 ms samples (velocity and
 acceleration as returned, torque by RNEA, jerk by finite differences of the accelerations).
@@ -22,10 +22,10 @@ import time
 
 import numpy as np
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.problem.waypoints import make_path
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.problem.waypoints import make_path
 
 JERK_FREE = ("velocity", "acceleration", "torque")
 JERK = (*JERK_FREE, "jerk")

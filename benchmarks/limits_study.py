@@ -18,10 +18,10 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.errors import InfeasiblePath, TimingFailed
-from robots.catalog import robot_from_model
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.robots.catalog import robot_from_model
 
 DATA = Path(__file__).parent.parent / "tests" / "data"
 KINDS = ("velocity", "acceleration", "torque")

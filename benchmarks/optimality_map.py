@@ -4,7 +4,7 @@ motions wins as the shoulder goal phi_b grows, with the elbow free (back to 0 or
     python benchmarks/optimality_map.py --step 0.1 --width 1e-3
 
 Discovers the families from the free-path answers at a few anchor goals
-(``planners.generators.collocation.optimality_map``), prints one row per phi_b (each family's T in s, "-"
+(``toptraj.planners.generators.collocation.optimality_map``), prints one row per phi_b (each family's T in s, "-"
 where it does not exist, and the winner), then the boundaries between winners by bisection.
 """
 
@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-import robots
-from planners.generators.collocation.optimality_map import boundary, discover, key, sweep
+from toptraj import robots
+from toptraj.planners.generators.collocation.optimality_map import boundary, discover, key, sweep
 
 #: The paper's names of the switching structures (u1; u2) for each elbow goal.
 PAPER_TYPES = {

@@ -73,11 +73,11 @@ import numpy as np
 from anchors import drake_plant, drake_runner, toppra_runner
 from converged import CONVERGED, KINDS, converged_duration, random_path
 
-import robots
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.paths.grid import path_grid
-from planners.timing import PhasePlaneMethod, ToppraMethod
+from toptraj import robots
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing import PhasePlaneMethod, ToppraMethod
 
 LADDER = (25, 50, 75, 100, 150, 200, 300, 450, 600, 900, 1200, 1800, 2400, 3600, 5000, 7200, 10000)
 ROBOTS = ("ur5", "panda", "geering_2r", "yamamoto_2r")

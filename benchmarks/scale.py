@@ -43,8 +43,8 @@ def _measure(count: int, repeat: int) -> dict:
     sys.path.insert(0, str(ROOT))
     import numpy as np
 
-    from service.planning import encode_json, plan_request, trajectory_body
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.planning import encode_json, plan_request, trajectory_body
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     def request(rows):
         return TrajectoryRequest.model_validate({
@@ -54,8 +54,8 @@ def _measure(count: int, repeat: int) -> dict:
             "output": {"dt": 0.01},
         })
 
-    from planners.paths import SplinePath
-    from planners.paths.grid import path_grid
+    from toptraj.planners.paths import SplinePath
+    from toptraj.planners.paths.grid import path_grid
 
     encode_json(trajectory_body(plan_request(request(waypoints(4)))))  # imports, numba cache
     baseline = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

@@ -23,12 +23,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import robots  # noqa: E402
-from planners.collision import BoxObstacle, SphereObstacle  # noqa: E402
-from planners.errors import InfeasiblePath  # noqa: E402
-from planners.generators.search.graph import SearchOptions  # noqa: E402
-from planners.generators.search.method import global_search  # noqa: E402
-from planners.generators.search.problem import build_problem  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.planners.collision import BoxObstacle, SphereObstacle  # noqa: E402
+from toptraj.planners.errors import InfeasiblePath  # noqa: E402
+from toptraj.planners.generators.search.graph import SearchOptions  # noqa: E402
+from toptraj.planners.generators.search.method import global_search  # noqa: E402
+from toptraj.planners.generators.search.problem import build_problem  # noqa: E402
 
 KINDS = {
     "geering_2r": ("torque",),
@@ -105,7 +105,7 @@ def main() -> int:
     cases = [case for case in cases if case[0] in args.arms]
     if args.quick:
         cases = [case for case in cases if (case[1].cells or (0,))[0] <= 16 and case[1].roadmap_points <= 100]
-    header = f"{'arm':<11} {'n':>2} {'graph':<8} {'resolution':<11} {'points':>7} {'edges':>7} {'turns':>7} {'pieces':>7} {'build s':>8} {'B&B s':>7} {'expanded':>8}  pruned t1/t2/t3/t4/t_u   best grid s"
+    header = f"{'arm':<11} {'n':>2} {'graph':<8} {'resolution':<11} {'points':>7} {'edges':>7} {'turns':>7} {'pieces':>7} {'build s':>8} {'ms/piece':>8} {'B&B s':>7} {'expanded':>8}  pruned t1/t2/t3/t4/t_u   best grid s"
     print(header)
     for name, options in cases:
         try:
@@ -116,7 +116,7 @@ def main() -> int:
         pruned = "/".join(str(row["pruned"][k]) for k in ("t1", "t2", "t3", "t4", "t_u"))
         print(
             f"{row['arm']:<11} {row['n']:>2} {row['graph']:<8} {row['resolution']:<11} {row['points']:>7} {row['edges']:>7} "
-            f"{row['turns']:>7} {row['pieces']:>7} {row['build_s']:>8.2f} {row['search_s']:>7.2f} {row['expanded']:>8}  "
+            f"{row['turns']:>7} {row['pieces']:>7} {row['build_s']:>8.2f} {1e3 * row['build_s'] / max(row['pieces'], 1):>8.3f} {row['search_s']:>7.2f} {row['expanded']:>8}  "
             f"{pruned:<22} {row['best']:.4f}",
             flush=True,
         )

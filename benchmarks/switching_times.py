@@ -5,9 +5,9 @@ switching times on the Geering arm, switch by switch.
 
 For each type: the caption's switching times of u1 and u2 and T, ours (the answer's
 ``switching_times``, from the bang-bang refinement, in the caption's orientation: a
-time-reversed motion is as fast on this arm, ``planners.generators.collocation.switching.mirrored``), and
+time-reversed motion is as fast on this arm, ``toptraj.planners.generators.collocation.switching.mirrored``), and
 the differences in ms. Type 1 is solved with its structure (Type 2 without u1's last arc),
-seeded by the Type 2 answer, as ``tests/test_switching_times.py`` does: at phi_b = 0.979 the
+seeded by the Type 2 answer, as ``tests/planners/generators/test_switching_times.py`` does: at phi_b = 0.979 the
 answer itself is Type 2. Then the switches read off the collocation's own instants (30
 intervals), without the refinement, against the refined ones of Type 3.
 """
@@ -21,11 +21,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import robots  # noqa: E402
-from planners import Timing, plan  # noqa: E402
-from planners.generators.collocation import FreeMotion  # noqa: E402
-from planners.generators.collocation.collocation import _optimize_motion  # noqa: E402
-from planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.planners import Timing, plan  # noqa: E402
+from toptraj.planners.generators.collocation.collocation import _optimize_motion  # noqa: E402
+from toptraj.planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching  # noqa: E402
+from toptraj.planners.problem.free_motion import FreeMotion  # noqa: E402
 
 
 def answer(arm, phi_b: float, revolutions: bool):

@@ -169,7 +169,7 @@ class Server:
         self.workers = workers
         self.port = _free_port()
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--workers", str(workers)],
+            [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(self.port), "--workers", str(workers)],
             cwd=ROOT,
             env={**os.environ, "PYTHONPATH": ROOT, **env},
             stdout=subprocess.DEVNULL,

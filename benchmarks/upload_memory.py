@@ -1,6 +1,6 @@
 """Memory of a server process over many URDF uploads, and uploads surviving a restart.
 
-Starts ``toptraj serve`` (``python -m service.cli serve``) on a free local port with
+Starts ``toptraj serve`` (``python -m toptraj.service.cli serve``) on a free local port with
 ``TOPTRAJ_DATA_DIR`` set to a fresh temporary directory, uploads ``--uploads`` copies of the UR5
 URDF of example-robot-data, each padded with an XML comment to ``--kib`` KiB and distinct, then
 reads every upload back (``GET /v1/robots/{name}``, which builds its model), and prints the
@@ -67,7 +67,7 @@ def _free_port() -> int:
 def _start(data_dir: Path, port: int) -> subprocess.Popen:
     env = {**os.environ, "TOPTRAJ_DATA_DIR": str(data_dir), "PYTHONPATH": str(REPO)}
     process = subprocess.Popen(
-        [sys.executable, "-m", "service.cli", "serve", "--port", str(port), "--workers", "1"],
+        [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(port), "--workers", "1"],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,

@@ -1,5 +1,5 @@
 """The converged optima of Yamamoto's free path, by a transcription of its own: the references
-of ``tests/test_free_path.py`` and ``tests/test_sparse_collocation.py``.
+of ``tests/planners/generators/test_free_path.py`` and ``tests/planners/generators/test_sparse_collocation.py``.
 
     python benchmarks/yamamoto_reference.py [--intervals 200,400,800,1600]
 
@@ -9,14 +9,14 @@ its torque limits (10 and 5 N m; no other limit), minimizing T (beta = 0) and th
 
 Hermite-Simpson collocation in separated form (Betts, *Practical Methods for Optimal Control*,
 2nd ed., section 4.6.6; Kelly 2017, SIAM Review 59(4), eq. 6.4-6.5), independent of the
-planner's own piecewise-linear-acceleration transcription (``planners.generators.collocation.collocation``):
+planner's own piecewise-linear-acceleration transcription (``toptraj.planners.generators.collocation.collocation``):
 states x = (q, v), x' = f = (v, a), the acceleration a a control at every node and interval
 midpoint, and with h = T / K
 
     x_mid = (x_k + x_k+1) / 2 + h (f_k - f_k+1) / 8,    x_k+1 - x_k = h (f_k + 4 f_mid + f_k+1) / 6;
 
-the torque tau = RNEA(q, v, a) (the robot's model, ``planners.generators.collocation.symbolic_dynamics``,
-checked against Pinocchio in ``tests/test_sparse_collocation.py``) within its limits at every
+the torque tau = RNEA(q, v, a) (the robot's model, ``toptraj.planners.generators.collocation.symbolic_dynamics``,
+checked against Pinocchio in ``tests/planners/generators/test_sparse_collocation.py``) within its limits at every
 node and midpoint, and the cost integrated by Simpson's rule. Solved by IPOPT (CasADi) from the
 straight joint line under a quintic time law. Its error falls as h^4 where the solution is
 smooth (the torques switch, so less at the switches): successive halvings of the grid agree
@@ -45,8 +45,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import robots  # noqa: E402
-from planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function  # noqa: E402
+from toptraj import robots  # noqa: E402
+from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function  # noqa: E402
 
 START = np.radians([45.0, -90.0])
 GOAL = np.radians([-90.0, 0.0])

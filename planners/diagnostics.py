@@ -6,7 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.constraints.path_constraints import PathConstraints
 
 
 class HeldLoad(NamedTuple):

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from robots.errors import InvalidInput, ToptrajError
+from toptraj.robots.errors import InvalidInput, ToptrajError
 
 
 class InvalidRequest(InvalidInput):
@@ -83,7 +83,7 @@ class InfeasiblePath(ToptrajError):
         joint: Name of the joint whose limit cannot be met there, if one is to blame.
         limit: The kind of limit that cannot be met ("velocity", "acceleration", "torque",
             "jerk"), when one is to blame.
-        held: A ``planners.diagnostics.HeldLoad`` when holding still there already needs more
+        held: A ``toptraj.planners.diagnostics.HeldLoad`` when holding still there already needs more
             torque than a joint's limit (gravity and friction), else ``None``.
     """
 
@@ -94,7 +94,7 @@ class InfeasiblePath(ToptrajError):
 
 class LimitExceeded(InfeasiblePath):
     """A timing that still exceeds a limit by the factor ``ratio`` (> 1) at ``s`` after the
-    gate's rounds of refinement (``planners.checks.gate``)."""
+    gate's rounds of refinement (``toptraj.planners.checks.gate``)."""
 
 
 class OutsideJointRange(InfeasiblePath):

@@ -12,33 +12,33 @@ import time
 
 import numpy as np
 
-from planners.checks.gate import TimedStretch, gate_threshold, samples_exceed
-from planners.collision import Obstacle, check_clearance
-from planners.collision.obstacles import check_obstacles
-from planners.constraints.admissible import admissible_set
-from planners.constraints.tool_speed import tool_speed_limit
-from planners.errors import Conflicting, NotServed, OutOfRange, TimingFailed, TooLarge, numerical_breakdown_is_failure
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.collocation import FreeMotion
-from planners.generators.collocation.switching import collocation_switches, switching_times
-from planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
-from planners.paths.blended import MIN_BLEND, BlendedPath
-from planners.paths.cartesian import CartesianLine
-from planners.paths.grid import MAX_POINTS, spread_indices
-from planners.problem.ranges import DT, check_scaled_limits, check_timing
-from planners.problem.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
-from planners.problem.waypoints import continuous_turns, make_path, without_repeats
-from planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
-from planners.runner.accuracy import answer_accuracy
-from planners.runner.given_path import timed_path, timed_unsynchronized, timed_via_points
-from planners.runner.timed_free import timed_free_motion, timed_search
-from planners.timing.base import TimingMethod
-from planners.timing.laws.law_timing import LawTiming
-from planners.timing.laws.method import ClassicalMethod
-from planners.timing.phase_plane.method import PhasePlaneMethod
-from planners.trajectory import sample_trajectory
-from robots import JointLimits, Robot
-from robots.notes import Note
+from toptraj.planners.checks.gate import TimedStretch, gate_threshold, samples_exceed
+from toptraj.planners.collision import Obstacle, check_clearance
+from toptraj.planners.collision.obstacles import check_obstacles
+from toptraj.planners.constraints.admissible import admissible_set
+from toptraj.planners.constraints.tool_speed import tool_speed_limit
+from toptraj.planners.errors import Conflicting, NotServed, OutOfRange, TimingFailed, TooLarge, numerical_breakdown_is_failure
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.collocation import FreeMotion
+from toptraj.planners.generators.collocation.switching import collocation_switches, switching_times
+from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
+from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
+from toptraj.planners.paths.cartesian import CartesianLine
+from toptraj.planners.paths.grid import MAX_POINTS, spread_indices
+from toptraj.planners.problem.ranges import DT, check_scaled_limits, check_timing
+from toptraj.planners.problem.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
+from toptraj.planners.problem.waypoints import continuous_turns, make_path, without_repeats
+from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
+from toptraj.planners.runner.accuracy import answer_accuracy
+from toptraj.planners.runner.given_path import timed_path, timed_unsynchronized, timed_via_points
+from toptraj.planners.runner.timed_free import timed_free_motion, timed_search
+from toptraj.planners.timing.base import TimingMethod
+from toptraj.planners.timing.laws.law_timing import LawTiming
+from toptraj.planners.timing.laws.method import ClassicalMethod
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.planners.trajectory import sample_trajectory
+from toptraj.robots import JointLimits, Robot
+from toptraj.robots.notes import Note
 
 MAX_SAMPLES = 200_000
 #: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
@@ -129,9 +129,9 @@ def plan(
     """Plan the timed trajectory of ``robot`` along ``path_spec``, sampled every ``dt`` seconds
     into at most ``max_samples`` samples. With ``exact_period`` the samples lie on whole periods
     ``dt``, the final state included: the motion is slowed uniformly to end on one
-    (``planners.trajectory.sample_trajectory``); ``duration`` stays the planned (optimal) one
+    (``toptraj.planners.trajectory.sample_trajectory``); ``duration`` stays the planned (optimal) one
     and ``sampled_duration`` is the samples' last instant. With ``obstacles`` (world frame),
-    every link keeps ``clearance`` (m) from them along the path (``planners.collision``), and
+    every link keeps ``clearance`` (m) from them along the path (``toptraj.planners.collision``), and
     the answer carries the smallest distance found.
 
     Every answer holds the requested limits on a dense resampling within ``LIMIT_TOLERANCE``

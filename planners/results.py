@@ -7,12 +7,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from planners.errors import NonFinite
-from planners.timing.base import Binding
-from planners.trajectory import Samples
+from toptraj.planners.errors import NonFinite
+from toptraj.planners.timing.base import Binding
+from toptraj.planners.trajectory import Samples
 
 if TYPE_CHECKING:
-    from planners.collision import Clearance
+    from toptraj.planners.collision import Clearance
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class PhasePlane:
 @dataclass(frozen=True)
 class Conditioning:
     """Frobenius condition number of the end effector's Jacobian along the trajectory
-    (``planners.kinematics.conditioning``), with the characteristic length L in m."""
+    (``toptraj.planners.kinematics.conditioning``), with the characteristic length L in m."""
 
     kappa_min: float
     kappa_max: float
@@ -38,7 +38,7 @@ class Conditioning:
 @dataclass(frozen=True)
 class Accuracy:
     """The answer's estimated relative distance from the converged optimum of its method's
-    problem (``planners.runner.accuracy``): ``relative_gap`` (``None`` when not estimated) and how it
+    problem (``toptraj.planners.runner.accuracy``): ``relative_gap`` (``None`` when not estimated) and how it
     was estimated, or why not (``basis``)."""
 
     relative_gap: float | None

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.paths.base import GeometricPath
-from planners.timing.base import PathTiming
-from robots import Robot
+from toptraj.planners.paths.base import GeometricPath
+from toptraj.planners.timing.base import PathTiming
+from toptraj.robots import Robot
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Robots: the catalog (bundled paper arms, example-robot-data arms), uploads and ``Robot``."""
 
-from robots.catalog import catalog_names
-from robots.errors import (
+from toptraj.robots.catalog import catalog_names
+from toptraj.robots.errors import (
     CatalogRobotReadOnly,
     InvalidLimits,
     InvalidRobotName,
@@ -12,11 +12,11 @@ from robots.errors import (
     UploadStoreFull,
     UploadStoreUnavailable,
 )
-from robots.limits import LIMIT_KINDS, JointLimits, ToolSpeedLimit
-from robots.registry import load
-from robots.robot import Robot
-from robots.store import StoredUpload, UploadStore, default_data_dir
-from robots.uploads import configure_uploads, delete_upload, list_uploads, register_urdf, upload_store
+from toptraj.robots.limits import LIMIT_KINDS, JointLimits, ToolSpeedLimit
+from toptraj.robots.registry import load
+from toptraj.robots.robot import Robot
+from toptraj.robots.store import StoredUpload, UploadStore, default_data_dir
+from toptraj.robots.uploads import configure_uploads, delete_upload, list_uploads, register_urdf, upload_store
 
 __all__ = [
     "LIMIT_KINDS",

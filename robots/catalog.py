@@ -1,5 +1,5 @@
 """The robot catalog: the bundled paper arms and the fixed-base arms of ``example-robot-data``.
-(Uploaded URDFs live in ``robots.uploads``; ``robots.load`` looks in both.)
+(Uploaded URDFs live in ``toptraj.robots.uploads``; ``robots.load`` looks in both.)
 
 Models are built once per process and shared read-only; see ``Robot.data`` for per-thread state.
 """
@@ -13,8 +13,8 @@ from os.path import join
 import numpy as np
 import pinocchio as pin
 
-from robots.limits import limits_with_sources
-from robots.robot import Robot, tangent_position_limits
+from toptraj.robots.limits import limits_with_sources
+from toptraj.robots.robot import Robot, tangent_position_limits
 
 #: Bundled URDFs: name -> end-effector frame.
 BUNDLED = {"geering_2r": "hand", "yamamoto_2r": "tip", "lecture_3r": "hand"}
@@ -117,7 +117,7 @@ def catalog_robot_built(name: str) -> bool:
 def _build(name: str) -> Robot:
     """Build the catalog robot ``name`` from its URDF."""
     if name in BUNDLED:
-        urdf = resources.files("robots").joinpath(f"urdf/{name}.urdf").read_text()
+        urdf = resources.files("toptraj.robots").joinpath(f"urdf/{name}.urdf").read_text()
         return robot_from_model(name, pin.buildModelFromXML(urdf), "bundled", BUNDLED[name])
     arm = EXAMPLE_ARMS[name]
     model = pin.buildModelFromUrdf(example_urdf_path(arm.loader))

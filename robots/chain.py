@@ -1,5 +1,5 @@
 """A robot's kinematic tree as plain arrays, for compiled kinematics and dynamics over many
-configurations (``planners.kinematics.frame_jacobians``, ``robots.chain_dynamics``): each
+configurations (``toptraj.planners.kinematics.frame_jacobians``, ``toptraj.robots.chain_dynamics``): each
 joint's placement in its parent, its axis, whether it turns or slides, which joint coordinate
 moves it, and the inertia of the body it carries; and the rotation about a joint's axis
 (``axis_rotation``, Rodrigues) that both compiled passes compose.

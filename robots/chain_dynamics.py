@@ -1,4 +1,4 @@
-"""Inverse dynamics of a ``robots.chain.Chain`` at many states in one compiled pass: the
+"""Inverse dynamics of a ``toptraj.robots.chain.Chain`` at many states in one compiled pass: the
 recursive Newton-Euler algorithm (Featherstone, *Rigid Body Dynamics Algorithms*, 2008, §5.3,
 Table 5.1) with spatial vectors in each joint's frame, for several sets of joint velocities and
 accelerations that share one configuration, so the joint placements are computed once per
@@ -18,7 +18,7 @@ R^T w), X_j^* moves a force back, (f; n) -> (R f; R n + p x R f), the cross prod
 (v; w) x (u; z) = (w x u + v x z; w x z) and (v; w) x* (f; n) = (w x f; w x n + v x f), and
 the spatial inertia of mass m, centre of mass c and rotational inertia I_c about it maps (v; w)
 to (h; I_c w + c x h) with h = m (v - c x w). Pinocchio's ``rnea`` computes the same sum,
-armature included; the two agree to rounding (``tests/test_chain_dynamics.py``).
+armature included; the two agree to rounding (``tests/robots/test_chain_dynamics.py``).
 
 Shapes: q (n, n_dof) in rad or m; qd, qdd, tau (n_sets, n, n_dof) in rad/s, rad/s^2 and N m
 (m/s, m/s^2 and N for a prismatic joint).
@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from robots.chain import Chain, axis_rotation
+from toptraj.robots.chain import Chain, axis_rotation
 
 
 def chain_rnea(chain: Chain, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
@@ -93,7 +93,7 @@ def _placements(q_row, prismatic, axis, rotation, translation, coordinate, turn,
 @njit(cache=True, nogil=True)
 def rnea_sets(q, qd, qdd, parent, prismatic, axis, rotation, translation, coordinate, mass, lever, inertia, armature, gravity, tau):  # pragma: no cover - compiled
     """The torques of every set at every configuration into ``tau`` (n_sets, n, n_dof); the
-    chain's arrays as ``robots.chain.Chain`` holds them (joints ordered parents first). Leading
+    chain's arrays as ``toptraj.robots.chain.Chain`` holds them (joints ordered parents first). Leading
     sets whose velocities are all zero (the build's g and M q' + g) take Table 5.1 without the
     terms that vanish with v (v_j = 0, a_j = X_j a_k + S qdd_j, f_j = I_j a_j): the same
     numbers with a third of the forward pass's work."""

@@ -132,7 +132,7 @@ def world_capsules(model: pin.Model, data: pin.Data, capsules: list[LinkCapsule]
 def _example_arm_capsules(name: str) -> list[LinkCapsule] | None:
     """Capsules of example-robot-data's arm ``name`` from its collision meshes, in the joints
     of the catalog's model (reduced where the catalog locks joints); None without meshes."""
-    from robots.catalog import EXAMPLE_ARMS, example_urdf_path
+    from toptraj.robots.catalog import EXAMPLE_ARMS, example_urdf_path
 
     arm = EXAMPLE_ARMS[name]
     path = example_urdf_path(arm.loader)

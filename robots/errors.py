@@ -63,7 +63,7 @@ class ToptrajError(Exception):
 
     def __reduce__(self):
         """Pickled with its attributes, without calling ``__init__`` again: an error raised in
-        a worker process (``planners.execution.isolated``) reaches its caller whole, whatever the
+        a worker process (``toptraj.planners.execution.isolated``) reaches its caller whole, whatever the
         subclass's constructor takes (``Exception``'s own pickling calls ``cls(*args)``, which
         fails for a constructor with more required arguments than ``detail``)."""
         return _restore_error, (type(self), self.args, self.__dict__.copy())

@@ -16,8 +16,8 @@ from importlib import resources
 
 import numpy as np
 
-from robots.errors import InvalidLimits
-from robots.ranges import LIMITS, limit_problem
+from toptraj.robots.errors import InvalidLimits
+from toptraj.robots.ranges import LIMITS, limit_problem
 
 #: How a message names each source of a limit.
 _SOURCE_NAMES = {"urdf": "the URDF", "limits.toml": "the service's limits.toml"}
@@ -34,7 +34,7 @@ LIMIT_KINDS = ("position_lower", "position_upper", "velocity", "acceleration", "
 
 @dataclass(frozen=True)
 class ToolSpeedLimit:
-    """Bounds on the speed of one frame of a robot (``planners.constraints.tool_speed``).
+    """Bounds on the speed of one frame of a robot (``toptraj.planners.constraints.tool_speed``).
 
     Attributes:
         frame: The frame's name.
@@ -164,7 +164,7 @@ def limits_with_sources(
     (acceleration / ``seconds_to_full_acceleration``) where nothing gave them.
 
     Every velocity, acceleration, jerk and torque limit, whatever its source, lies in the
-    accepted range of its kind (``robots.ranges``) or is ``inf`` (no limit).
+    accepted range of its kind (``toptraj.robots.ranges``) or is ``inf`` (no limit).
 
     Returns:
         The limits; {kind: one source per joint}, sources being "urdf", "limits.toml",

@@ -10,7 +10,7 @@ from typing import Any
 class Note(str):
     """A note: ``str(note)`` is the library's sentence; ``rule`` names what it reports and
     ``facts`` hold the numbers and names it is about (fields in the library's own names, as
-    ``robots.errors.InvalidInput.field``). A ``str``, so that every reader of notes keeps
+    ``toptraj.robots.errors.InvalidInput.field``). A ``str``, so that every reader of notes keeps
     working."""
 
     rule: str

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from robots.catalog import catalog_names, is_catalog_robot, load_catalog_robot
-from robots.errors import UnknownRobot
-from robots.robot import Robot
-from robots.uploads import load_upload
+from toptraj.robots.catalog import catalog_names, is_catalog_robot, load_catalog_robot
+from toptraj.robots.errors import UnknownRobot
+from toptraj.robots.robot import Robot
+from toptraj.robots.uploads import load_upload
 
 
 def load(name: str) -> Robot:

@@ -15,9 +15,9 @@ from functools import cached_property
 import numpy as np
 import pinocchio as pin
 
-from robots.chain import Chain, chain_of
-from robots.chain_dynamics import chain_rnea
-from robots.limits import JointLimits
+from toptraj.robots.chain import Chain, chain_of
+from toptraj.robots.chain_dynamics import chain_rnea
+from toptraj.robots.limits import JointLimits
 
 
 def _is_continuous(joint) -> bool:
@@ -131,7 +131,7 @@ class Robot:
 
     @cached_property
     def chain(self) -> Chain | None:
-        """The kinematic tree as arrays (``robots.chain``), ``None`` when a joint is neither
+        """The kinematic tree as arrays (``toptraj.robots.chain``), ``None`` when a joint is neither
         revolute nor prismatic."""
         return chain_of(self.model)
 
@@ -181,7 +181,7 @@ class Robot:
     def rnea(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """Inverse dynamics (Pinocchio's RNEA, armature included) for rows of ``q, qd, qdd``
         (each (n_samples, n_dof)); shape (n_samples, n_dof), N m (N). Arms with a ``chain``
-        take the compiled pass of ``robots.chain_dynamics``, the others one batched Pinocchio
+        take the compiled pass of ``toptraj.robots.chain_dynamics``, the others one batched Pinocchio
         call on the calling thread's model pool."""
         qd = np.atleast_2d(qd)
         return self.rnea_sets(q, qd[np.newaxis], np.atleast_2d(qdd)[np.newaxis])[0]

@@ -8,7 +8,7 @@ commit is atomic and durable (write-ahead log), which is what "write a temporary
 ``os.replace``" gives for one file but not for a file plus an index. The text is still content
 addressed: ``urdfs`` holds each distinct text once under its SHA-256, ``robots`` maps names to
 digests, so two names for one text store it once, each with its own options (locked joints,
-joint_limits.yaml: ``robots.upload_options``, as canonical JSON; "" for none). A database
+joint_limits.yaml: ``toptraj.robots.upload_options``, as canonical JSON; "" for none). A database
 written before options existed gets the column on first use, its uploads with no options.
 
 Nothing is cached here: every call opens its own connection, so a process sees what another
@@ -25,7 +25,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from robots.errors import RobotConflict, UploadStoreFull, UploadStoreUnavailable, excerpt
+from toptraj.robots.errors import RobotConflict, UploadStoreFull, UploadStoreUnavailable, excerpt
 
 DEFAULT_MAX_UPLOADS = 1_000
 DEFAULT_MAX_BYTES = 200_000_000
@@ -42,7 +42,7 @@ CREATE TABLE IF NOT EXISTS robots (
     digest TEXT NOT NULL REFERENCES urdfs (digest),
     dof INTEGER NOT NULL,
     created REAL NOT NULL,        -- Unix time, s
-    options TEXT NOT NULL DEFAULT ''  -- robots.upload_options.UploadOptions.to_json()
+    options TEXT NOT NULL DEFAULT ''  -- toptraj.robots.upload_options.UploadOptions.to_json()
 );
 """
 

@@ -20,10 +20,10 @@ MoveIt's ``joint_limits.yaml``.
   notes say so. Position limits stay the URDF's (noted when the file gives them), and
   MoveIt's default scaling factors are not applied (noted): requests scale limits themselves.
 
-The text is read by ``robots.bounded_yaml`` (at most 100,000 characters, 32 levels, 10,000
+The text is read by ``toptraj.robots.bounded_yaml`` (at most 100,000 characters, 32 levels, 10,000
 values with aliases expanded, 1,000 aliases; string keys, each once per mapping), and the same
 structure given as JSON is held to the same depth and count. Every maximum lies in the accepted
-range of its kind (``robots.ranges``: the range of a request's ``timing.limits`` overrides).
+range of its kind (``toptraj.robots.ranges``: the range of a request's ``timing.limits`` overrides).
 
 Options are checked against the URDF's model before anything is stored; a wrong joint name, a
 value outside the joint's range, a limit outside its accepted range or a malformed file is an
@@ -40,9 +40,9 @@ import numpy as np
 import pinocchio as pin
 import yaml
 
-from robots import bounded_yaml
-from robots.errors import ToptrajError, excerpt
-from robots.ranges import limit_problem
+from toptraj.robots import bounded_yaml
+from toptraj.robots.errors import ToptrajError, excerpt
+from toptraj.robots.ranges import limit_problem
 
 #: The keys of a joint's entry in joint_limits.yaml, and the limit kind each maximum sets.
 _MAXIMA = {"max_velocity": "velocity", "max_acceleration": "acceleration", "max_jerk": "jerk", "max_effort": "torque"}
@@ -117,7 +117,7 @@ def _number(value, where: str) -> float:
 
 
 def _check_json_structure(given) -> None:
-    """Hold a joint_limits given as JSON to the bounds of the YAML text (``robots.bounded_yaml``):
+    """Hold a joint_limits given as JSON to the bounds of the YAML text (``toptraj.robots.bounded_yaml``):
     at most ``MAX_DEPTH`` levels and ``MAX_NODES`` values, walked without recursion."""
     stack, count = [(given, 1)], 0
     while stack:
@@ -135,7 +135,7 @@ def _check_json_structure(given) -> None:
 
 
 def _parsed(given):
-    """The structure of a joint_limits text (YAML, read within ``robots.bounded_yaml``'s bounds)
+    """The structure of a joint_limits text (YAML, read within ``toptraj.robots.bounded_yaml``'s bounds)
     or of one given as JSON (held to the same bounds)."""
     if not isinstance(given, str):
         _check_json_structure(given)
@@ -200,7 +200,7 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
 
 def upload_options(locked_joints: dict | None = None, joint_limits=None) -> UploadOptions:
     """Options from an upload request, checked for form (names are checked against the model
-    by ``apply_locks`` and ``robots.limits``).
+    by ``apply_locks`` and ``toptraj.robots.limits``).
 
     Raises:
         InvalidUpload: a non-finite locked value, or a malformed joint_limits.

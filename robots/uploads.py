@@ -1,5 +1,5 @@
-"""Uploaded URDFs: checked at upload (``robots.urdf_check``), kept durably in an ``UploadStore``
-(``robots.store``), and built into ``Robot`` objects on demand, of which a bounded LRU cache keeps
+"""Uploaded URDFs: checked at upload (``toptraj.robots.urdf_check``), kept durably in an ``UploadStore``
+(``toptraj.robots.store``), and built into ``Robot`` objects on demand, of which a bounded LRU cache keeps
 the most recently used. However many uploads the store holds, a process keeps at most
 ``cache_size`` upload models in memory.
 
@@ -19,12 +19,20 @@ import threading
 from collections import OrderedDict
 from pathlib import Path
 
-from robots.catalog import catalog_names, is_catalog_robot, robot_from_model
-from robots.errors import CatalogRobotReadOnly, InvalidLimits, InvalidRobotName, InvalidURDF, RobotConflict, UnknownRobot, excerpt
-from robots.robot import Robot
-from robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, StoredUpload, UploadStore, default_data_dir
-from robots.upload_options import InvalidUpload, UploadOptions, apply_locks, yaml_limit_arrays
-from robots.urdf_check import check_urdf, mesh_count
+from toptraj.robots.catalog import catalog_names, is_catalog_robot, robot_from_model
+from toptraj.robots.errors import (
+    CatalogRobotReadOnly,
+    InvalidLimits,
+    InvalidRobotName,
+    InvalidURDF,
+    RobotConflict,
+    UnknownRobot,
+    excerpt,
+)
+from toptraj.robots.robot import Robot
+from toptraj.robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, StoredUpload, UploadStore, default_data_dir
+from toptraj.robots.upload_options import InvalidUpload, UploadOptions, apply_locks, yaml_limit_arrays
+from toptraj.robots.urdf_check import check_urdf, mesh_count
 
 DEFAULT_CACHE_SIZE = 32
 MAX_NAME_CHARS = 64
@@ -112,7 +120,7 @@ def build_upload(name: str, urdf: str, options: UploadOptions) -> Robot:
     Raises:
         InvalidURDF: the text is not a usable fixed-base arm.
         InvalidUpload: the options do not fit the URDF.
-        InvalidLimits: a limit outside the accepted range of its kind (``robots.ranges``).
+        InvalidLimits: a limit outside the accepted range of its kind (``toptraj.robots.ranges``).
     """
     full = check_urdf(urdf)
     model = apply_locks(full, options.locked_joints)
@@ -168,9 +176,9 @@ def register_urdf(urdf: str, name: str | None = None, options: UploadOptions | N
 
     Raises:
         InvalidRobotName: ``name`` breaks ``NAME_PATTERN``.
-        InvalidURDF: the text is not a usable fixed-base arm (see ``robots.urdf_check``).
-        InvalidUpload: the options do not fit the URDF (``robots.upload_options``).
-        InvalidLimits: a limit outside the accepted range of its kind (``robots.ranges``).
+        InvalidURDF: the text is not a usable fixed-base arm (see ``toptraj.robots.urdf_check``).
+        InvalidUpload: the options do not fit the URDF (``toptraj.robots.upload_options``).
+        InvalidLimits: a limit outside the accepted range of its kind (``toptraj.robots.ranges``).
         RobotConflict: ``name`` is a catalog robot or holds a different upload.
         UploadStoreFull: the store is at its cap of uploads or bytes.
     """

@@ -21,7 +21,7 @@ damping, friction                            0 to 1e6
 ==========================================  =========================================
 
 The effort and velocity bounds are those of every torque and velocity limit, whatever its
-source (``robots.ranges``, the ranges of a request's ``timing.limits`` too); the lower bound of
+source (``toptraj.robots.ranges``, the ranges of a request's ``timing.limits`` too); the lower bound of
 1e-6 refuses limits such as 1e-308 that are positive in name only (no real drive is that weak;
 every duration would overflow). An effort or velocity of 0 is refused as well: the URDF
 specification makes both attributes required limits, not "unlimited". Every ``<inertial>``
@@ -35,7 +35,7 @@ zero moment, the other two equal, ``finger_edu``'s lower link). Once built, the 
 inertia matrix at the zero configuration must be positive definite (condition number at most
 1e10): every moving joint moves some inertia about its axis, which is what the planners need.
 
-At most 1000 links, 1000 joints and 64 moving joints (the tree's checks: ``robots.urdf_tree``);
+At most 1000 links, 1000 joints and 64 moving joints (the tree's checks: ``toptraj.robots.urdf_tree``);
 no ``<!DOCTYPE>`` (entities could make Pinocchio's parser read something else than this check
 did).
 """
@@ -50,9 +50,9 @@ from collections.abc import Iterable
 import numpy as np
 import pinocchio as pin
 
-from robots.errors import InvalidURDF, excerpt
-from robots.ranges import TORQUE, VELOCITY
-from robots.urdf_tree import MOVING_JOINTS, check_structure
+from toptraj.robots.errors import InvalidURDF, excerpt
+from toptraj.robots.ranges import TORQUE, VELOCITY
+from toptraj.robots.urdf_tree import MOVING_JOINTS, check_structure
 
 MAX_OFFSET = 100.0  # m, each coordinate of an origin
 MAX_ANGLE = 100.0  # rad, each angle of an origin's rpy

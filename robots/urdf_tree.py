@@ -1,4 +1,4 @@
-"""The structure of an uploaded URDF (``robots.urdf_check``): one tree of links, each link the
+"""The structure of an uploaded URDF (``toptraj.robots.urdf_check``): one tree of links, each link the
 child of at most one joint, a single root, no cycle, every link and joint named once, only
 revolute, continuous, prismatic and fixed joints, and at most ``MAX_LINKS`` links,
 ``MAX_JOINTS`` joints and ``MAX_MOVING_JOINTS`` moving joints. Each refusal is an
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ElementTree
 
-from robots.errors import InvalidURDF, excerpt
+from toptraj.robots.errors import InvalidURDF, excerpt
 
 MOVING_JOINTS = ("revolute", "continuous", "prismatic")
 MAX_MOVING_JOINTS = 64

@@ -9,21 +9,21 @@ from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners import Timing, WaypointPath, plan
-from planners.execution.isolated import start_worker_server
-from planners.execution.threads import single_blas_thread
-from planners.kinematics.conditioning import frobenius_condition_number
-from service import stopping
-from service.body_limit import BodySizeLimit
-from service.errors import UnexpectedErrors, install_problem_handlers
-from service.finite import FiniteJSONResponse
-from service.jobs import JOB_MODULES, job_runner
-from service.routes import batches, health, jobs, trajectories, web
-from service.routes import robots as robot_routes
-from service.serving import open_connections
-from service.settings import Settings
-from service.workers import PlanningWorkers
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners.execution.isolated import start_worker_server
+from toptraj.planners.execution.threads import single_blas_thread
+from toptraj.planners.kinematics.conditioning import frobenius_condition_number
+from toptraj.service import stopping
+from toptraj.service.body_limit import BodySizeLimit
+from toptraj.service.errors import UnexpectedErrors, install_problem_handlers
+from toptraj.service.finite import FiniteJSONResponse
+from toptraj.service.jobs import JOB_MODULES, job_runner
+from toptraj.service.routes import batches, health, jobs, trajectories, web
+from toptraj.service.routes import robots as robot_routes
+from toptraj.service.serving import open_connections
+from toptraj.service.settings import Settings
+from toptraj.service.workers import PlanningWorkers
 
 
 def _warm_up() -> None:
@@ -48,7 +48,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """The toptraj HTTP service. Its settings also choose where this process keeps uploads
     (``robots.configure_uploads``): one upload store per process, the last app's."""
     settings = settings or Settings()
-    single_blas_thread()  # plannings run side by side; see planners.execution.threads
+    single_blas_thread()  # plannings run side by side; see toptraj.planners.execution.threads
     robots.configure_uploads(
         settings.data_dir,
         max_uploads=settings.max_uploads,

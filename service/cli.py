@@ -1,5 +1,5 @@
 """The ``toptraj`` command: ``toptraj serve [--host H] [--port P] [--workers N] [--access-log]``, and
-``toptraj plan|compare FILE|-`` and ``toptraj plot FILE|- -o OUT.html`` (``service.commands``)."""
+``toptraj plan|compare FILE|-`` and ``toptraj plot FILE|- -o OUT.html`` (``toptraj.service.commands``)."""
 
 from __future__ import annotations
 
@@ -7,12 +7,11 @@ import argparse
 import os
 import sys
 
-from service import commands as commands_
-from service.serving import LOOP
-from service.stopping import GRACEFUL_S
+from toptraj.service import commands as commands_
+from toptraj.service import warmup
 
 #: The app factory each server process calls (``create_app()``, settings from ``TOPTRAJ_*``).
-APP_FACTORY = "service.app:create_app"
+APP_FACTORY = "toptraj.service.app:create_app"
 
 
 def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
@@ -25,7 +24,10 @@ def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
 
 
 def _serve(args) -> int:
-    import uvicorn
+    import uvicorn  # here, as the server's own modules: ``toptraj plan`` needs none of them
+
+    from toptraj.service.serving import LOOP
+    from toptraj.service.stopping import GRACEFUL_S
 
     if args.workers < 1:
         print(f"toptraj serve: --workers must be at least 1, not {args.workers}", file=sys.stderr)
@@ -34,12 +36,19 @@ def _serve(args) -> int:
     os.environ.setdefault("TOPTRAJ_PLAN_WORKERS", str(plan_threads_per_process(args.workers)))
     # One process (workers=1) serves in this process; more are spawned processes sharing this
     # process's listening socket, each with its own app, planning threads and model caches,
-    # restarted by uvicorn's supervisor if one dies, taking connections in turns (service.serving).
+    # restarted by uvicorn's supervisor if one dies, taking connections in turns (toptraj.service.serving).
     # A line per request costs the event loop about 0.2 ms of a 7 ms request (uvicorn's access
     # formatter and a write per line), so it is asked for, as gunicorn's is; errors are logged
     # either way.
-    # A stop (SIGTERM, Ctrl-C) ends every process within seconds (service.stopping): open
+    # A stop (SIGTERM, Ctrl-C) ends every process within seconds (toptraj.service.stopping): open
     # requests get GRACEFUL_S to finish.
+    # Said before the seconds each process spends importing, and every few seconds while it
+    # does (toptraj.service.warmup); each then logs its start-up steps. A single process imports the app
+    # here, before uvicorn configures its logging; more import it in their own processes.
+    print(f"toptraj serve: {args.workers} server process(es) on http://{args.host}:{args.port}", file=sys.stderr, flush=True)
+    if args.workers == 1:
+        process = os.getpid()
+        warmup.say_while_importing(lambda line: print(f"INFO:     toptraj start-up [{process}]: {line}", file=sys.stderr, flush=True))
     uvicorn.run(
         APP_FACTORY,
         factory=True,
@@ -53,13 +62,75 @@ def _serve(args) -> int:
     return 0
 
 
+def _methods(text: str) -> list[str]:
+    """``--methods a,b``: the names, spaces and empty items left out."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError("give timing methods separated by commas, e.g. phase_plane,toppra")
+    return names
+
+
+def _request_commands(commands) -> None:
+    """``toptraj plan``, ``toptraj compare`` and ``toptraj plot``: one request each."""
+    exits = "Exit status: 0 answered, 1 answered with an error (printed on stderr as problem+json), 2 the request could not be read."
+    plan = commands.add_parser(
+        "plan",
+        help="plan one request and print the answer (errors on stderr)",
+        description="Plan one request and print the answer, as POST /v1/trajectories (or, for a body naming methods, "
+        "POST /v1/trajectories/compare) would. " + exits,
+    )
+    plan.add_argument("request", help="a JSON file shaped like the body of POST /v1/trajectories (or of a comparison), - for stdin")
+    plan.set_defaults(run=lambda args: commands_.plan(args.request))
+    compare = commands.add_parser(
+        "compare",
+        help="time one path under several methods and print the comparison",
+        description="Time one path under several methods: a table on a terminal (duration, ratio to the fastest, peak "
+        "utilization, warnings), JSON when piped or with --json. " + exits,
+    )
+    compare.add_argument(
+        "request",
+        help="a JSON file shaped like the body of POST /v1/trajectories/compare, or of POST /v1/trajectories "
+        "(its path and limits compared under --methods); - for stdin",
+    )
+    compare.add_argument(
+        "--methods",
+        type=_methods,
+        default=None,
+        help="timing methods, comma-separated, e.g. phase_plane,toppra (default: the request's own; for a trajectory "
+        "request, its method then phase_plane, toppra and quintic, or on a free path collocation and search)",
+    )
+    compare.add_argument("--json", action="store_true", help="print JSON even on a terminal")
+    compare.set_defaults(run=lambda args: commands_.compare(args.request, args.methods, True if args.json else None))
+    plot = commands.add_parser(
+        "plot",
+        help="write the web page's plots of one request to a self-contained HTML file",
+        description="Write the plots of one request to a self-contained HTML file (it opens offline): the phase plane, "
+        "the joints against their limits and the arm; for a comparison, every method drawn over the others. " + exits,
+    )
+    plot.add_argument("request", help="a JSON file shaped like the body of POST /v1/trajectories or of a comparison; - for stdin")
+    plot.add_argument("-o", "--output", required=True, help="the HTML file to write")
+    plot.add_argument("--methods", type=_methods, default=None, help="compare these timing methods, comma-separated, e.g. phase_plane,toppra")
+    plot.set_defaults(run=lambda args: commands_.plot(args.request, args.output, args.methods))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the console script."""
-    parser = argparse.ArgumentParser(prog="toptraj", description=__doc__)
-    commands = parser.add_subparsers(dest="command", required=True)
-    serve = commands.add_parser("serve", help="run the HTTP service")
-    serve.add_argument("--host", default="127.0.0.1")
-    serve.add_argument("--port", type=int, default=8000)
+    parser = argparse.ArgumentParser(
+        prog="toptraj",
+        description="Time-optimal trajectories for robot arms: serve the HTTP service, or plan, compare and\n"
+        "plot requests (JSON files shaped like the service's request bodies) in this process.",
+        epilog="examples:\n"
+        "  toptraj serve --port 8000\n"
+        "  toptraj plan examples/ur5_spline.json > answer.json\n"
+        "  toptraj compare examples/ur5_spline.json --methods phase_plane,toppra,quintic\n"
+        "  toptraj plot examples/compare_methods.json -o compare.html\n\n"
+        "toptraj COMMAND --help describes each command.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    serve = commands.add_parser("serve", help="run the HTTP service", description="Run the HTTP service (the API, its documentation at /docs and the web page at /).")
+    serve.add_argument("--host", default="127.0.0.1", help="the address to listen on (default: 127.0.0.1; 0.0.0.0 for every interface)")
+    serve.add_argument("--port", type=int, default=8000, help="the port to listen on (default: 8000)")
     serve.add_argument(
         "--workers",
         type=int,
@@ -68,16 +139,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     serve.add_argument("--access-log", action="store_true", help="log a line per request (uvicorn's access log; default off)")
     serve.set_defaults(run=_serve)
-    plan = commands.add_parser("plan", help="plan one request and print the answer (errors on stderr)")
-    plan.add_argument("request", help="a JSON file shaped like POST /v1/trajectories' body (or a compare body), - for stdin")
-    plan.set_defaults(run=lambda args: commands_.plan(args.request))
-    compare = commands.add_parser("compare", help="time one path under several methods and print the comparison")
-    compare.add_argument("request", help="a JSON file shaped like POST /v1/trajectories/compare's body, - for stdin")
-    compare.set_defaults(run=lambda args: commands_.compare(args.request))
-    plot = commands.add_parser("plot", help="write the web page's plots of one request to a self-contained HTML file")
-    plot.add_argument("request", help="a JSON file shaped like POST /v1/trajectories' body, - for stdin")
-    plot.add_argument("-o", "--output", required=True, help="the HTML file to write")
-    plot.set_defaults(run=lambda args: commands_.plot(args.request, args.output))
+    _request_commands(commands)
     batch = commands.add_parser("batch", help="plan a file of requests (JSON Lines) on Ray, resumably")
     batch.add_argument("requests", help="a JSON Lines file: a POST /v1/trajectories (or compare) body per line")
     batch.add_argument("-o", "--output", required=True, help="the JSON Lines file of results (appended; resumed)")

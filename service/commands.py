@@ -1,6 +1,6 @@
 """What ``toptraj plan``, ``toptraj compare`` and ``toptraj plot`` do: one request read from a
 file or standard input (``-``), planned in this process by the service's own code path
-(``service.planning``), its answer on standard output (or a page of plots in a file), its error
+(``toptraj.service.planning``), its answer on standard output (or a page of plots in a file), its error
 as problem+json on standard error with a non-zero exit status:
 
 * 0: answered;
@@ -51,8 +51,8 @@ def _is_compare(text: str) -> bool:
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
-    from robots import ToptrajError
-    from service.errors import detail, status_of, title_of, validation_problem
+    from toptraj.robots import ToptrajError
+    from toptraj.service.errors import detail, status_of, title_of, validation_problem
 
     try:
         content = answer(_read(source))
@@ -84,17 +84,17 @@ def _write(content: bytes, out=None) -> int:
 
 
 def _trajectory(text: str) -> bytes:
-    from service.planning import plan_request, render
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.planning import plan_request, render
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     request = TrajectoryRequest.model_validate_json(text)
     return render(plan_request(request), request)[0]
 
 
 def _compare(text: str) -> bytes:
-    from planners.execution.deadline import NO_DEADLINE
-    from service.planning import compare_request, encode_json
-    from service.schemas.trajectories import CompareRequest
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.service.planning import compare_request, encode_json
+    from toptraj.service.schemas.trajectories import CompareRequest
 
     return encode_json(compare_request(CompareRequest.model_validate_json(text), NO_DEADLINE))
 
@@ -112,9 +112,9 @@ def compare(source: str) -> int:
 def plot(source: str, output: str) -> int:
     """``toptraj plot FILE|- -o OUT.html``: the page's plots of one trajectory request, in a
     self-contained HTML file (Plotly's JavaScript inlined: it opens offline)."""
-    from service.planning import plan_request
-    from service.plots import figures_html
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.planning import plan_request
+    from toptraj.service.plots import figures_html
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     def page(text: str) -> bytes:
         if _is_compare(text):
@@ -143,15 +143,15 @@ def batch(
     retry_failed: bool = False,
 ) -> int:
     """``toptraj batch FILE -o OUT``: every request line planned (on Ray), one result line per
-    line, resumable (``service.batches``). Ctrl-C stops within seconds, keeps what finished,
+    line, resumable (``toptraj.service.batches``). Ctrl-C stops within seconds, keeps what finished,
     prints the command that resumes and exits with 130; a second Ctrl-C changes nothing."""
     import shlex
     import signal
     import threading
 
-    from service.batches import run_batch
-    from service.batches.lines import ForeignOutput
-    from service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
+    from toptraj.service.batches import run_batch
+    from toptraj.service.batches.lines import ForeignOutput
+    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
 
     if workers is not None and workers < 1:
         print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)

@@ -4,7 +4,7 @@ error, one handler per family and an outermost guard for the unexpected.
 * ``STATUS`` and ``TITLE`` give the HTTP status and title of each error class of the library
   (``status_of``, ``title_of``: its own class or nearest base in the table; the service's own
   errors carry theirs); ``detail`` words an error in the request's vocabulary
-  (``REQUEST_FIELD`` maps the library's fields to the request's; ``service.wordings`` holds one
+  (``REQUEST_FIELD`` maps the library's fields to the request's; ``toptraj.service.wordings`` holds one
   wording per rule). The HTTP answers, jobs, batches and the CLI all use these.
 * ``install_problem_handlers`` routes the error tree (``ToptrajError``), request validation and
   Starlette's HTTP errors (404, 405 with its ``Allow`` header, ...) to problem answers.
@@ -12,9 +12,9 @@ error, one handler per family and an outermost guard for the unexpected.
   and lets the server keep the connection: Starlette's own last-resort handler re-raises after
   answering, and uvicorn then drops the keep-alive connection without ``Connection: close``,
   so a client's next request on it fails.
-* ``service.finite.FiniteJSONResponse`` refuses NaN and infinity (JSON has no such numbers)
+* ``toptraj.service.finite.FiniteJSONResponse`` refuses NaN and infinity (JSON has no such numbers)
   with a 422 that says where the answer held one, instead of an encoder crash.
-* ``service.problem_docs`` makes the OpenAPI declare these answers.
+* ``toptraj.service.problem_docs`` makes the OpenAPI declare these answers.
 """
 
 from __future__ import annotations
@@ -29,10 +29,10 @@ from pydantic import ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
-from planners.collision.clearance import PathInCollision
-from planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
-from robots import ToptrajError
-from robots.errors import (
+from toptraj.planners.collision.clearance import PathInCollision
+from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
+from toptraj.robots import ToptrajError
+from toptraj.robots.errors import (
     MAX_DETAIL_CHARS,
     CatalogRobotReadOnly,
     InvalidLimits,
@@ -44,10 +44,10 @@ from robots.errors import (
     UploadStoreUnavailable,
     excerpt,
 )
-from robots.notes import Note
-from robots.upload_options import InvalidUpload
-from service.problem_docs import PROBLEM_JSON, declare_problems
-from service.wordings import WORDING
+from toptraj.robots.notes import Note
+from toptraj.robots.upload_options import InvalidUpload
+from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
+from toptraj.service.wordings import WORDING
 
 logger = logging.getLogger("toptraj")
 
@@ -166,7 +166,7 @@ _WORDS = _Words()
 
 
 def detail(error: ToptrajError) -> str:
-    """``error`` in the request's words: the wording of its rule (``service.wordings``) over its
+    """``error`` in the request's words: the wording of its rule (``toptraj.service.wordings``) over its
     facts, with its ``field`` as the request's; an error without a rule worded here is shown by
     its own sentence (the service's errors, and the library's that name no request field)."""
     rule = getattr(error, "rule", None)
@@ -181,7 +181,7 @@ def detail(error: ToptrajError) -> str:
 
 
 def note_text(note: str) -> str:
-    """A note of an answer (``robots.notes.Note``) in the request's words, as ``detail`` words
+    """A note of an answer (``toptraj.robots.notes.Note``) in the request's words, as ``detail`` words
     an error; a plain string as it is."""
     if not isinstance(note, Note):
         return note

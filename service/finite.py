@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from fastapi.responses import JSONResponse
 
-from robots import ToptrajError
+from toptraj.robots import ToptrajError
 
 
 class NonFiniteAnswer(ToptrajError):

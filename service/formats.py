@@ -7,25 +7,35 @@
   and ``time_from_start = {sec, nanosec}`` (``builtin_interfaces/Duration``: whole seconds and
   the nanoseconds within the second, rounded to the nanosecond), ready for a
   ``FollowJointTrajectory`` goal.
-* ``csv``: ``text/csv``, a header ``t,q.<joint>,…,qd.<joint>,…,qdd.<joint>,…,tau.<joint>,…`` and
-  a row per sample (numbers as JSON writes them, shortest round trip). Chosen by
-  ``output.format = "csv"`` or by ``Accept: text/csv`` (a client that prefers CSV over JSON).
+* ``csv``: ``text/csv``, a header ``t,q.<joint>,…,qd.<joint>,…,qdd.<joint>,…,tau.<joint>,…``,
+  then the answer's metadata as lines starting with ``#`` (``# key: value``: robot, method,
+  duration and sampled_duration in s, each peak utilization per joint in the columns' order,
+  the binding limit, the warnings), then a row per sample (numbers as JSON writes them,
+  shortest round trip). Chosen by ``output.format = "csv"`` or by ``Accept: text/csv`` (a
+  client that prefers CSV over JSON). The header comes first so that readers skipping comment
+  lines read it as the header: ``pandas.read_csv(f, comment="#")``,
+  ``numpy.loadtxt(f, delimiter=",", skiprows=1)``, ``numpy.genfromtxt(f, delimiter=",",
+  names=True)``.
 
 Controllers consume points at a fixed period, so ``joint_trajectory`` and ``csv`` put the
 samples on whole periods by default (``output.exact_period``, see
-``planners.trajectory.sample_trajectory``).
+``toptraj.planners.trajectory.sample_trajectory``).
 """
 
 from __future__ import annotations
 
 import io
+from collections.abc import Mapping
 
 import numpy as np
 
-from planners import PlannedTrajectory
+from toptraj.planners import PlannedTrajectory
+from toptraj.planners.checks.gate import LIMIT_TOLERANCE
 
 FORMATS = ("samples", "joint_trajectory", "csv")
 CSV_MEDIA_TYPE = "text/csv; charset=utf-8"
+#: How far past a limit asked an answer may go on a dense resampling, in percent of the limit.
+TOLERANCE_PERCENT = round((LIMIT_TOLERANCE - 1.0) * 100, 6)
 
 
 def _quality(accept: str, media: str) -> float:
@@ -91,14 +101,41 @@ def joint_trajectory(result: PlannedTrajectory) -> dict:
     }
 
 
-def csv_bytes(result: PlannedTrajectory) -> bytes:
-    """The samples as CSV: a header naming each column, then one row per sample."""
-    samples = result.samples
-    names = list(result.joint_names)
+def csv_metadata(body: Mapping) -> list[str]:
+    """The ``# key: value`` lines of a trajectory body's CSV (``body`` as
+    ``toptraj.service.planning.trajectory_body`` builds it, or as its JSON decodes): robot, method,
+    durations (s), peak utilization per limit (one value per joint, in the columns' order),
+    the binding limit and the warnings, one line each. Line breaks within a value become
+    spaces, so that every line stays a comment."""
+    lines = [
+        f"robot: {body['robot']}",
+        f"method: {body['method']}",
+        f"duration: {float(body['duration'])!r} s",
+        f"sampled_duration: {float(body['sampled_duration'])!r} s",
+        "peak_utilization: peak |value| / limit per joint on a dense resampling; 1 is at the limit, and the "
+        f"limits asked are held within {TOLERANCE_PERCENT:g} %",
+    ]
+    for kind, values in body["peak_utilization"].items():
+        lines.append(f"peak_utilization.{kind}: " + ",".join(repr(float(v)) for v in values))
+    binding = body.get("binding")
+    if binding is not None:
+        where = "the whole path" if binding["joint"] is None else f"joint {binding['joint']}"
+        lines.append(f"binding: {binding['kind']}, {where}, s = {float(binding['s'])!r}")
+    lines.append(f"warnings: {len(body['warnings'])}")
+    lines += [f"warning: {text}" for text in body["warnings"]]
+    return ["# " + " ".join(line.split()) for line in lines]
+
+
+def csv_bytes(body: Mapping) -> bytes:
+    """A trajectory body as CSV: a header naming each column, the ``#`` lines of
+    ``csv_metadata``, then one row per sample. ``body["samples"]`` holds numpy arrays or lists."""
+    samples = body["samples"]
+    names = list(body["joint_names"])
     header = ["t"] + [f"{quantity}.{name}" for quantity in ("q", "qd", "qdd", "tau") for name in names]
-    table = np.column_stack([samples.t, samples.q, samples.qd, samples.qdd, samples.tau])
+    table = np.column_stack([np.asarray(samples[key], dtype=float) for key in ("t", "q", "qd", "qdd", "tau")])
     out = io.StringIO()
     out.write(",".join(header) + "\n")
+    out.write("\n".join(csv_metadata(body)) + "\n")
     for row in table:
         out.write(",".join(repr(float(v)) for v in row) + "\n")
     return out.getvalue().encode()

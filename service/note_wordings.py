@@ -1,6 +1,6 @@
-"""The service's words for the notes of an answer (``robots.notes.Note``: dropped
+"""The service's words for the notes of an answer (``toptraj.robots.notes.Note``: dropped
 waypoints, turns of continuous joints, corners not blended, an accuracy above its target),
-as ``service.wordings`` words the errors (``NOTE_WORDING`` is part of its ``WORDING``), and
+as ``toptraj.service.wordings`` words the errors (``NOTE_WORDING`` is part of its ``WORDING``), and
 for a URDF limit outside the range of every limit of its kind."""
 
 from __future__ import annotations

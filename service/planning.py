@@ -1,4 +1,4 @@
-"""The bridge between the HTTP schemas and ``planners.plan``: request -> library call ->
+"""The bridge between the HTTP schemas and ``toptraj.planners.plan``: request -> library call ->
 response body, encoded to JSON bytes by the planning (in a planning thread, or on the event
 loop under a short leash for a small request: ``worth_a_leash``)."""
 
@@ -10,22 +10,22 @@ import math
 import numpy as np
 import orjson
 
-import robots
-from planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
-from planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
-from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, WrongLength
-from planners.execution.deadline import NO_DEADLINE
-from planners.generators.collocation import FreeMotion
-from planners.generators.search import SearchOptions
-from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-from planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
-from planners.problem.boundary import finite_vector
-from robots import InvalidLimits, UnknownRobot
-from robots.catalog import catalog_robot_built
-from service.errors import detail, note_text, status_of, title_of
-from service.finite import non_finite_answer
-from service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
-from service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
+from toptraj import robots
+from toptraj.planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
+from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, WrongLength
+from toptraj.planners.execution.deadline import NO_DEADLINE
+from toptraj.planners.generators.collocation import FreeMotion
+from toptraj.planners.generators.search import SearchOptions
+from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.planners.plan import DEFAULT_CLEARANCE, MAX_SAMPLES
+from toptraj.planners.problem.boundary import finite_vector
+from toptraj.robots import InvalidLimits, UnknownRobot
+from toptraj.robots.catalog import catalog_robot_built
+from toptraj.service.errors import detail, note_text, status_of, title_of
+from toptraj.service.finite import non_finite_answer
+from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
+from toptraj.service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.
 NUMBER_BYTES = 25
@@ -74,7 +74,7 @@ def heavy(method: str, path_kind: str, grid_points: int | None) -> bool:
     """Whether a planning is heavy: it takes seconds of CPU and up to a gigabyte (a search, a
     collocation or any free path, jerk_limited's linear programs, min_cost's convex program on
     more than ``HEAVY_MIN_COST_POINTS`` intervals or on its default grid). Heavy plannings are
-    admitted apart from the others (``service.workers``: ``plan_heavy_workers`` at once per
+    admitted apart from the others (``toptraj.service.workers``: ``plan_heavy_workers`` at once per
     process, ``plan_heavy_queue`` waiting), so that the short requests keep their threads and
     their latency while heavy ones run."""
     if method in HEAVY_METHODS or path_kind == "free":
@@ -140,7 +140,7 @@ def plan_request(
     ``output.dt`` whose samples would not fit in a body of that size (422 naming the smallest
     ``dt`` that fits). ``accept`` (the HTTP Accept header) may choose CSV, which puts the samples
     on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
-    (``planners.generators.search.memory``)."""
+    (``toptraj.planners.generators.search.memory``)."""
     robot = robots.load(request.robot)
     timing = _timing(request)
     if timing.method == "search":
@@ -177,7 +177,7 @@ def _obstacles(specs) -> tuple:
 
 
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
-    """The answer's bytes and media type in the format asked (``service.formats``)."""
+    """The answer's bytes and media type in the format asked (``toptraj.service.formats``)."""
     format_ = chosen_format(request.output.format, accept)
     if format_ == "csv":
         return csv_bytes(result), CSV_MEDIA_TYPE
@@ -306,7 +306,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
 
 def accuracy_body(result: PlannedTrajectory) -> dict:
     """``{"relative_gap", "basis"}``: the answer's estimated relative distance from the
-    converged optimum of its method's problem (``planners.runner.accuracy``), null when not estimated."""
+    converged optimum of its method's problem (``toptraj.planners.runner.accuracy``), null when not estimated."""
     accuracy = result.accuracy
     if accuracy is None:
         return {"relative_gap": None, "basis": f"not estimated for timing.method {result.method}"}

@@ -1,6 +1,6 @@
 """The web page's plots of one planned trajectory as a self-contained HTML file
 (``toptraj plot``): the phase plane with its maximum velocity curve and switching points, the
-joints against their limits, and the arm stroboscopically (``planners.kinematics.skeleton``).
+joints against their limits, and the arm stroboscopically (``toptraj.planners.kinematics.skeleton``).
 Plotly's JavaScript is inlined once, so the file opens offline."""
 
 from __future__ import annotations
@@ -12,11 +12,11 @@ import plotly.graph_objects as go
 from plotly.io import to_html
 from plotly.subplots import make_subplots
 
-import robots
-from planners import PlannedTrajectory
-from planners.kinematics.skeleton import skeleton
-from planners.paths.grid import spread_indices
-from service.errors import note_text
+from toptraj import robots
+from toptraj.planners import PlannedTrajectory
+from toptraj.planners.kinematics.skeleton import skeleton
+from toptraj.planners.paths.grid import spread_indices
+from toptraj.service.errors import note_text
 
 #: Instants of the stroboscopic picture.
 STROBE = 12

@@ -9,7 +9,7 @@ from typing import Any
 
 from fastapi import FastAPI
 
-from service.schemas.common import Problem
+from toptraj.service.schemas.common import Problem
 
 PROBLEM_JSON = "application/problem+json"
 _REF = "#/components/schemas/"

@@ -1,7 +1,7 @@
 """How ``toptraj serve --workers N`` spreads connections over N server processes on one port.
 
 uvicorn's multi-process mode binds the port once and spawns N processes that each run the app
-(``service.app:create_app``) and accept connections from the one listening socket. A process
+(``toptraj.service.app:create_app``) and accept connections from the one listening socket. A process
 plans on one core at a time (its planning threads share one interpreter lock), so the processes
 are what uses the cores, and a keep-alive connection stays with the process that accepted it:
 how connections spread over the processes decides how many cores a few clients can use.
@@ -35,6 +35,7 @@ from __future__ import annotations
 import asyncio
 import errno
 import logging
+import os
 import socket
 import sys
 import weakref
@@ -49,7 +50,7 @@ else:
         _BaseLoop = asyncio.SelectorEventLoop
 
 #: uvicorn's ``loop`` setting naming the event loop class of each server process.
-LOOP = "service.serving:new_server_loop"
+LOOP = "toptraj.service.serving:new_server_loop"
 #: The interpreter's thread switch interval in a server process, in s (Python's default: 5 ms).
 SWITCH_INTERVAL_S = 0.001
 #: Wait per open connection before a process takes the next one, in s.
@@ -85,11 +86,15 @@ class BalancedEventLoop(_BaseLoop):
 
 def new_server_loop() -> asyncio.AbstractEventLoop:
     """The event loop of a ``toptraj serve`` process (uvicorn's ``loop`` setting, ``LOOP``):
-    ``new_event_loop``'s, once the process's stop watch runs (``service.stopping``; uvicorn
-    makes the loop before it installs its signal handlers and before it loads the app)."""
-    from service import stopping
+    ``new_event_loop``'s, once the process's stop watch runs (``toptraj.service.stopping``; uvicorn
+    makes the loop before it installs its signal handlers and before it loads the app) and
+    while it says, every few seconds, that it is importing the app (``toptraj.service.warmup``)."""
+    from toptraj.service import stopping, warmup
 
     stopping.watch()
+    if "toptraj.service.app" not in sys.modules:  # one process: uvicorn imported it before (toptraj serve says so)
+        process = os.getpid()
+        warmup.say_while_importing(lambda line: _log.info("toptraj start-up [%d]: %s", process, line))
     return new_event_loop()
 
 

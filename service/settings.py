@@ -8,9 +8,10 @@ from pathlib import Path
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-from robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
-from robots.uploads import DEFAULT_CACHE_SIZE
+from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
+from toptraj.robots.uploads import DEFAULT_CACHE_SIZE
+from toptraj.service.web import GUIDE
 
 
 class Settings(BaseSettings):
@@ -32,18 +33,18 @@ class Settings(BaseSettings):
             number of cores; under ``toptraj serve --workers N``, the cores divided by N, at
             least 1: a process's planning threads share one interpreter lock, so more threads
             add no throughput, and N processes then run as many plannings as there are cores).
-        plan_leash_s: How long a small planning (``service.planning.worth_a_leash``) is first
+        plan_leash_s: How long a small planning (``toptraj.service.planning.worth_a_leash``) is first
             tried on the event loop when its process holds no other planning nor connection,
             in s (``PlanningWorkers.run``; 0: always in a thread).
         plan_queue: Requests that may wait for a planning worker of this process (within
             their budget); beyond, 503 with ``Retry-After``.
-        plan_heavy_workers: Heavy plannings (``service.planning.heavy``: search, collocation,
+        plan_heavy_workers: Heavy plannings (``toptraj.service.planning.heavy``: search, collocation,
             jerk_limited, min_cost on large grids) run at once in this process, in threads of
             their own: they never take the threads of ``plan_workers``.
         plan_heavy_queue: Heavy plannings that may wait for a heavy worker of this process
             (within their budget); beyond, 503 with ``Retry-After``.
         search_memory_bytes: Most memory one search may take by its estimate
-            (``planners.generators.search.memory``, 2 GiB by default): beyond, 422 naming the largest
+            (``toptraj.planners.generators.search.memory``, 2 GiB by default): beyond, 422 naming the largest
             ``roadmap_points``, ``neighbors`` or ``cells`` served.
         job_workers: Jobs (``/v1/jobs``) running at once, each in a worker process, over every
             server process on the data directory (default: half the cores, at least 1).
@@ -60,6 +61,8 @@ class Settings(BaseSettings):
         ray_address: A Ray cluster for batches (``POST /v1/batches``): ``auto``,
             ``ray://host:port`` or ``local`` (a Ray started in the job's process); none: a batch
             runs in the server's own job worker process.
+        guide_dir: The built documentation site served at ``/guide/`` (``make guide`` builds it
+            into ``service/web/guide``).
     """
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")
@@ -87,3 +90,4 @@ class Settings(BaseSettings):
     max_job_store_bytes: int = Field(default=1_000_000_000, ge=1_000_000)
     telemetry: bool = False
     ray_address: str | None = None
+    guide_dir: Path = GUIDE

@@ -17,7 +17,7 @@ parent 1. So each server process runs a watch (``watch``, started by its event l
 * A server process spawned by uvicorn's supervisor gets SIGTERM from the kernel when the
   supervisor ends, even killed outright (Linux ``PR_SET_PDEATHSIG``).
 
-The processes it started end with it: the fork server and its workers (``planners.execution.isolated``,
+The processes it started end with it: the fork server and its workers (``toptraj.planners.execution.isolated``,
 which end with the fork server), the ``multiprocessing`` resource tracker.
 """
 

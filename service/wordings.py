@@ -2,8 +2,8 @@
 a class's own rule by default), in the request's vocabulary.
 
 A wording is a ``str.format`` template over the error's facts, where ``{field}`` (and each of
-``fields``) is the request's field (``service.errors.REQUEST_FIELD``), ``{x!j}`` joins a sequence with ", ",
-``{x!e}`` shows a value excerpted (``robots.errors.excerpt``) and ``{x!f}`` maps a library field
+``fields``) is the request's field (``toptraj.service.errors.REQUEST_FIELD``), ``{x!j}`` joins a sequence with ", ",
+``{x!e}`` shows a value excerpted (``toptraj.robots.errors.excerpt``) and ``{x!f}`` maps a library field
 to the request's; or a function of the facts for what a template cannot say.
 """
 
@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from robots.ranges import Range
-from service.note_wordings import NOTE_WORDING
+from toptraj.robots.ranges import Range
+from toptraj.service.note_wordings import NOTE_WORDING
 
 
 def _range(facts: dict) -> str:

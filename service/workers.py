@@ -5,7 +5,7 @@ that a request is refused at once with 503 and ``Retry-After``.
 Memory is bounded the same way: each planning is capped (grid, samples, body size) and at most
 ``workers`` run. A worker slot is freed when its thread really ends, not when its caller stops
 waiting: after a 504 the deadline is cancelled, the thread stops at its next check (and kills any
-worker process it waits on, ``planners.execution.isolated``), and only then may the next planning start.
+worker process it waits on, ``toptraj.planners.execution.isolated``), and only then may the next planning start.
 
 Waiting requests get a thread in the order they came (a request arriving while others wait
 queues behind them), and the thread that frees a slot wakes the first of them at once: without
@@ -21,10 +21,10 @@ from collections import deque
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
-from planners import Deadline
-from planners.errors import BudgetExceeded
-from planners.execution.deadline import Leash, LeashSlipped
-from robots.errors import ToptrajError
+from toptraj.planners import Deadline
+from toptraj.planners.errors import BudgetExceeded
+from toptraj.planners.execution.deadline import Leash, LeashSlipped
+from toptraj.robots.errors import ToptrajError
 
 
 class ServiceBusy(ToptrajError):
@@ -70,11 +70,11 @@ class PlanningWorkers:
         leash_s: How long a planning that may run on the event loop is tried there, in s (see
             ``run``); 0 never tries one.
         connections: How many connections the process holds open
-            (``service.serving.open_connections``). A planning is tried on the loop only while
+            (``toptraj.service.serving.open_connections``). A planning is tried on the loop only while
             it holds at most one: a loop held by a try cannot take its turn at accepting, and a
             burst of connections would then all go to the other server processes.
         label: What its workers run, in the 503's detail (``"heavy planning"`` for the lane
-            of heavy plannings, ``service.planning.heavy``).
+            of heavy plannings, ``toptraj.service.planning.heavy``).
     """
 
     def __init__(

@@ -18,9 +18,9 @@ os.environ["TOPTRAJ_DATA_DIR"] = _SESSION_DATA_DIR
 
 from fastapi.testclient import TestClient  # noqa: E402
 
-from planners.execution.threads import single_blas_thread  # noqa: E402
-from service.app import create_app  # noqa: E402
-from service.settings import Settings  # noqa: E402
+from toptraj.planners.execution.threads import single_blas_thread  # noqa: E402
+from toptraj.service.app import create_app  # noqa: E402
+from toptraj.service.settings import Settings  # noqa: E402
 
 UR5_WAYPOINTS = [
     [0.0, -1.2, 1.0, 0.0, 0.0, 0.0],

@@ -25,7 +25,7 @@ def _free_port() -> int:
 
 
 class LiveServer:
-    """``python -m service.cli serve --workers W`` on a free port with ``TOPTRAJ_*`` settings
+    """``python -m toptraj.service.cli serve --workers W`` on a free port with ``TOPTRAJ_*`` settings
     ``env``; one server process unless ``workers`` asks for more."""
 
     def __init__(self, workers: int = 1, **env: str):
@@ -36,7 +36,7 @@ class LiveServer:
 
     def __enter__(self) -> LiveServer:
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--workers", str(self.workers)],
+            [sys.executable, "-m", "toptraj.service.cli", "serve", "--port", str(self.port), "--workers", str(self.workers)],
             cwd=ROOT,
             env=self.env,
             stdout=subprocess.DEVNULL,

@@ -1,7 +1,7 @@
 """Errors carry facts; the service words them (docs/design.md §2.3).
 
 The library raises with its own field names and the facts of the rule broken (value, bounds,
-lengths, the method and what it serves); ``service.errors`` maps the fields to the request's,
+lengths, the method and what it serves); ``toptraj.service.errors`` maps the fields to the request's,
 words every rule and picks the status. Checked here: the facts of a representative set of
 errors raised by ``plan`` and the checks it calls, that every rule raised in ``planners/`` and
 ``robots/`` has a wording and every wording a rule, that advice given as data lies in its
@@ -20,11 +20,11 @@ import sys
 import numpy as np
 import pytest
 
-import robots
-from planners import Deadline, Timing, WaypointPath, plan
-from planners.checks.gate import limit_exceeded
-from planners.checks.limit_check import Excess
-from planners.errors import (
+from toptraj import robots
+from toptraj.planners import Deadline, Timing, WaypointPath, plan
+from toptraj.planners.checks.gate import limit_exceeded
+from toptraj.planners.checks.limit_check import Excess
+from toptraj.planners.errors import (
     BudgetExceeded,
     Conflicting,
     InfeasiblePath,
@@ -37,14 +37,14 @@ from planners.errors import (
     TooLarge,
     WrongLength,
 )
-from planners.paths import SplinePath
-from planners.paths.grid import MAX_POINTS
-from planners.problem.ranges import DT, SCALE
-from planners.timing import METHODS
-from robots.errors import InvalidInput, ToptrajError, UnknownRobot
-from robots.notes import Note
-from service.errors import REQUEST_FIELD, STATUS, detail, note_text, request_field, status_of
-from service.wordings import WORDING
+from toptraj.planners.paths import SplinePath
+from toptraj.planners.paths.grid import MAX_POINTS
+from toptraj.planners.problem.ranges import DT, SCALE
+from toptraj.planners.timing import METHODS
+from toptraj.robots.errors import InvalidInput, ToptrajError, UnknownRobot
+from toptraj.robots.notes import Note
+from toptraj.service.errors import REQUEST_FIELD, STATUS, detail, note_text, request_field, status_of
+from toptraj.service.wordings import WORDING
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 UR5 = robots.load("ur5")
@@ -162,13 +162,13 @@ def test_budget_exceeded_carries_the_budget():
 def test_the_library_holds_no_status_or_title():
     """Statuses and titles are the service's: no error class of ``planners`` or ``robots``
     defines them."""
-    import planners.collision.clearance
-    import planners.errors
-    import planners.generators.search.outcome
-    import robots.errors
-    import robots.upload_options
+    import toptraj.planners.collision.clearance
+    import toptraj.planners.errors
+    import toptraj.planners.generators.search.outcome
+    import toptraj.robots.errors
+    import toptraj.robots.upload_options
 
-    modules = (planners.errors, robots.errors, planners.collision.clearance, planners.generators.search.outcome, robots.upload_options)
+    modules = (toptraj.planners.errors, toptraj.robots.errors, toptraj.planners.collision.clearance, toptraj.planners.generators.search.outcome, toptraj.robots.upload_options)
     classes = [value for module in modules for value in vars(module).values()
                if isinstance(value, type) and issubclass(value, ToptrajError)]
     assert len(classes) >= 15
@@ -240,7 +240,7 @@ def test_library_sentences_name_no_request_field():
 
 def test_every_request_field_is_one_the_schema_knows():
     """The request fields of ``REQUEST_FIELD`` are paths of the request's schema."""
-    from service.schemas.trajectories import TrajectoryRequest
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
 
     schema = TrajectoryRequest.model_json_schema()
     text = str(schema)

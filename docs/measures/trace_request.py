@@ -1,4 +1,4 @@
-"""One request's way through the modules: ``service.planning.plan_request`` traced with
+"""One request's way through the modules: ``toptraj.service.planning.plan_request`` traced with
 ``sys.setprofile`` (after a first, untraced run that compiles the kernels and loads the robot).
 
 Run from the repository root with the project's environment:
@@ -11,9 +11,9 @@ import collections
 import json
 import sys
 
-from planners.execution.deadline import Deadline
-from service.planning import plan_request
-from service.schemas.trajectories import TrajectoryRequest
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.service.planning import plan_request
+from toptraj.service.schemas.trajectories import TrajectoryRequest
 
 ROOTS = ("robots", "planners", "service", "client")
 

@@ -1,5 +1,5 @@
 """The limit gate every answer passes: a timing is checked on a dense resampling
-(``planners.checks.limit_check``); where a limit is exceeded, the grid is refined there and the path
+(``toptraj.planners.checks.limit_check``); where a limit is exceeded, the grid is refined there and the path
 timed again; a timing that still exceeds a limit, or that cannot be refined, is refused with the
 place, the joint and the limit.
 """
@@ -11,17 +11,17 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.checks.limit_check import Excess, LimitCheck, check_limits
-from planners.checks.limit_kernels import utilization_pass
-from planners.constraints.path_constraints import PathConstraints
-from planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
-from planners.errors import InfeasiblePath, LimitExceeded, TimingFailed
-from planners.paths.base import GeometricPath
-from planners.runner.accuracy import REFINE_ROUNDS, estimated, finer_constraints
-from planners.timing.base import PathTiming, TimeScaling
-from planners.timing.laws.law_timing import LawTiming
-from planners.timing.scaled import solve_well_scaled
-from robots import JointLimits, Robot
+from toptraj.planners.checks.limit_check import Excess, LimitCheck, check_limits
+from toptraj.planners.checks.limit_kernels import utilization_pass
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
+from toptraj.planners.errors import InfeasiblePath, LimitExceeded, TimingFailed
+from toptraj.planners.paths.base import GeometricPath
+from toptraj.planners.runner.accuracy import REFINE_ROUNDS, estimated, finer_constraints
+from toptraj.planners.timing.base import PathTiming, TimeScaling
+from toptraj.planners.timing.laws.law_timing import LawTiming
+from toptraj.planners.timing.scaled import solve_well_scaled
+from toptraj.robots import JointLimits, Robot
 
 #: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is
 #: 0.5 %; the gate is tighter, since a client's own resampling falls between the check's states.
@@ -59,8 +59,8 @@ def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
 def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
     """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
     exceeded by more than ``threshold``, refine the grid there and time the path again. Every
-    timing carries its estimated gap to the converged optimum (``planners.runner.accuracy``); a
-    time-optimal one above ``planners.runner.accuracy.GAP_TARGET`` on a grid the request did not name
+    timing carries its estimated gap to the converged optimum (``toptraj.planners.runner.accuracy``); a
+    time-optimal one above ``toptraj.planners.runner.accuracy.GAP_TARGET`` on a grid the request did not name
     (``grid_given``) is timed again on a finer grid, which replaces it only when it too holds
     the limits.
 

@@ -9,12 +9,12 @@ Along q(s) timed by s(t) (Yamamoto et al. eqs. (8), (9); jerk by one more deriva
     tau  = RNEA(q, qd, qdd) + D qd + F sign(qd)
 
 and, when a request limits a tool's speed, |v| and |w| of the frame's twist J(q) qd
-(``planners.constraints.tool_speed``; the frame velocities are computed only then).
+(``toptraj.planners.constraints.tool_speed``; the frame velocities are computed only then).
 
 evaluated at the timing's dense states (``PathTiming.dense_states``): for timings on a grid of s,
 ``POINTS_PER_INTERVAL`` states per interval of the grid the constraints were built on (as far
 apart in the intervals a method refined), both ends and both sides of every grid point. This
-check is the gate every answer passes: ``planners.plan`` refines the grid where it finds a limit
+check is the gate every answer passes: ``toptraj.planners.plan`` refines the grid where it finds a limit
 exceeded, and refuses the answer when refinement cannot bring it back.
 """
 
@@ -24,13 +24,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.checks.limit_kernels import utilization_pass
-from planners.constraints.path_constraints import PathConstraints
-from planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
-from planners.constraints.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel
-from planners.paths.base import GeometricPath
-from planners.timing.base import PathTiming, TimeScaling
-from robots import JointLimits, Robot
+from toptraj.planners.checks.limit_kernels import utilization_pass
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
+from toptraj.planners.constraints.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel
+from toptraj.planners.paths.base import GeometricPath
+from toptraj.planners.timing.base import PathTiming, TimeScaling
+from toptraj.robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included: the ends and the quarter points.
 #: Between two grid points where the rows hold, a limit can be exceeded only by an excursion
@@ -40,7 +40,7 @@ from robots import JointLimits, Robot
 POINTS_PER_INTERVAL = 5
 KINDS = ("velocity", "acceleration", "torque", "jerk")
 #: Largest estimated error, as a fraction of the joint's torque limit, of a torque interpolated
-#: between grid points from the rows (``planners.constraints.torque_interpolation``); a state whose estimate
+#: between grid points from the rows (``toptraj.planners.constraints.torque_interpolation``); a state whose estimate
 #: is larger gets the RNEA (``Robot.inverse_dynamics``). Far below the gate's ``LIMIT_TOLERANCE`` - 1.
 INTERPOLATION_TOLERANCE = 1e-5
 
@@ -106,7 +106,7 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     (when they hold a torque row for every joint) the torque is the row ``a u + b x + c + d sd``
     the build computed there with the RNEA (the same number, to rounding), on the side
     the state belongs to; between grid points it is interpolated from those rows
-    (``planners.constraints.torque_interpolation.dense_torques``) where the grid resolves them, the
+    (``toptraj.planners.constraints.torque_interpolation.dense_torques``) where the grid resolves them, the
     interpolation's estimated error is within ``INTERPOLATION_TOLERANCE`` of the limit and no
     joint has Coulomb friction (whose sign, inside c, is the grid point's). The RNEA runs,
     batched, at every other state."""

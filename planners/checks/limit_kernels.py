@@ -1,5 +1,5 @@
 """Compiled pass of the dense limit check (numba): |value| / limit of every state and joint,
-reduced in one sweep to what ``planners.checks.limit_check`` reports (the peak per joint, the worst
+reduced in one sweep to what ``toptraj.planners.checks.limit_check`` reports (the peak per joint, the worst
 state, the states beyond a threshold). No knowledge of paths or robots (``nogil``, cached)."""
 
 from __future__ import annotations

@@ -2,8 +2,8 @@
 configuration-space obstacles start here): ``obstacles`` (plain domain objects), ``distance``
 (capsule-to-obstacle distances, vectorized) and ``clearance`` (a path checked densely)."""
 
-from planners.collision.clearance import Clearance, check_clearance, clearance_along
-from planners.collision.obstacles import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
+from toptraj.planners.collision.clearance import Clearance, check_clearance, clearance_along
+from toptraj.planners.collision.obstacles import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 
 __all__ = [
     "BoxObstacle",

@@ -1,4 +1,4 @@
-"""The clearance of a path from the obstacles: every link capsule (``robots.collision``)
+"""The clearance of a path from the obstacles: every link capsule (``toptraj.robots.collision``)
 against every obstacle, at configurations dense enough to bound the distance in between.
 
 Between two configurations a point of the arm moves at most R * sum_j |dq_j|, R bounding its
@@ -17,12 +17,12 @@ from typing import Any
 
 import numpy as np
 
-from planners.collision.distance import capsule_distance
-from planners.collision.obstacles import Obstacle
-from planners.errors import InfeasiblePath
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from robots import Robot
-from robots.collision import robot_capsules, world_capsules
+from toptraj.planners.collision.distance import capsule_distance
+from toptraj.planners.collision.obstacles import Obstacle
+from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.robots import Robot
+from toptraj.robots.collision import robot_capsules, world_capsules
 
 #: Largest motion (m) of any point of the arm between two configurations of the first pass.
 COARSE_STEP = 0.02

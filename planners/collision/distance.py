@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.collision.obstacles import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
+from toptraj.planners.collision.obstacles import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 
 _GOLDEN_STEPS = 28
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planners.errors import InvalidRequest
+from toptraj.planners.errors import InvalidRequest
 
 #: How far from 1 the norm of a box's orientation quaternion may be (rounded printing), as for
 #: the poses of a cartesian path.

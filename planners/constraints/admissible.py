@@ -6,7 +6,7 @@ section 3.2 (the limit that the torque bounds (3.6) place on mu = lambda-dot).
 Each row ``lower <= a u + b x + c <= upper`` with a != 0 bounds u between two functions linear
 in x, l_k(x) <= u <= h_k(x). Some u exists iff l_i(x) <= h_j(x) for every pair (i, j): each pair
 is one linear inequality in x, and rows with a = 0 bound x directly. The admissible x therefore
-form one interval per grid point (``planners.constraints.admissible_kernels.admissible_intervals``).
+form one interval per grid point (``toptraj.planners.constraints.admissible_kernels.admissible_intervals``).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.constraints.admissible_kernels import ZERO_INERTIA, point_bounds
-from planners.constraints.path_constraints import LinearRows
+from toptraj.planners.constraints.admissible_kernels import ZERO_INERTIA, point_bounds
+from toptraj.planners.constraints.path_constraints import LinearRows
 
 
 @dataclass(frozen=True)

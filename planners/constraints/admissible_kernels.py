@@ -1,6 +1,6 @@
 """Compiled inner loops of the phase-plane method (numba): the per-point admissible interval of
 x = sd^2, the bounds on u of each grid interval in either discretization (the sweeps over
-them: ``planners.timing.phase_plane.sweep_kernels``) and the zero-inertia test of an interval's rows. Plain loops
+them: ``toptraj.planners.timing.phase_plane.sweep_kernels``) and the zero-inertia test of an interval's rows. Plain loops
 over small row counts, compiled once (``nogil``, so threads run them in parallel) and cached on
 disk; they hold no knowledge of paths or robots.
 

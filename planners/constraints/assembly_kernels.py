@@ -1,6 +1,6 @@
 """Compiled assembly of the constraint rows (numba): from the path's s-derivatives and three
 RNEA evaluations per point to the rows ``a u + b x + c + d sd`` and the first-order bound
-sd_max, in one pass over the grid. ``planners.constraints.path_constraints`` says what the rows mean; this
+sd_max, in one pass over the grid. ``toptraj.planners.constraints.path_constraints`` says what the rows mean; this
 module only writes them (``nogil``, cached on disk, no knowledge of paths or robots).
 """
 

@@ -16,7 +16,7 @@ that starts there; so do they at a break (where q'' jumps: a line meeting a circ
 The torque coefficients come from the RNEA (``Robot.rnea_sets``): a = rnea(q, 0, q') - g,
 b = rnea(q, q', q'') - g, c = g (+ Coulomb friction), so timing methods never see a robot; one
 batched RNEA per chunk of grid points, then one compiled pass
-(``planners.constraints.assembly_kernels``) writes every row and the velocity bound.
+(``toptraj.planners.constraints.assembly_kernels``) writes every row and the velocity bound.
 """
 
 from __future__ import annotations
@@ -28,13 +28,13 @@ from functools import cached_property
 
 import numpy as np
 
-from planners.constraints.assembly_kernels import assemble_rows, velocity_bound
-from planners.constraints.tool_speed import tool_speed_bound
-from planners.constraints.torque_interpolation import smooth_points
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.paths.base import GeometricPath
-from planners.paths.grid import on_points
-from robots import JointLimits, Robot
+from toptraj.planners.constraints.assembly_kernels import assemble_rows, velocity_bound
+from toptraj.planners.constraints.tool_speed import tool_speed_bound
+from toptraj.planners.constraints.torque_interpolation import smooth_points
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.paths.base import GeometricPath
+from toptraj.planners.paths.grid import on_points
+from toptraj.robots import JointLimits, Robot
 
 CONSTRAINT_KINDS = ("velocity", "acceleration", "torque", "jerk")
 
@@ -62,7 +62,7 @@ class PathConstraints:
             grid point (they differ from ``jerk``'s at the path's knots, where d3q/ds3 jumps).
         velocity_joint: Index of the joint whose velocity limit sets sd_max at each point
             (N + 1,), -1 where no velocity limit applies.
-        tool_bound: Where a tool-speed limit (``planners.constraints.tool_speed``) sets sd_max instead, the
+        tool_bound: Where a tool-speed limit (``toptraj.planners.constraints.tool_speed``) sets sd_max instead, the
             index of that limit in ``TOOL_KINDS`` (N + 1,), -1 elsewhere; ``None`` without one.
         knots: The s of the path's knots (where a derivative of q(s) jumps, so the rows are
             not smooth across them even where they are continuous); ``None`` when unknown.
@@ -167,7 +167,7 @@ class PathConstraints:
     @cached_property
     def smooth(self) -> np.ndarray:
         """(N + 1,): the grid points through which the rows are smooth, computed once
-        (``planners.constraints.torque_interpolation.smooth_points``), read-only."""
+        (``toptraj.planners.constraints.torque_interpolation.smooth_points``), read-only."""
         smooth = smooth_points(self)
         smooth.setflags(write=False)
         return smooth
@@ -274,7 +274,7 @@ def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.nd
     ddq``, each (n, n_dof)) and their (kind, joint) labels: each array (n, m), acceleration rows
     then torque rows, of the joints whose limit is finite (a row with an infinite limit
     constrains nothing). The torque rows take one batched RNEA per ``CHUNK_POINTS`` points, the
-    deadline checked before each; ``planners.constraints.assembly_kernels.assemble_rows`` writes them."""
+    deadline checked before each; ``toptraj.planners.constraints.assembly_kernels.assemble_rows`` writes them."""
     nothing = np.empty(0, dtype=np.intp)
     accelerated = np.flatnonzero(np.isfinite(limits.acceleration)) if "acceleration" in kinds else nothing
     torqued = np.flatnonzero(np.isfinite(limits.torque)) if "torque" in kinds else nothing

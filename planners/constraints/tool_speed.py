@@ -12,16 +12,16 @@ linear in the path speed sd. A bound |v| <= v_max is therefore a first-order bou
 
 of the same form as a joint velocity limit (``PathConstraints.sd_max``), and every timing method
 that reads ``sd_max`` holds it. The dense limit check computes |v| and |w| at its states from
-the frame's Jacobian (``planners.kinematics.frame_jacobians``).
+the frame's Jacobian (``toptraj.planners.kinematics.frame_jacobians``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from planners.errors import Conflicting, NotOneOf
-from planners.kinematics.frame_jacobians import frame_jacobians
-from robots import Robot, ToolSpeedLimit
+from toptraj.planners.errors import Conflicting, NotOneOf
+from toptraj.planners.kinematics.frame_jacobians import frame_jacobians
+from toptraj.robots import Robot, ToolSpeedLimit
 
 #: Names of the tool limits, as ``peak_utilization`` and error messages show them.
 TOOL_KINDS = ("tool_speed", "tool_angular_speed")

@@ -1,9 +1,9 @@
 """Joint torques between the grid points of a path's constraints, from the rows the build
 computed there with the RNEA (numba, ``nogil``, cached): the dense limit check's torques
-(``planners.checks.limit_check``) without a dynamics evaluation per state where the interpolation is
+(``toptraj.planners.checks.limit_check``) without a dynamics evaluation per state where the interpolation is
 accurate, and with one where it is not. (The rows a refining method adds at new grid points
 take the RNEA itself, ``PathConstraints.with_points``: with the compiled pass of
-``robots.chain_dynamics`` that is as fast as interpolating them, and exact.)
+``toptraj.robots.chain_dynamics`` that is as fast as interpolating them, and exact.)
 
 Along q(s) the torque of joint j at a state (s, sd, sdd) is (Jeong & Lee eq. (3.4b) with
 x = sd^2, u = sdd, and the URDF's joint friction)
@@ -44,7 +44,7 @@ def smooth_points(constraints) -> np.ndarray:
     """(N + 1,): the grid points of ``constraints`` (a ``PathConstraints``) through which the
     rows are smooth, so that a polynomial through them interpolates the rows: interior, no knot
     of the path, the same rows from both sides (also where ``phase_plane``'s excursion estimate,
-    ``planners.timing.phase_plane.refinement_kernels.row_excursions``, may reach across a grid point)."""
+    ``toptraj.planners.timing.phase_plane.refinement_kernels.row_excursions``, may reach across a grid point)."""
     grid = constraints.s
     smooth = np.ones(len(grid), dtype=bool)
     smooth[[0, -1]] = False

@@ -9,7 +9,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from planners.errors import BudgetExceeded
+from toptraj.planners.errors import BudgetExceeded
 
 #: ``progress(fraction, stage)``: fraction of the work done, in [0, 1], and what is under way.
 Progress = Callable[[float, str], None]
@@ -69,7 +69,7 @@ class Deadline:
     def ending_at(cls, end: float | None, budget_s: float | None, progress: Progress | None = None) -> Deadline:
         """A deadline that passes at ``end`` (``time.monotonic()``, the same clock in every
         process of the machine) and names ``budget_s`` when it does: the deadline of a caller,
-        carried into a worker process (``planners.execution.isolated``)."""
+        carried into a worker process (``toptraj.planners.execution.isolated``)."""
         deadline = cls(budget_s, progress)
         deadline._end = end
         return deadline

@@ -28,7 +28,7 @@ Children are forked from a fork server (``multiprocessing``'s ``forkserver`` con
 single-threaded process started once, which has imported the solver stacks (``PRELOAD``), so a
 child starts in milliseconds without copying the threads of the server. Where ``forkserver`` is
 not available, children are spawned (a fresh interpreter each). A child keeps to one BLAS
-thread (``planners.execution.threads``). As with any ``multiprocessing``
+thread (``toptraj.planners.execution.threads``). As with any ``multiprocessing``
 code, a script that plans with a deadline must guard its entry point with
 ``if __name__ == "__main__":`` (a child imports the main script as ``__mp_main__``).
 """
@@ -45,9 +45,9 @@ import threading
 import time
 from collections.abc import Sequence
 
-from planners.errors import OverMemory, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.execution.threads import single_blas_thread
+from toptraj.planners.errors import OverMemory, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.execution.threads import single_blas_thread
 
 #: Seconds between two deadline checks while waiting for the child.
 POLL_S = 0.02
@@ -56,8 +56,24 @@ PROGRESS_S = 0.1
 #: How much lower the CPU priority of a heavy planning's worker process is (``nice``): it
 #: shares the cores with a server's short requests, which keep theirs.
 LOW_PRIORITY = 5
-#: Modules the fork server imports once, so that children start with them loaded.
-PRELOAD = ["numpy", "threadpoolctl", "scipy.optimize", "cvxpy", "clarabel", "pinocchio", "planners.timing.min_cost", "planners.generators.collocation.collocation"]
+#: Modules the fork server imports once, so that children start with them loaded: the stacks of
+#: the computations that run in children, which their modules import only where they run
+#: (``min_cost``: cvxpy and Clarabel; the collocation: casadi and scipy's optimizers; the
+#: search: scipy's sparse graphs, optimizers and B-splines). The server process imports none.
+PRELOAD = [
+    "numpy",
+    "threadpoolctl",
+    "pinocchio",
+    "scipy.optimize",
+    "scipy.sparse.csgraph",
+    "scipy.interpolate",
+    "cvxpy",
+    "clarabel",
+    "toptraj.planners.timing.min_cost",
+    "toptraj.planners.generators.collocation.collocation",
+    "toptraj.planners.generators.collocation.sparse",
+    "toptraj.planners.generators.search.generator",
+]
 
 _context = None
 _lock = threading.Lock()

@@ -25,13 +25,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.errors import Conflicting, InfeasiblePath
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.via_points import ConstantSpeedTiming
-from planners.paths.base import GeometricPath, PathPoints
-from planners.timing.base import Binding
-from planners.timing.laws.profiles import NormalizedProfile
-from robots import JointLimits, Robot
+from toptraj.planners.errors import Conflicting, InfeasiblePath
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.via_points import ConstantSpeedTiming
+from toptraj.planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.timing.base import Binding
+from toptraj.planners.timing.laws.profiles import NormalizedProfile
+from toptraj.robots import JointLimits, Robot
 
 #: Samples of tau for the law's peak derivatives (its knots are added).
 PEAK_SAMPLES = 4001

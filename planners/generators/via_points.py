@@ -19,12 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.errors import InfeasiblePath, InvalidRequest, NotServed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.paths.base import GeometricPath, PathPoints
-from planners.timing.base import DenseStates, PathTiming
-from planners.timing.laws.profiles import cubic_coefficients, quintic_coefficients
-from robots import JointLimits, Robot
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.timing.base import DenseStates, PathTiming
+from toptraj.planners.timing.laws.profiles import cubic_coefficients, quintic_coefficients
+from toptraj.robots import JointLimits, Robot
 
 ROUNDS = 4
 SAMPLES_PER_SEGMENT = 120

@@ -1,5 +1,5 @@
 """Compiled Frobenius condition numbers of a stack of small Jacobians (numba), from their Gram
-matrices: ``planners.kinematics.conditioning`` says what the number means and when the singular
+matrices: ``toptraj.planners.kinematics.conditioning`` says what the number means and when the singular
 values must decide instead. No knowledge of robots (``nogil``, cached on disk)."""
 
 from __future__ import annotations

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
-from planners.kinematics.frame_jacobians import frame_jacobians
-from robots import Robot
+from toptraj.planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
+from toptraj.planners.kinematics.frame_jacobians import frame_jacobians
+from toptraj.robots import Robot
 
 #: A warning is raised above this condition number.
 NEAR_SINGULAR_KAPPA = 100.0
@@ -36,7 +36,7 @@ def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
 
     With G = J^T J (m >= n) or J J^T (m < n), the k = min(m, n) squared singular values are G's
     eigenvalues, so sum sigma_i^2 = tr G and sum sigma_i^-2 = tr G^-1: the small Gram matrices'
-    Cholesky factors, compiled (``planners.kinematics.condition_kernels``), instead of their
+    Cholesky factors, compiled (``toptraj.planners.kinematics.condition_kernels``), instead of their
     singular value decompositions. Where that gives kappa_F > ``GRAM_KAPPA`` (or G is not
     positive definite), the value comes from the singular values instead, which also decide
     rank deficiency.

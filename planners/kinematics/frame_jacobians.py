@@ -1,5 +1,5 @@
 """A frame's Jacobian at many configurations in one compiled pass, for arms whose joints all turn
-about or slide along a fixed axis (``robots.chain``); other arms take one Pinocchio call per
+about or slide along a fixed axis (``toptraj.robots.chain``); other arms take one Pinocchio call per
 configuration.
 
 Forward kinematics composes each joint's frame from its parent's: with the placement (R_0, t_0)
@@ -26,8 +26,8 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
-from robots import Robot
-from robots.chain import axis_rotation
+from toptraj.robots import Robot
+from toptraj.robots.chain import axis_rotation
 
 
 def frame_jacobians(robot: Robot, frame_id: int, q: np.ndarray) -> np.ndarray:
@@ -54,7 +54,7 @@ def frame_jacobians(robot: Robot, frame_id: int, q: np.ndarray) -> np.ndarray:
 def chain_jacobians(q, parent, prismatic, axis, rotation, translation, coordinate, frame_joint, frame_translation, out):  # pragma: no cover - compiled
     """The Jacobians (n, 6, n_dof) of the frame at ``frame_translation`` (3,) in joint
     ``frame_joint``'s frame, at the rows of ``q`` (n, n_dof), into ``out``; the chain's arrays
-    as ``robots.chain.Chain`` holds them."""
+    as ``toptraj.robots.chain.Chain`` holds them."""
     n_joints = parent.shape[0]
     frame_rotation = np.empty((n_joints, 3, 3))
     origin = np.empty((n_joints, 3))

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from robots import Robot
+from toptraj.robots import Robot
 
 #: Damping of the least-squares step (in the units of the task, m or rad).
 DAMPING = 1e-4

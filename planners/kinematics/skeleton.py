@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from robots import Robot
+from toptraj.robots import Robot
 
 
 def skeleton(robot: Robot, q: np.ndarray) -> tuple[list[str], np.ndarray]:

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.paths.base import GeometricPath, PathPoints
 
 #: 1 - cos(alpha) below this: the segments continue straight on (no blend needed, the direction
 #: changes by less than 1.5e-6 rad).

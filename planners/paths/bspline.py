@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import BSpline
 
-from planners.errors import InvalidRequest
-from planners.paths.base import GeometricPath, PathPoints
-from planners.paths.waypoints import cubic_pieces
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.paths.waypoints import cubic_pieces
 
 DEGREE = 3
 

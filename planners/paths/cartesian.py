@@ -17,13 +17,13 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from planners.errors import Conflicting, InvalidRequest
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.kinematics.ik import frame_pose, solve_ik
-from planners.paths.base import GeometricPath
-from planners.paths.concatenated import ConcatenatedPath
-from planners.paths.waypoints import SplinePath
-from robots import Robot
+from toptraj.planners.errors import Conflicting, InvalidRequest
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.kinematics.ik import frame_pose, solve_ik
+from toptraj.planners.paths.base import GeometricPath
+from toptraj.planners.paths.concatenated import ConcatenatedPath
+from toptraj.planners.paths.waypoints import SplinePath
+from toptraj.robots import Robot
 
 STEP_LENGTH_M = 0.002
 STEP_ANGLE_RAD = np.radians(1.0)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.paths.base import GeometricPath, PathPoints
 
 
 class ConcatenatedPath(GeometricPath):

@@ -13,8 +13,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from planners.errors import TimingFailed
-from planners.paths.base import GeometricPath
+from toptraj.planners.errors import TimingFailed
+from toptraj.planners.paths.base import GeometricPath
 
 #: Intervals per path segment (between consecutive knots) when the request names no grid size.
 DEFAULT_POINTS_PER_SEGMENT = 100

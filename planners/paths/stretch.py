@@ -2,14 +2,14 @@
 
 At a corner (kink) the motion stops, so the stretches between corners are independent
 rest-to-rest problems: each is timed on its own, in its own parameter, whatever its length
-relative to the rest of the path (``planners.timing.segmented``).
+relative to the rest of the path (``toptraj.planners.timing.segmented``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.paths.base import GeometricPath, PathPoints
 
 
 class Stretch(GeometricPath):

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from planners.errors import InvalidRequest
-from planners.paths.base import RANGE_SLACK, GeometricPath, PathPoints
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.paths.base import RANGE_SLACK, GeometricPath, PathPoints
 
 
 def chord_knots(waypoints: np.ndarray) -> np.ndarray:

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.errors import InvalidRequest, WrongLength
-from planners.paths.base import GeometricPath
+from toptraj.planners.errors import InvalidRequest, WrongLength
+from toptraj.planners.paths.base import GeometricPath
 
 
 def finite_vector(value, name: str, length: int) -> np.ndarray:

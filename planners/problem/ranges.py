@@ -17,13 +17,13 @@ import math
 
 import numpy as np
 
-from planners.errors import InvalidRequest, OutOfRange
-from robots.ranges import ACCELERATION as ACCELERATION
-from robots.ranges import JERK as JERK
-from robots.ranges import LIMITS as LIMITS
-from robots.ranges import TORQUE as TORQUE
-from robots.ranges import VELOCITY as VELOCITY
-from robots.ranges import Range as Range
+from toptraj.planners.errors import InvalidRequest, OutOfRange
+from toptraj.robots.ranges import ACCELERATION as ACCELERATION
+from toptraj.robots.ranges import JERK as JERK
+from toptraj.robots.ranges import LIMITS as LIMITS
+from toptraj.robots.ranges import TORQUE as TORQUE
+from toptraj.robots.ranges import VELOCITY as VELOCITY
+from toptraj.robots.ranges import Range as Range
 
 #: Joint coordinates (rad or m): a continuous joint may turn many times, not 1e300.
 COORDINATE = Range(0.0, 1e4, "rad or m")
@@ -32,7 +32,7 @@ DURATION = Range(1e-3, 1e4, "s")
 #: Sample period of the returned trajectory (s): 1 MHz is faster than any drive's loop.
 DT = Range(1e-6, 10.0, "s")
 #: Per-joint limit overrides and the magnitude of boundary states (rad or m, per s^k) lie in
-#: the ranges of the robots' own limits: ``robots.ranges`` VELOCITY, ACCELERATION, JERK, TORQUE.
+#: the ranges of the robots' own limits: ``toptraj.robots.ranges`` VELOCITY, ACCELERATION, JERK, TORQUE.
 
 #: Tool-speed limits (m/s, rad/s).
 TOOL_SPEED = Range(1e-6, 1e3, "m/s")
@@ -66,7 +66,7 @@ def check_vector(values, field: str, accepted: Range, signed: bool = False) -> N
 
 
 def check_timing(timing, dt: float) -> None:
-    """Hold every number of a ``planners.problem.requests.Timing`` and the sample period ``dt`` to its
+    """Hold every number of a ``toptraj.planners.problem.requests.Timing`` and the sample period ``dt`` to its
     range (OutOfRange naming the field and the range otherwise)."""
     check(dt, "sampling.dt", DT)
     if timing.duration is not None:

@@ -8,17 +8,17 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from planners.constraints.path_constraints import CONSTRAINT_KINDS
-from planners.errors import Conflicting, InvalidRequest, NotOneOf, NotServed, OutOfRange
-from planners.generators.search.graph import SearchOptions
-from planners.generators.search.method import SearchMethod
-from planners.timing import METHODS
-from planners.timing.base import TimingMethod
-from planners.timing.collocation_method import CollocationMethod
-from planners.timing.laws.method import ClassicalMethod
-from planners.timing.laws.profiles import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
-from planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
-from planners.timing.min_cost import MinCostMethod
+from toptraj.planners.constraints.path_constraints import CONSTRAINT_KINDS
+from toptraj.planners.errors import Conflicting, InvalidRequest, NotOneOf, NotServed, OutOfRange
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.method import SearchMethod
+from toptraj.planners.timing import METHODS
+from toptraj.planners.timing.base import TimingMethod
+from toptraj.planners.timing.collocation_method import CollocationMethod
+from toptraj.planners.timing.laws.method import ClassicalMethod
+from toptraj.planners.timing.laws.profiles import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
+from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
+from toptraj.planners.timing.min_cost import MinCostMethod
 
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
 #: default path tolerance of MoveIt's time-optimal trajectory generation.
@@ -46,7 +46,7 @@ class Timing:
     """How to time the path.
 
     Attributes:
-        method: A ``timing.method`` name (see ``planners.timing.METHODS``).
+        method: A ``timing.method`` name (see ``toptraj.planners.timing.METHODS``).
         constraints: Which limits to respect, among velocity, acceleration and torque.
         limit_overrides: Per-joint replacements, keys ``velocity``, ``acceleration``, ``jerk``,
             ``torque``.
@@ -62,12 +62,12 @@ class Timing:
         trapezoid_blend: ``"linear"`` (constant acceleration, Angeles 6.1) or ``"cycloidal"``
             (cycloidal blends, Angeles 6.3) for the trapezoidal law's speed ramps.
         supporting_points: For a time law, approximate it by the cubic spline through this many
-            equally spaced points of it (Angeles 6.1 (c), ``planners.timing.laws.splines``);
+            equally spaced points of it (Angeles 6.1 (c), ``toptraj.planners.timing.laws.splines``);
             ``None``: the law itself.
         synchronization: For a time law on a straight joint move (two waypoints):
             ``"normalized"`` times the straight joint line as one, every joint starting and
             stopping together; ``"none"`` runs every joint at its own full speed to its goal
-            (lecture "Trajectory Planning"; ``planners.generators.unsynchronized``).
+            (lecture "Trajectory Planning"; ``toptraj.planners.generators.unsynchronized``).
         torque_weight: beta of the cost integral of (1 + beta |tau|^2) dt, in 1/(N m)^2, for
             ``min_cost``.
         limit_margin: Fraction of every velocity, acceleration, jerk, torque and tool-speed
@@ -78,7 +78,7 @@ class Timing:
         tool_angular_speed: Largest angular speed of the tool frame, rad/s; ``None``: none.
         tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
         search: Options of the global search (``timing.method = "search"``); ``None``: the
-            defaults of ``planners.generators.search.SearchOptions``.
+            defaults of ``toptraj.planners.generators.search.SearchOptions``.
     """
 
     method: str = "phase_plane"

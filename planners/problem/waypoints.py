@@ -1,6 +1,6 @@
 """Joint waypoints as a request gives them: checked against the robot, repeats dropped, and
 turned into a geometric path (spline, stop-and-go or blended; via points are timed and shaped together
-in ``planners.generators.via_points``, Cartesian lines in ``planners.paths.cartesian``)."""
+in ``toptraj.planners.generators.via_points``, Cartesian lines in ``toptraj.planners.paths.cartesian``)."""
 
 from __future__ import annotations
 
@@ -8,15 +8,15 @@ import dataclasses
 
 import numpy as np
 
-from planners.errors import Conflicting, InvalidRequest, NotOneOf, OutOfRange, TooLarge, WrongLength
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.paths import GeometricPath, SplinePath, StopAndGoPath
-from planners.paths.blended import BlendedPath
-from planners.paths.cartesian import CartesianLine, cartesian_path
-from planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
-from planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
-from robots import Robot
-from robots.notes import Note
+from toptraj.planners.errors import Conflicting, InvalidRequest, NotOneOf, OutOfRange, TooLarge, WrongLength
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.paths import GeometricPath, SplinePath, StopAndGoPath
+from toptraj.planners.paths.blended import BlendedPath
+from toptraj.planners.paths.cartesian import CartesianLine, cartesian_path
+from toptraj.planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
+from toptraj.planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
+from toptraj.robots import Robot
+from toptraj.robots.notes import Note
 
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath, "blend": BlendedPath}
 MAX_WAYPOINTS = 1_000

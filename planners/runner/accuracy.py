@@ -6,7 +6,7 @@ or min_cost's cost with a torque weight) differs from the converged one (the lim
 interval goes to zero) by a discretization error. Each answer states an estimate of that
 relative error, found independently of the solve:
 
-* ``phase_plane``: its own refinement estimate (``planners.timing.phase_plane.method.GAP_BASIS``): the
+* ``phase_plane``: its own refinement estimate (``toptraj.planners.timing.phase_plane.method.GAP_BASIS``): the
   conservative discretization against the second-order midpoint one on the same grid, plus the
   switches and chords neither sees. No extra solve.
 * ``toppra``, ``min_cost`` with beta = 0: the phase-plane method on the same constraints, a
@@ -16,7 +16,7 @@ relative error, found independently of the solve:
   kept). The scheme is first order in the interval length h, J(h) = J* + C h, so the answer's
   error J(h) - J* is about J(2h) - J(h) (the Richardson difference).
 
-The policy (``finer_constraints``, applied by ``planners.checks.gate.gated``): for a time-optimal method
+The policy (``finer_constraints``, applied by ``toptraj.planners.checks.gate.gated``): for a time-optimal method
 on its default grid, an estimate above ``GAP_TARGET`` refines the grid where the phase-plane
 method's refinement put its points (the intervals that carry the error), within the method's grid
 cap and the time budget, and solves again; the finer answer replaces the first only when it too
@@ -31,16 +31,16 @@ import math
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.execution.deadline import Deadline
-from planners.paths.grid import MAX_POINTS, on_points
-from planners.results import Accuracy
-from planners.timing.base import GAP_TARGET, Boundary, PathTiming, TimeScaling, TimingMethod
-from planners.timing.phase_plane.method import GAP_BASIS as PHASE_PLANE_BASIS
-from planners.timing.phase_plane.method import PhasePlaneMethod
-from planners.timing.scaled import solve_well_scaled
-from robots.notes import Note
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.paths.grid import MAX_POINTS, on_points
+from toptraj.planners.results import Accuracy
+from toptraj.planners.timing.base import GAP_TARGET, Boundary, PathTiming, TimeScaling, TimingMethod
+from toptraj.planners.timing.phase_plane.method import GAP_BASIS as PHASE_PLANE_BASIS
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.planners.timing.scaled import solve_well_scaled
+from toptraj.robots.notes import Note
 
 #: Refinements of the grid for accuracy, each followed by a solve.
 REFINE_ROUNDS = 2

@@ -1,7 +1,7 @@
 """Timing a given path: each stretch between corners through the limit gate, via points, and
 joints moving on their own; the grid, the boundary and the checks every one of them shares.
 
-A ``Timed`` is what ``planners.plan`` turns into the answer: the path, its timing, its stretches
+A ``Timed`` is what ``toptraj.planners.plan`` turns into the answer: the path, its timing, its stretches
 as they were timed and checked, and what to tell about it.
 """
 
@@ -11,20 +11,20 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.checks.gate import TimedStretch, checked, gated
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import Conflicting, InfeasiblePath, NotServed, OutsideJointRange
-from planners.generators.unsynchronized import unsynchronized_trajectory
-from planners.generators.via_points import via_point_trajectory
-from planners.paths import GeometricPath
-from planners.paths.grid import path_grid
-from planners.paths.stretch import Stretch, stretches
-from planners.problem.boundary import path_acceleration, path_speed
-from planners.problem.requests import Timing, WaypointPath
-from planners.problem.waypoints import checked_waypoints
-from planners.timing.base import Boundary, PathTiming, TimingMethod
-from planners.timing.segmented import SegmentedTiming
-from robots import Robot
+from toptraj.planners.checks.gate import TimedStretch, checked, gated
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import Conflicting, InfeasiblePath, NotServed, OutsideJointRange
+from toptraj.planners.generators.unsynchronized import unsynchronized_trajectory
+from toptraj.planners.generators.via_points import via_point_trajectory
+from toptraj.planners.paths import GeometricPath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.paths.stretch import Stretch, stretches
+from toptraj.planners.problem.boundary import path_acceleration, path_speed
+from toptraj.planners.problem.requests import Timing, WaypointPath
+from toptraj.planners.problem.waypoints import checked_waypoints
+from toptraj.planners.timing.base import Boundary, PathTiming, TimingMethod
+from toptraj.planners.timing.segmented import SegmentedTiming
+from toptraj.robots import Robot
 
 
 def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:
@@ -100,7 +100,7 @@ class Timed(NamedTuple):
     switching_times: dict | None = None
     #: For a method that finds the motion itself (a free path): the estimated relative gap of
     #: its objective to the optimum of its own problem, and how it was estimated; ``None`` when
-    #: the answer's accuracy is that of its path's timing (``planners.runner.accuracy``).
+    #: the answer's accuracy is that of its path's timing (``toptraj.planners.runner.accuracy``).
     motion_gap: tuple[float | None, str] | None = None
 
 

@@ -9,28 +9,28 @@ import dataclasses
 
 import numpy as np
 
-from planners.checks.gate import TimedStretch, checked, gated
-from planners.collision import check_clearance
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import Conflicting, InfeasiblePath, NotServed, OutOfRange, OverMemory
-from planners.execution.deadline import Deadline
-from planners.execution.isolated import LOW_PRIORITY, run_isolated
-from planners.generators.collocation import FreeMotion, collocation_path, optimize_motion
-from planners.generators.collocation.switching import refine_collocation, switched_path, switching_times
-from planners.generators.search.curve import GridSplinePath
-from planners.generators.search.graph import DEFAULT_OPTIONS
-from planners.generators.search.local import optimize_locally
-from planners.generators.search.local_outcome import LocalOptimum
-from planners.generators.search.memory import check_search_memory
-from planners.generators.search.method import global_search
-from planners.paths import GeometricPath
-from planners.paths.grid import path_grid
-from planners.problem.requests import Timing
-from planners.runner.given_path import Timed, moving_velocity, path_boundary, timed_path, timing_grid
-from planners.timing.base import GAP_TARGET
-from planners.timing.min_cost import MinCostMethod
-from planners.timing.phase_plane.method import PhasePlaneMethod
-from robots.notes import Note
+from toptraj.planners.checks.gate import TimedStretch, checked, gated
+from toptraj.planners.collision import check_clearance
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import Conflicting, InfeasiblePath, NotServed, OutOfRange, OverMemory
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
+from toptraj.planners.generators.collocation import FreeMotion, collocation_path, optimize_motion
+from toptraj.planners.generators.collocation.switching import refine_collocation, switched_path, switching_times
+from toptraj.planners.generators.search.curve import GridSplinePath
+from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS
+from toptraj.planners.generators.search.local import optimize_locally
+from toptraj.planners.generators.search.local_outcome import LocalOptimum
+from toptraj.planners.generators.search.memory import check_search_memory
+from toptraj.planners.generators.search.method import global_search
+from toptraj.planners.paths import GeometricPath
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.problem.requests import Timing
+from toptraj.planners.runner.given_path import Timed, moving_velocity, path_boundary, timed_path, timing_grid
+from toptraj.planners.timing.base import GAP_TARGET
+from toptraj.planners.timing.min_cost import MinCostMethod
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.robots.notes import Note
 
 #: Most collocation intervals a request may ask for (timing.grid_points).
 MAX_INTERVALS = 100
@@ -122,7 +122,7 @@ def timed_free_motion(robot, spec, method, timing, kinds, limits, deadline, thre
 
 
 def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, deadline):
-    """The time-optimal free motion with exact bang-bang torques (``planners.generators.collocation.switching``)
+    """The time-optimal free motion with exact bang-bang torques (``toptraj.planners.generators.collocation.switching``)
     in place of ``timed`` (path, timing, stretch) when it reaches the goal, is not longer and
     passes the limit gate; with its switching times (else ``None``). The collocation's rivals
     (``CollocationResult.rivals``) are refined too and the shortest refined motion wins; the
@@ -148,15 +148,15 @@ def _switched(robot, spec, collocation, timed, kinds, limits, threshold, notes, 
 
 
 def timed_search(robot, spec, timing, kinds, limits, deadline, threshold, obstacles, clearance) -> Timed:
-    """The global search (``planners.generators.search``, Jeong & Lee section 2): the best grid path of
+    """The global search (``toptraj.planners.generators.search``, Jeong & Lee section 2): the best grid path of
     each tube, then each one's local optimization (section 2.6) within its share of the budget;
     the fastest optimized path that keeps the clearance is timed by phase_plane through the
     limit gate. The grid path's own curve stands in where its optimization finds nothing.
 
-    The search's memory is estimated from its settings first (``planners.generators.search.memory``,
+    The search's memory is estimated from its settings first (``toptraj.planners.generators.search.memory``,
     ``OverMemory`` beyond ``timing.search.memory_bytes``). Under a deadline the whole search
-    runs in a worker process (``planners.execution.isolated``) at a lower CPU priority
-    (``planners.execution.isolated.LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
+    runs in a worker process (``toptraj.planners.execution.isolated``) at a lower CPU priority
+    (``toptraj.planners.execution.isolated.LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
     killed when the budget is spent or the caller cancels, its memory gone with it."""
     if not isinstance(spec, FreeMotion):
         raise NotServed("method", "search", "search", rule="search_needs_free_path")

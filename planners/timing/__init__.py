@@ -1,12 +1,12 @@
 """Timing methods: each reads ``PathConstraints`` and returns a ``TimeScaling``."""
 
-from planners.timing.base import TimeScaling, TimingMethod
-from planners.timing.jerk.method import JerkLimitedMethod
-from planners.timing.laws.method import ClassicalMethod, classical_methods
-from planners.timing.min_cost import MinCostMethod
-from planners.timing.phase_plane.method import PhasePlaneMethod
-from planners.timing.ruckig_method import RuckigMethod
-from planners.timing.toppra_method import ToppraMethod
+from toptraj.planners.timing.base import TimeScaling, TimingMethod
+from toptraj.planners.timing.jerk.method import JerkLimitedMethod
+from toptraj.planners.timing.laws.method import ClassicalMethod, classical_methods
+from toptraj.planners.timing.min_cost import MinCostMethod
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.planners.timing.ruckig_method import RuckigMethod
+from toptraj.planners.timing.toppra_method import ToppraMethod
 
 #: ``timing.method`` name -> method.
 METHODS: dict[str, TimingMethod] = {

@@ -7,17 +7,18 @@ from __future__ import annotations
 import abc
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import ClassVar, Literal
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.state_kernels import grid_states
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.state_kernels import grid_states
 
 #: Largest estimated relative gap to the converged optimum that a time-optimal answer carries
 #: without being refined further or, when it cannot be, without a warning that gives the figure
-#: (``PathTiming.optimality_gap``; the policy in ``planners.runner.accuracy``).
+#: (``PathTiming.optimality_gap``; the policy in ``toptraj.planners.runner.accuracy``).
 GAP_TARGET = 1e-3
 
 
@@ -206,6 +207,8 @@ class TimingMethod(abc.ABC):
     """A way to time a path: reads ``PathConstraints``, returns a ``PathTiming``.
 
     Attributes:
+        family: ``"timing"``: the family of methods that time a given path (the other,
+            ``"generator"``, finds the motion itself: ``toptraj.planners.problem.methods``).
         name: The ``timing.method`` name.
         kinds: The limit kinds the method can respect.
         takes_duration: Whether a requested duration is honoured.
@@ -215,13 +218,14 @@ class TimingMethod(abc.ABC):
         continuous_acceleration: Whether the method's path acceleration is continuous, so that
             the jerk of its samples (by finite differences) is checked against a jerk limit too.
         absolute_tolerances: Whether the method's solver works with absolute tolerances, so
-            that it needs path speeds of order one (``planners.timing.scaled``).
+            that it needs path speeds of order one (``toptraj.planners.timing.scaled``).
         grid_budget: The largest grid the method serves, in grid intervals times joints: its
             memory grows with both (about 1.3 kB per interval and joint for phase_plane,
             2.3 kB for toppra, 9 kB for min_cost; ``benchmarks/budgets.py``). 140,000 is
             20,000 intervals on a 7-joint arm, about 300 MB at most.
     """
 
+    family: ClassVar[Literal["timing"]] = "timing"
     name: str
     kinds: frozenset[str] = frozenset({"velocity", "acceleration", "torque"})
     required_kinds: frozenset[str] = frozenset()

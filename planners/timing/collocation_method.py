@@ -1,16 +1,16 @@
 """``collocation``: the name under which a free motion is optimized (path and timing together,
-``planners.generators.collocation``). It does not time a given path, so ``solve`` refuses one."""
+``toptraj.planners.generators.collocation``). It does not time a given path, so ``solve`` refuses one."""
 
 from __future__ import annotations
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import NotServed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import NotServed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
 
 
 class CollocationMethod(TimingMethod):
-    """Direct collocation of path and timing from start to goal (see ``planners.generators.collocation``)."""
+    """Direct collocation of path and timing from start to goal (see ``toptraj.planners.generators.collocation``)."""
 
     name = "collocation"
     kinds = frozenset({"velocity", "acceleration", "torque"})

@@ -23,12 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.constraints.admissible import friction_reference
-from planners.constraints.path_constraints import LinearRows, PathConstraints
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.execution.isolated import LOW_PRIORITY, run_isolated
-from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from toptraj.planners.constraints.admissible import friction_reference
+from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
+from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
 
 
 @dataclass(frozen=True)

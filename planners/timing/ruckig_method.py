@@ -17,10 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import InfeasiblePath, NotServed, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.base import AT_REST, Boundary, DenseStates, PathTiming, TimingMethod
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import AT_REST, Boundary, DenseStates, PathTiming, TimingMethod
 
 #: Stand-in for an unlimited bound (ruckig needs finite numbers).
 _UNLIMITED = 1e12

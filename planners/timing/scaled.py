@@ -14,10 +14,10 @@ import dataclasses
 
 import numpy as np
 
-from planners.constraints.admissible import speed_scale
-from planners.constraints.path_constraints import PathConstraints
-from planners.execution.deadline import Deadline
-from planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
+from toptraj.planners.constraints.admissible import speed_scale
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
 
 #: Typical x within this factor of 1 is solved as it is.
 _WELL_SCALED = 1e2

@@ -1,7 +1,7 @@
 """``SegmentedTiming``: one s(t) made of the timings of a path's stretches between corners.
 
 Each stretch [a_k, b_k] of the path is timed in its own parameter sigma in [0, 1]
-(``planners.paths.stretch``), s = a_k + w_k sigma with w_k = b_k - a_k, so
+(``toptraj.planners.paths.stretch``), s = a_k + w_k sigma with w_k = b_k - a_k, so
 
     s-dot = w_k sigma-dot,  s-ddot = w_k sigma-ddot,  s-dddot = w_k sigma-dddot,
 
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.timing.base import Binding, DenseStates, PathTiming
+from toptraj.planners.timing.base import Binding, DenseStates, PathTiming
 
 
 @dataclass(frozen=True)

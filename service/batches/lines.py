@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import orjson
 
-from robots.errors import excerpt
+from toptraj.robots.errors import excerpt
 
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000

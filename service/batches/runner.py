@@ -31,9 +31,9 @@ from typing import Any, TextIO
 
 import orjson
 
-import robots
-from robots.catalog import is_catalog_robot
-from service.batches.lines import ForeignOutput, problem_body, read_requests, result_line, resume_output
+from toptraj import robots
+from toptraj.robots.catalog import is_catalog_robot
+from toptraj.service.batches.lines import ForeignOutput, problem_body, read_requests, result_line, resume_output
 
 #: Requests per Ray task.
 CHUNK = 4
@@ -119,7 +119,7 @@ class RayPool:
             import ray
         except ImportError:
             raise RayMissing(RAY_MISSING) from None
-        from service.batches.work import answer_chunk
+        from toptraj.service.batches.work import answer_chunk
 
         self._ray = ray
         self._started_here = False

@@ -1,5 +1,5 @@
 """One request answered as the service answers it, on whichever process runs it (a Ray
-worker): the same schemas and the same path through ``service.planning``, so a batch's result
+worker): the same schemas and the same path through ``toptraj.service.planning``, so a batch's result
 equals the synchronous endpoint's answer."""
 
 from __future__ import annotations
@@ -10,14 +10,14 @@ import tempfile
 import orjson
 from pydantic import ValidationError
 
-import robots
-from planners.execution.deadline import Deadline
-from robots import ToptrajError
-from robots.upload_options import UploadOptions
-from service.batches.lines import problem_body
-from service.errors import detail, status_of, title_of, validation_problem
-from service.planning import compare_request, encode_json, plan_request, render
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj import robots
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.robots import ToptrajError
+from toptraj.robots.upload_options import UploadOptions
+from toptraj.service.batches.lines import problem_body
+from toptraj.service.errors import detail, status_of, title_of, validation_problem
+from toptraj.service.planning import compare_request, encode_json, plan_request, render
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 logger = logging.getLogger("toptraj.batches")
 

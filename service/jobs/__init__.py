@@ -3,20 +3,20 @@
 
 from __future__ import annotations
 
-from service.jobs.runner import JobRunner
-from service.jobs.store import JobStore
-from service.jobs.work import WorkerSetup
+from toptraj.service.jobs.runner import JobRunner
+from toptraj.service.jobs.store import JobStore
+from toptraj.service.jobs.work import WorkerSetup
 
-#: Modules the fork server imports for the job workers (``planners.execution.isolated.PRELOAD`` has the
+#: Modules the fork server imports for the job workers (``toptraj.planners.execution.isolated.PRELOAD`` has the
 #: solver stacks), so that a job's process neither imports the web stack (1 to 2 s) nor loads
 #: the compiled kernels (0.5 s) again.
-JOB_MODULES = ("service.jobs.preload",)
+JOB_MODULES = ("toptraj.service.jobs.preload",)
 
 __all__ = ["JOB_MODULES", "JobRunner", "JobStore", "WorkerSetup", "job_runner"]
 
 
 def job_runner(settings) -> JobRunner:
-    """The job runner of a service with ``settings`` (``service.settings.Settings``), on the
+    """The job runner of a service with ``settings`` (``toptraj.service.settings.Settings``), on the
     job store in its data directory."""
     store = JobStore(settings.data_dir, settings.max_jobs, settings.job_max_age_s, settings.max_job_store_bytes)
     setup = WorkerSetup(

@@ -8,9 +8,9 @@ import logging
 
 import numpy as np
 
-import robots
-from planners import Timing, WaypointPath, plan
-from service.jobs import work  # noqa: F401
+from toptraj import robots
+from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.service.jobs import work  # noqa: F401
 
 
 def _warm_up() -> None:

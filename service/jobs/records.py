@@ -1,4 +1,4 @@
-"""What the job store (``service.jobs.store``) holds and answers: a job's record, a job a runner
+"""What the job store (``toptraj.service.jobs.store``) holds and answers: a job's record, a job a runner
 has claimed, the owner string that names a job's runner (host|pid|token) and whether that
 runner is known to be gone, and the store's errors (each with its HTTP status).
 """
@@ -10,7 +10,7 @@ import os
 import socket
 from dataclasses import dataclass
 
-from robots.errors import ToptrajError
+from toptraj.robots.errors import ToptrajError
 
 
 class JobStoreUnavailable(ToptrajError):
@@ -45,7 +45,7 @@ class Job:
     Attributes:
         id: 32 hex digits.
         kind: What it computes: "trajectory" or "compare".
-        status: One of ``service.jobs.store.STATUSES``.
+        status: One of ``toptraj.service.jobs.store.STATUSES``.
         fraction: Progress in [0, 1].
         stage: What is under way, e.g. "collocation: guess 3 of 15".
         budget_s: Computing time allowed once running, s.

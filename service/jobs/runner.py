@@ -4,7 +4,7 @@ cancelled job.
 
 * At most ``workers`` jobs run at once in all the processes sharing the store (the claim
   counts the running jobs in the same transaction); the rest wait, queued.
-* Each job runs ``work.compute`` through ``planners.execution.isolated.run_isolated``: a process forked
+* Each job runs ``work.compute`` through ``toptraj.planners.execution.isolated.run_isolated``: a process forked
   from the fork server, killed when the job is cancelled, when its budget (plus ``GRACE_S``) is
   spent, or when this server stops. The job thread of this process only waits on its pipe.
 * Progress reports come over that pipe and are written to the store at most every
@@ -26,14 +26,14 @@ import time
 import uuid
 from dataclasses import dataclass, field
 
-from planners import Deadline
-from planners.errors import BudgetExceeded
-from planners.execution.isolated import run_isolated
-from robots.errors import ToptrajError
-from service.errors import detail, status_of, title_of
-from service.jobs import work
-from service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
-from service.jobs.store import JobStore
+from toptraj.planners import Deadline
+from toptraj.planners.errors import BudgetExceeded
+from toptraj.planners.execution.isolated import run_isolated
+from toptraj.robots.errors import ToptrajError
+from toptraj.service.errors import detail, status_of, title_of
+from toptraj.service.jobs import work
+from toptraj.service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
+from toptraj.service.jobs.store import JobStore
 
 logger = logging.getLogger("toptraj.jobs")
 

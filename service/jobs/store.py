@@ -28,8 +28,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from robots.errors import excerpt
-from service.jobs.records import ClaimedJob, Job, JobEnded, JobQueueFull, JobStoreUnavailable, owner_is_gone
+from toptraj.robots.errors import excerpt
+from toptraj.service.jobs.records import ClaimedJob, Job, JobEnded, JobQueueFull, JobStoreUnavailable, owner_is_gone
 
 DATABASE = "jobs.sqlite3"
 STATUSES = ("queued", "running", "done", "failed", "cancelled", "interrupted")
@@ -171,6 +171,14 @@ class JobStore:
                 return None
             row = connection.execute("SELECT result FROM jobs WHERE id = ? AND status = 'done'", (job_id,)).fetchone()
         return None if row is None else bytes(row[0])
+
+    def request(self, job_id: str) -> str | None:
+        """The validated request (JSON) of job ``job_id``, ``None`` when there is none."""
+        with self._connect(write=False) as connection:
+            if connection is None:
+                return None
+            row = connection.execute("SELECT request FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        return None if row is None else str(row[0])
 
     def jobs(self, limit: int, before: int | None = None, status: str | None = None) -> list[Job]:
         """At most ``limit`` jobs, newest first, submitted before the job of sequence number

@@ -6,7 +6,7 @@ progress through ``deadline.progress`` and never knows it runs as a job. A kind 
 requests (a batch) is one more entry: it loops over its requests (or hands them to other
 workers) and reports "request k of n".
 
-``compute`` runs in a process forked from the fork server (``planners.execution.isolated``), which shares
+``compute`` runs in a process forked from the fork server (``toptraj.planners.execution.isolated``), which shares
 no module state with the server: the upload store and the body cap reach it in ``WorkerSetup``.
 """
 
@@ -16,13 +16,13 @@ from dataclasses import dataclass
 
 import orjson
 
-import robots
-from planners import Deadline
-from planners.execution.deadline import Progress
-from planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-from service.errors import RequestRefused
-from service.planning import compare_request, encode_json, plan_request, render
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj import robots
+from toptraj.planners import Deadline
+from toptraj.planners.execution.deadline import Progress
+from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.service.errors import RequestRefused
+from toptraj.service.planning import compare_request, encode_json, plan_request, render
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 
 @dataclass(frozen=True)
@@ -63,7 +63,7 @@ def _batch(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
 
 
 def _not_reached(budget_s: float | None) -> tuple[int, bytes]:
-    from service.batches.lines import problem_body
+    from toptraj.service.batches.lines import problem_body
 
     detail = f"the batch's time budget of {budget_s:g} s was spent before this request was planned; submit it again, or the batch with a larger budget_s"
     return 504, problem_body(504, "Time budget exceeded", detail)
@@ -76,7 +76,7 @@ def _line_budget(deadline: Deadline) -> float:
 
 
 def _here(texts: list[str], deadline: Deadline) -> list[tuple[int, bytes]]:
-    from service.batches.work import answer
+    from toptraj.service.batches.work import answer
 
     answers = []
     for k, text in enumerate(texts):
@@ -89,8 +89,8 @@ def _here(texts: list[str], deadline: Deadline) -> list[tuple[int, bytes]]:
 def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tuple[int, bytes]]:
     import ray
 
-    from service.batches.runner import _uploads_named
-    from service.batches.work import answer_chunk
+    from toptraj.service.batches.runner import _uploads_named
+    from toptraj.service.batches.work import answer_chunk
 
     if not ray.is_initialized():
         ray.init(address=None if setup.ray_address == "local" else setup.ray_address, log_to_driver=False, configure_logging=False)
@@ -116,7 +116,7 @@ def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tu
 
 
 def _worker_failed(error: BaseException) -> bytes:
-    from service.batches.lines import problem_body
+    from toptraj.service.batches.lines import problem_body
 
     return problem_body(500, "Worker failed", f"the worker planning this request failed ({type(error).__name__}); submit it again")
 

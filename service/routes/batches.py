@@ -1,4 +1,4 @@
-"""``POST /v1/batches``: many requests as one job (``service.jobs``, kind ``batch``), answered
+"""``POST /v1/batches``: many requests as one job (``toptraj.service.jobs``, kind ``batch``), answered
 by ``GET /v1/jobs/{id}`` like any job: in the server's own job worker process, or on the Ray
 cluster the server is configured with (``TOPTRAJ_RAY_ADDRESS``). For thousands of requests,
 ``toptraj batch`` on a file is the tool."""
@@ -11,10 +11,10 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
 from pydantic import ValidationError
 
-from service.errors import RequestRefused
-from service.routes.jobs import _job_response, _problem
-from service.schemas.jobs import BatchCreate, JobPublic
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.errors import RequestRefused
+from toptraj.service.routes.jobs import _job_response, _problem
+from toptraj.service.schemas.jobs import BatchCreate, JobPublic
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 router = APIRouter(prefix="/v1/batches", tags=["jobs"])
 

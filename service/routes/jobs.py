@@ -13,13 +13,13 @@ from fastapi.responses import Response
 from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from robots.errors import ToptrajError, excerpt
-from service.errors import RequestRefused
-from service.jobs.records import Job, JobEnded
-from service.jobs.store import JobStore
-from service.problem_docs import PROBLEM_JSON, problem_responses
-from service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
+from toptraj import robots
+from toptraj.robots.errors import ToptrajError, excerpt
+from toptraj.service.errors import RequestRefused
+from toptraj.service.jobs.records import Job, JobEnded
+from toptraj.service.jobs.store import JobStore
+from toptraj.service.problem_docs import PROBLEM_JSON, problem_responses
+from toptraj.service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
 
 router = APIRouter(prefix="/v1/jobs", tags=["jobs"])
 

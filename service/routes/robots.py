@@ -9,13 +9,13 @@ import numpy as np
 from fastapi import APIRouter, Response
 from starlette.concurrency import run_in_threadpool
 
-import robots
-from planners.kinematics.skeleton import skeleton
-from robots.limits import LIMIT_KINDS
-from robots.upload_options import upload_options
-from service.errors import RequestRefused
-from service.problem_docs import problem_responses
-from service.schemas.robots import (
+from toptraj import robots
+from toptraj.planners.kinematics.skeleton import skeleton
+from toptraj.robots.limits import LIMIT_KINDS
+from toptraj.robots.upload_options import upload_options
+from toptraj.service.errors import RequestRefused
+from toptraj.service.problem_docs import problem_responses
+from toptraj.service.schemas.robots import (
     RobotCreate,
     RobotLimits,
     RobotLimitSources,

@@ -7,11 +7,11 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
-from service.planning import compare_request, encode_json, heavy_request, plan_request, render, worth_a_leash
-from service.problem_docs import problem_responses
-from service.schemas.answers import CompareResponse, TrajectoryResponse
-from service.schemas.examples import openapi_examples
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.planning import compare_request, encode_json, heavy_request, plan_request, render, worth_a_leash
+from toptraj.service.problem_docs import problem_responses
+from toptraj.service.schemas.answers import CompareResponse, TrajectoryResponse
+from toptraj.service.schemas.examples import openapi_examples
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
 

@@ -8,12 +8,12 @@ from importlib import resources
 from fastapi import APIRouter, HTTPException
 from fastapi.responses import FileResponse, HTMLResponse
 
-from service.web import STATIC
+from toptraj.service.web import STATIC
 
 router = APIRouter(include_in_schema=False)
 
 #: Files of the page, by the name it loads them under, and their media types.
-_FILES = {"app.js": "text/javascript", "style.css": "text/css"}
+_FILES = {"app.js": "text/javascript", "draw.js": "text/javascript", "exports.js": "text/javascript", "style.css": "text/css"}
 _CACHE = {"Cache-Control": "public, max-age=3600"}
 
 

@@ -1,5 +1,5 @@
 """Schemas of the answers of ``POST /v1/trajectories`` and ``POST /v1/trajectories/compare``
-(DESIGN.md, HTTP contract); the requests are ``service.schemas.trajectories``."""
+(DESIGN.md, HTTP contract); the requests are ``toptraj.service.schemas.trajectories``."""
 
 from __future__ import annotations
 
@@ -167,7 +167,7 @@ class TrajectoryResponse(BaseModel):
         "at which its saturated torque changes sides, in increasing order; solver.switching says whether "
         "they were refined (exact bang-bang controls) or read off the samples.",
     )
-    solve_ms: float = Field(description="Planning time in the library (ms).")
+    solve_ms: float = Field(description="Time spent planning (ms), without reading the request nor writing the answer.")
     min_clearance: ClearancePublic | None = Field(
         default=None, description="With path.obstacles: the closest approach of any link to any obstacle."
     )

@@ -10,7 +10,7 @@ from annotated_types import GroupedMetadata
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, WithJsonSchema
 from pydantic_core import PydanticCustomError
 
-from planners.problem.ranges import Range
+from toptraj.planners.problem.ranges import Range
 
 
 class Schema(BaseModel):

@@ -8,9 +8,9 @@ from typing import Literal
 
 from pydantic import BaseModel, Field, model_validator
 
-from service.schemas.answers import CompareResponse, TrajectoryResponse
-from service.schemas.common import Problem, Schema
-from service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.schemas.answers import CompareResponse, TrajectoryResponse
+from toptraj.service.schemas.common import Problem, Schema
+from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 JobKind = Literal["trajectory", "compare", "batch"]
 JobStatus = Literal["queued", "running", "done", "failed", "cancelled", "interrupted"]
@@ -42,13 +42,6 @@ class JobCreate(Schema):
             raise ValueError(
                 "give exactly one of `trajectory` (a POST /v1/trajectories body) or `compare` "
                 f"(a POST /v1/trajectories/compare body); got {' and '.join(given) or 'neither'}"
-            )
-        if self.trajectory is not None and self.trajectory.output.format == "csv":
-            raise ValueError(
-                "a job's answer is JSON (it is part of GET /v1/jobs/{id}): set "
-                "trajectory.output.format to \"samples\" or \"joint_trajectory\" (with "
-                "output.exact_period true for samples on whole periods), or ask POST "
-                "/v1/trajectories for CSV"
             )
         return self
 
@@ -127,7 +120,9 @@ class JobPublic(JobSummary):
     """A job, with its answer once done."""
 
     result: TrajectoryResponse | CompareResponse | BatchResponse | None = Field(
-        default=None, description="When done: the very body the synchronous endpoint answers (a batch: every answer)."
+        default=None,
+        description="When done: the very body the synchronous endpoint answers (a batch: every answer); JSON "
+        "here, the samples of a trajectory that asked `csv` included: `GET /v1/jobs/{id}/result` serves them as CSV.",
     )
 
 

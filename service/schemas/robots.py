@@ -6,8 +6,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field
 
-from robots.uploads import MAX_NAME_CHARS, NAME_PATTERN
-from service.schemas.common import Schema
+from toptraj.robots.uploads import MAX_NAME_CHARS, NAME_PATTERN
+from toptraj.service.schemas.common import Schema
 
 MAX_URDF_CHARS = 1_000_000
 

@@ -1,5 +1,5 @@
 """Schemas of the requests of ``POST /v1/trajectories`` and ``POST /v1/trajectories/compare``
-(DESIGN.md, HTTP contract); the answers are ``service.schemas.answers``."""
+(DESIGN.md, HTTP contract); the answers are ``toptraj.service.schemas.answers``."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 from pydantic import Discriminator, Field, Tag
 
-from planners.problem import ranges
-from planners.timing import METHODS
-from planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
-from service.schemas.common import Schema, bounded, signed
+from toptraj.planners.problem import ranges
+from toptraj.planners.timing import METHODS
+from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
+from toptraj.service.schemas.common import Schema, bounded, signed
 
 MAX_WAYPOINTS = 1_000
 MAX_JOINTS = 64
@@ -329,7 +329,9 @@ class OutputRequest(Schema):
             "`samples`: arrays t, q, qd, qdd, tau; `joint_trajectory`: ROS's "
             "trajectory_msgs/JointTrajectory as JSON (joint_names, points with positions, "
             "velocities, accelerations, effort, time_from_start {sec, nanosec}); `csv`: text/csv, "
-            "a header and a row per sample (also chosen by `Accept: text/csv`)."
+            "a header, then the answer's robot, method, durations, peak utilization, binding limit and "
+            "warnings as `# key: value` lines, then a row per sample (also chosen by `Accept: text/csv`; "
+            "read it with pandas' `read_csv(f, comment=\"#\")` or numpy's `loadtxt(f, delimiter=\",\", skiprows=1)`)."
         ),
     )
     exact_period: bool | None = Field(

@@ -1,6 +1,6 @@
 """Free-path motions: the path and its timing optimized together from start to goal."""
 
-from planners.generators.collocation.collocation import collocation_path, optimize_motion
-from planners.generators.collocation.motion import CollocationResult, FreeMotion
+from toptraj.planners.generators.collocation.collocation import collocation_path, optimize_motion
+from toptraj.planners.generators.collocation.motion import CollocationResult
 
-__all__ = ["CollocationResult", "FreeMotion", "collocation_path", "optimize_motion"]
+__all__ = ["CollocationResult", "collocation_path", "optimize_motion"]

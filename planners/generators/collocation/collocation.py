@@ -13,7 +13,7 @@ tau_k = RNEA(q_k, v_k, a_k) from its Pinocchio model (URDF), with exact first de
 Pinocchio's analytical RNEA derivatives. The initial guesses are solved on a coarse grid by
 SLSQP (scipy), a dense sequential quadratic programming method fed with those gradients; the
 best is refined on the requested grid by IPOPT, whose sparse KKT system keeps fine grids and
-many joints affordable (``planners.generators.collocation.sparse``; SLSQP again should IPOPT fail).
+many joints affordable (``toptraj.planners.generators.collocation.sparse``; SLSQP again should IPOPT fail).
 
 Several initial guesses are tried: the straight joint line to the goal and, for continuous
 joints, to the goal shifted by +-2 pi (the elbow turning a full revolution, as in the Geering
@@ -31,16 +31,16 @@ import numpy as np
 import pinocchio as pin
 from scipy.optimize import minimize
 
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline, Progress
-from planners.execution.isolated import LOW_PRIORITY, run_isolated
-from planners.generators.collocation.motion import CollocationResult, FreeMotion
-from planners.generators.collocation.sparse import SparseCollocation, solve_sparse
-from planners.paths.grid import path_grid
-from planners.paths.waypoints import SplinePath
-from planners.timing.phase_plane.method import PhasePlaneMethod
-from robots import JointLimits, Robot
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline, Progress
+from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
+from toptraj.planners.generators.collocation.motion import CollocationResult, FreeMotion
+from toptraj.planners.generators.collocation.sparse import SparseCollocation, solve_sparse
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.paths.waypoints import SplinePath
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.robots import JointLimits, Robot
 
 
 class _Problem:
@@ -284,7 +284,7 @@ def optimize_motion(
 
     SLSQP holds the interpreter for seconds at a time and cannot check a deadline, so under a
     ``deadline`` the optimization runs in a worker process that is killed when it passes
-    (``planners.execution.isolated``), at a lower CPU priority. It reports its progress to ``deadline.progress``: each initial
+    (``toptraj.planners.execution.isolated``), at a lower CPU priority. It reports its progress to ``deadline.progress``: each initial
     guess ("collocation: guess 3 of 15"), then the refinement.
 
     Raises:
@@ -384,7 +384,7 @@ def _optimize_motion(
 def collocation_path(result: CollocationResult):
     """The optimized motion as a path with constant-speed timing: on each interval the exact
     cubic q_k + v_k t + a_k t^2 / 2 + (a_k+1 - a_k) t^3 / (6 h)."""
-    from planners.generators.via_points import ConstantSpeedTiming, ViaPath
+    from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
 
     h = np.diff(result.t)
     jerk_term = (result.a[1:] - result.a[:-1]) / (6 * h[:, None])

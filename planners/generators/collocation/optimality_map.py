@@ -6,7 +6,7 @@ phi_b = 0.76 rad, Type 3 up to 1.76 rad and Type 4 beyond.
 
 Families are discovered by the free-path service itself: the collocation with ``revolutions``
 (the elbow free among its goal and +-2 pi) at a few anchor goals, refined to exact bang-bang
-controls (``planners.generators.collocation.switching``). Each family is then continued in phi_b, every
+controls (``toptraj.planners.generators.collocation.switching``). Each family is then continued in phi_b, every
 motion solved with the family's switching structure from the nearest one already known (steps
 of at most ``CONTINUATION_STEP``); a family ends where its arcs would change order (a structure
 that no longer exists). At each phi_b the fastest family wins, and a boundary between two
@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planners.generators.collocation.collocation import _optimize_motion
-from planners.generators.collocation.motion import FreeMotion
-from planners.generators.collocation.switching import BangBang, refine_collocation, refine_switching
-from robots import Robot
+from toptraj.planners.generators.collocation.collocation import _optimize_motion
+from toptraj.planners.generators.collocation.switching import BangBang, refine_collocation, refine_switching
+from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.robots import Robot
 
 #: Largest step (rad) of phi_b between a family's solution and the next one solved from it.
 CONTINUATION_STEP = 0.1

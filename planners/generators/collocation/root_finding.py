@@ -1,5 +1,5 @@
 """Newton's method on residual functions with a finite-difference Jacobian, for the switching-time
-parameterization of a bang-bang motion (``planners.generators.collocation.switching``, after Jeong & Lee
+parameterization of a bang-bang motion (``toptraj.planners.generators.collocation.switching``, after Jeong & Lee
 section 4.3): the goal equations r(theta) = 0 (2 n_dof of them) in the unknowns theta (the
 switching times and the duration T, in s), solved with some unknowns held, and the shortest T
 along a one-dimensional family of solutions by the secant method on dT/dp, dT/dp from the

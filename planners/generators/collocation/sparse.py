@@ -1,7 +1,7 @@
-"""The collocation NLP of ``planners.generators.collocation.collocation`` solved by IPOPT (Wachter & Biegler,
+"""The collocation NLP of ``toptraj.planners.generators.collocation.collocation`` solved by IPOPT (Wachter & Biegler,
 *Math. Program.* 106, 2006), an interior-point method on the sparse KKT system, through CasADi,
 which ships IPOPT and MUMPS in its wheel and differentiates the problem exactly (Hessian
-included) from ``planners.generators.collocation.symbolic_dynamics``.
+included) from ``toptraj.planners.generators.collocation.symbolic_dynamics``.
 
 The same variables, constraints and cost as the dense problem (``_Problem``): z = [T, q, v, a]
 at K + 1 instants, the exact integration of piecewise-linear accelerations as equalities,
@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
+from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
 
 
 @dataclass(frozen=True)

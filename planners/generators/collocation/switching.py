@@ -3,7 +3,7 @@ parameterization (Jeong & Lee section 4.3, after Geering et al. 1986: the time-o
 of the two-link arm are bang-bang, each torque at one bound or the other between its switching
 times, and the paper's figure captions print those times).
 
-A collocation (``planners.generators.collocation.collocation``) places a switch only between two of its
+A collocation (``toptraj.planners.generators.collocation.collocation``) places a switch only between two of its
 instants: it changes sides somewhere within one interval h = T / K (36 ms at K = 30 on the
 Geering arm), and reading the instant where the interpolated torque crosses zero leaves errors
 of a good part of h. Here the controls are instead exactly bang-bang,
@@ -35,13 +35,13 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import minimize
 
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.collocation.motion import CollocationResult, FreeMotion
-from planners.generators.collocation.root_finding import held_newton, jacobian, newton, secant_minimum
-from planners.generators.via_points import ConstantSpeedTiming, ViaPath
-from robots import JointLimits, Robot
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.collocation.motion import CollocationResult
+from toptraj.planners.generators.collocation.root_finding import held_newton, jacobian, newton, secant_minimum
+from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
+from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.robots import JointLimits, Robot
 
 #: Longest Runge-Kutta step (s) while the switching times are solved for, and of the final
 #: integration of the refined motion.
@@ -259,6 +259,8 @@ def _solve(shooting: _Shooting, seed: BangBang, goal, goal_velocity) -> tuple[Ba
     if free == 1:
         theta, held = secant_minimum(residual, theta)
     elif free > 1:
+        from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
+
         theta = minimize(
             lambda x: x[-1],
             theta,

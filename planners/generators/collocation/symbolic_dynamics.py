@@ -1,5 +1,5 @@
 """Inverse dynamics of a Pinocchio model as a CasADi expression, for sparse nonlinear programs
-(``planners.generators.collocation.sparse``).
+(``toptraj.planners.generators.collocation.sparse``).
 
 The recursive Newton-Euler algorithm (Featherstone, *Rigid Body Dynamics Algorithms*, 2008,
 Table 5.1) in Pinocchio's conventions: spatial motions [v; w] and forces [f; n] in each joint's
@@ -11,7 +11,7 @@ For joint i with parent p, placement M_i in its parent and motion subspace S_i (
     tau_i = S_i^T f_i,     f_p += X_i f_i (children first).
 
 Joints served: 1-DoF revolute (bounded or continuous, any axis) and prismatic joints, the joints
-of every arm the service loads; ``tests/test_sparse_collocation.py`` checks the expression
+of every arm the service loads; ``tests/planners/generators/test_sparse_collocation.py`` checks the expression
 against ``pinocchio.rnea`` at random states. Units: rad (m), rad/s, rad/s^2 in; N m (N) out.
 """
 
@@ -21,7 +21,7 @@ import casadi as ca
 import numpy as np
 import pinocchio as pin
 
-from robots import Robot
+from toptraj.robots import Robot
 
 
 def _skew(w):

@@ -11,11 +11,11 @@ Dubowsky 1991), each a bound on the next, so that t1 <= t2 <= t3 <= t4 = t_opt:
 3. maximum acceleration, velocity limit, maximum deceleration (eq. 2.8): the speed no higher
    than the maximum-acceleration curve from rest at the start, the velocity limit curve, and
    the maximum-deceleration curve into rest at the goal;
-4. t4 = t_opt: the phase-plane timing of the grid path (``planners.timing.phase_plane.method``).
+4. t4 = t_opt: the phase-plane timing of the grid path (``toptraj.planners.timing.phase_plane.method``).
 
 All four are computed in the discretization the phase-plane method uses on the same grid (x =
 sd^2 linear in the curve's parameter over each interval, every limit row held at both ends of it;
-``planners.constraints.admissible_kernels.interval_bounds`` gives the rows of each interval as bounds on u), so each is
+``toptraj.planners.constraints.admissible_kernels.interval_bounds`` gives the rows of each interval as bounds on u), so each is
 a lower bound on the discrete t4 of that grid, which ``grid_path_time`` computes with the
 phase-plane method itself. Viscous friction, which the phase-plane method linearizes, is relaxed
 to the widest bounds it can take below the first-order speed bound. t1 and t2 add up over the
@@ -30,12 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
-from planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
-from planners.generators.search.curve import GridSplinePath
-from planners.generators.search.pieces import INTERVALS, Pieces
-from planners.timing.phase_plane.method import PhasePlaneMethod
-from robots import JointLimits, Robot
+from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
+from toptraj.planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
+from toptraj.planners.generators.search.curve import GridSplinePath
+from toptraj.planners.generators.search.pieces import INTERVALS, Pieces
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.robots import JointLimits, Robot
 
 _INF = np.inf
 #: Rows of limits evaluated between two deadline checks.
@@ -74,7 +74,7 @@ class PieceBounds:
 def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
     """Rows ``a u + b x + c in [lower, upper]`` at configurations q with parameter derivatives
     dq, ddq (each (k, n)), viscous friction relaxed below the speed bound, and that bound
-    x_bound (k,): the rows of ``planners.constraints.path_constraints.build_path_constraints``."""
+    x_bound (k,): the rows of ``toptraj.planners.constraints.path_constraints.build_path_constraints``."""
     x_bound = np.full(len(q), _INF)
     if "velocity" in kinds:
         x_bound = speed_bound(limits, dq)[0] ** 2
@@ -92,14 +92,17 @@ def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
 def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds, deadline) -> PieceBounds:
     """The bounds of every piece (t1, t2 and the arrays t3 runs on)."""
     count = len(pieces.ds)
-    parts = []
+    p = q = r = np.empty((count, 0))
+    cap_start, cap_end = np.empty(count), np.empty(count)
     for begin in range(0, count, CHUNK):
         deadline.check()
         rows = slice(begin, begin + CHUNK)
         start = _rows(robot, limits, kinds, pieces.q0[rows], pieces.dq0[rows], pieces.ddq0[rows])
         end = _rows(robot, limits, kinds, pieces.q1[rows], pieces.dq1[rows], pieces.ddq1[rows])
-        parts.append(_interval_arrays(pieces.ds[rows], start, end))
-    p, q, r, cap_start, cap_end = (np.concatenate([part[i] for part in parts]) for i in range(5))
+        part = _interval_arrays(pieces.ds[rows], start, end)
+        if begin == 0:  # the rows' count is known now: the arrays filled in place, chunk by chunk
+            p, q, r = (np.empty((count, part[0].shape[1])) for _ in range(3))
+        p[rows], q[rows], r[rows], cap_start[rows], cap_end[rows] = part
     owner = np.repeat(np.arange(len(pieces)), np.diff(pieces.first))
     last = np.zeros(count, dtype=bool)
     last[pieces.first[1:] - 1] = True
@@ -153,7 +156,7 @@ def _interval_arrays(ds, start, end):
         np.ascontiguousarray(a1), np.ascontiguousarray(b1), np.ascontiguousarray(c1),
         np.ascontiguousarray(lo1), np.ascontiguousarray(up1), np.ascontiguousarray(xb1),
     )[4]
-    return p[0::2].copy(), q[0::2].copy(), r[0::2].copy(), x_high[0::2].copy(), cap_end
+    return p[0::2], q[0::2], r[0::2], x_high[0::2], cap_end
 
 
 @njit(cache=True, nogil=True)
@@ -241,8 +244,8 @@ def path_time(intervals, ds, p, q, r, cap_start, cap_end):  # pragma: no cover -
 
 
 def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds) -> float:
-    """t4 (s): the phase-plane method (``planners.timing.phase_plane.method``, without refinement) on
-    the curve of the grid path through ``points`` (``planners.generators.search.curve``), on the grid of
+    """t4 (s): the phase-plane method (``toptraj.planners.timing.phase_plane.method``, without refinement) on
+    the curve of the grid path through ``points`` (``toptraj.planners.generators.search.curve``), on the grid of
     its pieces (``INTERVALS`` per span)."""
     curve = GridSplinePath(points)
     s = np.linspace(0.0, 1.0, curve.spans * INTERVALS + 1)

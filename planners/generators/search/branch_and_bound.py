@@ -29,12 +29,12 @@ import time
 
 import numpy as np
 
-from planners.errors import InfeasiblePath, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.bounds import forward_time, grid_path_time, path_time
-from planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
-from planners.generators.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
-from planners.generators.search.problem import SearchProblem
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search.bounds import forward_time, grid_path_time, path_time
+from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
+from toptraj.planners.generators.search.outcome import GridPath, NoGridPath, SearchResult, SearchStatistics
+from toptraj.planners.generators.search.problem import SearchProblem
 
 #: Relative slack of a bound over t_u before it discards (float rounding between the bound's
 #: and the phase-plane method's sums of the same intervals).

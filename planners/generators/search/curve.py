@@ -9,14 +9,14 @@ The curve has one span per edge, parameter u in [span, span + 1] for span k betw
 and s = u / L for L edges. It is C2 everywhere: no corner where the motion must stop, no jump of
 curvature. Span k depends on the control points k - 1 ... k + 2 only, that is on three
 consecutive moves of the grid path, which is what lets the search bound a partial path
-(``planners.generators.search.pieces``).
+(``toptraj.planners.generators.search.pieces``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.paths.base import GeometricPath, PathPoints
 
 #: B(t) = sum_j (row_0 + row_1 t + row_2 t^2 + row_3 t^3)_j P_j over the span's four control
 #: points: rows are the powers of t, columns the control points.

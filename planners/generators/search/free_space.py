@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.collision import Obstacle, clearance_along
-from planners.collision.distance import capsule_distance
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.curve import BASIS
-from planners.generators.search.pieces import Pieces
-from robots import Robot
-from robots.collision import robot_capsules
+from toptraj.planners.collision import Obstacle, clearance_along
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search.curve import BASIS
+from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, obstacle_row
+from toptraj.planners.generators.search.pieces import Pieces
+from toptraj.robots import Robot
+from toptraj.robots.collision import robot_capsules
 
 #: Largest arm motion (m) between the samples of a piece near an obstacle.
 COARSE_STEP = 0.02
@@ -78,33 +78,65 @@ def joint_placements(robot: Robot, q: np.ndarray):
     return rotation, translation
 
 
+def _chain_tables(robot: Robot):
+    """The kinematic chain as arrays for ``distance_kernels.capsule_ends`` (parents, placements,
+    prismatic flags, axes, q indices) and the capsules (joints, local ends, radii); None when a
+    joint is of a kind the batched kinematics does not handle (``_joint_motion``)."""
+    cached = _TABLES.get(id(robot))
+    if cached is not None and cached[0] is robot:
+        return cached[1]
+    model = robot.model
+    count = model.njoints
+    parent, index = np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
+    rotation, translation = np.zeros((count, 3, 3)), np.zeros((count, 3))
+    prismatic, axis = np.zeros(count, dtype=np.bool_), np.zeros((count, 3))
+    tables = None
+    motions = [_joint_motion(model.joints[j]) for j in range(1, count)]
+    if all(motion is not None for motion in motions):
+        for j, motion in enumerate(motions, start=1):
+            assert motion is not None
+            placement = model.jointPlacements[j]
+            parent[j], index[j] = model.parents[j], model.joints[j].idx_v
+            rotation[j], translation[j] = placement.rotation, placement.translation
+            prismatic[j], axis[j] = motion[0] == "prismatic", motion[1]
+        capsules = robot_capsules(robot)
+        tables = (
+            (parent, rotation, translation, prismatic, axis, index,
+             np.array([c.joint for c in capsules], dtype=np.int64),
+             np.array([c.a for c in capsules], dtype=float).reshape(-1, 3),
+             np.array([c.b for c in capsules], dtype=float).reshape(-1, 3)),
+            np.array([c.radius for c in capsules], dtype=float),
+        )
+    _TABLES[id(robot)] = (robot, tables)
+    return tables
+
+
+_TABLES: dict[int, tuple] = {}
+
+
 def point_distances(
     robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exact_below: float = np.inf, deadline: Deadline = NO_DEADLINE
 ) -> np.ndarray:
-    """Smallest signed distance (m) of the arm's link capsules (``robots.collision``) to any
+    """Smallest signed distance (m) of the arm's link capsules (``toptraj.robots.collision``) to any
     obstacle at each configuration (k, n_dof); distances above ``exact_below`` may be lower
-    bounds (``planners.collision.distance.capsule_distance``). ``deadline`` is checked
-    before each obstacle of each ``BATCH`` of configurations."""
+    bounds (``toptraj.planners.collision.distance.capsule_distance``), computed by the compiled
+    ``distance_kernels``. ``deadline`` is checked before each obstacle of each ``BATCH`` of
+    configurations."""
     out = np.empty(len(q))
-    capsules = robot_capsules(robot)
-    joints = np.array([c.joint for c in capsules])
-    local_a = np.array([c.a for c in capsules])
-    local_b = np.array([c.b for c in capsules])
-    radius = np.array([c.radius for c in capsules])
+    tables = _chain_tables(robot)
+    rows_of = [obstacle_row(obstacle) for obstacle in obstacles]
+    q = np.ascontiguousarray(q, dtype=float)
     for begin in range(0, len(q), BATCH):
         deadline.check()
         rows = q[begin : begin + BATCH]
-        placed = joint_placements(robot, rows)
-        if placed is None:
+        if tables is None:
             out[begin : begin + BATCH] = clearance_along(robot, rows, obstacles, exact_below)[0]
             continue
-        rotation, translation = placed[0][:, joints], placed[1][:, joints]
-        a = np.einsum("kcij,cj->kci", rotation, local_a) + translation
-        b = np.einsum("kcij,cj->kci", rotation, local_b) + translation
+        a, b = capsule_ends(rows, *tables[0])
         nearest = np.full(len(rows), np.inf)
-        for obstacle in obstacles:
+        for kind, row in rows_of:
             deadline.check()
-            np.minimum(nearest, capsule_distance(a, b, radius, obstacle, exact_below).min(axis=1), out=nearest)
+            lower_distances(a, b, tables[1], kind, row, float(exact_below), nearest)
         out[begin : begin + BATCH] = nearest
     return out
 

@@ -26,9 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.errors import InvalidRequest, OutOfRange, TooLarge, WrongLength
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from robots import Robot
+from toptraj.planners.errors import InvalidRequest, OutOfRange, TooLarge, WrongLength
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.robots import Robot
 
 #: Grid intervals per joint across the search region when a request names none, by joint count.
 DEFAULT_CELLS = {1: 32, 2: 16, 3: 8}
@@ -42,7 +42,7 @@ DEFAULT_MAX_TURN = {"lattice": 45.0, "roadmap": 90.0}
 CHECK_EVERY = 1_024
 #: Joints beyond which ``graph = "auto"`` takes a roadmap.
 LATTICE_MAX_JOINTS = 3
-#: Default memory cap of one search, in bytes (``planners.generators.search.memory``; the service's
+#: Default memory cap of one search, in bytes (``toptraj.planners.generators.search.memory``; the service's
 #: ``search_memory_bytes``): 2 GiB, which serves every arm's default search (the three-joint
 #: lattice's, estimated at 1.6 GiB, peaks at 1.45 GB).
 DEFAULT_SEARCH_MEMORY = 2**31
@@ -71,7 +71,7 @@ class SearchOptions:
         seed: Seed of the roadmap's random configurations.
         max_expansions: Most partial paths the branch and bound expands.
         memory_bytes: Most bytes the search may take by its estimate
-            (``planners.generators.search.memory``); set by the service, not by a request.
+            (``toptraj.planners.generators.search.memory``); set by the service, not by a request.
     """
 
     cells: tuple[int, ...] | None = None

@@ -1,11 +1,11 @@
 """Local optimization of a path among obstacles (Jeong & Lee §2.6, after Shiller & Dubowsky
 1991): a seed path from start to goal becomes a clamped cubic B-spline
-(``planners.paths.bspline``) whose interior control points minimize
+(``toptraj.planners.paths.bspline``) whose interior control points minimize
 
     J(P) = T(P) + W_obstacle * v_obstacle(P) + W_range * v_range(P)
 
 with T the path-constrained time-optimal duration along the spline, at rest at both ends
-(``planners.timing.phase_plane.method``, reused unchanged), and penalty functions on the obstacle
+(``toptraj.planners.timing.phase_plane.method``, reused unchanged), and penalty functions on the obstacle
 distance and the joint ranges; the number of control points grows, round by round, until the
 duration stops improving.
 
@@ -49,18 +49,18 @@ import time
 import numpy as np
 from scipy.optimize import minimize
 
-from planners.collision.clearance import Clearance, PathInCollision, check_clearance
-from planners.collision.obstacles import Obstacle
-from planners.constraints.path_constraints import build_path_constraints
-from planners.errors import InfeasiblePath, InvalidRequest
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.free_space import joint_reaches, point_distances
-from planners.generators.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
-from planners.paths.bspline import DEGREE, BSplinePath, clamped_knots, insert_knot
-from planners.paths.grid import path_grid
-from planners.timing.base import TimeScaling
-from planners.timing.phase_plane.method import PhasePlaneMethod, midpoint_duration
-from robots import JointLimits, Robot
+from toptraj.planners.collision.clearance import Clearance, PathInCollision, check_clearance
+from toptraj.planners.collision.obstacles import Obstacle
+from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search.free_space import joint_reaches, point_distances
+from toptraj.planners.generators.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
+from toptraj.planners.paths.bspline import DEGREE, BSplinePath, clamped_knots, insert_knot
+from toptraj.planners.paths.grid import path_grid
+from toptraj.planners.timing.base import TimeScaling
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod, midpoint_duration
+from toptraj.robots import JointLimits, Robot
 
 #: The objective of a path no timing can follow (s): above any duration served.
 _INFEASIBLE = 1e6

@@ -1,4 +1,4 @@
-"""The settings of the local optimization of a path among obstacles (``planners.generators.search.local``,
+"""The settings of the local optimization of a path among obstacles (``toptraj.planners.generators.search.local``,
 Jeong & Lee §2.6) and what it answers: each round's result, the statistics, and the optimum
 with its exact timing and clearance.
 """
@@ -9,9 +9,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planners.collision.clearance import Clearance
-from planners.paths.bspline import BSplinePath
-from planners.timing.base import TimeScaling
+from toptraj.planners.collision.clearance import Clearance
+from toptraj.planners.paths.bspline import BSplinePath
+from toptraj.planners.timing.base import TimeScaling
 
 
 @dataclass(frozen=True)

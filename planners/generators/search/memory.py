@@ -1,8 +1,8 @@
 """The memory a search needs, estimated from its settings before any work, against a cap.
 
-A search's memory is that of its spans of curve (``planners.generators.search.pieces``): per span, its
+A search's memory is that of its spans of curve (``toptraj.planners.generators.search.pieces``): per span, its
 control points, its samples and their derivatives at ``INTERVALS`` intervals, and the rows of
-its bounds (``planners.generators.search.bounds``), all proportional to the joint count n. The spans are
+its bounds (``toptraj.planners.generators.search.bounds``), all proportional to the joint count n. The spans are
 the pairs of consecutive turns of the direction-augmented graph, so their count K grows with
 the cube of a node's degree:
 
@@ -32,7 +32,7 @@ The estimate is conservative: ur5's default search (150 points, 10 neighbours) i
 1.45 GB. A search estimated above its cap (``DEFAULT_SEARCH_MEMORY``, 2 GiB) is refused before
 it starts (``check_search_memory``: ``OverMemory`` naming the setting and the largest value
 served with the others unchanged); a worker process running one is also capped by the system
-(``planners.runner.timed_free``: twice the estimate and 1 GiB), so that an estimate that is too low
+(``toptraj.planners.runner.timed_free``: twice the estimate and 1 GiB), so that an estimate that is too low
 is a clear error rather than the system killing a process.
 """
 
@@ -44,8 +44,8 @@ import math
 
 import numpy as np
 
-from planners.errors import NotOneOf, OverMemory
-from planners.generators.search.graph import (
+from toptraj.planners.errors import NotOneOf, OverMemory
+from toptraj.planners.generators.search.graph import (
     DEFAULT_MAX_TURN,
     LATTICE_MAX_JOINTS,
     MAX_ROADMAP_POINTS,
@@ -53,8 +53,8 @@ from planners.generators.search.graph import (
     goal_variants,
     lattice_axes,
 )
-from planners.generators.search.problem import GRAPH_KINDS
-from robots import Robot
+from toptraj.planners.generators.search.problem import GRAPH_KINDS
+from toptraj.robots import Robot
 
 #: C of K ~ C P k^3 for a roadmap whose turns reach at most 90 degrees (see the module).
 ROADMAP_SPANS = 0.35
@@ -170,7 +170,7 @@ def check_search_memory(
     Raises:
         OverMemory: the estimate exceeds the cap; the detail names the settings and the largest
             value of one of them served with the others unchanged.
-        InvalidRequest: settings the graph refuses (``planners.generators.search.graph``).
+        InvalidRequest: settings the graph refuses (``toptraj.planners.generators.search.graph``).
     """
     cap_bytes = options.memory_bytes if cap_bytes is None else cap_bytes
     need = search_bytes(robot, start, goal, options, revolutions)

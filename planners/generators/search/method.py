@@ -1,4 +1,4 @@
-"""``search``: the name under which a free motion is searched globally (``planners.generators.search``). It
+"""``search``: the name under which a free motion is searched globally (``toptraj.planners.generators.search``). It
 does not time a given path, so ``solve`` refuses one; ``global_search`` is the search itself,
 from a free motion to its best grid paths, their statistics and, for planar arms among
 obstacles, the obstacle shadows."""
@@ -10,18 +10,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.collision import Obstacle
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import NotServed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.branch_and_bound import branch_and_bound
-from planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
-from planners.generators.search.memory import check_search_memory
-from planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
-from planners.generators.search.problem import build_problem, toward_goal
-from planners.generators.search.shadows import obstacle_shadows
-from planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
-from robots import JointLimits, Robot
+from toptraj.planners.collision import Obstacle
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import NotServed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search.branch_and_bound import branch_and_bound
+from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
+from toptraj.planners.generators.search.memory import check_search_memory
+from toptraj.planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
+from toptraj.planners.generators.search.problem import build_problem, toward_goal
+from toptraj.planners.generators.search.shadows import obstacle_shadows
+from toptraj.planners.timing.base import AT_REST, Boundary, PathTiming, TimingMethod
+from toptraj.robots import JointLimits, Robot
 
 #: A goal variant is searched only for grid paths faster than this multiple of the best grid
 #: path of the variants searched before it (the local optimization takes a grid path down by
@@ -33,7 +33,7 @@ SEARCH_SHARE = 0.25
 
 
 class SearchMethod(TimingMethod):
-    """Global search of path and timing among obstacles (see ``planners.generators.search``)."""
+    """Global search of path and timing among obstacles (see ``toptraj.planners.generators.search``)."""
 
     name = "search"
     kinds = frozenset({"velocity", "acceleration", "torque"})
@@ -51,7 +51,7 @@ class SearchMethod(TimingMethod):
 @dataclass(frozen=True)
 class GlobalSearch:
     """A search's result, its region of joint space ((n_dof,) corners) and, for a planar arm
-    among obstacles, its obstacle shadows (``planners.generators.search.shadows``)."""
+    among obstacles, its obstacle shadows (``toptraj.planners.generators.search.shadows``)."""
 
     result: SearchResult
     low: np.ndarray
@@ -97,7 +97,7 @@ def global_search(
     a variant no grid path reaches, which would otherwise run until ``max_expansions``.
 
     Before any work, the search's memory is estimated from ``options`` and compared with
-    ``options.memory_bytes`` (``planners.generators.search.memory``).
+    ``options.memory_bytes`` (``toptraj.planners.generators.search.memory``).
 
     Raises:
         OverMemory: the estimate exceeds the cap (the detail names the largest value served).

@@ -1,4 +1,4 @@
-"""What the branch and bound over grid paths (``planners.generators.search.branch_and_bound``, Jeong & Lee
+"""What the branch and bound over grid paths (``toptraj.planners.generators.search.branch_and_bound``, Jeong & Lee
 sections 2.3 to 2.6) answers: the grid paths it found with their times and bounds, the tubes
 that seed the local optimization, what the search did, and the error when it found no grid
 path at all.
@@ -11,14 +11,14 @@ from typing import Any
 
 import numpy as np
 
-from planners.errors import InfeasiblePath
+from toptraj.planners.errors import InfeasiblePath
 
 
 @dataclass(frozen=True)
 class GridPath:
     """A grid path from start to goal: its grid points (k, n_dof), joint units, continuous
     joints unrolled (the last point is the goal, possibly one revolution away), its time t4
-    (s), the phase-plane time of its curve (``planners.generators.search.bounds.grid_path_curve``) on the
+    (s), the phase-plane time of its curve (``toptraj.planners.generators.search.bounds.grid_path_curve``) on the
     grid of its pieces, and its bounds t1, t2, t3 (s)."""
 
     points: np.ndarray

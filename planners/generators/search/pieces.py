@@ -1,4 +1,4 @@
-"""The curve of a grid path, piece by piece (``planners.generators.search.curve``): each span of the B-spline
+"""The curve of a grid path, piece by piece (``toptraj.planners.generators.search.curve``): each span of the B-spline
 depends on three consecutive moves of the grid path, so the pieces of curve the search needs are
 the spans of every three consecutive moves the direction-augmented graph allows:
 
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.generators.search.curve import span_values
+from toptraj.planners.generators.search.curve import span_values
 
 #: Intervals of the phase-plane grid per span.
 INTERVALS = 8

@@ -12,12 +12,12 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from planners.collision import Obstacle
-from planners.errors import InfeasiblePath, InvalidRequest, NotOneOf, OutOfRange
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.generators.search.bounds import PieceBounds, piece_bounds
-from planners.generators.search.free_space import clear_pieces, point_distances
-from planners.generators.search.graph import (
+from toptraj.planners.collision import Obstacle
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotOneOf, OutOfRange
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.search.bounds import PieceBounds, piece_bounds
+from toptraj.planners.generators.search.free_space import clear_pieces, point_distances
+from toptraj.planners.generators.search.graph import (
     DEFAULT_MAX_TURN,
     DEFAULT_OPTIONS,
     LATTICE_MAX_JOINTS,
@@ -26,8 +26,8 @@ from planners.generators.search.graph import (
     lattice_graph,
     roadmap_graph,
 )
-from planners.generators.search.pieces import DIRECT, FIRST, LAST, MIDDLE, Pieces, build_pieces
-from robots import JointLimits, Robot
+from toptraj.planners.generators.search.pieces import DIRECT, FIRST, LAST, MIDDLE, Pieces, build_pieces
+from toptraj.robots import JointLimits, Robot
 
 GRAPH_KINDS = ("auto", "lattice", "roadmap")
 
@@ -43,8 +43,8 @@ class SearchProblem:
     Attributes:
         graph: The grid points and moves.
         turn_in, turn_out: The turns of the augmented graph (pairs of moves), shape (T,).
-        pieces: Every span (``planners.generators.search.pieces``).
-        bounds: Every span's bounds (``planners.generators.search.bounds``).
+        pieces: Every span (``toptraj.planners.generators.search.pieces``).
+        bounds: Every span's bounds (``toptraj.planners.generators.search.bounds``).
         usable: Per span, whether it keeps the clearance and some motion can follow it.
         start_moves: Per move from the start: (edge, state, direct span): the state it leads to
             (-1 when it ends at a goal) and its usable direct span (-1 where none).

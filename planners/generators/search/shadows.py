@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.collision import Obstacle
-from planners.generators.search.free_space import joint_placements, point_distances
-from robots import Robot
+from toptraj.planners.collision import Obstacle
+from toptraj.planners.generators.search.free_space import joint_placements, point_distances
+from toptraj.robots import Robot
 
 #: Grid points per joint of the occupancy grid.
 RESOLUTION = 48

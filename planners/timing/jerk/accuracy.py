@@ -1,5 +1,5 @@
 """How far the jerk-limited timing's grid solution lies from the optimum of its continuous
-problem, estimated on a second grid (``planners.timing.jerk.method``).
+problem, estimated on a second grid (``toptraj.planners.timing.jerk.method``).
 
 The grid solution converges to the optimum as the grid is refined; the difference between the
 durations on two nested grids, T_coarse - T_fine, estimates the fine grid's error from above
@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.constraints.path_constraints import PathConstraints
 
 
 def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstraints | None:

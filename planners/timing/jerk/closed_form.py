@@ -2,7 +2,7 @@
 double-S (seven-segment) profile of the path parameter, in closed form.
 
 On a path whose limits do not change along it (a straight joint line under velocity,
-acceleration and jerk limits, ``planners.timing.jerk.method._uniform``) every row reduces to a
+acceleration and jerk limits, ``toptraj.planners.timing.jerk.method._uniform``) every row reduces to a
 bound on the path parameter alone,
 
     |sd| <= V = min_k v_k / |q'_k|,   |sdd| <= A = min_k a_k / |q'_k|,
@@ -30,8 +30,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.timing.jerk.segments import JerkSegmentsTiming
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming
 
 #: Relative size below which a coefficient that would make a row depend on the speed (q'' and
 #: q''' of a straight line, friction) counts as rounding noise.

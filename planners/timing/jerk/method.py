@@ -36,7 +36,7 @@ feasible, and each LP is sparse and solved by HiGHS's dual simplex, warm-started
 previous LP's basis.
 
 The discretization and the linear program of each restriction are
-``planners.timing.jerk.program``'s. Each LP step is followed by a line search on the true
+``toptraj.planners.timing.jerk.program``'s. Each LP step is followed by a line search on the true
 duration: along the segment from the current (feasible) solution to the LP's, every point lies
 in the current restriction, so the duration decreases monotonically. The first restriction is
 taken around the jerk-free time-optimal profile (``phase_plane``).
@@ -44,17 +44,17 @@ taken around the jerk-free time-optimal profile (``phase_plane``).
 The grid solution follows a phase of constant jerk only approximately (within about 0.2 % of
 the duration on the default grid). Where every limit is the same along the whole path (a
 straight joint line under velocity, acceleration and jerk limits) and the solution has at most
-nine phases, ``planners.timing.jerk.polish`` refines it in time, as segments of constant jerk
+nine phases, ``toptraj.planners.timing.jerk.polish`` refines it in time, as segments of constant jerk
 with free switching times: the exact optimum there (Berscheid & Kroeger's profile, the same as
 ruckig's along the line). Where, moreover, the motion goes from rest to rest and every row
 reduces to a symmetric bound on sd, sdd or sddd alone, the optimum is the double-S profile in
-closed form (``planners.timing.jerk.closed_form``), returned without solving anything: the
+closed form (``toptraj.planners.timing.jerk.closed_form``), returned without solving anything: the
 polish is a local method started from the grid solution's phases, and misses the optimum
 (keeping the grid solution, up to 2 % above it) where those phases differ from the profile's.
 
 Every answer carries an estimate of its distance from the optimum (``optimality_gap``): zero
 for the closed form, else the difference from the solution on a second grid of half as many
-points (``planners.timing.jerk.accuracy``); above ``GAP_TARGET`` the grid is doubled, at most
+points (``toptraj.planners.timing.jerk.accuracy``); above ``GAP_TARGET`` the grid is doubled, at most
 ``max_refinements`` times, while the grid budget and the time left allow.
 """
 
@@ -65,17 +65,17 @@ import time
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import InfeasiblePath, NotServed, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
-from planners.timing.jerk.accuracy import coarser, relative_gap
-from planners.timing.jerk.closed_form import closed_form_timing
-from planners.timing.jerk.polish import polish
-from planners.timing.jerk.program import RestrictedProgram
-from planners.timing.jerk.scaling import JerkTimeScaling
-from planners.timing.jerk.segments import JerkSegmentsTiming
-from planners.timing.phase_plane.method import PhasePlaneMethod
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
+from toptraj.planners.timing.jerk.accuracy import coarser, relative_gap
+from toptraj.planners.timing.jerk.closed_form import closed_form_timing
+from toptraj.planners.timing.jerk.polish import polish
+from toptraj.planners.timing.jerk.program import RestrictedProgram
+from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
+from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming
+from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
 #: Where the limits give no constant-jerk phase at an end at rest, the first interval is
 #: this fraction of the grid's own first interval.
@@ -96,7 +96,7 @@ class JerkLimitedMethod(TimingMethod):
         max_iterations: Most LPs solved.
         polish: Whether to refine the grid solution in time where the limits do not change.
         max_refinements: Most doublings of the grid while the estimated gap of the answer
-            (``planners.timing.jerk.accuracy``) exceeds ``GAP_TARGET``.
+            (``toptraj.planners.timing.jerk.accuracy``) exceeds ``GAP_TARGET``.
     """
 
     name = "jerk_limited"
@@ -197,7 +197,7 @@ class JerkLimitedMethod(TimingMethod):
 
     def _second_grid(self, constraints, original, boundary, best, deadline) -> tuple[float | None, str]:
         """The estimated relative gap of ``best`` and how it was obtained: the difference from
-        the solution on every other grid point (``planners.timing.jerk.accuracy``)."""
+        the solution on every other grid point (``toptraj.planners.timing.jerk.accuracy``)."""
         coarse = coarser(constraints, original)
         if coarse is None:
             return None, "none: the grid is too coarse for a second one"

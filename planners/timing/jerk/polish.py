@@ -1,7 +1,7 @@
 """The jerk-limited timing's polish: the grid solution refined in time, as segments of constant
 path jerk whose durations and jerks are free (``JerkSegmentsTiming``).
 
-The grid solution (``planners.timing.jerk.method``) holds u = sdd piecewise linear in s, which
+The grid solution (``toptraj.planners.timing.jerk.method``) holds u = sdd piecewise linear in s, which
 follows a phase of constant jerk (u^2 linear in sd) only approximately, and its switches fall
 between grid points. Time-optimal jerk-limited motions are made of arcs on which the jerk is at
 a bound or a limit holds with equality; where the limits do not change along the path (a
@@ -25,11 +25,10 @@ solution; for limits constant along the path it is the exact optimum.
 from __future__ import annotations
 
 import numpy as np
-from scipy import sparse
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.execution.deadline import Deadline
-from planners.timing.jerk.segments import JerkSegmentsTiming, segment_starts
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming, segment_starts
 
 #: Most segments polished: a time-optimal motion under limits that do not change along the
 #: path has at most seven; many more phases mean limits that change along it, where segments
@@ -280,6 +279,7 @@ def _solve(z, evaluate, M, deadline=None):
     (a jerk row along a segment whose limits do not change, a limit at the state two segments
     share) are kept once. ``None`` when it does not end at a feasible point."""
     import highspy
+    from scipy import sparse  # here: scipy.sparse is imported by jerk_limited only
 
     h, H, g, G = evaluate(z)
     keep = _distinct_rows(np.column_stack([g, G]))

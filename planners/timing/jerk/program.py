@@ -1,10 +1,10 @@
 """The linear program of one conservative restriction of the jerk-limited timing
-(``planners.timing.jerk.method``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
+(``toptraj.planners.timing.jerk.method``, after Lee, Bylard, Sun & Sentis, arXiv 2404.07889): every
 limit linear in (x, u) = (sd^2, sdd), the jerk limit's right-hand side J / sqrt(x) replaced by
 its tangent at the current solution, solved by HiGHS's dual simplex.
 
 Discretization (``JerkTimeScaling``): x and u at the grid points, u linear in s between them
-(x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``planners.timing.jerk.method``'s (1), its
+(x_i+1 = x_i + (u_i + u_i+1) h_i), the jerk rows (``toptraj.planners.timing.jerk.method``'s (1), its
 right-hand side the tangent) at both ends of every interval with du/ds = (u_i+1 - u_i) / h_i,
 the second-order rows at every grid point and at the middle of
 every interval (where x = x_i + (3 u_i + u_i+1) h_i / 4), the velocity bound at its quarters
@@ -21,11 +21,11 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.base import Boundary
-from planners.timing.jerk.scaling import JerkTimeScaling
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import Boundary
+from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
 
 
 class RestrictedProgram:

@@ -1,5 +1,5 @@
 """``JerkTimeScaling``: a time scaling s(t) with continuous path acceleration, for the
-jerk-limited timing (``planners.timing.jerk.method``).
+jerk-limited timing (``toptraj.planners.timing.jerk.method``).
 
 On the grid s_0 < ... < s_N it holds x_i = sd_i^2 and u_i = sdd_i. Within an interval of width
 h_i the path acceleration is linear in s, u(s) = u_i + w_i (s - s_i) with w_i = du/ds =
@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planners.timing.base import DenseStates, TimeScaling
+from toptraj.planners.timing.base import DenseStates, TimeScaling
 
 #: Gauss-Legendre nodes and weights on [0, 1] for the time of an interval.
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(12)

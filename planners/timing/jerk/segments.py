@@ -1,7 +1,7 @@
 """``JerkSegmentsTiming``: s(t) made of consecutive segments of constant path jerk, the form of
 every time-optimal jerk-limited motion whose limits do not change along the path (Berscheid &
 Kroeger's seven phases), and the result of the jerk-limited timing's polish
-(``planners.timing.jerk.polish``).
+(``toptraj.planners.timing.jerk.polish``).
 
 In segment k, of duration tau_k and path jerk sigma_k, from the state (s_k, v_k, a_k) at its
 start, at local time t:
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.timing.base import DenseStates, PathTiming
+from toptraj.planners.timing.base import DenseStates, PathTiming
 
 #: States per segment for the dense limit check.
 STATES_PER_SEGMENT = 120

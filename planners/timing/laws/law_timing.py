@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.timing.base import Binding, DenseStates, PathTiming
-from planners.timing.laws.profiles import NormalizedProfile, polynomial_derivatives
+from toptraj.planners.timing.base import Binding, DenseStates, PathTiming
+from toptraj.planners.timing.laws.profiles import NormalizedProfile, polynomial_derivatives
 
 #: Samples per segment (in normalized time) for checking limits.
 SAMPLES_PER_SEGMENT = 1000

@@ -23,14 +23,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from planners.constraints.path_constraints import PathConstraints
-from planners.constraints.tool_speed import TOOL_KINDS
-from planners.diagnostics import static_load
-from planners.errors import InfeasiblePath, InvalidRequest, NotServed
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
-from planners.timing.laws.law_timing import LawSegment, LawTiming
-from planners.timing.laws.profiles import (
+from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.constraints.tool_speed import TOOL_KINDS
+from toptraj.planners.diagnostics import static_load
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
+from toptraj.planners.timing.laws.law_timing import LawSegment, LawTiming
+from toptraj.planners.timing.laws.profiles import (
     CubicProfile,
     CycloidalProfile,
     NormalizedProfile,

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planners.timing.laws.profiles import NormalizedProfile
+from toptraj.planners.timing.laws.profiles import NormalizedProfile
 
 #: Fewest supporting points: Angeles' matrices of eqs. (80) and (83) need N >= 4.
 MIN_SUPPORTING_POINTS = 4

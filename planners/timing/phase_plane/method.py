@@ -24,7 +24,7 @@ collapses to one value and the sweeps take it: no chattering, no special case.
 Discretization: on the grid s_0 < ... < s_N, u is constant per interval (x linear in s) and every
 row holds at both ends of each interval (x_i+1 = x_i + 2 ds u), so the limits hold at every grid
 point and, to second order, between them. Each sweep step is a closed-form minimum over the rows
-(``planners.constraints.admissible_kernels``, ``planners.timing.phase_plane.sweep_kernels``): no LP is solved anywhere; one compiled call
+(``toptraj.planners.constraints.admissible_kernels``, ``toptraj.planners.timing.phase_plane.sweep_kernels``): no LP is solved anywhere; one compiled call
 per sweep pair builds the rows of every interval, linearizes viscous friction, finds the
 admissible intervals and runs both sweeps, without holding the GIL. This constant-u scheme is conservative by a first-order
 amount, so the grid is refined where it costs time: the error of each interval is estimated from
@@ -36,7 +36,7 @@ estimate under the tolerance (each new piece where it removes the most error), w
 constraint rows evaluated anew at the new points (one batched evaluation per round),
 until the estimated duration error is below the tolerance. The same rounds split the intervals
 where a limit, held at both ends, bulges past itself between them by more than a small fraction
-(``planners.timing.phase_plane.refinement_kernels.row_excursions``: the rows and the speed bound at the quarter
+(``toptraj.planners.timing.phase_plane.refinement_kernels.row_excursions``: the rows and the speed bound at the quarter
 points from the cubic through the neighbouring grid points, no dynamics evaluated), so that on a
 coarse grid the answer holds its limits between grid points too, not only at them.
 """
@@ -47,16 +47,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from planners.constraints.admissible import admissible_set
-from planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, point_bounds, zero_inertia_intervals
-from planners.constraints.path_constraints import LinearRows, PathConstraints
-from planners.diagnostics import static_load
-from planners.errors import InfeasiblePath
-from planners.execution.deadline import NO_DEADLINE, Deadline
-from planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
-from planners.timing.phase_plane.refinement_kernels import refinement, row_excursions
-from planners.timing.phase_plane.split_kernels import split_points
-from planners.timing.phase_plane.sweep_kernels import sweeps
+from toptraj.planners.constraints.admissible import admissible_set
+from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, point_bounds, zero_inertia_intervals
+from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
+from toptraj.planners.diagnostics import static_load
+from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from toptraj.planners.timing.phase_plane.refinement_kernels import refinement, row_excursions
+from toptraj.planners.timing.phase_plane.split_kernels import split_points
+from toptraj.planners.timing.phase_plane.sweep_kernels import sweeps
 
 #: Relative slack when comparing x values computed along different routes.
 _SLACK = 1e-9
@@ -99,18 +99,18 @@ def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> L
 
 
 #: A switching point is singular where a row's u-coefficient in its interval is within this
-#: fraction of the row's scale of zero (``planners.constraints.admissible_kernels.zero_inertia_intervals``).
+#: fraction of the row's scale of zero (``toptraj.planners.constraints.admissible_kernels.zero_inertia_intervals``).
 _ZERO_INERTIA_SWITCH = 1e-6
 #: Pieces into which one refinement round may split an interval at most.
 _MAX_PIECES = 8
 #: Refinement aims at this fraction of the tolerance, so that one round usually suffices.
 _AIM = 0.85
 #: Weight, in the estimated error, of the estimates that may cancel in its signed sum or
-#: estimate nothing (``planners.timing.phase_plane.refinement_kernels.refinement``): a guard against their own errors.
+#: estimate nothing (``toptraj.planners.timing.phase_plane.refinement_kernels.refinement``): a guard against their own errors.
 _GUARD = 0.15
 #: Relative excess of a row over its limit, midway between two grid points, above which the
-#: interval is split (``planners.timing.phase_plane.refinement_kernels.row_excursions``), well within the dense
-#: check's ``planners.checks.gate.LIMIT_TOLERANCE``.
+#: interval is split (``toptraj.planners.timing.phase_plane.refinement_kernels.row_excursions``), well within the dense
+#: check's ``toptraj.planners.checks.gate.LIMIT_TOLERANCE``.
 _EXCURSION = 3e-4
 #: The refined grid has at most 2^max_refinements times the intervals of the given one (what
 #: halving every interval in each round would give), or this many, whichever is more.
@@ -125,14 +125,14 @@ class PhasePlaneMethod(TimingMethod):
             estimated from the midpoint discretization on the same grid (second order, so it
             stands for the exact answer), from the time each interval would save by switching
             inside it, and from the chord error along the maximum velocity curve
-            (``planners.timing.phase_plane.refinement_kernels.refinement``); intervals are split where the estimates lie,
+            (``toptraj.planners.timing.phase_plane.refinement_kernels.refinement``); intervals are split where the estimates lie,
             each into as many pieces as its share asks for, with the constraint rows evaluated
             anew at the new points, until the estimate falls below ``tolerance`` or
             ``max_refinements`` rounds are done.
         max_refinements: Rounds of refinement; 0 keeps the given grid.
         excursion: In each round, intervals are also split where a limit, held at both ends,
             is estimated to be exceeded by more than this fraction midway between them
-            (``planners.timing.phase_plane.refinement_kernels.row_excursions``); ``None``: the duration alone
+            (``toptraj.planners.timing.phase_plane.refinement_kernels.row_excursions``); ``None``: the duration alone
             decides where points go, and the limits hold at the grid points only.
 
     The answer carries the last estimate of its relative duration error as its
@@ -219,7 +219,7 @@ GAP_BASIS = (
 
 def _duration_error(grid: _Grid, profile: _Profile, x_ends, deadline, tolerance: float) -> float | None:
     """The relative duration error of ``profile`` on ``grid``, estimated as in the refinement
-    (``planners.timing.phase_plane.refinement_kernels.refinement``); ``None`` when the midpoint discretization finds
+    (``toptraj.planners.timing.phase_plane.refinement_kernels.refinement``); ``None`` when the midpoint discretization finds
     no motion."""
     try:
         reference = _solve_on_grid(grid, x_ends, deadline, midpoint=True, x_ref=profile.x)
@@ -260,7 +260,7 @@ class _Grid(NamedTuple):
     seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
     first-order bound x_bound = sd_max^2 (N + 1,), the joint whose velocity limit sets it (N + 1,,
     -1 where none or unknown), whether the rows are smooth through each grid point (N + 1,,
-    ``planners.constraints.torque_interpolation.smooth_points``) and whether any row has viscous friction."""
+    ``toptraj.planners.constraints.torque_interpolation.smooth_points``) and whether any row has viscous friction."""
 
     constraints: PathConstraints
     s: np.ndarray
@@ -287,7 +287,7 @@ class _Grid(NamedTuple):
         return cls(constraints, s, rows, x_bound, binding, constraints.smooth, constraints.has_friction)
 
     def friction_reference(self) -> np.ndarray:
-        """``planners.constraints.admissible.friction_reference``: the maximum velocity curve without friction,
+        """``toptraj.planners.constraints.admissible.friction_reference``: the maximum velocity curve without friction,
         capped by the first-order bound (1 where it is not positive and finite)."""
         a, b, c, _, _, _, _, _, lower, upper = self.rows
         x_max = point_bounds(a, b, c, lower, upper, self.x_bound)[4]
@@ -297,8 +297,8 @@ class _Grid(NamedTuple):
 class _Profile(NamedTuple):
     """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
     envelope (N + 1,), the admissible upper x_i of each interval (N,), how much faster each
-    interval could be crossed at its bounds (N,, ``planners.timing.phase_plane.refinement_kernels.switch_excess``)
-    and the intervals' bounds (``planners.constraints.admissible_kernels.interval_bounds``' p, q, r, x_low, x_high)."""
+    interval could be crossed at its bounds (N,, ``toptraj.planners.timing.phase_plane.refinement_kernels.switch_excess``)
+    and the intervals' bounds (``toptraj.planners.constraints.admissible_kernels.interval_bounds``' p, q, r, x_low, x_high)."""
 
     x: np.ndarray
     capped: np.ndarray
@@ -339,7 +339,7 @@ def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoin
 
 
 def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> _Profile:
-    """One sweep pair (``planners.timing.phase_plane.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
+    """One sweep pair (``toptraj.planners.timing.phase_plane.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
     rows linearized around ``x_ref``."""
     x_bound, constraints = grid.x_bound, grid.constraints
     if x_end > x_bound[-1] * (1 + _SLACK) + _SLACK:

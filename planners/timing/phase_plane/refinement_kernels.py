@@ -2,8 +2,8 @@
 of a conservative (interpolation) profile loses, from the midpoint discretization on the same grid,
 from a switch inside the interval (``switch_excess``) and from the chord along a curved maximum
 velocity curve, and the pieces each interval is split into so that the estimated duration error
-falls to the tolerance (``refinement``, with ``planners.timing.phase_plane.split_kernels``), and how far the limits
-bulge between grid points (``row_excursions``). ``planners.timing.phase_plane.method`` explains the
+falls to the tolerance (``refinement``, with ``toptraj.planners.timing.phase_plane.split_kernels``), and how far the limits
+bulge between grid points (``row_excursions``). ``toptraj.planners.timing.phase_plane.method`` explains the
 scheme; these loops hold no knowledge of paths or robots (``nogil``, cached on disk).
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from planners.timing.phase_plane.split_kernels import _pieces
+from toptraj.planners.timing.phase_plane.split_kernels import _pieces
 
 _INF = np.inf
 
@@ -215,7 +215,7 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
     within ``target`` (relative to the limit) of their bounds at its quarter points; ``binding``
     (N + 1,) names the joint whose velocity limit sets x_bound at each grid point, ``smooth``
     (N + 1,) marks the grid points through which the rows are smooth (no knot of the path, no
-    jump; ``planners.constraints.torque_interpolation.smooth_points``).
+    jump; ``toptraj.planners.constraints.torque_interpolation.smooth_points``).
 
     The interpolation discretization holds every row ``a u + b x + c + d sd`` at both ends of
     an interval (u constant, x linear in s); between them the row departs from the chord of its
@@ -230,7 +230,7 @@ def row_excursions(s, a, b, c, d, a_left, b_left, c_left, d_left, lower, upper, 
     Only limits used to within ``_NEAR`` at an end of the interval are looked at. The excursion
     falls with the square of the piece length: k pieces leave e / k^2 of an excess e, so
     k = ceil(sqrt(e / target)), at most ``max_pieces``. The dense limit check
-    (``planners.checks.gate``) stays the judge; this only keeps the grid fine where the limits curve.
+    (``toptraj.planners.checks.gate``) stays the judge; this only keeps the grid fine where the limits curve.
     """
     n_stages = s.shape[0] - 1
     n_rows = a.shape[1]

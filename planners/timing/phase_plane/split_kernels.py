@@ -1,6 +1,6 @@
 """Compiled splitting of grid intervals for the phase-plane refinement (numba): the whole pieces
 per interval that bring a summed error to a target with the fewest in all (``_pieces``, which
-``planners.timing.phase_plane.refinement_kernels.refinement`` asks), and the points that split the intervals so
+``toptraj.planners.timing.phase_plane.refinement_kernels.refinement`` asks), and the points that split the intervals so
 (``split_points``). No knowledge of paths or robots (``nogil``, cached on disk).
 """
 

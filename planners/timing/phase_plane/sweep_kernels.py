@@ -1,9 +1,9 @@
 """Compiled sweeps of the phase-plane method (numba): the backward sweep of the controllable
 sets from the end state, the forward sweep of maximum acceleration under them, and ``sweeps``,
-one solve on a grid from the interval bounds of ``planners.constraints.admissible_kernels``. Each sweep is sequential
+one solve on a grid from the interval bounds of ``toptraj.planners.constraints.admissible_kernels``. Each sweep is sequential
 along the path; a step costs one pass over the rows of its interval.
 
-Bounds on u come as in ``planners.constraints.admissible_kernels``: lines ``p + q x <= u <= r + q x`` per row, (N, m),
+Bounds on u come as in ``toptraj.planners.constraints.admissible_kernels``: lines ``p + q x <= u <= r + q x`` per row, (N, m),
 the lower and upper line of a row sharing the slope q; -inf (p) or +inf (r) where a row gives no
 such bound.
 """
@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from planners.constraints.admissible_kernels import interval_bounds
-from planners.timing.phase_plane.refinement_kernels import switch_excess
+from toptraj.planners.constraints.admissible_kernels import interval_bounds
+from toptraj.planners.timing.phase_plane.refinement_kernels import switch_excess
 
 _INF = np.inf
 

@@ -1,0 +1,163 @@
+"""Free-path motions by direct collocation: the Geering arm's time-optimal motions (Jeong & Lee
+section 4) and Yamamoto's minimum-cost free path, with the robots' Pinocchio models."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from toptraj import robots
+from toptraj.planners import Timing, plan
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.problem.free_motion import FreeMotion
+
+#: The converged optima of Yamamoto's free path (torque limits only), from its own
+#: Hermite-Simpson transcription, ``benchmarks/yamamoto_reference.py``: the same to 7 digits on
+#: 400, 800 and 1,600 intervals (the cost on 200 too). Minimum time T* (s):
+YAMAMOTO_MINIMUM_TIME = 0.2059855
+#: and the minimum of the integral of (1 + 0.03 |tau|^2) dt (s):
+YAMAMOTO_COST = 0.5514515
+
+
+@pytest.fixture(scope="module")
+def client(patient_client):
+    """Free-path collocations take tens of seconds on a loaded machine."""
+    return patient_client
+
+
+def _geering(goal, revolutions=True):
+    arm = robots.load("geering_2r")
+    motion = FreeMotion(np.zeros(2), np.array(goal, dtype=float), revolutions=revolutions)
+    return arm, plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002)
+
+
+@pytest.mark.parametrize(
+    "goal, revolutions, paper_T, elbow_end",
+    [
+        ((0.76, -2 * np.pi), False, 0.9755, -2 * np.pi),  # type 3: the elbow turns a full revolution
+        ((0.98, 0.0), False, 1.085, 0.0),  # type 1/2, elbow back to 0
+        ((np.pi, 0.0), True, 1.252, -2 * np.pi),  # type 4
+    ],
+)
+def test_geering_time_optimal_motions(goal, revolutions, paper_T, elbow_end):
+    arm, result = _geering(goal, revolutions)
+    collocation_T = result.solver["duration"]
+    assert collocation_T == pytest.approx(paper_T, rel=1e-2)
+    assert result.duration == pytest.approx(paper_T, rel=1e-2)
+    # The path-constrained time-optimal duration along the returned path (phase plane) agrees
+    # with the collocation's own duration.
+    assert result.duration == pytest.approx(collocation_T, rel=1e-2)
+    assert result.samples.q[-1] == pytest.approx([goal[0], elbow_end], abs=1e-9)
+    if revolutions:
+        assert ("psi -6.2832" in result.solver["initial_guess"]) == (elbow_end != 0.0)
+    # Bang-bang: some torque saturated most of the time, and no limit exceeded.
+    ratio = np.abs(result.samples.tau) / arm.limits.torque
+    assert ratio.max() <= 1.005
+    assert np.mean(ratio.max(axis=1) >= 0.98) >= 0.7
+
+
+def test_free_motion_progress_never_goes_back():
+    """Every progress report of a free motion, unthrottled: the fractions never decrease, from
+    the collocation's guesses through the re-timing and the switching refinement to sampling."""
+    reports: list[tuple[float, str]] = []
+    arm = robots.load("geering_2r")
+    motion = FreeMotion(np.zeros(2), np.array([0.98, 0.0]), revolutions=False)
+    deadline = Deadline(progress=lambda fraction, stage: reports.append((fraction, stage)))
+    plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002, deadline=deadline)
+    fractions = [fraction for fraction, _ in reports]
+    assert fractions == sorted(fractions), reports
+    stages = [stage for _, stage in reports]
+    assert "re-timing along the collocation's path: timing" in stages, stages
+    assert stages.index("refining the switching times") > stages.index("re-timing along the collocation's path: timing")
+
+
+def test_geering_larger_moves_prefer_the_revolution():
+    """At phi_b = 0.98 with the elbow free, the revolution (type 3) beats the type-1 motion."""
+    _, free = _geering((0.98, 0.0), revolutions=True)
+    _, fixed = _geering((0.98, 0.0), revolutions=False)
+    assert free.samples.q[-1][1] == pytest.approx(-2 * np.pi)
+    assert free.duration < fixed.duration
+
+
+def test_yamamoto_free_path_cost_and_minimum_time():
+    arm = robots.load("yamamoto_2r")
+    motion = FreeMotion(np.radians([45.0, -90.0]), np.radians([-90.0, 0.0]))
+    cheap = plan(arm, motion, Timing(method="collocation", constraints=("torque",), torque_weight=0.03))
+    assert cheap.solver["cost"] <= 0.5777  # the paper's sixth iterate, 0.57766, bounds the optimum
+    assert cheap.cost <= 0.5777 * 1.01  # re-timed along the returned path by min_cost
+    # The converged beta = 0.03 cost (YAMAMOTO_COST); the collocation's own and the re-timed one
+    # within 0.5 %.
+    assert cheap.solver["cost"] == pytest.approx(YAMAMOTO_COST, rel=5e-3)
+    assert cheap.cost == pytest.approx(YAMAMOTO_COST, rel=5e-3)
+    # The stated gap (the cost on 12 collocation intervals against 30) bounds the distance
+    # from the converged cost.
+    assert "second grid" in cheap.solver["gap_basis"]
+    assert abs(cheap.solver["cost"] - YAMAMOTO_COST) / YAMAMOTO_COST <= cheap.solver["optimality_gap"] <= 5e-3
+    # ... and it is the answer's stated accuracy: that of the motion found, not of its re-timing
+    assert cheap.accuracy.relative_gap == cheap.solver["optimality_gap"]
+    assert cheap.accuracy.basis == cheap.solver["gap_basis"]
+    assert cheap.peak_utilization["torque"].max() <= 1.005
+    fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
+    assert fast.duration < cheap.duration
+    # refined to exact bang-bang torques (toptraj.planners.generators.collocation.switching): never longer than the
+    # collocation's own duration, and within 1e-4 (the largest gap it may state) of the
+    # converged minimum time (YAMAMOTO_MINIMUM_TIME; measured 2e-7)
+    assert fast.solver["switching"] == "refined"
+    assert fast.duration <= fast.solver["duration"]
+    assert fast.duration == pytest.approx(YAMAMOTO_MINIMUM_TIME, rel=1e-4)
+    assert fast.solver["optimality_gap"] <= 1e-4
+
+
+def test_ur5_smoke():
+    """Any fixed-base revolute arm: a 6-joint free motion over HTTP (a generous budget, so that
+    a loaded shared machine does not turn the smoke test into a timing test; 4 intervals keep
+    it quick, tests/test_sparse_collocation.py solves 30)."""
+    from fastapi.testclient import TestClient
+
+    from toptraj.service.app import create_app
+    from toptraj.service.settings import Settings
+
+    body = {
+        "robot": "ur5",
+        "path": {"kind": "free", "start": [0.0, -1.2, 1.0, 0.0, 0.3, 0.0], "goal": [0.8, -1.0, 1.4, -0.5, 0.6, 0.3]},
+        "timing": {"method": "collocation", "constraints": ["velocity", "torque"], "grid_points": 4},
+    }
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=300.0))) as client:
+        response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 200, response.text
+    result = response.json()
+    assert result["solver"]["status"] == "IPOPT: Solve_Succeeded"
+    assert result["samples"]["q"][-1] == pytest.approx(body["path"]["goal"], abs=1e-9)
+    assert max(result["peak_utilization"]["torque"]) <= 1.005
+
+
+@pytest.mark.parametrize(
+    "path, timing, words",
+    [
+        ({"kind": "free", "start": [0, 0], "goal": [1, 0]}, {"method": "phase_plane"}, ["collocation"]),
+        ({"kind": "free", "start": [0, 0], "goal": [1, 0], "obstacles": [{"sphere": [0, 0, 0, 1]}]}, {"method": "collocation"}, ["obstacles"]),
+        ({"waypoints": [[0, 0], [1, 0]]}, {"method": "collocation"}, ["free path"]),
+        ({"kind": "free", "start": [0, 0, 0], "goal": [1, 0]}, {"method": "collocation"}, ["path.start has 3 values"]),
+        ({"kind": "free", "start": [0, 0], "goal": [1, 0]}, {"method": "collocation", "boundary": {"end_velocity": [1.0]}}, ["timing.boundary.end_velocity has 1 values"]),
+    ],
+)
+def test_free_path_errors(client, path, timing, words):
+    response = client.post("/v1/trajectories", json={"robot": "geering_2r", "path": path, "timing": timing})
+    assert response.status_code == 422, response.text
+    for word in words:
+        assert word in response.json()["detail"]
+
+
+def test_free_path_with_a_start_velocity(client):
+    body = {
+        "robot": "geering_2r",
+        "path": {"kind": "free", "start": [0.0, 0.0], "goal": [0.5, 0.0], "revolutions": False},
+        "timing": {"method": "collocation", "constraints": ["torque"], "boundary": {"start_velocity": [1.0, 0.0]}},
+        "output": {"dt": 0.001},
+    }
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 200, response.text
+    result = response.json()
+    assert result["samples"]["qd"][0] == pytest.approx([1.0, 0.0], abs=1e-6)
+    assert result["samples"]["qd"][-1] == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert result["duration"] == pytest.approx(result["solver"]["duration"], rel=1e-2)

@@ -1,0 +1,166 @@
+"""The global search obeys its budget and its memory: it stops within a second of its budget
+wherever it is (in-process, at checks bounded in work), its memory is estimated from the
+settings before any work (an upper bound of the spans it builds; 422 beyond the cap, naming the
+largest value served), and a request's memory goes back when it ends."""
+
+from __future__ import annotations
+
+import re
+import time
+
+import numpy as np
+import psutil
+import pytest
+from fastapi.testclient import TestClient
+
+from toptraj import robots
+from toptraj.planners import BudgetExceeded, Deadline
+from toptraj.planners.collision import BoxObstacle
+from toptraj.planners.errors import OverMemory
+from toptraj.planners.generators.search.graph import SearchOptions, lattice_graph, roadmap_graph
+from toptraj.planners.generators.search.memory import check_search_memory, search_spans
+from toptraj.planners.generators.search.method import global_search
+from toptraj.planners.generators.search.pieces import span_keys
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
+
+UR5_START = [-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]
+UR5_GOAL = [1.0, -1.2, 1.5, -1.9, -1.57, 0.0]
+#: Where the tool is halfway along the straight joint line (as in ``test_search``).
+UR5_BOX = {"kind": "box", "center": [0.626, 0.109, 0.29], "size": [0.15, 0.15, 0.15]}
+#: 64 small boxes on an arc the arm sweeps past: each distance computation and each
+#: refinement round of the free space costs 64 obstacles' worth (the family where one round
+#: ran for seconds past the budget).
+ARC = tuple(
+    BoxObstacle(np.array([0.62 * np.cos(a), 0.62 * np.sin(a) + 0.109, 0.29 + 0.1 * np.sin(5.0 * a)]), np.full(3, 0.05))
+    for a in np.linspace(-0.6, 0.6, 64)
+)
+
+
+def _ur5_search(search: dict, budget_s: float, obstacles=(UR5_BOX,)) -> dict:
+    return {
+        "robot": "ur5",
+        "path": {"kind": "free", "start": UR5_START, "goal": UR5_GOAL, "obstacles": list(obstacles), "clearance": 0.02},
+        "timing": {"method": "search", "search": search},
+    }
+
+
+@pytest.mark.parametrize("budget_s", [1.0, 4.0])
+def test_the_search_stops_within_a_second_of_its_budget_in_process(budget_s):
+    # graph and free space at 1 s, the free space's refinement at 4 s: on the library's own
+    # thread (no worker process), so the checks inside the loops are what stops it
+    robot = robots.load("ur5")
+    began = time.monotonic()
+    with pytest.raises(BudgetExceeded):
+        global_search(
+            robot, robot.limits, ("velocity", "acceleration", "torque"), np.array(UR5_START), np.array(UR5_GOAL),
+            SearchOptions(tubes=1), True, ARC, 0.02, Deadline(budget_s),
+        )
+    overrun = time.monotonic() - began - budget_s
+    assert overrun < 1.0, f"the search ran {overrun:.2f} s past its budget of {budget_s} s"
+
+
+def _spans(robot, start, goal, options, max_turn) -> int:
+    """Spans of the search's graph, counted from its turns (what ``build_pieces`` builds)."""
+    if options.graph == "lattice":
+        graph = lattice_graph(robot, start, goal, options, True)
+    else:
+        graph = roadmap_graph(robot, start, goal, options, True, lambda q: np.ones(len(q), dtype=bool))
+    turn_in, turn_out = graph.transitions(max_turn)
+    return len(span_keys(graph.edge_from, graph.edge_to, graph.start, graph.goals, turn_in, turn_out)[0])
+
+
+@pytest.mark.parametrize(
+    "name, options, max_turn",
+    [
+        ("ur5", SearchOptions(graph="roadmap", roadmap_points=50, neighbors=5), 90.0),
+        ("ur5", SearchOptions(graph="roadmap", roadmap_points=150, neighbors=10), 90.0),
+        ("ur5", SearchOptions(graph="roadmap", roadmap_points=400, neighbors=20), 90.0),
+        ("panda", SearchOptions(graph="roadmap", roadmap_points=300, neighbors=15), 90.0),
+        ("geering_2r", SearchOptions(graph="roadmap", roadmap_points=300, neighbors=15), 90.0),
+        ("geering_2r", SearchOptions(graph="lattice"), 45.0),
+        ("geering_2r", SearchOptions(graph="lattice", cells=(40,)), 45.0),
+        ("lecture_3r", SearchOptions(graph="lattice"), 45.0),
+    ],
+)
+def test_the_estimate_bounds_the_spans_built_and_is_not_far_above(name, options, max_turn):
+    robot = robots.load(name)
+    start = np.zeros(robot.dof) if name != "ur5" else np.array(UR5_START)
+    goal = np.full(robot.dof, 0.5) if name != "ur5" else np.array(UR5_GOAL)
+    if name == "geering_2r":
+        goal = np.array([0.76, 0.0])
+    counted = _spans(robot, start, goal, options, max_turn)
+    estimated = search_spans(robot, start, goal, options, True)
+    assert counted <= estimated <= 3.0 * counted, (counted, estimated)
+
+
+def test_a_search_beyond_the_memory_cap_gets_422_naming_the_largest_setting_served():
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=5.0))) as client:
+        response = client.post("/v1/trajectories", json=_ur5_search({"roadmap_points": 2000, "neighbors": 50}, 5.0))
+    assert response.status_code == 422, response.text[:300]
+    detail = response.json()["detail"]
+    assert "roadmap_points 2000 with neighbors 50" in detail and "GiB" in detail
+    most = int(re.search(r"at most (\d+) roadmap points are served with 50 neighbors", detail).group(1))
+    fewest = int(re.search(r"at most (\d+) neighbors with 2000 roadmap points", detail).group(1))
+    robot = robots.load("ur5")
+    start, goal = np.array(UR5_START), np.array(UR5_GOAL)
+    cap = Settings().search_memory_bytes
+
+    def served(points, neighbors):
+        try:
+            check_search_memory(robot, start, goal, SearchOptions(roadmap_points=points, neighbors=neighbors), True, cap)
+        except OverMemory:
+            return False
+        return True
+
+    # the advice is followable, and the largest: one more is refused
+    assert 1 <= most < 2000 and served(most, 50) and not served(most + 1, 50)
+    assert 1 <= fewest < 50 and served(2000, fewest) and not served(2000, fewest + 1)
+    # the default searches are served: ur5's roadmap, and the three-joint lattice (1.45 GB)
+    assert served(150, 10)
+    lecture = robots.load("lecture_3r")
+    check_search_memory(lecture, np.zeros(3), np.array([1.5, 0.0, 0.0]), SearchOptions(), True, cap)
+
+
+def test_the_memory_of_a_search_goes_back_when_its_request_ends(monkeypatch):
+    # a search of about 2 GB (300 roadmap points, 12 neighbours, no obstacle) under a cap raised
+    # to 8 GiB, stopped by a 3 s budget while it builds its spans
+    monkeypatch.setenv("TOPTRAJ_SEARCH_MEMORY_BYTES", str(8 * 2**30))
+    process = psutil.Process()
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=3.0))) as client:
+        client.get("/v1/robots/ur5")
+        before = process.memory_info().rss
+        response = client.post("/v1/trajectories", json=_ur5_search({"roadmap_points": 300, "neighbors": 12}, 3.0, ()))
+        assert response.status_code == 504, response.text[:300]
+        time.sleep(2.0)  # what the search would have built meanwhile, had it run on
+        grown = process.memory_info().rss - before
+    assert grown < 200e6, f"the process holds {grown / 1e6:.0f} MB more after the search"
+
+
+def test_a_search_job_obeys_the_same_memory_cap(tmp_path):
+    settings = Settings(preload_robots=False, data_dir=tmp_path, job_workers=1, job_budget_s=5.0)
+    body = _ur5_search({"roadmap_points": 500, "neighbors": 50}, 5.0)
+    with TestClient(create_app(settings)) as client:
+        synchronous = client.post("/v1/trajectories", json=body)
+        assert synchronous.status_code == 422 and "at most" in synchronous.json()["detail"]
+        submitted = client.post("/v1/jobs", json={"trajectory": body})
+        assert submitted.status_code == 202, submitted.text[:300]
+        give_up = time.monotonic() + 30.0
+        while (job := client.get(f"/v1/jobs/{submitted.json()['id']}").json())["status"] in ("queued", "running"):
+            assert time.monotonic() < give_up, job
+            time.sleep(0.05)
+    assert job["status"] == "failed" and job["error"] == synchronous.json()
+
+
+def test_an_estimate_too_low_is_a_clear_error_not_the_system_killing_a_process(monkeypatch):
+    # as if the estimate said 1 byte: the search's worker process gets 64 MB of room, runs out
+    # while it builds its spans (about 0.5 GB), and the answer says so
+    import toptraj.planners.generators.search.generator as search_generator
+
+    monkeypatch.setattr(search_generator, "check_search_memory", lambda *args, **kwargs: 1)
+    monkeypatch.setattr(search_generator, "SEARCH_MEMORY_SLACK", 64 * 2**20)
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=30.0))) as client:
+        response = client.post("/v1/trajectories", json=_ur5_search({}, 30.0, ()))
+    assert response.status_code == 422, response.text[:300]
+    assert response.json()["title"] == "Computation over its memory cap"
+    assert "memory allowance" in response.json()["detail"] and "timing.search.roadmap_points" in response.json()["detail"]

@@ -1,0 +1,340 @@
+"""Batches never lose a line: every line of a request file, however hostile, gets exactly one
+result line carrying its line number; identical requests are computed once; an interrupted or
+failed run resumes by line number (``--retry-failed`` plans the 504s and 5xx again); a line's
+failure inside planning is that line's result, in ``toptraj batch`` and in ``POST /v1/batches``.
+
+The driver's logic runs here on ``InProcessPool`` (the requests answered in this process by
+the workers' own function); one test stops a real local Ray with SIGINT."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import orjson
+import psutil
+import pytest
+
+import toptraj.service.batches.work as batch_work
+from tests.paths import ROOT
+from toptraj.planners import Deadline
+from toptraj.service.batches import lines as lines_
+from toptraj.service.batches import run_batch, runner
+from toptraj.service.batches.lines import MAX_DEPTH, nesting_depth, request_key
+from toptraj.service.batches.work import answer, answer_chunk
+from toptraj.service.cli import main
+from toptraj.service.jobs.work import WorkerSetup, _batch
+
+GOOD = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.4, 0.3, -0.2, 0.1, 0.2, 0.3]]}}
+OTHER = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [-0.3, 0.2, 0.2, -0.1, 0.1, 0.2]]}}
+
+
+class _Done:
+    """A finished task of ``InProcessPool``."""
+
+    def __init__(self, answers):
+        self.answers = answers
+
+
+class InProcessPool:
+    """``RayPool``'s interface, each chunk answered at once in this process by
+    ``work.answer_chunk`` (what a Ray worker runs); ``after_submit(pool)`` runs after each."""
+
+    cpus = 1
+
+    def __init__(self, after_submit=None):
+        self.chunks: list[list[tuple[str, str]]] = []
+        self.after_submit = after_submit
+        self.closed = False
+
+    def share(self, uploads):
+        self.uploads = uploads
+
+    def submit(self, chunk, budget_s):
+        self.chunks.append(list(chunk))
+        done = _Done(answer_chunk(chunk, self.uploads, budget_s))
+        if self.after_submit:
+            self.after_submit(self)
+        return done
+
+    def wait(self, handles, timeout_s):
+        return list(handles), []
+
+    def result(self, handle):
+        return handle.answers
+
+    def cancel(self, handles):
+        pass
+
+    def close(self):
+        self.closed = True
+
+    @property
+    def keys(self) -> list[str]:
+        return [key for chunk in self.chunks for key, _ in chunk]
+
+
+def _rows(path: Path) -> list[dict]:
+    return [orjson.loads(raw) for raw in path.read_bytes().splitlines()]
+
+
+def _by_line(path: Path) -> dict[int, dict]:
+    rows = _rows(path)
+    numbers = [row["line"] for row in rows]
+    assert len(numbers) == len(set(numbers)), f"a line answered twice: {sorted(numbers)}"
+    return {row["line"]: row for row in rows}
+
+
+def _hostile_file(path: Path, monkeypatch) -> dict[int, int]:
+    """A request file of every kind of line, and the status each line must get."""
+    monkeypatch.setattr(lines_, "MAX_LINE_BYTES", 20_000)
+    deep = "[" * 1300 + "]" * 1300  # 2.6 KB: RecursionError in a recursive parser
+    lines: list[tuple[bytes, int]] = [
+        (b"\xef\xbb\xbf" + json.dumps(GOOD).encode(), 200),  # a byte order mark before the first line
+        (b"not json", 400),
+        (deep.encode(), 400),
+        (b'{"robot": "ur5", "path": ' + b"[" * 60 + b"]" * 60 + b"}", 400),
+        (b"", 400),
+        (b"   \t ", 400),
+        (b"42", 422),
+        (b"[1, 2]", 422),
+        (b'"a string"', 422),
+        (b"null", 422),
+        (json.dumps(GOOD, indent=None, separators=(", ", ": ")).encode(), 200),  # the same request again
+        (b'{"robot": "\xff\xfe"}', 400),  # not UTF-8
+        (b'{"robot": "ur5", "path": {"waypoints": "no"}}', 422),
+        (json.dumps({**GOOD, "robot": "nope"}).encode(), 404),
+        (b'{"robot": "' + b"x" * 30_000 + b'"}', 413),
+        (json.dumps(OTHER).encode(), 200),
+        (json.dumps(GOOD).encode(), 200),  # and again
+        (b'{"robot": "ur5", "path": {"waypoints": [[0,0,0,0,0,0]]}', 400),  # cut short
+        (b"{" + b'"a": {' * 40 + b"}" * 40 + b"}", 400),
+        (b'{"robot": "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[", "path": 1}', 422),  # brackets in a string are no nesting
+    ]
+    path.write_bytes(b"\n".join(raw for raw, _ in lines) + b"\n")
+    return {number: status for number, (_, status) in enumerate(lines, start=1)}
+
+
+def test_every_line_gets_exactly_one_result_line_with_its_number(tmp_path, monkeypatch):
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    expected = _hostile_file(requests, monkeypatch)
+    pool = InProcessPool()
+    report = run_batch(requests, output, pool=lambda: pool)
+    rows = _by_line(output)
+    assert {number: row["status"] for number, row in rows.items()} == expected
+    assert (report.total, report.skipped, report.planned, report.interrupted) == (len(expected), 0, len(expected), False)
+    # identical requests (whatever their formatting) are computed once, each line written
+    assert rows[1]["key"] == rows[11]["key"] == rows[17]["key"] == request_key(json.dumps(GOOD))
+    assert rows[1]["body"] == rows[11]["body"] == rows[17]["body"] and rows[1]["body"]["duration"] > 0
+    assert sorted(pool.keys) == sorted({rows[n]["key"] for n in (1, 13, 14, 16, 20)}) and pool.closed
+    # each refusal says what and where
+    assert rows[3]["body"]["title"] == "Too deeply nested" and "line 3" in rows[3]["body"]["detail"]
+    assert rows[15]["body"]["title"] == "Line too long" and "30013 bytes" in rows[15]["body"]["detail"]
+    assert "JSON int" in rows[7]["body"]["detail"] and "UTF-8" in rows[12]["body"]["detail"]
+    assert all(row["body"]["status"] == row["status"] for row in rows.values() if row["status"] != 200)
+    assert all(len(row["body"].get("detail", "")) < 1000 for row in rows.values())
+    # a second run has nothing left to do
+    assert run_batch(requests, output, pool=InProcessPool).planned == 0
+
+
+def test_the_nesting_depth_is_counted_without_recursion():
+    assert nesting_depth(b'{"a": [1, {"b": [[2]]}], "c": "]]]][[[[{{{{"}') == 5
+    assert nesting_depth(b'{"a": "\\"[[[[", "b": [[]]}') == 3  # an escaped quote does not end the string
+    assert nesting_depth(b"42") == 0 and nesting_depth(b"") == 0
+    started = time.perf_counter()
+    assert nesting_depth(b"[" * 1_000_000 + b"]" * 1_000_000) == 1_000_000
+    assert time.perf_counter() - started < 2.0
+    assert MAX_DEPTH >= nesting_depth(json.dumps({**GOOD, "limits": {"max_velocity": [1.0] * 6}}).encode())
+
+
+def test_a_stopped_run_keeps_what_finished_and_resumes_by_line_number(tmp_path):
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    bodies = [GOOD, OTHER, GOOD, {**OTHER, "robot": "nope"}, OTHER, {**GOOD, "output": {"dt": 0.02}}, GOOD, {**GOOD, "output": {"dt": 0.03}}]
+    bodies += [{**GOOD, "output": {"dt": 0.01 + 0.001 * k}} for k in range(8)]
+    requests.write_text("".join(json.dumps(body) + "\n" for body in bodies))
+    stop = threading.Event()
+    first = run_batch(requests, output, stop=stop, pool=lambda: InProcessPool(lambda pool: len(pool.chunks) == 2 and stop.set()))
+    assert first.interrupted and 0 < first.planned < len(bodies)
+    partial = _by_line(output)
+    assert len(partial) == first.planned
+    # the run after it was killed while writing a line
+    output.write_bytes(output.read_bytes() + b'{"line": 16, "key": "ab')
+    pool = InProcessPool()
+    second = run_batch(requests, output, pool=lambda: pool)
+    assert (second.skipped, second.planned, second.interrupted) == (first.planned, len(bodies) - first.planned, False)
+    rows = _by_line(output)
+    assert sorted(rows) == list(range(1, len(bodies) + 1))
+    assert all(rows[n]["key"] == request_key(json.dumps(body)) for n, body in enumerate(bodies, start=1))
+    assert not set(pool.keys) & {row["key"] for row in partial.values()}  # nothing planned twice
+
+
+def test_a_stop_before_the_planning_starts_no_pool(tmp_path):
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text("not json\n" + json.dumps(GOOD) + "\n")
+    stop = threading.Event()
+    stop.set()
+    report = run_batch(requests, output, stop=stop, pool=lambda: pytest.fail("no pool may start"))
+    assert report.interrupted and report.planned == 0
+    assert sorted(_by_line(output)) == []
+    assert run_batch(requests, output, pool=InProcessPool).planned == 2
+
+
+def test_retry_failed_plans_the_504s_and_5xx_again_within_the_given_budget(tmp_path):
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text(json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n" + json.dumps({**GOOD, "robot": "nope"}) + "\n")
+    run_batch(requests, output, budget_s=1e-9, pool=InProcessPool)  # a budget nothing fits in
+    assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 504, 2: 504, 3: 404}
+    assert "budget" in _by_line(output)[1]["body"]["detail"]
+    rows = output.read_bytes().splitlines(keepends=True)
+    output.write_bytes(rows[0] + rows[2] + rows[1].replace(b'"status":504', b'"status":503'))
+    assert run_batch(requests, output, pool=InProcessPool).planned == 0  # a resume keeps them
+    pool = InProcessPool()
+    report = run_batch(requests, output, retry_failed=True, pool=lambda: pool)
+    assert (report.skipped, report.planned) == (1, 2) and len(pool.keys) == 2
+    assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 200, 2: 200, 3: 404}
+    assert not list(tmp_path.glob("*.resuming"))
+
+
+class _Hanging(_Done):
+    """A task whose worker never ends (a solver step that cannot check its deadline)."""
+
+
+class HangingPool(InProcessPool):
+    """``InProcessPool`` whose tasks holding ``OTHER`` never end until cancelled."""
+
+    def __init__(self):
+        super().__init__()
+        self.cancelled: list = []
+
+    def submit(self, chunk, budget_s):
+        if any(text == json.dumps(OTHER) for _, text in chunk):
+            self.chunks.append(list(chunk))
+            return _Hanging(None)
+        return super().submit(chunk, budget_s)
+
+    def wait(self, handles, timeout_s):
+        ready = [h for h in handles if not isinstance(h, _Hanging)]
+        if not ready:
+            time.sleep(timeout_s)
+        return ready, [h for h in handles if isinstance(h, _Hanging)]
+
+    def cancel(self, handles):
+        self.cancelled += handles
+
+
+def test_a_task_past_its_budget_is_killed_and_its_lines_are_504s(tmp_path, monkeypatch):
+    monkeypatch.setattr(runner, "CHUNK", 1)
+    monkeypatch.setattr(runner, "TASK_SLACK_S", 0.5)
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text(json.dumps(OTHER) + "\n" + json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n")
+    pool = HangingPool()
+    started = time.monotonic()
+    report = run_batch(requests, output, budget_s=0.5, pool=lambda: pool)
+    assert time.monotonic() - started < 0.5 + 0.5 + 1.0  # its budget, the slack, the polls
+    assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 504, 2: 200, 3: 504}
+    assert "--retry-failed" in _by_line(output)[1]["body"]["detail"]
+    assert len(pool.cancelled) == 1 and not report.interrupted
+
+
+@pytest.mark.parametrize("budget", ["0", "-1", "nan", "1e9"])
+def test_the_budget_option_is_checked(tmp_path, capsys, budget):
+    (tmp_path / "in.jsonl").write_text(json.dumps(GOOD) + "\n")
+    assert main(["batch", str(tmp_path / "in.jsonl"), "-o", str(tmp_path / "out.jsonl"), "--budget", budget]) == 2
+    assert "--budget must be in (0, 3600] s" in capsys.readouterr().err
+
+
+def test_batch_without_ray_names_the_extra_to_install(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "ray", None)  # import ray raises ImportError
+    (tmp_path / "in.jsonl").write_text(json.dumps(GOOD) + "\nnot json\n")
+    assert main(["batch", str(tmp_path / "in.jsonl"), "-o", str(tmp_path / "out.jsonl")]) == 2
+    err = capsys.readouterr().err
+    assert "pip install 'toptraj[ray]'" in err and "Traceback" not in err
+    problem = json.loads(err.strip().splitlines()[-1])
+    assert problem["status"] == 400 and problem["title"] == "Ray is not installed"
+
+
+def _fails_on_panda(monkeypatch):
+    planned = batch_work.plan_request
+
+    def plan(request, *args, **kwargs):
+        if request.robot == "panda":
+            raise RuntimeError("ruckig: the input is out of range")
+        return planned(request, *args, **kwargs)
+
+    monkeypatch.setattr(batch_work, "plan_request", plan)
+
+
+def test_a_line_failing_inside_planning_is_that_lines_500(monkeypatch):
+    _fails_on_panda(monkeypatch)
+    status, body = answer(json.dumps({"robot": "panda", "path": {"waypoints": [[0.0] * 7, [0.1] * 7]}}), 5.0)
+    problem = orjson.loads(body)
+    assert status == 500 == problem["status"] and "RuntimeError" in problem["detail"]
+    assert "out of range" not in problem["detail"]  # the solver's text is logged, not answered
+    assert answer(json.dumps(GOOD), 5.0)[0] == 200
+
+
+def _setup(tmp_path) -> WorkerSetup:
+    return WorkerSetup(str(tmp_path), 10, 1_000_000, 4, 50_000_000)
+
+
+def test_a_batch_job_answers_every_good_line_when_one_fails_inside_planning(tmp_path, monkeypatch):
+    _fails_on_panda(monkeypatch)
+    bad = {"robot": "panda", "path": {"waypoints": [[0.0] * 7, [0.1] * 7]}}
+    request = orjson.dumps({"requests": [GOOD, bad, OTHER, {**GOOD, "robot": "nope"}]}).decode()
+    results = orjson.loads(_batch(request, Deadline(60.0), _setup(tmp_path)))["results"]
+    assert [(row["line"], row["status"]) for row in results] == [(1, 200), (2, 500), (3, 200), (4, 404)]
+    assert results[0]["body"]["duration"] > 0 and results[1]["body"]["title"] == "Internal error"
+
+
+def test_a_batch_job_out_of_budget_answers_each_line_it_did_not_reach_with_a_504(tmp_path):
+    request = orjson.dumps({"requests": [GOOD, OTHER]}).decode()
+    deadline = Deadline(0.01)
+    time.sleep(0.02)
+    results = orjson.loads(_batch(request, deadline, _setup(tmp_path)))["results"]
+    assert [(row["line"], row["status"]) for row in results] == [(1, 504), (2, 504)]
+    assert "budget_s" in results[0]["body"]["detail"]
+
+
+def test_sigint_stops_a_ray_batch_within_seconds_and_leaves_no_process(tmp_path):
+    """Two Ctrl-C (SIGINT to the driver's process group): it stops within seconds with status
+    130, says how to resume, keeps whole result lines only (a worker interrupted writes no
+    error line), and every process it started is gone."""
+    pytest.importorskip("ray")
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text("".join(json.dumps({**GOOD, "output": {"dt": 0.001 + 1e-6 * k}}) + "\n" for k in range(3000)))
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    driver = subprocess.Popen(
+        [sys.executable, "-m", "toptraj.service.cli", "batch", str(requests), "-o", str(output), "--workers", "2"],
+        stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path, start_new_session=True,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while not (output.exists() and output.stat().st_size > 0):
+            assert driver.poll() is None and time.monotonic() < deadline, "no result line came"
+            time.sleep(0.1)
+        children = psutil.Process(driver.pid).children(recursive=True)
+        assert any("raylet" in child.name() for child in children)
+        os.killpg(driver.pid, signal.SIGINT)  # as Ctrl-C in a terminal: to the driver and every process of its group
+        time.sleep(0.3)
+        os.killpg(driver.pid, signal.SIGINT)  # a second one changes nothing
+        started = time.monotonic()
+        err = driver.communicate(timeout=15)[1]
+        assert time.monotonic() - started < 10
+    finally:
+        if driver.poll() is None:
+            driver.kill()
+    assert driver.returncode == 130, err[-2000:]
+    assert f"resume with: toptraj batch {requests} -o {output} --workers 2" in err and "Traceback" not in err
+    gone = time.monotonic() + 5
+    while [c for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE] and time.monotonic() < gone:
+        time.sleep(0.1)
+    assert not [c.name() for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
+    assert output.read_bytes().endswith(b"\n")
+    rows = _by_line(output)
+    assert 0 < len(rows) < 3000 and all(row["status"] == 200 for row in rows.values())

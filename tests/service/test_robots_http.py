@@ -1,0 +1,103 @@
+"""/v1/robots: the catalog, one robot, URDF uploads."""
+
+from __future__ import annotations
+
+from importlib import resources
+
+import pytest
+
+GEERING = resources.files("toptraj.robots").joinpath("urdf/geering_2r.urdf").read_text()
+
+MINIMAL = """<robot name="one">
+  <link name="base"/>
+  <joint name="j" type="revolute">
+    <parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="{effort}" velocity="2"/>
+  </joint>
+  <link name="arm">{inertial}</link>
+</robot>"""
+INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>'
+
+
+def test_health_and_docs(client):
+    assert client.get("/health").json() == {"status": "ok"}
+    assert client.get("/docs").status_code == 200
+    spec = client.get("/openapi.json").json()
+    assert "/v1/trajectories" in spec["paths"] and "/v1/robots" in spec["paths"]
+
+
+def test_catalog_lists_paper_arms_and_example_arms(client):
+    listing = {row["name"]: row for row in client.get("/v1/robots").json()}
+    assert listing["geering_2r"] == {"name": "geering_2r", "dof": 2, "source": "bundled"}
+    assert listing["ur5"]["source"] == "example-robot-data"
+    assert listing["panda"]["dof"] == 7
+
+
+def test_one_robot(client):
+    body = client.get("/v1/robots/ur5").json()
+    assert body["joint_names"][0] == "shoulder_pan_joint"
+    assert body["end_effector"] == "tool0"
+    assert body["limits"]["torque"] == [150.0, 150.0, 150.0, 28.0, 28.0, 28.0]
+    assert body["limits"]["acceleration"] == [10.0] * 6
+    geering = client.get("/v1/robots/geering_2r").json()
+    assert geering["limits"]["velocity"] == [None, None]  # the paper arm is torque-limited only
+    missing = client.get("/v1/robots/nope")
+    assert missing.status_code == 404 and "no robot named 'nope'" in missing.json()["detail"]
+
+
+def test_upload_then_plan(client):
+    created = client.post("/v1/robots", json={"urdf": GEERING})
+    assert created.status_code == 201, created.text
+    name = created.json()["name"]
+    assert name.startswith("urdf-")
+    assert client.post("/v1/robots", json={"urdf": GEERING}).json()["name"] == name  # same content, same id
+    assert name in [row["name"] for row in client.get("/v1/robots").json()]
+    planned = client.post(
+        "/v1/trajectories",
+        json={"robot": name, "path": {"waypoints": [[0, 0], [0.76, 0]]}, "timing": {"constraints": ["torque"]}},
+    )
+    assert planned.status_code == 200, planned.text
+    bundled = client.post(
+        "/v1/trajectories",
+        json={"robot": "geering_2r", "path": {"waypoints": [[0, 0], [0.76, 0]]}, "timing": {"constraints": ["torque"]}},
+    )
+    assert planned.json()["duration"] == pytest.approx(bundled.json()["duration"], rel=1e-12)
+
+
+def test_upload_under_a_name(client):
+    urdf = MINIMAL.format(effort=5, inertial=INERTIAL)
+    created = client.post("/v1/robots", json={"name": "my_arm", "urdf": urdf})
+    assert created.status_code == 201 and created.json()["name"] == "my_arm"
+    assert created.json()["limits"]["acceleration"] == [10.0]  # default rule: 2 rad/s over 0.2 s
+    other = MINIMAL.format(effort=6, inertial=INERTIAL)
+    assert client.post("/v1/robots", json={"name": "my_arm", "urdf": other}).status_code == 409
+    assert client.post("/v1/robots", json={"name": "ur5", "urdf": urdf}).status_code == 409
+
+
+@pytest.mark.parametrize(
+    "urdf, words",
+    [
+        ("<robot><link name='a'>", ["malformed XML"]),
+        ("<nothing/>", ["root element is <nothing>"]),
+        (MINIMAL.format(effort=5, inertial=""), ["joint 'j'", "link 'arm' has no <inertial>"]),
+        (MINIMAL.format(effort=0, inertial=INERTIAL), ["joint 'j'", "effort limit must be positive"]),
+        (MINIMAL.format(effort="abc", inertial=INERTIAL), ["joint 'j'", "effort='abc' is not a number"]),
+        (MINIMAL.replace('effort="{effort}" ', "").format(inertial=INERTIAL), ["joint 'j'", "no effort"]),
+        (MINIMAL.replace("<limit", "<nolimit").format(effort=1, inertial=INERTIAL), ["joint 'j'", "has no <limit>"]),
+        (MINIMAL.replace('type="revolute"', 'type="floating"').format(effort=1, inertial=INERTIAL), ["floating", "not supported"]),
+        (MINIMAL.replace('<child link="arm"/>', '<child link="ghost"/>').format(effort=1, inertial=INERTIAL), ["link 'ghost'"]),
+        ('<robot name="x"><link name="a"/></robot>', ["no revolute, continuous or prismatic joint"]),
+    ],
+)
+def test_bad_urdf_is_422_saying_what_and_where(client, urdf, words):
+    response = client.post("/v1/robots", json={"urdf": urdf})
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"]
+    for word in words:
+        assert word in detail, detail
+
+
+def test_oversized_urdf(client):
+    response = client.post("/v1/robots", json={"urdf": "<robot>" + " " * 1_200_000 + "</robot>"})
+    assert response.status_code == 422
+    assert "urdf" in response.json()["detail"]
