@@ -12,7 +12,6 @@ status in the library.
 from __future__ import annotations
 
 import ast
-import pathlib
 import pickle
 import subprocess
 import sys
@@ -20,6 +19,7 @@ import sys
 import numpy as np
 import pytest
 
+from tests.paths import ROOT
 from toptraj import robots
 from toptraj.planners import Deadline, Timing, WaypointPath, plan
 from toptraj.planners.checks.gate import limit_exceeded
@@ -46,7 +46,6 @@ from toptraj.robots.notes import Note
 from toptraj.service.problems import REQUEST_FIELD, STATUS, detail, note_text, request_field, status_of
 from toptraj.service.wordings import WORDING
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
 UR5 = robots.load("ur5")
 START = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
 TWO = WaypointPath(np.array([START, START + 0.4]))
