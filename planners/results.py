@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from toptraj.planners.errors import TimingFailed
+from toptraj.planners.errors import NonFinite
 from toptraj.planners.timing.base import Binding
 from toptraj.planners.trajectory import Samples
 
@@ -71,7 +71,7 @@ class PlannedTrajectory:
 
 
 def require_finite(method: str, **quantities) -> None:
-    """TimingFailed unless every number of every named quantity (arrays, scalars or ``None``)
+    """NonFinite (a TimingFailed) unless every number of every named quantity (arrays, scalars or ``None``)
     is finite: a timing whose numbers overflowed is a failure of the method, never an answer."""
     for name, values in quantities.items():
         if values is None:
@@ -81,8 +81,9 @@ def require_finite(method: str, **quantities) -> None:
             continue
         bad = np.flatnonzero(~np.isfinite(array.ravel()))
         if bad.size:
-            raise TimingFailed(
+            raise NonFinite(
                 f"timing method {method!r} failed: its {name} holds {array.ravel()[bad[0]]} "
                 f"({bad.size} non-finite values); the request's durations, limits or boundary states "
-                "lie too far apart for this method"
+                "lie too far apart for this method",
+                method=method, quantity=name, count=int(bad.size),
             )

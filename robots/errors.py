@@ -1,8 +1,12 @@
 """The one exception tree of toptraj, rooted here because every layer (robots, planners, service)
-may raise it. Each subclass carries the facts a caller needs; the service turns them into
-``application/problem+json`` answers in one handler (``service/errors.py``)."""
+may raise it. Each error carries the facts a caller needs as attributes (the input's field in the
+library's own names, the value given, bounds, where along the path); ``str(error)`` is one sentence
+in the library's words. The service picks the HTTP status, the title and the wording of its
+answers from the class and the facts (``service/errors.py``)."""
 
 from __future__ import annotations
+
+from typing import Any
 
 #: Longest ``detail`` an error carries; longer sentences are cut (a detail never echoes a large
 #: request back).
@@ -39,19 +43,23 @@ class ToptrajError(Exception):
     """Root of all toptraj errors.
 
     Attributes:
-        detail: Human-readable sentence saying what is wrong and where.
-        status: The HTTP status the service answers with.
-        title: Short summary shared by all errors of the class.
+        detail: One sentence in the library's words saying what is wrong and where (``str``).
+        The facts of a subclass are attributes too, given as keywords (``field``, ``value``,
+        ``s``, ``joint``, ...).
     """
 
-    status: int = 422
-    title: str = "Unprocessable request"
-
-    def __init__(self, detail: str):
+    def __init__(self, detail: str = "", **facts: Any):
+        self.__dict__.update(facts)
+        detail = detail or self.sentence()
         if len(detail) > MAX_DETAIL_CHARS:
             detail = detail[: MAX_DETAIL_CHARS - 20] + " ... (detail cut)"
         super().__init__(detail)
         self.detail = detail
+
+    def sentence(self) -> str:
+        """The library's sentence for an error raised with facts only (``detail`` left out)."""
+        facts = ", ".join(f"{key} = {excerpt(value)}" for key, value in vars(self).items())
+        return f"{type(self).__name__}: {facts}"
 
     def __reduce__(self):
         """Pickled with its attributes, without calling ``__init__`` again: an error raised in
@@ -69,62 +77,69 @@ def _restore_error(cls: type[ToptrajError], args: tuple, state: dict) -> Toptraj
     return error
 
 
-class UnknownRobot(ToptrajError):
-    """No robot of that name is bundled, in example-robot-data, or uploaded."""
+class InvalidInput(ToptrajError):
+    """Input that cannot be used as given.
 
-    status = 404
-    title = "Unknown robot"
+    Attributes:
+        field: The input, in the library's own names: ``grid.intervals``, ``sampling.dt``,
+            ``waypoints[2][4]``, ``limits.velocity[1]``, ``boundary.start_velocity`` (the
+            service maps them to its request's fields).
+        value: What was given (shown only through ``excerpt``).
+        rule: The rule it breaks, a short key (``out_of_range``, ``needs_rest``, ...); further
+            facts by rule, as keywords.
+
+    ``detail``, when given, is the library's sentence (else one is made from the facts).
+    """
+
+    field: str
+    value: object
+    rule: str
+    rule_of_class = "invalid_input"
+
+    def __init__(self, field: str, value: object = None, *, rule: str = "", detail: str = "", **facts: Any):
+        super().__init__(detail, field=field, value=value, rule=rule or self.rule_of_class, **facts)
+
+    def sentence(self) -> str:
+        """``field = value`` and the rule it breaks, with the other facts."""
+        facts = ", ".join(f"{key} = {excerpt(value)}" for key, value in vars(self).items() if key not in ("field", "value", "rule"))
+        return f"{self.field} = {excerpt(self.value)} breaks the rule {self.rule!r}" + (f" ({facts})" if facts else "")
+
+
+class UnknownRobot(ToptrajError):
+    """No robot of that name is bundled, in example-robot-data, or uploaded (``name``; the
+    catalog's robots: ``known``)."""
 
     def __init__(self, name: str, known: list[str]):
         super().__init__(
-            f"no robot named {excerpt(name)}; catalog robots: {', '.join(known)}; "
-            "uploaded robots are listed by GET /v1/robots"
+            f"no robot named {excerpt(name)}; catalog robots: {', '.join(known)}", name=name, known=tuple(known), rule="unknown_robot"
         )
-        self.name = name
 
 
 class InvalidURDF(ToptrajError):
     """An uploaded URDF that cannot be turned into a usable robot."""
 
-    title = "Invalid URDF"
-
 
 class RobotConflict(ToptrajError):
     """An upload asks for a name that another robot already holds."""
-
-    status = 409
-    title = "Robot name taken"
 
 
 class InvalidRobotName(ToptrajError):
     """A name for an upload that breaks the naming rule (length, characters)."""
 
-    title = "Invalid robot name"
-
 
 class CatalogRobotReadOnly(ToptrajError):
     """A request to delete a bundled or example-robot-data robot: only uploads can be deleted."""
 
-    status = 409
-    title = "Catalog robot cannot be deleted"
-
 
 class UploadStoreFull(ToptrajError):
     """The upload store holds as many uploads, or as many bytes, as its caps allow."""
-
-    status = 409
-    title = "Upload store full"
 
 
 class UploadStoreUnavailable(ToptrajError):
     """The upload store cannot be read or written (the data directory is not writable, the disk
     is full, the database is damaged): a condition of the server, not of the request."""
 
-    status = 503
-    title = "Upload store unavailable"
 
-
-class InvalidLimits(ToptrajError):
+class InvalidLimits(InvalidInput):
     """A limit override of the wrong length or value."""
 
-    title = "Invalid limits"

@@ -101,18 +101,16 @@ class JointLimits:
                 continue
             array = np.asarray(given, dtype=float)
             if array.shape != (n_dof,):
-                raise InvalidLimits(
-                    f"timing.limits.{kind} has {array.size} values; the robot has {n_dof} joints"
-                )
+                raise InvalidLimits(f"limits.{kind}", given, rule="wrong_length", given=array.size, expected=n_dof)
             if np.any(np.isnan(array)) or np.any(array <= 0.0):
                 bad = int(np.flatnonzero(np.isnan(array) | (array <= 0.0))[0])
-                raise InvalidLimits(f"timing.limits.{kind}[{bad}] must be positive, got {array[bad]}")
+                raise InvalidLimits(f"limits.{kind}[{bad}]", float(array[bad]), rule="limit_not_positive")
             values[kind] = array
         for kind, factor in (scales or {}).items():
             if factor is None:
                 continue
             if not (math.isfinite(factor) and factor > 0.0):
-                raise InvalidLimits(f"timing.limits.{kind}_scale must be positive and finite, got {factor}")
+                raise InvalidLimits(f"limits.{kind}_scale", factor, rule="scale_not_positive")
             values[kind] = values[kind] * factor
         return JointLimits(**values, tool=self.tool)
 
@@ -227,7 +225,7 @@ def limits_with_sources(
         for joint, value in enumerate(values[kind]):
             problem = limit_problem(kind, float(value), names[joint], _source_name(sources[kind][joint]))
             if problem is not None:
-                raise InvalidLimits(problem)
+                raise InvalidLimits(f"{kind}[{joint}]", float(value), rule="catalog_limit", detail=problem)
     limits = JointLimits(
         values["position_lower"], values["position_upper"], values["velocity"], values["acceleration"], values["jerk"],
         values["torque"],

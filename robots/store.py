@@ -211,8 +211,8 @@ class UploadStore:
                     if row[0] != digest or row[1] != options:
                         what = "URDF" if row[0] != digest else "set of options (locked joints, joint limits)"
                         raise RobotConflict(
-                            f"name {excerpt(name)} already holds a different {what}; choose another name, or "
-                            "DELETE /v1/robots/{name} first"
+                            f"name {excerpt(name)} already holds a different {what}; choose another name, or delete it first",
+                            rule="name_taken", name=name, what=what,
                         )
                     connection.execute("ROLLBACK")
                     return False
@@ -222,8 +222,9 @@ class UploadStore:
                 if count + 1 > self.max_uploads or stored + added > self.max_bytes:
                     raise UploadStoreFull(
                         f"the upload store holds {count} uploads and {stored} bytes; its caps are "
-                        f"{self.max_uploads} uploads and {self.max_bytes} bytes, and this upload adds {added} "
-                        "bytes. Free space with DELETE /v1/robots/{name} (GET /v1/robots lists the uploads)."
+                        f"{self.max_uploads} uploads and {self.max_bytes} bytes, and this upload adds {added} bytes",
+                        rule="store_full", count=count, size=stored, max_uploads=self.max_uploads, max_bytes=self.max_bytes,
+                        added=added,
                     )
                 if not known:
                     connection.execute("INSERT INTO urdfs (digest, urdf, bytes) VALUES (?, ?, ?)", (digest, urdf, size))

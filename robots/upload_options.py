@@ -58,8 +58,6 @@ MAX_LIMITS_CHARS = bounded_yaml.MAX_CHARS
 class InvalidUpload(ToptrajError):
     """The options of an upload do not fit its URDF or are malformed."""
 
-    title = "Invalid upload options"
-
 
 @dataclass(frozen=True)
 class UploadOptions:
@@ -168,7 +166,7 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
         raise InvalidUpload(f"joint_limits: unknown top-level key {excerpt(unknown[0], 40)}; expected 'joint_limits'")
     scaling = sorted(set(given) & _SCALING_KEYS, key=str)
     if scaling:
-        notes.append(f"joint_limits.yaml's {', '.join(scaling)} not applied: requests scale limits (timing.limits)")
+        notes.append(f"joint_limits.yaml's {', '.join(scaling)} not applied: requests scale limits (a request's limit scales)")
     limits: dict[str, dict[str, float]] = {}
     positions = []
     for joint, entry in given["joint_limits"].items():

@@ -237,7 +237,8 @@ def _check_limits(joint: ElementTree.Element, kind: str, where: str) -> None:
         if not lowest <= value <= highest:
             raise InvalidURDF(
                 f"{where}: {name} limit {value:g} {unit} in the URDF is outside the accepted range "
-                f"[{lowest:g}, {highest:g}] (the range of every {name} limit, a request's timing.limits too)"
+                f"[{lowest:g}, {highest:g}] (the range of every {name} limit, a request's too)",
+                rule="urdf_limit_out_of_range", where=where, kind=name, value=value, unit=unit, low=lowest, high=highest,
             )
     lower, upper = values["lower"], values["upper"]
     if kind == "continuous":

@@ -15,7 +15,8 @@ from toptraj.planners.execution.isolated import start_worker_server
 from toptraj.planners.execution.threads import single_blas_thread
 from toptraj.service import stopping, warmup
 from toptraj.service.body_limit import BodySizeLimit
-from toptraj.service.errors import FiniteJSONResponse, UnexpectedErrors, install_problem_handlers
+from toptraj.service.errors import UnexpectedErrors, install_problem_handlers
+from toptraj.service.finite import FiniteJSONResponse
 from toptraj.service.jobs import JOB_MODULES, job_runner
 from toptraj.service.routes import batches, guide, health, jobs, trajectories, web
 from toptraj.service.routes import robots as robot_routes

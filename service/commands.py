@@ -81,7 +81,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
     from toptraj.robots import ToptrajError
-    from toptraj.service.problems import status_of, validation_problem
+    from toptraj.service.problems import detail, status_of, title_of, validation_problem
 
     try:
         content = answer(_read(source))
@@ -92,7 +92,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
         print(json.dumps(validation_problem(error)), file=sys.stderr)
         return 1
     except ToptrajError as error:
-        print(json.dumps(_problem(error.title, status_of(error), error.detail)), file=sys.stderr)
+        print(json.dumps(_problem(title_of(error), status_of(error), detail(error))), file=sys.stderr)
         return 1
     return _write(content, out)
 

@@ -1,26 +1,22 @@
-"""Errors as ``application/problem+json`` (RFC 9457): one handler per family, an outermost guard
-for the unexpected, an encoder that refuses NaN and infinity, and the OpenAPI declaring all of it.
+"""Errors as ``application/problem+json`` (RFC 9457): the status, title and words of each
+error, one handler per family and an outermost guard for the unexpected.
 
-* ``STATUS`` gives the HTTP status of each error class of the library (``status_of``: its own
-  class or nearest base in the table; the service's own errors carry theirs); it lives in
-  ``toptraj.service.problems`` with the rest that needs no web framework, and is re-exported here.
+* ``toptraj.service.problems`` gives the status, title and words of each error (framework-free:
+  the CLI, jobs and batches use it too).
 * ``install_problem_handlers`` routes the error tree (``ToptrajError``), request validation and
   Starlette's HTTP errors (404, 405 with its ``Allow`` header, ...) to problem answers.
 * ``UnexpectedErrors`` (pure ASGI, outermost) answers any other exception with a problem 500
   and lets the server keep the connection: Starlette's own last-resort handler re-raises after
   answering, and uvicorn then drops the keep-alive connection without ``Connection: close``,
   so a client's next request on it fails.
-* ``FiniteJSONResponse`` refuses NaN and infinity (JSON has no such numbers) with a 422 that
-  says where the answer held one, instead of an encoder crash.
-* ``problem_responses`` and ``declare_problems`` make the OpenAPI say what the service answers:
-  problem+json bodies for 400, 404, 409, 413, 422 and 504, in place of FastAPI's default 422.
+* ``toptraj.service.finite.FiniteJSONResponse`` refuses NaN and infinity (JSON has no such numbers)
+  with a 422 that says where the answer held one, instead of an encoder crash.
+* ``toptraj.service.problem_docs`` makes the OpenAPI declare these answers.
 """
 
 from __future__ import annotations
 
-import json
 import logging
-from typing import Any
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
@@ -29,36 +25,10 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
 from toptraj.robots import ToptrajError
-from toptraj.service.problems import non_finite_answer, status_of
-from toptraj.service.schemas.common import Problem
+from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
+from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of
 
-PROBLEM_JSON = "application/problem+json"
 logger = logging.getLogger("toptraj")
-
-_TITLES = {
-    400: "Bad request",
-    404: "Not found",
-    405: "Method not allowed",
-    409: "Conflict",
-    413: "Request body too large",
-    422: "Invalid request",
-    500: "Internal error",
-    504: "Computation over its time budget",
-}
-
-
-class FiniteJSONResponse(JSONResponse):
-    """JSON that never carries NaN or infinity: such a number is a ``NonFiniteAnswer`` (422)
-    naming where it is, never invalid JSON and never an encoder crash."""
-
-    def render(self, content: Any) -> bytes:
-        try:
-            return json.dumps(content, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode("utf-8")
-        except ValueError:
-            error = non_finite_answer(content)
-            if error is None:
-                raise
-            raise error from None
 
 
 def problem(status: int, title: str, detail: str, headers: dict[str, str] | None = None, **extra) -> JSONResponse:
@@ -88,7 +58,7 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
     retry_after = getattr(error, "retry_after", None)
     headers = None if retry_after is None else {"Retry-After": str(retry_after)}
-    return problem(status_of(error), error.title, error.detail, headers, **extra)
+    return problem(status_of(error), title_of(error), detail(error), headers, **extra)
 
 
 def _message(item: dict) -> str:
@@ -119,7 +89,7 @@ def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse
         detail = f"{request.method} is not allowed on {request.url.path}; use {' or '.join(allowed)}"
     else:
         detail = str(error.detail)
-    return problem(error.status_code, _TITLES.get(error.status_code, "HTTP error"), detail, headers=headers)
+    return problem(error.status_code, HTTP_TITLES.get(error.status_code, "HTTP error"), detail, headers=headers)
 
 
 _METHODS = ("DELETE", "GET", "HEAD", "PATCH", "POST", "PUT")
@@ -163,7 +133,7 @@ class UnexpectedErrors:
             if started:
                 raise
             logger.exception("unexpected error on %s %s", scope.get("method"), scope.get("path"))
-            response = problem(500, _TITLES[500], f"an unexpected {type(error).__name__} occurred; it has been logged")
+            response = problem(500, HTTP_TITLES[500], f"an unexpected {type(error).__name__} occurred; it has been logged")
             await response(scope, receive, send)
 
 
@@ -175,65 +145,3 @@ def install_problem_handlers(app: FastAPI) -> None:
     app.add_exception_handler(RequestValidationError, _validation_error)  # type: ignore[arg-type]
     app.add_exception_handler(StarletteHTTPException, _http_error)  # type: ignore[arg-type]
     declare_problems(app)
-
-
-# --- OpenAPI -------------------------------------------------------------------------------
-
-_REF = "#/components/schemas/"
-_DESCRIPTIONS = {
-    400: "The request body cannot be read.",
-    404: "No such resource (e.g. an unknown robot).",
-    409: "The name is taken.",
-    413: "The request body exceeds the size cap.",
-    422: "Malformed or impossible input: a field out of range, wrong lengths, NaN/inf, a path "
-    "that no timing can follow (the detail says where).",
-    503: "The service cannot do this now (e.g. its data directory cannot be written).",
-    504: "The computation ran past its time budget.",
-}
-#: What every operation with a body may answer, whatever it declares (FastAPI itself adds a
-#: 422 to operations with parameters; its content is replaced below).
-_WITH_BODY = (400, 413, 422)
-
-
-def _problem_content() -> dict:
-    return {PROBLEM_JSON: {"schema": {"$ref": _REF + "Problem"}}}
-
-
-def problem_responses(*statuses: int) -> dict[int | str, dict[str, Any]]:
-    """``responses=`` of a route: each status answered with a problem+json body."""
-    return {status: {"description": _DESCRIPTIONS[status], "content": _problem_content()} for status in statuses}
-
-
-def _problem_schemas() -> dict[str, dict]:
-    schema = Problem.model_json_schema(ref_template=_REF + "{model}")
-    definitions = schema.pop("$defs", {})
-    return {"Problem": schema, **definitions}
-
-
-def _declare(openapi: dict) -> dict:
-    components = openapi.setdefault("components", {}).setdefault("schemas", {})
-    components.update(_problem_schemas())
-    for operations in openapi.get("paths", {}).values():
-        for operation in operations.values():
-            if not isinstance(operation, dict) or "responses" not in operation:
-                continue
-            responses = operation["responses"]
-            for status in _WITH_BODY if "requestBody" in operation else ():
-                responses[str(status)] = problem_responses(status)[status]
-            for status, response in responses.items():
-                if status.isdigit() and int(status) >= 400:
-                    response["content"] = _problem_content()
-    for name in ("HTTPValidationError", "ValidationError"):
-        if f'"{_REF}{name}"' not in json.dumps(openapi):
-            components.pop(name, None)
-    return openapi
-
-
-def declare_problems(app: FastAPI) -> None:
-    """Make ``app``'s OpenAPI declare its error answers as problem+json (``Problem``), with
-    FastAPI's default 422 schema replaced."""
-
-    def openapi() -> dict:
-        return _declare(FastAPI.openapi(app))
-
-    app.openapi = openapi  # type: ignore[method-assign]  # FastAPI's way to extend its schema

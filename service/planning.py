@@ -13,7 +13,7 @@ import orjson
 from toptraj import robots
 from toptraj.planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
 from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, WrongLength
 from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.generators.search import SearchOptions
 from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
@@ -23,7 +23,7 @@ from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
-from toptraj.service.problems import non_finite_answer, status_of
+from toptraj.service.problems import detail, non_finite_answer, note_text, status_of, title_of
 from toptraj.service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.
@@ -191,12 +191,12 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
     if spec.kind == "free":
         for name in ("start", "goal"):
             if len(getattr(spec, name)) != robot.dof:
-                raise InvalidRequest(f"path.{name} has {len(getattr(spec, name))} values; {robot.name} has {robot.dof} joints")
+                raise WrongLength(name, getattr(spec, name), len(getattr(spec, name)), robot.dof, robot=robot.name)
         boundary = request.timing.boundary
 
         def velocity(name):
             value = getattr(boundary, name)
-            return None if value is None else finite_vector(value, f"timing.boundary.{name}", robot.dof)
+            return None if value is None else finite_vector(value, f"boundary.{name}", robot.dof)
 
         return FreeMotion(
             start=np.asarray(spec.start, dtype=float),
@@ -207,7 +207,7 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
         )
     if spec.kind == "cartesian":
         if len(spec.start) != robot.dof:
-            raise InvalidRequest(f"path.start has {len(spec.start)} values; {robot.name} has {robot.dof} joints")
+            raise WrongLength("start", spec.start, len(spec.start), robot.dof, robot=robot.name)
         return CartesianLine(
             start=np.asarray(spec.start, dtype=float),
             positions=None if spec.positions is None else np.asarray(spec.positions, dtype=float),
@@ -216,10 +216,7 @@ def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath
         )
     for index, row in enumerate(spec.waypoints):
         if len(row) != robot.dof:
-            raise InvalidRequest(
-                f"path.waypoints[{index}] has {len(row)} values; {robot.name} has {robot.dof} joints "
-                f"({', '.join(robot.joint_names)})"
-            )
+            raise WrongLength(f"waypoints[{index}]", row, len(row), robot.dof, robot=robot.name, joint_names=robot.joint_names)
     return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous)
 
 
@@ -253,7 +250,7 @@ def compare_results(request: CompareRequest, deadline: Deadline, dt: float = 1.0
         except UnknownRobot:
             raise
         except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:
-            results.append(({"method": method, "error": {"status": status_of(error), "title": error.title, "detail": error.detail}}, None))
+            results.append(({"method": method, "error": {"status": status_of(error), "title": title_of(error), "detail": detail(error)}}, None))
             continue
         body = trajectory_body(result)
         entry = {key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")}
@@ -313,7 +310,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         "solver": result.solver,
         "switching_times": result.switching_times,
         "solve_ms": result.solve_ms,
-        "warnings": list(result.warnings),
+        "warnings": [note_text(note) for note in result.warnings],
         "min_clearance": None if result.clearance is None else {
             "distance": result.clearance.distance,
             "link": result.clearance.link,
@@ -331,7 +328,7 @@ def accuracy_body(result: PlannedTrajectory) -> dict:
     accuracy = result.accuracy
     if accuracy is None:
         return {"relative_gap": None, "basis": f"not estimated for timing.method {result.method}"}
-    return {"relative_gap": accuracy.relative_gap, "basis": accuracy.basis}
+    return {"relative_gap": accuracy.relative_gap, "basis": note_text(accuracy.basis)}
 
 
 def _plain(value):

@@ -16,6 +16,7 @@ from toptraj import robots
 from toptraj.planners import PlannedTrajectory
 from toptraj.planners.kinematics.skeleton import skeleton
 from toptraj.planners.paths.grid import spread_indices
+from toptraj.service.problems import note_text
 
 #: Instants of the stroboscopic picture.
 STROBE = 12
@@ -125,7 +126,7 @@ def figures_html(result: PlannedTrajectory) -> str:
         to_html(figure, full_html=False, include_plotlyjs=(k == 0))
         for k, figure in enumerate((phase_plane_figure(result), joints_figure(result, robot.limits), arm_figure(result, robot)))
     ]
-    warnings = "".join(f"<li>{html.escape(text)}</li>" for text in result.warnings)
+    warnings = "".join(f"<li>{html.escape(note_text(text))}</li>" for text in result.warnings)
     title = f"{html.escape(result.robot)}, {html.escape(result.method)}: {result.duration:.4f} s"
     return (
         f"<!doctype html><html><head><meta charset='utf-8'><title>toptraj: {title}</title></head>"

@@ -1,21 +1,53 @@
-"""Errors as ``application/problem+json`` (RFC 9457) without the web framework: the HTTP status
-of each error class of the library, the problem of a request that does not fit its schema and the
-search for a NaN or infinity in an answer. ``toptraj plan`` and the batch workers answer with
-these, without importing FastAPI; ``toptraj.service.errors`` serves them over HTTP.
+"""Errors as ``application/problem+json`` (RFC 9457) without the web framework: the HTTP
+status and title of each error class of the library (``STATUS``, ``TITLE``: ``status_of``,
+``title_of``, its own class or nearest base in the table; the service's own errors carry theirs),
+``detail`` that words an error in the request's vocabulary (``REQUEST_FIELD`` maps the library's
+fields to the request's; ``toptraj.service.wordings`` holds one wording per rule), the problem of a
+request that does not fit its schema, and the search for a NaN or infinity in an answer. The HTTP
+answers (``toptraj.service.errors``), jobs, batches and the CLI all use these; ``toptraj plan`` and
+the batch workers without importing FastAPI.
 """
 
 from __future__ import annotations
 
 import math
+import string
 from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
 from pydantic import ValidationError
 
-from toptraj.planners.errors import BudgetExceeded
+from toptraj.planners.collision.clearance import PathInCollision
+from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
 from toptraj.robots import ToptrajError
-from toptraj.robots.errors import CatalogRobotReadOnly, RobotConflict, UnknownRobot, UploadStoreFull, UploadStoreUnavailable
+from toptraj.robots.errors import (
+    MAX_DETAIL_CHARS,
+    CatalogRobotReadOnly,
+    InvalidLimits,
+    InvalidRobotName,
+    InvalidURDF,
+    RobotConflict,
+    UnknownRobot,
+    UploadStoreFull,
+    UploadStoreUnavailable,
+    excerpt,
+)
+from toptraj.robots.notes import Note
+from toptraj.robots.upload_options import InvalidUpload
+from toptraj.service.wordings import WORDING
+
+HTTP_TITLES = {
+    400: "Bad request",
+    404: "Not found",
+    405: "Method not allowed",
+    409: "Conflict",
+    413: "Request body too large",
+    422: "Invalid request",
+    500: "Internal error",
+    504: "Computation over its time budget",
+}
+
 
 #: HTTP status of the library's errors by class; a class not in the table answers with its
 #: nearest base's (``ToptrajError``: 422, malformed or impossible input).
@@ -30,15 +62,171 @@ STATUS: dict[type[ToptrajError], int] = {
 }
 
 
+#: Title of the library's errors by class (nearest base, as ``STATUS``).
+TITLE: dict[type[ToptrajError], str] = {
+    ToptrajError: "Unprocessable request",
+    UnknownRobot: "Unknown robot",
+    InvalidURDF: "Invalid URDF",
+    RobotConflict: "Robot name taken",
+    InvalidRobotName: "Invalid robot name",
+    CatalogRobotReadOnly: "Catalog robot cannot be deleted",
+    UploadStoreFull: "Upload store full",
+    UploadStoreUnavailable: "Upload store unavailable",
+    InvalidLimits: "Invalid limits",
+    InvalidUpload: "Invalid upload options",
+    InvalidRequest: "Invalid request",
+    InfeasiblePath: "Path cannot be followed within the limits",
+    PathInCollision: "Path comes too close to an obstacle",
+    TimingFailed: "Timing method failed",
+    OverMemory: "Computation over its memory cap",
+    BudgetExceeded: "Computation over its time budget",
+}
+
+#: The request's field of each of the library's (``InvalidInput.field``); a library field
+#: ``name[i]...`` or ``name.part`` maps by its longest listed prefix (``waypoints[2][4]`` ->
+#: ``path.waypoints[2][4]``).
+REQUEST_FIELD: dict[str, str] = {
+    "method": "timing.method",
+    "constraints": "timing.constraints",
+    "grid.intervals": "timing.grid_points",
+    "duration": "timing.duration",
+    "boundary": "timing.boundary",
+    "boundary.start_velocity": "timing.boundary.start_velocity",
+    "boundary.end_velocity": "timing.boundary.end_velocity",
+    "boundary.start_acceleration": "timing.boundary.start_acceleration",
+    "boundary.end_acceleration": "timing.boundary.end_acceleration",
+    "method.torque_weight": "timing.cost.torque_weight",
+    "law.trapezoid": "timing.trapezoid",
+    "law.blend": "timing.trapezoid.blend",
+    "law.supporting_points": "timing.supporting_points",
+    "law.synchronization": "timing.synchronization",
+    "limits": "timing.limits",
+    "limits.margin": "timing.limit_margin",
+    "tool.frame": "timing.limits.tool_frame",
+    "search": "timing.search",
+    "sampling.dt": "output.dt",
+    "sampling.exact_period": "output.exact_period",
+    "sampling.samples": "output.dt",
+    "waypoints": "path.waypoints",
+    "interpolation": "path.interpolation",
+    "max_deviation": "path.max_deviation",
+    "continuous": "path.continuous",
+    "start": "path.start",
+    "goal": "path.goal",
+    "revolutions": "path.revolutions",
+    "obstacles": "path.obstacles",
+    "clearance": "path.clearance",
+    "frame": "path.frame",
+    "positions": "path.positions",
+    "poses": "path.poses",
+}
+
+
+def request_field(field: str) -> str:
+    """The request's name of the library's ``field`` (``REQUEST_FIELD`` by its longest prefix
+    ending before a ``[`` or ``.``; a field not listed is shown as it is)."""
+    for end in range(len(field), 0, -1):
+        if end < len(field) and field[end] not in "[.":
+            continue
+        head = REQUEST_FIELD.get(field[:end])
+        if head is not None:
+            return head + field[end:]
+    return field
+
+
+class _Words(string.Formatter):
+    """``str.format`` with ``!j`` (join a sequence with ", "), ``!e`` (excerpt) and ``!f`` (a
+    library field as the request's)."""
+
+    def convert_field(self, value, conversion):
+        if conversion == "j":
+            return ", ".join(map(str, value))
+        if conversion == "e":
+            return excerpt(value)
+        if conversion == "f":
+            return request_field(value)
+        return super().convert_field(value, conversion)
+
+
+_WORDS = _Words()
+
+
+def detail(error: ToptrajError) -> str:
+    """``error`` in the request's words: the wording of its rule (``toptraj.service.wordings``) over its
+    facts, with its ``field`` as the request's; an error without a rule worded here is shown by
+    its own sentence (the service's errors, and the library's that name no request field)."""
+    rule = getattr(error, "rule", None)
+    text = _worded(rule, dict(vars(error)), error.detail)
+    held = getattr(error, "held", None)
+    if held is not None:
+        text += (
+            f": holding still at s = {held.s:.4f} needs {held.torque:.4g} N m on joint {held.joint!r}, "
+            f"above its limit of {held.limit:.4g} N m"
+        )
+    return _cut(text)
+
+
+def note_text(note: str) -> str:
+    """A note of an answer (``toptraj.robots.notes.Note``) in the request's words, as ``detail`` words
+    an error; a plain string as it is."""
+    if not isinstance(note, Note):
+        return note
+    return _worded(note.rule, dict(note.facts), str(note))
+
+
+def _worded(rule: object, facts: dict, sentence: str) -> str:
+    """The wording of ``rule`` over ``facts`` (fields mapped to the request's), or ``sentence``
+    when the rule has none."""
+    wording = WORDING.get(rule) if isinstance(rule, str) else None
+    if wording is None:
+        return sentence
+    if isinstance(facts.get("field"), str):
+        facts["field"] = request_field(facts["field"])
+    if isinstance(facts.get("fields"), tuple):
+        facts["fields"] = tuple(request_field(name) for name in facts["fields"])
+    return _cut(wording(facts) if callable(wording) else _WORDS.format(wording, **facts))
+
+
+def _cut(text: str) -> str:
+    """``text`` within ``MAX_DETAIL_CHARS`` (a detail never echoes a large request back)."""
+    if len(text) > MAX_DETAIL_CHARS:
+        text = text[: MAX_DETAIL_CHARS - 20] + " ... (detail cut)"
+    return text
+
+
+def title_of(error: ToptrajError) -> str:
+    """The title of ``error``'s answer: ``TITLE`` of its class or nearest base there; an error
+    class of the service itself states its own."""
+    for cls in type(error).__mro__:
+        if cls in TITLE:
+            return TITLE[cls]
+        if cls.__module__.startswith("toptraj.service.") and "title" in vars(cls):
+            return vars(cls)["title"]
+    return TITLE[ToptrajError]
+
+
 def status_of(error: ToptrajError) -> int:
     """The HTTP status of ``error``: ``STATUS`` of its class or nearest base there; an error
-    class of the service itself (``toptraj.service.*``: a busy queue, an unknown job) states its own."""
+    class of the service itself (``service.*``: a busy queue, an unknown job) states its own."""
     for cls in type(error).__mro__:
         if cls in STATUS:
             return STATUS[cls]
         if cls.__module__.startswith("toptraj.service.") and "status" in vars(cls):
             return vars(cls)["status"]
     return STATUS[ToptrajError]
+
+
+class RequestRefused(ToptrajError):
+    """A request the service refuses by its own rules (a job's kind, a cursor, a budget above the
+    server's cap, a skeleton's configurations), in the service's words."""
+
+    title = "Invalid request"
+
+
+def validation_problem(error: ValidationError) -> dict:
+    """The problem+json of a request that does not fit its schema (as the HTTP API's 422)."""
+    detail = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in error.errors())
+    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": detail}
 
 
 class NonFiniteAnswer(ToptrajError):
@@ -104,7 +292,3 @@ def _all_finite_numbers(values: list | tuple) -> bool:
     return array.ndim == 1 and bool(np.isfinite(array).all())
 
 
-def validation_problem(error: ValidationError) -> dict:
-    """The problem+json of a request that does not fit its schema (as the HTTP API's 422)."""
-    detail = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in error.errors())
-    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": detail}

@@ -15,7 +15,7 @@ from toptraj.planners.checks.limit_check import Excess, LimitCheck, check_limits
 from toptraj.planners.checks.limit_kernels import utilization_pass
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
-from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, LimitExceeded, TimingFailed
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.planners.runner.accuracy import REFINE_ROUNDS, estimated, finer_constraints
 from toptraj.planners.timing.base import PathTiming, TimeScaling
@@ -126,17 +126,19 @@ def _held(robot, path, method, constraints, result, boundary, duration, kinds, l
     raise limit_exceeded(method.name, check.worst, robot, path)
 
 
-def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> InfeasiblePath:
+def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> LimitExceeded:
     s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
     joint = None if worst.joint < 0 else robot.joint_names[worst.joint]
     what = f"{worst.kind} limit of joint {joint!r}" if joint is not None else f"{worst.kind.replace('_', ' ')} limit"
-    return InfeasiblePath(
+    return LimitExceeded(
         f"the {method} timing exceeds the {what} by "
         f"{100 * (worst.ratio - 1):.2f} % at s = {s:.4f}, and refining the grid there did not bring "
         "it back within the limits; use another timing method, a lower limit scale or more grid points",
         s=s,
         joint=joint,
         limit=worst.kind,
+        ratio=float(worst.ratio),
+        method=method,
     )
 
 

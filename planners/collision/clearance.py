@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -37,12 +38,8 @@ class PathInCollision(InfeasiblePath):
     """The path comes closer to an obstacle than the clearance: ``link``, ``obstacle`` (its
     index in ``path.obstacles``) and ``s`` say where."""
 
-    title = "Path comes too close to an obstacle"
-
-    def __init__(self, detail: str, s: float, link: str, obstacle: int):
-        super().__init__(detail, s=s)
-        self.link = link
-        self.obstacle = obstacle
+    def __init__(self, detail: str, s: float, link: str, obstacle: int, **facts: Any):
+        super().__init__(detail, s=s, link=link, obstacle=obstacle, rule="path_in_collision", **facts)
 
 
 @dataclass(frozen=True)
@@ -97,14 +94,16 @@ def _too_close(s, distances, capsule, obstacle, capsules, clearance: float, foun
         return
     first = int(closer[0])
     link, index, distance = capsules[capsule[first]].name, int(obstacle[first]), float(distances[first])
-    how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of path.obstacles[{index}]"
+    how = f"is inside obstacle {index} (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of obstacle {index}"
     closest = "" if found is None else f"; the closest approach is {found.distance:.4g} m at s = {found.s:.4g}"
     raise PathInCollision(
-        f"link {link!r} {how} at s = {s[first]:.4g} (the clearance is {clearance:g} m{closest}): "
-        "move the waypoints away from the obstacle or lower path.clearance",
+        f"link {link!r} {how} at s = {s[first]:.4g} (the clearance is {clearance:g} m{closest})",
         s=float(s[first]),
         link=link,
         obstacle=index,
+        distance=distance,
+        clearance=clearance,
+        closest=None if found is None else (found.distance, found.s),
     )
 
 

@@ -66,7 +66,4 @@ def check_obstacles(obstacles: tuple[Obstacle, ...] | list[Obstacle]) -> None:
         quaternion = np.asarray(obstacle.orientation, dtype=float)
         norm = float(np.linalg.norm(quaternion)) if quaternion.shape == (4,) else math.nan
         if not abs(norm - 1.0) <= UNIT_TOLERANCE:
-            raise InvalidRequest(
-                f"path.obstacles[{index}].orientation has norm {norm:.6g}; a box's orientation is a unit quaternion "
-                "[qx, qy, qz, qw] (norm 1 within 1e-3), e.g. [0, 0, 0, 1] for a box along the world's axes"
-            )
+            raise InvalidRequest(f"obstacles[{index}].orientation", obstacle.orientation, rule="orientation_not_unit", norm=norm)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import Conflicting, NotOneOf
 from toptraj.planners.kinematics.frame_jacobians import frame_jacobians
 from toptraj.robots import Robot, ToolSpeedLimit
 
@@ -36,15 +36,12 @@ def tool_speed_limit(robot: Robot, frame: str | None, speed: float | None, angul
     """
     if speed is None and angular_speed is None:
         if frame is not None:
-            raise InvalidRequest(
-                "timing.limits.tool_frame is given without timing.limits.tool_speed or tool_angular_speed"
-            )
+            raise Conflicting("tool.frame", frame, ("limits.tool_speed", "limits.tool_angular_speed"), rule="frame_without_speed")
         return None
     name = frame or robot.end_effector
     if not robot.model.existFrame(name):
-        frames = [item.name for item in robot.model.frames if item.name != "universe"]
-        shown = ", ".join(repr(item) for item in frames[:60]) + (", ..." if len(frames) > 60 else "")
-        raise InvalidRequest(f"timing.limits.tool_frame {name[:100]!r} is not a frame of {robot.name}; its frames are {shown}")
+        frames = tuple(item.name for item in robot.model.frames if item.name != "universe")
+        raise NotOneOf("tool.frame", name, frames, rule="unknown_tool_frame", robot=robot.name)
     return ToolSpeedLimit(
         frame=name,
         frame_id=robot.frame_id(name),

@@ -92,8 +92,8 @@ class Deadline:
         """Raise ``BudgetExceeded`` when the budget is spent or the caller cancelled."""
         if self._cancelled.is_set() or (self._end is not None and time.monotonic() > self._end):
             if self.budget_s is None:
-                raise BudgetExceeded("planning was stopped by its caller")
-            raise BudgetExceeded(f"planning exceeded its time budget of {self.budget_s:.3g} s")
+                raise BudgetExceeded("planning was stopped by its caller", budget_s=None)
+            raise BudgetExceeded(f"planning exceeded its time budget of {self.budget_s:.3g} s", budget_s=self.budget_s)
 
     def within(self, start: float, end: float, label: str = "") -> Deadline:
         """This deadline (the same end, the same cancellation) for a part of the work spanning

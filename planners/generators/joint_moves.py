@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from toptraj.planners.checks.gate import TimedStretch, checked
 from toptraj.planners.constraints.path_constraints import build_path_constraints
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import Conflicting
 from toptraj.planners.generators.unsynchronized import unsynchronized_trajectory
 from toptraj.planners.generators.via_points import via_point_trajectory
 from toptraj.planners.paths import GeometricPath
@@ -58,9 +58,9 @@ class ViaPoints(_LawMotion):
 
     def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
         if options.start_velocity is not None or options.end_velocity is not None:
-            raise InvalidRequest("via-point trajectories start and end at rest: leave timing.boundary out")
+            raise Conflicting("boundary", None, ("interpolation",), rule="via_points_from_rest")
         if options.supporting_points is not None:
-            raise InvalidRequest("via-point segments are polynomials: leave timing.supporting_points out, or use 'spline' or 'linear'")
+            raise Conflicting("law.supporting_points", options.supporting_points, ("interpolation",), rule="via_points_are_polynomials")
         if "jerk" in kinds and isinstance(self.law, ClassicalMethod) and self.name in ("cubic", "quintic"):
             self.law.refuse_jerk_limit()
 
@@ -80,16 +80,11 @@ class Unsynchronized(_LawMotion):
 
     def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
         if not isinstance(motion, WaypointPath) or motion.interpolation == "via" or len(motion.waypoints) != 2:
-            raise InvalidRequest(
-                "timing.synchronization 'none' moves every joint on its own from a start to a goal: give "
-                "exactly 2 waypoints (interpolation 'spline' or 'linear'), or use 'normalized'"
-            )
+            raise Conflicting("law.synchronization", options.synchronization, ("waypoints",), rule="unsynchronized_needs_two_waypoints")
         boundary = (options.start_velocity, options.end_velocity, options.start_acceleration, options.end_acceleration)
         if any(value is not None for value in boundary) or limits.tool is not None:
-            raise InvalidRequest(
-                "timing.synchronization 'none' moves every joint from rest to rest on its own: leave "
-                "timing.boundary and the tool-speed limits out, or use 'normalized'"
-            )
+            raise Conflicting("law.synchronization", options.synchronization, ("boundary", "limits.tool_speed"),
+                              rule="unsynchronized_from_rest")
         if "jerk" in kinds and isinstance(self.law, ClassicalMethod):
             self.law.refuse_jerk_limit()
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.errors import Conflicting, InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.via_points import ConstantSpeedTiming
 from toptraj.planners.paths.base import GeometricPath, PathPoints
@@ -111,19 +111,13 @@ def own_durations(profile: NormalizedProfile, span: np.ndarray, limits: JointLim
                 value = np.nan_to_num(distance * peaks[order] / getattr(limits, kind), nan=0.0) ** (1.0 / (order + 1))
                 candidates.append((kind, value))
     if not candidates:
-        raise InvalidRequest(
-            "timing.synchronization 'none' runs each joint at its own full speed, which a velocity, "
-            "acceleration or jerk limit sets: add one to timing.constraints"
-        )
+        raise Conflicting("law.synchronization", "none", ("constraints",), rule="unsynchronized_needs_a_limit")
     stacked = np.array([value for _, value in candidates])
     durations = stacked.max(axis=0)
     unbounded = np.flatnonzero((distance > 0) & (durations == 0.0))
     if unbounded.size:
-        raise InvalidRequest(
-            f"timing.synchronization 'none': joint {joint_names[unbounded[0]]!r} has no finite velocity, "
-            "acceleration or jerk limit among timing.constraints, so its own full-speed duration is "
-            "undefined; set one in timing.limits"
-        )
+        raise Conflicting("law.synchronization", "none", ("constraints", "limits"), rule="unsynchronized_joint_unlimited",
+                          joint_name=joint_names[unbounded[0]])
     return durations, [candidates[i][0] for i in stacked.argmax(axis=0)]
 
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.base import GeometricPath, PathPoints
 from toptraj.planners.timing.base import DenseStates, PathTiming
@@ -170,11 +170,11 @@ def via_point_trajectory(
         BudgetExceeded: ``deadline`` passed (checked before every limit evaluation).
     """
     if law not in ("cubic", "quintic"):
-        raise InvalidRequest(f"via points need timing.method 'cubic' or 'quintic', not {law!r}")
+        raise NotServed("method", law, law, rule="via_points_need_polynomials", alternatives=("cubic", "quintic"))
     steps = np.diff(waypoints, axis=0)
     if np.any(np.all(np.abs(steps) < 1e-12, axis=1)):
         index = int(np.flatnonzero(np.all(np.abs(steps) < 1e-12, axis=1))[0])
-        raise InvalidRequest(f"path.waypoints[{index}] and path.waypoints[{index + 1}] coincide")
+        raise InvalidRequest(f"waypoints[{index}]", waypoints[index], rule="waypoints_coincide", index=index)
     n_segments, n_dof = steps.shape
     with np.errstate(divide="ignore"):
         velocity_time = np.nan_to_num(np.abs(steps) / limits.velocity, posinf=0.0).max(axis=1) * 1.5

@@ -56,7 +56,10 @@ class BSplinePath(GeometricPath):
     def __init__(self, control: np.ndarray, interior: np.ndarray | None = None):
         control = np.asarray(control, dtype=float)
         if control.ndim != 2 or len(control) < DEGREE + 1:
-            raise InvalidRequest(f"a cubic B-spline needs at least 4 control points of shape (k, n_dof); got shape {control.shape}")
+            raise InvalidRequest(
+                "control", control.shape, rule="bspline_control_points",
+                detail=f"a cubic B-spline needs at least 4 control points of shape (k, n_dof); got shape {control.shape}",
+            )
         if interior is None:
             interior = np.linspace(0.0, 1.0, len(control) - DEGREE + 1)[1:-1]
         interior = np.asarray(interior, dtype=float).ravel()
@@ -64,8 +67,9 @@ class BSplinePath(GeometricPath):
             interior.size and (interior[0] <= 0.0 or interior[-1] >= 1.0)
         ):
             raise InvalidRequest(
-                f"a clamped cubic B-spline with {len(control)} control points needs {len(control) - DEGREE - 1} "
-                "increasing interior knots inside (0, 1)"
+                "interior", interior, rule="bspline_knots",
+                detail=f"a clamped cubic B-spline with {len(control)} control points needs {len(control) - DEGREE - 1} "
+                "increasing interior knots inside (0, 1)",
             )
         self.control = control
         self.interior = interior

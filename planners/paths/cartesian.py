@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import Conflicting, InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.kinematics.ik import frame_pose, solve_ik
 from toptraj.planners.paths.base import GeometricPath
@@ -53,22 +53,22 @@ class CartesianLine:
 
 def _targets(line: CartesianLine, start_pose: pin.SE3):
     if (line.positions is None) == (line.poses is None):
-        raise InvalidRequest("a cartesian path needs exactly one of path.positions and path.poses")
-    field = "path.positions" if line.poses is None else "path.poses"
+        raise Conflicting("positions", line.positions, ("positions", "poses"), rule="positions_or_poses")
+    field = "positions" if line.poses is None else "poses"
     points = np.asarray(line.positions if line.poses is None else line.poses, dtype=float)
     width = 3 if line.poses is None else 7
     if points.ndim != 2 or points.shape[1] != width or len(points) == 0:
-        raise InvalidRequest(f"{field} must be a list of [{'x, y, z' if width == 3 else 'x, y, z, qx, qy, qz, qw'}] rows")
+        raise InvalidRequest(field, points, rule="not_cartesian_rows", width=width)
     bad = np.argwhere(~np.isfinite(points))
     if bad.size:
-        raise InvalidRequest(f"{field}[{bad[0][0]}][{bad[0][1]}] is not a finite number")
+        raise InvalidRequest(f"{field}[{bad[0][0]}][{bad[0][1]}]", float(points[tuple(bad[0])]), rule="not_finite_number")
     positions = points[:, :3]
     rotations = [None] * len(points)
     if width == 7:
         norms = np.linalg.norm(points[:, 3:], axis=1)
         if np.any(np.abs(norms - 1.0) > 1e-3):
             index = int(np.argmax(np.abs(norms - 1.0)))
-            raise InvalidRequest(f"{field}[{index}] has a quaternion of norm {norms[index]:.6g}, not 1")
+            raise InvalidRequest(f"{field}[{index}]", points[index], rule="quaternion_not_unit", norm=float(norms[index]))
         rotations = [pin.Quaternion(w, x, y, z).normalized().toRotationMatrix() for x, y, z, w in points[:, 3:]]
     first_is_start = np.linalg.norm(positions[0] - start_pose.translation) < 1e-6 and (
         rotations[0] is None or np.linalg.norm(pin.log3(rotations[0] @ start_pose.rotation.T)) < 1e-6
@@ -76,7 +76,7 @@ def _targets(line: CartesianLine, start_pose: pin.SE3):
     offset = 1 if first_is_start else 0
     positions, rotations = positions[offset:], rotations[offset:]
     if len(positions) == 0:
-        raise InvalidRequest(f"{field} holds only the start pose: give at least one more point")
+        raise InvalidRequest(field, points, rule="only_the_start_pose")
     start_rotation = start_pose.rotation if width == 7 else None
     return field, offset, np.vstack([start_pose.translation, positions]), [start_rotation, *rotations]
 
@@ -91,15 +91,15 @@ def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DE
     """
     frame = line.frame or robot.end_effector
     if not robot.model.existFrame(frame):
-        raise InvalidRequest(f"path.frame {frame!r} is not a frame of {robot.name}")
+        raise InvalidRequest("frame", frame, rule="unknown_frame", robot=robot.name)
     frame_id = robot.frame_id(frame)
     start = np.asarray(line.start, dtype=float)
     if start.shape != (robot.dof,) or not np.all(np.isfinite(start)):
-        raise InvalidRequest(f"path.start must hold {robot.dof} finite joint values")
+        raise InvalidRequest("start", line.start, rule="not_finite_joint_values", expected=robot.dof)
     outside = robot.outside_position_limits(start)
     if outside is not None:
         column = outside[1]
-        raise InvalidRequest(f"path.start[{column}] = {start[column]:.6g} is outside the limits of joint {robot.joint_names[column]!r}")
+        raise InvalidRequest(f"start[{column}]", float(start[column]), rule="outside_joint_limits", joint_name=robot.joint_names[column])
     field, offset, positions, rotations = _targets(line, frame_pose(robot, start, frame_id))
     pieces: list[GeometricPath] = []
     lengths: list[float] = []
@@ -107,27 +107,24 @@ def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DE
     for k in range(len(positions) - 1):
         span = np.linalg.norm(positions[k + 1] - positions[k])
         if span / STEP_LENGTH_M > MAX_STEPS_PER_LINE:
-            raise InvalidRequest(
-                f"the line to {field}[{k + offset}] is {span:.4g} m long: it leaves the workspace of {robot.name}"
-            )
+            raise InvalidRequest(f"{field}[{k + offset}]", positions[k + 1], rule="line_too_long", length=float(span), robot=robot.name)
         samples = _line_samples(positions[k], positions[k + 1], rotations[k], rotations[k + 1])
         if samples is None:
-            raise InvalidRequest(f"{field}[{k + offset}] repeats the previous point")
+            raise InvalidRequest(f"{field}[{k + offset}]", positions[k + 1], rule="repeated_point")
         solutions = [q]
         for fraction, (position, rotation) in samples:
             deadline.check()
             result = solve_ik(robot, solutions[-1], frame_id, position, rotation)
-            where = f"{field}[{k + offset}] on the way to point {k + offset + 1}, {100 * fraction:.1f} % along (at {np.round(position, 4).tolist()} m)"
+            where = {"index": k + offset, "fraction": fraction, "position": np.round(position, 4).tolist(), "robot": robot.name}
             if result.error > 1e-6:
-                raise InvalidRequest(f"the line leaves the workspace of {robot.name}: no joint solution reaches the point {where}")
+                raise InvalidRequest(f"{field}[{k + offset}]", positions[k + 1], rule="point_out_of_reach", **where)
             if result.sigma_min < SINGULAR_VALUE_FLOOR:
-                raise InvalidRequest(f"the line crosses a singularity of {robot.name} near the point {where}")
+                raise InvalidRequest(f"{field}[{k + offset}]", positions[k + 1], rule="line_crosses_singularity", **where)
             jump = np.abs(result.q - solutions[-1])
             if jump.max() > MAX_JOINT_STEP:
                 joint = robot.joint_names[int(np.argmax(jump))]
-                raise InvalidRequest(
-                    f"the line needs a joint jump of {jump.max():.3g} rad on joint {joint!r} near the point {where}"
-                )
+                raise InvalidRequest(f"{field}[{k + offset}]", positions[k + 1], rule="joint_jump", jump=float(jump.max()),
+                                     joint_name=joint, **where)
             solutions.append(result.q)
         joint_points = np.array(solutions)
         piece = SplinePath(joint_points)
@@ -167,7 +164,4 @@ def _check_deviation(robot, frame_id, piece, p0, p1, field, index, deadline):
             offset = offset - along * direction
         worst = max(worst, float(np.linalg.norm(offset)))
     if worst > POSITION_TOLERANCE:
-        raise InvalidRequest(
-            f"the joint path strays {worst * 1e3:.3g} mm from the line after {field}[{index}] "
-            f"(tolerance {POSITION_TOLERANCE * 1e3:g} mm): the line passes too close to a singularity"
-        )
+        raise InvalidRequest(f"{field}[{index}]", None, rule="joint_path_strays", deviation=worst, tolerance=POSITION_TOLERANCE)

@@ -26,7 +26,7 @@ def chord_knots(waypoints: np.ndarray) -> np.ndarray:
     lengths = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
     if np.any(lengths <= 1e-12):
         index = int(np.flatnonzero(lengths <= 1e-12)[0])
-        raise InvalidRequest(f"path.waypoints[{index}] and path.waypoints[{index + 1}] coincide")
+        raise InvalidRequest(f"waypoints[{index}]", waypoints[index], rule="waypoints_coincide", index=index)
     cumulative = np.concatenate(([0.0], np.cumsum(lengths)))
     knots = cumulative / cumulative[-1]
     knots[-1] = 1.0

@@ -10,21 +10,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import InvalidRequest, WrongLength
 from toptraj.planners.paths.base import GeometricPath
 
 
 def finite_vector(value, name: str, length: int) -> np.ndarray:
-    """``value`` as a float vector of ``length`` finite numbers (InvalidRequest otherwise)."""
+    """``value`` as a float vector of ``length`` finite numbers (InvalidRequest naming the
+    library's field ``name`` otherwise)."""
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise InvalidRequest(f"{name} must be a list of numbers") from None
+        raise InvalidRequest(name, value, rule="not_numbers") from None
     if array.shape != (length,):
-        raise InvalidRequest(f"{name} has {array.size} values; the robot has {length} joints")
+        raise WrongLength(name, value, array.size, length)
     bad = np.flatnonzero(~np.isfinite(array))
     if bad.size:
-        raise InvalidRequest(f"{name}[{bad[0]}] is {array[bad[0]]}, not a finite number")
+        raise InvalidRequest(f"{name}[{bad[0]}]", float(array[bad[0]]), rule="not_finite")
     return array
 
 
@@ -40,10 +41,8 @@ def path_speed(path: GeometricPath, velocity, s_end: float, name: str) -> float:
     velocity = finite_vector(velocity, name, tangent.size)
     sd = float(velocity @ tangent / (tangent @ tangent))
     if np.linalg.norm(velocity - sd * tangent) > _tolerance(velocity) or sd < 0.0:
-        raise InvalidRequest(
-            f"{name} is not tangent to the path at s = {s_end:g}: the path's direction there is "
-            f"{np.round(tangent / np.linalg.norm(tangent), 6).tolist()}"
-        )
+        raise InvalidRequest(name, velocity, rule="not_tangent", at_s=s_end,
+                             direction=np.round(tangent / np.linalg.norm(tangent), 6).tolist())
     return sd
 
 
@@ -57,9 +56,6 @@ def path_acceleration(path: GeometricPath, acceleration, sd: float, s_end: float
     along = acceleration - curvature * sd**2
     sdd = float(along @ tangent / (tangent @ tangent))
     if np.linalg.norm(along - sdd * tangent) > _tolerance(acceleration):
-        raise InvalidRequest(
-            f"{name} does not fit the path at s = {s_end:g}: at path speed {sd:.6g} 1/s every "
-            f"admissible joint acceleration is {np.round(curvature * sd**2, 6).tolist()} plus a "
-            f"multiple of the tangent {np.round(tangent, 6).tolist()}"
-        )
+        raise InvalidRequest(name, acceleration, rule="acceleration_off_path", at_s=s_end, path_speed=sd,
+                             curvature_term=np.round(curvature * sd**2, 6).tolist(), tangent=np.round(tangent, 6).tolist())
     return sdd

@@ -20,7 +20,7 @@ from toptraj.planners.checks.gate import gate_threshold
 from toptraj.planners.collision import Obstacle
 from toptraj.planners.collision.obstacles import check_obstacles
 from toptraj.planners.constraints.tool_speed import tool_speed_limit
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import Conflicting, NotServed, OutOfRange, TooLarge
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -65,7 +65,7 @@ def build_problem(
     _check_grid(timing, method, robot)
     margin = timing.limit_margin
     if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
-        raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
+        raise OutOfRange("limits.margin", margin, 0.0, MAX_LIMIT_MARGIN, rule="margin_out_of_range")
     limits = _limits(robot, motion, method, timing)
     limits = limits.tightened(margin) if margin else limits
     notes: tuple[str, ...] = ()
@@ -86,23 +86,17 @@ def _check_sampling(sampling: Sampling, timing: Timing) -> None:
     if sampling.exact_period and any(
         v is not None and np.any(np.asarray(v) != 0.0) for v in (timing.start_velocity, timing.end_velocity)
     ):
-        raise InvalidRequest(
-            "output.exact_period slows the motion uniformly, which would change the nonzero "
-            "timing.boundary velocities: set output.exact_period to false (samples every dt "
-            "plus the final instant) or plan from and to rest"
-        )
+        raise Conflicting("sampling.exact_period", sampling.exact_period, ("boundary",), rule="exact_period_with_moving_ends")
 
 
 def _check_grid(timing: Timing, method: TimingMethod | MotionGenerator, robot: Robot) -> None:
     """The grid asked for, within the grid's range and the method's memory on this robot."""
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
-        raise InvalidRequest(f"timing.grid_points must lie in [2, {MAX_POINTS}], got {timing.grid_points}")
+        raise OutOfRange("grid.intervals", timing.grid_points, 2, MAX_POINTS, rule="grid_out_of_range")
     if timing.grid_points is not None and timing.grid_points > method.max_grid_intervals(robot.dof):
-        raise InvalidRequest(
-            f"timing.grid_points = {timing.grid_points} is more than {method.name} serves on a "
-            f"{robot.dof}-joint robot (its memory grows with grid intervals times joints): use "
-            f"timing.grid_points <= {method.max_grid_intervals(robot.dof)}"
-        )
+        cap = method.max_grid_intervals(robot.dof)
+        raise TooLarge("grid.intervals", timing.grid_points, timing.grid_points, cap, "intervals", largest=cap,
+                       rule="grid_over_method_cap", method=method.name, dof=robot.dof)
 
 
 def _limits(robot: Robot, motion: MotionSpec, method: TimingMethod | MotionGenerator, timing: Timing) -> JointLimits:
@@ -120,35 +114,20 @@ def _check_tool_limit_served(motion: MotionSpec, method: TimingMethod | MotionGe
     """Tool-speed limits bound the path speed of a given path: refuse them where the path is
     shaped by the timing (free motions, via points)."""
     if isinstance(motion, FreeMotion) or method.name == "collocation":
-        raise InvalidRequest(
-            "timing.limits.tool_speed and tool_angular_speed are not served by collocation on a free path; "
-            "give the path (waypoints or a cartesian line) and a method such as phase_plane"
-        )
+        raise NotServed("limits.tool_speed", None, method.name, rule="tool_speed_on_free_path", alternatives=("phase_plane",))
     if isinstance(motion, WaypointPath) and motion.interpolation == "via":
-        raise InvalidRequest(
-            "timing.limits.tool_speed and tool_angular_speed are not served with interpolation 'via' "
-            "(its segments are shaped by their time laws); use 'spline' or 'linear'"
-        )
+        raise NotServed("limits.tool_speed", None, method.name, rule="tool_speed_through_via", alternatives=("spline", "linear"))
 
 
 def _check_method_serves(method, motion: MotionSpec, obstacles, robot: Robot, timing: Timing, kinds, limits: JointLimits) -> None:
     """The method against the motion: state-to-state methods take two waypoints, a free motion
     needs a generator that finds its path, obstacles on a free path need the search."""
     if method.two_waypoints_only and (not isinstance(motion, WaypointPath) or len(motion.waypoints) != 2):
-        given = f"{len(motion.waypoints)} waypoints" if isinstance(motion, WaypointPath) else "a cartesian path"
-        raise InvalidRequest(
-            f"timing.method {method.name!r} plans state-to-state motions: give exactly 2 waypoints, not "
-            f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
-            "law through several waypoints"
-        )
+        count = len(motion.waypoints) if isinstance(motion, WaypointPath) else None
+        raise NotServed("waypoints", count, method.name, rule="needs_two_waypoints", alternatives=("phase_plane",))
     if obstacles and isinstance(motion, FreeMotion) and method.name != "search":
-        raise InvalidRequest(
-            "path.obstacles on a free path are served by timing.method 'search' (the global search among obstacles); "
-            "collocation does not see obstacles"
-        )
+        raise NotServed("obstacles", len(obstacles), method.name, rule="obstacles_need_search", alternatives=("search",))
     if isinstance(method, MotionGenerator):
         method.validate(robot, motion, timing, kinds, limits)
     elif isinstance(motion, FreeMotion):
-        raise InvalidRequest(
-            "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
-        )
+        raise NotServed("method", method.name, method.name, rule="free_path_needs_collocation", alternatives=("collocation", "search"))

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.errors import InfeasiblePath, NotServed, OutsideJointRange
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.boundary import path_acceleration, path_speed
@@ -23,12 +23,15 @@ def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -
     outside = path.outside_range(lower, upper, 4 * len(s) + 1)
     if outside is not None:
         at, joint, value = outside
-        raise InfeasiblePath(
+        raise OutsideJointRange(
             f"the interpolated path leaves the range [{lower[joint]:.6g}, {upper[joint]:.6g}] of joint "
             f"{robot.joint_names[joint]!r} at s = {at:.4f} (q = {value:.6g}); "
             "add waypoints or use interpolation 'linear'",
             s=at,
             joint=robot.joint_names[joint],
+            value=float(value),
+            lower=float(lower[joint]),
+            upper=float(upper[joint]),
         )
 
 
@@ -40,11 +43,11 @@ def check_jerk_finite(path: GeometricPath, kinds) -> None:
         return
     s = float(path.breaks[0])
     raise InfeasiblePath(
-        f"the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend), "
-        "so the joint accelerations jump there and no motion that passes it has a finite jerk: use "
-        "interpolation 'spline' with a jerk limit, or leave 'jerk' out of timing.constraints",
+        f"the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend): "
+        "no motion that passes it has a finite jerk",
         s=s,
         limit="jerk",
+        rule="curvature_jump",
     )
 
 
@@ -57,21 +60,16 @@ def moving_velocity(velocity):
 
 def path_boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
     if (timing.start_acceleration is not None or timing.end_acceleration is not None) and not method.takes_acceleration_boundary:
-        raise InvalidRequest(
-            f"timing.boundary accelerations are not used by timing.method {method.name!r}; use quintic"
-        )
+        raise NotServed("boundary", None, method.name, rule="boundary_accelerations_not_used", alternatives=("quintic",))
     if timing.duration is not None and not method.takes_duration:
-        raise InvalidRequest(
-            f"timing.duration is not used by timing.method {method.name!r}, which finds the shortest "
-            "duration itself; leave it out or use a time law"
-        )
-    sd_start = path_speed(path, timing.start_velocity, 0.0, "timing.boundary.start_velocity")
-    sd_end = path_speed(path, timing.end_velocity, 1.0, "timing.boundary.end_velocity")
+        raise NotServed("duration", timing.duration, method.name, rule="duration_not_used")
+    sd_start = path_speed(path, timing.start_velocity, 0.0, "boundary.start_velocity")
+    sd_end = path_speed(path, timing.end_velocity, 1.0, "boundary.end_velocity")
     return Boundary(
         sd_start=sd_start,
         sd_end=sd_end,
-        sdd_start=path_acceleration(path, timing.start_acceleration, sd_start, 0.0, "timing.boundary.start_acceleration"),
-        sdd_end=path_acceleration(path, timing.end_acceleration, sd_end, 1.0, "timing.boundary.end_acceleration"),
+        sdd_start=path_acceleration(path, timing.start_acceleration, sd_start, 0.0, "boundary.start_acceleration"),
+        sdd_end=path_acceleration(path, timing.end_acceleration, sd_end, 1.0, "boundary.end_acceleration"),
     )
 
 

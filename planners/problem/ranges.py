@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import InvalidRequest, OutOfRange
 from toptraj.robots.ranges import ACCELERATION as ACCELERATION
 from toptraj.robots.ranges import JERK as JERK
 from toptraj.robots.ranges import LIMITS as LIMITS
@@ -46,44 +46,44 @@ TRAPEZOID_FRACTION = Range(1e-3, 1.0 - 1e-3, "")
 
 
 def check(value: float, field: str, accepted: Range) -> None:
-    """InvalidRequest unless ``value`` lies in ``accepted``."""
+    """OutOfRange (the library's ``field``) unless ``value`` lies in ``accepted``."""
     if not (isinstance(value, (int, float)) and math.isfinite(value) and accepted.holds(value)):
-        raise InvalidRequest(f"{field} = {value!r} is outside the accepted range {accepted.describe()}")
+        raise OutOfRange(field, value, accepted.low, accepted.high, accepted.unit)
 
 
 def check_vector(values, field: str, accepted: Range, signed: bool = False) -> None:
-    """InvalidRequest unless every entry of ``values`` lies in ``accepted`` (by magnitude, and
-    any sign, when ``signed``)."""
+    """OutOfRange (``field[i]``) unless every entry of ``values`` lies in ``accepted`` (by
+    magnitude, and any sign, when ``signed``: [-high, high])."""
     try:
         array = np.asarray(values, dtype=float).ravel()
     except (TypeError, ValueError):
-        raise InvalidRequest(f"{field} must be a list of numbers") from None
+        raise InvalidRequest(field, values, rule="not_numbers") from None
     inside = (np.abs(array) <= accepted.high) if signed else ((array >= accepted.low) & (array <= accepted.high))
     bad = np.flatnonzero(~inside)
     if bad.size:
-        shown = f"[-{accepted.high:g}, {accepted.high:g}] {accepted.unit}".rstrip() if signed else accepted.describe()
-        raise InvalidRequest(f"{field}[{bad[0]}] = {array[bad[0]]!r} is outside the accepted range {shown}")
+        low = -accepted.high if signed else accepted.low
+        raise OutOfRange(f"{field}[{bad[0]}]", array[bad[0]], low, accepted.high, accepted.unit, signed=signed)
 
 
 def check_timing(timing, dt: float) -> None:
     """Hold every number of a ``toptraj.planners.problem.requests.Timing`` and the sample period ``dt`` to its
-    range (InvalidRequest naming the field and the range otherwise)."""
-    check(dt, "output.dt", DT)
+    range (OutOfRange naming the field and the range otherwise)."""
+    check(dt, "sampling.dt", DT)
     if timing.duration is not None:
-        check(timing.duration, "timing.duration", DURATION)
+        check(timing.duration, "duration", DURATION)
     if timing.method == "trapezoidal":
         for name, value in zip(("tau1", "tau2"), timing.trapezoid_fractions):
-            check(value, f"timing.trapezoid.{name}", TRAPEZOID_FRACTION)
+            check(value, f"law.trapezoid.{name}", TRAPEZOID_FRACTION)
     for kind, values in (timing.limit_overrides or {}).items():
         if values is not None and kind in LIMITS:
-            check_vector(values, f"timing.limits.{kind}", LIMITS[kind])
+            check_vector(values, f"limits.{kind}", LIMITS[kind])
     for name, accepted in (("tool_speed", TOOL_SPEED), ("tool_angular_speed", TOOL_ANGULAR_SPEED)):
         value = getattr(timing, name, None)
         if value is not None:
-            check(value, f"timing.limits.{name}", accepted)
+            check(value, f"limits.{name}", accepted)
     for kind, factor in (timing.limit_scales or {}).items():
         if factor is not None:
-            check(factor, f"timing.limits.{kind}_scale", SCALE)
+            check(factor, f"limits.{kind}_scale", SCALE)
     for name, accepted in (
         ("start_velocity", VELOCITY),
         ("end_velocity", VELOCITY),
@@ -92,7 +92,7 @@ def check_timing(timing, dt: float) -> None:
     ):
         values = getattr(timing, name)
         if values is not None:
-            check_vector(values, f"timing.boundary.{name}", accepted, signed=True)
+            check_vector(values, f"boundary.{name}", accepted, signed=True)
 
 
 def _round_inward(low: float, high: float) -> tuple[float, float]:
@@ -132,12 +132,7 @@ def check_scaled_limits(limits, scales: dict[str, float | None] | None, joint_na
             max(SCALE.low, accepted.low / float(values[finite].min())),
             min(SCALE.high, accepted.high / float(values[finite].max())),
         )
-        advice = (
-            f"use timing.limits.{kind}_scale in [{low:g}, {high:g}]"
-            if low <= high
-            else f"give timing.limits.{kind} per joint instead of a scale"
-        )
-        raise InvalidRequest(
-            f"timing.limits.{kind}_scale = {factor:g} makes the {kind} limit of joint {name[:64]!r} "
-            f"{scaled[joint]:g} {accepted.unit}, outside the accepted range {accepted.describe()}; {advice}"
+        raise OutOfRange(
+            f"limits.{kind}_scale", factor, accepted.low, accepted.high, accepted.unit, rule="scaled_limit_out_of_range",
+            kind=kind, joint_name=name, scaled=float(scaled[joint]), advised=(low, high) if low <= high else None,
         )

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from toptraj.planners.constraints.path_constraints import CONSTRAINT_KINDS
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import Conflicting, InvalidRequest, NotOneOf, NotServed, OutOfRange
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.base import TimingMethod
@@ -108,17 +108,13 @@ class Timing:
 def check_constraint_kinds(kinds, method: TimingMethod | MotionGenerator) -> tuple[str, ...]:
     unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
     if unknown:
-        raise InvalidRequest(f"timing.constraints holds {unknown[0]!r}; use any of {list(CONSTRAINT_KINDS)}")
+        raise NotOneOf("constraints", unknown[0], CONSTRAINT_KINDS, rule="unknown_constraint")
     unsupported = [kind for kind in kinds if kind not in method.kinds]
     if unsupported:
-        hint = " (for jerk, use jerk_limited, a time law or ruckig)" if unsupported[0] == "jerk" else ""
-        raise InvalidRequest(
-            f"timing.method {method.name!r} cannot limit {unsupported[0]}; it handles "
-            f"{sorted(method.kinds)}{hint}"
-        )
+        raise NotServed("constraints", unsupported[0], method.name, rule="kind_not_served", handles=sorted(method.kinds))
     kinds = tuple(dict.fromkeys([*kinds, *sorted(method.required_kinds)]))
     if not kinds:
-        raise InvalidRequest("timing.constraints is empty: without limits the time-optimal motion is instantaneous")
+        raise InvalidRequest("constraints", kinds, rule="no_constraints")
     return kinds
 
 
@@ -136,9 +132,9 @@ def law_profile(timing: Timing) -> NormalizedProfile:
     if timing.method == "trapezoidal":
         tau1, tau2 = timing.trapezoid_fractions
         if not (np.isfinite(tau1) and np.isfinite(tau2) and 0.0 < tau1 <= tau2 < 1.0):
-            raise InvalidRequest(f"timing.trapezoid needs 0 < tau1 <= tau2 < 1, got {tau1}, {tau2}")
+            raise InvalidRequest("law.trapezoid", (tau1, tau2), rule="trapezoid_order")
         if timing.trapezoid_blend not in BLENDS:
-            raise InvalidRequest(f"timing.trapezoid.blend {timing.trapezoid_blend!r} is unknown; use one of {list(BLENDS)}")
+            raise NotOneOf("law.blend", timing.trapezoid_blend, list(BLENDS))
         profile = BLENDS[timing.trapezoid_blend](tau1, tau2)
     else:
         profile = PROFILES[timing.method]()
@@ -146,38 +142,30 @@ def law_profile(timing: Timing) -> NormalizedProfile:
         return profile
     points = timing.supporting_points
     if not (isinstance(points, int) and MIN_SUPPORTING_POINTS <= points <= MAX_SUPPORTING_POINTS):
-        raise InvalidRequest(
-            f"timing.supporting_points = {points!r} is outside [{MIN_SUPPORTING_POINTS}, {MAX_SUPPORTING_POINTS}]"
-        )
+        raise OutOfRange("law.supporting_points", points, MIN_SUPPORTING_POINTS, MAX_SUPPORTING_POINTS, rule="count_out_of_range")
     try:
         return SplineProfile(profile, points)
     except ValueError as error:
-        raise InvalidRequest(f"timing.supporting_points: {error}") from None
+        raise InvalidRequest("law.supporting_points", points, rule="law_spline_failed", reason=str(error)) from None
 
 
 def _check_law_options(timing: Timing) -> None:
     """Refuse the time-law options with a method that does not use them."""
     law = timing.method in PROFILES
     if timing.trapezoid_blend != "linear" and timing.method != "trapezoidal":
-        raise InvalidRequest(f"timing.trapezoid.blend is used by timing.method 'trapezoidal', not {timing.method!r}")
+        raise NotServed("law.blend", timing.trapezoid_blend, timing.method, rule="blend_needs_trapezoidal", alternatives=("trapezoidal",))
     if timing.supporting_points is not None and not law:
-        raise InvalidRequest(
-            f"timing.supporting_points approximates a time law ({', '.join(PROFILES)}), not timing.method {timing.method!r}"
-        )
+        raise NotServed("law.supporting_points", timing.supporting_points, timing.method, rule="needs_time_law",
+                        alternatives=tuple(PROFILES))
     moving = [value for value in (timing.start_velocity, timing.end_velocity, timing.start_acceleration, timing.end_acceleration)
               if value is not None and np.any(np.asarray(value) != 0.0)]
     if timing.supporting_points is not None and moving:
-        raise InvalidRequest(
-            "timing.supporting_points gives a law from rest to rest: leave timing.boundary out, or drop "
-            "supporting_points to use cubic or quintic with boundary states"
-        )
+        raise Conflicting("law.supporting_points", timing.supporting_points, ("boundary",), rule="law_from_rest")
     if timing.synchronization not in SYNCHRONIZATIONS:
-        raise InvalidRequest(f"timing.synchronization {timing.synchronization!r} is unknown; use one of {list(SYNCHRONIZATIONS)}")
+        raise NotOneOf("law.synchronization", timing.synchronization, SYNCHRONIZATIONS)
     if timing.synchronization == "none" and not law:
-        raise InvalidRequest(
-            f"timing.synchronization 'none' runs each joint with a time law ({', '.join(PROFILES)}), not with "
-            f"timing.method {timing.method!r}"
-        )
+        raise NotServed("law.synchronization", timing.synchronization, timing.method, rule="unsynchronized_needs_law",
+                        alternatives=tuple(PROFILES))
 
 
 def timing_method(timing: Timing) -> TimingMethod | None:
@@ -190,16 +178,17 @@ def timing_method(timing: Timing) -> TimingMethod | None:
         boundary_law = getattr(method, "boundary_law", None) if timing.supporting_points is None else None
         return ClassicalMethod(law_profile(timing), boundary_law=boundary_law)
     if timing.torque_weight != 0.0 and timing.method not in ("min_cost", "collocation"):
-        raise InvalidRequest(f"timing.cost.torque_weight is not used by timing.method {timing.method!r}; use min_cost")
+        raise NotServed("method.torque_weight", timing.torque_weight, timing.method, rule="weight_needs_min_cost",
+                        alternatives=("min_cost",))
     if timing.method == "min_cost":
         if not (np.isfinite(timing.torque_weight) and timing.torque_weight >= 0.0):
-            raise InvalidRequest(f"timing.cost.torque_weight must be a non-negative number, got {timing.torque_weight}")
+            raise OutOfRange("method.torque_weight", timing.torque_weight, 0.0, float("inf"), "1/(N m)^2", rule="negative_weight")
         return MinCostMethod(timing.torque_weight)
     if timing.method in GENERATORS:
         return None
     if timing.search is not None:
-        raise InvalidRequest(f"timing.search sets up timing.method 'search', not {timing.method!r}")
+        raise NotServed("search", None, timing.method, rule="options_need_search", alternatives=("search",))
     named = METHODS.get(timing.method)
     if named is None:
-        raise InvalidRequest(f"timing.method {timing.method!r} is unknown; use one of {sorted([*METHODS, 'collocation', 'search'])}")
+        raise NotOneOf("method", timing.method, sorted([*METHODS, "collocation", "search"]))
     return named

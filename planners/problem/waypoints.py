@@ -8,7 +8,7 @@ import dataclasses
 
 import numpy as np
 
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import Conflicting, InvalidRequest, NotOneOf, OutOfRange, TooLarge, WrongLength
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from toptraj.planners.paths.blended import BlendedPath
@@ -16,6 +16,7 @@ from toptraj.planners.paths.cartesian import CartesianLine, cartesian_path
 from toptraj.planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
 from toptraj.planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
 from toptraj.robots import Robot
+from toptraj.robots.notes import Note
 
 INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath, "blend": BlendedPath}
 MAX_WAYPOINTS = 1_000
@@ -28,40 +29,30 @@ COINCIDENT = 1e-12
 def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
     """The waypoints of ``spec`` as an (n, n_dof) array, checked against the robot."""
     if spec.interpolation not in (*INTERPOLATIONS, "via"):
-        raise InvalidRequest(
-            f"path.interpolation {spec.interpolation!r} is unknown; use one of {sorted([*INTERPOLATIONS, 'via'])}"
-        )
+        raise NotOneOf("interpolation", spec.interpolation, sorted([*INTERPOLATIONS, "via"]))
     if spec.max_deviation is not None and spec.interpolation != "blend":
-        raise InvalidRequest(
-            f"path.max_deviation applies to interpolation 'blend', not {spec.interpolation!r}: leave it out or use 'blend'"
-        )
+        raise Conflicting("max_deviation", spec.max_deviation, ("interpolation",), rule="deviation_needs_blend",
+                          interpolation=spec.interpolation)
     waypoints = np.asarray(spec.waypoints, dtype=float) if np.ndim(spec.waypoints) == 2 else None
     if waypoints is None:
-        raise InvalidRequest("path.waypoints must be a list of joint vectors (a 2-D array)")
+        raise InvalidRequest("waypoints", spec.waypoints, rule="not_joint_vectors")
     count, width = waypoints.shape
     if count < 2:
-        raise InvalidRequest(f"path.waypoints holds {count} waypoint(s); at least 2 are needed")
+        raise InvalidRequest("waypoints", spec.waypoints, rule="too_few_waypoints", count=count)
     if count > MAX_WAYPOINTS:
-        raise InvalidRequest(f"path.waypoints holds {count} waypoints; at most {MAX_WAYPOINTS} are served")
+        raise TooLarge("waypoints", spec.waypoints, count, MAX_WAYPOINTS, "waypoints", rule="too_many_waypoints")
     if width != robot.dof:
-        raise InvalidRequest(
-            f"path.waypoints[0] has {width} values; {robot.name} has {robot.dof} joints "
-            f"({', '.join(robot.joint_names)})"
-        )
+        raise WrongLength("waypoints[0]", waypoints[0], width, robot.dof, robot=robot.name, joint_names=robot.joint_names)
     bad = np.argwhere(~np.isfinite(waypoints) | (np.abs(waypoints) > MAX_COORDINATE))
     if bad.size:
-        raise InvalidRequest(
-            f"path.waypoints[{bad[0][0]}][{bad[0][1]}] is {waypoints[tuple(bad[0])]:.6g}: not a finite "
-            f"number within +-{MAX_COORDINATE:g} (rad or m)"
-        )
+        raise OutOfRange(f"waypoints[{bad[0][0]}][{bad[0][1]}]", waypoints[tuple(bad[0])], -MAX_COORDINATE, MAX_COORDINATE,
+                         "rad or m", rule="coordinate_out_of_range")
     lower, upper = robot.limits.position_lower, robot.limits.position_upper
     outside = robot.outside_position_limits(waypoints)
     if outside is not None:
         index, joint = outside
-        raise InvalidRequest(
-            f"path.waypoints[{index}][{joint}] = {waypoints[index, joint]:.6g} is outside the limits "
-            f"[{lower[joint]:.6g}, {upper[joint]:.6g}] of joint {robot.joint_names[joint]!r}"
-        )
+        raise OutOfRange(f"waypoints[{index}][{joint}]", waypoints[index, joint], lower[joint], upper[joint],
+                         rule="outside_joint_range", joint_name=robot.joint_names[joint])
     return waypoints
 
 
@@ -79,12 +70,12 @@ def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
     if repeats.size == 0:
         return spec, ()
     if repeats.size == len(waypoints) - 1:
-        raise InvalidRequest(
-            f"path.waypoints[0] and path.waypoints[1] coincide, as do all {len(waypoints)} waypoints: "
-            "there is nothing to move"
-        )
+        raise InvalidRequest("waypoints", waypoints, rule="all_waypoints_coincide", count=len(waypoints))
     shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
-    note = f"path.waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)"
+    note = Note(
+        f"waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)",
+        "waypoints_dropped", field="waypoints", indices=tuple(int(i) for i in repeats),
+    )
     return dataclasses.replace(spec, waypoints=np.delete(waypoints, repeats, axis=0)), (note,)
 
 
@@ -102,7 +93,7 @@ def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tu
       that turns more than pi between two waypoints (the short way is shorter).
     """
     if spec.continuous not in CONTINUOUS:
-        raise InvalidRequest(f"path.continuous {spec.continuous!r} is unknown; use one of {list(CONTINUOUS)}")
+        raise NotOneOf("continuous", spec.continuous, CONTINUOUS)
     waypoints = np.asarray(spec.waypoints, dtype=float)
     mask = np.asarray(robot.continuous, dtype=bool)
     if waypoints.ndim != 2 or waypoints.shape[1] != mask.size or not mask.any() or not np.all(np.isfinite(waypoints)):
@@ -115,9 +106,10 @@ def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tu
         shifted = waypoints.copy()
         shifted[:, mask] = waypoints[0, mask] + np.vstack([np.zeros(mask.sum()), np.cumsum(wrapped, axis=0)])
         moved = [robot.joint_names[j] for j, m in zip(np.flatnonzero(mask), (wrapped != steps).any(axis=0)) if m]
-        note = (
-            f"path.continuous 'shortest': continuous joint(s) {', '.join(map(repr, moved))} turn the short "
-            "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"
+        note = Note(
+            f"continuous joint(s) {', '.join(map(repr, moved))} turn the short way; their waypoints after "
+            "the first are reached as equivalent angles (whole turns apart)",
+            "turned_the_short_way", field="continuous", joints=tuple(moved),
         )
         return dataclasses.replace(spec, waypoints=shifted), (note,)
     index, column = np.nonzero(np.abs(steps) > np.pi)
@@ -128,9 +120,12 @@ def continuous_turns(robot: Robot, spec: WaypointPath) -> tuple[WaypointPath, tu
     for i, c in zip(index, column):
         seen.setdefault(joints[int(c)], int(i))
     notes = tuple(
-        f"continuous joint {robot.joint_names[j]!r} turns {steps[i][joints.index(j)]:+.4g} rad from "
-        f"path.waypoints[{i}] to [{i + 1}], more than pi: the other way round is shorter; "
-        "path.continuous = 'shortest' takes it"
+        Note(
+            f"continuous joint {robot.joint_names[j]!r} turns {steps[i][joints.index(j)]:+.4g} rad from "
+            f"waypoint {i} to {i + 1}, more than pi: the other way round is shorter",
+            "turns_the_long_way", field=f"waypoints[{i}]", joint_name=robot.joint_names[j],
+            turn=float(steps[i][joints.index(j)]), index=i,
+        )
         for j, i in seen.items()
     )
     return spec, notes
@@ -144,6 +139,6 @@ def make_path(robot: Robot, spec: WaypointPath | CartesianLine, deadline: Deadli
     waypoints = checked_waypoints(robot, spec)
     if spec.interpolation == "blend":
         deviation = DEFAULT_MAX_DEVIATION if spec.max_deviation is None else spec.max_deviation
-        check(deviation, "path.max_deviation", MAX_DEVIATION)
+        check(deviation, "max_deviation", MAX_DEVIATION)
         return BlendedPath(waypoints, deviation)
     return INTERPOLATIONS[spec.interpolation](waypoints)

@@ -40,6 +40,7 @@ from toptraj.planners.timing.base import GAP_TARGET, Boundary, PathTiming, TimeS
 from toptraj.planners.timing.phase_plane.method import GAP_BASIS as PHASE_PLANE_BASIS
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.planners.timing.scaled import solve_well_scaled
+from toptraj.robots.notes import Note
 
 #: Refinements of the grid for accuracy, each followed by a solve.
 REFINE_ROUNDS = 2
@@ -189,31 +190,28 @@ def finer_constraints(
     return constraints.with_points(extra)
 
 
-def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid_given: bool) -> str:
+def gap_warning(method: TimingMethod, gap: float, intervals: int, dof: int, grid_given: bool) -> Note:
     """The warning of a time-optimal answer whose estimated gap exceeds ``GAP_TARGET``, with
-    a remedy the request can follow. On a grid the request named: a ``timing.grid_points``
-    within what the method serves (first order: the gap shrinks as the intervals grow). On the
-    default grid, which ``accurate_solve`` refined as far as it could (the cap or the budget
-    stopped it, or the gap is not the grid's): the phase-plane method, which refines where the
-    error lies."""
-    figure = f"the duration is within about {100 * gap:.2g} % of the time-optimal one on this grid"
+    a remedy the request can follow (the note's ``remedy``): on a grid the request named, a
+    number of grid intervals ``wanted`` within what the method serves (first order: the gap
+    shrinks as the intervals grow); on the default grid, which ``accurate_solve`` refined as far
+    as it could (the cap or the budget stopped it, or the gap is not the grid's), the
+    phase-plane method, which refines where the error lies; none for the phase-plane method
+    itself, or for jerk_limited beyond its cap (phase_plane would drop the jerk limits)."""
     cap = min(method.max_grid_intervals(dof), MAX_POINTS)
     wanted = math.ceil(1.25 * intervals * gap / GAP_TARGET)
-    if grid_given and intervals < wanted <= cap:
-        return (
-            f"{figure} (the grid given by timing.grid_points, {intervals} intervals); "
-            f"timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
-        )
-    if method.name == "jerk_limited":  # phase_plane would drop the jerk limits: no remedy there
-        if intervals < wanted <= cap:
-            return f"{figure} ({intervals} intervals); timing.grid_points {wanted} would bring it within {100 * GAP_TARGET:g} %"
-        return f"{figure} ({intervals} intervals, refined as far as jerk_limited's grid cap and the time budget allowed)"
-    remedy = "timing.method phase_plane refines its grid where the error lies"
-    if grid_given and method.name != "phase_plane":
-        return f"{figure} (the grid given by timing.grid_points, {intervals} intervals; {method.name} serves at most {cap} on this robot): {remedy}"
-    if method.name != "phase_plane":
-        return f"{figure} (the default grid, {intervals} intervals, refined as far as the limits, the grid cap and the time budget allowed): {remedy}"
-    return f"{figure} ({intervals} intervals, refined as far as phase_plane's grid cap and the time budget allowed)"
+    more_points = intervals < wanted <= cap and (grid_given or method.name == "jerk_limited")
+    if more_points:
+        remedy = "grid.intervals"
+    elif method.name not in ("jerk_limited", "phase_plane"):
+        remedy = "method"
+    else:
+        remedy = None
+    return Note(
+        f"the duration is within about {100 * gap:.2g} % of the time-optimal one on this grid of {intervals} intervals",
+        "gap_above_target", gap=gap, intervals=intervals, wanted=wanted if more_points else None, cap=cap, method=method.name,
+        grid_given=grid_given, remedy=remedy, target=GAP_TARGET,
+    )
 
 
 def answer_accuracy(
@@ -225,13 +223,13 @@ def answer_accuracy(
     grid_given: bool,
     duration_given: bool,
     law_utilization: list[tuple[float, dict[str, np.ndarray]]] | None = None,
-) -> tuple[Accuracy, str | None]:
+) -> tuple[Accuracy, Note | None]:
     """The answer's ``Accuracy`` from its timing, and the warning the policy asks for: a
     time-optimal answer (``method``: the method that timed the path) whose estimated gap still
-    exceeds ``GAP_TARGET`` after ``accurate_solve`` on its ``intervals`` grid intervals. Time
-    laws at their shortest (``law_utilization``: each stretch's duration and its dense check's
-    peak utilization against the limits it was timed under) are estimated from that
-    (``law_gap``), the stretches' gaps weighted by their durations."""
+    exceeds ``GAP_TARGET`` after ``accurate_solve`` on its ``intervals`` grid intervals (a
+    ``Note``). Time laws at their shortest (``law_utilization``: each stretch's duration and
+    its dense check's peak utilization against the limits it was timed under) are estimated
+    from that (``law_gap``), the stretches' gaps weighted by their durations."""
     gap, basis = timing.optimality_gap, timing.gap_basis
     if method.name == "jerk_limited" and isinstance(timing, TimeScaling):
         intervals = len(timing.s) - 1  # the grid it refined to, not the one it started from
@@ -242,9 +240,9 @@ def answer_accuracy(
         if len(known) == len(gaps) and total > 0.0:
             gap, basis = sum(duration * g for duration, g in known) / total, LAW_BASIS
     if gap is None and duration_given:
-        return Accuracy(None, "not estimated: timing.duration sets the duration, which is no optimum"), None
+        return Accuracy(None, Note("not estimated: the duration given sets it, which is no optimum", "duration_given")), None
     if gap is None:
-        return Accuracy(None, basis or f"not estimated for timing.method {method_name}"), None
+        return Accuracy(None, basis or Note(f"not estimated for the method {method_name}", "not_estimated", method=method_name)), None
     if method_name == "collocation" and basis == PHASE_PLANE_BASIS:
         # The re-timing along the collocation's path, not the free path's own optimality.
         basis = f"the re-timing along the collocation's path only (not the path's own optimality): {basis}"

@@ -13,7 +13,7 @@ from toptraj.planners.checks.gate import TimedStretch, samples_exceed
 from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.constraints.admissible import admissible_set
-from toptraj.planners.errors import InvalidRequest, TimingFailed
+from toptraj.planners.errors import TimingFailed, TooLarge
 from toptraj.planners.generators.collocation.switching import collocation_switches, switching_times
 from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
@@ -28,6 +28,7 @@ from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.trajectory import Samples, sample_trajectory
+from toptraj.robots.notes import Note
 
 #: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
 #: encoding of the answer that follow it (measured about 0.3 us on ur5 at 236 to 23,409
@@ -78,15 +79,17 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     )
 
 
-def _blend_notes(path) -> list[str]:
+def _blend_notes(path) -> list[Note]:
     """Corners a blend could not round within the path's deviation: the motion stops there."""
     if not (isinstance(path, BlendedPath) and path.tight_corners):
         return []
-    return [
-        f"path.max_deviation = {path.max_deviation:g} is too small to blend the corners at waypoints "
+    return [Note(
+        f"the largest deviation {path.max_deviation:g} is too small to blend the corners at waypoints "
         f"{', '.join(map(str, path.tight_corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
-        "stops there"
-    ]
+        "stops there",
+        "corners_not_blended", field="max_deviation", value=path.max_deviation, corners=tuple(path.tight_corners),
+        min_blend=MIN_BLEND,
+    )]
 
 
 def _samples(problem: Problem, timed: Timed) -> Samples:
@@ -95,7 +98,7 @@ def _samples(problem: Problem, timed: Timed) -> Samples:
     robot, result, sampling, method = problem.robot, timed.timing, problem.sampling, problem.method
     require_finite(timed.method, duration=result.duration)
     if result.duration / sampling.dt > sampling.max_samples - 2:
-        raise InvalidRequest(_too_many_samples(result.duration, sampling.dt, sampling.max_samples, problem.options))
+        raise _too_many_samples(result.duration, sampling.dt, sampling.max_samples, problem.options)
     problem.deadline.expect((result.duration / sampling.dt + 2) * robot.dof * SAMPLE_SECONDS)
     samples = sample_trajectory(timed.path, result, robot, sampling.dt, sampling.exact_period)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
@@ -195,19 +198,18 @@ def _unasked_limits(
     return notes
 
 
-def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> str:
-    """Why ``duration`` (s) sampled every ``dt`` (s) is not served, and advice that can be
-    followed: the smallest ``output.dt`` that fits when it lies in ``DT``, else the limits that
-    make the motion this slow (no ``output.dt`` beyond its own range is ever advised)."""
-    given = f"output.dt = {dt:g} s gives {math.ceil(duration / dt) + 1} samples over the {duration:.4g} s motion; at most {max_samples} are served"
+def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> TooLarge:
+    """Why ``duration`` (s) sampled every ``dt`` (s) is not served, with advice that can be
+    followed: ``smallest_dt``, the smallest sample period that fits when it lies in ``DT`` (else
+    ``None``, and ``longest_s``, the longest motion the largest period serves, with the tool
+    limits given, ``fields``, among what makes the motion this slow): no period beyond its own
+    range is ever advised."""
     needed = _round_up(duration / (max_samples - 2))
-    if needed <= DT.high:
-        return f"{given}: use output.dt >= {needed:g} s"
-    slowing = [f"timing.limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None]
-    slowing += ["the velocity and acceleration limits (timing.limits and their scales)"]
-    return (
-        f"{given}, and even the largest output.dt ({DT.high:g} s) serves at most {_round_down(DT.high * (max_samples - 2)):g} s "
-        f"of motion: the limits make this motion too slow to serve; raise {' or '.join(slowing)}"
+    return TooLarge(
+        "sampling.dt", dt, math.ceil(duration / dt) + 1, max_samples, "samples", rule="too_many_samples",
+        duration=duration, smallest_dt=needed if needed <= DT.high else None, largest_dt=DT.high,
+        longest_s=_round_down(DT.high * (max_samples - 2)),
+        fields=tuple(f"limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None),
     )
 
 

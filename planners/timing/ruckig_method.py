@@ -18,7 +18,7 @@ import numpy as np
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Boundary, DenseStates, PathTiming, TimingMethod
 
@@ -94,7 +94,8 @@ class RuckigMethod(TimingMethod):
         assert constraints.jerk is not None  # ruckig requires the jerk rows (required_kinds)
         dq, ddq, _, jerk_limit = constraints.jerk
         if np.abs(ddq).max() > 1e-9 * max(1.0, np.abs(dq).max()):
-            raise InvalidRequest("ruckig times straight joint-space moves only: give exactly two waypoints")
+            raise NotServed("waypoints", None, "ruckig", rule="ruckig_straight_only",
+                            detail="ruckig times straight joint-space moves only: give exactly two waypoints")
         direction = np.abs(dq[0])
         moving = direction > 0
         with np.errstate(divide="ignore"):

@@ -169,13 +169,14 @@ def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Excepti
     if K is not None and np.isnan(K).any():
         return _uncontrollable(constraints, np.flatnonzero(np.isnan(K).any(axis=1)).max())
     if K is not None and not K[0, 0] <= sd_start**2 + 1e-9:
-        detail, joint, limit = static_load(constraints, 0)
+        held, joint, limit = static_load(constraints, 0)
         return InfeasiblePath(
             f"the motion cannot start at path speed {sd_start:g} 1/s at s = 0: every admissible "
-            f"motion there needs sd >= {np.sqrt(K[0, 0]):.4g} 1/s{detail}",
+            f"motion there needs sd >= {np.sqrt(K[0, 0]):.4g} 1/s",
             s=0.0,
             joint=joint,
             limit=limit,
+            held=held,
         )
     return TimingFailed("toppra failed to parameterize the path")
 
@@ -184,11 +185,12 @@ def _uncontrollable(constraints: PathConstraints, last_bad: int) -> InfeasiblePa
     """From grid point ``last_bad`` backwards no motion reaches the end of the path at the
     required speed: say where, and which joint cannot hold its load there."""
     where = min(last_bad + 1, len(constraints.s) - 1)
-    detail, joint, limit = static_load(constraints, where)
+    held, joint, limit = static_load(constraints, where)
     return InfeasiblePath(
         f"no motion can follow the path from s = {constraints.s[last_bad]:.4f} to its end: the "
-        f"limits cannot bring the motion to the required speed by s = {constraints.s[where]:.4f}{detail}",
+        f"limits cannot bring the motion to the required speed by s = {constraints.s[where]:.4f}",
         s=float(constraints.s[last_bad]),
         joint=joint,
         limit=limit,
+        held=held,
     )

@@ -16,7 +16,7 @@ from toptraj.robots import ToptrajError
 from toptraj.robots.upload_options import UploadOptions
 from toptraj.service.batches.lines import problem_body
 from toptraj.service.planning import compare_request, encode_json, plan_request, render
-from toptraj.service.problems import status_of, validation_problem
+from toptraj.service.problems import detail, status_of, title_of, validation_problem
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 logger = logging.getLogger("toptraj.batches")
@@ -60,7 +60,7 @@ def answer(text: str, budget_s: float) -> tuple[int, bytes]:
     except ToptrajError as error:
         extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
         status = status_of(error)
-        return status, orjson.dumps({"type": "about:blank", "title": error.title, "status": status, "detail": error.detail, **extra})
+        return status, orjson.dumps({"type": "about:blank", "title": title_of(error), "status": status, "detail": detail(error), **extra})
     except Exception as error:  # a solver's own failure: this line's answer, logged
         logger.error("a batch line failed unexpectedly", exc_info=error)
         return 500, problem_body(500, "Internal error", f"an unexpected {type(error).__name__} occurred while planning this line")

@@ -33,7 +33,7 @@ from toptraj.robots.errors import ToptrajError
 from toptraj.service.jobs import work
 from toptraj.service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
 from toptraj.service.jobs.store import JobStore
-from toptraj.service.problems import status_of
+from toptraj.service.problems import detail, status_of, title_of
 
 logger = logging.getLogger("toptraj.jobs")
 
@@ -68,7 +68,7 @@ def problem_of(error: BaseException) -> dict:
     """The problem+json object of a job's error: a ``ToptrajError`` with its status, title,
     detail and the ``s``, ``joint`` and ``limit`` facts it carries; anything else as a 500."""
     if isinstance(error, ToptrajError):
-        body = {"type": "about:blank", "title": error.title, "status": status_of(error), "detail": error.detail}
+        body = {"type": "about:blank", "title": title_of(error), "status": status_of(error), "detail": detail(error)}
         for key in ("s", "joint", "limit"):
             if getattr(error, key, None) is not None:
                 body[key] = getattr(error, key)

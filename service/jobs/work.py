@@ -18,10 +18,10 @@ import orjson
 
 from toptraj import robots
 from toptraj.planners import Deadline
-from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.execution.deadline import Progress
 from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from toptraj.service.planning import compare_request, encode_json, plan_request, render
+from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
 
@@ -144,7 +144,7 @@ def compute(kind: str, request: str, budget_s: float, setup: WorkerSetup, progre
             ``InfeasiblePath``, ``BudgetExceeded``).
     """
     if kind not in KINDS:
-        raise InvalidRequest(f"unknown job kind {kind!r}; known: {', '.join(KINDS)}")
+        raise RequestRefused(f"unknown job kind {kind!r}; known: {', '.join(KINDS)}")
     robots.configure_uploads(
         setup.data_dir,
         max_uploads=setup.max_uploads,

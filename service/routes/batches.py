@@ -11,7 +11,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
 from pydantic import ValidationError
 
-from toptraj.planners.errors import InvalidRequest
+from toptraj.service.problems import RequestRefused
 from toptraj.service.routes.jobs import _job_response, _problem
 from toptraj.service.schemas.jobs import BatchCreate, JobPublic
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
@@ -50,7 +50,7 @@ async def create_batch(body: BatchCreate, request: Request) -> Response:
     settings = request.app.state.settings
     budget_s = settings.job_budget_s if body.budget_s is None else body.budget_s
     if budget_s > settings.job_max_budget_s:
-        raise InvalidRequest(f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= {settings.job_max_budget_s:g}")
+        raise RequestRefused(f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= {settings.job_max_budget_s:g}")
     runner = request.app.state.jobs
     from starlette.concurrency import run_in_threadpool
 

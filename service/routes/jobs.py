@@ -14,12 +14,12 @@ from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from toptraj import robots
-from toptraj.planners.errors import InvalidRequest
 from toptraj.robots.errors import ToptrajError, excerpt
-from toptraj.service.errors import PROBLEM_JSON, problem_responses
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes
 from toptraj.service.jobs.records import Job, JobEnded
 from toptraj.service.jobs.store import JobStore
+from toptraj.service.problem_docs import PROBLEM_JSON, problem_responses
+from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
 
 router = APIRouter(prefix="/v1/jobs", tags=["jobs"])
@@ -162,7 +162,7 @@ async def create_job(body: Annotated[JobCreate, Body(openapi_examples=EXAMPLES)]
     settings = request.app.state.settings
     budget_s = min(settings.job_budget_s, settings.job_max_budget_s) if body.budget_s is None else body.budget_s
     if budget_s > settings.job_max_budget_s:
-        raise InvalidRequest(
+        raise RequestRefused(
             f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= "
             f"{settings.job_max_budget_s:g} (setting TOPTRAJ_JOB_MAX_BUDGET_S)"
         )
@@ -185,7 +185,7 @@ def list_jobs(
     before = None
     if cursor is not None:
         if not cursor.isdigit():
-            raise InvalidRequest(f"cursor {excerpt(cursor)} is not a next_cursor of GET /v1/jobs")
+            raise RequestRefused(f"cursor {excerpt(cursor)} is not a next_cursor of GET /v1/jobs")
         before = int(cursor)
     jobs = _store(request).jobs(limit + 1, before, status)
     page = jobs[:limit]

@@ -10,11 +10,11 @@ from fastapi import APIRouter, Response
 from starlette.concurrency import run_in_threadpool
 
 from toptraj import robots
-from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.kinematics.skeleton import skeleton
 from toptraj.robots.limits import LIMIT_KINDS
 from toptraj.robots.upload_options import upload_options
-from toptraj.service.errors import problem_responses
+from toptraj.service.problem_docs import problem_responses
+from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.robots import (
     RobotCreate,
     RobotLimits,
@@ -127,9 +127,9 @@ def robot_skeleton(name: str, body: SkeletonRequest) -> SkeletonPublic:
     robot = robots.load(name)
     q = np.array(body.q, dtype=float) if len({len(row) for row in body.q}) == 1 else None
     if q is None or q.shape[1] != robot.dof:
-        raise InvalidRequest(f"each row of q must hold {robot.dof} values, one per joint of {name} ({', '.join(robot.joint_names)})")
+        raise RequestRefused(f"each row of q must hold {robot.dof} values, one per joint of {name} ({', '.join(robot.joint_names)})")
     if not np.all(np.isfinite(q)):
         row, joint = np.argwhere(~np.isfinite(q))[0]
-        raise InvalidRequest(f"q[{row}][{joint}] is not a finite number")
+        raise RequestRefused(f"q[{row}][{joint}] is not a finite number")
     points, positions = skeleton(robot, q)
     return SkeletonPublic(points=points, positions=positions.tolist())

@@ -7,8 +7,8 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
-from toptraj.service.errors import problem_responses
 from toptraj.service.planning import compare_request, encode_json, heavy_request, plan_request, render, worth_a_leash
+from toptraj.service.problem_docs import problem_responses
 from toptraj.service.schemas.answers import CompareResponse, TrajectoryResponse
 from toptraj.service.schemas.examples import openapi_examples
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest

@@ -50,12 +50,15 @@ def test_request_overrides_and_scales():
     assert changed.velocity.tolist() == [1.0] * 6
     assert changed.torque == pytest.approx(limits.torque * 0.5)
     assert changed.acceleration.tolist() == limits.acceleration.tolist()
-    with pytest.raises(robots.InvalidLimits, match="has 2 values"):
+    with pytest.raises(robots.InvalidLimits) as refused:
         limits.with_request({"velocity": [1.0, 2.0]})
-    with pytest.raises(robots.InvalidLimits, match=r"velocity\[1\] must be positive"):
+    assert (refused.value.field, refused.value.given, refused.value.expected) == ("limits.velocity", 2, 6)
+    with pytest.raises(robots.InvalidLimits) as refused:
         limits.with_request({"velocity": [1.0, 0.0, 1, 1, 1, 1]})
-    with pytest.raises(robots.InvalidLimits, match="torque_scale"):
+    assert (refused.value.field, refused.value.value, refused.value.rule) == ("limits.velocity[1]", 0.0, "limit_not_positive")
+    with pytest.raises(robots.InvalidLimits) as refused:
         limits.with_request(None, {"torque": -1.0})
+    assert (refused.value.field, refused.value.value, refused.value.rule) == ("limits.torque_scale", -1.0, "scale_not_positive")
 
 
 def test_continuous_joints_map_to_cos_sin():

@@ -14,6 +14,7 @@ import pytest
 from toptraj import robots
 from toptraj.planners import Timing, WaypointPath, plan
 from toptraj.planners.errors import InvalidRequest
+from toptraj.service.problems import detail
 
 UR5 = robots.load("ur5")
 TWO = WaypointPath(np.array([[0.0, -1.2, 1.0, 0.0, 0.3, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3]]))
@@ -33,13 +34,12 @@ def test_a_scale_that_leaves_the_range_is_refused_with_followable_advice(method,
     overrides = {kind: [value] * UR5.dof}
     with pytest.raises(InvalidRequest) as refused:
         plan(UR5, TWO, Timing(method=method, constraints=constraints, limit_overrides=overrides, limit_scales={kind: factor}), dt=10.0)
-    message = str(refused.value)
-    assert f"timing.limits.{kind}_scale = {factor:g}" in message
-    assert "joint 'shoulder_pan_joint'" in message
-    advised = re.search(rf"use timing.limits.{kind}_scale in \[([^,]+), ([^\]]+)\]", message)
-    assert advised is not None, message
-    assert (float(advised[1]), float(advised[2])) == pytest.approx((low, high))
-    for advice in (float(advised[1]), float(advised[2])):
+    error = refused.value
+    assert (error.field, error.value, error.joint_name) == (f"limits.{kind}_scale", factor, "shoulder_pan_joint")
+    assert error.advised == pytest.approx((low, high))
+    advised = re.search(rf"use timing.limits.{kind}_scale in \[([^,]+), ([^\]]+)\]", detail(error))
+    assert advised is not None and (float(advised[1]), float(advised[2])) == error.advised, detail(error)
+    for advice in error.advised:
         timing = Timing(method=method, constraints=constraints, limit_overrides=overrides, limit_scales={kind: advice})
         assert plan(UR5, TWO, timing, dt=10.0).duration > 0.0
 

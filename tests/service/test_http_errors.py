@@ -131,7 +131,7 @@ def test_over_the_time_budget_is_504():
 
 
 def test_the_service_picks_the_status_not_the_library(client, monkeypatch):
-    """The HTTP status of a library error comes from the service's table (``toptraj.service.errors.STATUS``),
+    """The HTTP status of a library error comes from the service's table (``toptraj.service.problems.STATUS``),
     never from an attribute of the library's class: changing that attribute changes no answer."""
     from toptraj.planners.errors import BudgetExceeded
     from toptraj.robots.errors import UnknownRobot

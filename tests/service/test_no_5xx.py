@@ -15,13 +15,14 @@ import uvicorn
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Deadline, InvalidRequest, Timing, TimingFailed, WaypointPath, plan
+from toptraj.planners import Deadline, Timing, TimingFailed, WaypointPath, plan
+from toptraj.planners.errors import OutOfRange
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.results import require_finite
 from toptraj.planners.timing.laws.profiles import quintic_coefficients
 from toptraj.service.app import create_app
-from toptraj.service.errors import FiniteJSONResponse
-from toptraj.service.problems import NonFiniteAnswer, non_finite_answer
+from toptraj.service.finite import FiniteJSONResponse
+from toptraj.service.problems import NonFiniteAnswer, detail, non_finite_answer
 from toptraj.service.settings import Settings
 
 DIRECTION = [0.8, 0.2, 0.4, -0.5, 0.6, 0.3]
@@ -87,16 +88,18 @@ def test_the_library_holds_the_same_ranges():
     """``plan`` called without the service checks the ranges too."""
     arm = robots.load("geering_2r")
     path = WaypointPath(np.array([[0.0, 0.0], [1.0, 1.0]]))
-    for timing, dt, words in [
-        (Timing(method="cubic", duration=1e-300), 0.01, "timing.duration = 1e-300"),
-        (Timing(method="trapezoidal", trapezoid_fractions=(5e-324, 0.5)), 0.01, "timing.trapezoid.tau1"),
-        (Timing(method="quintic", start_acceleration=np.array([1e308, 1e308])), 0.01, "timing.boundary.start_acceleration[0]"),
-        (Timing(limit_scales={"torque": 1e-300}), 0.01, "timing.limits.torque_scale"),
-        (Timing(), 5e-324, "output.dt"),
+    for timing, dt, field, words in [
+        (Timing(method="cubic", duration=1e-300), 0.01, "duration", "timing.duration = 1e-300"),
+        (Timing(method="trapezoidal", trapezoid_fractions=(5e-324, 0.5)), 0.01, "law.trapezoid.tau1", "timing.trapezoid.tau1"),
+        (Timing(method="quintic", start_acceleration=np.array([1e308, 1e308])), 0.01, "boundary.start_acceleration[0]",
+         "timing.boundary.start_acceleration[0]"),
+        (Timing(limit_scales={"torque": 1e-300}), 0.01, "limits.torque_scale", "timing.limits.torque_scale"),
+        (Timing(), 5e-324, "sampling.dt", "output.dt"),
     ]:
-        with pytest.raises(InvalidRequest, match="accepted range") as caught:
+        with pytest.raises(OutOfRange) as caught:
             plan(arm, path, timing, dt, Deadline())
-        assert words in caught.value.detail
+        assert caught.value.field == field and not caught.value.low <= abs(caught.value.value) <= caught.value.high
+        assert words in detail(caught.value) and "accepted range" in detail(caught.value)
 
 
 def test_extreme_numbers_inside_the_ranges_plan_or_fail_cleanly(client):

@@ -312,9 +312,9 @@ def _optimize_motion(
     from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
 
     if robot.outside_position_limits(motion.start) is not None:
-        raise InvalidRequest("path.start is outside the joint limits")
+        raise InvalidRequest("start", motion.start, rule="outside_the_joint_limits")
     if robot.outside_position_limits(motion.goal) is not None:
-        raise InvalidRequest("path.goal is outside the joint limits")
+        raise InvalidRequest("goal", motion.goal, rule="outside_the_joint_limits")
     started = time.perf_counter()
     tried: list[str] = []
     coarse_solver = None

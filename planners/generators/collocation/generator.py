@@ -12,7 +12,7 @@ import numpy as np
 
 from toptraj.planners.checks.gate import TimedStretch, checked, gated
 from toptraj.planners.constraints.path_constraints import build_path_constraints
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.errors import InfeasiblePath, NotServed, OutOfRange
 from toptraj.planners.generators.collocation import collocation_path, optimize_motion
 from toptraj.planners.generators.collocation.switching import refine_collocation, switched_path, switching_times
 from toptraj.planners.paths.grid import path_grid
@@ -25,6 +25,7 @@ from toptraj.planners.timing.base import GAP_TARGET, TimingMethod
 from toptraj.planners.timing.min_cost import MinCostMethod
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.robots import JointLimits, Robot
+from toptraj.robots.notes import Note
 
 #: Most collocation intervals a request may ask for (timing.grid_points).
 MAX_INTERVALS = 100
@@ -50,11 +51,9 @@ class Collocation(MotionGenerator):
 
     def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
         if not isinstance(motion, FreeMotion):
-            raise InvalidRequest(
-                "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
-            )
+            raise NotServed("method", self.name, self.name, rule="free_path_needs_collocation", alternatives=("collocation", "search"))
         if options.grid_points is not None and not 4 <= options.grid_points <= MAX_INTERVALS:
-            raise InvalidRequest(f"timing.grid_points sets the collocation intervals, 4 to {MAX_INTERVALS}; got {options.grid_points}")
+            raise OutOfRange("grid.intervals", options.grid_points, 4, MAX_INTERVALS, rule="collocation_intervals")
 
     def generate(self, problem: Problem, execution: Execution) -> Timed:
         """The collocation's path, re-timed exactly along itself, its switching times refined."""
@@ -105,11 +104,11 @@ class Collocation(MotionGenerator):
         optimum, with the advice that brings it closer where there is one."""
         if self.torque_weight != 0.0 or source.optimality_gap is None or source.optimality_gap <= GAP_TARGET:
             return ()
-        advice = (
-            f": more timing.grid_points (collocation intervals, up to {MAX_INTERVALS}) bring it closer"
-            if len(collocation.t) - 1 < MAX_INTERVALS else ""
-        )
-        return (f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis}){advice}",)
+        return (Note(
+            f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis})",
+            "collocation_gap", gap=source.optimality_gap, basis=source.gap_basis,
+            most_intervals=MAX_INTERVALS if len(collocation.t) - 1 < MAX_INTERVALS else None,
+        ),)
 
 
 def _optimized(problem: Problem, deadline):

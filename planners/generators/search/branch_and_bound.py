@@ -232,27 +232,18 @@ def branch_and_bound(
     search.run()
     if not search.found:
         stats = search.stats
-        roadmap = problem.graph.kind == "roadmap"
         if not stats.complete:
-            smaller = "timing.search.roadmap_points or timing.search.neighbors" if roadmap else "timing.search.cells"
             raise NoGridPath(
                 f"the search found no grid path within its share of the time budget or its max_expansions "
-                f"({stats.expanded} partial paths expanded): give it a larger budget (a job's budget_s), fewer "
-                f"{smaller} or more timing.search.max_expansions",
-                stats,
+                f"({stats.expanded} partial paths expanded)",
+                stats, rule="search_incomplete", graph=problem.graph.kind,
             )
-        finer = (
-            "raise timing.search.roadmap_points or timing.search.neighbors (within the memory cap), try another "
-            "timing.search.seed"
-            if roadmap
-            else "refine timing.search.cells"
-        )
         below = f" faster than {cap:.4g} s" if np.isfinite(cap) else ""
         raise NoGridPath(
             f"the search found no grid path from start to goal{below} that keeps the clearance and the limits "
             f"({stats.grid_points} grid points, {stats.removed_by_obstacles} pieces of path removed by obstacles, "
-            f"{stats.points_blocked} grid points blocked): {finer}, widen timing.search.margin, or move the obstacles",
-            stats,
+            f"{stats.points_blocked} grid points blocked)",
+            stats, rule="no_grid_path", graph=problem.graph.kind, cap=cap,
         )
     scale = problem.graph.scale
     radius = options.tube_radius if options.tube_radius is not None else 3.0 * float(np.linalg.norm(scale))

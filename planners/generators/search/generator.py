@@ -18,7 +18,7 @@ import dataclasses
 import numpy as np
 
 from toptraj.planners.collision import check_clearance
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, OverMemory
+from toptraj.planners.errors import Conflicting, InfeasiblePath, NotServed, OverMemory
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.generators.search.curve import GridSplinePath
@@ -60,10 +60,10 @@ class Search(MotionGenerator):
 
     def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
         if not isinstance(motion, FreeMotion):
-            raise InvalidRequest("timing.method 'search' finds the path itself: give a free path (path.kind 'free', start and goal)")
+            raise NotServed("method", "search", "search", rule="search_needs_free_path")
         moving = moving_velocity(motion.start_velocity) is not None or moving_velocity(motion.end_velocity) is not None
         if moving or options.duration is not None:
-            raise InvalidRequest("the search plans the fastest motion from rest to rest: leave timing.boundary and timing.duration out")
+            raise Conflicting("method", "search", ("boundary", "duration"), rule="search_from_rest")
 
     def generate(self, problem: Problem, execution: Execution) -> Timed:
         """The search's motion, in a worker process under a budget (``run_isolated``)."""
@@ -82,8 +82,8 @@ class Search(MotionGenerator):
             )
         except OverMemory as error:
             raise OverMemory(
-                f"the search needed more memory than its estimate of {need / 2**30:.3g} GiB allowed ({error.detail}): "
-                "lower timing.search.roadmap_points or neighbors (cells on a lattice)"
+                f"the search needed more memory than its estimate of {need / 2**30:.3g} GiB allowed ({error.detail})",
+                rule="search_over_estimate", estimate=need, cause=error.detail,
             ) from None
 
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import InvalidRequest, OutOfRange, TooLarge, WrongLength
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.robots import Robot
 
@@ -163,14 +163,10 @@ def search_region(robot: Robot, start: np.ndarray, goal: np.ndarray, goals: np.n
     joint span from start to goal, within the joint limits."""
     widest = float(np.abs(goal - start).max())
     if widest <= 0.0 and len(goals) == 1:
-        raise InvalidRequest("path.start and path.goal are the same configuration: there is no motion to search")
+        raise InvalidRequest("goal", goal, rule="goal_is_start")
     if np.any(np.all(np.abs(goals - start) <= 1e-9, axis=1)):
         # Staying put reaches one of the goals allowed: every motion found would be slower.
-        raise InvalidRequest(
-            "path.goal is path.start up to whole revolutions of its continuous joints, which path.revolutions "
-            "allows: there is no motion to search; to turn a joint a full revolution, give that goal with "
-            "path.revolutions false"
-        )
+        raise InvalidRequest("goal", goal, rule="goal_is_start_turned")
     reach = margin * (widest if widest > 0.0 else 1.0)
     low = np.minimum(start, goals.min(axis=0)) - reach
     high = np.maximum(start, goals.max(axis=0)) + reach
@@ -184,9 +180,9 @@ def _cells(options: SearchOptions, n_dof: int) -> np.ndarray:
     if cells.size == 1:
         cells = np.full(n_dof, int(cells[0]))
     if cells.size != n_dof:
-        raise InvalidRequest(f"timing.search.cells has {cells.size} values; give one, or one per joint ({n_dof})")
+        raise WrongLength("search.cells", options.cells, cells.size, n_dof, rule="search_cells_length")
     if np.any(cells < 1) or np.any(cells > 1_000):
-        raise InvalidRequest(f"timing.search.cells must lie in [1, 1000], got {cells.tolist()}")
+        raise OutOfRange("search.cells", cells.tolist(), 1, 1_000, rule="search_cells_out_of_range")
     return cells
 
 
@@ -258,10 +254,7 @@ def lattice_graph(robot: Robot, start: np.ndarray, goal: np.ndarray, options: Se
     shape = tuple(len(axis) for axis in axes)
     total = math.prod(shape)
     if total > MAX_LATTICE_POINTS:
-        raise InvalidRequest(
-            f"timing.search.cells gives a lattice of {total} grid points ({' x '.join(map(str, shape))}); at most "
-            f"{MAX_LATTICE_POINTS} are searched: use fewer cells, or timing.search.graph 'roadmap'"
-        )
+        raise TooLarge("search.cells", options.cells, total, MAX_LATTICE_POINTS, "grid points", rule="lattice_too_large", shape=shape)
     index = np.indices(shape).reshape(n, -1).T  # (P, n)
     points = np.column_stack([axes[j][index[:, j]] for j in range(n)])
     moves = np.array([m for m in itertools.product((-1, 0, 1), repeat=n) if any(m)])
@@ -290,7 +283,7 @@ def _find(points: np.ndarray, q: np.ndarray, what: str) -> int:
     distance = np.abs(points - q).max(axis=1)
     index = int(np.argmin(distance))
     if distance[index] > 1e-6:  # pragma: no cover - the axes are built through start and goals
-        raise InvalidRequest(f"the {what} is not on the search grid")
+        raise InvalidRequest(what, q, rule="off_the_grid", detail=f"the {what} is not on the search grid")
     return index
 
 
@@ -314,7 +307,7 @@ def roadmap_graph(
     low, high = search_region(robot, start, goal, goals, options.margin)
     count = int(options.roadmap_points)
     if not 1 <= count <= MAX_ROADMAP_POINTS:
-        raise InvalidRequest(f"timing.search.roadmap_points must lie in [1, {MAX_ROADMAP_POINTS}], got {count}")
+        raise OutOfRange("search.roadmap_points", count, 1, MAX_ROADMAP_POINTS, rule="grid_out_of_range")
     rng = np.random.default_rng(options.seed)
     found: list[np.ndarray] = []
     drawn = 0

@@ -243,18 +243,21 @@ def optimize_locally(
     started = time.perf_counter()
     seed = np.asarray(seed, dtype=float)
     if seed.ndim != 2 or seed.shape[0] < 2 or seed.shape[1] != robot.dof or not np.all(np.isfinite(seed)):
-        raise InvalidRequest(f"the seed path must be finite joint configurations of shape (m >= 2, {robot.dof}); got shape {seed.shape}")
+        raise InvalidRequest("seed", seed.shape, rule="seed_shape",
+                             detail=f"the seed path must be finite joint configurations of shape (m >= 2, {robot.dof}): {seed.shape}")
     keep = np.concatenate([[True], np.linalg.norm(np.diff(seed, axis=0), axis=1) > 1e-12])
     seed = seed[keep]
     if len(seed) < 2:
-        raise InvalidRequest("the seed path's start and goal coincide")
+        raise InvalidRequest("seed", None, rule="seed_ends_coincide", detail="the seed path's start and goal coincide")
     if settings.grid_intervals & (settings.grid_intervals - 1):
-        raise InvalidRequest(f"the optimization grid must have a power of two of intervals; got {settings.grid_intervals}")
+        raise InvalidRequest("local.grid_intervals", settings.grid_intervals, rule="not_a_power_of_two",
+                             detail=f"the optimization grid must have a power of two of intervals; got {settings.grid_intervals}")
     objective = _Objective(robot, limits, kinds, seed[0], seed[-1], obstacles, clearance, settings, deadline)
     counts = _schedule(max(settings.first_control_points, DEGREE + 1), settings.max_control_points)
     if 8 * (counts[-1] - DEGREE) > settings.grid_intervals:
         raise InvalidRequest(
-            f"{counts[-1]} control points need at least {8 * (counts[-1] - DEGREE)} grid intervals (8 per knot interval)"
+            "local.grid_intervals", settings.grid_intervals, rule="grid_too_coarse",
+            detail=f"{counts[-1]} control points need at least {8 * (counts[-1] - DEGREE)} grid intervals (8 per knot interval)",
         )
     extent = np.maximum(np.ptp(seed, axis=0) * settings.step, settings.min_step)
 

@@ -48,7 +48,7 @@ import math
 
 import numpy as np
 
-from toptraj.planners.errors import InvalidRequest, OverMemory
+from toptraj.planners.errors import NotOneOf, OverMemory
 from toptraj.planners.generators.search.graph import (
     DEFAULT_MAX_TURN,
     LATTICE_MAX_JOINTS,
@@ -59,7 +59,6 @@ from toptraj.planners.generators.search.graph import (
 )
 from toptraj.planners.generators.search.problem import GRAPH_KINDS
 from toptraj.robots import Robot
-from toptraj.robots.errors import excerpt
 
 #: C of K ~ C P k^3 for a roadmap whose turns reach at most 90 degrees (see the module).
 ROADMAP_SPANS = 0.35
@@ -73,7 +72,7 @@ BASE_BYTES = 32 * 2**20
 
 def _graph_kind(robot: Robot, options: SearchOptions) -> str:
     if options.graph not in GRAPH_KINDS:
-        raise InvalidRequest(f"timing.search.graph {excerpt(options.graph)} is unknown; use one of {list(GRAPH_KINDS)}")
+        raise NotOneOf("search.graph", options.graph, GRAPH_KINDS, rule="unknown_graph")
     if options.graph == "auto":
         return "lattice" if robot.dof <= LATTICE_MAX_JOINTS else "roadmap"
     return options.graph
@@ -194,22 +193,18 @@ def check_search_memory(
             return lattice_bytes(tuple(len(axis) for axis in grid), max_turn) <= cap_bytes
 
         cells = _largest(lattice_fits, 1, 1_000)
-        advice = (
-            f"at most {cells} cells per joint are served" if cells is not None else "no lattice fits: use timing.search.graph 'roadmap'"
+        raise OverMemory(
+            f"a lattice of {shape} grid points on a {n}-joint arm needs {about}", rule="lattice_over_memory",
+            field="search.cells", shape=shape, dof=n, estimate=need, cap=cap_bytes, largest=cells,
         )
-        raise OverMemory(f"timing.search.cells gives a lattice of {shape} grid points on a {n}-joint arm, which needs {about}; {advice}")
     extra = 1 + goal_variants(robot, revolutions)
     points, neighbors = int(options.roadmap_points), int(options.neighbors)
     most_points = _largest(lambda p: roadmap_bytes(n, p + extra, neighbors, max_turn) <= cap_bytes, 1, MAX_ROADMAP_POINTS)
     most_neighbors = _largest(lambda k: roadmap_bytes(n, points + extra, k, max_turn) <= cap_bytes, 1, max(1, neighbors))
-    served = []
-    if most_points is not None:
-        served.append(f"at most {most_points} roadmap points are served with {neighbors} neighbors")
-    if most_neighbors is not None:
-        served.append(f"at most {most_neighbors} neighbors with {points} roadmap points")
     raise OverMemory(
-        f"timing.search.roadmap_points {points} with neighbors {neighbors} on a {n}-joint arm needs {about}; "
-        + ("; ".join(served) if served else "lower timing.search.neighbors and roadmap_points")
+        f"a roadmap of {points} points with {neighbors} neighbors on a {n}-joint arm needs {about}", rule="roadmap_over_memory",
+        field="search.roadmap_points", points=points, neighbors=neighbors, dof=n, estimate=need, cap=cap_bytes,
+        most_points=most_points, most_neighbors=most_neighbors,
     )
 
 

@@ -7,6 +7,7 @@ path at all.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -101,8 +102,10 @@ class SearchResult:
 
 
 class NoGridPath(InfeasiblePath):
-    """No grid path was found: with its search's ``statistics``."""
+    """No grid path was found: with its search's ``statistics`` (and ``rule``: why none, and
+    the ``graph`` kind searched)."""
 
-    def __init__(self, detail: str, statistics: SearchStatistics):
-        super().__init__(detail)
-        self.statistics = statistics
+    statistics: SearchStatistics
+
+    def __init__(self, detail: str, statistics: SearchStatistics, **facts: Any):
+        super().__init__(detail, statistics=statistics, **facts)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.collision import Obstacle
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotOneOf, OutOfRange
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.bounds import PieceBounds, piece_bounds
 from toptraj.planners.generators.search.free_space import clear_pieces, point_distances
@@ -80,7 +80,7 @@ class SearchProblem:
 def _graph(robot, start, goal, options: SearchOptions, revolutions, obstacles, clearance, deadline: Deadline) -> SearchGraph:
     kind = options.graph
     if kind not in GRAPH_KINDS:
-        raise InvalidRequest(f"timing.search.graph {kind!r} is unknown; use one of {list(GRAPH_KINDS)}")
+        raise NotOneOf("search.graph", kind, GRAPH_KINDS)
     if kind == "auto":
         kind = "lattice" if robot.dof <= LATTICE_MAX_JOINTS else "roadmap"
     if kind == "lattice":
@@ -135,19 +135,19 @@ def build_problem(
     obstacle_list = list(obstacles)
     for name, q in (("start", start), ("goal", goal)):
         if robot.outside_position_limits(q) is not None:
-            raise InvalidRequest(f"path.{name} is outside the joint limits")
+            raise InvalidRequest(name, q, rule="outside_the_joint_limits")
         if obstacle_list:
             nearest = float(point_distances(robot, q[None, :], obstacle_list)[0])
             if nearest < clearance:
                 raise InfeasiblePath(
-                    f"path.{name} comes within {nearest:.4g} m of an obstacle (the clearance is {clearance:g} m): "
-                    "move it away from the obstacles or lower path.clearance"
+                    f"the {name} comes within {nearest:.4g} m of an obstacle (the clearance is {clearance:g} m)",
+                    rule="end_too_close", field=name, distance=nearest, clearance=clearance,
                 )
     deadline.progress(0.0, "search: graph")
     graph = _graph(robot, start, goal, options, revolutions, obstacle_list, clearance, deadline)
     max_turn = options.max_turn if options.max_turn is not None else DEFAULT_MAX_TURN[graph.kind]
     if not 0.0 < max_turn < 180.0:
-        raise InvalidRequest(f"timing.search.max_turn must lie in (0, 180) degrees, got {max_turn}")
+        raise OutOfRange("search.max_turn", max_turn, 0.0, 180.0, "degrees", rule="max_turn_out_of_range")
     turn_in, turn_out = graph.transitions(max_turn, deadline)
     pieces = build_pieces(graph.points, graph.edge_from, graph.edge_to, graph.start, graph.goals, turn_in, turn_out)
     deadline.check()

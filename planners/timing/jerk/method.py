@@ -73,7 +73,7 @@ import time
 import numpy as np
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
 from toptraj.planners.timing.jerk.accuracy import coarser, relative_gap
@@ -135,9 +135,9 @@ class JerkLimitedMethod(TimingMethod):
         deadline: Deadline = NO_DEADLINE,
     ) -> JerkTimeScaling | JerkSegmentsTiming:
         if constraints.jerk is None:
-            raise InvalidRequest("timing.method 'jerk_limited' needs the jerk constraint")
+            raise NotServed("constraints", None, self.name, rule="jerk_limited_needs_jerk")
         if boundary.sdd_start or boundary.sdd_end:
-            raise InvalidRequest("timing.method 'jerk_limited' starts and ends with zero acceleration")
+            raise NotServed("boundary", None, self.name, rule="jerk_limited_from_zero_acceleration")
         if boundary.sd_start == 0.0 and boundary.sd_end == 0.0 and _uniform(constraints):
             exact = closed_form_timing(constraints)
             if exact is not None:

@@ -159,7 +159,7 @@ class WorkingSetLP:
                 return False
         if status == highspy.HighsModelStatus.kTimeLimit:
             self.deadline.check()
-            raise BudgetExceeded(f"planning exceeded its time budget of {self.deadline.budget_s:.3g} s")
+            raise BudgetExceeded(f"planning exceeded its time budget of {self.deadline.budget_s:.3g} s", budget_s=self.deadline.budget_s)
         if status == highspy.HighsModelStatus.kInfeasible:
             raise InfeasiblePath(
                 "no jerk-limited motion follows the path within the limits (the linear program is infeasible)"
@@ -169,7 +169,8 @@ class WorkingSetLP:
         if status != highspy.HighsModelStatus.kOptimal:
             raise TimingFailed(
                 f"the jerk-limited timing's linear program ended without a solution (HiGHS: "
-                f"{solver.modelStatusToString(status).lower()}); try other timing.grid_points"
+                f"{solver.modelStatusToString(status).lower()})",
+                rule="jerk_program_unsolved", method="jerk_limited", solver_status=solver.modelStatusToString(status).lower(),
             )
         return True
 

@@ -26,7 +26,7 @@ import numpy as np
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.constraints.tool_speed import TOOL_KINDS
 from toptraj.planners.diagnostics import static_load
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Binding, Boundary, TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawSegment, LawTiming
@@ -120,11 +120,12 @@ class ClassicalMethod(TimingMethod):
         where = ", ".join(f"{tau:.4g}" for tau in steps)
         raise InfeasiblePath(
             f"the {self.profile.description}'s acceleration jumps at tau = {where} (as a fraction of each stretch's "
-            "duration), so its jerk is infinite there and no duration holds a jerk limit: use quintic, "
-            "cycloidal, trapezoidal with blend 'cycloidal' or jerk_limited, or leave 'jerk' out of "
-            "timing.constraints",
+            "duration), so its jerk is infinite there and no duration holds a jerk limit",
             s=float(self.profile.derivatives(steps[:1])[0][0]),
             limit="jerk",
+            rule="law_acceleration_steps",
+            law=self.profile.description,
+            steps=tuple(float(tau) for tau in steps),
         )
 
     def solve(
@@ -138,10 +139,7 @@ class ClassicalMethod(TimingMethod):
             self.refuse_jerk_limit()
         moving = boundary.sd_start != 0.0 or boundary.sd_end != 0.0 or bool(boundary.sdd_start) or bool(boundary.sdd_end)
         if moving and self.boundary_law is None:
-            raise InvalidRequest(
-                f"timing.method {self.name!r} starts and ends at rest; use cubic or quintic for "
-                "non-zero boundary velocities"
-            )
+            raise NotServed("boundary", None, self.name, rule="law_from_rest_only", alternatives=("cubic", "quintic"))
         corners = constraints.s[1:-1][constraints.sd_max[1:-1] == 0.0]
         edges = np.concatenate(([0.0], corners, [1.0]))
         segments, bindings, minimal = [], [], []
@@ -183,23 +181,23 @@ class ClassicalMethod(TimingMethod):
             rows = self._samples(constraints, start, end, start + span * sigma)
             y, where = _largest_inverse_duration(rows, span, d1, d2, d3)
             if where is None:
-                raise InvalidRequest(
-                    f"no requested limit bounds the {self.name} law's speed: add a velocity or acceleration limit"
-                )
+                raise InvalidRequest("constraints", None, rule="law_unbounded", law=self.name,
+                                     detail=f"no requested limit bounds the {self.name} law's speed")
             if y <= best:
                 best, (kind, index, sample), binding_rows = y, where, rows
                 around = tau[max(where[2] - 1, 0)], tau[min(where[2] + 1, len(tau) - 1)]
             tau = np.linspace(*around, 33)
         y, rows = best, binding_rows
         if y <= 0.0:
-            clause, joint, _ = static_load(rows, sample)
+            held, joint, _ = static_load(rows, sample)
             exceeded = kind if kind != "row" else rows.rows[index][0]
             raise InfeasiblePath(
                 f"the {self.name} law cannot meet the limits at any duration: at s = {rows.s[sample]:.4f} "
-                f"the {exceeded} limit is exceeded at rest{clause}",
+                f"the {exceeded} limit is exceeded at rest",
                 s=float(rows.s[sample]),
                 joint=joint,
                 limit=exceeded,
+                held=held,
             )
         return LawSegment(start, end, 1.0 / y, profile=self.profile), _binding(rows, kind, index, sample)
 

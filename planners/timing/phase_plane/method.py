@@ -357,13 +357,14 @@ def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTH
         stage = discretize(constraints.s, constraints.linearized(x_ref), constraints.linearized(x_ref, "left"))
         raise _stuck(constraints, admissible_set(stage, x_bound[:-1]), stage, int(failed))
     if x_start < floor[0] * (1 - 1e-7) - 1e-12:
-        clause, joint, limit = static_load(constraints, 0)
+        held, joint, limit = static_load(constraints, 0)
         raise InfeasiblePath(
             f"the motion cannot start at path speed {np.sqrt(x_start):.6g} 1/s at s = 0: every "
-            f"motion that can follow the path needs at least {np.sqrt(floor[0]):.6g} 1/s there{clause}",
+            f"motion that can follow the path needs at least {np.sqrt(floor[0]):.6g} 1/s there",
             s=0.0,
             joint=joint,
             limit=limit,
+            held=held,
         )
     if x_start > envelope[0] * (1 + _BOUNDARY_SLACK) + 1e-12:
         raise InfeasiblePath(
@@ -424,11 +425,12 @@ def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) 
             joint=constraints.joint_names[constraints.rows[first % len(constraints.rows)][1]],
             limit=constraints.rows[first % len(constraints.rows)][0],
         )
-    clause, joint, limit = static_load(constraints, i + 1)
+    held, joint, limit = static_load(constraints, i + 1)
     return InfeasiblePath(
         f"no motion can follow the path from s = {s[i]:.4f} to its end: the limits cannot bring "
-        f"the motion to the required speed by s = {s[i + 1]:.4f}{clause}",
+        f"the motion to the required speed by s = {s[i + 1]:.4f}",
         s=float(s[i]),
         joint=joint,
         limit=limit,
+        held=held,
     )

@@ -10,7 +10,7 @@ import pickle
 
 import pytest
 
-from toptraj.planners.errors import InfeasiblePath, OverMemory
+from toptraj.planners.errors import InfeasiblePath, OutOfRange, OverMemory, WrongLength
 from toptraj.planners.generators.search.outcome import NoGridPath
 from toptraj.robots.errors import UnknownRobot
 
@@ -25,6 +25,8 @@ UR5_GOAL = [1.0, -1.2, 1.5, -1.9, -1.57, 0.0]
         InfeasiblePath("cannot follow", s=0.25, joint="elbow_joint", limit="torque"),
         UnknownRobot("nope", ["ur5", "panda"]),
         OverMemory("x" * 5_000),
+        OutOfRange("sampling.dt", 5e-324, 1e-6, 10.0, "s"),
+        WrongLength("waypoints[0]", [0.0], 1, 6, robot="ur5"),
     ],
     ids=lambda error: type(error).__name__,
 )

@@ -7,6 +7,7 @@ and stated as within 0.04 % of the optimum. The 422 says how to ask for the revo
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -15,6 +16,7 @@ from toptraj import robots
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.generators.search import build_problem
 from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.service.problems import detail
 
 GEERING = robots.load("geering_2r")  # phi revolute (+-2 pi), psi continuous
 OPTIONS = SearchOptions(tubes=1)
@@ -28,8 +30,10 @@ def _build(goal, revolutions):
 
 @pytest.mark.parametrize("goal", [[0.0, 0.0], [0.0, 2.0 * math.pi], [0.0, -2.0 * math.pi]])
 def test_a_goal_that_is_the_start_up_to_revolutions_is_refused(goal):
-    with pytest.raises(InvalidRequest, match="no motion to search.*path.revolutions false"):
+    with pytest.raises(InvalidRequest) as refused:
         _build(goal, revolutions=True)
+    assert (refused.value.field, refused.value.rule) == ("goal", "goal_is_start_turned")
+    assert re.search("no motion to search.*path.revolutions false", detail(refused.value))
 
 
 def test_the_advice_plans_the_revolution():

@@ -8,6 +8,7 @@ import pytest
 
 from toptraj import robots
 from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.service.problems import note_text
 
 TURN = np.array([[0.0, 0.2], [0.3, 6.0]])  # psi: 0.2 -> 6.0 rad, 5.8 rad as given, 0.483 the short way
 
@@ -19,7 +20,10 @@ def _planned(mode: str):
 def test_as_given_follows_the_numbers_and_warns():
     result = _planned("as_given")
     np.testing.assert_allclose(result.samples.q[-1], TURN[-1], atol=1e-9)
-    assert any("'psi' turns +5.8 rad" in note and "shortest" in note for note in result.warnings)
+    (note,) = [note for note in result.warnings if getattr(note, "rule", None) == "turns_the_long_way"]
+    assert (note.facts["joint_name"], note.facts["field"]) == ("psi", "waypoints[0]")
+    assert note.facts["turn"] == pytest.approx(5.8, abs=0.05)
+    assert "'psi' turns +5.8 rad" in note_text(note) and "path.continuous = 'shortest'" in note_text(note)
 
 
 def test_shortest_turns_the_short_way_to_the_equivalent_angle():

@@ -7,6 +7,7 @@ import pytest
 
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.paths import SplinePath, StopAndGoPath
+from toptraj.service.problems import detail
 
 WAYPOINTS = np.array([[0.0, 0.0], [1.0, 0.5], [1.5, 2.0], [3.0, 2.5]])
 
@@ -61,8 +62,10 @@ def test_continuous_joints_are_not_wrapped():
 
 
 def test_coincident_waypoints_are_refused():
-    with pytest.raises(InvalidRequest, match=r"path.waypoints\[1\] and path.waypoints\[2\] coincide"):
+    with pytest.raises(InvalidRequest) as refused:
         SplinePath(np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 1.0]]))
+    assert (refused.value.field, refused.value.rule, refused.value.index) == ("waypoints[1]", "waypoints_coincide", 1)
+    assert detail(refused.value) == "path.waypoints[1] and path.waypoints[2] coincide"
 
 
 @pytest.mark.parametrize("count", [2, 3, 4, 7, 40])

@@ -19,6 +19,7 @@ from toptraj.planners import Timing, WaypointPath, plan
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.paths import SplinePath
 from toptraj.planners.timing.min_cost import MinCostMethod
+from toptraj.service.problems import note_text
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda", "geering_2r", "yamamoto_2r"])
@@ -208,12 +209,18 @@ def test_the_warning_advises_only_what_the_method_serves():
     from toptraj.planners.timing.toppra_method import ToppraMethod
 
     within = gap_warning(ToppraMethod(), 0.008, 100, 6, grid_given=True)
-    assert "0.8 %" in within and "timing.grid_points 1000 would bring it within 0.1 %" in within
+    assert (within.facts["remedy"], within.facts["wanted"], within.facts["gap"]) == ("grid.intervals", 1000, 0.008)
+    assert within.facts["wanted"] <= within.facts["cap"]
+    assert "0.8 %" in note_text(within) and "timing.grid_points 1000 would bring it within 0.1 %" in note_text(within)
     cap = MinCostMethod().max_grid_intervals(7)
     beyond = gap_warning(MinCostMethod(), 0.01, 2000, 7, grid_given=True)
-    assert "timing.grid_points" not in beyond.split(":")[-1] and "phase_plane" in beyond and str(cap) in beyond
+    assert (beyond.facts["remedy"], beyond.facts["wanted"], beyond.facts["cap"]) == ("method", None, cap)
+    text = note_text(beyond)
+    assert "timing.grid_points" not in text.split(":")[-1] and "phase_plane" in text and str(cap) in text
     refined = gap_warning(ToppraMethod(), 0.003, 400, 6, grid_given=False)
-    assert "1 %" not in refined and "0.3 %" in refined and refined.endswith("timing.method phase_plane refines its grid where the error lies")
+    assert (refined.facts["remedy"], refined.facts["grid_given"]) == ("method", False)
+    text = note_text(refined)
+    assert "1 %" not in text and "0.3 %" in text and text.endswith("timing.method phase_plane refines its grid where the error lies")
 
 
 def test_the_joint_trajectory_format_carries_the_accuracy(client):
@@ -238,7 +245,8 @@ def test_a_finer_grid_that_breaks_a_limit_leaves_the_default_answer_with_a_warni
     assert true_gap > 1e-3
     assert result.accuracy is not None and result.accuracy.relative_gap == pytest.approx(true_gap, abs=1e-4)
     (warning,) = [text for text in result.warnings if "of the time-optimal one" in text]
-    assert f"{100 * result.accuracy.relative_gap:.2g} %" in warning and "phase_plane" in warning
+    assert (warning.rule, warning.facts["gap"], warning.facts["remedy"]) == ("gap_above_target", result.accuracy.relative_gap, "method")
+    assert f"{100 * result.accuracy.relative_gap:.2g} %" in note_text(warning) and "phase_plane" in note_text(warning)
 
 
 @pytest.mark.parametrize(

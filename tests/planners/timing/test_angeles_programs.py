@@ -14,6 +14,7 @@ from toptraj.planners import Timing, WaypointPath, plan
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest
 from toptraj.planners.timing.laws.profiles import CycloidalBlendProfile, CycloidalProfile, QuinticProfile, TrapezoidalProfile
 from toptraj.planners.timing.laws.splines import SplineProfile, clamped_spline, periodic_spline, spline_from_accelerations
+from toptraj.service.problems import detail
 
 TAU1, TAU2 = 0.2, 0.9
 TRAPEZOID = TrapezoidalProfile(TAU1, TAU2)
@@ -207,19 +208,22 @@ def test_single_joint_closed_form_of_the_cycloidal_blend():
 
 
 @pytest.mark.parametrize(
-    "options, fragment",
+    "options, field, rule, fragment",
     [
-        ({"method": "cubic", "trapezoid_blend": "cycloidal"}, "timing.trapezoid.blend"),
-        ({"method": "phase_plane", "supporting_points": 8}, "timing.supporting_points"),
+        ({"method": "cubic", "trapezoid_blend": "cycloidal"}, "law.blend", "blend_needs_trapezoidal", "timing.trapezoid.blend"),
+        ({"method": "phase_plane", "supporting_points": 8}, "law.supporting_points", "needs_time_law", "timing.supporting_points"),
         ({"method": "trapezoidal", "trapezoid_fractions": (0.001, 0.001), "trapezoid_blend": "cycloidal",
-          "supporting_points": 5}, "backwards"),
-        ({"method": "quintic", "supporting_points": 8, "start_velocity": np.full(6, 0.1)}, "rest to rest"),
+          "supporting_points": 5}, "law.supporting_points", "law_spline_failed", "backwards"),
+        ({"method": "quintic", "supporting_points": 8, "start_velocity": np.full(6, 0.1)}, "law.supporting_points",
+         "law_from_rest", "rest to rest"),
     ],
 )
-def test_law_options_refused_where_they_do_not_apply(options, fragment):
+def test_law_options_refused_where_they_do_not_apply(options, field, rule, fragment):
     path = WaypointPath(np.array(UR5_WAYPOINTS[:2]))
-    with pytest.raises(InvalidRequest, match=fragment):
+    with pytest.raises(InvalidRequest) as refused:
         plan(UR5, path, Timing(**options))
+    assert (refused.value.field, refused.value.rule) == (field, rule)
+    assert fragment in detail(refused.value)
 
 
 def test_laws_over_http(client):
@@ -255,5 +259,7 @@ def test_laws_over_http(client):
 
 def test_supporting_points_refused_with_via_points():
     path = WaypointPath(np.array(UR5_WAYPOINTS), "via")
-    with pytest.raises(InvalidRequest, match="supporting_points"):
+    with pytest.raises(InvalidRequest) as refused:
         plan(UR5, path, Timing(method="cubic", supporting_points=8))
+    assert (refused.value.field, refused.value.rule) == ("law.supporting_points", "via_points_are_polynomials")
+    assert "leave timing.supporting_points out" in detail(refused.value)

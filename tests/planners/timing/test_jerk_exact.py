@@ -29,6 +29,7 @@ from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.timing.jerk.closed_form import ScalarLimits, double_s
 from toptraj.planners.timing.jerk.method import JerkLimitedMethod
 from toptraj.planners.timing.jerk.segments import segment_starts
+from toptraj.service.problems import note_text
 
 JERK_KINDS = ("velocity", "acceleration", "jerk")
 
@@ -205,9 +206,12 @@ def test_a_coarse_grid_answer_states_its_gap_and_advises_a_grid_that_holds_a_ten
     assert coarse.accuracy.relative_gap > 1e-3
     assert "second grid" in coarse.accuracy.basis
     (warning,) = [w for w in coarse.warnings if "time-optimal one" in w]
-    assert f"{100 * coarse.accuracy.relative_gap:.2g} %" in warning
-    assert "phase_plane" not in warning
-    advised = int(re.search(r"timing\.grid_points (\d+)", warning).group(1))
+    assert (warning.facts["remedy"], warning.facts["method"]) == ("grid.intervals", "jerk_limited")
+    text = note_text(warning)
+    assert f"{100 * coarse.accuracy.relative_gap:.2g} %" in text
+    assert "phase_plane" not in text
+    advised = int(re.search(r"timing\.grid_points (\d+)", text).group(1))
+    assert advised == warning.facts["wanted"]
     assert advised <= JerkLimitedMethod().max_grid_intervals(arm.dof)
     fine = plan(arm, WaypointPath(waypoints), Timing(method="jerk_limited", constraints=kinds, grid_points=advised), dt=0.05)
     assert fine.accuracy.relative_gap <= 1e-3

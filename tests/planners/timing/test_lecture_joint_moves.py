@@ -17,6 +17,7 @@ from toptraj import robots
 from toptraj.planners import Timing, WaypointPath, plan
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.timing.laws.profiles import QuinticProfile, polynomial_derivatives, quintic_coefficients
+from toptraj.service.problems import detail
 
 ARM = robots.load("geering_2r")
 A = np.radians([20.0, 30.0])
@@ -117,26 +118,30 @@ def test_given_duration_sets_the_slowest_joint():
 
 
 @pytest.mark.parametrize(
-    "path, options, fragment",
+    "path, options, rule, fragment",
     [
-        (np.array([A, (A + B) / 2, B]), {}, "exactly 2 waypoints"),
-        (np.array([A, B]), {"start_velocity": B - A}, "rest to rest"),
-        (np.array([A, B]), {"method": "phase_plane"}, "time law"),
-        (np.array([A, B]), {"constraints": ("torque",)}, "velocity, acceleration or jerk"),
+        (np.array([A, (A + B) / 2, B]), {}, "unsynchronized_needs_two_waypoints", "exactly 2 waypoints"),
+        (np.array([A, B]), {"start_velocity": B - A}, "unsynchronized_from_rest", "rest to rest"),
+        (np.array([A, B]), {"method": "phase_plane"}, "unsynchronized_needs_law", "time law"),
+        (np.array([A, B]), {"constraints": ("torque",)}, "unsynchronized_needs_a_limit", "velocity, acceleration or jerk"),
     ],
 )
-def test_non_normalized_refusals(path, options, fragment):
+def test_non_normalized_refusals(path, options, rule, fragment):
     settings = {"method": "trapezoidal", "synchronization": "none", "limit_overrides": {"velocity": [SPEED, SPEED]}}
     settings.update(options)
-    with pytest.raises(InvalidRequest, match=fragment):
+    with pytest.raises(InvalidRequest) as refused:
         plan(ARM, WaypointPath(path), Timing(**settings))
+    assert (refused.value.field, refused.value.value, refused.value.rule) == ("law.synchronization", "none", rule)
+    assert fragment in detail(refused.value)
 
 
 def test_unlimited_joint_is_named():
-    """geering_2r has no velocity limit of its own: the message says which joint lacks one."""
+    """geering_2r has no velocity limit of its own: the error names the joint that lacks one."""
     timing = Timing(method="trapezoidal", constraints=("velocity",), synchronization="none")
-    with pytest.raises(InvalidRequest, match="'phi'"):
+    with pytest.raises(InvalidRequest) as refused:
         plan(ARM, WaypointPath(np.array([A, B])), timing)
+    assert (refused.value.rule, refused.value.joint_name) == ("unsynchronized_joint_unlimited", "phi")
+    assert "'phi'" in detail(refused.value)
 
 
 def test_lecture_over_http(client):

@@ -20,6 +20,7 @@ from toptraj.planners.timing.laws.profiles import (
     polynomial_derivatives,
     quintic_coefficients,
 )
+from toptraj.service.problems import detail, status_of
 
 
 def test_lecture_example_1_cubic():
@@ -127,8 +128,9 @@ def test_laws_with_acceleration_steps_refuse_a_jerk_limit(law, steps, interpolat
     path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
     with pytest.raises(InfeasiblePath) as refused:
         plan(UR5, path, Timing(method=law, constraints=("velocity", "acceleration", "jerk")))
-    assert refused.value.limit == "jerk"
-    assert "quintic" in str(refused.value)
+    assert (refused.value.limit, refused.value.rule) == ("jerk", "law_acceleration_steps")
+    assert refused.value.steps == pytest.approx(ClassicalMethod(PROFILES[law]()).profile.acceleration_steps())
+    assert "quintic" in detail(refused.value)
     assert ClassicalMethod(PROFILES[law]()).profile.acceleration_steps() == pytest.approx(steps)
 
 
@@ -139,8 +141,9 @@ def test_via_points_refuse_the_trapezoid_whatever_the_limits(kinds):
     path = WaypointPath(np.array(UR5_WAYPOINTS), "via")
     with pytest.raises(InvalidRequest) as refused:
         plan(UR5, path, Timing(method="trapezoidal", constraints=kinds))
-    assert refused.value.status == 422
-    assert "'cubic' or 'quintic'" in str(refused.value) and "trapezoidal" in str(refused.value)
+    assert status_of(refused.value) == 422
+    assert (refused.value.field, refused.value.value, refused.value.alternatives) == ("method", "trapezoidal", ("cubic", "quintic"))
+    assert "'cubic' or 'quintic'" in detail(refused.value) and "trapezoidal" in detail(refused.value)
 
 
 def test_single_joint_closed_forms():

@@ -1,0 +1,65 @@
+"""The service's words for the notes of an answer (``toptraj.robots.notes.Note``: dropped
+waypoints, turns of continuous joints, corners not blended, an accuracy above its target),
+as ``toptraj.service.wordings`` words the errors (``NOTE_WORDING`` is part of its ``WORDING``), and
+for a URDF limit outside the range of every limit of its kind."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+
+def _gap_above_target(facts: dict) -> str:
+    gap, intervals, method = facts["gap"], facts["intervals"], facts["method"]
+    figure = f"the duration is within about {100 * gap:.2g} % of the time-optimal one on this grid"
+    within = f"timing.grid_points {facts['wanted']} would bring it within {100 * facts['target']:g} %"
+    phase_plane = "timing.method phase_plane refines its grid where the error lies"
+    if facts["remedy"] == "grid.intervals":
+        if facts["grid_given"]:
+            return f"{figure} (the grid given by timing.grid_points, {intervals} intervals); {within}"
+        return f"{figure} ({intervals} intervals); {within}"
+    if facts["remedy"] == "method" and facts["grid_given"]:
+        return f"{figure} (the grid given by timing.grid_points, {intervals} intervals; {method} serves at most {facts['cap']} on this robot): {phase_plane}"
+    if facts["remedy"] == "method":
+        return f"{figure} (the default grid, {intervals} intervals, refined as far as the limits, the grid cap and the time budget allowed): {phase_plane}"
+    return f"{figure} ({intervals} intervals, refined as far as {method}'s grid cap and the time budget allowed)"
+
+
+def _waypoints_dropped(facts: dict) -> str:
+    repeats = facts["indices"]
+    shown = ", ".join(map(str, repeats[:10])) + (", ..." if len(repeats) > 10 else "")
+    return f"{facts['field']} [{shown}] repeat the waypoint before them and were dropped ({len(repeats)} in all)"
+
+
+def _collocation_gap(facts: dict) -> str:
+    advice = (
+        f": more timing.grid_points (collocation intervals, up to {facts['most_intervals']}) bring it closer"
+        if facts["most_intervals"] is not None else ""
+    )
+    return f"the duration may lie up to {100 * facts['gap']:.2g} % above the optimum ({facts['basis']}){advice}"
+
+
+NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
+    "gap_above_target": _gap_above_target,
+    "duration_given": "not estimated: timing.duration sets the duration, which is no optimum",
+    "not_estimated": "not estimated for timing.method {method}",
+    "waypoints_dropped": _waypoints_dropped,
+    "turned_the_short_way": lambda facts: (
+        f"{facts['field']} 'shortest': continuous joint(s) {', '.join(map(repr, facts['joints']))} turn the short "
+        "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"
+    ),
+    "turns_the_long_way": lambda facts: (
+        f"continuous joint {facts['joint_name']!r} turns {facts['turn']:+.4g} rad from "
+        f"{facts['field']} to [{facts['index'] + 1}], more than pi: the other way round is shorter; "
+        "path.continuous = 'shortest' takes it"
+    ),
+    "corners_not_blended": lambda facts: (
+        f"{facts['field']} = {facts['value']:g} is too small to blend the corners at waypoints "
+        f"{', '.join(map(str, facts['corners']))} (a blend shorter than {facts['min_blend']:g} of the path): the motion "
+        "stops there"
+    ),
+    "collocation_gap": _collocation_gap,
+    "urdf_limit_out_of_range": (
+        "{where}: {kind} limit {value:g} {unit} in the URDF is outside the accepted range "
+        "[{low:g}, {high:g}] (the range of every {kind} limit, a request's timing.limits too)"
+    ),
+}

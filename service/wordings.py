@@ -1,0 +1,345 @@
+"""The service's words for the library's errors: one wording per rule (``rule`` of an error;
+a class's own rule by default), in the request's vocabulary.
+
+A wording is a ``str.format`` template over the error's facts, where ``{field}`` (and each of
+``fields``) is the request's field (``toptraj.service.problems.REQUEST_FIELD``), ``{x!j}`` joins a sequence with ", ",
+``{x!e}`` shows a value excerpted (``toptraj.robots.errors.excerpt``) and ``{x!f}`` maps a library field
+to the request's; or a function of the facts for what a template cannot say.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from toptraj.robots.ranges import Range
+from toptraj.service.note_wordings import NOTE_WORDING
+
+
+def _range(facts: dict) -> str:
+    """``[low, high] unit`` as ``Range.describe`` shows it; a signed range as [-high, high]."""
+    if facts.get("signed"):
+        return f"[-{facts['high']:g}, {facts['high']:g}] {facts['unit']}".rstrip()
+    return Range(facts["low"], facts["high"], facts["unit"]).describe()
+
+
+def _out_of_range(facts: dict) -> str:
+    return f"{facts['field']} = {facts['value']!r} is outside the accepted range {_range(facts)}"
+
+
+def _scaled_limit(facts: dict) -> str:
+    kind, advised = facts["kind"], facts["advised"]
+    advice = (
+        f"use timing.limits.{kind}_scale in [{advised[0]:g}, {advised[1]:g}]"
+        if advised is not None
+        else f"give timing.limits.{kind} per joint instead of a scale"
+    )
+    return (
+        f"{facts['field']} = {facts['value']:g} makes the {kind} limit of joint {facts['joint_name'][:64]!r} "
+        f"{facts['scaled']:g} {facts['unit']}, outside the accepted range {_range(facts)}; {advice}"
+    )
+
+
+def _wrong_length(facts: dict) -> str:
+    text = f"{facts['field']} has {facts['given']} values; "
+    if "robot" in facts:
+        text += f"{facts['robot']} has {facts['expected']} joints"
+    else:
+        text += f"the robot has {facts['expected']} joints"
+    if "joint_names" in facts:
+        text += f" ({', '.join(facts['joint_names'])})"
+    return text
+
+
+def _kind_not_served(facts: dict) -> str:
+    hint = " (for jerk, use jerk_limited, a time law or ruckig)" if facts["value"] == "jerk" else ""
+    return f"timing.method {facts['method']!r} cannot limit {facts['value']}; it handles {facts['handles']}{hint}"
+
+
+def _too_many_samples(facts: dict) -> str:
+    given = (
+        f"{facts['field']} = {facts['value']:g} s gives {facts['estimate']} samples over the {facts['duration']:.4g} s "
+        f"motion; at most {facts['cap']} are served"
+    )
+    if facts["smallest_dt"] is not None:
+        return f"{given}: use {facts['field']} >= {facts['smallest_dt']:g} s"
+    slowing = list(facts["fields"])
+    slowing += ["the velocity and acceleration limits (timing.limits and their scales)"]
+    return (
+        f"{given}, and even the largest {facts['field']} ({facts['largest_dt']:g} s) serves at most {facts['longest_s']:g} s "
+        f"of motion: the limits make this motion too slow to serve; raise {' or '.join(slowing)}"
+    )
+
+
+def _needs_two_waypoints(facts: dict) -> str:
+    given = "a cartesian path" if facts["value"] is None else f"{facts['value']} waypoints"
+    return (
+        f"timing.method {facts['method']!r} plans state-to-state motions: give exactly 2 waypoints, not "
+        f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
+        "law through several waypoints"
+    )
+
+
+def _where(facts: dict) -> str:
+    """Where along a Cartesian line: the point's field, the next point, how far along."""
+    return (
+        f"{facts['field']} on the way to point {facts['index'] + 1}, {100 * facts['fraction']:.1f} % along "
+        f"(at {facts['position']} m)"
+    )
+
+
+def _about(facts: dict) -> str:
+    return f"about {facts['estimate'] / 2**30:.3g} GiB, above the cap of {facts['cap'] / 2**30:.3g} GiB per search"
+
+
+def _lattice_over_memory(facts: dict) -> str:
+    cells = facts["largest"]
+    advice = f"at most {cells} cells per joint are served" if cells is not None else "no lattice fits: use timing.search.graph 'roadmap'"
+    return (
+        f"{facts['field']} gives a lattice of {facts['shape']} grid points on a {facts['dof']}-joint arm, which needs "
+        f"{_about(facts)}; {advice}"
+    )
+
+
+def _roadmap_over_memory(facts: dict) -> str:
+    points, neighbors = facts["points"], facts["neighbors"]
+    served = []
+    if facts["most_points"] is not None:
+        served.append(f"at most {facts['most_points']} roadmap points are served with {neighbors} neighbors")
+    if facts["most_neighbors"] is not None:
+        served.append(f"at most {facts['most_neighbors']} neighbors with {points} roadmap points")
+    return (
+        f"{facts['field']} {points} with neighbors {neighbors} on a {facts['dof']}-joint arm needs {_about(facts)}; "
+        + ("; ".join(served) if served else "lower timing.search.neighbors and roadmap_points")
+    )
+
+
+def _search_incomplete(facts: dict) -> str:
+    smaller = "timing.search.roadmap_points or timing.search.neighbors" if facts["graph"] == "roadmap" else "timing.search.cells"
+    return (
+        f"the search found no grid path within its share of the time budget or its max_expansions "
+        f"({facts['statistics'].expanded} partial paths expanded): give it a larger budget (a job's budget_s), fewer "
+        f"{smaller} or more timing.search.max_expansions"
+    )
+
+
+def _no_grid_path(facts: dict) -> str:
+    stats = facts["statistics"]
+    finer = (
+        "raise timing.search.roadmap_points or timing.search.neighbors (within the memory cap), try another "
+        "timing.search.seed"
+        if facts["graph"] == "roadmap"
+        else "refine timing.search.cells"
+    )
+    below = f" faster than {facts['cap']:.4g} s" if math.isfinite(facts["cap"]) else ""
+    return (
+        f"the search found no grid path from start to goal{below} that keeps the clearance and the limits "
+        f"({stats.grid_points} grid points, {stats.removed_by_obstacles} pieces of path removed by obstacles, "
+        f"{stats.points_blocked} grid points blocked): {finer}, widen timing.search.margin, or move the obstacles"
+    )
+
+
+def _law_acceleration_steps(facts: dict) -> str:
+    where = ", ".join(f"{tau:.4g}" for tau in facts["steps"])
+    return (
+        f"the {facts['law']}'s acceleration jumps at tau = {where} (as a fraction of each stretch's "
+        "duration), so its jerk is infinite there and no duration holds a jerk limit: use quintic, "
+        "cycloidal, trapezoidal with blend 'cycloidal' or jerk_limited, or leave 'jerk' out of "
+        "timing.constraints"
+    )
+
+
+def _path_in_collision(facts: dict) -> str:
+    index, distance = facts["obstacle"], facts["distance"]
+    how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of path.obstacles[{index}]"
+    closest = "" if facts["closest"] is None else f"; the closest approach is {facts['closest'][0]:.4g} m at s = {facts['closest'][1]:.4g}"
+    return (
+        f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): "
+        "move the waypoints away from the obstacle or lower path.clearance"
+    )
+
+
+def _unknown_tool_frame(facts: dict) -> str:
+    frames = facts["allowed"]
+    shown = ", ".join(repr(item) for item in frames[:60]) + (", ..." if len(frames) > 60 else "")
+    return f"{facts['field']} {facts['value'][:100]!r} is not a frame of {facts['robot']}; its frames are {shown}"
+
+
+Wording = str | Callable[[dict], str]
+
+#: Wording by rule.
+WORDING: dict[str, Wording] = {
+    "out_of_range": _out_of_range,
+    "scaled_limit_out_of_range": _scaled_limit,
+    "not_numbers": "{field} must be a list of numbers",
+    "wrong_length": _wrong_length,
+    "too_large": "{field} asks for {estimate} {unit}; at most {cap} are served",
+    "not_one_of": "{field} {value!r} is unknown; use one of {allowed}",
+    "deviation_needs_blend": "{field} applies to interpolation 'blend', not {interpolation!r}: leave it out or use 'blend'",
+    "not_joint_vectors": "{field} must be a list of joint vectors (a 2-D array)",
+    "too_few_waypoints": "{field} holds {count} waypoint(s); at least 2 are needed",
+    "too_many_waypoints": "{field} holds {estimate} waypoints; at most {cap} are served",
+    "coordinate_out_of_range": "{field} is {value:.6g}: not a finite number within +-{high:g} ({unit})",
+    "outside_joint_range": "{field} = {value:.6g} is outside the limits [{low:.6g}, {high:.6g}] of joint {joint_name!r}",
+    "unknown_constraint": "{field} holds {value!r}; use any of {allowed}",
+    "kind_not_served": _kind_not_served,
+    "no_constraints": "{field} is empty: without limits the time-optimal motion is instantaneous",
+    "trapezoid_order": "{field} needs 0 < tau1 <= tau2 < 1, got {value[0]}, {value[1]}",
+    "count_out_of_range": "{field} = {value!r} is outside [{low}, {high}]",
+    "law_spline_failed": "{field}: {reason}",
+    "blend_needs_trapezoidal": "{field} is used by timing.method 'trapezoidal', not {method!r}",
+    "needs_time_law": "{field} approximates a time law ({alternatives!j}), not timing.method {method!r}",
+    "law_from_rest": (
+        "{field} gives a law from rest to rest: leave timing.boundary out, or drop "
+        "supporting_points to use cubic or quintic with boundary states"
+    ),
+    "unsynchronized_needs_law": "{field} {value!r} runs each joint with a time law ({alternatives!j}), not with timing.method {method!r}",
+    "weight_needs_min_cost": "{field} is not used by timing.method {method!r}; use min_cost",
+    "negative_weight": "{field} must be a non-negative number, got {value}",
+    "options_need_search": "{field} sets up timing.method 'search', not {method!r}",
+    "tool_speed_on_free_path": (
+        "{field} and tool_angular_speed are not served by collocation on a free path; "
+        "give the path (waypoints or a cartesian line) and a method such as phase_plane"
+    ),
+    "tool_speed_through_via": (
+        "{field} and tool_angular_speed are not served with interpolation 'via' "
+        "(its segments are shaped by their time laws); use 'spline' or 'linear'"
+    ),
+    "exact_period_with_moving_ends": (
+        "{field} slows the motion uniformly, which would change the nonzero "
+        "timing.boundary velocities: set {field} to false (samples every dt "
+        "plus the final instant) or plan from and to rest"
+    ),
+    "grid_out_of_range": "{field} must lie in [{low}, {high}], got {value}",
+    "grid_over_method_cap": (
+        "{field} = {value} is more than {method} serves on a {dof}-joint robot (its memory grows with grid "
+        "intervals times joints): use {field} <= {largest}"
+    ),
+    "margin_out_of_range": "{field} must lie in [{low:g}, {high}], got {value}",
+    "needs_two_waypoints": _needs_two_waypoints,
+    "obstacles_need_search": (
+        "{field} on a free path are served by timing.method 'search' (the global search among obstacles); "
+        "collocation does not see obstacles"
+    ),
+    "too_many_samples": _too_many_samples,
+    "curvature_jump": (
+        "the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend), "
+        "so the joint accelerations jump there and no motion that passes it has a finite jerk: use "
+        "interpolation 'spline' with a jerk limit, or leave 'jerk' out of timing.constraints"
+    ),
+    "boundary_accelerations_not_used": "{field} accelerations are not used by timing.method {method!r}; use quintic",
+    "duration_not_used": (
+        "{field} is not used by timing.method {method!r}, which finds the shortest "
+        "duration itself; leave it out or use a time law"
+    ),
+    "via_points_from_rest": "via-point trajectories start and end at rest: leave {field} out",
+    "via_points_are_polynomials": "via-point segments are polynomials: leave {field} out, or use 'spline' or 'linear'",
+    "unsynchronized_needs_two_waypoints": (
+        "{field} 'none' moves every joint on its own from a start to a goal: give "
+        "exactly 2 waypoints (interpolation 'spline' or 'linear'), or use 'normalized'"
+    ),
+    "unsynchronized_from_rest": (
+        "{field} 'none' moves every joint from rest to rest on its own: leave "
+        "timing.boundary and the tool-speed limits out, or use 'normalized'"
+    ),
+    "not_finite": "{field} is {value}, not a finite number",
+    "not_tangent": "{field} is not tangent to the path at s = {at_s:g}: the path's direction there is {direction}",
+    "acceleration_off_path": (
+        "{field} does not fit the path at s = {at_s:g}: at path speed {path_speed:.6g} 1/s every "
+        "admissible joint acceleration is {curvature_term} plus a multiple of the tangent {tangent}"
+    ),
+    "unsynchronized_needs_a_limit": (
+        "{field} 'none' runs each joint at its own full speed, which a velocity, "
+        "acceleration or jerk limit sets: add one to timing.constraints"
+    ),
+    "unsynchronized_joint_unlimited": (
+        "{field} 'none': joint {joint_name!r} has no finite velocity, "
+        "acceleration or jerk limit among timing.constraints, so its own full-speed duration is "
+        "undefined; set one in timing.limits"
+    ),
+    "via_points_need_polynomials": "via points need {field} 'cubic' or 'quintic', not {value!r}",
+    "waypoints_coincide": lambda facts: f"path.waypoints[{facts['index']}] and path.waypoints[{facts['index'] + 1}] coincide",
+    "search_needs_free_path": "{field} 'search' finds the path itself: give a free path (path.kind 'free', start and goal)",
+    "search_from_rest": "the search plans the fastest motion from rest to rest: leave timing.boundary and timing.duration out",
+    "search_over_estimate": lambda facts: (
+        f"the search needed more memory than its estimate of {facts['estimate'] / 2**30:.3g} GiB allowed ({facts['cause']}): "
+        "lower timing.search.roadmap_points or neighbors (cells on a lattice)"
+    ),
+    "free_path_needs_collocation": (
+        "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
+    ),
+    "collocation_intervals": "{field} sets the collocation intervals, {low} to {high}; got {value}",
+    "positions_or_poses": "a cartesian path needs exactly one of path.positions and path.poses",
+    "not_cartesian_rows": lambda facts: (
+        f"{facts['field']} must be a list of [{'x, y, z' if facts['width'] == 3 else 'x, y, z, qx, qy, qz, qw'}] rows"
+    ),
+    "not_finite_number": "{field} is not a finite number",
+    "quaternion_not_unit": "{field} has a quaternion of norm {norm:.6g}, not 1",
+    "only_the_start_pose": "{field} holds only the start pose: give at least one more point",
+    "unknown_frame": "{field} {value!r} is not a frame of {robot}",
+    "not_finite_joint_values": "{field} must hold {expected} finite joint values",
+    "outside_joint_limits": "{field} = {value:.6g} is outside the limits of joint {joint_name!r}",
+    "line_too_long": "the line to {field} is {length:.4g} m long: it leaves the workspace of {robot}",
+    "repeated_point": "{field} repeats the previous point",
+    "point_out_of_reach": lambda facts: (
+        f"the line leaves the workspace of {facts['robot']}: no joint solution reaches the point {_where(facts)}"
+    ),
+    "line_crosses_singularity": lambda facts: f"the line crosses a singularity of {facts['robot']} near the point {_where(facts)}",
+    "joint_jump": lambda facts: (
+        f"the line needs a joint jump of {facts['jump']:.3g} rad on joint {facts['joint_name']!r} near the point {_where(facts)}"
+    ),
+    "joint_path_strays": lambda facts: (
+        f"the joint path strays {facts['deviation'] * 1e3:.3g} mm from the line after {facts['field']} "
+        f"(tolerance {facts['tolerance'] * 1e3:g} mm): the line passes too close to a singularity"
+    ),
+    "goal_is_start": "path.start and {field} are the same configuration: there is no motion to search",
+    "goal_is_start_turned": (
+        "{field} is path.start up to whole revolutions of its continuous joints, which path.revolutions "
+        "allows: there is no motion to search; to turn a joint a full revolution, give that goal with "
+        "path.revolutions false"
+    ),
+    "search_cells_length": "{field} has {given} values; give one, or one per joint ({expected})",
+    "search_cells_out_of_range": "{field} must lie in [{low}, {high}], got {value}",
+    "lattice_too_large": lambda facts: (
+        f"{facts['field']} gives a lattice of {facts['estimate']} grid points ({' x '.join(map(str, facts['shape']))}); "
+        f"at most {facts['cap']} are searched: use fewer cells, or timing.search.graph 'roadmap'"
+    ),
+    "unknown_graph": "{field} {value!e} is unknown; use one of {allowed}",
+    "lattice_over_memory": _lattice_over_memory,
+    "roadmap_over_memory": _roadmap_over_memory,
+    "outside_the_joint_limits": "{field} is outside the joint limits",
+    "end_too_close": lambda facts: (
+        f"path.{facts['field']} comes within {facts['distance']:.4g} m of an obstacle (the clearance is {facts['clearance']:g} m): "
+        "move it away from the obstacles or lower path.clearance"
+    ),
+    "max_turn_out_of_range": "{field} must lie in (0, 180) degrees, got {value}",
+    "search_incomplete": _search_incomplete,
+    "no_grid_path": _no_grid_path,
+    "frame_without_speed": "{field} is given without timing.limits.tool_speed or tool_angular_speed",
+    "unknown_tool_frame": _unknown_tool_frame,
+    "jerk_limited_needs_jerk": "timing.method 'jerk_limited' needs the jerk constraint",
+    "jerk_limited_from_zero_acceleration": "timing.method 'jerk_limited' starts and ends with zero acceleration",
+    "law_acceleration_steps": _law_acceleration_steps,
+    "law_from_rest_only": "timing.method {method!r} starts and ends at rest; use cubic or quintic for non-zero boundary velocities",
+    "law_unbounded": "no requested limit bounds the {law} law's speed: add a velocity or acceleration limit",
+    "orientation_not_unit": (
+        "{field} has norm {norm:.6g}; a box's orientation is a unit quaternion "
+        "[qx, qy, qz, qw] (norm 1 within 1e-3), e.g. [0, 0, 0, 1] for a box along the world's axes"
+    ),
+    "path_in_collision": _path_in_collision,
+    "jerk_program_unsolved": (
+        "the jerk-limited timing's linear program ended without a solution (HiGHS: {solver_status}); "
+        "try other timing.grid_points"
+    ),
+    "limit_not_positive": "{field} must be positive, got {value}",
+    "scale_not_positive": "{field} must be positive and finite, got {value}",
+    "unknown_robot": "no robot named {name!e}; catalog robots: {known!j}; uploaded robots are listed by GET /v1/robots",
+    "name_taken": "name {name!e} already holds a different {what}; choose another name, or DELETE /v1/robots/{{name}} first",
+    "store_full": (
+        "the upload store holds {count} uploads and {size} bytes; its caps are {max_uploads} uploads and "
+        "{max_bytes} bytes, and this upload adds {added} bytes. Free space with DELETE /v1/robots/{{name}} "
+        "(GET /v1/robots lists the uploads)."
+    ),
+    "all_waypoints_coincide": "path.waypoints[0] and path.waypoints[1] coincide, as do all {count} waypoints: there is nothing to move",
+    **NOTE_WORDING,
+}
