@@ -94,7 +94,7 @@ async def upload_robot(body: RobotCreate) -> RobotPublic:
 def _register(body: RobotCreate) -> robots.Robot:
     """Read the options (YAML within its bounds) and store the upload: in a worker thread, so
     that neither the parse nor the build holds the event loop."""
-    options = upload_options(body.locked_joints, body.joint_limits)
+    options = upload_options(body.locked_joints, body.joint_limits, None if body.payload is None else body.payload.payload())
     return robots.register_urdf(body.urdf, body.name, options)
 
 

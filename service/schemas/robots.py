@@ -8,6 +8,7 @@ from pydantic import BaseModel, Field
 
 from toptraj.robots.uploads import MAX_NAME_CHARS, NAME_PATTERN
 from toptraj.service.schemas.common import Schema
+from toptraj.service.schemas.equipment import PayloadRequest
 
 MAX_URDF_CHARS = 1_000_000
 
@@ -78,6 +79,11 @@ class RobotCreate(Schema):
         max_length=64,
         description="Joints to fix at a value (rad, m), e.g. a gripper's fingers: "
         '`{"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}`. The robot plans the other joints.',
+    )
+    payload: PayloadRequest | None = Field(
+        default=None,
+        description="The payload the robot carries by default (mass, centre of mass, inertia; as a trajectory "
+        "request's `payload`): requests that give none plan with it.",
     )
     joint_limits: str | dict[str, Any] | None = Field(
         default=None,
