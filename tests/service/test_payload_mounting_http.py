@@ -72,19 +72,19 @@ def test_a_ceiling_mounted_arm_feels_the_floor_arms_gravity_reversed(client):
 
 
 @pytest.mark.parametrize(
-    ("mounting", "field"),
+    ("mounting", "field", "words"),
     [
-        ({"rotation": [[1, 0, 0], [0, 1, 0], [0, 0.5, 1]]}, "mounting.rotation"),
-        ({"rotation": [[1, 0, 0], [0, 1, 0], [0, 0, -1]]}, "mounting.rotation"),
-        ({"orientation": [0.0, 0.0, 0.0, 2.0]}, "mounting.orientation"),
-        ({"orientation": [0.0, 0.0, 0.0, 1.0], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}, "mounting"),
-        ({"position": [0.0, 0.0, 1e7]}, "mounting.position[2]"),
+        ({"rotation": [[1, 0, 0], [0, 1, 0], [0, 0.5, 1]]}, "mounting.rotation", "R^T R differs from the identity by 0.5"),
+        ({"rotation": [[1, 0, 0], [0, 1, 0], [0, 0, -1]]}, "mounting.rotation", "a reflection"),
+        ({"orientation": [0.0, 0.0, 0.0, 2.0]}, "mounting.orientation", "norm 2: not a rotation"),
+        ({"orientation": [0.0, 0.0, 0.0, 1.0], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}, "mounting", "not both"),
+        ({"position": [0.0, 0.0, 1e7]}, "mounting.position[2]", "[-1000, 1000] m"),
     ],
 )
-def test_a_base_pose_that_is_not_a_rotation_is_a_422_naming_the_field(client, mounting, field):
+def test_a_base_pose_that_is_not_a_rotation_is_a_422_naming_the_field(client, mounting, field, words):
     code, problem = _plan(client, mounting=mounting)
     assert code == 422, problem
-    assert [error["field"] for error in problem["errors"]] == [field]
+    assert [error["field"] for error in problem["errors"]] == [field] and words in problem["detail"], problem
 
 
 @pytest.mark.parametrize(
