@@ -123,3 +123,17 @@ def test_unphysical_equipment_is_refused_naming_the_quantity(call, field, words)
     with pytest.raises(equipment.InvalidEquipment) as raised:
         call()
     assert raised.value.field == field and words in raised.value.detail
+
+
+def test_an_equipped_robot_reaches_a_worker_process_whole():
+    """Methods that run in a child process receive the robot pickled."""
+    import pickle
+
+    ur5 = robots.load("ur5")
+    load, base = equipment.payload(2.0, (0.0, 0.05, 0.1)), equipment.mounting(position=(1.0, 2.0, 0.5), orientation=(0.0, 0.0, 1.0, 0.0))
+    sent = equipment.equip(ur5, load, base)
+    received = pickle.loads(pickle.dumps(sent))
+    q, qd, qdd = _states(5)
+    assert np.abs(received.inverse_dynamics(q, qd, qdd) - sent.inverse_dynamics(q, qd, qdd)).max() == 0.0
+    assert received.payload == load and received.mounting == base
+    assert [c.a.tolist() for c in robot_capsules(received)] == [c.a.tolist() for c in robot_capsules(sent)]

@@ -171,3 +171,13 @@ def test_obstacles_are_in_the_world_frame_of_a_moved_base(client):
     assert code == 200 and answer["min_clearance"]["distance"] > 0.5, answer
     code, moved = plan_around((base * pin.SE3(np.eye(3), middle)).translation, mounting=mounting)
     assert code == 422 and moved["link"] == bare["link"] and moved["s"] == pytest.approx(bare["s"], abs=1e-9), moved
+
+
+def test_a_comparison_plans_every_method_with_the_payload(client):
+    payload = {"mass": 2.0, "center_of_mass": [0.0, 0.0, 0.1]}
+    code, alone = _plan(client, payload=payload)
+    assert code == 200, alone
+    body = {"robot": "ur5", "payload": payload, "path": {"waypoints": UR5_WAYPOINTS}, "methods": ["phase_plane"], "timing": HALF_TORQUE}
+    response = client.post("/v1/trajectories/compare", json=body)
+    assert response.status_code == 200, response.text
+    assert response.json()["results"][0]["duration"] == pytest.approx(alone["duration"], rel=1e-12)
