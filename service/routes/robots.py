@@ -16,6 +16,7 @@ from toptraj.robots.limits import LIMIT_KINDS
 from toptraj.robots.upload_options import upload_options
 from toptraj.service.errors import problem_responses
 from toptraj.service.schemas.robots import (
+    PayloadPublic,
     RobotCreate,
     RobotLimits,
     RobotLimitSources,
@@ -46,6 +47,12 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
         limit_sources=RobotLimitSources(**{kind: list(robot.limit_sources.get(kind, ())) for kind in LIMIT_KINDS}),
         locked_joints=robot.locked_joints,
         notes=list(robot.notes),
+        payload=None if robot.payload is None else PayloadPublic(
+            mass=robot.payload.mass,
+            center_of_mass=list(robot.payload.center_of_mass),
+            inertia=np.reshape(robot.payload.inertia, (3, 3)).tolist(),
+            frame=robot.payload.frame or robot.end_effector,
+        ),
     )
 
 

@@ -47,6 +47,15 @@ class RobotLimitSources(BaseModel):
     torque: list[str] = Field(description="Source of each torque limit.")
 
 
+class PayloadPublic(BaseModel):
+    """A payload as the robot carries it."""
+
+    mass: float = Field(description="Mass (kg).")
+    center_of_mass: list[float] = Field(description="Centre of mass [x, y, z] (m) in `frame`.")
+    inertia: list[list[float]] = Field(description="Rotational inertia about the centre of mass, in `frame`'s axes (kg m^2), 3x3.")
+    frame: str = Field(description="The frame holding it.")
+
+
 class RobotPublic(BaseModel):
     """A robot as the service sees it."""
 
@@ -61,6 +70,9 @@ class RobotPublic(BaseModel):
         description="Joints of the URDF fixed at a value (rad, m) and left out of joint_names (grippers)."
     )
     notes: list[str] = Field(description="What was not used or was changed: mesh files, limits not applied.")
+    payload: PayloadPublic | None = Field(
+        default=None, description="The payload the robot carries unless a request gives its own (an upload's option); null: none."
+    )
 
 
 class RobotCreate(Schema):

@@ -140,6 +140,8 @@ def test_an_uploads_default_payload_applies_unless_a_request_gives_its_own(clien
     default = {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0]}
     created = client.post("/v1/robots", json={"name": "lecture_loaded", "urdf": urdf, "payload": default})
     assert created.status_code == 201, created.text
+    described = client.get("/v1/robots/lecture_loaded").json()["payload"]
+    assert described == {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0], "inertia": [[0.0] * 3] * 3, "frame": "hand"}
     catalog = robots.load("lecture_3r")
     path = {"waypoints": [[0.0, 0.2, -0.3], [0.8, -0.4, 0.5]]}
     for payload, expected in ((None, default), ({"mass": 0.0}, None), ({"mass": 0.5}, {"mass": 0.5})):
