@@ -137,3 +137,17 @@ def test_an_equipped_robot_reaches_a_worker_process_whole():
     assert np.abs(received.inverse_dynamics(q, qd, qdd) - sent.inverse_dynamics(q, qd, qdd)).max() == 0.0
     assert received.payload == load and received.mounting == base
     assert [c.a.tolist() for c in robot_capsules(received)] == [c.a.tolist() for c in robot_capsules(sent)]
+
+
+def test_collocations_symbolic_dynamics_see_the_payload_and_the_mounting():
+    """Collocation builds its own dynamics from the model (CasADi): they carry both too."""
+    from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
+
+    ur5 = robots.load("ur5")
+    base = equipment.mounting(rotation=pin.rpy.rpyToMatrix(1.0, 0.4, -0.3), gravity=(0.0, 0.0, -9.81))
+    equipped = equipment.equip(ur5, equipment.payload(MASS, COM, INERTIA), base)
+    function = inverse_dynamics_function(equipped)
+    q, qd, qdd = _states(6, 5)
+    symbolic = np.array([np.asarray(function(*state)).ravel() for state in zip(q, qd, qdd)])
+    assert np.abs(symbolic - equipped.rnea(q, qd, qdd)).max() <= 1e-9
+    assert np.abs(symbolic - ur5.rnea(q, qd, qdd)).max() > 1.0

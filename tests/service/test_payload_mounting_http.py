@@ -183,3 +183,17 @@ def test_a_comparison_plans_every_method_with_the_payload(client):
     response = client.post("/v1/trajectories/compare", json=body)
     assert response.status_code == 200, response.text
     assert response.json()["results"][0]["duration"] == pytest.approx(alone["duration"], rel=1e-12)
+
+
+def test_a_tool_speed_limit_holds_in_the_world_whatever_the_base_pose(client):
+    """A speed is the same in every frame: moving and turning the base changes none, so a motion
+    bound by the tool's speed and the joints' accelerations (not by torques) lasts as long on a
+    wall as on the floor, the tool at its limit in both."""
+    timing = {"constraints": ["velocity", "acceleration"], "limits": {"tool_speed": 0.3}}
+    code, floor = _plan(client, timing=timing)
+    assert code == 200 and floor["peak_utilization"]["tool_speed"] == pytest.approx(1.0, abs=5e-3), floor
+    wall = {"position": [0.5, 1.0, 1.5], "rotation": pin.rpy.rpyToMatrix(np.pi / 2, 0.0, 0.3).tolist()}
+    code, mounted = _plan(client, timing=timing, mounting=wall)
+    assert code == 200, mounted
+    assert mounted["duration"] == pytest.approx(floor["duration"], rel=1e-9)
+    assert mounted["peak_utilization"]["tool_speed"] == pytest.approx(floor["peak_utilization"]["tool_speed"], rel=1e-9)
