@@ -251,7 +251,9 @@ def _build(bare: Robot, payload: Payload | None, mounting: Mounting | None) -> R
     if payload is not None:
         frame_name = payload.frame or bare.end_effector
         if not model.existFrame(frame_name):
-            raise InvalidEquipment(f"payload frame {frame_name[:100]!r} is not a frame of {bare.name}", "frame")
+            frames = [item.name for item in model.frames if item.name != "universe"]
+            shown = ", ".join(repr(item) for item in frames[:60]) + (", ..." if len(frames) > 60 else "")
+            raise InvalidEquipment(f"the payload's frame {frame_name[:100]!r} is not a frame of {bare.name}; its frames are {shown}", "frame")
         frame = model.frames[model.getFrameId(frame_name)]
         body = pin.Inertia(payload.mass, np.array(payload.center_of_mass), np.array(payload.inertia).reshape(3, 3))
         model.appendBodyToJoint(frame.parentJoint, body, frame.placement)

@@ -197,3 +197,9 @@ def test_a_tool_speed_limit_holds_in_the_world_whatever_the_base_pose(client):
     assert code == 200, mounted
     assert mounted["duration"] == pytest.approx(floor["duration"], rel=1e-9)
     assert mounted["peak_utilization"]["tool_speed"] == pytest.approx(floor["peak_utilization"]["tool_speed"], rel=1e-9)
+
+
+def test_a_payload_on_a_frame_the_robot_lacks_is_a_422_listing_its_frames(client):
+    code, problem = _plan(client, payload={"mass": 1.0, "frame": "gripper_tip"})
+    assert code == 422, problem
+    assert "'gripper_tip' is not a frame of ur5" in problem["detail"] and "'tool0'" in problem["detail"]
