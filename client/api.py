@@ -138,11 +138,13 @@ class Client(JobCalls):
         """
         self.request("DELETE", f"/v1/robots/{name}")
 
-    def skeleton(self, name: str, q: Any) -> Skeleton:
+    def skeleton(self, name: str, q: Any, mounting: dict | None = None) -> Skeleton:
         """``POST /v1/robots/{name}/skeleton``: the arm as a stick figure in configurations
-        ``q`` (rad, m; shape (n_configurations, n_dof), at most 1,000 rows)."""
+        ``q`` (rad, m; shape (n_configurations, n_dof), at most 1,000 rows); with ``mounting``
+        (``{"position": [x, y, z], "orientation": [qx, qy, qz, qw]}``), its base placed in the world."""
         rows = np.atleast_2d(np.asarray(q, dtype=float)).tolist()
-        body = self._call("POST", f"/v1/robots/{name}/skeleton", {"q": rows})
+        request: dict[str, Any] = {"q": rows} if mounting is None else {"q": rows, "mounting": dict(mounting)}
+        body = self._call("POST", f"/v1/robots/{name}/skeleton", request)
         return Skeleton(list(body["points"]), np.asarray(body["positions"], dtype=float).reshape(len(rows), -1, 3))
 
     # --- trajectories ----------------------------------------------------------------------

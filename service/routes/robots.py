@@ -130,8 +130,11 @@ def delete_robot(name: str) -> Response:
 )
 def robot_skeleton(name: str, body: SkeletonRequest) -> SkeletonPublic:
     """The world positions (m) of the joint origins and the end effector of robot ``name`` in
-    each configuration of ``q``: the arm as a stick figure, for stroboscopic pictures."""
+    each configuration of ``q``: the arm as a stick figure, for stroboscopic pictures; with a
+    ``mounting``, its base placed in the world."""
     robot = robots.load(name)
+    if body.mounting is not None:
+        robot = robots.equip(robot, mounting=body.mounting.mounting())
     q = np.array(body.q, dtype=float) if len({len(row) for row in body.q}) == 1 else None
     if q is None or q.shape[1] != robot.dof:
         raise InvalidRequest(f"each row of q must hold {robot.dof} values, one per joint of {name} ({', '.join(robot.joint_names)})")

@@ -8,7 +8,7 @@ from pydantic import BaseModel, Field
 
 from toptraj.robots.uploads import MAX_NAME_CHARS, NAME_PATTERN
 from toptraj.service.schemas.common import Schema
-from toptraj.service.schemas.equipment import PayloadRequest
+from toptraj.service.schemas.equipment import MountingRequest, PayloadRequest
 
 MAX_URDF_CHARS = 1_000_000
 
@@ -118,6 +118,9 @@ class SkeletonRequest(Schema):
 
     q: list[Annotated[list[float], Field(min_length=1, max_length=64)]] = Field(
         min_length=1, max_length=MAX_CONFIGURATIONS, description="Joint configurations (rad, m), one row each."
+    )
+    mounting: MountingRequest | None = Field(
+        default=None, description="The base pose in the world, as a trajectory request's `mounting`: positions are then world positions."
     )
 
 

@@ -203,3 +203,13 @@ def test_a_payload_on_a_frame_the_robot_lacks_is_a_422_listing_its_frames(client
     code, problem = _plan(client, payload={"mass": 1.0, "frame": "gripper_tip"})
     assert code == 422, problem
     assert "'gripper_tip' is not a frame of ur5" in problem["detail"] and "'tool0'" in problem["detail"]
+
+
+def test_the_skeleton_of_a_mounted_arm_is_placed_in_the_world(client):
+    q = [UR5_WAYPOINTS[1], UR5_WAYPOINTS[2]]
+    base = pin.SE3(pin.rpy.rpyToMatrix(np.pi, 0.0, 0.5), np.array([0.2, -0.4, 2.0]))
+    bare = client.post("/v1/robots/ur5/skeleton", json={"q": q}).json()["positions"]
+    mounting = {"position": base.translation.tolist(), "rotation": base.rotation.tolist()}
+    moved = client.post("/v1/robots/ur5/skeleton", json={"q": q, "mounting": mounting}).json()["positions"]
+    expected = np.array(bare) @ base.rotation.T + base.translation
+    assert np.abs(np.array(moved) - expected).max() <= 1e-12
