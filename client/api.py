@@ -96,6 +96,7 @@ class Client(JobCalls):
         *,
         locked_joints: dict[str, float] | None = None,
         joint_limits: str | os.PathLike[str] | dict | None = None,
+        payload: dict | None = None,
         timeout: float | None = None,
     ) -> Robot:
         """``POST /v1/robots``: check, build and store a fixed-base arm's URDF.
@@ -108,6 +109,8 @@ class Client(JobCalls):
             joint_limits: Limits in the form of MoveIt's ``joint_limits.yaml``: its text, a
                 ``pathlib.Path`` to it, or the same structure as a dict. Acceleration and jerk
                 limits are taken as given, velocity and effort limits only tighten the URDF's.
+            payload: What the robot carries unless a request gives its own: ``{"mass": kg,
+                "center_of_mass": [x, y, z], "inertia": [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]}`` (m, kg m^2).
             timeout: Seconds to wait for this answer instead of the client's.
 
         Returns:
@@ -123,6 +126,8 @@ class Client(JobCalls):
             body["locked_joints"] = dict(locked_joints)
         if joint_limits is not None:
             body["joint_limits"] = joint_limits if isinstance(joint_limits, dict) else _text(joint_limits)
+        if payload is not None:
+            body["payload"] = dict(payload)
         return Robot.from_body(self._call("POST", "/v1/robots", body, timeout=timeout))
 
     def delete_robot(self, name: str) -> None:
@@ -133,11 +138,13 @@ class Client(JobCalls):
         """
         self.request("DELETE", f"/v1/robots/{name}")
 
-    def skeleton(self, name: str, q: Any) -> Skeleton:
+    def skeleton(self, name: str, q: Any, mounting: dict | None = None) -> Skeleton:
         """``POST /v1/robots/{name}/skeleton``: the arm as a stick figure in configurations
-        ``q`` (rad, m; shape (n_configurations, n_dof), at most 1,000 rows)."""
+        ``q`` (rad, m; shape (n_configurations, n_dof), at most 1,000 rows); with ``mounting``
+        (``{"position": [x, y, z], "orientation": [qx, qy, qz, qw]}``), its base placed in the world."""
         rows = np.atleast_2d(np.asarray(q, dtype=float)).tolist()
-        body = self._call("POST", f"/v1/robots/{name}/skeleton", {"q": rows})
+        request: dict[str, Any] = {"q": rows} if mounting is None else {"q": rows, "mounting": dict(mounting)}
+        body = self._call("POST", f"/v1/robots/{name}/skeleton", request)
         return Skeleton(list(body["points"]), np.asarray(body["positions"], dtype=float).reshape(len(rows), -1, 3))
 
     # --- trajectories ----------------------------------------------------------------------

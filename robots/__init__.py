@@ -1,6 +1,7 @@
 """Robots: the catalog (bundled paper arms, example-robot-data arms), uploads and ``Robot``."""
 
 from toptraj.robots.catalog import catalog_names
+from toptraj.robots.equipment import InvalidEquipment, Mounting, Payload, equip
 from toptraj.robots.errors import (
     CatalogRobotReadOnly,
     InvalidLimits,
@@ -21,10 +22,13 @@ from toptraj.robots.uploads import configure_uploads, delete_upload, list_upload
 __all__ = [
     "LIMIT_KINDS",
     "CatalogRobotReadOnly",
+    "InvalidEquipment",
     "InvalidLimits",
     "InvalidRobotName",
     "InvalidURDF",
     "JointLimits",
+    "Mounting",
+    "Payload",
     "ToolSpeedLimit",
     "Robot",
     "RobotConflict",
@@ -38,6 +42,7 @@ __all__ = [
     "configure_uploads",
     "default_data_dir",
     "delete_upload",
+    "equip",
     "list_uploads",
     "load",
     "register_urdf",

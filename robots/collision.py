@@ -157,13 +157,27 @@ _CATALOG_CAPSULES: dict[str, list[LinkCapsule]] = {}
 
 def robot_capsules(robot) -> list[LinkCapsule]:
     """The capsules of ``robot`` (a ``robots.Robot``), built once per catalog robot: from the
-    collision meshes of example-robot-data's arms, else along the links (``LINK_RADIUS``)."""
+    collision meshes of example-robot-data's arms, else along the links (``LINK_RADIUS``); those
+    of the fixed base placed by the robot's mounting."""
     cached = _CATALOG_CAPSULES.get(robot.name) if robot.source != "upload" else None
     if cached is not None:
-        return cached
+        return _mounted(cached, robot.mounting)
     capsules = _example_arm_capsules(robot.name) if robot.source == "example-robot-data" else None
     if capsules is None:
         capsules = skeleton_capsules(robot.model, robot.frame_id(robot.end_effector))
     if robot.source != "upload":
         _CATALOG_CAPSULES[robot.name] = capsules
-    return capsules
+    return _mounted(capsules, robot.mounting)
+
+
+def _mounted(capsules: list[LinkCapsule], mounting) -> list[LinkCapsule]:
+    """``capsules`` with those of the fixed base (joint 0, the world) moved by the base pose of
+    ``mounting`` (a ``toptraj.robots.equipment.Mounting``; ``None``: as they are)."""
+    if mounting is None:
+        return capsules
+    rotation = np.array(mounting.rotation, dtype=float).reshape(3, 3)
+    position = np.array(mounting.position, dtype=float)
+    return [
+        LinkCapsule(c.name, 0, rotation @ c.a + position, rotation @ c.b + position, c.radius) if c.joint == 0 else c
+        for c in capsules
+    ]

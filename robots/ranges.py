@@ -64,3 +64,17 @@ def limit_problem(kind: str, value: float, joint: str, source: str) -> str | Non
         f"joint {joint!r}: the {kind} limit {value:g} {accepted.unit} from {source} is outside the accepted range "
         f"{accepted.describe()}"
     )
+
+
+#: What a robot carries and how it is mounted (``toptraj.robots.equipment``): one range per quantity.
+#: A payload's mass: none to a heavy-duty arm's rated load.
+PAYLOAD_MASS = Range(0.0, 1e3, "kg")
+#: Each coordinate of a payload's centre of mass in its frame (signed): a tool is within a few metres.
+CENTER_OF_MASS = Range(0.0, 10.0, "m")
+#: Each entry of a payload's rotational inertia about its centre of mass (principal moments in
+#: [0, high], products of inertia in [-high, high]): a 1,000 kg box 3 m wide holds 1.5e3 kg m^2.
+PAYLOAD_INERTIA = Range(0.0, 1e4, "kg m^2")
+#: Each coordinate of a robot's base in the world (signed).
+BASE_POSITION = Range(0.0, 1e3, "m")
+#: Each component of the gravity vector in the world (signed): 0 (space) to 10 g.
+GRAVITY = Range(0.0, 100.0, "m/s^2")

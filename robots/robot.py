@@ -11,6 +11,7 @@ from __future__ import annotations
 import threading
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -18,6 +19,9 @@ import pinocchio as pin
 from toptraj.robots.chain import Chain, chain_of
 from toptraj.robots.chain_dynamics import chain_rnea
 from toptraj.robots.limits import JointLimits
+
+if TYPE_CHECKING:
+    from toptraj.robots.equipment import Mounting, Payload
 
 
 def _is_continuous(joint) -> bool:
@@ -55,6 +59,10 @@ class Robot:
             "limits.toml", "joint_limits.yaml", "default: ..."); empty when not recorded.
         locked_joints: Joints of the URDF fixed at a value (rad, m), not among ``joint_names``.
         notes: What a user of the robot should know (ignored meshes, limits not applied).
+        payload: What the model carries at its tool (``toptraj.robots.equipment``), ``None``: nothing.
+        mounting: The base pose in the world and the world's gravity written into the model,
+            ``None``: the base frame is the world.
+        bare: The robot without payload and mounting when this one has either, else ``None``.
     """
 
     name: str
@@ -75,6 +83,9 @@ class Robot:
     limit_sources: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False, compare=False)
     locked_joints: dict[str, float] = field(default_factory=dict, repr=False, compare=False)
     notes: tuple[str, ...] = field(default=(), repr=False, compare=False)
+    payload: Payload | None = field(default=None, compare=False)
+    mounting: Mounting | None = field(default=None, compare=False)
+    bare: Robot | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def from_model(
@@ -87,8 +98,12 @@ class Robot:
         limit_sources: dict[str, tuple[str, ...]] | None = None,
         locked_joints: dict[str, float] | None = None,
         notes: tuple[str, ...] = (),
+        payload: Payload | None = None,
+        mounting: Mounting | None = None,
+        bare: Robot | None = None,
     ) -> Robot:
-        """Wrap ``model``, precomputing the map from tangent coordinates to Pinocchio's q."""
+        """Wrap ``model``, precomputing the map from tangent coordinates to Pinocchio's q
+        (``payload``, ``mounting`` and ``bare``: what ``toptraj.robots.equipment.equip`` wrote into it)."""
         cos_index: list[int] = []
         pair_angle: list[int] = []
         plain_q: list[int] = []
@@ -120,13 +135,17 @@ class Robot:
             limit_sources=dict(limit_sources or {}),
             locked_joints=dict(locked_joints or {}),
             notes=tuple(notes),
+            payload=payload,
+            mounting=mounting,
+            bare=bare,
         )
 
     def __reduce__(self):
         """Pickled as its model and metadata (the per-thread workspaces are rebuilt), so that a
         robot can be sent to a worker process."""
         return Robot.from_model, (
-            self.name, self.model, self.source, self.end_effector, self.limits, self.limit_sources, self.locked_joints, self.notes
+            self.name, self.model, self.source, self.end_effector, self.limits, self.limit_sources, self.locked_joints, self.notes,
+            self.payload, self.mounting, self.bare,
         )
 
     @cached_property

@@ -32,6 +32,7 @@ value outside the joint's range, a limit outside its accepted range or a malform
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
@@ -41,6 +42,7 @@ import pinocchio as pin
 import yaml
 
 from toptraj.robots import bounded_yaml
+from toptraj.robots.equipment import Payload
 from toptraj.robots.errors import ToptrajError, excerpt
 from toptraj.robots.ranges import limit_problem
 
@@ -68,25 +70,27 @@ class UploadOptions:
         joint_limits: {joint name: {kind: value}}, kinds among velocity, acceleration, jerk,
             torque (rad/s, rad/s^2, rad/s^3, N m; m/s..., N for prismatic joints).
         notes: What the file gave that is not applied (position limits, scaling factors).
+        payload: The payload the robot carries unless a request gives its own
+            (``toptraj.robots.equipment.Payload``), ``None``: none.
     """
 
     locked_joints: dict[str, float] = field(default_factory=dict)
     joint_limits: dict[str, dict[str, float]] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    payload: Payload | None = None
 
     def __bool__(self) -> bool:
-        return bool(self.locked_joints or self.joint_limits or self.notes)
+        return bool(self.locked_joints or self.joint_limits or self.notes or self.payload)
 
     def to_json(self) -> str:
         """Canonical JSON for the store ("" for no options, what records stored before options
         existed hold)."""
         if not self:
             return ""
-        return json.dumps(
-            {"locked_joints": self.locked_joints, "joint_limits": self.joint_limits, "notes": list(self.notes)},
-            sort_keys=True,
-            separators=(",", ":"),
-        )
+        written: dict = {"locked_joints": self.locked_joints, "joint_limits": self.joint_limits, "notes": list(self.notes)}
+        if self.payload is not None:
+            written["payload"] = dataclasses.asdict(self.payload)
+        return json.dumps(written, sort_keys=True, separators=(",", ":"))
 
     @classmethod
     def from_json(cls, text: str | None) -> UploadOptions:
@@ -94,7 +98,13 @@ class UploadOptions:
         if not text:
             return cls()
         data = json.loads(text)
-        return cls(dict(data.get("locked_joints", {})), dict(data.get("joint_limits", {})), tuple(data.get("notes", ())))
+        held = data.get("payload")
+        payload = None if held is None else Payload(
+            held["mass"], tuple(held["center_of_mass"]), tuple(held["inertia"]), held.get("frame")
+        )
+        return cls(
+            dict(data.get("locked_joints", {})), dict(data.get("joint_limits", {})), tuple(data.get("notes", ())), payload
+        )
 
 
 def _short(name) -> str:
@@ -198,9 +208,10 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
     return limits, notes
 
 
-def upload_options(locked_joints: dict | None = None, joint_limits=None) -> UploadOptions:
+def upload_options(locked_joints: dict | None = None, joint_limits=None, payload: Payload | None = None) -> UploadOptions:
     """Options from an upload request, checked for form (names are checked against the model
-    by ``apply_locks`` and ``toptraj.robots.limits``).
+    by ``apply_locks`` and ``toptraj.robots.limits``); ``payload`` (checked by
+    ``toptraj.robots.equipment.payload``) is the robot's default payload.
 
     Raises:
         InvalidUpload: a non-finite locked value, or a malformed joint_limits.
@@ -209,7 +220,7 @@ def upload_options(locked_joints: dict | None = None, joint_limits=None) -> Uplo
     for joint, value in (locked_joints or {}).items():
         locked[str(joint)] = _number(value, f"locked_joints.{_short(joint)}")
     limits, notes = ({}, []) if joint_limits is None else _joint_limits(joint_limits)
-    return UploadOptions(locked, limits, tuple(notes))
+    return UploadOptions(locked, limits, tuple(notes), payload if payload is not None and payload.mass > 0.0 else None)
 
 
 def _moving_joints(model: pin.Model) -> dict[str, int]:

@@ -20,6 +20,7 @@ from collections import OrderedDict
 from pathlib import Path
 
 from toptraj.robots.catalog import catalog_names, is_catalog_robot, robot_from_model
+from toptraj.robots.equipment import InvalidEquipment, equip
 from toptraj.robots.errors import (
     CatalogRobotReadOnly,
     InvalidLimits,
@@ -120,6 +121,7 @@ def build_upload(name: str, urdf: str, options: UploadOptions) -> Robot:
     Raises:
         InvalidURDF: the text is not a usable fixed-base arm.
         InvalidUpload: the options do not fit the URDF.
+        InvalidEquipment: the default payload's frame is not a frame of the robot.
         InvalidLimits: a limit outside the accepted range of its kind (``toptraj.robots.ranges``).
     """
     full = check_urdf(urdf)
@@ -134,7 +136,8 @@ def build_upload(name: str, urdf: str, options: UploadOptions) -> Robot:
         )
     if options.locked_joints:
         notes.append("joints locked: " + ", ".join(f"{joint} = {value:g}" for joint, value in options.locked_joints.items()))
-    return robot_from_model(name, model, "upload", None, given, options.locked_joints, tuple(notes))
+    robot = robot_from_model(name, model, "upload", None, given, options.locked_joints, tuple(notes))
+    return robot if options.payload is None else equip(robot, options.payload)
 
 
 def _build(name: str, key: tuple[str, str], urdf: str) -> Robot:
@@ -165,7 +168,7 @@ def load_upload(name: str) -> Robot | None:
     digest, urdf, options = stored
     try:
         return _build(name, (digest, options), urdf)
-    except (InvalidURDF, InvalidUpload, InvalidLimits) as error:
+    except (InvalidURDF, InvalidUpload, InvalidLimits, InvalidEquipment) as error:
         raise InvalidURDF(f"the stored upload {excerpt(name)} no longer passes the checks: {error.detail}") from None
 
 

@@ -22,6 +22,7 @@ from toptraj.planners.problem.build import DEFAULT_CLEARANCE, MAX_SAMPLES
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
+from toptraj.service.equipping import equipped_robot, payload_named
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
 from toptraj.service.problems import detail, non_finite_answer, note_text, status_of, title_of
 from toptraj.service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
@@ -140,7 +141,7 @@ def plan_request(
     ``dt`` that fits). ``accept`` (the HTTP Accept header) may choose CSV, which puts the samples
     on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
     (``toptraj.planners.generators.search.memory``)."""
-    robot = robots.load(request.robot)
+    robot = equipped_robot(request)
     timing = _timing(request)
     if timing.method == "search":
         timing = dataclasses.replace(timing, search=dataclasses.replace(timing.search or SearchOptions(), memory_bytes=search_memory_bytes))
@@ -149,6 +150,13 @@ def plan_request(
     output = request.output
     format_ = chosen_format(output.format, accept)
     max_samples = MAX_SAMPLES if max_body_bytes is None else min(MAX_SAMPLES, samples_within(max_body_bytes, robot.dof, format_))
+    with payload_named(robot):
+        return _planned(request, robot, timing, deadline, max_samples, format_)
+
+
+def _planned(request: TrajectoryRequest, robot: robots.Robot, timing: Timing, deadline, max_samples: int, format_: str) -> PlannedTrajectory:
+    """``plan`` on the request's path, obstacles and output for ``robot`` and ``timing``."""
+    output = request.output
     return plan(
         robot,
         _path(request.path, robot, request),
@@ -224,6 +232,8 @@ def method_request(request: CompareRequest, method: str, dt: float = 1.0) -> Tra
     """The trajectory request of one method of a comparison, sampled every ``dt`` seconds."""
     return TrajectoryRequest(
         robot=request.robot,
+        payload=request.payload,
+        mounting=request.mounting,
         path=request.path,
         timing=request.timing.model_copy(update={"method": method}),
         output=OutputRequest(dt=dt),

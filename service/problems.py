@@ -163,6 +163,12 @@ def detail(error: ToptrajError) -> str:
             f": holding still at s = {held.s:.4f} needs {held.torque:.4g} N m on joint {held.joint!r}, "
             f"above its limit of {held.limit:.4g} N m"
         )
+    carried = getattr(error, "payload_carried", None)
+    if carried is not None:
+        text += (
+            f"; the torques include the payload of {carried[0]:g} kg at {carried[1]}: a lighter payload "
+            "(payload.mass) or higher torque limits (timing.limits.torque) may make the path feasible"
+        )
     return _cut(text)
 
 

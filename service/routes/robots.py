@@ -16,6 +16,7 @@ from toptraj.robots.upload_options import upload_options
 from toptraj.service.problem_docs import problem_responses
 from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.robots import (
+    PayloadPublic,
     RobotCreate,
     RobotLimits,
     RobotLimitSources,
@@ -46,6 +47,12 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
         limit_sources=RobotLimitSources(**{kind: list(robot.limit_sources.get(kind, ())) for kind in LIMIT_KINDS}),
         locked_joints=robot.locked_joints,
         notes=list(robot.notes),
+        payload=None if robot.payload is None else PayloadPublic(
+            mass=robot.payload.mass,
+            center_of_mass=list(robot.payload.center_of_mass),
+            inertia=np.reshape(robot.payload.inertia, (3, 3)).tolist(),
+            frame=robot.payload.frame or robot.end_effector,
+        ),
     )
 
 
@@ -94,7 +101,7 @@ async def upload_robot(body: RobotCreate) -> RobotPublic:
 def _register(body: RobotCreate) -> robots.Robot:
     """Read the options (YAML within its bounds) and store the upload: in a worker thread, so
     that neither the parse nor the build holds the event loop."""
-    options = upload_options(body.locked_joints, body.joint_limits)
+    options = upload_options(body.locked_joints, body.joint_limits, None if body.payload is None else body.payload.payload())
     return robots.register_urdf(body.urdf, body.name, options)
 
 
@@ -123,8 +130,11 @@ def delete_robot(name: str) -> Response:
 )
 def robot_skeleton(name: str, body: SkeletonRequest) -> SkeletonPublic:
     """The world positions (m) of the joint origins and the end effector of robot ``name`` in
-    each configuration of ``q``: the arm as a stick figure, for stroboscopic pictures."""
+    each configuration of ``q``: the arm as a stick figure, for stroboscopic pictures; with a
+    ``mounting``, its base placed in the world."""
     robot = robots.load(name)
+    if body.mounting is not None:
+        robot = robots.equip(robot, mounting=body.mounting.mounting())
     q = np.array(body.q, dtype=float) if len({len(row) for row in body.q}) == 1 else None
     if q is None or q.shape[1] != robot.dof:
         raise RequestRefused(f"each row of q must hold {robot.dof} values, one per joint of {name} ({', '.join(robot.joint_names)})")

@@ -18,6 +18,7 @@ SUMMARIES = {
     "ur5_jerk_limited": "ur5: the spline example under a jerk limit too (jerk_limited)",
     "compare_methods": "several methods on one path",
     "ur5_spline_obstacles": "ur5: the spline example above a table and beside a pole, keeping 2 cm of clearance (min_clearance in the answer)",
+    "ur5_ceiling_payload": "ur5 hanging from the ceiling with a 2.5 kg tool: the spline example, torques with the payload and gravity as the base feels it",
     "geering_search_obstacle": "Geering's arm around a sphere: the global search among obstacles, then local optimization (tens of seconds; see /v1/jobs)",
 }
 

@@ -8,6 +8,7 @@ from pydantic import BaseModel, Field
 
 from toptraj.robots.uploads import MAX_NAME_CHARS, NAME_PATTERN
 from toptraj.service.schemas.common import Schema
+from toptraj.service.schemas.equipment import MountingRequest, PayloadRequest
 
 MAX_URDF_CHARS = 1_000_000
 
@@ -46,6 +47,15 @@ class RobotLimitSources(BaseModel):
     torque: list[str] = Field(description="Source of each torque limit.")
 
 
+class PayloadPublic(BaseModel):
+    """A payload as the robot carries it."""
+
+    mass: float = Field(description="Mass (kg).")
+    center_of_mass: list[float] = Field(description="Centre of mass [x, y, z] (m) in `frame`.")
+    inertia: list[list[float]] = Field(description="Rotational inertia about the centre of mass, in `frame`'s axes (kg m^2), 3x3.")
+    frame: str = Field(description="The frame holding it.")
+
+
 class RobotPublic(BaseModel):
     """A robot as the service sees it."""
 
@@ -60,6 +70,9 @@ class RobotPublic(BaseModel):
         description="Joints of the URDF fixed at a value (rad, m) and left out of joint_names (grippers)."
     )
     notes: list[str] = Field(description="What was not used or was changed: mesh files, limits not applied.")
+    payload: PayloadPublic | None = Field(
+        default=None, description="The payload the robot carries unless a request gives its own (an upload's option); null: none."
+    )
 
 
 class RobotCreate(Schema):
@@ -78,6 +91,11 @@ class RobotCreate(Schema):
         max_length=64,
         description="Joints to fix at a value (rad, m), e.g. a gripper's fingers: "
         '`{"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}`. The robot plans the other joints.',
+    )
+    payload: PayloadRequest | None = Field(
+        default=None,
+        description="The payload the robot carries by default (mass, centre of mass, inertia; as a trajectory "
+        "request's `payload`): requests that give none plan with it.",
     )
     joint_limits: str | dict[str, Any] | None = Field(
         default=None,
@@ -100,6 +118,9 @@ class SkeletonRequest(Schema):
 
     q: list[Annotated[list[float], Field(min_length=1, max_length=64)]] = Field(
         min_length=1, max_length=MAX_CONFIGURATIONS, description="Joint configurations (rad, m), one row each."
+    )
+    mounting: MountingRequest | None = Field(
+        default=None, description="The base pose in the world, as a trajectory request's `mounting`: positions are then world positions."
     )
 
 

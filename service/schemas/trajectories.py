@@ -11,6 +11,7 @@ from toptraj.planners.problem import ranges
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
 from toptraj.service.schemas.common import Schema, bounded, signed
+from toptraj.service.schemas.equipment import MOUNTING, PAYLOAD, MountingRequest, PayloadRequest
 
 MAX_WAYPOINTS = 1_000
 MAX_JOINTS = 64
@@ -350,6 +351,8 @@ class TrajectoryRequest(Schema):
     """A motion to plan."""
 
     robot: Name = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
+    payload: PayloadRequest | None = PAYLOAD
+    mounting: MountingRequest | None = MOUNTING
     path: PathRequest = Field(
         description="The geometric path: waypoints, a Cartesian line, or a free start and goal; `kind` says which.",
         json_schema_extra={"discriminator": PATH_DISCRIMINATOR},
@@ -362,6 +365,8 @@ class CompareRequest(Schema):
     """One path under several timing methods."""
 
     robot: Name = Field(description="Catalog or uploaded robot name, e.g. `ur5`.")
+    payload: PayloadRequest | None = PAYLOAD
+    mounting: MountingRequest | None = MOUNTING
     path: PathRequest = Field(
         description="The path, as in POST /v1/trajectories.", json_schema_extra={"discriminator": PATH_DISCRIMINATOR}
     )

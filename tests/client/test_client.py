@@ -145,6 +145,8 @@ def test_robots_list_describe_and_draw(toptraj):
     assert figure.points[-1] == "tool0" and figure.positions.shape == (2, 7, 3)
     np.testing.assert_allclose(figure.positions[0, -1], [0.425 + 0.39225, 0.10915 + 0.0823, 0.089159 - 0.09465], atol=1e-8)
     assert not np.allclose(figure.positions[1, -1], figure.positions[0, -1])
+    hanging = toptraj.skeleton("ur5", [[0.0] * 6], mounting={"position": [0.0, 0.0, 2.0], "orientation": [1.0, 0.0, 0.0, 0.0]})
+    np.testing.assert_allclose(hanging.positions[0], figure.positions[0] * [1.0, -1.0, -1.0] + [0.0, 0.0, 2.0], atol=1e-12)
 
 
 def test_upload_with_its_options_then_delete(toptraj):

@@ -108,9 +108,13 @@ def _chain_tables(robot: Robot):
             np.array([c.radius for c in capsules], dtype=float),
         )
     _TABLES[id(robot)] = (robot, tables)
+    while len(_TABLES) > MAX_TABLES:  # a robot per payload and mounting: keep the most recent
+        del _TABLES[next(iter(_TABLES))]
     return tables
 
 
+#: Robots whose tables are kept (each table holds its robot, whose id is the key).
+MAX_TABLES = 64
 _TABLES: dict[int, tuple] = {}
 
 

@@ -1,0 +1,118 @@
+"""Schemas of what a robot carries (``payload``) and how it is mounted (``mounting``), beside
+``robot`` in a trajectory or comparison request; an upload may give a default payload. The rules
+(ranges, a physical inertia, a rotation) are ``toptraj.robots.equipment``'s, checked here so that
+a 422 names the field."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from pydantic import Field, field_validator, model_validator
+
+from toptraj.robots import equipment
+from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS
+from toptraj.service.schemas.common import Schema, bounded, signed
+
+_Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+_Row = Annotated[list[float], Field(min_length=3, max_length=3)]
+
+
+def _checked(check, *args, **kwargs):
+    """``check(*args, **kwargs)``, its ``InvalidEquipment`` as the ``ValueError`` pydantic reports
+    at the field being validated."""
+    try:
+        return check(*args, **kwargs)
+    except equipment.InvalidEquipment as error:
+        raise ValueError(error.detail) from None
+
+
+class PayloadRequest(Schema):
+    """A rigid body held at the tool: its mass, centre of mass and, optionally, rotational
+    inertia. Torques, torque limits and `tau` include it."""
+
+    mass: Annotated[float, bounded(PAYLOAD_MASS)] = Field(description="Mass (kg); 0 is no payload.")
+    center_of_mass: Annotated[list[Annotated[float, signed(CENTER_OF_MASS)]], Field(min_length=3, max_length=3)] = Field(
+        default=[0.0, 0.0, 0.0], description="Centre of mass [x, y, z] (m) in the payload's frame."
+    )
+    inertia: (
+        Annotated[list[Annotated[float, signed(PAYLOAD_INERTIA)]], Field(min_length=6, max_length=6)]
+        | Annotated[list[_Row], Field(min_length=3, max_length=3)]
+        | None
+    ) = Field(
+        default=None,
+        description="Rotational inertia about the centre of mass in the frame's axes (kg m^2): 6 values "
+        "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a symmetric 3x3 matrix, positive definite, its principal moments "
+        "each at most the sum of the other two; left out, a point mass.",
+    )
+    frame: Annotated[str, Field(max_length=256)] | None = Field(
+        default=None, description="Frame holding the payload (its centre of mass and inertia are in it); default the robot's end effector."
+    )
+
+    @field_validator("inertia")
+    @classmethod
+    def _physical(cls, value):
+        if value is not None:
+            _checked(equipment.inertia_matrix, value)
+        return value
+
+    def payload(self) -> equipment.Payload:
+        """The library's ``Payload``."""
+        return equipment.payload(self.mass, self.center_of_mass, self.inertia, self.frame)
+
+
+class MountingRequest(Schema):
+    """The robot's base in the world (floor, wall or ceiling mounting) and the world's gravity.
+    Obstacles, Cartesian positions and poses are then in the world frame; torques follow the
+    gravity as the base feels it."""
+
+    position: Annotated[list[Annotated[float, signed(BASE_POSITION)]], Field(min_length=3, max_length=3)] = Field(
+        default=[0.0, 0.0, 0.0], description="The base frame's origin [x, y, z] in the world (m)."
+    )
+    orientation: Annotated[list[float], Field(min_length=4, max_length=4)] | None = Field(
+        default=None,
+        description="The base frame's orientation in the world as a unit quaternion [qx, qy, qz, qw] (norm 1 "
+        "within 1e-3); a ceiling mount is [1, 0, 0, 0]. Give this or rotation; default the identity.",
+    )
+    rotation: Annotated[list[_Row], Field(min_length=3, max_length=3)] | None = Field(
+        default=None,
+        description="The base frame's orientation as a 3x3 rotation matrix, base axes to world axes (orthonormal "
+        "within 1e-6, determinant +1). Give this or orientation.",
+    )
+    gravity: Annotated[list[Annotated[float, signed(GRAVITY)]], Field(min_length=3, max_length=3)] | None = Field(
+        default=None, description="Gravity in the world (m/s^2); default the robot's own, [0, 0, -9.81] for the catalog arms."
+    )
+
+    @field_validator("orientation")
+    @classmethod
+    def _unit(cls, value):
+        if value is not None:
+            _checked(equipment.rotation_matrix, orientation=value)
+        return value
+
+    @field_validator("rotation")
+    @classmethod
+    def _rotation(cls, value):
+        if value is not None:
+            _checked(equipment.rotation_matrix, rotation=value)
+        return value
+
+    @model_validator(mode="after")
+    def _one_rotation(self):
+        if self.orientation is not None and self.rotation is not None:
+            raise ValueError("give mounting.orientation or mounting.rotation, not both")
+        return self
+
+    def mounting(self) -> equipment.Mounting:
+        """The library's ``Mounting``."""
+        return equipment.mounting(self.position, self.rotation, self.orientation, self.gravity)
+
+
+PAYLOAD = Field(
+    default=None,
+    description="What the robot carries at its tool (mass, centre of mass, inertia): torques, torque limits, "
+    "`tau` and peak utilization include it; default the upload's payload, else none.",
+)
+MOUNTING = Field(
+    default=None,
+    description="The base pose in the world and the world's gravity; default the base at the world's origin.",
+)
