@@ -17,6 +17,7 @@ from toptraj.planners.collision import Obstacle, check_clearance
 from toptraj.planners.collision.obstacles import check_obstacles
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.tool_speed import tool_speed_limit
+from toptraj.planners.constraints.zones import BINDING_SHARE
 from toptraj.planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.collocation import FreeMotion
@@ -28,7 +29,8 @@ from toptraj.planners.paths.grid import MAX_POINTS, spread_indices
 from toptraj.planners.problem.ranges import DT, check_scaled_limits, check_timing
 from toptraj.planners.problem.requests import Timing, WaypointPath, check_constraint_kinds, timing_method
 from toptraj.planners.problem.waypoints import continuous_turns, make_path, without_repeats
-from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
+from toptraj.planners.problem.zones import check_zones, check_zones_served, zone_limits
+from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, ZoneReport, require_finite
 from toptraj.planners.runner.accuracy import answer_accuracy
 from toptraj.planners.runner.given_path import timed_path, timed_unsynchronized, timed_via_points
 from toptraj.planners.runner.timed_free import timed_free_motion, timed_search
@@ -37,7 +39,7 @@ from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.planners.trajectory import sample_trajectory
-from toptraj.robots import JointLimits, Robot
+from toptraj.robots import JointLimits, Robot, ToolSpeedLimit
 
 MAX_SAMPLES = 200_000
 #: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
@@ -68,6 +70,41 @@ def _check_tool_limit_served(path_spec, method: TimingMethod) -> None:
             "timing.limits.tool_speed and tool_angular_speed are not served with interpolation 'via' "
             "(its segments are shaped by their time laws); use 'spline' or 'linear'"
         )
+
+
+def _tool_limit(robot: Robot, path_spec, method: TimingMethod, timing: Timing) -> ToolSpeedLimit | None:
+    """The request's tool limit; with zones (checked, and refused where not served) that limit
+    the tool's speed, the tool frame's limit even without a speed of its own."""
+    tool = tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
+    if not timing.zones:
+        return tool
+    check_zones(timing.zones)
+    given = not isinstance(path_spec, FreeMotion) and timing.synchronization != "none" and not (
+        isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via"
+    )
+    check_zones_served(method.name, given)
+    if tool is None and any(zone.tool_speed is not None for zone in timing.zones):
+        tool = tool_speed_limit(robot, timing.tool_frame, math.inf, None)
+    return tool
+
+
+def _with_zones(robot: Robot, path, timing: Timing, limits: JointLimits, margin: float, deadline: Deadline) -> JointLimits:
+    """``limits`` with the request's zones located on ``path`` (a region where the tool frame's
+    origin, the end effector's without a tool limit, lies in it), tightened by ``margin``."""
+    if not timing.zones:
+        return limits
+    frame_id = robot.frame_id(robot.end_effector) if limits.tool is None else limits.tool.frame_id
+    zones = zone_limits(robot, path, timing.zones, frame_id, deadline)
+    return dataclasses.replace(limits, zones=tuple(zone.tightened(margin) for zone in zones))
+
+
+def _zone_reports(zones, stretches_: tuple[TimedStretch, ...]) -> tuple[ZoneReport, ...]:
+    """Where each zone lies and its peak inside over every stretch (``ZoneReport``)."""
+    reports = []
+    for zone in zones:
+        peak = max((item.check.zones.get(zone.index, 0.0) for item in stretches_), default=0.0)
+        reports.append(ZoneReport(zone.index, zone.ranges, peak, peak >= BINDING_SHARE))
+    return tuple(reports)
 
 
 def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -177,7 +214,7 @@ def plan(
         raise InvalidRequest(f"timing.limit_margin must lie in [0, {MAX_LIMIT_MARGIN}], got {margin}")
     check_scaled_limits(robot.limits.with_request(timing.limit_overrides), timing.limit_scales, robot.joint_names)
     requested: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
-    tool = tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
+    tool = _tool_limit(robot, path_spec, method, timing)
     if tool is not None:
         _check_tool_limit_served(path_spec, method)
         requested = dataclasses.replace(requested, tool=tool)
@@ -216,6 +253,7 @@ def plan(
         else:
             timing_part.progress(0.0, "path")
             path = make_path(robot, path_spec, deadline)
+            limits = _with_zones(robot, path, timing, limits, margin, deadline)
             if obstacles:
                 timing_part.progress(0.05, "clearance")
                 checked_first = check_clearance(path, robot, list(obstacles), clearance, deadline)
@@ -309,6 +347,7 @@ def plan(
         clearance=found_clearance,
         search=timed.search,
         accuracy=accuracy,
+        zones=_zone_reports(limits.zones, timed.stretches) if timing.zones else None,
     )
 
 

@@ -12,6 +12,7 @@ from toptraj.planners.constraints.path_constraints import CONSTRAINT_KINDS
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.method import SearchMethod
+from toptraj.planners.problem.zones import Zone
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.collocation_method import CollocationMethod
@@ -79,6 +80,8 @@ class Timing:
         tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
         search: Options of the global search (``timing.method = "search"``); ``None``: the
             defaults of ``toptraj.planners.generators.search.SearchOptions``.
+        zones: Limits of their own on parts of the path (``toptraj.planners.problem.zones.Zone``),
+            at most ``MAX_ZONES``; the robot's hold elsewhere.
     """
 
     method: str = "phase_plane"
@@ -101,6 +104,7 @@ class Timing:
     tool_angular_speed: float | None = None
     tool_frame: str | None = None
     search: SearchOptions | None = None
+    zones: tuple[Zone, ...] = ()
 
 
 def check_constraint_kinds(kinds, method: TimingMethod) -> tuple[str, ...]:
