@@ -136,20 +136,21 @@ def _zoned(limits: JointLimits, s: np.ndarray, values: dict, limit_of: dict, spe
     """Divide ``values`` (per kind, (n, k) at the states ``s``) in place by the zones' factors at
     each state, so that the robot's limits in ``limit_of`` stand for those in force there; the
     tool's linear speed becomes its share of the speed in force (limit 1). Returns the zones'
-    peaks (``toptraj.planners.constraints.zones.zone_peaks``)."""
+    peaks against their own limits (``toptraj.planners.constraints.zones.zone_peaks``)."""
+    robot_ratios = {}
+    for kind in ("velocity", "acceleration", "torque"):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.abs(values[kind]) / np.asarray(limit_of[kind], dtype=float)
+        robot_ratios[kind] = np.nan_to_num(ratio, nan=0.0, posinf=np.inf).max(axis=1, initial=0.0)
     factors = zone_factors(limits.zones, s)
     for kind, factor in (("velocity", factors.velocity), ("acceleration", factors.acceleration), ("torque", factors.torque)):
         values[kind] = values[kind] / factor[:, None]
     if speeds is not None and has_tool_zone(limits):
+        robot_ratios["tool_speed"] = speeds[:, 0]  # m/s: against each zone's own speed
         with np.errstate(divide="ignore", invalid="ignore"):
             share = speeds[:, 0] / tool_speed_at(limits, s, factors)
         values["tool_speed"], limit_of["tool_speed"] = np.nan_to_num(share, posinf=np.inf)[:, None], np.ones(1)
-    ratios = {}
-    for kind, value in values.items():
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.abs(value) / np.asarray(limit_of[kind], dtype=float)
-        ratios[kind] = np.nan_to_num(ratio, nan=0.0, posinf=np.inf).max(axis=1, initial=0.0)
-    return zone_peaks(limits.zones, s, ratios)
+    return zone_peaks(limits.zones, s, robot_ratios)
 
 
 def check_limits(

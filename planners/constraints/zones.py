@@ -119,15 +119,16 @@ def with_edges(s: np.ndarray, zones: tuple[LimitZone, ...], knots: np.ndarray) -
 
 
 def zone_peaks(zones: tuple[LimitZone, ...], s: np.ndarray, ratios: dict[str, np.ndarray]) -> dict[int, float]:
-    """{zone index: the largest ratio to its limit, inside the zone, of each quantity the zone
-    limits}, from ``ratios``: per kind ("velocity", "acceleration", "torque", "tool_speed"), the
-    |value| / limit in force of every state at ``s`` (n,), shape (n,) (the worst joint)."""
+    """{zone index: the largest ratio, inside the zone, of each quantity the zone limits to the
+    zone's own limit}, from ``ratios`` at the states ``s`` (n,), each (n,): per kind
+    ("velocity", "acceleration", "torque") the worst joint's |value| / the robot's limit, and
+    ("tool_speed") the tool's linear speed in m/s. 1.0: the zone's limit binds there."""
     peaks = {}
     for zone in zones:
         mask = inside(zone, s)
-        limited = [kind for kind, value in (("velocity", zone.velocity), ("acceleration", zone.acceleration),
-                                            ("torque", zone.torque), ("tool_speed", zone.tool_speed))
-                   if (value != 1.0 if kind != "tool_speed" else np.isfinite(value)) and kind in ratios]
-        values = [float(ratios[kind][mask].max()) for kind in limited if mask.any()]
+        limited = [(kind, value) for kind, value in (("velocity", zone.velocity), ("acceleration", zone.acceleration),
+                                                     ("torque", zone.torque), ("tool_speed", zone.tool_speed))
+                   if kind in ratios and (value != 1.0 if kind != "tool_speed" else np.isfinite(value))]
+        values = [float(ratios[kind][mask].max()) / value for kind, value in limited if mask.any()]
         peaks[zone.index] = max(values, default=0.0)
     return peaks
