@@ -98,12 +98,14 @@ def _with_zones(robot: Robot, path, timing: Timing, limits: JointLimits, margin:
     return dataclasses.replace(limits, zones=tuple(zone.tightened(margin) for zone in zones))
 
 
-def _zone_reports(zones, stretches_: tuple[TimedStretch, ...]) -> tuple[ZoneReport, ...]:
-    """Where each zone lies and its peak inside over every stretch (``ZoneReport``)."""
+def _zone_reports(zones, stretches_: tuple[TimedStretch, ...], margin: float) -> tuple[ZoneReport, ...]:
+    """Where each zone lies and its peak inside over every stretch (``ZoneReport``), against its
+    limits as requested (before any margin); it binds where it reaches the limits it was
+    planned under (tightened by the margin)."""
     reports = []
     for zone in zones:
         peak = max((item.check.zones.get(zone.index, 0.0) for item in stretches_), default=0.0)
-        reports.append(ZoneReport(zone.index, zone.ranges, peak, peak >= BINDING_SHARE))
+        reports.append(ZoneReport(zone.index, zone.ranges, (1.0 - margin) * peak, peak >= BINDING_SHARE))
     return tuple(reports)
 
 
@@ -347,7 +349,7 @@ def plan(
         clearance=found_clearance,
         search=timed.search,
         accuracy=accuracy,
-        zones=_zone_reports(limits.zones, timed.stretches) if timing.zones else None,
+        zones=_zone_reports(limits.zones, timed.stretches, margin) if timing.zones else None,
     )
 
 

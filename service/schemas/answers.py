@@ -32,8 +32,9 @@ class PhasePlanePublic(BaseModel):
 
 
 class UtilizationPublic(BaseModel):
-    """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds); jerk
-    for timings with a finite jerk (jerk_limited, time laws, ruckig)."""
+    """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds), against
+    the limit in force at each state (a zone's inside it); jerk for timings with a finite jerk
+    (jerk_limited, time laws, ruckig)."""
 
     velocity: list[float] = Field(description="Peak |qd| / velocity limit per joint.")
     acceleration: list[float] = Field(description="Peak |qdd| / acceleration limit per joint.")
@@ -148,8 +149,8 @@ class ZonePublic(BaseModel):
 
     index: int = Field(description="The zone's place in timing.zones.")
     ranges: list[list[float]] = Field(description="The closed s-ranges [s0, s1] it covers (empty: a region the path never enters).")
-    peak: float = Field(description="Largest ratio inside the zone of a quantity it limits to its limit there (1.0: it binds).")
-    binding: bool = Field(description="Whether its limits bound the timing (peak within 0.5 % of 1).")
+    peak: float = Field(description="Largest ratio inside the zone of a quantity it limits to the zone's own limit (1.0: reached; with timing.limit_margin, against the limit as given).")
+    binding: bool = Field(description="Whether its limits bound the timing (its peak within 0.5 % of the limits it was planned under).")
 
 
 class TrajectoryResponse(BaseModel):
