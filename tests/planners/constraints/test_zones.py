@@ -6,6 +6,8 @@ and reaches the zone's limit there, and exceeds it elsewhere."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -14,10 +16,14 @@ from scipy.spatial import cKDTree
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
 from toptraj.planners import CartesianLine, Timing, WaypointPath, plan
+from toptraj.planners.checks.gate import samples_exceed
 from toptraj.planners.collision import SphereObstacle
+from toptraj.planners.constraints.zones import with_edges
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.problem.zones import EDGE_TOLERANCE, Zone
+from toptraj.planners.trajectory import Samples
+from toptraj.robots import LimitZone
 
 UR5_START = np.array([0.3, -1.6, 1.7, -1.6, -1.57, 0.2])
 WELD = CartesianLine(start=UR5_START, positions=np.array([[0.413, 0.542, 0.286]]))
@@ -152,3 +158,27 @@ def test_bad_zones_are_refused_naming_the_zone(ur5, zones, words):
 def test_methods_that_do_not_hold_zones_refuse_them(ur5):
     with pytest.raises(InvalidRequest, match="zones are held by the timing methods phase_plane, toppra"):
         plan(ur5, WaypointPath(np.array(UR5_WAYPOINTS)), Timing(method="quintic", zones=(MIDDLE,)), dt=0.01)
+
+
+def test_the_grid_holds_every_zone_edge_and_keeps_its_knots():
+    knots = np.array([0.0, 0.25, 0.5, 1.0])
+    s = np.linspace(0.0, 1.0, 101)
+    zones = (LimitZone(0, ((0.2501, 0.3337),), velocity=0.5), LimitZone(1, ((0.6, 0.60004), (0.9, 1.0)), tool_speed=0.1))
+    grid = with_edges(s, zones, knots)
+    assert np.all(np.isin([0.2501, 0.3337, 0.6, 0.60004, 0.9, 1.0], grid)) and np.all(np.isin(knots, grid))
+    assert np.all(np.diff(grid) > 0.0) and grid[0] == 0.0 and grid[-1] == 1.0
+    assert len(grid) <= len(s) + 4  # points near an edge moved onto it
+
+
+def test_the_samples_check_holds_each_sample_to_the_limits_in_force_at_its_s(ur5):
+    """A sample within the robot's velocity limits but above half of them inside a zone of
+    factor 0.5 exceeds; the same sample outside the zone does not."""
+    n = ur5.dof
+    qd = np.zeros((3, n))
+    qd[1, 2] = 0.7 * ur5.limits.velocity[2]
+    zone = LimitZone(0, ((0.4, 0.6),), velocity=0.5)
+    limits = dataclasses.replace(ur5.limits, zones=(zone,))
+    for s_middle, expected in ((0.5, ("velocity", 1, 2)), (0.7, None)):
+        samples = Samples(t=np.arange(3.0), q=np.zeros((3, n)), qd=qd, qdd=np.zeros((3, n)), tau=np.zeros((3, n)),
+                          s=np.array([0.0, s_middle, 1.0]))
+        assert samples_exceed(samples, limits, 1.003, ("velocity",)) == expected
