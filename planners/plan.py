@@ -73,19 +73,20 @@ def _check_tool_limit_served(path_spec, method: TimingMethod) -> None:
 
 
 def _tool_limit(robot: Robot, path_spec, method: TimingMethod, timing: Timing) -> ToolSpeedLimit | None:
-    """The request's tool limit; with zones (checked, and refused where not served) that limit
-    the tool's speed, the tool frame's limit even without a speed of its own."""
-    tool = tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
+    """The request's tool limit. With zones (checked, and refused where not served) that limit
+    the tool's speed, or a tool frame named for the zones' regions, the tool frame's limit even
+    without a speed of its own."""
     if not timing.zones:
-        return tool
+        return tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
     check_zones(timing.zones)
     given = not isinstance(path_spec, FreeMotion) and timing.synchronization != "none" and not (
         isinstance(path_spec, WaypointPath) and path_spec.interpolation == "via"
     )
     check_zones_served(method.name, given)
-    if tool is None and any(zone.tool_speed is not None for zone in timing.zones):
-        tool = tool_speed_limit(robot, timing.tool_frame, math.inf, None)
-    return tool
+    unset = timing.tool_speed is None and timing.tool_angular_speed is None
+    framed = timing.tool_frame is not None or any(zone.tool_speed is not None for zone in timing.zones)
+    speed = math.inf if unset and framed else timing.tool_speed
+    return tool_speed_limit(robot, timing.tool_frame, speed, timing.tool_angular_speed)
 
 
 def _with_zones(robot: Robot, path, timing: Timing, limits: JointLimits, margin: float, deadline: Deadline) -> JointLimits:
