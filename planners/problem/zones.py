@@ -32,6 +32,8 @@ SCAN_POINTS = 2001
 FK_SECONDS = 2e-5
 #: Width in s to which bisection locates a region's edge.
 EDGE_TOLERANCE = 1e-9
+#: Most s-ranges of all zones together (each edge becomes a grid point).
+MAX_RANGES = 128
 #: Timing methods that hold zones (limits that vary along the path, on the constraints' grid).
 ZONE_METHODS = ("phase_plane", "toppra")
 
@@ -150,6 +152,11 @@ def zone_limits(robot: Robot, path: GeometricPath, zones: tuple[Zone, ...], fram
             ranges: tuple[tuple[float, float], ...] = ((float(zone.s_range[0]), float(zone.s_range[1])),)
         else:
             ranges = region_ranges(robot, path, frame_id, zone.region, deadline)
+        if sum(len(item.ranges) for item in limited) + len(ranges) > MAX_RANGES:
+            raise InvalidRequest(
+                f"the zones cover more than {MAX_RANGES} stretches of the path from zone {index} on (a region the "
+                "tool point enters and leaves many times); give fewer or larger regions, or s-ranges"
+            )
         limited.append(LimitZone(
             index=index,
             ranges=ranges,

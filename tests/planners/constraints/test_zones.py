@@ -20,6 +20,7 @@ from toptraj.planners.checks.gate import samples_exceed
 from toptraj.planners.collision import SphereObstacle
 from toptraj.planners.constraints.zones import with_edges
 from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.problem import zones as zones_module
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.problem.zones import EDGE_TOLERANCE, Zone
 from toptraj.planners.trajectory import Samples
@@ -182,3 +183,11 @@ def test_the_samples_check_holds_each_sample_to_the_limits_in_force_at_its_s(ur5
         samples = Samples(t=np.arange(3.0), q=np.zeros((3, n)), qd=qd, qdd=np.zeros((3, n)), tau=np.zeros((3, n)),
                           s=np.array([0.0, s_middle, 1.0]))
         assert samples_exceed(samples, limits, 1.003, ("velocity",)) == expected
+
+
+def test_zones_that_cover_too_many_stretches_of_the_path_are_refused(ur5, monkeypatch):
+    monkeypatch.setattr(zones_module, "MAX_RANGES", 1)
+    sphere = SphereObstacle(center=np.array([0.413, 0.39, 0.34]), radius=0.05)  # the line's middle
+    zones = (Zone(region=sphere, tool_speed=ZONE_SPEED), MIDDLE)
+    with pytest.raises(InvalidRequest, match="more than 1 stretches of the path from zone 1 on"):
+        plan(ur5, WELD, Timing(tool_speed=SPEED, zones=zones), dt=0.01)
