@@ -119,23 +119,25 @@ def test_a_workspace_sphere_is_found_where_the_tool_point_enters_and_leaves_it(u
     assert result.zones[0].binding
 
 
-def test_a_velocity_zone_scales_the_joint_velocity_limits_inside_it(ur5):
-    """On joint waypoints, a velocity factor of 0.3 over [0.4, 0.6]: the joint velocities of
-    the samples there (each sample's s: its nearest point of the path, on a grid of 1e-5) stay
-    within 0.3 times the robot's limits and reach them; the motion slows."""
+@pytest.mark.parametrize(("kind", "factor"), [("velocity", 0.3), ("acceleration", 0.4), ("torque", 0.4)])
+def test_a_zone_scales_the_joint_limits_of_its_kind_inside_it(ur5, kind, factor):
+    """On joint waypoints, a factor on one kind of joint limit over [0.4, 0.6]: the samples
+    there (each sample's s: its nearest point of the path, on a grid of 1e-5) stay within the
+    factor times the robot's limits and reach them; the motion slows."""
     spec = WaypointPath(np.array(UR5_WAYPOINTS))
-    free = plan(ur5, spec, Timing(constraints=("velocity", "acceleration")), dt=0.01)
-    zone = Zone(s_range=(0.4, 0.6), velocity=0.3)
-    result = plan(ur5, spec, Timing(constraints=("velocity", "acceleration"), zones=(zone,)), dt=0.002)
-    assert result.duration > free.duration * 1.05
+    free = plan(ur5, spec, Timing(), dt=0.01)
+    zone = dataclasses.replace(Zone(s_range=(0.4, 0.6)), **{kind: factor})
+    result = plan(ur5, spec, Timing(zones=(zone,)), dt=0.002)
+    assert result.duration > free.duration * 1.005
     grid = np.linspace(0.0, 1.0, 100_001)
     _, nearest = cKDTree(make_path(ur5, spec).evaluate(grid).q).query(result.samples.q)
     s = grid[nearest]
-    share = np.abs(result.samples.qd) / ur5.limits.velocity
+    values = {"velocity": result.samples.qd, "acceleration": result.samples.qdd, "torque": result.samples.tau}[kind]
+    share = (np.abs(values) / getattr(ur5.limits, kind)).max(axis=1)
     inside = (s >= 0.4 + 1e-4) & (s <= 0.6 - 1e-4)
     assert inside.sum() > 100
-    assert 0.3 * 0.995 <= share[inside].max() <= 0.3 * 1.005
-    assert share[~inside].max() > 0.5
+    assert factor * 0.99 <= share[inside].max() <= factor * 1.005
+    assert share[~inside].max() > factor * 1.1
     (report,) = result.zones
     assert report.binding and abs(report.peak - 1.0) <= 0.005
 
