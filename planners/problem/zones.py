@@ -146,7 +146,7 @@ def zone_limits(robot: Robot, path: GeometricPath, zones: tuple[Zone, ...], fram
     """The zones on ``path`` as the timing holds them: s-ranges as given, regions where the
     origin of frame ``frame_id`` lies in them (``region_ranges``); a region the path never enters
     keeps no range and limits nothing."""
-    limited = []
+    limited: list[LimitZone] = []
     for index, zone in enumerate(zones):
         if zone.s_range is not None:
             ranges: tuple[tuple[float, float], ...] = ((float(zone.s_range[0]), float(zone.s_range[1])),)
