@@ -46,6 +46,19 @@ class Accuracy:
 
 
 @dataclass(frozen=True)
+class ZoneReport:
+    """Where a zone lies on the path and whether its limits bound the timing: ``ranges``, the
+    closed s-ranges it covers; ``peak``, the largest ratio inside it of a quantity it limits to
+    its limit there; ``binding``, whether that peak reaches
+    ``toptraj.planners.constraints.zones.BINDING_SHARE``."""
+
+    index: int
+    ranges: tuple[tuple[float, float], ...]
+    peak: float
+    binding: bool
+
+
+@dataclass(frozen=True)
 class PlannedTrajectory:
     """What ``plan`` returns: samples and diagnostics of one timed path."""
 
@@ -68,6 +81,7 @@ class PlannedTrajectory:
     switching_times: dict[str, list[float]] | None = None
     search: dict | None = None
     accuracy: Accuracy | None = None
+    zones: tuple[ZoneReport, ...] | None = None
 
 
 def require_finite(method: str, **quantities) -> None:

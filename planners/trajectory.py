@@ -18,13 +18,15 @@ from toptraj.robots import Robot
 
 @dataclass(frozen=True)
 class Samples:
-    """Trajectory samples, rows are time: t (n,), q, qd, qdd, tau (n, n_dof), in SI units."""
+    """Trajectory samples, rows are time: t (n,), q, qd, qdd, tau (n, n_dof), in SI units, and
+    the path parameter s (n,) of each (``None`` where unknown)."""
 
     t: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
     tau: np.ndarray
+    s: np.ndarray | None = None
 
 
 def _joint_motion(path: GeometricPath, s, sd, sdd, side: str = "right"):
@@ -66,4 +68,4 @@ def sample_trajectory(
             t = np.append(t, duration)
         s, sd, sdd = scaling.at_times(t)
     q, qd, qdd = _joint_motion(path, s, sd, sdd)
-    return Samples(t=t, q=q, qd=qd, qdd=qdd, tau=robot.inverse_dynamics(q, qd, qdd))
+    return Samples(t=t, q=q, qd=qd, qdd=qdd, tau=robot.inverse_dynamics(q, qd, qdd), s=s)

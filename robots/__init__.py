@@ -13,7 +13,7 @@ from toptraj.robots.errors import (
     UploadStoreFull,
     UploadStoreUnavailable,
 )
-from toptraj.robots.limits import LIMIT_KINDS, JointLimits, ToolSpeedLimit
+from toptraj.robots.limits import LIMIT_KINDS, JointLimits, LimitZone, ToolSpeedLimit
 from toptraj.robots.registry import load
 from toptraj.robots.robot import Robot
 from toptraj.robots.store import StoredUpload, UploadStore, default_data_dir
@@ -27,6 +27,7 @@ __all__ = [
     "InvalidRobotName",
     "InvalidURDF",
     "JointLimits",
+    "LimitZone",
     "Mounting",
     "Payload",
     "ToolSpeedLimit",

@@ -60,12 +60,34 @@ class ToolSpeedLimit:
 
 
 @dataclass(frozen=True)
+class LimitZone:
+    """Limits of their own on part of a path (``toptraj.planners.constraints.zones``): on the
+    closed s-ranges ``ranges`` of the path being timed, the robot's velocity, acceleration and
+    torque limits times ``velocity``, ``acceleration`` and ``torque`` (factors in (0, 1] or
+    beyond), and a largest linear speed ``tool_speed`` (m/s, ``inf``: none) of the tool frame's
+    origin. ``index`` is the zone's place in the caller's list, for messages and answers."""
+
+    index: int
+    ranges: tuple[tuple[float, float], ...]
+    velocity: float = 1.0
+    acceleration: float = 1.0
+    torque: float = 1.0
+    tool_speed: float = math.inf
+
+    def tightened(self, margin: float) -> LimitZone:
+        """The zone with its tool speed reduced by the fraction ``margin`` (its factors apply to
+        limits already tightened)."""
+        return dataclasses.replace(self, tool_speed=self.tool_speed * (1.0 - margin))
+
+
+@dataclass(frozen=True)
 class JointLimits:
     """Per-joint limits, each an array of shape (n_dof,), in the Pinocchio model's joint order.
 
     Units: rad, rad/s, rad/s^2, rad/s^3 and N m for revolute joints (m, m/s, m/s^2, m/s^3 and N for
     prismatic ones). ``inf`` means unlimited; symmetric limits are given by their magnitude.
-    ``tool``, when a request limits the speed of a frame, holds those bounds.
+    ``tool``, when a request limits the speed of a frame, holds those bounds; ``zones``, the
+    limits that hold on parts of the path instead (``LimitZone``).
     """
 
     position_lower: np.ndarray
@@ -75,6 +97,7 @@ class JointLimits:
     jerk: np.ndarray
     torque: np.ndarray
     tool: ToolSpeedLimit | None = None
+    zones: tuple[LimitZone, ...] = ()
 
     def as_lists(self) -> dict[str, list[float | None]]:
         """The limits as JSON-friendly lists, ``None`` standing for unlimited."""
@@ -112,7 +135,7 @@ class JointLimits:
             if not (math.isfinite(factor) and factor > 0.0):
                 raise InvalidLimits(f"limits.{kind}_scale", factor, rule="scale_not_positive")
             values[kind] = values[kind] * factor
-        return JointLimits(**values, tool=self.tool)
+        return JointLimits(**values, tool=self.tool, zones=self.zones)
 
     def tightened(self, margin: float) -> JointLimits:
         """These limits with the velocity, acceleration, jerk and torque limits reduced by the
@@ -125,6 +148,7 @@ class JointLimits:
             jerk=self.jerk * factor,
             torque=self.torque * factor,
             tool=None if self.tool is None else self.tool.tightened(margin),
+            zones=tuple(zone.tightened(margin) for zone in self.zones),
         )
 
 

@@ -20,6 +20,7 @@ from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from toptraj.planners.problem.boundary import finite_vector
 from toptraj.planners.problem.build import DEFAULT_CLEARANCE, MAX_SAMPLES
 from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.planners.problem.zones import Zone
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
 from toptraj.service.equipping import equipped_robot, payload_named
@@ -116,6 +117,24 @@ def _timing(request: TrajectoryRequest) -> Timing:
             cells=None if timing.search.cells is None else tuple(timing.search.cells),
             **timing.search.model_dump(exclude={"cells"}),
         ),
+        zones=tuple(_zone(spec) for spec in timing.zones),
+    )
+
+
+def _zone(spec) -> Zone:
+    """A zone of ``timing.zones`` as the library's ``Zone``."""
+    region: SphereObstacle | BoxObstacle | None = None
+    if spec.sphere is not None:
+        region = SphereObstacle(np.array(spec.sphere.center, dtype=float), spec.sphere.radius)
+    elif spec.box is not None:
+        region = BoxObstacle(np.array(spec.box.center, dtype=float), np.array(spec.box.size, dtype=float), np.array(spec.box.orientation, dtype=float))
+    return Zone(
+        s_range=None if spec.s_range is None else (spec.s_range[0], spec.s_range[1]),
+        region=region,
+        velocity=spec.velocity_scale,
+        acceleration=spec.acceleration_scale,
+        torque=spec.torque_scale,
+        tool_speed=spec.tool_speed,
     )
 
 
@@ -329,6 +348,10 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
         },
         "search": result.search,
         "accuracy": accuracy_body(result),
+        "zones": None if result.zones is None else [
+            {"index": zone.index, "ranges": [list(item) for item in zone.ranges], "peak": zone.peak, "binding": zone.binding}
+            for zone in result.zones
+        ],
     }
 
 

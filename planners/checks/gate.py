@@ -15,6 +15,7 @@ from toptraj.planners.checks.limit_check import Excess, LimitCheck, check_limits
 from toptraj.planners.checks.limit_kernels import utilization_pass
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
+from toptraj.planners.constraints.zones import tool_speed_at, zone_factors
 from toptraj.planners.errors import InfeasiblePath, LimitExceeded, TimingFailed
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.planners.runner.accuracy import REFINE_ROUNDS, estimated, finer_constraints
@@ -151,6 +152,23 @@ def checked(robot, path, result, method, kinds, limits, threshold, constraints) 
     return TimedStretch(path, result, constraints, check)
 
 
+def _zoned(checks: list, limits: JointLimits, s: np.ndarray) -> list:
+    """``samples_exceed``'s (kind, values, limit) with each value divided by the zones' factor
+    at its sample's s (``toptraj.planners.constraints.zones``) and the tool's linear speed
+    against the speed in force there, so that each stands against the limit in force."""
+    factors = zone_factors(limits.zones, s)
+    factor_of = {"velocity": factors.velocity, "acceleration": factors.acceleration, "torque": factors.torque}
+    zoned = []
+    for kind, values, limit in checks:
+        if kind in factor_of:
+            values = values / factor_of[kind][:, None]
+        elif kind == "tool" and limits.tool is not None:
+            bounds = np.column_stack([tool_speed_at(limits, s, factors), np.full(len(s), limits.tool.angular_speed)])
+            values, limit = np.nan_to_num(values / bounds), np.ones(2)
+        zoned.append((kind, values, limit))
+    return zoned
+
+
 def samples_exceed(
     samples, limits: JointLimits, threshold: float, kinds, robot: Robot | None = None, jerk: bool = False
 ) -> tuple[str, int, int] | None:
@@ -170,6 +188,8 @@ def samples_exceed(
     if limits.tool is not None and robot is not None:
         speeds = tool_speeds(robot, limits.tool, samples.q, samples.qd)
         checks.append(("tool", speeds, limits.tool.bounds))  # columns in the order of TOOL_KINDS
+    if limits.zones and samples.s is not None:
+        checks = _zoned(checks, limits, samples.s)
     for kind, values, limit in checks:
         if not values.size:
             continue

@@ -20,7 +20,7 @@ exceeded, and refuses the answer when refinement cannot bring it back.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -28,6 +28,7 @@ from toptraj.planners.checks.limit_kernels import utilization_pass
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from toptraj.planners.constraints.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel
+from toptraj.planners.constraints.zones import has_tool_zone, tool_speed_at, zone_factors, zone_peaks
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.planners.timing.base import PathTiming, TimeScaling
 from toptraj.robots import JointLimits, Robot
@@ -68,11 +69,13 @@ class LimitCheck:
     """Peak utilization per limit kind and joint (shape (n_dof,) each; 0 where unlimited; a
     tool limit's, when one is requested, of shape () under its ``TOOL_KINDS`` name), the worst
     state, and the grid intervals holding a state above the threshold (empty when none,
-    or when the timing has no grid)."""
+    or when the timing has no grid). With zones, each limit is the one in force at the state's
+    s, and ``zones`` holds {zone index: the peak inside it of the limits it sets}."""
 
     utilization: dict[str, np.ndarray]
     worst: Excess | None
     intervals_over: np.ndarray
+    zones: dict[int, float] = field(default_factory=dict)
 
 
 def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
@@ -129,6 +132,27 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     return tau
 
 
+def _zoned(limits: JointLimits, s: np.ndarray, values: dict, limit_of: dict, speeds: np.ndarray | None) -> dict[int, float]:
+    """Divide ``values`` (per kind, (n, k) at the states ``s``) in place by the zones' factors at
+    each state, so that the robot's limits in ``limit_of`` stand for those in force there; the
+    tool's linear speed becomes its share of the speed in force (limit 1). Returns the zones'
+    peaks against their own limits (``toptraj.planners.constraints.zones.zone_peaks``)."""
+    robot_ratios = {}
+    for kind in ("velocity", "acceleration", "torque"):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.abs(values[kind]) / np.asarray(limit_of[kind], dtype=float)
+        robot_ratios[kind] = np.nan_to_num(ratio, nan=0.0, posinf=np.inf).max(axis=1, initial=0.0)
+    factors = zone_factors(limits.zones, s)
+    for kind, factor in (("velocity", factors.velocity), ("acceleration", factors.acceleration), ("torque", factors.torque)):
+        values[kind] = values[kind] / factor[:, None]
+    if speeds is not None and has_tool_zone(limits):
+        robot_ratios["tool_speed"] = speeds[:, 0]  # m/s: against each zone's own speed
+        with np.errstate(divide="ignore", invalid="ignore"):
+            share = speeds[:, 0] / tool_speed_at(limits, s, factors)
+        values["tool_speed"], limit_of["tool_speed"] = np.nan_to_num(share, posinf=np.inf)[:, None], np.ones(1)
+    return zone_peaks(limits.zones, s, robot_ratios)
+
+
 def check_limits(
     path: GeometricPath,
     timing: PathTiming,
@@ -163,11 +187,13 @@ def check_limits(
     if jerk is not None:
         values["jerk"] = jerk
     limit_of = {kind: getattr(limits, kind) for kind in values}
+    speeds = None
     if limits.tool is not None:
         speeds = tool_speeds(robot, limits.tool, q, qd)
         for column, kind in enumerate(TOOL_KINDS):
             if np.isfinite(limits.tool.bounds[column]):
                 values[kind], limit_of[kind] = speeds[:, column : column + 1], limits.tool.bounds[column : column + 1]
+    peaks = _zoned(limits, states.s, values, limit_of, speeds) if limits.zones else {}
     utilization, worst = {}, None
     over = np.zeros(len(states.s), dtype=bool)
     for kind, value in values.items():
@@ -182,4 +208,4 @@ def check_limits(
             joint = -1 if kind in TOOL_KINDS else int(column)
             worst = Excess(float(ratio), kind, joint, float(states.s[state]))
     intervals = np.empty(0, dtype=int) if states.interval is None or not over.any() else np.unique(states.interval[over])
-    return LimitCheck(utilization, worst, intervals)
+    return LimitCheck(utilization, worst, intervals, peaks)

@@ -31,6 +31,7 @@ import numpy as np
 from toptraj.planners.constraints.assembly_kernels import assemble_rows, velocity_bound
 from toptraj.planners.constraints.tool_speed import tool_speed_bound
 from toptraj.planners.constraints.torque_interpolation import smooth_points
+from toptraj.planners.constraints.zones import tool_speed_at, zone_factors, zoned_rows
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.planners.paths.grid import on_points
@@ -343,17 +344,23 @@ def build_path_constraints(
 ) -> PathConstraints:
     """Evaluate the requested ``kinds`` of limits (subset of velocity, acceleration, torque)
     along ``path`` at the grid ``s`` (which must hold the path's kinks); a tool-speed limit
-    (``limits.tool``) joins the first-order bound sd_max."""
+    (``limits.tool``) joins the first-order bound sd_max. Where ``limits.zones`` cover a point,
+    its limits are theirs (``toptraj.planners.constraints.zones``)."""
     points, (a, b, c, d, lower, upper), rows = _second_order_rows(path, robot, limits, kinds, s, "right", deadline)
     deadline.check()
+    factors = zone_factors(limits.zones, s) if limits.zones else None
+    if factors is not None:
+        lower, upper = zoned_rows(rows, lower, upper, factors)
     if "velocity" in kinds:
         sd_max, velocity_joint = speed_bound(limits, points.dq)
+        sd_max = sd_max if factors is None else sd_max * factors.velocity
     else:
         sd_max, velocity_joint = np.full(len(s), np.inf), np.full(len(s), -1)
     tool_bound = None
     if limits.tool is not None:
         deadline.check()
-        tool_sd_max, tool_kind = tool_speed_bound(robot, limits.tool, points.q, points.dq)
+        speed = None if factors is None else tool_speed_at(limits, s, factors)
+        tool_sd_max, tool_kind = tool_speed_bound(robot, limits.tool, points.q, points.dq, speed)
         tool_bound = np.where(tool_sd_max < sd_max, tool_kind, -1)
         sd_max = np.minimum(sd_max, tool_sd_max)
     a_left, b_left, c_left, d_left = a, b, c, d

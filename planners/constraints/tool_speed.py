@@ -63,11 +63,15 @@ def tool_speeds(robot: Robot, tool: ToolSpeedLimit, q: np.ndarray, qd: np.ndarra
     return np.column_stack([np.linalg.norm(twists[:, :3], axis=1), np.linalg.norm(twists[:, 3:], axis=1)])
 
 
-def tool_speed_bound(robot: Robot, tool: ToolSpeedLimit, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def tool_speed_bound(
+    robot: Robot, tool: ToolSpeedLimit, q: np.ndarray, dq: np.ndarray, speed: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """The first-order bound the tool limit puts on sd along a path.
 
     Args:
         q, dq: The path and its s-derivative at n values of s, each (n, n_dof).
+        speed: The largest linear speed (m/s) at each of the n points, (n,), where it varies
+            along the path (``toptraj.planners.constraints.zones``); ``None``: ``tool.speed``.
 
     Returns:
         sd_max: Shape (n,), in 1/s (``inf`` where the frame does not move with s).
@@ -75,6 +79,9 @@ def tool_speed_bound(robot: Robot, tool: ToolSpeedLimit, q: np.ndarray, dq: np.n
     """
     per_unit = tool_speeds(robot, tool, q, dq)  # speeds per unit of sd
     with np.errstate(divide="ignore"):
-        bounds = tool.bounds / per_unit
+        limit = np.broadcast_to(tool.bounds, per_unit.shape) if speed is None else np.column_stack(
+            [speed, np.full(len(speed), tool.angular_speed)]
+        )
+        bounds = limit / per_unit
     kind = np.argmin(bounds, axis=1)
     return bounds[np.arange(len(bounds)), kind], kind

@@ -13,6 +13,7 @@ range, its boundary tangents) is checked where the path is built.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -29,8 +30,9 @@ from toptraj.planners.problem.problem import MotionSpec, Problem, Sampling
 from toptraj.planners.problem.ranges import check_scaled_limits, check_timing
 from toptraj.planners.problem.requests import Timing, WaypointPath, check_constraint_kinds
 from toptraj.planners.problem.waypoints import continuous_turns, without_repeats
+from toptraj.planners.problem.zones import check_zones, check_zones_served
 from toptraj.planners.timing.base import TimingMethod
-from toptraj.robots import JointLimits, Robot
+from toptraj.robots import JointLimits, Robot, ToolSpeedLimit
 
 #: Most samples an answer holds unless the caller says otherwise.
 MAX_SAMPLES = 200_000
@@ -103,11 +105,28 @@ def _limits(robot: Robot, motion: MotionSpec, method: TimingMethod | MotionGener
     """The robot's limits with the overrides and scales asked for, and the tool-speed limit."""
     check_scaled_limits(robot.limits.with_request(timing.limit_overrides), timing.limit_scales, robot.joint_names)
     limits: JointLimits = robot.limits.with_request(timing.limit_overrides, timing.limit_scales)
-    tool = tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
+    tool = _tool_limit(robot, motion, method, timing)
     if tool is None:
         return limits
     _check_tool_limit_served(motion, method)
     return dataclasses.replace(limits, tool=tool)
+
+
+def _tool_limit(robot: Robot, motion: MotionSpec, method: TimingMethod | MotionGenerator, timing: Timing) -> ToolSpeedLimit | None:
+    """The request's tool limit. With zones (checked, and refused where not served) that limit
+    the tool's speed, or a tool frame named for the zones' regions, the tool frame's limit even
+    without a speed of its own."""
+    if not timing.zones:
+        return tool_speed_limit(robot, timing.tool_frame, timing.tool_speed, timing.tool_angular_speed)
+    check_zones(timing.zones)
+    given = not isinstance(motion, FreeMotion) and timing.synchronization != "none" and not (
+        isinstance(motion, WaypointPath) and motion.interpolation == "via"
+    )
+    check_zones_served(method.name, given)
+    unset = timing.tool_speed is None and timing.tool_angular_speed is None
+    framed = timing.tool_frame is not None or any(zone.tool_speed is not None for zone in timing.zones)
+    speed = math.inf if unset and framed else timing.tool_speed
+    return tool_speed_limit(robot, timing.tool_frame, speed, timing.tool_angular_speed)
 
 
 def _check_tool_limit_served(motion: MotionSpec, method: TimingMethod | MotionGenerator) -> None:

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 from toptraj.planners.constraints.path_constraints import CONSTRAINT_KINDS
 from toptraj.planners.errors import Conflicting, InvalidRequest, NotOneOf, NotServed, OutOfRange
 from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.problem.zones import Zone
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.method import ClassicalMethod
@@ -81,6 +82,8 @@ class Timing:
         tool_frame: The frame those speeds limit; ``None``: the robot's end effector.
         search: Options of the global search (``timing.method = "search"``); ``None``: the
             defaults of ``toptraj.planners.generators.search.SearchOptions``.
+        zones: Limits of their own on parts of the path (``toptraj.planners.problem.zones.Zone``),
+            at most ``MAX_ZONES``; the robot's hold elsewhere.
     """
 
     method: str = "phase_plane"
@@ -103,6 +106,7 @@ class Timing:
     tool_angular_speed: float | None = None
     tool_frame: str | None = None
     search: SearchOptions | None = None
+    zones: tuple[Zone, ...] = ()
 
 
 def check_constraint_kinds(kinds, method: TimingMethod | MotionGenerator) -> tuple[str, ...]:

@@ -13,6 +13,7 @@ from toptraj.planners.checks.gate import TimedStretch, samples_exceed
 from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.constraints.admissible import admissible_set
+from toptraj.planners.constraints.zones import BINDING_SHARE
 from toptraj.planners.errors import TimingFailed, TooLarge
 from toptraj.planners.generators.collocation.switching import collocation_switches, switching_times
 from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
@@ -22,7 +23,7 @@ from toptraj.planners.problem.methods import MotionGenerator, Timed
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.problem.ranges import DT
 from toptraj.planners.problem.requests import Timing
-from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, require_finite
+from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, ZoneReport, require_finite
 from toptraj.planners.runner.accuracy import answer_accuracy
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
@@ -76,7 +77,19 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
         solve_ms=(time.perf_counter() - started) * 1e3, warnings=tuple(notes), binding=result.binding,
         conditioning=Conditioning(kappa_min, kappa_max, length), cost=timed.cost, solver=timed.solver,
         switching_times=switching, clearance=found_clearance, search=timed.search, accuracy=accuracy,
+        zones=_zone_reports(problem.limits.zones, timed.stretches, problem.margin) if problem.options.zones else None,
     )
+
+
+def _zone_reports(zones, stretches_: tuple[TimedStretch, ...], margin: float) -> tuple[ZoneReport, ...]:
+    """Where each zone lies and its peak inside over every stretch (``ZoneReport``), against its
+    limits as requested (before any margin); it binds where it reaches the limits it was
+    planned under (tightened by the margin)."""
+    reports = []
+    for zone in zones:
+        peak = max((item.check.zones.get(zone.index, 0.0) for item in stretches_), default=0.0)
+        reports.append(ZoneReport(zone.index, zone.ranges, (1.0 - margin) * peak, peak >= BINDING_SHARE))
+    return tuple(reports)
 
 
 def _blend_notes(path) -> list[Note]:

@@ -10,6 +10,7 @@ import numpy as np
 
 from toptraj.planners.checks.gate import TimedStretch, gated
 from toptraj.planners.constraints.path_constraints import build_path_constraints
+from toptraj.planners.constraints.zones import on_stretch, with_edges
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.stretch import Stretch, stretches
 from toptraj.planners.problem.methods import Timed
@@ -33,7 +34,11 @@ def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool)
 
 
 def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, duration, threshold, deadline, grid=None):
+    if isinstance(stretch, Stretch):  # the zones in the stretch's own parameter
+        limits = on_stretch(limits, stretch.start, stretch.width)
     s = timing_grid(stretch, grid_points, method, robot, grid)
+    if limits.zones:
+        s = with_edges(s, limits.zones, stretch.knots)
     deadline.progress(0.0, "constraints")
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
     deadline.check()

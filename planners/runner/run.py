@@ -10,6 +10,7 @@ accuracy stated, the phase plane and the peak utilization read off.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 from toptraj.planners.collision import check_clearance
@@ -20,6 +21,7 @@ from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.problem.zones import zone_limits
 from toptraj.planners.results import PlannedTrajectory
 from toptraj.planners.runner.answer import answer
 from toptraj.planners.runner.given_path import timed_path
@@ -43,16 +45,18 @@ def run(problem: Problem) -> PlannedTrajectory:
         if isinstance(method, MotionGenerator):
             timed = method.generate(problem, Execution(part, timed_path))
         else:
-            timed, checked_first = _given_path(problem, part)
+            timed, checked_first, problem = _given_path(problem, part)
     return answer(problem, timed, checked_first, started)
 
 
-def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | None]:
+def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | None, Problem]:
     """The given path built, kept clear of the obstacles, and timed by the problem's timing
-    method; with the clearance found, when there are obstacles."""
+    method; with the clearance found, when there are obstacles, and the problem with its zones
+    located on the path."""
     part.progress(0.0, "path")
     assert not isinstance(problem.motion, FreeMotion)  # build_problem gives free motions to generators
     path = make_path(problem.robot, problem.motion, problem.deadline)
+    problem = _with_zones(problem, path)
     checked = None
     if problem.obstacles:
         part.progress(0.05, "clearance")
@@ -61,4 +65,16 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
         problem.robot, path, problem.method, problem.options, problem.kinds, problem.limits, part.within(0.1, 1.0),
         problem.threshold,
     )
-    return timed, checked
+    return timed, checked, problem
+
+
+def _with_zones(problem: Problem, path) -> Problem:
+    """The problem with its zones located on ``path`` (a region where the tool frame's origin,
+    the end effector's without a tool limit, lies in it), tightened by the margin."""
+    zones, limits, robot = problem.options.zones, problem.limits, problem.robot
+    if not zones:
+        return problem
+    frame_id = robot.frame_id(robot.end_effector) if limits.tool is None else limits.tool.frame_id
+    located = zone_limits(robot, path, zones, frame_id, problem.deadline)
+    zoned = dataclasses.replace(limits, zones=tuple(zone.tightened(problem.margin) for zone in located))
+    return dataclasses.replace(problem, limits=zoned)

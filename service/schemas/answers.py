@@ -32,14 +32,15 @@ class PhasePlanePublic(BaseModel):
 
 
 class UtilizationPublic(BaseModel):
-    """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds); jerk
-    for timings with a finite jerk (jerk_limited, time laws, ruckig)."""
+    """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds), against
+    the limit in force at each state (a zone's inside it); jerk for timings with a finite jerk
+    (jerk_limited, time laws, ruckig)."""
 
     velocity: list[float] = Field(description="Peak |qd| / velocity limit per joint.")
     acceleration: list[float] = Field(description="Peak |qdd| / acceleration limit per joint.")
     torque: list[float] = Field(description="Peak |tau| / torque limit per joint.")
     jerk: list[float] | None = Field(default=None, description="Peak |qddd| / jerk limit per joint, for timings with a finite jerk.")
-    tool_speed: float | None = Field(default=None, description="Peak tool speed / timing.limits.tool_speed, when limited.")
+    tool_speed: float | None = Field(default=None, description="Peak tool speed / the tool-speed limit in force (timing.limits.tool_speed, or a zone's), when limited.")
     tool_angular_speed: float | None = Field(
         default=None, description="Peak angular tool speed / timing.limits.tool_angular_speed, when limited."
     )
@@ -143,6 +144,15 @@ class AccuracyPublic(BaseModel):
     basis: str = Field(description="How the estimate was obtained (a second discretization, another method), or why there is none.")
 
 
+class ZonePublic(BaseModel):
+    """Where a zone of timing.zones lies on the path and whether it bound the timing."""
+
+    index: int = Field(description="The zone's place in timing.zones.")
+    ranges: list[list[float]] = Field(description="The closed s-ranges [s0, s1] it covers (empty: a region the path never enters).")
+    peak: float = Field(description="Largest ratio inside the zone of a quantity it limits to the zone's own limit (1.0: reached; with timing.limit_margin, against the limit as given).")
+    binding: bool = Field(description="Whether its limits bound the timing (its peak within 0.5 % of the limits it was planned under).")
+
+
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
@@ -174,6 +184,7 @@ class TrajectoryResponse(BaseModel):
     search: SearchPublic | None = Field(default=None, description="timing.method `search`: what the global search did.")
     warnings: list[str] = Field(description="What the answer should be read with: dropped waypoints, singularities, turns of continuous joints, an accuracy above 0.1 %.")
     accuracy: AccuracyPublic = Field(description="The answer's estimated relative distance from the converged optimum of its method's problem.")
+    zones: list[ZonePublic] | None = Field(default=None, description="With timing.zones: where each lies on the path and whether it bound the timing.")
 
 
 class CompareResult(BaseModel):

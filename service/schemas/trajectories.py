@@ -12,6 +12,7 @@ from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
 from toptraj.service.schemas.common import Schema, bounded, signed
 from toptraj.service.schemas.equipment import MOUNTING, PAYLOAD, MountingRequest, PayloadRequest
+from toptraj.service.schemas.zones import ZONES, ZoneRequest
 
 MAX_WAYPOINTS = 1_000
 MAX_JOINTS = 64
@@ -318,6 +319,7 @@ class TimingRequest(Schema):
         "the motion is planned under the limits times (1 - margin). With a positive margin no returned "
         "sample exceeds any limit; with 0, no limit is exceeded by more than 0.3 % on a dense resampling.",
     )
+    zones: list[ZoneRequest] = ZONES
 
 
 class OutputRequest(Schema):

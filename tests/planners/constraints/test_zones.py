@@ -1,0 +1,195 @@
+"""Zones (``toptraj.planners.problem.zones``, ``toptraj.planners.constraints.zones``): limits of
+their own on part of a path, held in one timing. The weld line of the README (ur5's tool along a
+straight line at 5 cm/s) gets a slower zone over its middle third; the tool speed recomputed
+from the returned samples by Pinocchio (its Jacobian, not the planner's tool-speed code) holds
+and reaches the zone's limit there, and exceeds it elsewhere."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.spatial import cKDTree
+
+from tests.conftest import UR5_WAYPOINTS
+from toptraj import robots
+from toptraj.planners import CartesianLine, Timing, WaypointPath, plan
+from toptraj.planners.checks.gate import samples_exceed
+from toptraj.planners.collision import SphereObstacle
+from toptraj.planners.constraints.zones import with_edges
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.problem import zones as zones_module
+from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.problem.zones import EDGE_TOLERANCE, Zone
+from toptraj.planners.trajectory import Samples
+from toptraj.robots import LimitZone
+
+UR5_START = np.array([0.3, -1.6, 1.7, -1.6, -1.57, 0.2])
+WELD = CartesianLine(start=UR5_START, positions=np.array([[0.413, 0.542, 0.286]]))
+SPEED, ZONE_SPEED = 0.05, 0.02
+MIDDLE = Zone(s_range=(1 / 3, 2 / 3), tool_speed=ZONE_SPEED)
+DT = 0.002
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return robots.load("ur5")
+
+
+def _tool_points(arm, q: np.ndarray) -> np.ndarray:
+    model, data, frame = arm.model, arm.model.createData(), arm.model.getFrameId(arm.end_effector)
+    points = []
+    for row in q:
+        pin.framesForwardKinematics(model, data, arm.configuration(row))
+        points.append(data.oMf[frame].translation.copy())
+    return np.array(points)
+
+
+def _tool_speeds(arm, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    model, data, frame = arm.model, arm.model.createData(), arm.model.getFrameId(arm.end_effector)
+    speeds = []
+    for row, velocity in zip(q, qd):
+        jacobian = pin.computeFrameJacobian(model, data, arm.configuration(row), frame, pin.LOCAL_WORLD_ALIGNED)
+        speeds.append(np.linalg.norm(jacobian[:3] @ velocity))
+    return np.array(speeds)
+
+
+def _path_s(arm, q: np.ndarray) -> np.ndarray:
+    """The path parameter of each configuration of ``q`` on the weld line: the tool point's
+    position along the line, inverted through the path's own (monotone) map s -> position."""
+    path = make_path(arm, WELD)
+    grid = np.linspace(0.0, 1.0, 20_001)
+    along_grid = _tool_points(arm, path.evaluate(grid).q)
+    start, direction = along_grid[0], along_grid[-1] - along_grid[0]
+    position = (along_grid - start) @ direction
+    assert np.all(np.diff(position) > 0.0)
+    return np.interp((_tool_points(arm, q) - start) @ direction, position, grid)
+
+
+@pytest.mark.parametrize("method", ["phase_plane", "toppra"])
+def test_a_tool_speed_zone_binds_at_its_limit_there_and_nowhere_else(ur5, method):
+    result = plan(ur5, WELD, Timing(method=method, tool_speed=SPEED, zones=(MIDDLE,)), dt=DT)
+    samples = result.samples
+    speed = _tool_speeds(ur5, samples.q, samples.qd)
+    s = _path_s(ur5, samples.q)
+    inside = (s >= 1 / 3) & (s <= 2 / 3)
+    assert inside.sum() > 1000
+    assert speed[inside].max() <= ZONE_SPEED * 1.005
+    assert speed[inside].max() >= ZONE_SPEED * 0.995  # it binds
+    assert speed[~inside].max() > ZONE_SPEED * 1.5  # and nowhere else: the weld's own 5 cm/s there
+    assert speed.max() <= SPEED * 1.005
+    (report,) = result.zones
+    assert report.index == 0 and report.ranges == ((1 / 3, 2 / 3),)
+    assert report.binding and abs(report.peak - 1.0) <= 0.005
+
+
+def test_the_zoned_duration_lies_between_the_unzoned_one_and_the_zone_everywhere(ur5):
+    durations = [
+        plan(ur5, WELD, Timing(tool_speed=speed, zones=zones), dt=0.01).duration
+        for speed, zones in ((SPEED, ()), (SPEED, (MIDDLE,)), (ZONE_SPEED, ()))
+    ]
+    unzoned, zoned, everywhere = durations
+    # A third of the line at 2 instead of 5 cm/s costs about (1/0.02 - 1/0.05) m/s of it: a
+    # third of the 0.316 m line, 3.2 s; the whole line at 2 cm/s, 9.5 s.
+    assert unzoned + 2.8 < zoned < everywhere - 5.5
+
+
+def test_a_zone_above_the_speed_reached_there_does_not_bind(ur5):
+    result = plan(ur5, WELD, Timing(tool_speed=SPEED, zones=(Zone(s_range=(0.4, 0.6), tool_speed=0.08),)), dt=0.01)
+    (report,) = result.zones
+    assert not report.binding and report.peak == pytest.approx(SPEED / 0.08, rel=0.005)
+
+
+def test_a_workspace_sphere_is_found_where_the_tool_point_enters_and_leaves_it(ur5):
+    path = make_path(ur5, WELD)
+    middle = _tool_points(ur5, path.evaluate(np.array([0.5])).q)[0]
+    sphere = SphereObstacle(center=middle + np.array([0.0, 0.0, 0.01]), radius=0.05)
+    result = plan(ur5, WELD, Timing(tool_speed=SPEED, zones=(Zone(region=sphere, tool_speed=ZONE_SPEED),)), dt=0.01)
+    ((enter, leave),) = result.zones[0].ranges
+    assert 0.2 < enter < 0.5 < leave < 0.8
+    # Independently: the tool point by Pinocchio at the path's points is on the sphere at both
+    # edges, outside just before entering and just after leaving, inside in between.
+    at = np.array([enter, leave, enter - 1e-6, leave + 1e-6, 0.5 * (enter + leave)])
+    distance = np.linalg.norm(_tool_points(ur5, path.evaluate(at).q) - sphere.center, axis=1)
+    slope = 0.5  # |dp/ds| of the 0.32 m line is below 0.5 m per unit of s
+    assert np.all(np.abs(distance[:2] - sphere.radius) <= slope * EDGE_TOLERANCE + 1e-12)
+    assert np.all(distance[2:4] > sphere.radius) and distance[4] < sphere.radius
+    assert result.zones[0].binding
+
+
+@pytest.mark.parametrize(("kind", "factor"), [("velocity", 0.3), ("acceleration", 0.4), ("torque", 0.4)])
+def test_a_zone_scales_the_joint_limits_of_its_kind_inside_it(ur5, kind, factor):
+    """On joint waypoints, a factor on one kind of joint limit over [0.4, 0.6]: the samples
+    there (each sample's s: its nearest point of the path, on a grid of 1e-5) stay within the
+    factor times the robot's limits and reach them; the motion slows."""
+    spec = WaypointPath(np.array(UR5_WAYPOINTS))
+    free = plan(ur5, spec, Timing(), dt=0.01)
+    zone = dataclasses.replace(Zone(s_range=(0.4, 0.6)), **{kind: factor})
+    result = plan(ur5, spec, Timing(zones=(zone,)), dt=0.002)
+    assert result.duration > free.duration * 1.005
+    grid = np.linspace(0.0, 1.0, 100_001)
+    _, nearest = cKDTree(make_path(ur5, spec).evaluate(grid).q).query(result.samples.q)
+    s = grid[nearest]
+    values = {"velocity": result.samples.qd, "acceleration": result.samples.qdd, "torque": result.samples.tau}[kind]
+    share = (np.abs(values) / getattr(ur5.limits, kind)).max(axis=1)
+    inside = (s >= 0.4 + 1e-4) & (s <= 0.6 - 1e-4)
+    assert inside.sum() > 100
+    assert factor * 0.99 <= share[inside].max() <= factor * 1.005
+    assert share[~inside].max() > factor * 1.1
+    (report,) = result.zones
+    assert report.binding and abs(report.peak - 1.0) <= 0.005
+
+
+@pytest.mark.parametrize(
+    ("zones", "words"),
+    [
+        ((Zone(s_range=(0.6, 0.4), tool_speed=0.1),), "zone 0 has the s-range"),
+        ((MIDDLE, Zone(s_range=(0.2, 1.5), tool_speed=0.1)), "zone 1 has the s-range"),
+        ((MIDDLE, MIDDLE, Zone(s_range=(0.2, 0.3), tool_speed=-1.0)), "zone 2 has a tool speed"),
+        ((Zone(s_range=(0.2, 0.3), torque=-0.5),), "zone 0 has a torque factor"),
+        ((Zone(s_range=(0.2, 0.3)),), "zone 0 sets no limit"),
+        ((MIDDLE,) * 33, "33 zones are given; at most 32"),
+    ],
+)
+def test_bad_zones_are_refused_naming_the_zone(ur5, zones, words):
+    with pytest.raises(InvalidRequest, match=words):
+        plan(ur5, WELD, Timing(tool_speed=SPEED, zones=zones), dt=0.01)
+
+
+def test_methods_that_do_not_hold_zones_refuse_them(ur5):
+    with pytest.raises(InvalidRequest, match="zones are held by the timing methods phase_plane, toppra"):
+        plan(ur5, WaypointPath(np.array(UR5_WAYPOINTS)), Timing(method="quintic", zones=(MIDDLE,)), dt=0.01)
+
+
+def test_the_grid_holds_every_zone_edge_and_keeps_its_knots():
+    knots = np.array([0.0, 0.25, 0.5, 1.0])
+    s = np.linspace(0.0, 1.0, 101)
+    zones = (LimitZone(0, ((0.2501, 0.3337),), velocity=0.5), LimitZone(1, ((0.6, 0.60004), (0.9, 1.0)), tool_speed=0.1))
+    grid = with_edges(s, zones, knots)
+    assert np.all(np.isin([0.2501, 0.3337, 0.6, 0.60004, 0.9, 1.0], grid)) and np.all(np.isin(knots, grid))
+    assert np.all(np.diff(grid) > 0.0) and grid[0] == 0.0 and grid[-1] == 1.0
+    assert len(grid) <= len(s) + 4  # points near an edge moved onto it
+
+
+def test_the_samples_check_holds_each_sample_to_the_limits_in_force_at_its_s(ur5):
+    """A sample within the robot's velocity limits but above half of them inside a zone of
+    factor 0.5 exceeds; the same sample outside the zone does not."""
+    n = ur5.dof
+    qd = np.zeros((3, n))
+    qd[1, 2] = 0.7 * ur5.limits.velocity[2]
+    zone = LimitZone(0, ((0.4, 0.6),), velocity=0.5)
+    limits = dataclasses.replace(ur5.limits, zones=(zone,))
+    for s_middle, expected in ((0.5, ("velocity", 1, 2)), (0.7, None)):
+        samples = Samples(t=np.arange(3.0), q=np.zeros((3, n)), qd=qd, qdd=np.zeros((3, n)), tau=np.zeros((3, n)),
+                          s=np.array([0.0, s_middle, 1.0]))
+        assert samples_exceed(samples, limits, 1.003, ("velocity",)) == expected
+
+
+def test_zones_that_cover_too_many_stretches_of_the_path_are_refused(ur5, monkeypatch):
+    monkeypatch.setattr(zones_module, "MAX_RANGES", 1)
+    sphere = SphereObstacle(center=np.array([0.413, 0.39, 0.34]), radius=0.05)  # the line's middle
+    zones = (Zone(region=sphere, tool_speed=ZONE_SPEED), MIDDLE)
+    with pytest.raises(InvalidRequest, match="more than 1 stretches of the path from zone 1 on"):
+        plan(ur5, WELD, Timing(tool_speed=SPEED, zones=zones), dt=0.01)

@@ -1,0 +1,61 @@
+"""``timing.zones`` over HTTP: the answer lists where each zone lies and whether it bound the
+timing; a bad zone is a 422 naming it (its index in the field), a method that does not hold
+zones a 422 saying which do."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.conftest import UR5_WAYPOINTS
+
+WELD_LINE = {"kind": "cartesian", "start": [0.3, -1.6, 1.7, -1.6, -1.57, 0.2], "positions": [[0.413, 0.542, 0.286]]}
+MIDDLE = {"s_range": [1 / 3, 2 / 3], "tool_speed": 0.02}
+
+
+def _body(zones, method="phase_plane", path=WELD_LINE) -> dict:
+    return {
+        "robot": "ur5",
+        "path": path,
+        "timing": {"method": method, "limits": {"tool_speed": 0.05}, "zones": zones},
+        "output": {"dt": 0.05},
+    }
+
+
+def test_the_answer_lists_where_each_zone_lies_and_whether_it_bound(client):
+    zones = [MIDDLE, {"box": {"center": [5.0, 5.0, 5.0], "size": [0.1, 0.1, 0.1]}, "velocity_scale": 0.5}]
+    response = client.post("/v1/trajectories", json=_body(zones))
+    assert response.status_code == 200, response.text
+    middle, away = response.json()["zones"]
+    assert middle["index"] == 0 and middle["ranges"] == [[1 / 3, 2 / 3]] and middle["binding"] is True
+    assert abs(middle["peak"] - 1.0) <= 0.005
+    assert away == {"index": 1, "ranges": [], "peak": 0.0, "binding": False}  # never entered
+    plain = client.post("/v1/trajectories", json=_body([])).json()
+    assert plain["zones"] is None and plain["duration"] < response.json()["duration"]
+
+
+@pytest.mark.parametrize(
+    ("zones", "field", "words"),
+    [
+        ([MIDDLE, {"s_range": [0.6, 0.4], "tool_speed": 0.1}], "timing.zones[1]", "runs backwards"),
+        ([{"s_range": [0.2, 1.5], "tool_speed": 0.1}], "timing.zones[0].s_range[1]", "less than or equal to 1"),
+        ([{"s_range": [-0.1, 0.5], "tool_speed": 0.1}], "timing.zones[0].s_range[0]", "greater than or equal to 0"),
+        ([MIDDLE, MIDDLE, {"s_range": [0.2, 0.3], "tool_speed": -1.0}], "timing.zones[2].tool_speed", "not within"),
+        ([{"s_range": [0.2, 0.3], "torque_scale": -0.5}], "timing.zones[0].torque_scale", "greater than 0"),
+        ([{"s_range": [0.2, 0.3]}], "timing.zones[0]", "sets no limit"),
+        ([{"s_range": [0.2, 0.3], "sphere": {"center": [0, 0, 0], "radius": 1}, "tool_speed": 1}], "timing.zones[0]", "exactly one"),
+        ([MIDDLE] * 33, "timing.zones", "at most 32"),
+    ],
+)
+def test_bad_zones_are_422_naming_the_zone(client, zones, field, words):
+    response = client.post("/v1/trajectories", json=_body(zones))
+    assert response.status_code == 422, response.text
+    assert response.headers["content-type"].startswith("application/problem+json")
+    errors = response.json()["errors"]
+    assert errors[0]["field"] == field and words in errors[0]["message"], errors
+
+
+def test_a_method_that_does_not_hold_zones_is_422(client):
+    path = {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}
+    response = client.post("/v1/trajectories", json=_body([MIDDLE], method="quintic", path=path))
+    assert response.status_code == 422, response.text
+    assert "zones are held by the timing methods phase_plane, toppra" in response.json()["detail"]
