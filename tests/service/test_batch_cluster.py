@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -17,9 +18,8 @@ import psutil
 import pytest
 
 from tests.paths import ROOT
-from toptraj.service.batches import run_batch
 
-ray = pytest.importorskip("ray")  # the "ray" extra, which make test installs
+pytest.importorskip("ray")  # the "ray" extra, which make test installs
 
 #: Seconds a ``ray start`` may take on a busy machine.
 START_S = 180
@@ -55,15 +55,12 @@ def _ray_start(arguments: list[str], env: dict[str, str]) -> subprocess.Complete
 
 
 @pytest.fixture
-def two_nodes(monkeypatch):
+def two_nodes():
     """The address of a Ray cluster of two nodes of one CPU each, the second with the resource
-    ``node2``; ended (its processes killed) afterwards. Token authentication off: the nodes
-    and the driver share no token file here."""
-    if ray.is_initialized():
-        ray.shutdown()
+    ``node2``, and the environment to reach it; ended (its processes killed) afterwards. Token
+    authentication off: the nodes and the driver share no token file here."""
     temp_dir = tempfile.mkdtemp(prefix="ray-", dir="/tmp")  # short: Ray's socket paths live under it
     env = {**os.environ, "RAY_AUTH_MODE": "disabled", "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-    monkeypatch.setenv("RAY_AUTH_MODE", "disabled")
     address = f"127.0.0.1:{_free_port()}"
     try:
         head = _ray_start(["--head", "--port", address.rsplit(":", 1)[1], "--include-dashboard", "false", "--temp-dir", temp_dir], env)
@@ -72,35 +69,27 @@ def two_nodes(monkeypatch):
         second = _ray_start(["--address", address, "--resources", json.dumps({"node2": 1})], env)
         if second.returncode != 0:
             pytest.skip(f"ray cannot start a second node here: {second.stderr[-500:]}")
-        yield address
+        yield address, env
     finally:
-        if ray.is_initialized():
-            ray.shutdown()
         _end_processes_of(temp_dir)
         shutil.rmtree(temp_dir, ignore_errors=True)
 
 
-def _nodes(address: str) -> dict[str, dict]:
-    """The cluster's live nodes by id, with their resources."""
-    ray.init(address=address, log_to_driver=False, configure_logging=False)
-    try:
-        return {node["NodeID"]: node["Resources"] for node in ray.nodes() if node["Alive"]}
-    finally:
-        ray.shutdown()
-
-
 def test_a_batch_spreads_over_the_nodes_of_a_cluster(two_nodes, tmp_path):
-    nodes = _nodes(two_nodes)
-    assert len(nodes) == 2 and sum("node2" in resources for resources in nodes.values()) == 1, nodes
+    """``toptraj batch --ray-address HOST:PORT``, as a user runs it (its own process, the
+    driver of the cluster's job)."""
     lines = [
         json.dumps({"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.3 + 0.02 * k, 0.2, -0.2, 0.1, 0.2, 0.3]]}})
         for k in range(16)
     ]
     requests, output = tmp_path / "requests.jsonl", tmp_path / "results.jsonl"
     requests.write_text("\n".join(lines) + "\n")
-    report = run_batch(requests, output, ray_address=two_nodes)
+    address, env = two_nodes
+    command = [sys.executable, "-m", "toptraj.service.cli", "batch", str(requests), "-o", str(output), "--ray-address", address]
+    done = subprocess.run(command, env=env, cwd=ROOT, capture_output=True, text=True, timeout=300, check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
     rows = [json.loads(row) for row in output.read_text().splitlines()]
     assert sorted(row["line"] for row in rows) == list(range(1, 17))  # every line once
     assert {row["status"] for row in rows} == {200}, rows
-    assert (report.planned, sum(report.nodes.values())) == (16, 16)
-    assert set(report.nodes) == set(nodes), (report.nodes, nodes)  # both nodes answered lines
+    spread = re.search(r"16 answered, .*, on 2 Ray nodes \((\d+), (\d+) requests\)", done.stderr)
+    assert spread and int(spread[1]) + int(spread[2]) == 16, done.stderr[-2000:]  # both nodes answered
