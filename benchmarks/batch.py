@@ -29,6 +29,7 @@ import os
 import sys
 import tempfile
 import time
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -154,6 +155,9 @@ def main() -> None:
                 ours = rate[f"toptraj batch ({kind})"]
                 print(f"  toptraj batch ({kind}): {ours / (cores * rate['single']):.2f} x cores x single (goal >= 0.8), "
                       f"{ours / rate['POST /v1/batches']:.2f} x POST /v1/batches (goal >= 1)")
+            for kind in ray_s:
+                counts = Counter(json.loads(row)["status"] for row in (work / f"round{round_}-{kind}.jsonl").read_text().splitlines())
+                print(f"  toptraj batch ({kind}) statuses: {dict(sorted(counts.items()))}; single: {dict(sorted(Counter(s for s, _ in answers).items()))}")
             same = same_answers(work / f"round{round_}-warm.jsonl", answers, args.check)
             print(f"  identical to the single requests: {same} of {min(args.check, args.count)} checked")
 
