@@ -144,7 +144,7 @@ def main(argv: list[str] | None = None) -> int:
     batch.add_argument("requests", help="a JSON Lines file: a POST /v1/trajectories (or compare) body per line")
     batch.add_argument("-o", "--output", required=True, help="the JSON Lines file of results (appended; resumed)")
     batch.add_argument("--workers", type=int, default=None, help="Ray workers (CPUs) of a local Ray (default: the cores)")
-    batch.add_argument("--ray-address", default=None, help="an existing Ray cluster: auto or ray://host:port (default: a local Ray)")
+    batch.add_argument("--ray-address", default=None, help="an existing Ray cluster: host:port of its head, auto or ray://host:port (default: a local Ray)")
     batch.add_argument("--budget", type=float, default=None, help="planning budget of each request, in s (default: 20; a line over it is a 504)")
     batch.add_argument(
         "--retry-failed", action="store_true", help="plan again the lines answered with a budget error (504) or another 5xx"

@@ -226,6 +226,7 @@ def batch(
     summary = (
         f"{report.planned} answered, {report.skipped} already in {output}, {report.total} in all, "
         f"{report.seconds:.1f} s ({report.rate:.1f} lines/s)"
+        + (f", on {len(report.nodes)} Ray nodes ({', '.join(str(n) for n in sorted(report.nodes.values(), reverse=True))} requests)" if len(report.nodes) > 1 else "")
     )
     if not report.interrupted:
         print(summary, file=sys.stderr)

@@ -24,8 +24,9 @@ import os
 import sys
 import threading
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -58,14 +59,16 @@ class RayMissing(RuntimeError):
 @dataclass(frozen=True)
 class BatchReport:
     """What a run did: lines in the file, already answered before it, answered now (each
-    line of a group of identical requests counted), seconds, and whether it was stopped
-    before the end (``stop``)."""
+    line of a group of identical requests counted), seconds, whether it was stopped before
+    the end (``stop``), and the requests each Ray node answered (by node id; identical
+    requests counted once)."""
 
     total: int
     skipped: int
     planned: int
     seconds: float
     interrupted: bool = False
+    nodes: dict[str, int] = field(default_factory=dict)
 
     @property
     def rate(self) -> float:
@@ -106,9 +109,12 @@ def progress_bar(stream: TextIO = sys.stderr) -> Callable[[int, int, float], Non
 
 
 class RayPool:
-    """Chunks of requests computed as Ray tasks (``work.answer_chunk``): on the cluster at
-    ``address`` (``auto``, ``ray://host:port``), or on a local Ray with ``workers`` CPUs
-    (default: the cores) started here and shut down by ``close`` with its processes.
+    """Chunks of requests computed as Ray tasks (``work.answer_on_worker``): on the cluster at
+    ``address`` (``auto``, ``host:port``, ``ray://host:port``), or on a local Ray with
+    ``workers`` CPUs (default: the cores) started here and shut down by ``close`` with its
+    processes. Each worker is prepared once (``prepare``: Ray's worker setup hook, in this
+    job's ``runtime_env``); tasks are spread over the nodes (``SPREAD``); ``nodes`` counts the
+    requests answered by each node (by Ray node id).
 
     Raises:
         RayMissing: Ray is not installed.
@@ -119,23 +125,28 @@ class RayPool:
             import ray
         except ImportError:
             raise RayMissing(RAY_MISSING) from None
-        from toptraj.service.batches.work import answer_chunk
+        from toptraj.service.batches.prepare import SETUP_HOOK
+        from toptraj.service.batches.work import answer_on_worker
 
         self._ray = ray
         self._started_here = False
+        self.nodes: Counter[str] = Counter()
         if not ray.is_initialized():
+            hook = {"worker_process_setup_hook": SETUP_HOOK}
             if address in (None, "local"):
+                cpus = workers or os.cpu_count() or 1
                 ray.init(
-                    num_cpus=workers or os.cpu_count() or 1,
+                    num_cpus=cpus,
                     include_dashboard=False,
                     object_store_memory=100 * 1024 * 1024,
                     log_to_driver=False,
                     configure_logging=False,
+                    runtime_env=hook,
                 )
             else:
-                ray.init(address=address, log_to_driver=False, configure_logging=False)
+                ray.init(address=address, log_to_driver=False, configure_logging=False, runtime_env=hook)
             self._started_here = True
-        self._remote = ray.remote(num_cpus=1, max_retries=2)(answer_chunk)
+        self._remote = ray.remote(num_cpus=1, max_retries=2, scheduling_strategy="SPREAD")(answer_on_worker)
         self._uploads: Any = ray.put({})
         self.cpus = int(ray.available_resources().get("CPU", workers or 1) or 1)
 
@@ -157,7 +168,9 @@ class RayPool:
 
     def result(self, handle: Any) -> list[tuple[str, int, bytes]]:
         """(key, status, body) of each request of a finished task (raises its failure)."""
-        return self._ray.get(handle)
+        node, answers = self._ray.get(handle)
+        self.nodes[node] += len(answers)
+        return answers
 
     def cancel(self, handles: list) -> None:
         """Stop these tasks, killing the workers that run them."""
@@ -315,4 +328,4 @@ def run_batch(
                 runner.cancel(rest)
         finally:
             runner.close()
-    return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted)
+    return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted, dict(getattr(runner, "nodes", {})))

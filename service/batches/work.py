@@ -15,6 +15,7 @@ from toptraj.planners.execution.deadline import Deadline
 from toptraj.robots import ToptrajError
 from toptraj.robots.upload_options import UploadOptions
 from toptraj.service.batches.lines import problem_body
+from toptraj.service.batches.prepare import prepare_worker
 from toptraj.service.planning import compare_request, encode_json, plan_request, render
 from toptraj.service.problems import detail, status_of, title_of, validation_problem
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
@@ -70,3 +71,16 @@ def answer_chunk(chunk: list[tuple[str, str]], uploads: dict[str, tuple[str, str
     """(key, status, body) of each (key, request text) of a chunk."""
     _uploads_here(uploads)
     return [(key, *answer(text, budget_s)) for key, text in chunk]
+
+
+def answer_on_worker(
+    chunk: list[tuple[str, str]], uploads: dict[str, tuple[str, str]], budget_s: float
+) -> tuple[str, list[tuple[str, int, bytes]]]:
+    """What a Ray task of a batch runs: ``answer_chunk`` on a worker prepared once
+    (``prepare.prepare_worker``, whose calls then run inline: never in another process), and
+    the id of the Ray node that answered."""
+    import ray
+
+    prepare_worker()
+    answers = answer_chunk(chunk, uploads, budget_s)
+    return ray.get_runtime_context().get_node_id(), answers

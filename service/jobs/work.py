@@ -96,11 +96,11 @@ def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tu
     import ray
 
     from toptraj.service.batches.runner import _uploads_named
-    from toptraj.service.batches.work import answer_chunk
+    from toptraj.service.batches.work import answer_on_worker
 
     if not ray.is_initialized():
         ray.init(address=None if setup.ray_address == "local" else setup.ray_address, log_to_driver=False, configure_logging=False)
-    remote = ray.remote(num_cpus=1)(answer_chunk)
+    remote = ray.remote(num_cpus=1, scheduling_strategy="SPREAD")(answer_on_worker)
     uploads = ray.put(_uploads_named(texts))
     budget = _line_budget(deadline)
     pending = {remote.remote([(str(k), text)], uploads, budget): k for k, text in enumerate(texts)}
@@ -110,7 +110,7 @@ def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tu
         for ref in ready:
             k = pending.pop(ref)
             try:
-                [(_, status, body)] = ray.get(ref)
+                _, [(_, status, body)] = ray.get(ref)
                 answers[k] = (status, body)
             except Exception as error:  # the task as a whole: its worker died
                 answers[k] = (500, _worker_failed(error))

@@ -173,3 +173,46 @@ def test_a_batch_over_http_runs_on_ray_when_the_server_has_an_address(tmp_path):
     assert job["status"] == "done", job
     assert [(r["line"], r["status"]) for r in job["result"]["results"]] == [(1, 200), (2, 404)]
     assert started & ours, (started, ours)
+
+
+def _typical(method: str, shift: float) -> str:
+    """The typical request (``warmup.TYPICAL``) timed by ``method``, its first waypoint moved."""
+    from toptraj.service.warmup import TYPICAL
+
+    body = json.loads(json.dumps(TYPICAL))
+    body["timing"]["method"] = method
+    body["path"]["waypoints"][0][0] += shift
+    return json.dumps(body)
+
+
+def test_each_ray_worker_is_prepared_once_and_plans_min_cost_in_itself(tmp_path):
+    """A worker is prepared once whatever the lines it answers, and its ``min_cost`` lines run
+    inline: no fork server, no child process per line (the cause of seconds per line in a
+    Ray worker); their answers equal the service's own."""
+    lines = [_typical(("min_cost", "phase_plane")[k % 2], 0.02 * k) for k in range(8)]
+    requests = tmp_path / "requests.jsonl"
+    requests.write_text("\n".join(lines) + "\n")
+    assert run_batch(requests, tmp_path / "results.jsonl").planned == 8
+    results = _results(tmp_path / "results.jsonl")
+    for number in (1, 2, 7):
+        request = TrajectoryRequest.model_validate_json(lines[number - 1])
+        alone = orjson.loads(render(plan_request(request), request)[0])
+        assert results[number]["status"] == 200, results[number]
+        np.testing.assert_allclose(results[number]["body"]["duration"], alone["duration"], rtol=1e-9)
+
+    def state(_: int) -> tuple[int, int, list[str]]:
+        import os
+        import time
+
+        import psutil
+
+        from toptraj.service.batches.prepare import times_prepared
+
+        time.sleep(0.3)  # both workers busy at once: each probe on its own worker
+        return os.getpid(), times_prepared(), [" ".join(child.cmdline())[:80] for child in psutil.Process().children(recursive=True)]
+
+    probe = ray.remote(num_cpus=1)(state)
+    seen = {pid: (times, children) for pid, times, children in ray.get([probe.remote(k) for k in range(4)])}
+    prepared = {pid: (times, children) for pid, (times, children) in seen.items() if times}
+    assert prepared, seen  # the workers that answered the lines
+    assert all(times == 1 and children == [] for times, children in prepared.values()), prepared
