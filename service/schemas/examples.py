@@ -19,6 +19,7 @@ SUMMARIES = {
     "compare_methods": "several methods on one path",
     "ur5_spline_obstacles": "ur5: the spline example above a table and beside a pole, keeping 2 cm of clearance (min_clearance in the answer)",
     "geering_search_obstacle": "Geering's arm around a sphere: the global search among obstacles, then local optimization (tens of seconds; see /v1/jobs)",
+    "cell_two_ur5": "two ur5 facing each other across a table, crossing paths, kept 2 cm apart",
 }
 
 
@@ -27,9 +28,19 @@ def _load() -> dict[str, dict]:
 
 
 def openapi_examples(compare: bool) -> dict[str, dict]:
-    """The examples that are compare bodies (they name ``methods``), or the others."""
+    """The examples that are compare bodies (they name ``methods``), or the others (cell
+    bodies, which name ``arms``, apart)."""
     return {
         stem: {"summary": SUMMARIES.get(stem, stem.replace("_", " ")), "value": body}
         for stem, body in _load().items()
-        if ("methods" in body) == compare
+        if ("methods" in body) == compare and "arms" not in body
+    }
+
+
+def cell_examples() -> dict[str, dict]:
+    """The examples that are ``POST /v1/cells`` bodies (they name ``arms``)."""
+    return {
+        stem: {"summary": SUMMARIES.get(stem, stem.replace("_", " ")), "value": body}
+        for stem, body in _load().items()
+        if "arms" in body
     }
