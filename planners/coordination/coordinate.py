@@ -20,10 +20,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import binary_dilation
 
 from toptraj.planners.coordination.cell import MAX_ARMS, Cell
-from toptraj.planners.coordination.curve import SmoothCurve, shortcut, shortest_curve
+from toptraj.planners.coordination.curve import SmoothCurve, shortcut, shortest_curve, widened
 from toptraj.planners.coordination.diagram import Diagram, check_ends, coordination_diagram
 from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
 from toptraj.planners.coordination.verify import PairClearance, peak_utilization, schedule_clearance
@@ -73,22 +72,21 @@ def _delayed(diagram: Diagram, solo: list[TimeScaling], late: int) -> Schedule |
 
 
 def _curved(cell: Cell, diagram: Diagram, solo: list[TimeScaling], deadline: Deadline) -> Schedule | None:
-    """Both arms along the quickest smoothed curve of the diagram, or None when none is free."""
+    """Both arms along the quickest smoothed curve of the diagram, or None when none is free:
+    the curve is sought in the collision region widened by two nodes (``curve.shortcut``),
+    then by more where the smoothed curve still cuts into it."""
     dt1, dt2 = (np.diff(np.interp(diagram.s, scaling.s, scaling.t)) for scaling in solo)
-    blocked = diagram.blocked
-    for _ in range(WIDENINGS):
+    for cells in range(2, 2 + WIDENINGS):
         deadline.check()
         try:
-            nodes = shortest_curve(Diagram(diagram.s, diagram.distance, blocked, diagram.step1, diagram.step2), dt1, dt2)
+            nodes = shortest_curve(widened(diagram, cells), dt1, dt2)
         except InfeasiblePath:
             return None
-        curve = SmoothCurve(shortcut(Diagram(diagram.s, diagram.distance, blocked, diagram.step1, diagram.step2), nodes))
+        curve = SmoothCurve(shortcut(widened(diagram, cells - 2), nodes))
         scaling = pair_timing(cell, curve, deadline=deadline)
         schedule = Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated")
         if _free(diagram, schedule):
             return schedule
-        blocked = binary_dilation(blocked)
-        blocked[0, 0] = blocked[-1, -1] = False  # the ends were checked free before widening
     return None
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.interpolate import BSpline
+from scipy.ndimage import binary_dilation
 
 from toptraj.planners.coordination.diagram import Diagram
 from toptraj.planners.errors import InfeasiblePath
@@ -85,11 +86,24 @@ def _segment_free(diagram: Diagram, start: np.ndarray, end: np.ndarray) -> bool:
     return bool(diagram.free_at(points[:, 0], points[:, 1]).all())
 
 
-def shortcut(diagram: Diagram, nodes: np.ndarray, spacing: float = 0.02) -> np.ndarray:
+def widened(diagram: Diagram, cells: int) -> Diagram:
+    """``diagram`` with its collision region grown by ``cells`` nodes (8-neighbourhood), the
+    two ends left free."""
+    blocked = binary_dilation(diagram.blocked, np.ones((3, 3), dtype=bool), iterations=cells)
+    blocked[0, 0] = blocked[-1, -1] = False
+    return Diagram(diagram.s, diagram.distance, blocked, diagram.step1, diagram.step2)
+
+
+def shortcut(diagram: Diagram, nodes: np.ndarray, spacing: float | None = None) -> np.ndarray:
     """The staircase ``nodes`` (n, 2) straightened: from each kept node, on to the farthest
-    node that a straight free segment reaches; the polyline then resampled every ``spacing``
-    at most, so that the B-spline of its points (``SmoothCurve``) follows it closely, rounding
-    its corners only. Straight segments between monotone nodes stay monotone."""
+    node that a straight segment reaches through ``diagram`` widened by one node; the polyline
+    then resampled every ``spacing`` (default: one grid step) at most, so that the B-spline of
+    its points (``SmoothCurve``) strays less than a grid step from it, rounding its corners.
+    Straight segments between monotone nodes stay monotone. With ``nodes`` found in the
+    diagram widened by two nodes, the smoothed curve stays in cells of ``diagram`` with four
+    free corners."""
+    spacing = float(diagram.s[1] - diagram.s[0]) if spacing is None else spacing
+    diagram = widened(diagram, 1)
     kept, k = [0], 0
     while k < len(nodes) - 1:
         m = len(nodes) - 1
