@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.coordination.cell import MAX_ARMS, Cell
-from toptraj.planners.coordination.curve import SmoothCurve, shortcut, shortest_curve, widened
+from toptraj.planners.coordination.curve import SmoothCurve, resampled, shortcut, shortest_curve, widened
 from toptraj.planners.coordination.diagram import Diagram, check_ends, coordination_diagram
 from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
 from toptraj.planners.coordination.verify import PairClearance, peak_utilization, schedule_clearance
@@ -34,8 +34,10 @@ from toptraj.planners.timing.base import TimeScaling
 DELAYS = 64
 #: Samples in time at which a candidate is checked against the diagram.
 DIAGRAM_SAMPLES = 2_000
-#: Widenings of the collision region tried when the smoothed curve cuts into it.
-WIDENINGS = 3
+#: Widenings (grid nodes) of the collision region in which the quickest curve is sought.
+WIDENINGS = (1, 2, 3)
+#: Spacings (in s) of the control points of the smoothed curves tried.
+SPACINGS = (0.2, 0.1, 0.05, 0.02, 0.01)
 
 
 @dataclass(frozen=True)
@@ -71,23 +73,38 @@ def _delayed(diagram: Diagram, solo: list[TimeScaling], late: int) -> Schedule |
     return None
 
 
-def _curved(cell: Cell, diagram: Diagram, solo: list[TimeScaling], deadline: Deadline) -> Schedule | None:
-    """Both arms along the quickest smoothed curve of the diagram, or None when none is free:
-    the curve is sought in the collision region widened by two nodes (``curve.shortcut``),
-    then by more where the smoothed curve still cuts into it."""
-    dt1, dt2 = (np.diff(np.interp(diagram.s, scaling.s, scaling.t)) for scaling in solo)
-    for cells in range(2, 2 + WIDENINGS):
+def _smoothed(cell: Cell, diagram: Diagram, points: np.ndarray, deadline: Deadline) -> Schedule | None:
+    """The quickest free schedule along B-splines of ``points`` resampled at each of
+    ``SPACINGS`` (wider rounding of the corners, faster where it stays free), or None."""
+    best: Schedule | None = None
+    for spacing in SPACINGS:
         deadline.check()
+        curve = SmoothCurve(resampled(points, spacing))
+        s = curve.evaluate(np.linspace(0.0, 1.0, DIAGRAM_SAMPLES + 1))[0]
+        if not diagram.free_at(s[:, 0], s[:, 1]).all():
+            continue
+        scaling = pair_timing(cell, curve, deadline=deadline)
+        schedule = _within_limits(cell, Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated"))
+        if (best is None or schedule.duration < best.duration) and _free(diagram, schedule):
+            best = schedule
+    return best
+
+
+def curve_schedule(cell: Cell, diagram: Diagram, solo: list[TimeScaling], deadline: Deadline) -> Schedule | None:
+    """Both arms along the quickest smoothed curve of the diagram, or None when none is free:
+    the curve is sought in the collision region widened by ``WIDENINGS`` nodes in turn, its
+    staircase straightened (``curve.shortcut``) and smoothed (``_smoothed``)."""
+    dt1, dt2 = (np.diff(np.interp(diagram.s, scaling.s, scaling.t)) for scaling in solo)
+    found = []
+    for cells in WIDENINGS:
         try:
             nodes = shortest_curve(widened(diagram, cells), dt1, dt2)
         except InfeasiblePath:
-            return None
-        curve = SmoothCurve(shortcut(widened(diagram, cells - 2), nodes))
-        scaling = pair_timing(cell, curve, deadline=deadline)
-        schedule = Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated")
-        if _free(diagram, schedule):
-            return schedule
-    return None
+            continue
+        schedule = _smoothed(cell, diagram, shortcut(widened(diagram, max(cells - 2, 0)), nodes), deadline)
+        if schedule is not None:
+            found.append(schedule)
+    return min(found, key=lambda schedule: schedule.duration, default=None)
 
 
 def _within_limits(cell: Cell, schedule: Schedule) -> Schedule:
@@ -115,10 +132,9 @@ def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
     check_ends(cell)
     solo = [solo_timing(arm, cell.kinds, deadline=deadline) for arm in cell.arms]
     diagram = coordination_diagram(cell, deadline=deadline)
-    candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), _curved(cell, diagram, solo, deadline)]
-    found = sorted((c for c in candidates if c is not None), key=lambda c: c.duration)
+    candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), curve_schedule(cell, diagram, solo, deadline)]
+    found = sorted((_within_limits(cell, c) for c in candidates if c is not None), key=lambda c: c.duration)
     for schedule in found:
-        schedule = _within_limits(cell, schedule)
         clearance = schedule_clearance(cell, schedule, deadline)
         if clearance.bound >= cell.clearance:
             t = np.linspace(0.0, schedule.duration, DIAGRAM_SAMPLES + 1)

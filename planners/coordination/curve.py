@@ -95,8 +95,8 @@ def widened(diagram: Diagram, cells: int) -> Diagram:
 
 
 def shortcut(diagram: Diagram, nodes: np.ndarray, spacing: float | None = None) -> np.ndarray:
-    """The staircase ``nodes`` (n, 2) straightened: from each kept node, on to the farthest
-    node that a straight segment reaches through ``diagram`` widened by one node; the polyline
+    """The staircase ``nodes`` (n, 2) straightened: from each kept node, on along the nodes as
+    long as a straight segment reaches them through ``diagram`` widened by one node; the polyline
     then resampled every ``spacing`` (default: one grid step) at most, so that the B-spline of
     its points (``SmoothCurve``) strays less than a grid step from it, rounding its corners.
     Straight segments between monotone nodes stay monotone. With ``nodes`` found in the
@@ -106,9 +106,9 @@ def shortcut(diagram: Diagram, nodes: np.ndarray, spacing: float | None = None) 
     diagram = widened(diagram, 1)
     kept, k = [0], 0
     while k < len(nodes) - 1:
-        m = len(nodes) - 1
-        while m > k + 1 and not _segment_free(diagram, nodes[k], nodes[m]):
-            m -= 1
+        m = k + 1
+        while m < len(nodes) - 1 and _segment_free(diagram, nodes[k], nodes[m + 1]):
+            m += 1
         kept.append(m)
         k = m
     points = [nodes[0]]
@@ -116,6 +116,16 @@ def shortcut(diagram: Diagram, nodes: np.ndarray, spacing: float | None = None) 
         pieces = max(1, int(np.ceil(np.abs(nodes[b] - nodes[a]).max() / spacing)))
         points += [nodes[a] + (nodes[b] - nodes[a]) * w for w in np.linspace(0.0, 1.0, pieces + 1)[1:]]
     return np.array(points)
+
+
+def resampled(points: np.ndarray, spacing: float) -> np.ndarray:
+    """Points every ``spacing`` or less of arc length along the polyline ``points`` (n, 2), its
+    ends kept and its other vertices dropped: control points of a smoother ``SmoothCurve``
+    that rounds the polyline's corners more widely (monotone: points of a monotone polyline in
+    order)."""
+    length = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    at = np.linspace(0.0, length[-1], int(np.ceil(length[-1] / spacing)) + 1)
+    return np.column_stack([np.interp(at, length, points[:, 0]), np.interp(at, length, points[:, 1])])
 
 
 class SmoothCurve:

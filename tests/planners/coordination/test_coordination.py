@@ -12,8 +12,10 @@ from tests.planners.coordination.cells import FIRST, SECOND, TURNED, facing_cell
 from tests.planners.coordination.independent import coal_distance
 from toptraj import robots
 from toptraj.planners.coordination import Cell, coordinate
+from toptraj.planners.coordination.coordinate import curve_schedule
 from toptraj.planners.coordination.timing import Schedule, SoloMotion, solo_timing
 from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.plan import plan
 from toptraj.planners.problem.requests import Timing, WaypointPath
 
@@ -92,3 +94,17 @@ def test_a_third_arm_is_refused():
     cell = facing_cell()
     with pytest.raises(InvalidRequest, match="give exactly two arms"):
         coordinate(Cell(cell.arms + cell.arms[:1], cell.clearance))
+
+
+def test_the_coordinated_curve_keeps_clearance_and_limits(crossing):
+    # the curve candidate on its own (on the example a late start is quicker, and is chosen)
+    cell, found = crossing
+    solo = [solo_timing(arm, KINDS) for arm in cell.arms]
+    schedule = curve_schedule(cell, found.diagram, solo, NO_DEADLINE)
+    assert schedule is not None and schedule.kind == "coordinated"
+    assert max(found.solo) < found.schedule.duration <= schedule.duration < sum(found.solo)
+    assert _coal_min(cell, schedule, 300) >= cell.clearance
+    t = np.linspace(0.0, schedule.duration, 20_001)
+    for arm, (_, qd, qdd) in zip(cell.arms, schedule.states(cell, t)):
+        assert (np.abs(qd) <= arm.limits.velocity * 1.005).all()
+        assert (np.abs(qdd) <= arm.limits.acceleration * 1.005).all()
