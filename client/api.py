@@ -3,6 +3,7 @@ the service, robots and trajectories here, jobs and batches from ``toptraj.clien
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ ENDPOINTS: dict[tuple[str, str], str] = {
     ("POST", "/v1/robots/{name}/skeleton"): "skeleton",
     ("POST", "/v1/trajectories"): "plan",
     ("POST", "/v1/trajectories/compare"): "compare",
+    ("POST", "/v1/cells"): "cell",
     ("POST", "/v1/jobs"): "submit",
     ("GET", "/v1/jobs"): "jobs",
     ("GET", "/v1/jobs/{job_id}"): "job",
@@ -237,3 +239,14 @@ class Client(JobCalls):
                 raise ValueError("give methods, e.g. ['phase_plane', 'quintic']")
             body = compare_request(robot, waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing)
         return comparisons(self._call("POST", "/v1/trajectories/compare", body, timeout=timeout))
+
+    def cell(self, body: dict | str | os.PathLike[str], *, timeout: float | None = None) -> dict:
+        """``POST /v1/cells``: two arms in one workspace timed together so that they keep a
+        clearance (``examples/cell_two_ur5.json``: a dict, JSON text or a file's path).
+
+        Returns:
+            The answer as sent: ``duration``, ``solo_durations``, ``time_lost``, ``t``, one
+            ``trajectory`` (a JointTrajectory) per arm and the coordination ``diagram``.
+        """
+        request = body if isinstance(body, dict) else json.loads(_text(body))
+        return self._call("POST", "/v1/cells", request, timeout=timeout)

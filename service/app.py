@@ -18,7 +18,7 @@ from toptraj.service.body_limit import BodySizeLimit
 from toptraj.service.errors import UnexpectedErrors, install_problem_handlers
 from toptraj.service.finite import FiniteJSONResponse
 from toptraj.service.jobs import JOB_MODULES, job_runner
-from toptraj.service.routes import batches, guide, health, jobs, trajectories, web
+from toptraj.service.routes import batches, cells, guide, health, jobs, trajectories, web
 from toptraj.service.routes import robots as robot_routes
 from toptraj.service.serving import open_connections
 from toptraj.service.settings import Settings
@@ -92,6 +92,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(health.router)
     app.include_router(robot_routes.router)
     app.include_router(trajectories.router)
+    app.include_router(cells.router)
     app.include_router(jobs.router)
     app.include_router(batches.router)
     app.include_router(web.router)

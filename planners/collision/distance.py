@@ -45,6 +45,12 @@ def _segment_segment(p1, q1, p2, q2):
     return np.linalg.norm(closest1 - closest2, axis=-1)
 
 
+def segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Distance (m) between the segments [p1, q1] and [p2, q2], end points (..., 3) broadcast
+    over the leading axes; shape: those axes."""
+    return _segment_segment(p1, q1, p2, q2)
+
+
 def _box_signed(points, half):
     """Signed distance of points (..., 3), in the box's frame, to the box of half sizes (3,)."""
     excess = np.abs(points) - half

@@ -20,6 +20,7 @@ SUMMARIES = {
     "ur5_spline_obstacles": "ur5: the spline example above a table and beside a pole, keeping 2 cm of clearance (min_clearance in the answer)",
     "ur5_ceiling_payload": "ur5 hanging from the ceiling with a 2.5 kg tool: the spline example, torques with the payload and gravity as the base feels it",
     "geering_search_obstacle": "Geering's arm around a sphere: the global search among obstacles, then local optimization (tens of seconds; see /v1/jobs)",
+    "cell_two_ur5": "two ur5 facing each other across a table, crossing paths, kept 2 cm apart",
 }
 
 
@@ -28,9 +29,19 @@ def _load() -> dict[str, dict]:
 
 
 def openapi_examples(compare: bool) -> dict[str, dict]:
-    """The examples that are compare bodies (they name ``methods``), or the others."""
+    """The examples that are compare bodies (they name ``methods``), or the others (cell
+    bodies, which name ``arms``, apart)."""
     return {
         stem: {"summary": SUMMARIES.get(stem, stem.replace("_", " ")), "value": body}
         for stem, body in _load().items()
-        if ("methods" in body) == compare
+        if ("methods" in body) == compare and "arms" not in body
+    }
+
+
+def cell_examples() -> dict[str, dict]:
+    """The examples that are ``POST /v1/cells`` bodies (they name ``arms``)."""
+    return {
+        stem: {"summary": SUMMARIES.get(stem, stem.replace("_", " ")), "value": body}
+        for stem, body in _load().items()
+        if "arms" in body
     }

@@ -305,3 +305,9 @@ def test_csv_comments_and_columns_are_read():
     np.testing.assert_array_equal(table.t, [0.0, 1.0, 2.0])
     np.testing.assert_array_equal(table.tau[:, 1], [0.8, 1.8, 2.8])
     assert table.q.shape == table.qd.shape == table.qdd.shape == (3, 2)
+
+
+def test_a_cell_through_the_client(toptraj):
+    answer = toptraj.cell(ROOT / "examples" / "cell_two_ur5.json", timeout=120.0)
+    assert max(answer["solo_durations"]) < answer["duration"] <= answer["sequential_duration"]
+    assert [arm["robot"] for arm in answer["arms"]] == ["ur5", "ur5"]

@@ -25,7 +25,11 @@ def _body_examples(openapi, path):
 
 
 def test_every_example_file_is_an_example_of_its_endpoint(openapi):
-    shown = {**_body_examples(openapi, "/v1/trajectories"), **_body_examples(openapi, "/v1/trajectories/compare")}
+    shown = {
+        **_body_examples(openapi, "/v1/trajectories"),
+        **_body_examples(openapi, "/v1/trajectories/compare"),
+        **_body_examples(openapi, "/v1/cells"),
+    }
     files = {path.stem: json.loads(path.read_text()) for path in EXAMPLES.glob("*.json")}
     assert files and shown == files
     assert all("methods" in body for body in _body_examples(openapi, "/v1/trajectories/compare").values())

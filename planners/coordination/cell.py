@@ -1,0 +1,99 @@
+"""A robot cell: arms sharing one world, each with its base pose, its own given path and its
+limits, and the clearance they must keep from each other (path-velocity decomposition, Kant &
+Zucker 1986: each path is fixed, only the timing along it is chosen).
+
+Geometry: every arm is its link capsules (``toptraj.robots.collision``) placed by its base pose,
+p_world = R p_base + t (R (3, 3) the base's axes in the world, t (3,) in m). The distance
+between two arms is the smallest capsule-to-capsule distance (segments as in Ericson,
+*Real-Time Collision Detection*, §5.1.9, minus both radii), in m, negative when they overlap.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from toptraj.planners.collision.distance import segment_distance
+from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.paths.base import GeometricPath
+from toptraj.robots import JointLimits, Robot
+from toptraj.robots.collision import robot_capsules, world_capsules
+
+#: Arms a cell holds (the coordination space is the square of the two path parameters).
+MAX_ARMS = 2
+#: How far R R^T may be from the identity, entry by entry, for R to count as a rotation.
+ROTATION_TOLERANCE = 1e-6
+
+
+def checked_rotation(rotation, where: str) -> np.ndarray:
+    """``rotation`` as a (3, 3) rotation matrix, or InvalidRequest naming ``where`` and why."""
+    matrix = np.asarray(rotation, dtype=float)
+    if matrix.shape != (3, 3) or not np.isfinite(matrix).all():
+        raise InvalidRequest(f"{where} must be a 3x3 matrix of finite numbers (the base's axes as columns, in the world)")
+    error = float(np.abs(matrix @ matrix.T - np.eye(3)).max())
+    determinant = float(np.linalg.det(matrix))
+    if error > ROTATION_TOLERANCE or determinant <= 0.0:
+        raise InvalidRequest(
+            f"{where} is not a rotation: R R^T differs from the identity by {error:.3g} and det R = {determinant:.4g}; "
+            "give an orthonormal matrix with determinant +1 (e.g. [[1,0,0],[0,1,0],[0,0,1]], or [[-1,0,0],[0,-1,0],[0,0,1]] "
+            "for a base turned half a turn about z)"
+        )
+    return matrix
+
+
+@dataclass(frozen=True)
+class CellArm:
+    """One arm of a cell: its ``robot``, its given ``path`` (s in [0, 1]), its ``limits`` and
+    its base pose, ``base_rotation`` (3, 3) and ``base_position`` (3,) in m."""
+
+    robot: Robot
+    path: GeometricPath
+    limits: JointLimits
+    base_rotation: np.ndarray
+    base_position: np.ndarray
+
+    def capsules_at(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """World end points a, b (n, k, 3) of the arm's k capsules at joint positions ``q``
+        (n, n_dof), and their radii (k,), in m."""
+        capsules = robot_capsules(self.robot)
+        a, b = world_capsules(self.robot.model, self.robot.data, capsules, self.robot.configuration(q))
+        rotation, position = self.base_rotation, self.base_position
+        radius = np.array([capsule.radius for capsule in capsules])
+        return a @ rotation.T + position, b @ rotation.T + position, radius
+
+    def link_names(self) -> list[str]:
+        """The names of the arm's capsules, in the order of ``capsules_at``."""
+        return [capsule.name for capsule in robot_capsules(self.robot)]
+
+    def reach(self) -> float:
+        """A bound (m) on how far any point of the arm lies from any of its joints, so that a
+        joint motion dq moves no point by more than reach * sum |dq_j|."""
+        model = self.robot.model
+        chain = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(2, model.njoints))
+        tip = max(max(np.linalg.norm(c.a), np.linalg.norm(c.b)) + c.radius for c in robot_capsules(self.robot))
+        return chain + float(tip)
+
+
+@dataclass(frozen=True)
+class Cell:
+    """Arms sharing a workspace, to be kept ``clearance`` (m) apart, under the limit ``kinds``
+    (velocity, acceleration) of each."""
+
+    arms: tuple[CellArm, ...]
+    clearance: float
+    kinds: tuple[str, ...] = ("velocity", "acceleration")
+
+
+def pair_distances(first, second) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Smallest distance (m) between two arms' capsules, pairwise over leading axes: ``first``
+    = (a, b, radius) with a, b of shape (..., k1, 3) and ``second`` likewise (..., k2, 3);
+    returns the distances (...) and the indices of the two capsules that give them."""
+    a1, b1, r1 = first
+    a2, b2, r2 = second
+    d = segment_distance(a1[..., :, None, :], b1[..., :, None, :], a2[..., None, :, :], b2[..., None, :, :])
+    d = d - r1[:, None] - r2[None, :]
+    flat = d.reshape(*d.shape[:-2], -1)
+    best = flat.argmin(axis=-1)
+    distance = np.take_along_axis(flat, best[..., None], axis=-1)[..., 0]
+    return distance, best // d.shape[-1], best % d.shape[-1]

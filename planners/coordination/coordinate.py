@@ -1,0 +1,145 @@
+"""Two arms timed along their given paths so that they keep their clearance, as early as
+possible on one clock (path-velocity decomposition: Kant & Zucker 1986; O'Donnell &
+Lozano-Pérez 1989).
+
+Candidates, each checked against the coordination diagram, the quickest kept:
+
+* both arms on their own time-optimal motions at once: when the arms never come near each
+  other this is optimal (neither can finish before its own optimum);
+* one arm started late by the least delay that keeps them apart (the late start by the other
+  arm's whole duration is moving one arm after the other);
+* the quickest monotone curve through the free diagram (``curve``), smoothed, both arms timed
+  along it by one time-optimal solve (``timing.pair_timing``).
+
+The one kept is verified at fine samples (``verify.schedule_clearance``) and slowed uniformly
+where a dense resampling finds a limit exceeded between the solver's grid points.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from toptraj.planners.coordination.cell import MAX_ARMS, Cell
+from toptraj.planners.coordination.curve import SmoothCurve, resampled, shortcut, shortest_curve, widened
+from toptraj.planners.coordination.diagram import Diagram, check_ends, coordination_diagram
+from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
+from toptraj.planners.coordination.verify import PairClearance, peak_utilization, schedule_clearance
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.timing.base import TimeScaling
+
+#: Late starts tried per arm, evenly over the other arm's duration.
+DELAYS = 64
+#: Samples in time at which a candidate is checked against the diagram.
+DIAGRAM_SAMPLES = 2_000
+#: Widenings (grid nodes) of the collision region in which the quickest curve is sought.
+WIDENINGS = (1, 2, 3)
+#: Spacings (in s) of the control points of the smoothed curves tried.
+SPACINGS = (0.2, 0.1, 0.05, 0.02, 0.01)
+
+
+@dataclass(frozen=True)
+class Coordination:
+    """The timed pair: its ``schedule``, each arm's own optimum ``solo`` (s), the ``diagram``,
+    the (s1, s2) the schedule passes through (``curve``, (n, 2)), and its ``clearance``."""
+
+    schedule: Schedule
+    solo: tuple[float, float]
+    diagram: Diagram
+    curve: np.ndarray
+    clearance: PairClearance
+
+    @property
+    def time_lost(self) -> float:
+        """Seconds beyond the slower arm's own optimum, spent keeping the arms apart."""
+        return self.schedule.duration - max(self.solo)
+
+
+def _free(diagram: Diagram, schedule: Schedule) -> bool:
+    s = schedule.path_parameters(np.linspace(0.0, schedule.duration, DIAGRAM_SAMPLES + 1))
+    return bool(diagram.free_at(s[:, 0], s[:, 1]).all())
+
+
+def _delayed(diagram: Diagram, solo: list[TimeScaling], late: int) -> Schedule | None:
+    """The schedule with arm ``late`` started after the least delay that keeps it free."""
+    for delay in np.linspace(0.0, solo[1 - late].duration, DELAYS + 1):
+        motions = [SoloMotion(solo[0]), SoloMotion(solo[1])]
+        motions[late] = SoloMotion(solo[late], float(delay))
+        schedule = Schedule(tuple(motions), "simultaneous" if delay == 0.0 else f"arms[{late}] waits")
+        if _free(diagram, schedule):
+            return schedule
+    return None
+
+
+def _smoothed(cell: Cell, diagram: Diagram, points: np.ndarray, deadline: Deadline) -> Schedule | None:
+    """The quickest free schedule along B-splines of ``points`` resampled at each of
+    ``SPACINGS`` (wider rounding of the corners, faster where it stays free), or None."""
+    best: Schedule | None = None
+    for spacing in SPACINGS:
+        deadline.check()
+        curve = SmoothCurve(resampled(points, spacing))
+        s = curve.evaluate(np.linspace(0.0, 1.0, DIAGRAM_SAMPLES + 1))[0]
+        if not diagram.free_at(s[:, 0], s[:, 1]).all():
+            continue
+        scaling = pair_timing(cell, curve, deadline=deadline)
+        schedule = _within_limits(cell, Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated"))
+        if (best is None or schedule.duration < best.duration) and _free(diagram, schedule):
+            best = schedule
+    return best
+
+
+def curve_schedule(cell: Cell, diagram: Diagram, solo: list[TimeScaling], deadline: Deadline) -> Schedule | None:
+    """Both arms along the quickest smoothed curve of the diagram, or None when none is free:
+    the curve is sought in the collision region widened by ``WIDENINGS`` nodes in turn, its
+    staircase straightened (``curve.shortcut``) and smoothed (``_smoothed``)."""
+    dt1, dt2 = (np.diff(np.interp(diagram.s, scaling.s, scaling.t)) for scaling in solo)
+    found = []
+    for cells in WIDENINGS:
+        try:
+            nodes = shortest_curve(widened(diagram, cells), dt1, dt2)
+        except InfeasiblePath:
+            continue
+        schedule = _smoothed(cell, diagram, shortcut(widened(diagram, max(cells - 2, 0)), nodes), deadline)
+        if schedule is not None:
+            found.append(schedule)
+    return min(found, key=lambda schedule: schedule.duration, default=None)
+
+
+def _within_limits(cell: Cell, schedule: Schedule) -> Schedule:
+    """``schedule`` slowed uniformly where the dense peak of a limit exceeds 1 (velocity
+    scales as 1 / stretch, acceleration as 1 / stretch^2)."""
+    velocity, acceleration = peak_utilization(cell, schedule)
+    stretch = max(1.0, velocity, float(np.sqrt(acceleration)))
+    return schedule if stretch == 1.0 else Schedule(schedule.motions, schedule.kind, stretch)
+
+
+def _check_cell(cell: Cell) -> None:
+    if len(cell.arms) != MAX_ARMS:
+        raise InvalidRequest(f"a cell has {len(cell.arms)} arms; {MAX_ARMS} are served: give exactly two arms")
+
+
+def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
+    """Time the cell's two arms along their paths, kept ``cell.clearance`` apart, both done as
+    early as possible (module docstring).
+
+    Raises:
+        InvalidRequest: not two arms, or arms that collide at their start.
+        InfeasiblePath: no timing keeps the arms apart along these paths.
+    """
+    _check_cell(cell)
+    check_ends(cell)
+    solo = [solo_timing(arm, cell.kinds, deadline=deadline) for arm in cell.arms]
+    diagram = coordination_diagram(cell, deadline=deadline)
+    candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), curve_schedule(cell, diagram, solo, deadline)]
+    found = sorted((_within_limits(cell, c) for c in candidates if c is not None), key=lambda c: c.duration)
+    for schedule in found:
+        clearance = schedule_clearance(cell, schedule, deadline)
+        if clearance.bound >= cell.clearance:
+            t = np.linspace(0.0, schedule.duration, DIAGRAM_SAMPLES + 1)
+            return Coordination(schedule, (solo[0].duration, solo[1].duration), diagram, schedule.path_parameters(t), clearance)
+    raise InfeasiblePath(
+        "no timing keeps the arms apart along these paths (neither waiting nor a coordinated curve through the "
+        "coordination diagram is free): move a base apart, change a path or lower clearance"
+    )

@@ -1,0 +1,105 @@
+"""The coordination diagram of two arms (O'Donnell & Lozano-Pérez 1989, §3): the square of
+their path parameters (s1, s2) in [0, 1]^2, on a grid of (M + 1) x (M + 1) nodes, with the
+distance between the arms at every node and the region where they would come closer than the
+clearance marked as an obstacle.
+
+Between nodes the distance changes by at most the arms' motion over a grid step (estimated from
+the capsules' displacement, ``motion_steps``). A node is blocked when its distance is below the
+clearance plus the motion of both arms over one grid step and ``FINE_STEP``: so any (s1, s2)
+in a cell whose four corners are free is about ``clearance + FINE_STEP`` from a collision or
+farther. The schedule finally chosen is verified apart, at fine samples, with a strict bound
+(``toptraj.planners.coordination.verify``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from toptraj.planners.coordination.cell import Cell, CellArm, pair_distances
+from toptraj.planners.errors import InvalidRequest, OverMemory
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+
+#: Grid intervals along each path parameter.
+GRID = 100
+#: Margin (m) kept above the clearance by the blocked region, for the checks between samples.
+FINE_STEP = 0.005
+#: Factor on the capsules' displacement between grid nodes for their motion in between.
+STEP_SAFETY = 1.5
+#: Memory (bytes) the distance grid may take at once: one row of nodes, every capsule pair.
+MEMORY_CAP = 200_000_000
+
+
+@dataclass(frozen=True)
+class Diagram:
+    """The coordination diagram on ``s`` (M + 1,): ``distance`` (M + 1, M + 1) between the
+    arms at (s1[i], s2[j]) in m, ``blocked`` (M + 1, M + 1) where it is too close, and the arms'
+    motion bound over each grid step, ``step1`` and ``step2`` (M,), in m."""
+
+    s: np.ndarray
+    distance: np.ndarray
+    blocked: np.ndarray
+    step1: np.ndarray
+    step2: np.ndarray
+
+    def free_at(self, s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
+        """Whether each point (s1, s2) (n,) lies in a cell with four free corners."""
+        m = len(self.s) - 1
+        i = np.clip(np.floor(np.asarray(s1) * m).astype(int), 0, m - 1)
+        j = np.clip(np.floor(np.asarray(s2) * m).astype(int), 0, m - 1)
+        b = self.blocked
+        return ~(b[i, j] | b[i + 1, j] | b[i, j + 1] | b[i + 1, j + 1])
+
+
+def arm_capsules(arm: CellArm, s: np.ndarray):
+    """The arm's world capsules at path parameters ``s`` (n,): a, b (n, k, 3), radius (k,)."""
+    return arm.capsules_at(arm.path.evaluate(s).q)
+
+
+def motion_steps(capsules) -> np.ndarray:
+    """How far (m) the arm's capsules move between successive samples, from their world end
+    points a, b (n, k, 3): (n - 1,). A capsule moved rigidly moves each point of its axis by a
+    convex combination of its ends' displacements, so by at most the larger; ``STEP_SAFETY``
+    covers the motion between the samples."""
+    a, b = capsules[0], capsules[1]
+    ends = np.maximum(np.linalg.norm(np.diff(a, axis=0), axis=-1), np.linalg.norm(np.diff(b, axis=0), axis=-1))
+    return STEP_SAFETY * ends.max(axis=1)
+
+
+def _check_start(cell: Cell, distance: float, links: tuple[str, str]) -> None:
+    if distance < cell.clearance:
+        first, second = cell.arms
+        raise InvalidRequest(
+            f"the arms collide at their start: link {links[0]!r} of arms[0] ({first.robot.name}) is {distance:.4g} m from "
+            f"link {links[1]!r} of arms[1] ({second.robot.name}) at s1 = s2 = 0 (the clearance is {cell.clearance:g} m): "
+            "move a base apart, change the first waypoints or lower clearance"
+        )
+
+
+def check_ends(cell: Cell) -> None:
+    """InvalidRequest when the arms are closer than the clearance at their starts (where no
+    timing can help), naming the two links."""
+    first, second = cell.arms
+    distance, i, j = pair_distances(arm_capsules(first, np.zeros(1)), arm_capsules(second, np.zeros(1)))
+    _check_start(cell, float(distance[0]), (first.link_names()[int(i[0])], second.link_names()[int(j[0])]))
+
+
+def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE) -> Diagram:
+    """The diagram of the cell's two arms on ``grid`` intervals per axis (memory checked
+    first: one row of (grid + 1) nodes, k1 x k2 capsule pairs, about 40 arrays of 8 bytes)."""
+    first, second = cell.arms
+    s = np.linspace(0.0, 1.0, grid + 1)
+    one, two = arm_capsules(first, s), arm_capsules(second, s)
+    row_bytes = 40 * 8 * (grid + 1) * one[0].shape[1] * two[0].shape[1] * 3
+    if row_bytes > MEMORY_CAP:
+        raise OverMemory(f"the coordination diagram needs {row_bytes / 1e6:.0f} MB per row: use arms with fewer links")
+    distance = np.empty((grid + 1, grid + 1))
+    for i in range(grid + 1):
+        deadline.check()
+        distance[i] = pair_distances((one[0][i][None], one[1][i][None], one[2]), two)[0]
+    step1, step2 = motion_steps(one), motion_steps(two)
+    local1 = np.maximum(np.r_[step1, 0.0], np.r_[0.0, step1])  # the larger step beside each node
+    local2 = np.maximum(np.r_[step2, 0.0], np.r_[0.0, step2])
+    blocked = distance < cell.clearance + FINE_STEP + local1[:, None] + local2[None, :]
+    return Diagram(s=s, distance=distance, blocked=blocked, step1=step1, step2=step2)

@@ -1,0 +1,77 @@
+"""Checks of a schedule at fine samples, independent of the diagram's grid: the arms' distance
+along the motion, and each arm's limits.
+
+Clearance: samples in time dense enough that no point of either arm moves more than
+``FINE_STEP`` between two; between samples the distance is at least the smaller of the two
+sampled distances minus half the motion of both arms (each point moves at most reach * sum |dq|,
+``CellArm.reach``). Limits: the peak of |qd| / v_max and |qdd| / a_max over dense samples.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from toptraj.planners.coordination.cell import Cell, pair_distances
+from toptraj.planners.coordination.diagram import FINE_STEP
+from toptraj.planners.coordination.timing import Schedule
+from toptraj.planners.errors import OverMemory
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+
+#: Samples of the first, coarse pass that measures the motion.
+COARSE = 400
+#: Most samples of a clearance check (each one a forward kinematics per arm).
+MAX_SAMPLES = 20_000
+#: Samples of the limit check per second of motion, and at least.
+LIMIT_RATE, LIMIT_MIN = 2_000, 4_000
+
+
+@dataclass(frozen=True)
+class PairClearance:
+    """The smallest sampled distance (m) between the arms, at time ``t`` (s) between link
+    ``links[0]`` of arm 0 and ``links[1]`` of arm 1; ``bound``, the smallest distance
+    guaranteed between samples; ``samples`` checked."""
+
+    distance: float
+    t: float
+    links: tuple[str, str]
+    bound: float
+    samples: int
+
+
+def _motion(cell: Cell, states) -> np.ndarray:
+    """A bound (m) on the motion of any point of both arms between successive samples."""
+    return sum(arm.reach() * np.abs(np.diff(q, axis=0)).sum(axis=1) for arm, (q, _, _) in zip(cell.arms, states))
+
+
+def schedule_clearance(cell: Cell, schedule: Schedule, deadline: Deadline = NO_DEADLINE) -> PairClearance:
+    """The arms' distance along ``schedule`` at fine samples (module docstring)."""
+    coarse = schedule.states(cell, np.linspace(0.0, schedule.duration, COARSE + 1))
+    count = math.ceil(float(_motion(cell, coarse).sum()) / FINE_STEP) + 1
+    if count > MAX_SAMPLES:
+        raise OverMemory(f"checking the arms' clearance needs {count} samples, more than {MAX_SAMPLES}: shorten the paths")
+    t = np.linspace(0.0, schedule.duration, max(count, COARSE) + 1)
+    states = schedule.states(cell, t)
+    deadline.check()
+    first, second = cell.arms
+    distance, i, j = pair_distances(first.capsules_at(states[0][0]), second.capsules_at(states[1][0]))
+    bound = np.minimum(distance[:-1], distance[1:]) - _motion(cell, states) / 2.0
+    worst = int(np.argmin(distance))
+    links = (first.link_names()[int(i[worst])], second.link_names()[int(j[worst])])
+    return PairClearance(float(distance[worst]), float(t[worst]), links, float(bound.min()), len(t))
+
+
+def peak_utilization(cell: Cell, schedule: Schedule) -> tuple[float, float]:
+    """The largest |qd| / v_max and |qdd| / a_max of any arm and joint over dense samples of
+    ``schedule`` (only the limit kinds of the cell; 0 for a kind not asked)."""
+    count = max(LIMIT_MIN, math.ceil(LIMIT_RATE * schedule.duration))
+    t = np.linspace(0.0, schedule.duration, count + 1)
+    velocity = acceleration = 0.0
+    for arm, (_, qd, qdd) in zip(cell.arms, schedule.states(cell, t)):
+        if "velocity" in cell.kinds:
+            velocity = max(velocity, float((np.abs(qd) / arm.limits.velocity).max()))
+        if "acceleration" in cell.kinds:
+            acceleration = max(acceleration, float((np.abs(qdd) / arm.limits.acceleration).max()))
+    return velocity, acceleration

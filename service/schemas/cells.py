@@ -1,0 +1,60 @@
+"""Schemas of ``POST /v1/cells``: arms sharing a workspace, each along its own joint path,
+timed together so that they keep a clearance (DESIGN.md, HTTP contract)."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import Field
+
+from toptraj.service.schemas.common import Schema
+from toptraj.service.schemas.trajectories import JointVector, Name, Point
+
+#: Arms a request may list (the planner serves two; more are refused with a 422 saying so).
+MAX_CELL_ARMS = 8
+#: Waypoints per arm.
+MAX_CELL_WAYPOINTS = 100
+RotationRow = Annotated[list[Annotated[float, Field(ge=-2.0, le=2.0)]], Field(min_length=3, max_length=3)]
+IDENTITY = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+
+
+class BasePose(Schema):
+    """Where an arm's base stands in the world: p_world = rotation p_base + position."""
+
+    position: Point = Field(default=[0.0, 0.0, 0.0], description="The base's origin [x, y, z] (m), world frame.")
+    rotation: Annotated[list[RotationRow], Field(min_length=3, max_length=3)] = Field(
+        default=IDENTITY,
+        description="Rotation matrix (rows) from the base's axes to the world's: orthonormal, determinant +1 "
+        "(entries within 1e-6). [[-1,0,0],[0,-1,0],[0,0,1]] turns the base half a turn about z.",
+    )
+
+
+class CellArmRequest(Schema):
+    """One arm of the cell: its robot, base pose, joint path and limit scales."""
+
+    robot: Name = Field(description="Robot name (GET /v1/robots).")
+    base: BasePose = Field(default=BasePose(), description="The base pose in the world.")
+    waypoints: list[JointVector] = Field(
+        min_length=2,
+        max_length=MAX_CELL_WAYPOINTS,
+        description="Joint configurations (rad, m), one row each, through which a C2 cubic spline runs.",
+    )
+    velocity_scale: Annotated[float, Field(gt=0.0, le=1.0)] = Field(
+        default=1.0, description="Factor on the robot's velocity limits."
+    )
+    acceleration_scale: Annotated[float, Field(gt=0.0, le=1.0)] = Field(
+        default=1.0, description="Factor on the robot's acceleration limits."
+    )
+
+
+class CellRequest(Schema):
+    """Two arms in one workspace, each along its own path, to be timed together."""
+
+    arms: list[CellArmRequest] = Field(min_length=1, max_length=MAX_CELL_ARMS, description="The arms (two are served).")
+    clearance: Annotated[float, Field(ge=0.0, le=1.0)] = Field(
+        default=0.01, description="Smallest distance (m) the arms' link capsules keep from each other at all times."
+    )
+    constraints: list[Literal["velocity", "acceleration"]] = Field(
+        default=["velocity", "acceleration"], min_length=1, max_length=2, description="Limits each arm keeps."
+    )
+    dt: Annotated[float, Field(ge=1e-3, le=1.0)] = Field(default=0.01, description="Sample period (s) of the answer.")

@@ -1,0 +1,91 @@
+"""POST /v1/cells: two arms timed together, their answer on one clock, and the 4xx of a bad
+cell (issue 37)."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import numpy as np
+import pytest
+
+from tests.paths import ROOT
+
+EXAMPLE = json.loads((ROOT / "examples" / "cell_two_ur5.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def answer(patient_client):
+    response = patient_client.post("/v1/cells", json=EXAMPLE)
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def _points(arm: dict) -> tuple[np.ndarray, np.ndarray]:
+    points = arm["trajectory"]["points"]
+    t = np.array([p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in points])
+    return t, np.array([p["positions"] for p in points])
+
+
+def test_both_arms_are_sampled_on_one_clock_from_start_to_end(answer):
+    (t1, q1), (t2, q2) = (_points(arm) for arm in answer["arms"])
+    assert np.array_equal(t1, t2) and t1[0] == 0.0 and t1[-1] == pytest.approx(answer["duration"], abs=1e-9)
+    assert np.allclose(t1, answer["t"], atol=1e-9)
+    for q, arm in ((q1, EXAMPLE["arms"][0]), (q2, EXAMPLE["arms"][1])):
+        assert np.allclose(q[0], arm["waypoints"][0], atol=1e-9) and np.allclose(q[-1], arm["waypoints"][-1], atol=1e-9)
+    assert answer["arms"][0]["trajectory"]["joint_names"][0] == "shoulder_pan_joint"
+
+
+def test_the_answer_reports_the_time_lost_and_the_diagram(answer):
+    assert answer["time_lost"] == pytest.approx(answer["duration"] - max(answer["solo_durations"]))
+    assert max(answer["solo_durations"]) < answer["duration"] <= answer["sequential_duration"]
+    diagram = answer["diagram"]
+    blocked = np.array(diagram["blocked"])
+    s = np.array(diagram["s"])
+    assert blocked.shape == (len(s), len(s)) and blocked.any() and not blocked[0, 0]
+    curve = np.array(diagram["curve"])
+    assert curve[0] == pytest.approx([0.0, 0.0]) and curve[-1] == pytest.approx([1.0, 1.0])
+    assert (np.diff(curve, axis=0) >= -1e-12).all()
+    # the curve never enters a cell of the collision region
+    i, j = (np.clip(np.floor(curve[:, k] * (len(s) - 1)).astype(int), 0, len(s) - 2) for k in (0, 1))
+    assert not (blocked[i, j] | blocked[i + 1, j] | blocked[i, j + 1] | blocked[i + 1, j + 1]).any()
+    assert answer["min_distance"]["guaranteed"] >= EXAMPLE["clearance"]
+
+
+def _cell(**change) -> dict:
+    body = copy.deepcopy(EXAMPLE)
+    for index, fields in change.items():
+        body["arms"][int(index[1:])].update(fields)
+    return body
+
+
+def test_an_unknown_robot_is_a_404_naming_it(patient_client):
+    response = patient_client.post("/v1/cells", json=_cell(a1={"robot": "ur55"}))
+    assert response.status_code == 404 and "ur55" in response.json()["detail"]
+
+
+def test_a_base_that_is_not_a_rotation_is_a_422_saying_where(patient_client):
+    mirrored = {"position": [1.2, 0.0, 0.0], "rotation": [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]}
+    response = patient_client.post("/v1/cells", json=_cell(a1={"base": mirrored}))
+    assert response.status_code == 422
+    detail = response.json()["detail"]
+    assert "arms[1].base.rotation is not a rotation" in detail and "det R = -1" in detail
+    assert response.headers["content-type"].startswith("application/problem+json")
+
+
+def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_client):
+    response = patient_client.post("/v1/cells", json=_cell(a1={"base": {"position": [0.1, 0.0, 0.0]}}))
+    assert response.status_code == 422
+    assert "collide at their start" in response.json()["detail"] and "link '" in response.json()["detail"]
+
+
+def test_three_arms_are_a_422_asking_for_two(patient_client):
+    body = copy.deepcopy(EXAMPLE)
+    body["arms"].append(copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.0, 3.0, 0.0]}})
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 422 and "give exactly two arms" in response.json()["detail"]
+
+
+def test_a_waypoint_of_the_wrong_length_is_a_422_naming_the_arm(patient_client):
+    response = patient_client.post("/v1/cells", json=_cell(a0={"waypoints": [[0.0] * 5, [0.1] * 5]}))
+    assert response.status_code == 422 and "arms[0]" in response.json()["detail"]
