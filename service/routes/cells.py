@@ -8,8 +8,8 @@ from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
 from toptraj.service.cells import plan_cell
-from toptraj.service.errors import problem_responses
 from toptraj.service.planning import encode_json
+from toptraj.service.problem_docs import problem_responses
 from toptraj.service.schemas.cells import CellRequest
 from toptraj.service.schemas.examples import cell_examples
 
