@@ -238,7 +238,6 @@ def optimize_locally(
             clearance and the joint ranges (a ``PathInCollision`` when it is the clearance).
         BudgetExceeded: ``deadline`` passed.
     """
-    from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
 
     started = time.perf_counter()
     seed = _seed_points(seed, robot.dof)
@@ -348,6 +347,8 @@ def _nelder_mead(objective: _Objective, x0: np.ndarray, extent: np.ndarray) -> t
     """One round of Nelder-Mead from ``x0`` (the interior control points, flattened), its first
     simplex stepping ``extent`` (n_dof,) along each joint: the best point and its objective, and
     whether the allowance was spent (the best point so far, ``None`` when there is none)."""
+    from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
+
     settings = objective.settings
     simplex = np.vstack([x0, x0 + np.diag(np.tile(extent, len(x0) // len(extent)))])
     objective.round_begins()
