@@ -5,7 +5,7 @@ switching times on the Geering arm, switch by switch.
 
 For each type: the caption's switching times of u1 and u2 and T, ours (the answer's
 ``switching_times``, from the bang-bang refinement, in the caption's orientation: a
-time-reversed motion is as fast on this arm, ``toptraj.planners.generators.collocation.switching.mirrored``), and
+time-reversed motion is as fast on this arm, ``toptraj.planners.generators.collocation.bang_bang.mirrored``), and
 the differences in ms. Type 1 is solved with its structure (Type 2 without u1's last arc),
 seeded by the Type 2 answer, as ``tests/planners/generators/test_switching_times.py`` does: at phi_b = 0.979 the
 answer itself is Type 2. Then the switches read off the collocation's own instants (30
@@ -23,8 +23,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from toptraj import robots  # noqa: E402
 from toptraj.planners import Timing, plan  # noqa: E402
+from toptraj.planners.generators.collocation.bang_bang import BangBang, collocation_switches, mirrored  # noqa: E402
 from toptraj.planners.generators.collocation.collocation import _optimize_motion  # noqa: E402
-from toptraj.planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching  # noqa: E402
+from toptraj.planners.generators.collocation.switching import refine_switching  # noqa: E402
 from toptraj.planners.problem.free_motion import FreeMotion  # noqa: E402
 
 
@@ -35,7 +36,7 @@ def answer(arm, phi_b: float, revolutions: bool):
 
 def controls_of(answer, arm) -> BangBang:
     read = collocation_switches(answer.samples.t, answer.samples.tau, arm.limits.torque)
-    switches = tuple(np.array(answer.switching_times[name]) for name in arm.joint_names)
+    switches = tuple(np.array(answer.switching_times.of(name)) for name in arm.joint_names)
     return BangBang(read.signs, switches, answer.duration)
 
 

@@ -9,10 +9,12 @@ import numpy as np
 
 from toptraj.planners.errors import NonFinite
 from toptraj.planners.timing.base import Binding
-from toptraj.planners.trajectory import Samples
+from toptraj.planners.trajectory import Samples, SwitchingTimes
 
 if TYPE_CHECKING:
     from toptraj.planners.collision import Clearance
+    from toptraj.planners.generators.collocation.report import CollocationReport
+    from toptraj.planners.generators.search.report import SearchReport
 
 
 @dataclass(frozen=True)
@@ -74,12 +76,14 @@ class PlannedTrajectory:
     binding: Binding | None = None
     conditioning: Conditioning | None = None
     cost: float | None = None
-    solver: dict | None = None
+    #: The collocation's figures (timing method ``collocation``).
+    solver: CollocationReport | None = None
     clearance: Clearance | None = None
-    #: Free paths with time-optimal (bang-bang) torques: {joint name: [t, ...]} in s, the
-    #: instants where each saturated torque changes sides.
-    switching_times: dict[str, list[float]] | None = None
-    search: dict | None = None
+    #: Free paths with time-optimal (bang-bang) torques: the instants where each saturated
+    #: torque changes sides.
+    switching_times: SwitchingTimes | None = None
+    #: What the global search did (timing method ``search``).
+    search: SearchReport | None = None
     accuracy: Accuracy | None = None
     zones: tuple[ZoneReport, ...] | None = None
 

@@ -29,6 +29,19 @@ class Samples:
     s: np.ndarray | None = None
 
 
+@dataclass(frozen=True)
+class SwitchingTimes:
+    """The instants (s) where each saturated torque of a bang-bang motion changes sides:
+    ``times[j]`` (n_switches_j,), increasing, for the joint ``joint_names[j]``."""
+
+    joint_names: tuple[str, ...]
+    times: tuple[np.ndarray, ...]
+
+    def of(self, joint: str) -> np.ndarray:
+        """The switching times (s) of the joint named ``joint``."""
+        return self.times[self.joint_names.index(joint)]
+
+
 def _joint_motion(path: GeometricPath, s, sd, sdd, side: str = "right"):
     points = path.evaluate(s, side)
     qd = points.dq * sd[:, None]

@@ -170,6 +170,51 @@ def limits_for(
     return limits_with_sources(robot_name, position_lower, position_upper, velocity, torque)[0]
 
 
+def _tightened(values: dict[str, np.ndarray], sources: dict[str, list[str]], given: dict[str, np.ndarray], names: list[str]) -> list[str]:
+    """``given``'s velocity and torque limits (an upload's joint_limits.yaml; NaN where it gives
+    none) taken into ``values`` and ``sources`` where they tighten them; a note for each one
+    that would loosen them, which is not taken."""
+    notes = []
+    for kind in ("velocity", "torque"):
+        if kind not in given:
+            continue
+        for k in np.flatnonzero(np.isfinite(given[kind])):
+            if given[kind][k] <= values[kind][k]:
+                values[kind] = values[kind].copy()
+                values[kind][k] = given[kind][k]
+                sources[kind][k] = "joint_limits.yaml"
+            else:
+                unit = "N m" if kind == "torque" else "rad/s"
+                notes.append(
+                    f"joint_limits.yaml allows joint {names[k]!r} a {kind} of {given[kind][k]:g} {unit}, above the "
+                    f"URDF's {values[kind][k]:g}: the URDF's limit is kept"
+                )
+    return notes
+
+
+def _derived(
+    values: dict[str, np.ndarray], sources: dict[str, list[str]], entry: dict, given: dict[str, np.ndarray], rule: dict, n_dof: int
+) -> None:
+    """The acceleration and jerk limits into ``values`` and ``sources``: the default rule
+    (velocity / ``seconds_to_full_speed``, acceleration / ``seconds_to_full_acceleration``),
+    replaced by the data file's ``entry``, then by ``given`` joint by joint."""
+    for kind, default, seconds in (
+        ("acceleration", "velocity", "seconds_to_full_speed"),
+        ("jerk", "acceleration", "seconds_to_full_acceleration"),
+    ):
+        with np.errstate(invalid="ignore"):
+            values[kind] = values[default] / rule[seconds]
+        sources[kind] = [f"default: {default} limit / {rule[seconds]:g} s"] * n_dof
+        if kind in entry:
+            values[kind] = np.asarray(entry[kind], dtype=float)
+            sources[kind] = ["limits.toml"] * n_dof
+        if kind in given:
+            for k in np.flatnonzero(np.isfinite(given[kind])):
+                values[kind] = values[kind].copy()
+                values[kind][k] = given[kind][k]
+                sources[kind][k] = "joint_limits.yaml"
+
+
 def limits_with_sources(
     robot_name: str,
     position_lower: np.ndarray,
@@ -215,36 +260,8 @@ def limits_with_sources(
             values[kind] = np.asarray(entry[kind], dtype=float)
             sources[kind] = ["limits.toml"] * n_dof
     given = given or {}
-    notes = []
-    for kind in ("velocity", "torque"):
-        if kind not in given:
-            continue
-        for k in np.flatnonzero(np.isfinite(given[kind])):
-            if given[kind][k] <= values[kind][k]:
-                values[kind] = values[kind].copy()
-                values[kind][k] = given[kind][k]
-                sources[kind][k] = "joint_limits.yaml"
-            else:
-                unit = "N m" if kind == "torque" else "rad/s"
-                notes.append(
-                    f"joint_limits.yaml allows joint {names[k]!r} a {kind} of {given[kind][k]:g} {unit}, above the "
-                    f"URDF's {values[kind][k]:g}: the URDF's limit is kept"
-                )
-    for kind, default, seconds in (
-        ("acceleration", "velocity", "seconds_to_full_speed"),
-        ("jerk", "acceleration", "seconds_to_full_acceleration"),
-    ):
-        with np.errstate(invalid="ignore"):
-            values[kind] = values[default] / rule[seconds]
-        sources[kind] = [f"default: {default} limit / {rule[seconds]:g} s"] * n_dof
-        if kind in entry:
-            values[kind] = np.asarray(entry[kind], dtype=float)
-            sources[kind] = ["limits.toml"] * n_dof
-        if kind in given:
-            for k in np.flatnonzero(np.isfinite(given[kind])):
-                values[kind] = values[kind].copy()
-                values[kind][k] = given[kind][k]
-                sources[kind][k] = "joint_limits.yaml"
+    notes = _tightened(values, sources, given, names)
+    _derived(values, sources, entry, given, rule, n_dof)
     for kind in LIMITS:
         for joint, value in enumerate(values[kind]):
             problem = limit_problem(kind, float(value), names[joint], _source_name(sources[kind][joint]))

@@ -223,11 +223,7 @@ def batch(
         return 2
     finally:
         signal.signal(signal.SIGINT, previous)
-    summary = (
-        f"{report.planned} answered, {report.skipped} already in {output}, {report.total} in all, "
-        f"{report.seconds:.1f} s ({report.rate:.1f} lines/s)"
-        + (f", on {len(report.nodes)} Ray nodes ({', '.join(str(n) for n in sorted(report.nodes.values(), reverse=True))} requests)" if len(report.nodes) > 1 else "")
-    )
+    summary = _batch_summary(report, output)
     if not report.interrupted:
         print(summary, file=sys.stderr)
         return 0
@@ -237,3 +233,14 @@ def batch(
             command += [option, f"{value:g}" if isinstance(value, float) else str(value)]
     print(f"interrupted: {summary}\nresume with: {shlex.join(command)}", file=sys.stderr)
     return 130
+
+
+def _batch_summary(report, output: str) -> str:
+    """What a batch did: lines answered, found done, in all, its time and rate, and the Ray
+    nodes that answered (when more than one)."""
+    nodes = sorted(report.nodes.values(), reverse=True)
+    return (
+        f"{report.planned} answered, {report.skipped} already in {output}, {report.total} in all, "
+        f"{report.seconds:.1f} s ({report.rate:.1f} lines/s)"
+        + (f", on {len(nodes)} Ray nodes ({', '.join(map(str, nodes))} requests)" if len(nodes) > 1 else "")
+    )

@@ -26,6 +26,7 @@ from toptraj.robots.catalog import catalog_robot_built
 from toptraj.service.equipping import equipped_robot, payload_named
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
 from toptraj.service.problems import detail, non_finite_answer, note_text, status_of, title_of
+from toptraj.service.reports import search_body, solver_body, switching_body
 from toptraj.service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
 
 #: Longest JSON number written (``-1.2345678901234567e-300``) with its separator, in bytes.
@@ -336,8 +337,8 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "characteristic_length": conditioning.characteristic_length,
         },
         "cost": result.cost,
-        "solver": result.solver,
-        "switching_times": result.switching_times,
+        "solver": solver_body(result.solver),
+        "switching_times": switching_body(result.switching_times),
         "solve_ms": result.solve_ms,
         "warnings": [note_text(note) for note in result.warnings],
         "min_clearance": None if result.clearance is None else {
@@ -346,7 +347,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "obstacle": result.clearance.obstacle,
             "s": result.clearance.s,
         },
-        "search": result.search,
+        "search": search_body(result.search),
         "accuracy": accuracy_body(result),
         "zones": None if result.zones is None else [
             {"index": zone.index, "ranges": [list(item) for item in zone.ranges], "peak": zone.peak, "binding": zone.binding}

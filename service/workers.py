@@ -127,47 +127,36 @@ class PlanningWorkers:
             # One future of this loop, settled by the planning thread through one callback: the
             # answer reaches the request in one turn of the loop, not a chain of wrapped futures.
             answer: asyncio.Future = loop.create_future()
-
-            def work():
-                try:
-                    outcome = (function(deadline), None)
-                except BaseException as error:  # delivered to the request, as an executor would
-                    outcome = (None, error)
-                finally:
-                    self._release()
-                try:
-                    loop.call_soon_threadsafe(_settle, answer, outcome)
-                except RuntimeError:  # the loop closed: nobody waits for the answer
-                    pass
-
-            try:
-                self._threads().submit(work)
-            except BaseException:
-                self._slots.release()
-                self._wake_first()
-                raise
+            self._submit(function, deadline, loop, answer)
             started = True
-            remaining = deadline.remaining()
-            timer = None if remaining is None else loop.call_later(max(remaining, 0.0), _settle, answer, _EXPIRED)
-            try:
-                outcome = await answer
-            except asyncio.CancelledError:  # the client went away, or the server stops
-                deadline.cancel()
-                raise
-            finally:
-                if timer is not None:
-                    timer.cancel()
-            if outcome is _EXPIRED:
-                deadline.cancel()
-                raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s")
-            result, error = outcome
-            if error is not None:
-                raise error
-            return result
+            return await _awaited(answer, deadline, budget_s, loop)
         finally:
             if not started:
                 with self._lock:
                     self._admitted -= 1
+
+    def _submit(self, function, deadline: Deadline, loop: asyncio.AbstractEventLoop, answer: asyncio.Future) -> None:
+        """``function(deadline)`` submitted to a planning thread (a slot already held), which
+        frees its slot when it ends and settles ``answer`` with (result, error)."""
+
+        def work():
+            try:
+                outcome = (function(deadline), None)
+            except BaseException as error:  # delivered to the request, as an executor would
+                outcome = (None, error)
+            finally:
+                self._release()
+            try:
+                loop.call_soon_threadsafe(_settle, answer, outcome)
+            except RuntimeError:  # the loop closed: nobody waits for the answer
+                pass
+
+        try:
+            self._threads().submit(work)
+        except BaseException:
+            self._slots.release()
+            self._wake_first()
+            raise
 
     async def _alone(self) -> bool:
         """Whether this request's planning is the only one admitted, on the only connection the
@@ -257,3 +246,26 @@ def _settle(answer: asyncio.Future, outcome) -> None:
     an answer nobody waits for any more (a request past its budget, or gone) is dropped."""
     if not answer.done():
         answer.set_result(outcome)
+
+
+async def _awaited(answer: asyncio.Future, deadline: Deadline, budget_s: float, loop: asyncio.AbstractEventLoop):
+    """The planning's result once a planning thread settles ``answer``; its deadline cancelled
+    and ``BudgetExceeded`` raised when the budget passes first, its deadline cancelled when the
+    request is (the client went away, or the server stops)."""
+    remaining = deadline.remaining()
+    timer = None if remaining is None else loop.call_later(max(remaining, 0.0), _settle, answer, _EXPIRED)
+    try:
+        outcome = await answer
+    except asyncio.CancelledError:  # the client went away, or the server stops
+        deadline.cancel()
+        raise
+    finally:
+        if timer is not None:
+            timer.cancel()
+    if outcome is _EXPIRED:
+        deadline.cancel()
+        raise BudgetExceeded(f"planning exceeded its time budget of {budget_s:g} s")
+    result, error = outcome
+    if error is not None:
+        raise error
+    return result

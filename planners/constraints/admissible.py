@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.constraints.admissible_kernels import ZERO_INERTIA, point_bounds
-from toptraj.planners.constraints.path_constraints import LinearRows
+from toptraj.planners.constraints.linear_rows import LinearRows
 
 
 @dataclass(frozen=True)

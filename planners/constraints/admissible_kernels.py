@@ -300,10 +300,10 @@ def interval_bounds(s, ra, rb, rc, rd, la, lb, lc, ld, lower, upper, x_bound, x_
 
     * interpolation (``midpoint`` False): every row at s_i, ``ra_i u + rb_i x_i + rc_i``, and at
       s_i+1 as seen from the interval, ``la_i+1 u + lb_i+1 (x_i + 2 ds u) + lc_i+1``:
-      conservative, the limits hold at every grid point (``phase_plane.interval_rows``);
+      conservative, the limits hold at every grid point (``phase_plane.grid.interval_rows``);
     * midpoint (``midpoint`` True): every row at the interval's midpoint with the coefficients
       averaged from its ends, ``a_m u + b_m (x_i + ds u) + c_m``: second-order accurate, no
-      bound (``phase_plane.midpoint_stage_rows``).
+      bound (``phase_plane.grid.midpoint_stage_rows``).
 
     With ``friction``, each row is first split into its halves against the upper and the lower
     bound, the viscous term of each replaced by its tangent at x_ref (N + 1,), exactly as
@@ -355,7 +355,7 @@ def zero_inertia_intervals(s, a, b, a_left, b_left, intervals, threshold):  # pr
     """Whether each of ``intervals`` (k,) of the grid s has a row of the interpolation
     discretization whose u-coefficient is within ``threshold`` of its scale |a| + |b| of zero:
     at the interval's start (a, b, each (N + 1, m)) or at its end as the interval sees it
-    (a_left + 2 ds b_left, b_left; ``phase_plane.interval_rows``), viscous friction left out;
+    (a_left + 2 ds b_left, b_left; ``phase_plane.grid.interval_rows``), viscous friction left out;
     (k,) bool."""
     found = np.zeros(intervals.shape[0], dtype=np.bool_)
     for n in range(intervals.shape[0]):

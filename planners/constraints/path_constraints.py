@@ -29,6 +29,7 @@ from functools import cached_property
 import numpy as np
 
 from toptraj.planners.constraints.assembly_kernels import assemble_rows, velocity_bound
+from toptraj.planners.constraints.linear_rows import LinearRows
 from toptraj.planners.constraints.tool_speed import tool_speed_bound
 from toptraj.planners.constraints.torque_interpolation import smooth_points
 from toptraj.planners.constraints.zones import tool_speed_at, zone_factors, zoned_rows
@@ -217,42 +218,6 @@ class PathConstraints:
         return f"{kind} of joint {self.joint_names[joint]!r}"
 
 
-@dataclass(frozen=True)
-class LinearRows:
-    """Second-order rows ``a u + b x + c in [lower, upper]``, each of shape (N + 1, m)."""
-
-    a: np.ndarray
-    b: np.ndarray
-    c: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-
-    def normalized(self) -> LinearRows:
-        """The same rows, each column divided by the largest magnitude over the grid of its
-        coefficients a and b and its finite bounds (columns with none keep their scale):
-        ``a u + b x + c in [lower, upper]`` holds exactly when the row divided by k > 0 does. A
-        solver with absolute tolerances (toppra's LP, Clarabel; about 1e-8) then sees rows of
-        order one whatever the limits: without it, it could not tell an acceleration limit of
-        1e-6 rad/s^2 from zero. One factor per column: a factor per grid point made toppra's
-        answer on a blended path 29 % slower; coefficients alone, without the bounds, failed
-        limits 1e-6 and 1e5 apart on the joints of one arm. Only columns whose scale lies outside
-        ``ROW_SCALES`` are divided: on rows of ordinary size the solvers' own conditioning is
-        the better one (dividing every column made toppra fail on torque-limited paths of the
-        Yamamoto arm that it solves as given)."""
-        k = np.maximum.reduce([np.abs(self.a), np.abs(self.b), np.abs(self.lower), np.abs(self.upper)])
-        k = np.where(np.isfinite(k), k, np.maximum(np.abs(self.a), np.abs(self.b)))
-        k = np.where(np.isfinite(k), k, 0.0).max(axis=0, initial=0.0)
-        low, high = ROW_SCALES
-        k = np.where((k > 0.0) & ((k < low) | (k > high)), k, 1.0)
-        return LinearRows(self.a / k, self.b / k, self.c / k, self.lower / k, self.upper / k)
-
-
-#: Scales of a row's column (its largest coefficient or finite bound over the grid) that
-#: ``LinearRows.normalized`` leaves as they are: within them, a solver's absolute tolerance
-#: (about 1e-8) is small against the row.
-ROW_SCALES = (1e-2, 1e4)
-
-
 def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> np.ndarray:
     """(3 n, n_dof): RNEA(q, 0, 0) = g, RNEA(q, 0, q') = M q' + g and RNEA(q, q', q'') =
     M q'' + C(q, q') q' + g at the n rows of ``q, dq, ddq``, in one batched call whose three
@@ -334,6 +299,20 @@ def _left_derivatives(path: GeometricPath, s: np.ndarray, points, third: np.ndar
     return dq, ddq, dddq
 
 
+def _left_rows(path, robot: Robot, limits: JointLimits, kinds: tuple[str, ...], s: np.ndarray, right, deadline: Deadline):
+    """The rows (a, b, c, d) seen from the interval that ends at each point: ``right``'s, but at
+    a corner or a break of the curvature, where the left-hand derivatives differ."""
+    a, b, c, d = right
+    kink_index = _points_at(s, np.concatenate([path.kinks, path.breaks]))
+    if not kink_index.size:
+        return a, b, c, d
+    _, (a_k, b_k, c_k, d_k, _, _), _ = _second_order_rows(path, robot, limits, kinds, s[kink_index], "left", deadline)
+    a_left, b_left, c_left, d_left = a.copy(), b.copy(), c.copy(), d.copy()
+    a_left[kink_index], b_left[kink_index] = a_k, b_k
+    c_left[kink_index], d_left[kink_index] = c_k, d_k
+    return a_left, b_left, c_left, d_left
+
+
 def build_path_constraints(
     path: GeometricPath,
     robot: Robot,
@@ -363,17 +342,8 @@ def build_path_constraints(
         tool_sd_max, tool_kind = tool_speed_bound(robot, limits.tool, points.q, points.dq, speed)
         tool_bound = np.where(tool_sd_max < sd_max, tool_kind, -1)
         sd_max = np.minimum(sd_max, tool_sd_max)
-    a_left, b_left, c_left, d_left = a, b, c, d
     sd_max[_points_at(s, path.kinks)] = 0.0
-    # The rows seen from the interval that ends at a corner or a break of the curvature.
-    kink_index = _points_at(s, np.concatenate([path.kinks, path.breaks]))
-    if kink_index.size:
-        _, (a_k, b_k, c_k, d_k, _, _), _ = _second_order_rows(
-            path, robot, limits, kinds, s[kink_index], "left", deadline
-        )
-        a_left, b_left, c_left, d_left = a.copy(), b.copy(), c.copy(), d.copy()
-        a_left[kink_index], b_left[kink_index] = a_k, b_k
-        c_left[kink_index], d_left[kink_index] = c_k, d_k
+    a_left, b_left, c_left, d_left = _left_rows(path, robot, limits, kinds, s, (a, b, c, d), deadline)
     third = path.third_derivative(s) if "jerk" in kinds else None
     return PathConstraints(
         s=s,

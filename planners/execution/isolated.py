@@ -225,6 +225,23 @@ def _child(connection, function, args, progress: bool, memory_bytes: int | None 
         connection.close()
 
 
+def _inline_within(memory_bytes: int, function, *args, **kwargs):
+    """``function(*args, **kwargs)`` in this process (a job's worker), its address space
+    allowed to grow by ``memory_bytes`` for this call only."""
+    before = resource.getrlimit(resource.RLIMIT_AS)
+    limited = _limit_memory(memory_bytes)
+    try:
+        return function(*args, **kwargs)
+    except MemoryError:
+        if not limited:
+            raise
+        resource.setrlimit(resource.RLIMIT_AS, before)
+        raise OverMemory(f"the computation ran out of its memory allowance of {memory_bytes / 2**30:.3g} GiB: ask for a smaller problem") from None
+    finally:
+        if limited:
+            resource.setrlimit(resource.RLIMIT_AS, before)
+
+
 def run_isolated(
     function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0
 ):
@@ -243,19 +260,7 @@ def run_isolated(
         kwargs = {"progress": deadline.progress} if progress else {}
         if not (_in_worker and memory_bytes is not None):
             return function(*args, **kwargs)
-        # in a worker process (a job's): the same memory allowance, for this call only
-        before = resource.getrlimit(resource.RLIMIT_AS)
-        limited = _limit_memory(memory_bytes)
-        try:
-            return function(*args, **kwargs)
-        except MemoryError:
-            if not limited:
-                raise
-            resource.setrlimit(resource.RLIMIT_AS, before)
-            raise OverMemory(f"the computation ran out of its memory allowance of {memory_bytes / 2**30:.3g} GiB: ask for a smaller problem") from None
-        finally:
-            if limited:
-                resource.setrlimit(resource.RLIMIT_AS, before)
+        return _inline_within(memory_bytes, function, *args, **kwargs)
     context = _get_context()
     reader, writer = context.Pipe(duplex=False)
     process = context.Process(target=_child, args=(writer, function, args, progress, memory_bytes, nice), daemon=True)

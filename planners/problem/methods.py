@@ -21,11 +21,18 @@ from toptraj.planners.checks.gate import TimedStretch
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.timing.base import PathTiming, TimingMethod
+from toptraj.planners.trajectory import SwitchingTimes
 from toptraj.robots import JointLimits, Robot
 
 if TYPE_CHECKING:
     from toptraj.planners.problem.problem import MotionSpec, Problem
     from toptraj.planners.problem.requests import Timing
+
+
+class Report:
+    """A generator's typed account of its work, carried to the answer as it is
+    (``toptraj.planners.generators.collocation.report.CollocationReport``,
+    ``toptraj.planners.generators.search.report.SearchReport``)."""
 
 
 class Timed(NamedTuple):
@@ -38,9 +45,9 @@ class Timed(NamedTuple):
     method: str
     notes: tuple[str, ...] = ()
     cost: float | None = None
-    solver: dict | None = None
-    search: dict | None = None
-    switching_times: dict | None = None
+    solver: Report | None = None
+    search: Report | None = None
+    switching_times: SwitchingTimes | None = None
     #: For a method that finds the motion itself (a free path): the estimated relative gap of
     #: its objective to the optimum of its own problem, and how it was estimated; ``None`` when
     #: the answer's accuracy is that of its path's timing (``toptraj.planners.runner.accuracy``).

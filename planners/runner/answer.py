@@ -15,7 +15,9 @@ from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.zones import BINDING_SHARE
 from toptraj.planners.errors import TimingFailed, TooLarge
-from toptraj.planners.generators.collocation.switching import collocation_switches, switching_times
+from toptraj.planners.generators.collocation.bang_bang import collocation_switches, switching_times
+from toptraj.planners.generators.collocation.report import CollocationReport
+from toptraj.planners.generators.search.report import SearchReport
 from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
 from toptraj.planners.paths.grid import spread_indices
@@ -71,12 +73,15 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
         switching = switching_times(read, robot.joint_names)
     s, sd, mvc = _phase_plane(timed.stretches)
     require_finite(timed.method, path_speed=sd, cost=timed.cost)
+    solver, search = timed.solver, timed.search
+    assert solver is None or isinstance(solver, CollocationReport)
+    assert search is None or isinstance(search, SearchReport)
     return PlannedTrajectory(
         robot=robot.name, method=timed.method, joint_names=robot.joint_names, duration=result.duration, samples=samples,
         phase_plane=PhasePlane(s, sd, mvc, result.switch_points), peak_utilization=utilization,
         solve_ms=(time.perf_counter() - started) * 1e3, warnings=tuple(notes), binding=result.binding,
-        conditioning=Conditioning(kappa_min, kappa_max, length), cost=timed.cost, solver=timed.solver,
-        switching_times=switching, clearance=found_clearance, search=timed.search, accuracy=accuracy,
+        conditioning=Conditioning(kappa_min, kappa_max, length), cost=timed.cost, solver=solver,
+        switching_times=switching, clearance=found_clearance, search=search, accuracy=accuracy,
         zones=_zone_reports(problem.limits.zones, timed.stretches, problem.margin) if problem.options.zones else None,
     )
 

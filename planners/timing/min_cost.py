@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.constraints.admissible import friction_reference
-from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
+from toptraj.planners.constraints.linear_rows import LinearRows
+from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated

@@ -263,69 +263,101 @@ def run_batch(
     total = count_lines(requests_path)
     done = resume_output(output_path, retry_failed)
     skipped = sum(1 for number in done if number <= total)
-    numbers: dict[str, list[int]] = {}  # key -> the line numbers of its request
-    texts: dict[str, str] = {}
-    written = 0
-    todo = total - skipped
 
-    def report() -> None:
+    def report(written: int) -> None:
         if progress:
-            progress(written, todo, time.perf_counter() - started)
+            progress(written, total - skipped, time.perf_counter() - started)
 
     with open(output_path, "ab") as out:
-        for line in read_requests(requests_path, skip=set(done)):
-            if stop.is_set():  # before any planning: what was read is resumed later
-                out.flush()
-                return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=True)
-            if line.problem is not None:
-                out.write(result_line(line.number, line.key, *line.problem))
-                written += 1
-            else:
-                numbers.setdefault(line.key, []).append(line.number)
-                texts.setdefault(line.key, line.text)
-        out.flush()
-        report()
+        numbers, texts, written, stopped = _read_lines(out, requests_path, set(done), stop)
+        if stopped:  # before any planning: what was read is resumed later
+            return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=True)
+        report(written)
         if not texts or stop.is_set():
             return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=bool(texts))
         runner = (pool or (lambda: RayPool(ray_address, workers)))()
         try:
-            runner.share(_uploads_named(list(texts.values())))
-            keys = list(texts)
-            chunks = [[(key, texts[key]) for key in keys[k : k + CHUNK]] for k in range(0, len(keys), CHUNK)]
-            del texts, keys
-            window = 2 * runner.cpus + 1
-            running: dict[Any, list[tuple[str, str]]] = {}  # in the order submitted
-            started_at: dict[Any, float] = {}
-            next_chunk = 0
-            while (running or next_chunk < len(chunks)) and not stop.is_set():
-                while next_chunk < len(chunks) and len(running) < window and not stop.is_set():
-                    running[runner.submit(chunks[next_chunk], budget_s)] = chunks[next_chunk]
-                    chunks[next_chunk] = []  # its texts are the task's now
-                    next_chunk += 1
-                ready, _ = runner.wait(list(running), WAIT_S)
-                for handle in ready:
-                    started_at.pop(handle, None)
-                    chunk = running.pop(handle)
-                    try:
-                        answers = runner.result(handle)
-                    except Exception as error:  # the task as a whole: a worker died
-                        if stop.is_set():
-                            continue  # cancelled by the stop: resumed later
-                        answers = _failed(chunk, error)
-                    written += _write(out, numbers, answers)
-                overdue = _kill_overdue(runner, running, started_at, budget_s, out, numbers)
-                written += overdue
-                if ready or overdue:
-                    report()
-            interrupted = bool(running) or next_chunk < len(chunks)
-            if interrupted:
-                ready, rest = runner.wait(list(running), 0) if running else ([], [])
-                for handle in ready:
-                    try:
-                        written += _write(out, numbers, runner.result(handle))
-                    except Exception:  # noqa: S112 - cancelled or failed: resumed later
-                        continue
-                runner.cancel(rest)
+            planned, interrupted = _plan_lines(runner, texts, numbers, out, budget_s, stop, lambda count: report(written + count))
         finally:
             runner.close()
-    return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted, dict(getattr(runner, "nodes", {})))
+    return BatchReport(
+        total, skipped, written + planned, time.perf_counter() - started, interrupted, dict(getattr(runner, "nodes", {}))
+    )
+
+
+def _read_lines(out, requests_path: Path, done: set[int], stop: threading.Event) -> tuple[dict[str, list[int]], dict[str, str], int, bool]:
+    """The lines of ``requests_path`` not in ``done``: those refused before planning answered in
+    ``out`` at once, the others gathered by key. Returns the line numbers of each key, each
+    key's request text, the result lines written and whether ``stop`` ended the reading."""
+    numbers: dict[str, list[int]] = {}  # key -> the line numbers of its request
+    texts: dict[str, str] = {}
+    written = 0
+    for line in read_requests(requests_path, skip=done):
+        if stop.is_set():
+            out.flush()
+            return numbers, texts, written, True
+        if line.problem is not None:
+            out.write(result_line(line.number, line.key, *line.problem))
+            written += 1
+        else:
+            numbers.setdefault(line.key, []).append(line.number)
+            texts.setdefault(line.key, line.text)
+    out.flush()
+    return numbers, texts, written, False
+
+
+def _plan_lines(
+    runner, texts: dict[str, str], numbers: dict[str, list[int]], out, budget_s: float, stop: threading.Event,
+    report: Callable[[int], None],
+) -> tuple[int, bool]:
+    """Every request of ``texts`` (emptied: the tasks hold the texts) planned by ``runner`` in
+    chunks of ``CHUNK``, at most ``2 * runner.cpus + 1`` chunks at a time, each answer written to
+    ``out`` as it comes, a chunk past its budget answered 504; ``report(written)`` after each
+    step that wrote. Returns the result lines written and whether ``stop`` interrupted it."""
+    runner.share(_uploads_named(list(texts.values())))
+    keys = list(texts)
+    chunks = [[(key, texts[key]) for key in keys[k : k + CHUNK]] for k in range(0, len(keys), CHUNK)]
+    texts.clear()
+    del keys
+    window = 2 * runner.cpus + 1
+    running: dict[Any, list[tuple[str, str]]] = {}  # in the order submitted
+    started_at: dict[Any, float] = {}
+    next_chunk, written = 0, 0
+    while (running or next_chunk < len(chunks)) and not stop.is_set():
+        while next_chunk < len(chunks) and len(running) < window and not stop.is_set():
+            running[runner.submit(chunks[next_chunk], budget_s)] = chunks[next_chunk]
+            chunks[next_chunk] = []  # its texts are the task's now
+            next_chunk += 1
+        ready, _ = runner.wait(list(running), WAIT_S)
+        for handle in ready:
+            started_at.pop(handle, None)
+            chunk = running.pop(handle)
+            try:
+                answers = runner.result(handle)
+            except Exception as error:  # the task as a whole: a worker died
+                if stop.is_set():
+                    continue  # cancelled by the stop: resumed later
+                answers = _failed(chunk, error)
+            written += _write(out, numbers, answers)
+        overdue = _kill_overdue(runner, running, started_at, budget_s, out, numbers)
+        written += overdue
+        if ready or overdue:
+            report(written)
+    interrupted = bool(running) or next_chunk < len(chunks)
+    if interrupted:
+        written += _collect_finished(runner, running, out, numbers)
+    return written, interrupted
+
+
+def _collect_finished(runner, running: dict, out, numbers: dict[str, list[int]]) -> int:
+    """On a stop: the answers of the tasks already finished written, the others cancelled (they
+    are resumed later). Returns the result lines written."""
+    written = 0
+    ready, rest = runner.wait(list(running), 0) if running else ([], [])
+    for handle in ready:
+        try:
+            written += _write(out, numbers, runner.result(handle))
+        except Exception:  # noqa: S112 - cancelled or failed: resumed later
+            continue
+    runner.cancel(rest)
+    return written

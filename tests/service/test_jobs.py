@@ -28,11 +28,9 @@ EXAMPLES = ROOT / "examples"
 QUICK = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}}
 #: A free-path collocation of a six-joint arm on a fine grid: minutes of SLSQP in its worker
 #: process, so it is still running whenever a test looks.
-SLOW = {
-    "robot": "ur5",
-    "path": {"kind": "free", "start": [0.0] * 6, "goal": [0.5] * 6},
-    "timing": {"method": "collocation", "grid_points": 60},
-}
+#: A planning that runs for seconds on any machine: the global search around a sphere, whose
+#: local optimization takes its share of whatever budget it is given.
+SLOW = json.loads((ROOT / "examples" / "geering_search_obstacle.json").read_text())
 ENDED = {"done", "failed", "cancelled", "interrupted"}
 
 

@@ -387,15 +387,3 @@ def _optimize_motion(
     finished.sort(key=lambda result: result.cost)
     return dataclasses.replace(finished[0], rivals=tuple(finished[1:]))
 
-
-def collocation_path(result: CollocationResult):
-    """The optimized motion as a path with constant-speed timing: on each interval the exact
-    cubic q_k + v_k t + a_k t^2 / 2 + (a_k+1 - a_k) t^3 / (6 h)."""
-    from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
-
-    h = np.diff(result.t)
-    jerk_term = (result.a[1:] - result.a[:-1]) / (6 * h[:, None])
-    zeros = np.zeros_like(jerk_term)
-    coefficients = np.stack([result.q[:-1], result.v[:-1], result.a[:-1] / 2, jerk_term, zeros, zeros], axis=2)
-    path = ViaPath(coefficients, h)
-    return path, ConstantSpeedTiming(path.total, path.knots)

@@ -14,7 +14,9 @@ from toptraj.planners.checks.gate import TimedStretch, checked, gated
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, NotServed, OutOfRange
 from toptraj.planners.generators.collocation import collocation_path, optimize_motion
-from toptraj.planners.generators.collocation.switching import refine_collocation, switched_path, switching_times
+from toptraj.planners.generators.collocation.bang_bang import switching_times
+from toptraj.planners.generators.collocation.report import CollocationReport
+from toptraj.planners.generators.collocation.switching import refine_collocation, switched_path
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
@@ -62,7 +64,6 @@ class Collocation(MotionGenerator):
         robot, spec, kinds, limits, threshold = problem.robot, problem.motion, problem.kinds, problem.limits, problem.threshold
         collocation = _optimized(problem, deadline.within(0.0, 0.8))
         path, collocation_timing = collocation_path(collocation)
-        solver = _solver_report(collocation)
         retimer = self.timed_by
         retiming = deadline.within(0.8, 0.9, "re-timing along the collocation's path")
         retiming.progress(0.0, "constraints")
@@ -84,14 +85,14 @@ class Collocation(MotionGenerator):
             result = collocation_timing
             stretch = checked(robot, path, result, "collocation", kinds, limits, threshold, constraints)
             notes = (f"the collocation's own timing is returned (re-timing along its path failed: {error.detail})",)
-        switching, source = None, collocation
+        switching, winner, source, how = None, collocation, collocation, None
         if self.torque_weight == 0.0:
             deadline.progress(0.9, "refining the switching times")
             path, result, stretch, switching, notes, winner, source = _switched(
                 problem, collocation, (path, result, stretch), notes, deadline
             )
-            solver = {**solver, **_solver_report(winner), "switching": "refined" if switching is not None else "read off the samples"}
-        solver = {**solver, "optimality_gap": source.optimality_gap, "gap_basis": source.gap_basis}
+            how = "refined" if switching is not None else "read off the samples"
+        solver = CollocationReport.of(winner, how, source)
         notes = (*notes, *self._gap_note(source, collocation))
         cost = getattr(result, "cost", None) if self.torque_weight else result.duration
         return Timed(
@@ -125,18 +126,6 @@ def _optimized(problem: Problem, deadline):
         acceleration=limits.acceleration if "acceleration" in options.constraints else unlimited,
     )
     return optimize_motion(robot, limits, spec, options.torque_weight, deadline)
-
-
-def _solver_report(result) -> dict:
-    """The collocation's figures for the answer's ``solver``."""
-    return {
-        "cost": result.cost,
-        "duration": float(result.t[-1]),
-        "status": result.status,
-        "iterations": result.iterations,
-        "initial_guess": result.initial_guess,
-        "solve_s": result.solve_s,
-    }
 
 
 def _switched(problem: Problem, collocation, timed, notes, deadline):

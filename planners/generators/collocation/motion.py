@@ -49,3 +49,16 @@ class CollocationResult:
         if self.coarse_cost is None:
             return "none"
         return f"second grid: the cost on {self.coarse_intervals} intervals against {len(self.t) - 1}"
+
+
+def collocation_path(result: CollocationResult):
+    """The optimized motion as a path with constant-speed timing: on each interval the exact
+    cubic q_k + v_k t + a_k t^2 / 2 + (a_k+1 - a_k) t^3 / (6 h)."""
+    from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
+
+    h = np.diff(result.t)
+    jerk_term = (result.a[1:] - result.a[:-1]) / (6 * h[:, None])
+    zeros = np.zeros_like(jerk_term)
+    coefficients = np.stack([result.q[:-1], result.v[:-1], result.a[:-1] / 2, jerk_term, zeros, zeros], axis=2)
+    path = ViaPath(coefficients, h)
+    return path, ConstantSpeedTiming(path.total, path.knots)

@@ -19,8 +19,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from toptraj.planners.generators.collocation.bang_bang import BangBang
 from toptraj.planners.generators.collocation.collocation import _optimize_motion
-from toptraj.planners.generators.collocation.switching import BangBang, refine_collocation, refine_switching
+from toptraj.planners.generators.collocation.switching import refine_collocation, refine_switching
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.robots import Robot
 

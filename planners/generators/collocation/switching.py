@@ -37,6 +37,7 @@ import numpy as np
 import pinocchio as pin
 
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.generators.collocation.bang_bang import BangBang, collocation_switches, pruned
 from toptraj.planners.generators.collocation.motion import CollocationResult
 from toptraj.planners.generators.collocation.root_finding import held_newton, jacobian, newton, secant_minimum
 from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
@@ -49,30 +50,8 @@ SOLVE_STEP = 8e-3
 FINAL_STEP = 1e-3
 #: Largest goal error (rad, rad/s) of an accepted refinement.
 GOAL_TOLERANCE = 1e-8
-#: A torque is saturated on one side where it lies beyond this fraction of its limit.
-SATURATED = 0.5
 #: Duration (s) of a boundary arc added when neighbouring structures are tried.
 NEW_ARC = 0.01
-
-
-@dataclass(frozen=True)
-class BangBang:
-    """Bang-bang controls: per joint, the signs of its arcs (n_arcs,), +1 or -1, and the times
-    (n_arcs - 1,) in s where it changes sides, over a duration T (s)."""
-
-    signs: tuple[np.ndarray, ...]
-    switches: tuple[np.ndarray, ...]
-    duration: float
-
-    def unknowns(self) -> np.ndarray:
-        return np.concatenate([*self.switches, [self.duration]])
-
-    def with_unknowns(self, theta: np.ndarray) -> BangBang:
-        cuts = np.cumsum([len(s) for s in self.switches])[:-1]
-        return BangBang(self.signs, tuple(np.array(x) for x in np.split(theta[:-1], cuts)), float(theta[-1]))
-
-    def label(self) -> str:
-        return "; ".join("(" + ", ".join("max" if s > 0 else "min" for s in signs) + ")" for signs in self.signs)
 
 
 @dataclass(frozen=True)
@@ -113,57 +92,6 @@ class SwitchedMotion:
             f"second integration: the switching times solved with {SOLVE_STEP * 1e3:g} ms Runge-Kutta steps against "
             f"{FINAL_STEP * 1e3:g} ms (the switching structure itself is the fastest of those tried)"
         )
-
-
-def collocation_switches(
-    t: np.ndarray, tau: np.ndarray, torque_limit: np.ndarray, level: float = SATURATED, every_crossing: bool = False
-) -> BangBang:
-    """The bang-bang structure read off sampled torques (t (n,) in s, tau (n, n_dof) in N m): per
-    joint, the sides where |tau| exceeds ``level`` of its limit, and between two sides the instant where the linearly interpolated
-    torque crosses zero. Its accuracy is bounded by the sampling step (the collocation's h).
-
-    With ``every_crossing``, every zero crossing between two saturated samples is a switch (the
-    arcs between them alternate in sign), so that arcs too short for any sample to saturate (the
-    middle arcs of u1 in Type 3 near its boundary with Type 4, where the collocation's torque
-    lingers near zero for a few instants) are kept; else only the first crossing between two
-    different sides is."""
-    signs, switches = [], []
-    for j in range(tau.shape[1]):
-        bound = level * torque_limit[j]
-        side = np.where(tau[:, j] > bound, 1, np.where(tau[:, j] < -bound, -1, 0))
-        saturated = np.flatnonzero(side)
-        joint_signs: list = []
-        joint_switches: list = []
-        for k, index in enumerate(saturated):
-            if joint_signs and side[index] == joint_signs[-1] and not every_crossing:
-                continue
-            if joint_signs:
-                previous = saturated[k - 1]
-                segment = tau[previous : index + 1, j]
-                crossings = _crossings(segment)
-                if not every_crossing:
-                    crossings = crossings[:1]
-                for crossing in crossings:
-                    a, b = previous + crossing, previous + crossing + 1
-                    joint_switches.append(t[a] + (t[b] - t[a]) * tau[a, j] / (tau[a, j] - tau[b, j]))
-                    joint_signs.append(-joint_signs[-1])
-                continue
-            joint_signs.append(int(side[index]))
-        if not joint_signs:
-            joint_signs = [1 if tau[:, j].mean() >= 0 else -1]
-        signs.append(np.array(joint_signs))
-        switches.append(np.array(joint_switches))
-    return BangBang(tuple(signs), tuple(switches), float(t[-1]))
-
-
-def _crossings(values: np.ndarray) -> np.ndarray:
-    """Indices i where the sign of ``values`` changes between i and i + 1, a sample exactly at
-    zero counted with the sign before it (so that it crosses once, where it lies)."""
-    sign = np.sign(values)
-    for i in range(1, len(sign)):
-        if sign[i] == 0:
-            sign[i] = sign[i - 1]
-    return np.flatnonzero(np.diff(sign) != 0)
 
 
 class _Shooting:
@@ -336,7 +264,7 @@ def refine_switching(
             best = solved
     if best is None:
         return None
-    motion = _motion(shooting, _pruned(best[0]), np.asarray(goal, float), goal_velocity)
+    motion = _motion(shooting, pruned(best[0]), np.asarray(goal, float), goal_velocity)
     return dataclasses.replace(motion, solve_step_duration=best[1])
 
 
@@ -367,41 +295,11 @@ def refine_collocation(
     return best
 
 
-def _pruned(controls: BangBang) -> BangBang:
-    """Arcs that shrank to nothing removed (two switches at one instant, or one at an end)."""
-    signs, switches = [], []
-    for joint_signs, joint_switches in zip(controls.signs, controls.switches):
-        edges = np.concatenate([[0.0], joint_switches, [controls.duration]])
-        keep = np.diff(edges) > 1e-9
-        kept_signs = joint_signs[keep]
-        kept_edges = np.concatenate([[0.0], edges[1:][keep]])
-        merged_signs, merged_switches = [kept_signs[0]], []
-        for sign, edge in zip(kept_signs[1:], kept_edges[1:-1]):
-            if sign != merged_signs[-1]:
-                merged_signs.append(sign)
-                merged_switches.append(edge)
-        signs.append(np.array(merged_signs))
-        switches.append(np.array(merged_switches))
-    return BangBang(tuple(signs), tuple(switches), controls.duration)
-
-
 def _motion(shooting: _Shooting, controls: BangBang, goal, goal_velocity) -> SwitchedMotion:
     q, v, record = shooting.run(controls, FINAL_STEP, keep=True)
     error = float(np.abs(np.concatenate([q - goal, v - goal_velocity])).max())
     t, qs, vs, accelerations, torques = (np.array(column) for column in zip(*record))
     return SwitchedMotion(controls, t, qs, vs, accelerations, torques, error)
-
-
-def mirrored(controls: BangBang) -> BangBang:
-    """The time-reversed twin of a rest-to-rest bang-bang motion on an arm whose inertia depends
-    on cos(q) only and without gravity (the Geering arm between stretched poses): u(t) -> -u(T - t),
-    equally fast; its switching times are T - t in reverse order."""
-    T = controls.duration
-    return BangBang(
-        tuple(-signs[::-1] for signs in controls.signs),
-        tuple((T - switches)[::-1] for switches in controls.switches),
-        T,
-    )
 
 
 #: Spacing (s) of the quintic Hermite pieces that carry a refined motion into an answer.
@@ -444,6 +342,3 @@ def _quintic(q0, v0, a0, q1, v1, a1, h):
     return np.stack([q0, v0, a0 / 2, c3, c4, c5], axis=1)
 
 
-def switching_times(controls: BangBang, joint_names) -> dict[str, list[float]]:
-    """{joint name: [t, ...]} (s): where each joint's saturated torque changes sides."""
-    return {name: [float(t) for t in switches] for name, switches in zip(joint_names, controls.switches)}

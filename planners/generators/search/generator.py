@@ -27,6 +27,7 @@ from toptraj.planners.generators.search.local import optimize_locally
 from toptraj.planners.generators.search.local_outcome import LocalOptimum
 from toptraj.planners.generators.search.memory import check_search_memory
 from toptraj.planners.generators.search.method import global_search
+from toptraj.planners.generators.search.report import LocalReport
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed, TimePath
@@ -156,9 +157,8 @@ def _search(work: _Work, deadline: Deadline) -> Timed:
         except InfeasiblePath as error:
             failures.append(f"tube {index + 1}{' (optimized)' if optimum is not None else ''}: {error.detail}")
             continue
-        report = found.as_dict(index)
-        report["local"] = [_local_report(tubes[i].time, item) for _, i, item in sorted(optimized, key=lambda item: item[1])]
-        report["final_time"] = timed.timing.duration
+        local = tuple(LocalReport.of(tubes[i].time, item) for _, i, item in sorted(optimized, key=lambda item: item[1]))
+        report = found.report(index, local, timed.timing.duration)
         return timed._replace(method="search", notes=tuple(_notes(robot, spec, path, timed, optimum)), search=report)
     raise InfeasiblePath("no path the search found could be followed: " + "; ".join(failures))
 
@@ -181,18 +181,3 @@ def _notes(robot: Robot, spec: FreeMotion, path: GeometricPath, timed: Timed, op
             "budget_s may find a faster path"
         )
     return notes
-
-
-def _local_report(grid_time: float, local) -> dict:
-    """A tube's local optimization for the answer's ``search.local`` (times in s)."""
-    stats = local.statistics
-    return {
-        "grid_time": grid_time,
-        "seed_time": stats.seed_duration if np.isfinite(stats.seed_duration) else None,
-        "time": local.duration,
-        "control_points": [r.control_points for r in stats.rounds],
-        "round_times": [r.duration if np.isfinite(r.duration) else None for r in stats.rounds],
-        "evaluations": stats.evaluations,
-        "stopped": stats.stopped,
-        "wall_s": stats.wall_s,
-    }

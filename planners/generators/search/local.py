@@ -238,94 +238,17 @@ def optimize_locally(
             clearance and the joint ranges (a ``PathInCollision`` when it is the clearance).
         BudgetExceeded: ``deadline`` passed.
     """
-    from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
 
     started = time.perf_counter()
-    seed = np.asarray(seed, dtype=float)
-    if seed.ndim != 2 or seed.shape[0] < 2 or seed.shape[1] != robot.dof or not np.all(np.isfinite(seed)):
-        raise InvalidRequest("seed", seed.shape, rule="seed_shape",
-                             detail=f"the seed path must be finite joint configurations of shape (m >= 2, {robot.dof}): {seed.shape}")
-    keep = np.concatenate([[True], np.linalg.norm(np.diff(seed, axis=0), axis=1) > 1e-12])
-    seed = seed[keep]
-    if len(seed) < 2:
-        raise InvalidRequest("seed", None, rule="seed_ends_coincide", detail="the seed path's start and goal coincide")
-    if settings.grid_intervals & (settings.grid_intervals - 1):
-        raise InvalidRequest("local.grid_intervals", settings.grid_intervals, rule="not_a_power_of_two",
-                             detail=f"the optimization grid must have a power of two of intervals; got {settings.grid_intervals}")
-    objective = _Objective(robot, limits, kinds, seed[0], seed[-1], obstacles, clearance, settings, deadline)
+    seed = _seed_points(seed, robot.dof)
     counts = _schedule(max(settings.first_control_points, DEGREE + 1), settings.max_control_points)
-    if 8 * (counts[-1] - DEGREE) > settings.grid_intervals:
-        raise InvalidRequest(
-            "local.grid_intervals", settings.grid_intervals, rule="grid_too_coarse",
-            detail=f"{counts[-1]} control points need at least {8 * (counts[-1] - DEGREE)} grid intervals (8 per knot interval)",
-        )
+    _check_grid(settings, counts)
+    objective = _Objective(robot, limits, kinds, seed[0], seed[-1], obstacles, clearance, settings, deadline)
     extent = np.maximum(np.ptp(seed, axis=0) * settings.step, settings.min_step)
-
-    objective.interior = np.sort(dyadic_knots(counts[0] - DEGREE - 1))
-    control = fit_seed(seed, objective.interior)
-    seed_path = BSplinePath(control, objective.interior)
-    seed_timing = _exact(seed_path, robot, limits, kinds, deadline)
-    seed_duration = np.inf if seed_timing is None else seed_timing.duration
-
-    rounds: list[LocalRound] = []
-    best = None  # (duration, path, timing, clearance): the fitted seed first, when it passes
-    if seed_timing is not None:
-        clear, found = _clear(seed_path, robot, limits, obstacles, clearance, deadline)
-        if clear:
-            best = (seed_timing.duration, seed_path, seed_timing, found)
-    stopped, stalls = "most control points", 0
+    control, seed_duration, best = _fitted_seed(objective, seed, counts[0])
     if allowance_s is not None:
         objective.stop_at = time.monotonic() + allowance_s
-    for number, count in enumerate(counts):
-        deadline.progress(number / len(counts), f"local optimization: {count} control points")
-        while len(control) < count:
-            knots, control = insert_knot(clamped_knots(objective.interior), control, dyadic_knots(len(control) - DEGREE)[-1])
-            objective.interior = knots[DEGREE + 1 : -DEGREE - 1]
-        x0 = control[1:-1].ravel()
-        steps = np.tile(extent, len(control) - 2) * (1.0 if number == 0 else 0.5)
-        simplex = np.vstack([x0, x0 + np.diag(steps)])
-        before = objective.evaluations
-        objective.round_begins()
-        spent = False
-        try:
-            result = minimize(
-                objective,
-                x0,
-                method="Nelder-Mead",
-                options={
-                    "initial_simplex": simplex,
-                    "maxfev": settings.evaluations_per_variable * len(x0),
-                    "xatol": 1e-4,
-                    "fatol": 1e-6,
-                    "adaptive": len(x0) > 4,
-                },
-            )
-            x, value = result.x, float(result.fun)
-        except _AllowanceSpent:
-            spent = True
-            value, x = objective.best
-            if x is None:
-                stopped = "allowance spent"
-                break
-        path = objective.path(x)
-        control = path.control
-        timing = _exact(path, robot, limits, kinds, deadline)
-        clear, found = _clear(path, robot, limits, obstacles, clearance, deadline)
-        duration = np.inf if timing is None else timing.duration
-        rounds.append(LocalRound(count, float(value), float(duration), clear, objective.evaluations - before))
-        if timing is not None and clear:
-            if best is not None and duration > best[0] * (1.0 - settings.improvement):
-                stalls += 1
-            else:
-                stalls = 0
-            if best is None or duration < best[0]:
-                best = (duration, path, timing, found)
-        if spent:
-            stopped = "allowance spent"
-            break
-        if stalls >= settings.patience:
-            stopped = "converged"
-            break
+    rounds, best, stopped = _rounds(objective, control, counts, extent, best)
     if best is None:
         raise InfeasiblePath(
             f"the local optimization found no path that a timing can follow and that keeps the clearance "
@@ -335,3 +258,114 @@ def optimize_locally(
     duration, path, timing, found = best
     statistics = LocalStatistics(objective.evaluations, tuple(rounds), float(seed_duration), stopped, time.perf_counter() - started)
     return LocalOptimum(path, float(duration), timing, path.control, path.interior, found, statistics)
+
+
+#: The best path so far: (exact duration in s, path, timing, clearance found).
+_Best = tuple[float, BSplinePath, TimeScaling, Clearance | None]
+
+
+def _seed_points(seed: np.ndarray, dof: int) -> np.ndarray:
+    """The seed's configurations (m, dof), repeated ones dropped."""
+    seed = np.asarray(seed, dtype=float)
+    if seed.ndim != 2 or seed.shape[0] < 2 or seed.shape[1] != dof or not np.all(np.isfinite(seed)):
+        raise InvalidRequest("seed", seed.shape, rule="seed_shape",
+                             detail=f"the seed path must be finite joint configurations of shape (m >= 2, {dof}): {seed.shape}")
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(seed, axis=0), axis=1) > 1e-12])
+    seed = seed[keep]
+    if len(seed) < 2:
+        raise InvalidRequest("seed", None, rule="seed_ends_coincide", detail="the seed path's start and goal coincide")
+    return seed
+
+
+def _check_grid(settings: LocalSettings, counts: list[int]) -> None:
+    """The optimization grid holds the dyadic knots of the largest round (8 intervals per knot
+    interval)."""
+    if settings.grid_intervals & (settings.grid_intervals - 1):
+        raise InvalidRequest("local.grid_intervals", settings.grid_intervals, rule="not_a_power_of_two",
+                             detail=f"the optimization grid must have a power of two of intervals; got {settings.grid_intervals}")
+    if 8 * (counts[-1] - DEGREE) > settings.grid_intervals:
+        raise InvalidRequest(
+            "local.grid_intervals", settings.grid_intervals, rule="grid_too_coarse",
+            detail=f"{counts[-1]} control points need at least {8 * (counts[-1] - DEGREE)} grid intervals (8 per knot interval)",
+        )
+
+
+def _fitted_seed(objective: _Objective, seed: np.ndarray, count: int) -> tuple[np.ndarray, float, _Best | None]:
+    """The spline of ``count`` control points fitted to ``seed``: its control points, its exact
+    duration (s, ``inf`` when no timing can follow it), and itself as the best path so far when
+    it is timed and keeps the clearance and the joint ranges."""
+    robot, limits, kinds, deadline = objective.robot, objective.limits, objective.kinds, objective.deadline
+    objective.interior = np.sort(dyadic_knots(count - DEGREE - 1))
+    control = fit_seed(seed, objective.interior)
+    path = BSplinePath(control, objective.interior)
+    timing = _exact(path, robot, limits, kinds, deadline)
+    if timing is None:
+        return control, np.inf, None
+    clear, found = _clear(path, robot, limits, objective.obstacles, objective.clearance, deadline)
+    return control, timing.duration, (timing.duration, path, timing, found) if clear else None
+
+
+def _rounds(
+    objective: _Objective, control: np.ndarray, counts: list[int], extent: np.ndarray, best: _Best | None
+) -> tuple[list[LocalRound], _Best | None, str]:
+    """The rounds, one per control point count of ``counts`` (``control`` the fitted seed's,
+    ``extent`` (n_dof,) the first simplex's steps), until the duration stops improving, the
+    counts run out or the allowance is spent: the rounds, the best path and why they stopped."""
+    settings, deadline = objective.settings, objective.deadline
+    rounds: list[LocalRound] = []
+    stopped, stalls = "most control points", 0
+    for number, count in enumerate(counts):
+        deadline.progress(number / len(counts), f"local optimization: {count} control points")
+        while len(control) < count:
+            knots, control = insert_knot(clamped_knots(objective.interior), control, dyadic_knots(len(control) - DEGREE)[-1])
+            objective.interior = knots[DEGREE + 1 : -DEGREE - 1]
+        before = objective.evaluations
+        x, value, spent = _nelder_mead(objective, control[1:-1].ravel(), extent * (1.0 if number == 0 else 0.5))
+        if x is None:
+            stopped = "allowance spent"
+            break
+        path = objective.path(x)
+        control = path.control
+        timing = _exact(path, objective.robot, objective.limits, objective.kinds, deadline)
+        clear, found = _clear(path, objective.robot, objective.limits, objective.obstacles, objective.clearance, deadline)
+        duration = np.inf if timing is None else timing.duration
+        rounds.append(LocalRound(count, float(value), float(duration), clear, objective.evaluations - before))
+        if timing is not None and clear:
+            stalls = stalls + 1 if best is not None and duration > best[0] * (1.0 - settings.improvement) else 0
+            if best is None or duration < best[0]:
+                best = (duration, path, timing, found)
+        if spent:
+            stopped = "allowance spent"
+            break
+        if stalls >= settings.patience:
+            stopped = "converged"
+            break
+    return rounds, best, stopped
+
+
+def _nelder_mead(objective: _Objective, x0: np.ndarray, extent: np.ndarray) -> tuple[np.ndarray | None, float, bool]:
+    """One round of Nelder-Mead from ``x0`` (the interior control points, flattened), its first
+    simplex stepping ``extent`` (n_dof,) along each joint: the best point and its objective, and
+    whether the allowance was spent (the best point so far, ``None`` when there is none)."""
+    from scipy.optimize import minimize  # here: scipy's optimizers take a second to import
+
+    settings = objective.settings
+    simplex = np.vstack([x0, x0 + np.diag(np.tile(extent, len(x0) // len(extent)))])
+    objective.round_begins()
+    try:
+        result = minimize(
+            objective,
+            x0,
+            method="Nelder-Mead",
+            options={
+                "initial_simplex": simplex,
+                "maxfev": settings.evaluations_per_variable * len(x0),
+                "xatol": 1e-4,
+                "fatol": 1e-6,
+                "adaptive": len(x0) > 4,
+            },
+        )
+    except _AllowanceSpent:
+        value, x = objective.best
+        return x, value, True
+    return result.x, float(result.fun), False

@@ -16,6 +16,7 @@ from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOpti
 from toptraj.planners.generators.search.memory import check_search_memory
 from toptraj.planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
 from toptraj.planners.generators.search.problem import build_problem, toward_goal
+from toptraj.planners.generators.search.report import LocalReport, SearchReport
 from toptraj.planners.generators.search.shadows import obstacle_shadows
 from toptraj.robots import JointLimits, Robot
 
@@ -38,19 +39,13 @@ class GlobalSearch:
     high: np.ndarray
     shadows: dict | None
 
-    def as_dict(self, chosen: int = 0) -> dict:
-        """The answer's ``search`` (JSON-ready): the statistics, the tubes' best grid paths
-        (``chosen`` the one returned), the region searched and the shadows."""
-        body = self.result.statistics.as_dict()
-        body["tube_radius"] = self.result.tube_radius
-        body["tubes"] = [
-            {"time": tube.time, "t1": tube.bounds[0], "t2": tube.bounds[1], "t3": tube.bounds[2], "points": tube.points.tolist()}
-            for tube in self.result.tubes
-        ]
-        body["chosen_tube"] = chosen
-        body["region"] = {"lower": self.low.tolist(), "upper": self.high.tolist()}
-        body["shadows"] = self.shadows
-        return body
+    def report(self, chosen: int, local: tuple[LocalReport, ...], final_time: float) -> SearchReport:
+        """The search's report, ``chosen`` the tube whose path is returned, with the tubes' local
+        optimizations and the returned motion's duration (s)."""
+        return SearchReport(
+            self.result.statistics, self.result.tube_radius, self.result.tubes, chosen, self.low, self.high, self.shadows,
+            local, final_time,
+        )
 
 
 def global_search(

@@ -72,15 +72,6 @@ class SearchStatistics:
     search_s: float = 0.0
     goal_variants: int = 1
 
-    def as_dict(self) -> dict:
-        """JSON-ready (``inf`` as ``None``)."""
-        out = dict(self.__dict__)
-        out["pruned"] = dict(self.pruned)
-        for key in ("v_max", "best_grid_time", "upper_bound"):
-            if out[key] is not None and not np.isfinite(out[key]):
-                out[key] = None
-        return out
-
 
 @dataclass(frozen=True)
 class SearchResult:

@@ -43,17 +43,23 @@ coarse grid the answer holds its limits between grid points too, not only at the
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
 
 from toptraj.planners.constraints.admissible import admissible_set
-from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, point_bounds, zero_inertia_intervals
+from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, zero_inertia_intervals
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.diagnostics import static_load
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from toptraj.planners.timing.phase_plane.grid import (
+    Grid,
+    Profile,
+    interval_rows,
+    interval_times,
+    kept_intervals,
+    midpoint_stage_rows,
+)
 from toptraj.planners.timing.phase_plane.refinement_kernels import refinement, row_excursions
 from toptraj.planners.timing.phase_plane.split_kernels import split_points
 from toptraj.planners.timing.phase_plane.sweep_kernels import sweeps
@@ -65,37 +71,6 @@ _SLACK = 1e-9
 #: which the discretization places a few 1e-7 lower; the first interval then absorbs the
 #: difference, a relative change of its acceleration of that order.
 _BOUNDARY_SLACK = 1e-5
-
-
-def interval_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> LinearRows:
-    """Rows of each interval i (shape (N, 2m)) on its start state (u_i, x_i): every row at s_i,
-    ``a_i u + b_i x_i + c_i``, and at s_i+1 as seen from the interval,
-    ``a_i+1 u + b_i+1 (x_i + 2 ds u) + c_i+1`` (the interpolation discretization)."""
-    ds = np.diff(s)[:, None]
-    return LinearRows(
-        a=np.hstack([right.a[:-1], left.a[1:] + 2.0 * ds * left.b[1:]]),
-        b=np.hstack([right.b[:-1], left.b[1:]]),
-        c=np.hstack([right.c[:-1], left.c[1:]]),
-        lower=np.hstack([right.lower[:-1], right.lower[1:]]),
-        upper=np.hstack([right.upper[:-1], right.upper[1:]]),
-    )
-
-
-def midpoint_stage_rows(s: np.ndarray, right: LinearRows, left: LinearRows) -> LinearRows:
-    """Rows of each interval i (shape (N, m)) on its start state (u_i, x_i): every row taken at
-    the interval's midpoint, ``a_m u + b_m (x_i + ds u) + c_m``, with the coefficients averaged
-    from the two ends (the right-hand side of s_i, the left-hand side of s_i+1)."""
-    ds = np.diff(s)[:, None]
-    a_mid = 0.5 * (right.a[:-1] + left.a[1:])
-    b_mid = 0.5 * (right.b[:-1] + left.b[1:])
-    c_mid = 0.5 * (right.c[:-1] + left.c[1:])
-    return LinearRows(
-        a=a_mid + ds * b_mid,
-        b=b_mid,
-        c=c_mid,
-        lower=right.lower[:-1],
-        upper=right.upper[:-1],
-    )
 
 
 #: A switching point is singular where a row's u-coefficient in its interval is within this
@@ -156,7 +131,7 @@ class PhasePlaneMethod(TimingMethod):
     ) -> TimeScaling:
         x_ends = (boundary.sd_start**2, boundary.sd_end**2)
         most_intervals = max(2**self.max_refinements * (len(constraints.s) - 1), _MIN_REFINED_INTERVALS)
-        grid = _Grid.of(constraints)
+        grid = Grid.of(constraints)
         profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False)
         kept, reference_bounds = NOTHING_KEPT, NOTHING_BEFORE
         # The estimated duration error of ``profile``, and whether it is the estimate on its
@@ -188,10 +163,10 @@ class PhasePlaneMethod(TimingMethod):
                 break
             deadline.check()
             previous = grid
-            grid = _Grid.of(grid.constraints.with_points(extra))
+            grid = Grid.of(grid.constraints.with_points(extra))
             # The profile on the coarser grid is a close reference for viscous friction.
             x_ref = np.interp(grid.s, previous.s, profile.x) if grid.friction else None
-            kept, reference_bounds = _kept_intervals(grid.s, previous.s), reference.bounds
+            kept, reference_bounds = kept_intervals(grid.s, previous.s), reference.bounds
             profile = _solve_on_grid(grid, x_ends, deadline, midpoint=False, x_ref=x_ref, kept=kept, before=profile.bounds)
             estimated = error <= self.tolerance  # within it before the split: still within it
             if error <= self.tolerance:
@@ -217,7 +192,7 @@ GAP_BASIS = (
 )
 
 
-def _duration_error(grid: _Grid, profile: _Profile, x_ends, deadline, tolerance: float) -> float | None:
+def _duration_error(grid: Grid, profile: Profile, x_ends, deadline, tolerance: float) -> float | None:
     """The relative duration error of ``profile`` on ``grid``, estimated as in the refinement
     (``toptraj.planners.timing.phase_plane.refinement_kernels.refinement``); ``None`` when the midpoint discretization finds
     no motion."""
@@ -234,99 +209,18 @@ def midpoint_duration(constraints: PathConstraints, boundary: Boundary = AT_REST
     refinement: second-order accurate, but no bound (the limits may be exceeded between grid
     points). On a fine grid, an estimate of the converged time-optimal duration."""
     states = (boundary.sd_start**2, boundary.sd_end**2)
-    grid = _Grid.of(constraints)
+    grid = Grid.of(constraints)
     first = _solve_on_grid(grid, states, NO_DEADLINE, midpoint=False)
     second = _solve_on_grid(grid, states, NO_DEADLINE, midpoint=True, x_ref=first.x)
-    return float(_interval_times(grid.s, second.x).sum())
+    return float(interval_times(grid.s, second.x).sum())
 
 
-class _Rows(NamedTuple):
-    """The kernels' row arrays, each (N + 1, m): seen from the right, from the left, bounds."""
-
-    a: np.ndarray
-    b: np.ndarray
-    c: np.ndarray
-    d: np.ndarray
-    a_left: np.ndarray
-    b_left: np.ndarray
-    c_left: np.ndarray
-    d_left: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-
-
-class _Grid(NamedTuple):
-    """The constraints on one grid as contiguous arrays for the kernels: s (N + 1,), the rows
-    seen from the right and from the left (``a, b, c, d`` each (N + 1, m)), their bounds, the
-    first-order bound x_bound = sd_max^2 (N + 1,), the joint whose velocity limit sets it (N + 1,,
-    -1 where none or unknown), whether the rows are smooth through each grid point (N + 1,,
-    ``toptraj.planners.constraints.torque_interpolation.smooth_points``) and whether any row has viscous friction."""
-
-    constraints: PathConstraints
-    s: np.ndarray
-    rows: _Rows
-    x_bound: np.ndarray
-    binding: np.ndarray
-    smooth: np.ndarray
-    friction: bool
-
-    @classmethod
-    def of(cls, constraints: PathConstraints) -> _Grid:
-        rows = _Rows(*(
-            np.ascontiguousarray(array, dtype=np.float64)
-            for array in (
-                constraints.a, constraints.b, constraints.c, constraints.d,
-                constraints.a_left, constraints.b_left, constraints.c_left, constraints.d_left,
-                constraints.lower, constraints.upper,
-            )
-        ))  # fmt: skip
-        s = np.ascontiguousarray(constraints.s, dtype=np.float64)
-        x_bound = np.ascontiguousarray(constraints.sd_max**2, dtype=np.float64)
-        joint = constraints.velocity_joint
-        binding = np.full(len(s), -1, dtype=np.int64) if joint is None else np.ascontiguousarray(joint, dtype=np.int64)
-        return cls(constraints, s, rows, x_bound, binding, constraints.smooth, constraints.has_friction)
-
-    def friction_reference(self) -> np.ndarray:
-        """``toptraj.planners.constraints.admissible.friction_reference``: the maximum velocity curve without friction,
-        capped by the first-order bound (1 where it is not positive and finite)."""
-        a, b, c, _, _, _, _, _, lower, upper = self.rows
-        x_max = point_bounds(a, b, c, lower, upper, self.x_bound)[4]
-        return np.where(np.isfinite(x_max) & (x_max > 0), x_max, 1.0)
-
-
-class _Profile(NamedTuple):
-    """A solution on one grid: x = sd^2 (N + 1,), which intervals the envelope capped (N,), the
-    envelope (N + 1,), the admissible upper x_i of each interval (N,), how much faster each
-    interval could be crossed at its bounds (N,, ``toptraj.planners.timing.phase_plane.refinement_kernels.switch_excess``)
-    and the intervals' bounds (``toptraj.planners.constraints.admissible_kernels.interval_bounds``' p, q, r, x_low, x_high)."""
-
-    x: np.ndarray
-    capped: np.ndarray
-    envelope: np.ndarray
-    x_high: np.ndarray
-    switch_excess: np.ndarray
-    bounds: tuple = NOTHING_BEFORE
-
-
-def _interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
-    root = np.sqrt(x)
-    return 2.0 * np.diff(s) / np.maximum(root[:-1] + root[1:], 1e-300)
-
-
-def _kept_intervals(s: np.ndarray, coarser: np.ndarray) -> np.ndarray:
-    """For each interval of the refined grid ``s`` (N + 1,), the interval of the grid
-    ``coarser`` it refines that it keeps whole (the same two ends), or -1 (N,, int64)."""
-    at = np.minimum(np.searchsorted(coarser, s[:-1]), len(coarser) - 2)
-    whole = (coarser[at] == s[:-1]) & (coarser[at + 1] == s[1:])
-    return np.where(whole, at, -1).astype(np.int64)
-
-
-def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoint: bool, x_ref=None, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> _Profile:
+def _solve_on_grid(grid: Grid, boundary: tuple[float, float], deadline, midpoint: bool, x_ref=None, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> Profile:
     """Integrate on one grid, in the interpolation (conservative) or the midpoint
     discretization. Viscous friction is linearized around ``x_ref`` (default: a first pass
     around the frictionless maximum velocity curve, then one around its answer). ``kept`` and
     ``before``: the intervals this grid keeps whole from a coarser one and that grid's bounds
-    in the same discretization (``_Profile.bounds``), copied instead of computed again."""
+    in the same discretization (``Profile.bounds``), copied instead of computed again."""
     passes = 1
     if x_ref is None:
         passes = 2 if grid.friction else 1
@@ -338,7 +232,7 @@ def _solve_on_grid(grid: _Grid, boundary: tuple[float, float], deadline, midpoin
     return profile
 
 
-def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> _Profile:
+def _integrate(grid: Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> Profile:
     """One sweep pair (``toptraj.planners.timing.phase_plane.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
     rows linearized around ``x_ref``."""
     x_bound, constraints = grid.x_bound, grid.constraints
@@ -374,10 +268,10 @@ def _integrate(grid: _Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTH
             s=0.0,
         )
     x[0], x[-1] = x_start, x_end
-    return _Profile(np.maximum(x, 0.0), capped, envelope, x_high, switch_excess, bounds)
+    return Profile(np.maximum(x, 0.0), capped, envelope, x_high, switch_excess, bounds)
 
 
-def _switch_points(constraints: PathConstraints, profile: _Profile) -> tuple[tuple[float, str], ...]:
+def _switch_points(constraints: PathConstraints, profile: Profile) -> tuple[tuple[float, str], ...]:
     """Where the profile changes between accelerating (at beta) and following the envelope."""
     capped, envelope, x_high = profile.capped, profile.envelope, profile.x_high
     changes = (np.flatnonzero(capped[1:] != capped[:-1]) + 1).tolist()

@@ -7,7 +7,7 @@ import pytest
 from scipy.optimize import linprog
 
 from toptraj.planners.constraints.admissible import admissible_set
-from toptraj.planners.constraints.path_constraints import LinearRows
+from toptraj.planners.constraints.linear_rows import LinearRows
 
 RNG = np.random.default_rng(11)
 

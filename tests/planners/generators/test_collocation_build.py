@@ -58,7 +58,7 @@ def test_a_motion_shaped_by_its_acceleration_limits_is_not_refined_to_bang_bang(
     result = plan(arm, FreeMotion(START, GOAL, intervals=12, revolutions=False),
                   Timing(method="collocation", constraints=("velocity", "acceleration", "torque")), dt=0.01)
     assert calls == []
-    assert result.solver["switching"] == "read off the samples"
+    assert result.solver.switching == "read off the samples"
     assert max(result.peak_utilization["torque"]) < 0.5
     assert max(result.peak_utilization["acceleration"]) <= 1.005
 

@@ -41,7 +41,7 @@ def _geering(goal, revolutions=True):
 )
 def test_geering_time_optimal_motions(goal, revolutions, paper_T, elbow_end):
     arm, result = _geering(goal, revolutions)
-    collocation_T = result.solver["duration"]
+    collocation_T = result.solver.duration
     assert collocation_T == pytest.approx(paper_T, rel=1e-2)
     assert result.duration == pytest.approx(paper_T, rel=1e-2)
     # The path-constrained time-optimal duration along the returned path (phase plane) agrees
@@ -49,7 +49,7 @@ def test_geering_time_optimal_motions(goal, revolutions, paper_T, elbow_end):
     assert result.duration == pytest.approx(collocation_T, rel=1e-2)
     assert result.samples.q[-1] == pytest.approx([goal[0], elbow_end], abs=1e-9)
     if revolutions:
-        assert ("psi -6.2832" in result.solver["initial_guess"]) == (elbow_end != 0.0)
+        assert ("psi -6.2832" in result.solver.initial_guess) == (elbow_end != 0.0)
     # Bang-bang: some torque saturated most of the time, and no limit exceeded.
     ratio = np.abs(result.samples.tau) / arm.limits.torque
     assert ratio.max() <= 1.005
@@ -83,29 +83,29 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     arm = robots.load("yamamoto_2r")
     motion = FreeMotion(np.radians([45.0, -90.0]), np.radians([-90.0, 0.0]))
     cheap = plan(arm, motion, Timing(method="collocation", constraints=("torque",), torque_weight=0.03))
-    assert cheap.solver["cost"] <= 0.5777  # the paper's sixth iterate, 0.57766, bounds the optimum
+    assert cheap.solver.cost <= 0.5777  # the paper's sixth iterate, 0.57766, bounds the optimum
     assert cheap.cost <= 0.5777 * 1.01  # re-timed along the returned path by min_cost
     # The converged beta = 0.03 cost (YAMAMOTO_COST); the collocation's own and the re-timed one
     # within 0.5 %.
-    assert cheap.solver["cost"] == pytest.approx(YAMAMOTO_COST, rel=5e-3)
+    assert cheap.solver.cost == pytest.approx(YAMAMOTO_COST, rel=5e-3)
     assert cheap.cost == pytest.approx(YAMAMOTO_COST, rel=5e-3)
     # The stated gap (the cost on 12 collocation intervals against 30) bounds the distance
     # from the converged cost.
-    assert "second grid" in cheap.solver["gap_basis"]
-    assert abs(cheap.solver["cost"] - YAMAMOTO_COST) / YAMAMOTO_COST <= cheap.solver["optimality_gap"] <= 5e-3
+    assert "second grid" in cheap.solver.gap_basis
+    assert abs(cheap.solver.cost - YAMAMOTO_COST) / YAMAMOTO_COST <= cheap.solver.optimality_gap <= 5e-3
     # ... and it is the answer's stated accuracy: that of the motion found, not of its re-timing
-    assert cheap.accuracy.relative_gap == cheap.solver["optimality_gap"]
-    assert cheap.accuracy.basis == cheap.solver["gap_basis"]
+    assert cheap.accuracy.relative_gap == cheap.solver.optimality_gap
+    assert cheap.accuracy.basis == cheap.solver.gap_basis
     assert cheap.peak_utilization["torque"].max() <= 1.005
     fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
     assert fast.duration < cheap.duration
     # refined to exact bang-bang torques (toptraj.planners.generators.collocation.switching): never longer than the
     # collocation's own duration, and within 1e-4 (the largest gap it may state) of the
     # converged minimum time (YAMAMOTO_MINIMUM_TIME; measured 2e-7)
-    assert fast.solver["switching"] == "refined"
-    assert fast.duration <= fast.solver["duration"]
+    assert fast.solver.switching == "refined"
+    assert fast.duration <= fast.solver.duration
     assert fast.duration == pytest.approx(YAMAMOTO_MINIMUM_TIME, rel=1e-4)
-    assert fast.solver["optimality_gap"] <= 1e-4
+    assert fast.solver.optimality_gap <= 1e-4
 
 
 def test_ur5_smoke():

@@ -9,7 +9,7 @@ integration (1 ms Runge-Kutta steps, goal error below 1e-8): the captions are ma
 0.9755, 0.14 ms).
 
 A time-reversed motion u(t) -> -u(T - t) is as fast as the original on this arm
-(``switching.mirrored``). Types 3 and 4 are their own mirror images; the captions of Types 1
+(``bang_bang.mirrored``). Types 3 and 4 are their own mirror images; the captions of Types 1
 and 2 start u1 at its maximum and u2 at its minimum, and the Type 2 answer comes as the mirror
 image (u1 starting at its minimum: which of the two equally fast twins the collocation's
 initial guesses reach first), so the tests mirror an answer into the caption's orientation
@@ -23,7 +23,8 @@ import pytest
 
 from toptraj import robots
 from toptraj.planners import Timing, plan
-from toptraj.planners.generators.collocation.switching import BangBang, collocation_switches, mirrored, refine_switching
+from toptraj.planners.generators.collocation.bang_bang import BangBang, collocation_switches, mirrored
+from toptraj.planners.generators.collocation.switching import refine_switching
 from toptraj.planners.problem.free_motion import FreeMotion
 
 CAPTION_TOLERANCE = 5e-3  # s
@@ -59,7 +60,7 @@ def type_4(arm):
 def _controls(answer, arm) -> BangBang:
     """The answer's bang-bang controls: signs from its torques, switches from ``switching_times``."""
     read = collocation_switches(answer.samples.t, answer.samples.tau, arm.limits.torque)
-    switches = tuple(np.array(answer.switching_times[name]) for name in arm.joint_names)
+    switches = tuple(np.array(answer.switching_times.of(name)) for name in arm.joint_names)
     assert [len(s) for s in switches] == [len(s) - 1 for s in read.signs]
     return BangBang(read.signs, switches, answer.duration)
 
@@ -82,7 +83,7 @@ def _assert_caption(controls: BangBang, u1, u2, T, T_tolerance):
 def test_type_2_caption(arm, type_2):
     """Fig. 2, phi_b = 0.981, psi_b = 0: u1 (max, min, max) at 0.513 and 1.056 s, u2 (min, max,
     min) at 0.113 and 0.634 s, T = 1.085 s (ours 1.08446)."""
-    assert type_2.solver["switching"] == "refined"
+    assert type_2.solver.switching == "refined"
     assert type_2.samples.q[-1] == pytest.approx([0.981, 0.0], abs=1e-9)
     controls = _as_caption(_controls(type_2, arm), 1, -1)
     assert controls is not None and list(controls.signs[0]) == [1, -1, 1] and list(controls.signs[1]) == [-1, 1, -1]
@@ -106,7 +107,7 @@ def test_type_1_caption(arm, type_2):
 def test_type_3_caption(arm, type_3):
     """Fig. 3, phi_b = 0.76, psi_b = -2 pi: u1 (max, min, max, min) at 0.190, T/2 and 0.785 s,
     u2 (min, max) at T/2, T = 0.9755 s (ours 0.97564)."""
-    assert type_3.solver["switching"] == "refined"
+    assert type_3.solver.switching == "refined"
     assert type_3.samples.q[-1] == pytest.approx([0.76, -2 * np.pi], abs=1e-9)
     controls = _controls(type_3, arm)
     assert list(controls.signs[0]) == [1, -1, 1, -1] and list(controls.signs[1]) == [-1, 1]
@@ -120,7 +121,7 @@ def test_type_3_caption(arm, type_3):
 def test_type_4_caption(arm, type_4):
     """Fig. 4, phi_b = pi, psi_b = -2 pi: u1 (max, min) at T/2, u2 (min, max, min, max) at
     0.278 s, T/2 and 0.974 s, T = 1.252 s (ours 1.25196)."""
-    assert type_4.solver["switching"] == "refined"
+    assert type_4.solver.switching == "refined"
     assert type_4.samples.q[-1] == pytest.approx([np.pi, -2 * np.pi], abs=1e-9)
     controls = _controls(type_4, arm)
     assert list(controls.signs[0]) == [1, -1] and list(controls.signs[1]) == [-1, 1, -1, 1]
@@ -209,12 +210,12 @@ def test_at_0_76_the_elbow_returns(arm, type_3):
     its goal, not the -2 pi one (0.975644 s), which the 30-interval collocation ranks first."""
     free = _answer(arm, 0.76, revolutions=True)
     returning = _answer(arm, 0.76, revolutions=False)
-    assert free.solver["switching"] == returning.solver["switching"] == type_3.solver["switching"] == "refined"
+    assert free.solver.switching == returning.solver.switching == type_3.solver.switching == "refined"
     assert free.samples.q[-1] == pytest.approx([0.76, 0.0], abs=1e-9)
     assert free.duration == pytest.approx(returning.duration, rel=1e-9)
     assert free.duration == pytest.approx(0.974963, abs=1e-6)
     assert type_3.duration == pytest.approx(0.975644, abs=1e-6)
-    assert free.solver["optimality_gap"] <= 1e-6
+    assert free.solver.optimality_gap <= 1e-6
 
 
 def test_at_1_74_the_switches_are_refined_to_the_type_3_optimum(arm, type_3):
@@ -224,12 +225,12 @@ def test_at_1_74_the_switches_are_refined_to_the_type_3_optimum(arm, type_3):
     family continued from phi_b = 0.76 (an independent computation: switching times solved step
     by step from Fig. 3's motion)."""
     answer = _answer(arm, 1.74, revolutions=True)
-    assert answer.solver["switching"] == "refined"
+    assert answer.solver.switching == "refined"
     assert answer.samples.q[-1] == pytest.approx([1.74, -2 * np.pi], abs=1e-9)
     reference = _family(arm, type_3, 0.76).at(1.74)
     assert reference is not None and reference.label() == "(max, min, max, min); (min, max)"
     assert answer.duration == pytest.approx(reference.duration, rel=1e-6)
-    assert answer.solver["optimality_gap"] <= 1e-6
-    assert "second integration" in answer.solver["gap_basis"]
-    assert answer.accuracy.relative_gap == answer.solver["optimality_gap"]
+    assert answer.solver.optimality_gap <= 1e-6
+    assert "second integration" in answer.solver.gap_basis
+    assert answer.accuracy.relative_gap == answer.solver.optimality_gap
     assert "second integration" in answer.accuracy.basis

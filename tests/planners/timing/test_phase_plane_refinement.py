@@ -17,7 +17,8 @@ from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.paths import SplinePath
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.timing import PhasePlaneMethod
-from toptraj.planners.timing.phase_plane.method import _kept_intervals, interval_rows, midpoint_duration, midpoint_stage_rows
+from toptraj.planners.timing.phase_plane.grid import interval_rows, kept_intervals, midpoint_stage_rows
+from toptraj.planners.timing.phase_plane.method import midpoint_duration
 from toptraj.planners.timing.phase_plane.refinement_kernels import row_excursions, switch_excess
 from toptraj.planners.timing.phase_plane.split_kernels import _pieces
 
@@ -129,7 +130,7 @@ def test_interval_bounds_kept_from_a_coarser_grid_are_the_bounds_computed_afresh
 
     everything = np.arange(150)
     before = bounds(coarse_points, NOTHING_KEPT, NOTHING_BEFORE)
-    kept = _kept_intervals(fine.s, fine.s[coarse_points])
+    kept = kept_intervals(fine.s, fine.s[coarse_points])
     assert 50 < (kept >= 0).sum() < 140  # some intervals kept, some new
     afresh = bounds(everything, NOTHING_KEPT, NOTHING_BEFORE)
     for copied, computed in zip(bounds(everything, kept, before), afresh):
