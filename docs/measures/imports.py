@@ -49,6 +49,10 @@ ROOM_LAYER = {
 }
 
 
+# the modules are read under their folders' names: the one import name's prefix is dropped
+ROOM = {name.removeprefix("toptraj."): target for name, target in ROOM.items()}
+
+
 def module_name(path: pathlib.Path) -> str:
     parts = list(path.with_suffix("").parts)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
@@ -68,9 +72,9 @@ def import_graph() -> dict[str, set[str]]:
         targets = set()
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Import):
-                names = [alias.name for alias in node.names]
+                names = [alias.name.removeprefix("toptraj.") for alias in node.names]
             elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-                names = [f"{node.module}.{alias.name}" for alias in node.names]
+                names = [f"{node.module}.{alias.name}".removeprefix("toptraj.") for alias in node.names]
             else:
                 continue
             targets |= {t for t in map(resolve, names) if t is not None and t != module}
