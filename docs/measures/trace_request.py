@@ -19,7 +19,7 @@ ROOTS = ("robots", "planners", "service", "client")
 
 
 def _module(frame) -> str | None:
-    name = frame.f_globals.get("__name__", "")
+    name = frame.f_globals.get("__name__", "").removeprefix("toptraj.")
     return name if name.split(".")[0] in ROOTS else None
 
 
