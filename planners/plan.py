@@ -15,6 +15,7 @@ import numpy as np
 from toptraj.planners.checks.gate import TimedStretch, gate_threshold, samples_exceed
 from toptraj.planners.collision import Obstacle, check_clearance
 from toptraj.planners.collision.obstacles import check_obstacles
+from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.tool_speed import tool_speed_limit
 from toptraj.planners.errors import InvalidRequest, TimingFailed, numerical_breakdown_is_failure
@@ -130,6 +131,7 @@ def plan(
     exact_period: bool = False,
     obstacles: tuple[Obstacle, ...] = (),
     clearance: float = DEFAULT_CLEARANCE,
+    self_collision: bool = False,
 ) -> PlannedTrajectory:
     """Plan the timed trajectory of ``robot`` along ``path_spec``, sampled every ``dt`` seconds
     into at most ``max_samples`` samples. With ``exact_period`` the samples lie on whole periods
@@ -137,7 +139,9 @@ def plan(
     (``toptraj.planners.trajectory.sample_trajectory``); ``duration`` stays the planned (optimal) one
     and ``sampled_duration`` is the samples' last instant. With ``obstacles`` (world frame),
     every link keeps ``clearance`` (m) from them along the path (``toptraj.planners.collision``), and
-    the answer carries the smallest distance found.
+    the answer carries the smallest distance found. With ``self_collision`` no two links of the
+    arm touch along the path (``toptraj.planners.collision.self_collision``; the search checks it
+    always).
 
     Every answer holds the requested limits on a dense resampling within ``LIMIT_TOLERANCE``
     (with ``timing.limit_margin`` > 0, strictly within the limits): the gate refines the grid
@@ -197,6 +201,7 @@ def plan(
         )
     timing_part = deadline.within(0.0, 0.9)
     checked_first = None
+    self_checked = None
     if obstacles and isinstance(path_spec, FreeMotion) and method.name != "search":
         raise InvalidRequest(
             "path.obstacles on a free path are served by timing.method 'search' (the global search among obstacles); "
@@ -219,6 +224,9 @@ def plan(
             if obstacles:
                 timing_part.progress(0.05, "clearance")
                 checked_first = check_clearance(path, robot, list(obstacles), clearance, deadline)
+            if self_collision:
+                timing_part.progress(0.07, "self-collision")
+                self_checked = check_self_collision(path, robot, deadline=deadline)
             timed = timed_path(robot, path, method, timing, kinds, limits, timing_part.within(0.1, 1.0), threshold)
     path, result, notes = timed.path, timed.timing, [*dropped, *timed.notes]
     if isinstance(path, BlendedPath) and path.tight_corners:
@@ -232,6 +240,8 @@ def plan(
     if obstacles:
         # a given path was checked before its timing; a path shaped with its timing (via points) now
         found_clearance = checked_first or check_clearance(path, robot, list(obstacles), clearance, deadline)
+    if self_collision and self_checked is None and method.name != "search":  # the search checked its own path
+        check_self_collision(path, robot, deadline=deadline)
     deadline.progress(0.9, "sampling")
     require_finite(timed.method, duration=result.duration)
     if result.duration / dt > max_samples - 2:

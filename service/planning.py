@@ -159,6 +159,7 @@ def plan_request(
         exact_period=exact_period_for(format_, output.exact_period),
         obstacles=_obstacles(getattr(request.path, "obstacles", [])),
         clearance=getattr(request.path, "clearance", DEFAULT_CLEARANCE),
+        self_collision=getattr(request.path, "self_collision", False),
     )
 
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from toptraj.planners.checks.gate import TimedStretch, checked, gated
 from toptraj.planners.collision import check_clearance
+from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, OverMemory
 from toptraj.planners.execution.deadline import Deadline
@@ -218,6 +219,7 @@ def _search(robot, spec, timing, kinds, limits, deadline, threshold, obstacles, 
         try:
             if obstacles:
                 check_clearance(path, robot, list(obstacles), clearance, deadline)
+            check_self_collision(path, robot, deadline=deadline)
             timed = timed_path(robot, path, PhasePlaneMethod(), plain, kinds, limits, deadline.within(0.9, 1.0), threshold)
         except InfeasiblePath as error:
             failures.append(f"tube {index + 1}{' (optimized)' if optimum is not None else ''}: {error.detail}")

@@ -182,3 +182,17 @@ def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: n
             if lower < threshold:
                 lower = _segment_box(a[i, c], b[i, c], row) - radius[c]
             nearest[i] = min(nearest[i], lower)
+
+
+@njit(cache=True, nogil=True)
+def pair_minimum(a, b, first, second, radius, out):  # pragma: no cover - compiled
+    """Smallest signed distance (m) between the capsules ``first[p]`` and ``second[p]`` (m,),
+    of radius sum ``radius[p]``, over the pairs, at each configuration of the capsule ends a, b
+    (k, C, 3): into ``out`` (k,) (inf without pairs)."""
+    for i in range(a.shape[0]):
+        best = np.inf
+        for p in range(first.shape[0]):
+            d = _segment_segment(a[i, first[p]], b[i, first[p]], a[i, second[p]], b[i, second[p]]) - radius[p]
+            if d < best:
+                best = d
+        out[i] = best
