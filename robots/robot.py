@@ -8,6 +8,7 @@ through -2 pi without any wrap-around.
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -55,6 +56,8 @@ class Robot:
             "limits.toml", "joint_limits.yaml", "default: ..."); empty when not recorded.
         locked_joints: Joints of the URDF fixed at a value (rad, m), not among ``joint_names``.
         notes: What a user of the robot should know (ignored meshes, limits not applied).
+        allowed_collisions: Pairs of links (sorted names) allowed to touch: not checked for
+            self-collision (``toptraj.planners.collision.self_collision``).
     """
 
     name: str
@@ -75,6 +78,7 @@ class Robot:
     limit_sources: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False, compare=False)
     locked_joints: dict[str, float] = field(default_factory=dict, repr=False, compare=False)
     notes: tuple[str, ...] = field(default=(), repr=False, compare=False)
+    allowed_collisions: frozenset[tuple[str, str]] = field(default_factory=frozenset, repr=False, compare=False)
 
     @classmethod
     def from_model(
@@ -125,8 +129,9 @@ class Robot:
     def __reduce__(self):
         """Pickled as its model and metadata (the per-thread workspaces are rebuilt), so that a
         robot can be sent to a worker process."""
-        return Robot.from_model, (
-            self.name, self.model, self.source, self.end_effector, self.limits, self.limit_sources, self.locked_joints, self.notes
+        return _rebuilt, (
+            self.name, self.model, self.source, self.end_effector, self.limits, self.limit_sources, self.locked_joints, self.notes,
+            self.allowed_collisions,
         )
 
     @cached_property
@@ -257,3 +262,9 @@ class Robot:
     @cached_property
     def _frame_anchors(self) -> dict[int, tuple[int, np.ndarray]]:
         return {}
+
+
+def _rebuilt(name, model, source, end_effector, limits, limit_sources, locked_joints, notes, allowed_collisions) -> Robot:
+    """A pickled ``Robot`` rebuilt (``Robot.__reduce__``)."""
+    robot = Robot.from_model(name, model, source, end_effector, limits, limit_sources, locked_joints, notes)
+    return dataclasses.replace(robot, allowed_collisions=allowed_collisions) if allowed_collisions else robot

@@ -23,7 +23,7 @@ MAX_SRDF_CHARS = 200_000
 #: Most elements of an SRDF, at most nesting levels, and most allowed pairs.
 MAX_ELEMENTS = 20_000
 MAX_DEPTH = 8
-MAX_PAIRS = 5_000
+MAX_PAIRS = 2_000
 #: Longest link name.
 MAX_NAME_CHARS = 200
 
