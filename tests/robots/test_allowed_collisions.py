@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from toptraj.robots.srdf import MAX_PAIRS, MAX_SRDF_CHARS, InvalidCollisionList, allowed_pairs, shipped_pairs, srdf_pairs
 from tests.paths import ROOT
+from toptraj.robots.srdf import MAX_PAIRS, MAX_SRDF_CHARS, InvalidCollisionList, allowed_pairs, shipped_pairs, srdf_pairs
 
 ARM_3R = (ROOT / "robots" / "urdf" / "lecture_3r.urdf").read_text()
 SRDF = """<?xml version="1.0"?>
