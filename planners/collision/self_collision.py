@@ -39,6 +39,8 @@ from toptraj.robots.srdf import pair, shipped_pairs
 RESOLUTION = 1e-3
 #: Most configurations checked along one path (first pass and refinement together).
 MAX_CONFIGURATIONS = 20_000
+#: Configurations whose pair distances are computed at once.
+BATCH = 1_000
 
 
 class SelfCollision(InfeasiblePath):
@@ -156,11 +158,14 @@ def self_distances(robot: Robot, q: np.ndarray, pairs: SelfPairs | None = None) 
     """Per configuration of ``q`` (n, n_dof): the smallest signed distance (m) between two
     checked links (inf without pairs) and the index of the pair; shapes (n,)."""
     pairs = self_pairs(robot) if pairs is None else pairs
+    nearest, which = np.full(len(q), np.inf), np.zeros(len(q), dtype=int)
     if not len(pairs.first):
-        return np.full(len(q), np.inf), np.zeros(len(q), dtype=int)
-    distances = pair_distances(robot, pairs, q)
-    which = distances.argmin(axis=1)
-    return distances[np.arange(len(q)), which], which
+        return nearest, which
+    for begin in range(0, len(q), BATCH):  # temporaries of BATCH x pairs x 3 floats at most
+        distances = pair_distances(robot, pairs, q[begin : begin + BATCH])
+        which[begin : begin + BATCH] = distances.argmin(axis=1)
+        nearest[begin : begin + BATCH] = distances[np.arange(len(distances)), which[begin : begin + BATCH]]
+    return nearest, which
 
 
 def _refuse(s: float, pairs: SelfPairs, which: int, distance: float, certain: bool) -> SelfCollision:
