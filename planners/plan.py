@@ -32,6 +32,7 @@ def plan(
     exact_period: bool = False,
     obstacles: tuple[Obstacle, ...] = (),
     clearance: float = DEFAULT_CLEARANCE,
+    self_collision: bool = False,
 ) -> PlannedTrajectory:
     """Plan the timed trajectory of ``robot`` along ``path_spec``, sampled every ``dt`` seconds
     into at most ``max_samples`` samples. With ``exact_period`` the samples lie on whole periods
@@ -39,7 +40,9 @@ def plan(
     (``toptraj.planners.trajectory.sample_trajectory``); ``duration`` stays the planned (optimal) one
     and ``sampled_duration`` is the samples' last instant. With ``obstacles`` (world frame),
     every link keeps ``clearance`` (m) from them along the path (``toptraj.planners.collision``), and
-    the answer carries the smallest distance found.
+    the answer carries the smallest distance found. With ``self_collision`` no two links of the
+    arm touch along the path (``toptraj.planners.collision.self_collision``; the search checks it
+    always).
 
     Every answer holds the requested limits on a dense resampling within ``LIMIT_TOLERANCE``
     (with ``timing.limit_margin`` > 0, strictly within the limits): the gate refines the grid
@@ -55,6 +58,6 @@ def plan(
     """
     problem = build_problem(
         robot, path_spec, method_for(timing, path_spec), timing, sampling=Sampling(dt, max_samples, exact_period),
-        obstacles=obstacles, clearance=clearance, deadline=deadline,
+        obstacles=obstacles, clearance=clearance, deadline=deadline, self_collision=self_collision,
     )
     return run(problem)

@@ -13,7 +13,8 @@ A capsule is a segment [a, b] in the frame of the joint that moves it (Pinocchio
   a capsule along each link, from its joint to the next joint (the last to the end effector),
   of radius ``LINK_RADIUS`` (0.03 m; the papers give none).
 
-Only the robot against obstacles is checked: links never collide with each other here.
+The links against each other (self-collision) are checked by
+``toptraj.planners.collision.self_collision`` on the same capsules.
 """
 
 from __future__ import annotations
@@ -30,13 +31,15 @@ LINK_RADIUS = 0.03
 @dataclass(frozen=True)
 class LinkCapsule:
     """A capsule of a link: ``name``, the Pinocchio ``joint`` moving it (0: the fixed base), end
-    points ``a``, ``b`` (3,) in that joint's frame (m) and its ``radius`` (m)."""
+    points ``a``, ``b`` (3,) in that joint's frame (m), its ``radius`` (m) and the ``link`` (URDF
+    link name) it belongs to ("": not known)."""
 
     name: str
     joint: int
     a: np.ndarray
     b: np.ndarray
     radius: float
+    link: str = ""
 
 
 def fit_capsule(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -92,7 +95,8 @@ def capsules_from_geometry(model: pin.Model, geometry_model: pin.GeometryModel) 
             continue
         placed = points @ item.placement.rotation.T + item.placement.translation
         a, b, radius = fit_capsule(placed)
-        capsules.append(LinkCapsule(item.name, int(item.parentJoint), a, b, radius))
+        link = model.frames[item.parentFrame].name if item.parentFrame < len(model.frames) else item.name
+        capsules.append(LinkCapsule(item.name, int(item.parentJoint), a, b, radius, link))
     return capsules
 
 
@@ -104,11 +108,21 @@ def skeleton_capsules(model: pin.Model, end_effector_frame: int, radius: float =
         parent = model.parents[child]
         if parent == 0:
             continue
-        capsules.append(LinkCapsule(model.names[parent], parent, np.zeros(3), np.array(model.jointPlacements[child].translation), radius))
+        end = np.array(model.jointPlacements[child].translation)
+        capsules.append(LinkCapsule(model.names[parent], parent, np.zeros(3), end, radius, _body_of(model, parent)))
     frame = model.frames[end_effector_frame]
     tip = np.array(frame.placement.translation)
-    capsules.append(LinkCapsule(model.names[frame.parentJoint], int(frame.parentJoint), np.zeros(3), tip, radius))
+    joint = int(frame.parentJoint)
+    capsules.append(LinkCapsule(model.names[joint], joint, np.zeros(3), tip, radius, _body_of(model, joint)))
     return capsules
+
+
+def _body_of(model: pin.Model, joint: int) -> str:
+    """The name of the link (first body frame) that ``joint`` moves; the joint's name if none."""
+    for frame in model.frames:
+        if frame.type == pin.FrameType.BODY and frame.parentJoint == joint:
+            return frame.name
+    return model.names[joint]
 
 
 def world_capsules(model: pin.Model, data: pin.Data, capsules: list[LinkCapsule], configurations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -8,6 +8,7 @@ through -2 pi without any wrap-around.
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -63,6 +64,8 @@ class Robot:
         mounting: The base pose in the world and the world's gravity written into the model,
             ``None``: the base frame is the world.
         bare: The robot without payload and mounting when this one has either, else ``None``.
+        allowed_collisions: Pairs of links (sorted names) allowed to touch: not checked for
+            self-collision (``toptraj.planners.collision.self_collision``).
     """
 
     name: str
@@ -86,6 +89,7 @@ class Robot:
     payload: Payload | None = field(default=None, compare=False)
     mounting: Mounting | None = field(default=None, compare=False)
     bare: Robot | None = field(default=None, repr=False, compare=False)
+    allowed_collisions: frozenset[tuple[str, str]] = field(default_factory=frozenset, repr=False, compare=False)
 
     @classmethod
     def from_model(
@@ -143,9 +147,9 @@ class Robot:
     def __reduce__(self):
         """Pickled as its model and metadata (the per-thread workspaces are rebuilt), so that a
         robot can be sent to a worker process."""
-        return Robot.from_model, (
+        return _rebuilt, (
             self.name, self.model, self.source, self.end_effector, self.limits, self.limit_sources, self.locked_joints, self.notes,
-            self.payload, self.mounting, self.bare,
+            self.payload, self.mounting, self.bare, self.allowed_collisions,
         )
 
     @cached_property
@@ -276,3 +280,10 @@ class Robot:
     @cached_property
     def _frame_anchors(self) -> dict[int, tuple[int, np.ndarray]]:
         return {}
+
+
+def _rebuilt(name, model, source, end_effector, limits, limit_sources, locked_joints, notes, payload, mounting, bare,
+             allowed_collisions) -> Robot:
+    """A pickled ``Robot`` rebuilt (``Robot.__reduce__``)."""
+    robot = Robot.from_model(name, model, source, end_effector, limits, limit_sources, locked_joints, notes, payload, mounting, bare)
+    return dataclasses.replace(robot, allowed_collisions=allowed_collisions) if allowed_collisions else robot

@@ -4,6 +4,8 @@ MoveIt's ``joint_limits.yaml``.
 * ``locked_joints`` {joint: value (rad or m)}: the robot is the reduced model with those joints
   fixed (``pinocchio.buildReducedModel``), as the catalog locks Panda's fingers: an uploaded
   Panda with both finger joints locked plans its 7 arm joints.
+* ``allowed_collisions``: pairs of links allowed to touch, as an SRDF's ``disable_collisions``
+  (its text) or a list of [link, link] pairs (``toptraj.robots.srdf``, bounded there).
 * ``joint_limits``: the text of a ``joint_limits.yaml`` (or the same structure as JSON):
 
       joint_limits:
@@ -45,6 +47,7 @@ from toptraj.robots import bounded_yaml
 from toptraj.robots.equipment import Payload
 from toptraj.robots.errors import ToptrajError, excerpt
 from toptraj.robots.ranges import limit_problem
+from toptraj.robots.srdf import allowed_pairs
 
 #: The keys of a joint's entry in joint_limits.yaml, and the limit kind each maximum sets.
 _MAXIMA = {"max_velocity": "velocity", "max_acceleration": "acceleration", "max_jerk": "jerk", "max_effort": "torque"}
@@ -72,15 +75,17 @@ class UploadOptions:
         notes: What the file gave that is not applied (position limits, scaling factors).
         payload: The payload the robot carries unless a request gives its own
             (``toptraj.robots.equipment.Payload``), ``None``: none.
+        allowed_collisions: Pairs of links allowed to touch (``toptraj.robots.srdf``), sorted.
     """
 
     locked_joints: dict[str, float] = field(default_factory=dict)
     joint_limits: dict[str, dict[str, float]] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
     payload: Payload | None = None
+    allowed_collisions: tuple[tuple[str, str], ...] = ()
 
     def __bool__(self) -> bool:
-        return bool(self.locked_joints or self.joint_limits or self.notes or self.payload)
+        return bool(self.locked_joints or self.joint_limits or self.notes or self.payload or self.allowed_collisions)
 
     def to_json(self) -> str:
         """Canonical JSON for the store ("" for no options, what records stored before options
@@ -90,6 +95,8 @@ class UploadOptions:
         written: dict = {"locked_joints": self.locked_joints, "joint_limits": self.joint_limits, "notes": list(self.notes)}
         if self.payload is not None:
             written["payload"] = dataclasses.asdict(self.payload)
+        if self.allowed_collisions:  # records without the key read as before
+            written["allowed_collisions"] = [list(item) for item in self.allowed_collisions]
         return json.dumps(written, sort_keys=True, separators=(",", ":"))
 
     @classmethod
@@ -103,7 +110,8 @@ class UploadOptions:
             held["mass"], tuple(held["center_of_mass"]), tuple(held["inertia"]), held.get("frame")
         )
         return cls(
-            dict(data.get("locked_joints", {})), dict(data.get("joint_limits", {})), tuple(data.get("notes", ())), payload
+            dict(data.get("locked_joints", {})), dict(data.get("joint_limits", {})), tuple(data.get("notes", ())), payload,
+            tuple((str(a), str(b)) for a, b in data.get("allowed_collisions", ())),
         )
 
 
@@ -208,19 +216,23 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
     return limits, notes
 
 
-def upload_options(locked_joints: dict | None = None, joint_limits=None, payload: Payload | None = None) -> UploadOptions:
+def upload_options(locked_joints: dict | None = None, joint_limits=None, payload: Payload | None = None,
+                   allowed_collisions=None) -> UploadOptions:
     """Options from an upload request, checked for form (names are checked against the model
-    by ``apply_locks`` and ``toptraj.robots.limits``); ``payload`` (checked by
-    ``toptraj.robots.equipment.payload``) is the robot's default payload.
+    by ``apply_locks``, ``toptraj.robots.limits`` and ``toptraj.robots.srdf.check_links``);
+    ``payload`` (checked by ``toptraj.robots.equipment.payload``) is the robot's default payload;
+    ``allowed_collisions``: SRDF text or a list of [link, link] pairs (``toptraj.robots.srdf``).
 
     Raises:
         InvalidUpload: a non-finite locked value, or a malformed joint_limits.
+        InvalidCollisionList: a malformed or oversized allowed_collisions.
     """
     locked = {}
     for joint, value in (locked_joints or {}).items():
         locked[str(joint)] = _number(value, f"locked_joints.{_short(joint)}")
     limits, notes = ({}, []) if joint_limits is None else _joint_limits(joint_limits)
-    return UploadOptions(locked, limits, tuple(notes), payload if payload is not None and payload.mass > 0.0 else None)
+    allowed = () if allowed_collisions is None else tuple(sorted(allowed_pairs(allowed_collisions)))
+    return UploadOptions(locked, limits, tuple(notes), payload if payload is not None and payload.mass > 0.0 else None, allowed)
 
 
 def _moving_joints(model: pin.Model) -> dict[str, int]:

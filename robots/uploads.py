@@ -13,11 +13,14 @@ until then it is ``UploadStore(default_data_dir())`` with the default caps.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import re
 import threading
 from collections import OrderedDict
 from pathlib import Path
+
+import pinocchio as pin
 
 from toptraj.robots.catalog import catalog_names, is_catalog_robot, robot_from_model
 from toptraj.robots.equipment import InvalidEquipment, equip
@@ -31,6 +34,7 @@ from toptraj.robots.errors import (
     excerpt,
 )
 from toptraj.robots.robot import Robot
+from toptraj.robots.srdf import check_links
 from toptraj.robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, StoredUpload, UploadStore, default_data_dir
 from toptraj.robots.upload_options import InvalidUpload, UploadOptions, apply_locks, yaml_limit_arrays
 from toptraj.robots.urdf_check import check_urdf, mesh_count
@@ -136,7 +140,11 @@ def build_upload(name: str, urdf: str, options: UploadOptions) -> Robot:
         )
     if options.locked_joints:
         notes.append("joints locked: " + ", ".join(f"{joint} = {value:g}" for joint, value in options.locked_joints.items()))
+    if options.allowed_collisions:
+        check_links(options.allowed_collisions, [frame.name for frame in model.frames if frame.type == pin.FrameType.BODY])
     robot = robot_from_model(name, model, "upload", None, given, options.locked_joints, tuple(notes))
+    if options.allowed_collisions:
+        robot = dataclasses.replace(robot, allowed_collisions=frozenset(options.allowed_collisions))
     return robot if options.payload is None else equip(robot, options.payload)
 
 

@@ -55,7 +55,7 @@ def _location(loc) -> str:
 
 
 def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
-    extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
+    extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle", "link_a", "link_b") if hasattr(error, key)}
     retry_after = getattr(error, "retry_after", None)
     headers = None if retry_after is None else {"Retry-After": str(retry_after)}
     return problem(status_of(error), title_of(error), detail(error), headers, **extra)

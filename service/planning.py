@@ -187,6 +187,7 @@ def _planned(request: TrajectoryRequest, robot: robots.Robot, timing: Timing, de
         exact_period=exact_period_for(format_, output.exact_period),
         obstacles=_obstacles(getattr(request.path, "obstacles", [])),
         clearance=getattr(request.path, "clearance", DEFAULT_CLEARANCE),
+        self_collision=getattr(request.path, "self_collision", False),
     )
 
 

@@ -52,6 +52,7 @@ def build_problem(
     obstacles: tuple[Obstacle, ...] = (),
     clearance: float = DEFAULT_CLEARANCE,
     deadline: Deadline = NO_DEADLINE,
+    self_collision: bool = False,
 ) -> Problem:
     """The validated problem of moving ``robot`` along ``motion`` by ``method`` (built from
     ``timing.method`` and its options by the caller), sampled as ``sampling`` says, keeping
@@ -79,7 +80,7 @@ def build_problem(
     return Problem(
         robot=robot, motion=motion, method=method, options=timing, kinds=kinds, limits=limits, margin=margin,
         threshold=gate_threshold(margin), sampling=sampling, obstacles=tuple(obstacles), clearance=clearance,
-        deadline=deadline, notes=notes,
+        deadline=deadline, notes=notes, self_collision=self_collision,
     )
 
 

@@ -58,6 +58,8 @@ class Problem:
         obstacles: Obstacles in the world frame; ``clearance`` (m) is kept from them.
         deadline: Budget, cancellation and progress of the whole planning.
         notes: What the build changed (waypoints dropped, turns taken), told in the answer.
+        self_collision: Whether no two links may touch along the path (the search checks it
+            always).
     """
 
     robot: Robot
@@ -73,3 +75,4 @@ class Problem:
     clearance: float
     deadline: Deadline
     notes: tuple[str, ...] = ()
+    self_collision: bool = False

@@ -15,6 +15,7 @@ import time
 
 from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.clearance import Clearance
+from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.errors import numerical_breakdown_is_failure
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -44,6 +45,8 @@ def run(problem: Problem) -> PlannedTrajectory:
     with numerical_breakdown_is_failure(method.name):
         if isinstance(method, MotionGenerator):
             timed = method.generate(problem, Execution(part, timed_path))
+            if problem.self_collision and method.name != "search":  # the search checks its own paths
+                check_self_collision(timed.path, problem.robot, deadline=problem.deadline)
         else:
             timed, checked_first, problem = _given_path(problem, part)
     return answer(problem, timed, checked_first, started)
@@ -61,6 +64,9 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
     if problem.obstacles:
         part.progress(0.05, "clearance")
         checked = check_clearance(path, problem.robot, list(problem.obstacles), problem.clearance, problem.deadline)
+    if problem.self_collision:
+        part.progress(0.07, "self-collision")
+        check_self_collision(path, problem.robot, deadline=problem.deadline)
     timed = timed_path(
         problem.robot, path, problem.method, problem.options, problem.kinds, problem.limits, part.within(0.1, 1.0),
         problem.threshold,

@@ -91,7 +91,8 @@ async def upload_robot(body: RobotCreate) -> RobotPublic:
     """Check a fixed-base arm's URDF (tree structure, finite and physically possible masses,
     inertias, origins and limits), build it with Pinocchio and store it durably under ``name``
     (default: a content hash), with its options: joints locked at a value (``locked_joints``)
-    and limits in MoveIt's ``joint_limits.yaml`` form (``joint_limits``). Uploading the same
+    limits in MoveIt's ``joint_limits.yaml`` form (``joint_limits``) and the pairs of links allowed
+    to touch (``allowed_collisions``, an SRDF or a list of pairs). Uploading the same
     URDF with the same options under the same name again is harmless. The answer says where
     each limit comes from and what was not used (``limit_sources``, ``notes``)."""
     robot = await run_in_threadpool(_register, body)
@@ -101,7 +102,9 @@ async def upload_robot(body: RobotCreate) -> RobotPublic:
 def _register(body: RobotCreate) -> robots.Robot:
     """Read the options (YAML within its bounds) and store the upload: in a worker thread, so
     that neither the parse nor the build holds the event loop."""
-    options = upload_options(body.locked_joints, body.joint_limits, None if body.payload is None else body.payload.payload())
+    options = upload_options(
+        body.locked_joints, body.joint_limits, None if body.payload is None else body.payload.payload(), body.allowed_collisions
+    )
     return robots.register_urdf(body.urdf, body.name, options)
 
 

@@ -108,6 +108,14 @@ class RobotCreate(Schema):
         "100,000 characters, 32 levels of nesting, 10,000 values with its aliases expanded and 1,000 aliases; keys "
         "are strings, each once per mapping; one document.",
     )
+    allowed_collisions: str | list[Annotated[list[str], Field(min_length=2, max_length=2)]] | None = Field(
+        default=None,
+        max_length=2_000,
+        description="Pairs of links allowed to touch, not checked for self-collision (path.self_collision and the "
+        "search): an SRDF's text (its `<disable_collisions link1=... link2=.../>` are read, at most 200,000 "
+        "characters, no DOCTYPE) or a list of `[link, link]` pairs (at most 2,000). Adjacent links are never "
+        "checked; an allowed pair also covers the links fixed to its links.",
+    )
 
 
 MAX_CONFIGURATIONS = 1_000

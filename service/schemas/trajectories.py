@@ -72,6 +72,11 @@ OBSTACLES: Any = Field(
     "from them along the path, else 422 naming the link, the obstacle and s; the answer reports min_clearance.",
 )
 CLEARANCE = Field(default=0.01, ge=0.0, le=1.0, description="Distance (m) every link keeps from every obstacle.")
+SELF_COLLISION = Field(
+    default=False,
+    description="Whether to check that no two links of the arm touch along the path (adjacent links and the "
+    "robot's allowed pairs excepted), else 422 naming the two links and s. timing.method `search` checks it always.",
+)
 
 
 class WaypointsPath(Schema):
@@ -102,6 +107,7 @@ class WaypointsPath(Schema):
     )
     obstacles: list[ObstacleRequest] = OBSTACLES
     clearance: float = CLEARANCE
+    self_collision: bool = SELF_COLLISION
 
 
 class CartesianPathRequest(Schema):
@@ -119,6 +125,7 @@ class CartesianPathRequest(Schema):
     )
     obstacles: list[ObstacleRequest] = OBSTACLES
     clearance: float = CLEARANCE
+    self_collision: bool = SELF_COLLISION
 
 
 class FreePathRequest(Schema):
@@ -138,6 +145,7 @@ class FreePathRequest(Schema):
         "link keeps path.clearance from them along the motion found; the answer reports min_clearance.",
     )
     clearance: float = CLEARANCE
+    self_collision: bool = SELF_COLLISION
 
 
 def _path_kind(value) -> str:

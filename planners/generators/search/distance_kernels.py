@@ -182,3 +182,40 @@ def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: n
             if lower < threshold:
                 lower = _segment_box(a[i, c], b[i, c], row) - radius[c]
             nearest[i] = min(nearest[i], lower)
+
+
+@njit(cache=True, nogil=True)
+def _segments(p1, q1, p2, q2):  # pragma: no cover - compiled
+    """``_segment_segment`` on scalars, without temporaries (end points (3,) each)."""
+    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
+    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
+    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
+    a = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f = d2x * rx + d2y * ry + d2z * rz
+    c = d1x * rx + d1y * ry + d1z * rz
+    b = d1x * d2x + d1y * d2y + d1z * d2z
+    denom = a * e - b * b
+    s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > _TINY else 0.0
+    t = (b * s + f) / e if e > _TINY else 0.0
+    if t < 0.0:
+        s = min(max(-c / a, 0.0), 1.0) if a > _TINY else 0.0
+    elif t > 1.0:
+        s = min(max((b - c) / a, 0.0), 1.0) if a > _TINY else 0.0
+    t = min(max(t, 0.0), 1.0)
+    x, y, z = rx + s * d1x - t * d2x, ry + s * d1y - t * d2y, rz + s * d1z - t * d2z
+    return math.sqrt(x * x + y * y + z * z)
+
+
+@njit(cache=True, nogil=True)
+def pair_minimum(a, b, first, second, radius, out):  # pragma: no cover - compiled
+    """Smallest signed distance (m) between the capsules ``first[p]`` and ``second[p]`` (m,),
+    of radius sum ``radius[p]``, over the pairs, at each configuration of the capsule ends a, b
+    (k, C, 3): into ``out`` (k,) (inf without pairs)."""
+    for i in range(a.shape[0]):
+        best = np.inf
+        for p in range(first.shape[0]):
+            d = _segments(a[i, first[p]], b[i, first[p]], a[i, second[p]], b[i, second[p]]) - radius[p]
+            if d < best:
+                best = d
+        out[i] = best

@@ -1,6 +1,6 @@
 """Configuration-space obstacles on the search graph (Jeong & Lee eq. 2.4, CO(b) = {y | R(y)
 meets b}): the pieces of curve whose configurations come closer to an obstacle than the
-clearance are removed from the graph.
+clearance, or where two links of the arm touch, are removed from the graph.
 
 The distance of the arm from an obstacle changes by at most sum_j R_j |dq_j| between
 configurations dq apart (R_j bounds the distance from joint j to any point of the arm beyond
@@ -15,9 +15,10 @@ from __future__ import annotations
 import numpy as np
 
 from toptraj.planners.collision import Obstacle, clearance_along
+from toptraj.planners.collision.self_collision import self_distances, self_pairs
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.curve import BASIS
-from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, obstacle_row
+from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, obstacle_row, pair_minimum
 from toptraj.planners.generators.search.pieces import Pieces
 from toptraj.robots import Robot
 from toptraj.robots.collision import robot_capsules
@@ -119,30 +120,54 @@ _TABLES: dict[int, tuple] = {}
 
 
 def point_distances(
-    robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exact_below: float = np.inf, deadline: Deadline = NO_DEADLINE
+    robot: Robot, q: np.ndarray, obstacles: list[Obstacle], exact_below: float = np.inf, deadline: Deadline = NO_DEADLINE,
+    self_offset: float | None = None,
 ) -> np.ndarray:
     """Smallest signed distance (m) of the arm's link capsules (``toptraj.robots.collision``) to any
     obstacle at each configuration (k, n_dof); distances above ``exact_below`` may be lower
     bounds (``toptraj.planners.collision.distance.capsule_distance``), computed by the compiled
-    ``distance_kernels``. ``deadline`` is checked before each obstacle of each ``BATCH`` of
-    configurations."""
+    ``distance_kernels``. With ``self_offset``, each is at most ``self_offset`` plus the
+    smallest distance between two checked links (``toptraj.planners.collision.self_collision``).
+    ``deadline`` is checked before each obstacle of each ``BATCH`` of configurations."""
     out = np.empty(len(q))
     tables = _chain_tables(robot)
     rows_of = [obstacle_row(obstacle) for obstacle in obstacles]
+    pairs = self_pairs(robot) if self_offset is not None else None
     q = np.ascontiguousarray(q, dtype=float)
     for begin in range(0, len(q), BATCH):
         deadline.check()
         rows = q[begin : begin + BATCH]
         if tables is None:
-            out[begin : begin + BATCH] = clearance_along(robot, rows, obstacles, exact_below)[0]
+            nearest = clearance_along(robot, rows, obstacles, exact_below)[0] if obstacles else np.full(len(rows), np.inf)
+            if pairs is not None and self_offset is not None:
+                nearest = np.minimum(nearest, self_offset + self_distances(robot, rows, pairs)[0])
+            out[begin : begin + BATCH] = nearest
             continue
         a, b = capsule_ends(rows, *tables[0])
         nearest = np.full(len(rows), np.inf)
         for kind, row in rows_of:
             deadline.check()
             lower_distances(a, b, tables[1], kind, row, float(exact_below), nearest)
+        if pairs is not None and self_offset is not None and len(pairs.first):
+            touching = np.empty(len(rows))
+            pair_minimum(a, b, pairs.first, pairs.second, pairs.radius, touching)
+            nearest = np.minimum(nearest, self_offset + touching)
         out[begin : begin + BATCH] = nearest
     return out
+
+
+def free_distances(
+    robot: Robot, q: np.ndarray, obstacles: list[Obstacle], clearance: float, exact_below: float = np.inf,
+    deadline: Deadline = NO_DEADLINE,
+) -> np.ndarray:
+    """What the search keeps at or above ``clearance`` (m) at each configuration (k, n_dof):
+    the smaller of the distance to the obstacles and ``clearance`` plus the smallest distance
+    between two checked links (``point_distances`` with ``self_offset``). It falls below the
+    clearance exactly where an obstacle comes nearer or two links touch, and changes no faster
+    than a distance to an obstacle: a pair's distance changes only by the motion of one link
+    relative to the other, each joint between them moving it by at most R_j |dq_j|
+    (``joint_reaches``), so the bounds of ``clear_pieces`` hold for it."""
+    return point_distances(robot, q, obstacles, exact_below, deadline, self_offset=clearance)
 
 
 def joint_reaches(robot: Robot) -> np.ndarray:
@@ -177,8 +202,8 @@ def _span_points(control: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: list[Obstacle], clearance: float,
                  deadline: Deadline) -> tuple[np.ndarray, np.ndarray]:
-    """Which pieces keep ``clearance`` (m) from ``obstacles`` along all of them, shape (K,),
-    and the distance of every grid point, shape (P,).
+    """Which pieces keep ``clearance`` (m) from ``obstacles`` and the links apart along all of
+    them, shape (K,), and the distance of every grid point (``free_distances``), shape (P,).
 
     The arm's points move at most sum_j R_j |dq_j| (``joint_reaches``); along a span, |dq_j/dt|
     is at most the largest difference of its control points in joint j, so over a parameter
@@ -190,7 +215,7 @@ def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: li
     one: a sample closer than the clearance, or an interval still undecided then, removes the
     span.
     """
-    distance = point_distances(robot, points, obstacles, deadline=deadline)
+    distance = free_distances(robot, points, obstacles, clearance, deadline=deadline)
     weights = joint_reaches(robot)
     control = pieces.control
     hull = (np.abs(control - control[:, 1:2]) * weights).sum(axis=2).max(axis=1)
@@ -220,7 +245,7 @@ def _refine(spans: np.ndarray, count: int, control: np.ndarray, speed: np.ndarra
     t = np.linspace(0.0, 1.0, count + 1)
     owner = np.repeat(spans, count + 1)
     q = _span_points(control[owner], np.tile(t, len(spans)))
-    d = point_distances(robot, q, obstacles, clearance + COARSE_STEP, deadline)
+    d = free_distances(robot, q, obstacles, clearance, clearance + COARSE_STEP, deadline)
     blocked[owner[d < clearance]] = True
     d_rows = d.reshape(len(spans), count + 1)
     stack = [(np.repeat(spans, count), np.tile(t[:-1], len(spans)), np.full(len(spans) * count, 1.0 / count),
@@ -241,7 +266,7 @@ def _refine(spans: np.ndarray, count: int, control: np.ndarray, speed: np.ndarra
         width = width / 4.0
         inner = t_a[:, None] + width[:, None] * np.arange(1, 4)[None, :]  # (m, 3)
         q = _span_points(control[np.repeat(piece, 3)], inner.ravel())
-        new = point_distances(robot, q, obstacles, clearance + COARSE_STEP, deadline).reshape(-1, 3)
+        new = free_distances(robot, q, obstacles, clearance, clearance + COARSE_STEP, deadline).reshape(-1, 3)
         blocked[piece[(new < clearance).any(axis=1)]] = True
         ends = np.column_stack([d_a, new, d_b])  # (m, 5)
         stack.append((

@@ -18,6 +18,7 @@ import dataclasses
 import numpy as np
 
 from toptraj.planners.collision import check_clearance
+from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.errors import Conflicting, InfeasiblePath, NotServed, OverMemory
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
@@ -153,6 +154,7 @@ def _search(work: _Work, deadline: Deadline) -> Timed:
         try:
             if work.obstacles:
                 check_clearance(path, robot, list(work.obstacles), work.clearance, deadline)
+            check_self_collision(path, robot, deadline=deadline)
             timed = work.time_path(robot, path, PhasePlaneMethod(), plain, work.kinds, work.limits, deadline.within(0.9, 1.0), work.threshold)
         except InfeasiblePath as error:
             failures.append(f"tube {index + 1}{' (optimized)' if optimum is not None else ''}: {error.detail}")

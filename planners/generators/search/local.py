@@ -50,10 +50,11 @@ import numpy as np
 
 from toptraj.planners.collision.clearance import Clearance, PathInCollision, check_clearance
 from toptraj.planners.collision.obstacles import Obstacle
+from toptraj.planners.collision.self_collision import SelfCollision, check_self_collision
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
-from toptraj.planners.generators.search.free_space import joint_reaches, point_distances
+from toptraj.planners.generators.search.free_space import free_distances, joint_reaches
 from toptraj.planners.generators.search.local_outcome import LocalOptimum, LocalRound, LocalSettings, LocalStatistics
 from toptraj.planners.paths.bspline import DEGREE, BSplinePath, clamped_knots, insert_knot
 from toptraj.planners.paths.grid import path_grid
@@ -120,7 +121,7 @@ class _Objective:
         self.deadline = deadline
         self.grid = np.linspace(0.0, 1.0, settings.grid_intervals + 1)
         self.samples = np.linspace(0.0, 1.0, settings.obstacle_samples + 1)
-        self.reach = joint_reaches(robot) if self.obstacles else None
+        self.reach = joint_reaches(robot)
         lower, upper = limits.position_lower, limits.position_upper
         self.ranged = np.isfinite(lower) | np.isfinite(upper)
         self.evaluations = 0
@@ -136,13 +137,12 @@ class _Objective:
         return BSplinePath(np.vstack([self.start, inner, self.goal]), self.interior)
 
     def penalty(self, path: BSplinePath) -> float:
-        """The weighted penalties (s) of ``path``: obstacles and joint ranges."""
+        """The weighted penalties (s) of ``path``: obstacles, self-collision (``free_distances``)
+        and joint ranges."""
         settings, total = self.settings, 0.0
-        if not self.obstacles and not self.ranged.any():
-            return 0.0
         q = path(self.samples)
-        if self.obstacles:
-            distance = point_distances(self.robot, q, self.obstacles, self.clearance + 0.1)
+        distance = free_distances(self.robot, q, self.obstacles, self.clearance, self.clearance + 0.1)
+        if np.isfinite(distance).all():
             motion = np.abs(np.diff(q, axis=0)) @ self.reach
             inside = (distance[:-1] + distance[1:] - motion) / 2.0
             shortfall = np.maximum(self.clearance + settings.margin - np.minimum(inside, distance[:-1]), 0.0)
@@ -194,6 +194,10 @@ def _clear(path, robot, limits, obstacles, clearance, deadline) -> tuple[bool, C
     the default grid); the clearance found."""
     q = path(path_grid(path))
     if robot.outside_position_limits(q) is not None:
+        return False, None
+    try:
+        check_self_collision(path, robot, deadline=deadline)
+    except SelfCollision:
         return False, None
     if not obstacles:
         return True, None

@@ -11,10 +11,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.collision import Obstacle
+from toptraj.planners.collision.self_collision import SelfCollision, self_distances, self_pairs
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotOneOf, OutOfRange
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.bounds import PieceBounds, piece_bounds
-from toptraj.planners.generators.search.free_space import clear_pieces, point_distances
+from toptraj.planners.generators.search.free_space import clear_pieces, free_distances, point_distances
 from toptraj.planners.generators.search.graph import (
     DEFAULT_MAX_TURN,
     DEFAULT_OPTIONS,
@@ -87,11 +88,22 @@ def _graph(robot, start, goal, options: SearchOptions, revolutions, obstacles, c
         return lattice_graph(robot, start, goal, options, revolutions)
 
     def free(q):
-        if not obstacles:
-            return np.ones(len(q), dtype=bool)
-        return point_distances(robot, q, obstacles, deadline=deadline) >= clearance
+        return free_distances(robot, q, obstacles, clearance, deadline=deadline) >= clearance
 
     return roadmap_graph(robot, start, goal, options, revolutions, free, deadline)
+
+
+def _check_apart(robot: Robot, name: str, q: np.ndarray) -> None:
+    """Raise ``SelfCollision`` when two checked links touch at the configuration ``q``."""
+    distance, which = self_distances(robot, q[None, :])
+    if distance[0] < 0.0:
+        link_a, link_b = self_pairs(robot).links[int(which[0])]
+        s = 0.0 if name == "start" else 1.0
+        raise SelfCollision(
+            f"at path.{name}, links {link_a!r} and {link_b!r} touch (their capsules overlap by {-distance[0]:.4g} m): "
+            "move it so that the arm does not fold onto itself",
+            s=s, link_a=link_a, link_b=link_b, distance=float(distance[0]),
+        )
 
 
 def _cost_to_go(n_states: int, source: np.ndarray, target: np.ndarray, weight: np.ndarray) -> np.ndarray:
@@ -143,6 +155,7 @@ def build_problem(
                     f"the {name} comes within {nearest:.4g} m of an obstacle (the clearance is {clearance:g} m)",
                     rule="end_too_close", field=name, distance=nearest, clearance=clearance,
                 )
+        _check_apart(robot, name, q)
     deadline.progress(0.0, "search: graph")
     graph = _graph(robot, start, goal, options, revolutions, obstacle_list, clearance, deadline)
     max_turn = options.max_turn if options.max_turn is not None else DEFAULT_MAX_TURN[graph.kind]
@@ -151,12 +164,9 @@ def build_problem(
     turn_in, turn_out = graph.transitions(max_turn, deadline)
     pieces = build_pieces(graph.points, graph.edge_from, graph.edge_to, graph.start, graph.goals, turn_in, turn_out)
     deadline.check()
-    usable = np.ones(len(pieces), dtype=bool)
-    points_blocked = 0
-    if obstacle_list:
-        deadline.progress(0.1, "search: obstacles")
-        usable, distance = clear_pieces(pieces, graph.points, robot, obstacle_list, clearance, deadline)
-        points_blocked = int((distance < clearance).sum())
+    deadline.progress(0.1, "search: obstacles and self-collision")
+    usable, distance = clear_pieces(pieces, graph.points, robot, obstacle_list, clearance, deadline)
+    points_blocked = int((distance < clearance).sum())
     removed = int((~usable).sum())
     deadline.progress(0.2, "search: bounds")
     bounds = piece_bounds(pieces, robot, limits, kinds, deadline)
