@@ -40,12 +40,11 @@ def excerpt(value: object, limit: int = 60) -> str:
 
 
 class ToptrajError(Exception):
-    """Root of all toptraj errors.
+    """Root of all toptraj errors. The facts of a subclass are attributes too, given as
+    keywords (``field``, ``value``, ``s``, ``joint``, ...).
 
     Attributes:
         detail: One sentence in the library's words saying what is wrong and where (``str``).
-        The facts of a subclass are attributes too, given as keywords (``field``, ``value``,
-        ``s``, ``joint``, ...).
     """
 
     def __init__(self, detail: str = "", **facts: Any):

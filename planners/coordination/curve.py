@@ -17,8 +17,6 @@ of four successive nodes.
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import BSpline
-from scipy.ndimage import binary_dilation
 
 from toptraj.planners.coordination.diagram import Diagram
 from toptraj.planners.errors import InfeasiblePath
@@ -89,6 +87,8 @@ def _segment_free(diagram: Diagram, start: np.ndarray, end: np.ndarray) -> bool:
 def widened(diagram: Diagram, cells: int) -> Diagram:
     """``diagram`` with its collision region grown by ``cells`` nodes (8-neighbourhood), the
     two ends left free."""
+    from scipy.ndimage import binary_dilation  # here: scipy's modules load where a cell is planned
+
     blocked = binary_dilation(diagram.blocked, np.ones((3, 3), dtype=bool), iterations=cells)
     blocked[0, 0] = blocked[-1, -1] = False
     return Diagram(diagram.s, diagram.distance, blocked, diagram.step1, diagram.step2)
@@ -139,6 +139,8 @@ class SmoothCurve:
         interior = np.linspace(0.0, 1.0, len(nodes) - 2)[1:-1]
         knots = np.r_[np.zeros(4), interior, np.ones(4)]
         self.nodes = nodes
+        from scipy.interpolate import BSpline  # here: scipy's modules load where a cell is planned
+
         self._spline = BSpline(knots, nodes, 3, extrapolate=False)
 
     def evaluate(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -28,9 +28,13 @@ EXAMPLES = ROOT / "examples"
 QUICK = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}}
 #: A free-path collocation of a six-joint arm on a fine grid: minutes of SLSQP in its worker
 #: process, so it is still running whenever a test looks.
-#: A planning that runs for seconds on any machine: the global search around a sphere, whose
-#: local optimization takes its share of whatever budget it is given.
-SLOW = json.loads((ROOT / "examples" / "geering_search_obstacle.json").read_text())
+#: A planning that runs for seconds on any machine and cannot shorten itself to a budget:
+#: min_cost at its largest grid on ur5 (one convex program in a worker process).
+SLOW = {
+    "robot": "ur5",
+    "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS},
+    "timing": {"method": "min_cost", "grid_points": 4000},
+}
 ENDED = {"done", "failed", "cancelled", "interrupted"}
 
 
