@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.collision.clearance import COARSE, COARSE_STEP, _reach
-from toptraj.planners.collision.distance import _segment_segment
+from toptraj.planners.collision.distance import segment_distance
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.robots import Robot
@@ -113,7 +113,7 @@ def pair_distances(robot: Robot, pairs: SelfPairs, q: np.ndarray) -> np.ndarray:
     """Signed distances (m) of every pair at each configuration of ``q`` (n, n_dof): (n, m)."""
     a, b = world_capsules(robot.model, robot.data, list(pairs.capsules), robot.configuration(np.atleast_2d(q)))
     i, j = pairs.first, pairs.second
-    return _segment_segment(a[:, i], b[:, i], a[:, j], b[:, j]) - pairs.radius
+    return segment_distance(a[:, i], b[:, i], a[:, j], b[:, j]) - pairs.radius
 
 
 def touching_at_zero(robot: Robot) -> frozenset[tuple[str, str]]:

@@ -108,22 +108,6 @@ def _point_segment(p, a, b):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _segment_segment(p1, q1, p2, q2):  # pragma: no cover - compiled
-    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a, e, f = np.dot(d1, d1), np.dot(d2, d2), np.dot(d2, r)
-    c, b = np.dot(d1, r), np.dot(d1, d2)
-    denom = a * e - b * b
-    s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > _TINY else 0.0
-    t = (b * s + f) / e if e > _TINY else 0.0
-    if t < 0.0:
-        s = min(max(-c / a, 0.0), 1.0) if a > _TINY else 0.0
-    elif t > 1.0:
-        s = min(max((b - c) / a, 0.0), 1.0) if a > _TINY else 0.0
-    t = min(max(t, 0.0), 1.0)
-    return np.linalg.norm(p1 + s * d1 - (p2 + t * d2))
-
-
-@njit(cache=True, nogil=True)
 def _box_at(la, lb, half, t):  # pragma: no cover - compiled
     outside, inside = 0.0, -np.inf
     for i in range(3):
@@ -167,7 +151,7 @@ def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: n
     if kind == CAPSULE:
         for i in range(k):
             for c in range(n_caps):
-                nearest[i] = min(nearest[i], _segment_segment(a[i, c], b[i, c], row[0:3], row[3:6]) - radius[c] - row[6])
+                nearest[i] = min(nearest[i], _segments(a[i, c], b[i, c], row[0:3], row[3:6]) - radius[c] - row[6])
         return
     to_center = np.empty((k, n_caps))
     least = np.inf
@@ -186,7 +170,9 @@ def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: n
 
 @njit(cache=True, nogil=True)
 def _segments(p1, q1, p2, q2):  # pragma: no cover - compiled
-    """``_segment_segment`` on scalars, without temporaries (end points (3,) each)."""
+    """The distance between segments [p1, q1] and [p2, q2] (end points (3,) each), the closest
+    parameters clamped to the segments (Ericson, Real-Time Collision Detection, 5.1.9), on
+    scalars without temporaries."""
     d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
     d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
     rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
