@@ -12,7 +12,8 @@ Candidates, each checked against the coordination diagram, the quickest kept:
   along it by one time-optimal solve (``timing.pair_timing``).
 
 The one kept is verified at fine samples (``verify.schedule_clearance``) and slowed uniformly
-where a dense resampling finds a limit exceeded between the solver's grid points.
+where a dense resampling finds a limit (velocity, acceleration, torque) exceeded between the
+solver's grid points (``limits.within_limits``).
 """
 
 from __future__ import annotations
@@ -21,11 +22,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from toptraj.planners.collision.self_collision import SelfCollision, check_self_collision
 from toptraj.planners.coordination.cell import MAX_ARMS, Cell
 from toptraj.planners.coordination.curve import SmoothCurve, resampled, shortcut, shortest_curve, widened
 from toptraj.planners.coordination.diagram import Diagram, check_ends, coordination_diagram
+from toptraj.planners.coordination.limits import within_limits
 from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
-from toptraj.planners.coordination.verify import PairClearance, peak_utilization, schedule_clearance
+from toptraj.planners.coordination.verify import PairClearance, schedule_clearance
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import TimeScaling
@@ -84,7 +87,7 @@ def _smoothed(cell: Cell, diagram: Diagram, points: np.ndarray, deadline: Deadli
         if not diagram.free_at(s[:, 0], s[:, 1]).all():
             continue
         scaling = pair_timing(cell, curve, deadline=deadline)
-        schedule = _within_limits(cell, Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated"))
+        schedule = within_limits(cell, Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated"))
         if (best is None or schedule.duration < best.duration) and _free(diagram, schedule):
             best = schedule
     return best
@@ -107,17 +110,27 @@ def curve_schedule(cell: Cell, diagram: Diagram, solo: list[TimeScaling], deadli
     return min(found, key=lambda schedule: schedule.duration, default=None)
 
 
-def _within_limits(cell: Cell, schedule: Schedule) -> Schedule:
-    """``schedule`` slowed uniformly where the dense peak of a limit exceeds 1 (velocity
-    scales as 1 / stretch, acceleration as 1 / stretch^2)."""
-    velocity, acceleration = peak_utilization(cell, schedule)
-    stretch = max(1.0, velocity, float(np.sqrt(acceleration)))
-    return schedule if stretch == 1.0 else Schedule(schedule.motions, schedule.kind, stretch)
-
-
 def _check_cell(cell: Cell) -> None:
     if len(cell.arms) != MAX_ARMS:
         raise InvalidRequest(f"a cell has {len(cell.arms)} arms; {MAX_ARMS} are served: give exactly two arms")
+
+
+def _arms_alone(cell: Cell, deadline: Deadline) -> list[TimeScaling]:
+    """Each arm's own path checked for self-collision, then timed alone; an arm's failure
+    raised again naming the arm (``arms[i]``)."""
+    solo = []
+    for index, arm in enumerate(cell.arms):
+        where = f"arms[{index}] ({arm.robot.name})"
+        try:
+            check_self_collision(arm.path, arm.robot, deadline=deadline)
+            solo.append(solo_timing(arm, cell.kinds, deadline=deadline))
+        except SelfCollision as error:
+            s = float(getattr(error, "s", 0.0))
+            raise SelfCollision(f"{where}: {error.detail}", s, error.link_a, error.link_b, error.distance) from error
+        except InfeasiblePath as error:
+            facts = {key: getattr(error, key, None) for key in ("s", "joint", "limit")}
+            raise InfeasiblePath(f"{where} cannot follow its own path alone: {error.detail}", **facts) from error
+    return solo
 
 
 def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
@@ -126,14 +139,17 @@ def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
 
     Raises:
         InvalidRequest: not two arms, or arms that collide at their start.
-        InfeasiblePath: no timing keeps the arms apart along these paths.
+        SelfCollision: an arm's own path makes two of its links touch (naming the arm, the
+            links and s).
+        InfeasiblePath: an arm cannot follow its path within its limits (naming the arm, the
+            joint, the limit and s), or no timing keeps the arms apart along these paths.
     """
     _check_cell(cell)
     check_ends(cell)
-    solo = [solo_timing(arm, cell.kinds, deadline=deadline) for arm in cell.arms]
+    solo = _arms_alone(cell, deadline)
     diagram = coordination_diagram(cell, deadline=deadline)
     candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), curve_schedule(cell, diagram, solo, deadline)]
-    found = sorted((_within_limits(cell, c) for c in candidates if c is not None), key=lambda c: c.duration)
+    found = sorted((within_limits(cell, c) for c in candidates if c is not None), key=lambda c: c.duration)
     for schedule in found:
         clearance = schedule_clearance(cell, schedule, deadline)
         if clearance.bound >= cell.clearance:

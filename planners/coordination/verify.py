@@ -1,10 +1,10 @@
 """Checks of a schedule at fine samples, independent of the diagram's grid: the arms' distance
-along the motion, and each arm's limits.
+along the motion (each arm's limits: ``toptraj.planners.coordination.limits``).
 
 Clearance: samples in time dense enough that no point of either arm moves more than
 ``FINE_STEP`` between two; between samples the distance is at least the smaller of the two
 sampled distances minus half the motion of both arms (each point moves at most reach * sum |dq|,
-``CellArm.reach``). Limits: the peak of |qd| / v_max and |qdd| / a_max over dense samples.
+``CellArm.reach``).
 """
 
 from __future__ import annotations
@@ -24,8 +24,6 @@ from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 COARSE = 400
 #: Most samples of a clearance check (each one a forward kinematics per arm).
 MAX_SAMPLES = 20_000
-#: Samples of the limit check per second of motion, and at least.
-LIMIT_RATE, LIMIT_MIN = 2_000, 4_000
 
 
 @dataclass(frozen=True)
@@ -61,17 +59,3 @@ def schedule_clearance(cell: Cell, schedule: Schedule, deadline: Deadline = NO_D
     worst = int(np.argmin(distance))
     links = (first.link_names()[int(i[worst])], second.link_names()[int(j[worst])])
     return PairClearance(float(distance[worst]), float(t[worst]), links, float(bound.min()), len(t))
-
-
-def peak_utilization(cell: Cell, schedule: Schedule) -> tuple[float, float]:
-    """The largest |qd| / v_max and |qdd| / a_max of any arm and joint over dense samples of
-    ``schedule`` (only the limit kinds of the cell; 0 for a kind not asked)."""
-    count = max(LIMIT_MIN, math.ceil(LIMIT_RATE * schedule.duration))
-    t = np.linspace(0.0, schedule.duration, count + 1)
-    velocity = acceleration = 0.0
-    for arm, (_, qd, qdd) in zip(cell.arms, schedule.states(cell, t)):
-        if "velocity" in cell.kinds:
-            velocity = max(velocity, float((np.abs(qd) / arm.limits.velocity).max()))
-        if "acceleration" in cell.kinds:
-            acceleration = max(acceleration, float((np.abs(qdd) / arm.limits.acceleration).max()))
-    return velocity, acceleration

@@ -16,13 +16,13 @@ EXAMPLE = json.loads((ROOT / "examples" / "cell_two_ur5.json").read_text())
 
 @pytest.fixture(scope="module")
 def answer(patient_client):
-    response = patient_client.post("/v1/cells", json=EXAMPLE)
+    response = patient_client.post("/v1/cells", json=EXAMPLE | {"format": "joint_trajectory"})
     assert response.status_code == 200, response.text
     return response.json()
 
 
 def _points(arm: dict) -> tuple[np.ndarray, np.ndarray]:
-    points = arm["trajectory"]["points"]
+    points = arm["joint_trajectory"]["points"]
     t = np.array([p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in points])
     return t, np.array([p["positions"] for p in points])
 
@@ -33,7 +33,7 @@ def test_both_arms_are_sampled_on_one_clock_from_start_to_end(answer):
     assert np.allclose(t1, answer["t"], atol=1e-9)
     for q, arm in ((q1, EXAMPLE["arms"][0]), (q2, EXAMPLE["arms"][1])):
         assert np.allclose(q[0], arm["waypoints"][0], atol=1e-9) and np.allclose(q[-1], arm["waypoints"][-1], atol=1e-9)
-    assert answer["arms"][0]["trajectory"]["joint_names"][0] == "shoulder_pan_joint"
+    assert answer["arms"][0]["joint_trajectory"]["joint_names"][0] == "shoulder_pan_joint"
 
 
 def test_the_answer_reports_the_time_lost_and_the_diagram(answer):
