@@ -10,7 +10,8 @@
 
 Beside the samples: the durations (the cell's, each arm's own optimum, one after the other, the
 time lost to coordination), each arm's peak utilization per limit on a dense resampling, the
-arms' smallest distance, and the coordination diagram.
+arms' smallest distance (the closest pair), and the coordination diagram of arms 0 and 1
+(``diagram``) and of every pair (``diagrams``).
 """
 
 from __future__ import annotations
@@ -84,11 +85,20 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str) -> dict:
         "min_distance": {
             "distance": clearance.distance,
             "t": clearance.t,
+            "arms": list(clearance.arms),
             "links": list(clearance.links),
             "guaranteed": clearance.bound,
         },
-        "diagram": {"s": found.diagram.s, "blocked": found.diagram.blocked.astype(int), "curve": found.curve[pick]},
+        "diagram": _diagram(found, (0, 1), pick),
+        "diagrams": [_diagram(found, pair, pick) for pair in found.diagrams],
     }
+
+
+def _diagram(found: Coordination, pair: tuple[int, int], pick: np.ndarray) -> dict:
+    """The coordination diagram of arms ``pair`` = (a, b): the grid ``s``, ``blocked`` (rows
+    s_a) and the ``curve`` (s_a, s_b) the schedule passes through."""
+    diagram = found.diagrams[pair]
+    return {"arms": list(pair), "s": diagram.s, "blocked": diagram.blocked.astype(int), "curve": found.curve[pick][:, list(pair)]}
 
 
 def _metadata(body: dict) -> list[str]:
@@ -103,7 +113,8 @@ def _metadata(body: dict) -> list[str]:
         f"time_lost: {float(body['time_lost'])!r} s",
         f"schedule: {body['schedule']}",
         f"min_distance: {float(distance['distance'])!r} m at t = {float(distance['t'])!r} s between link {distance['links'][0]} "
-        f"of arms[0] and link {distance['links'][1]} of arms[1]; guaranteed {float(distance['guaranteed'])!r} m",
+        f"of arms[{distance['arms'][0]}] and link {distance['links'][1]} of arms[{distance['arms'][1]}]; "
+        f"guaranteed {float(distance['guaranteed'])!r} m",
     ]
     for index, arm in enumerate(arms):
         for kind, values in arm["peak_utilization"].items():

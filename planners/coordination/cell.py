@@ -22,8 +22,10 @@ from toptraj.planners.paths.base import GeometricPath
 from toptraj.robots import JointLimits, Robot
 from toptraj.robots.collision import robot_capsules, world_capsules
 
-#: Arms a cell holds (the coordination space is the square of the two path parameters).
-MAX_ARMS = 2
+#: Arms a cell holds: two coordinated in full (the square of their path parameters), more by
+#: prioritized planning over every order of the arms (``prioritized``: 4! = 24 orders, 6 pairwise
+#: diagrams).
+MAX_ARMS = 4
 #: How far R R^T may be from the identity, entry by entry, for R to count as a rotation.
 ROTATION_TOLERANCE = 1e-6
 

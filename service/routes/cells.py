@@ -27,15 +27,16 @@ CSV_EXAMPLE = "t,arms[0].q.shoulder_pan_joint,…\n# robots: ur5, ur5\n# duratio
 )
 async def create_cell(body: Annotated[CellRequest, Body(openapi_examples=cell_examples())], request: Request) -> Response:
     """Time each arm along its own joint path so that the arms never come closer than
-    `clearance`, both done as early as possible on one clock (path-velocity decomposition:
-    the coordination diagram of the two path parameters with the collision region marked, each
+    `clearance`, all done as early as possible on one clock (path-velocity decomposition:
+    two arms on the coordination diagram of their path parameters with the collision region
+    marked; three or four by prioritized planning, each waiting at its start; each
     arm held by its own velocity, acceleration and torque limits, its payload and base pose
     included, waiting or slowing where needed). Returns every arm on the same times in the
     format asked (`format`: `samples`, one `joint_trajectory` per arm, or `csv`; CSV also when
     `Accept` prefers `text/csv`), each arm's peak utilization, the coordination diagram
     (`blocked` on the grid `s` x `s`, rows s1, and the `curve` taken), each arm's own optimum
     and the time lost to coordination. Errors: an unknown robot (404), a base rotation that is
-    not one, a payload that is not physical, more than two arms, arms that collide at their
+    not one, a payload that is not physical, more than four arms, arms that collide at their
     start, an arm's path whose links touch (naming them and s), a torque no timing holds,
     paths that cannot pass each other (422).
     \f

@@ -12,7 +12,8 @@ from toptraj.service.schemas.common import Schema, signed
 from toptraj.service.schemas.equipment import PayloadRequest
 from toptraj.service.schemas.trajectories import JointVector, Name, Point
 
-#: Arms a request may list (the planner serves two; more are refused with a 422 saying so).
+#: Arms a request may list (the planner serves up to ``coordination.cell.MAX_ARMS``; more are
+#: refused with a 422 saying so).
 MAX_CELL_ARMS = 8
 #: Waypoints per arm.
 MAX_CELL_WAYPOINTS = 100
@@ -56,9 +57,14 @@ class CellArmRequest(Schema):
 
 
 class CellRequest(Schema):
-    """Two arms in one workspace, each along its own path, to be timed together."""
+    """Arms in one workspace, each along its own path, to be timed together."""
 
-    arms: list[CellArmRequest] = Field(min_length=1, max_length=MAX_CELL_ARMS, description="The arms (two are served).")
+    arms: list[CellArmRequest] = Field(
+        min_length=1,
+        max_length=MAX_CELL_ARMS,
+        description="The arms: two coordinated in full, three or four by prioritized planning (each arm on its own "
+        "optimum, waiting at its start; every order tried); more are refused.",
+    )
     clearance: Annotated[float, Field(ge=0.0, le=1.0)] = Field(
         default=0.01, description="Smallest distance (m) the arms' link capsules keep from each other at all times."
     )

@@ -79,11 +79,28 @@ def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_cli
     assert "collide at their start" in response.json()["detail"] and "link '" in response.json()["detail"]
 
 
-def test_three_arms_are_a_422_asking_for_two(patient_client):
-    body = copy.deepcopy(EXAMPLE)
-    body["arms"].append(copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.0, 3.0, 0.0]}})
+def test_three_arms_are_answered_on_one_clock_with_every_pairs_diagram(patient_client):
+    body = copy.deepcopy(EXAMPLE) | {"format": "joint_trajectory"}
+    quarter = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    body["arms"].append(copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.6, 1.1, 0.0], "rotation": quarter}})
     response = patient_client.post("/v1/cells", json=body)
-    assert response.status_code == 422 and "give exactly two arms" in response.json()["detail"]
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    times = [_points(arm)[0] for arm in answer["arms"]]
+    assert len(times) == 3 and all(np.array_equal(t, times[0]) for t in times)
+    assert [d["arms"] for d in answer["diagrams"]] == [[0, 1], [0, 2], [1, 2]]
+    assert max(answer["solo_durations"]) <= answer["duration"] <= answer["sequential_duration"]
+    assert answer["min_distance"]["guaranteed"] >= body["clearance"] and answer["schedule"].startswith("prioritized")
+
+
+def test_five_arms_are_a_422_naming_the_bound(patient_client):
+    body = copy.deepcopy(EXAMPLE)
+    body["arms"] += [copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.0, 3.0 * k, 0.0]}} for k in range(1, 4)]
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 422 and "a cell has 5 arms; from 2 to 4 are served" in response.json()["detail"]
+    nine = copy.deepcopy(EXAMPLE)
+    nine["arms"] = (nine["arms"] * 5)[:9]  # past the schema's bound of 8
+    assert patient_client.post("/v1/cells", json=nine).status_code == 422
 
 
 def test_a_waypoint_of_the_wrong_length_is_a_422_naming_the_arm(patient_client):
