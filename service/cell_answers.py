@@ -8,6 +8,9 @@
   arms[i].tau.<joint>,…`` arm after arm, the answer's facts as ``# key: value`` lines, then a row
   per sample (numbers as JSON writes them, shortest round trip).
 
+As the trajectory endpoint's, ``joint_trajectory`` and ``csv`` put the samples on whole periods
+by default (``exact_period``, ``toptraj.service.formats.exact_period_for``).
+
 Beside the samples: the durations (the cell's, each arm's own optimum, one after the other, the
 time lost to coordination), each arm's peak utilization per limit on a dense resampling, the
 arms' smallest distance (the closest pair), and the coordination diagram of arms 0 and 1
@@ -17,11 +20,13 @@ arms' smallest distance (the closest pair), and the coordination diagram of arms
 from __future__ import annotations
 
 import io
+import math
 
 import numpy as np
 
 from toptraj.planners.coordination import Cell, Coordination
 from toptraj.planners.coordination.limits import dense_loads, peak_utilization
+from toptraj.planners.coordination.timing import Schedule
 from toptraj.planners.errors import InvalidRequest
 from toptraj.service.formats import time_from_start
 
@@ -63,16 +68,29 @@ def _arm_body(arm, t: np.ndarray, states, peaks: dict, format_: str) -> dict:
     return body
 
 
-def cell_body(cell: Cell, found: Coordination, dt: float, format_: str) -> dict:
+def on_whole_periods(schedule: Schedule, dt: float) -> Schedule:
+    """``schedule`` slowed uniformly (by less than one period ``dt``, s) to end on a whole
+    period: velocities scale by 1/k, accelerations by 1/k^2 and torques move towards the static
+    torque of the same pose (``toptraj.planners.coordination.limits``); the arms pass through
+    the same configurations together, so their clearance is the same."""
+    periods = max(1, math.ceil(schedule.duration / dt - 1e-9))
+    return Schedule(schedule.motions, schedule.kind, schedule.stretch * periods * dt / schedule.duration)
+
+
+def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_period: bool) -> dict:
     """The answer (module docstring); ``format_`` ``csv`` gives the ``samples`` body that
-    ``csv_bytes`` writes."""
-    schedule = found.schedule
+    ``csv_bytes`` writes. With ``exact_period`` the samples lie on whole periods ``dt``, the
+    final state included (``on_whole_periods``); ``duration`` stays the planned one and
+    ``sampled_duration`` is the last sample's time. The peak utilization is that of the
+    samples' motion."""
+    schedule = on_whole_periods(found.schedule, dt) if exact_period else found.schedule
     t = sample_times(schedule.duration, dt)
     peaks = peak_utilization(cell, dense_loads(cell, schedule))
     pick = np.linspace(0, len(found.curve) - 1, CURVE_POINTS).round().astype(int)
     clearance = found.clearance
     return {
-        "duration": schedule.duration,
+        "duration": found.schedule.duration,
+        "sampled_duration": float(t[-1]),
         "solo_durations": list(found.solo),
         "sequential_duration": sum(found.solo),
         "time_lost": found.time_lost,
@@ -108,6 +126,7 @@ def _metadata(body: dict) -> list[str]:
     lines = [
         "robots: " + ", ".join(arm["robot"] for arm in arms),
         f"duration: {float(body['duration'])!r} s",
+        f"sampled_duration: {float(body['sampled_duration'])!r} s",
         "solo_durations: " + ",".join(repr(float(d)) for d in body["solo_durations"]) + " s",
         f"sequential_duration: {float(body['sequential_duration'])!r} s",
         f"time_lost: {float(body['time_lost'])!r} s",

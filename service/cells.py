@@ -15,6 +15,7 @@ from toptraj.planners.problem.requests import WaypointPath
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.robots.equipment import InvalidEquipment, equip, mounting
 from toptraj.service.cell_answers import cell_body
+from toptraj.service.formats import exact_period_for
 from toptraj.service.schemas.cells import CellArmRequest, CellRequest
 
 
@@ -49,4 +50,6 @@ def plan_cell(body: CellRequest, deadline: Deadline, format_: str | None = None)
     ``samples`` body that ``cell_answers.csv_bytes`` writes)."""
     arms = tuple(_arm(index, arm, body.gravity, deadline) for index, arm in enumerate(body.arms))
     cell = Cell(arms, body.clearance, tuple(body.constraints))
-    return cell_body(cell, coordinate(cell, deadline), body.dt, format_ or body.format)
+    format_ = format_ or body.format
+    exact = exact_period_for(format_, body.exact_period)
+    return cell_body(cell, coordinate(cell, deadline), body.dt, format_, exact)

@@ -85,3 +85,10 @@ class CellRequest(Schema):
         "(text/csv: a header `t,arms[i].q.<joint>,…`, the answer's facts as `# key: value` lines, a row per "
         "sample; also chosen by `Accept: text/csv`). Every arm on the same times.",
     )
+    exact_period: bool | None = Field(
+        default=None,
+        description="Samples on whole periods `dt`, the final state included: the cell's motion is slowed uniformly "
+        "(by less than one period) to end on a sample; `duration` stays the planned one, `sampled_duration` is the "
+        "last sample's time. Default: true for `joint_trajectory` and `csv`, false for `samples` (samples every dt "
+        "plus the final instant).",
+    )

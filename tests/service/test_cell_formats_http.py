@@ -24,8 +24,8 @@ GRAVITY = [1.0, 0.0, -9.7]
 INERTIA6 = [INERTIA[0, 0], INERTIA[1, 1], INERTIA[2, 2], INERTIA[0, 1], INERTIA[0, 2], INERTIA[1, 2]]
 
 
-def _body(format_: str) -> dict:
-    body = copy.deepcopy(EXAMPLE) | {"format": format_, "gravity": GRAVITY, "dt": 0.02}
+def _body(format_: str, **fields) -> dict:
+    body = copy.deepcopy(EXAMPLE) | {"format": format_, "gravity": GRAVITY, "dt": 0.02} | fields
     body["arms"][0]["payload"] = {"mass": MASS, "center_of_mass": list(COM), "inertia": INERTIA6}
     return body
 
@@ -37,7 +37,21 @@ def answers(patient_client):
         response = patient_client.post("/v1/cells", json=_body(format_))
         assert response.status_code == 200, response.text
         out[format_] = response
+    out["periods"] = patient_client.post("/v1/cells", json=_body("samples", exact_period=True))
+    assert out["periods"].status_code == 200, out["periods"].text
     return out
+
+
+def test_the_controller_formats_sample_on_whole_periods_to_the_final_state(answers):
+    free, exact = answers["samples"].json(), answers["periods"].json()
+    assert exact["duration"] == free["duration"] and free["sampled_duration"] == free["duration"]
+    t = np.array(exact["t"])
+    assert np.allclose(t, 0.02 * np.arange(len(t)), atol=1e-12) and 0.0 <= exact["sampled_duration"] - exact["duration"] < 0.02
+    assert exact["sampled_duration"] == t[-1]
+    for arm, given in zip(exact["arms"], EXAMPLE["arms"]):
+        q = np.array(arm["samples"]["q"])
+        assert np.allclose(q[-1], given["waypoints"][-1], atol=1e-9) and np.allclose(arm["samples"]["qd"][-1], 0.0, atol=1e-9)
+        assert max(max(values) for values in arm["peak_utilization"].values()) <= 1.005
 
 
 def _rnea(model: pin.Model, gravity, q, qd, qdd) -> np.ndarray:
@@ -59,7 +73,7 @@ def test_each_arms_torques_are_an_independent_rnea_with_its_payload_and_gravity(
 
 
 def test_one_joint_trajectory_per_arm_with_the_samples_and_efforts(answers):
-    samples = answers["samples"].json()
+    samples = answers["periods"].json()
     answer = answers["joint_trajectory"].json()
     assert answer["t"] == samples["t"]
     for arm, same in zip(answer["arms"], samples["arms"]):
@@ -75,7 +89,7 @@ def test_one_joint_trajectory_per_arm_with_the_samples_and_efforts(answers):
 def test_csv_holds_every_arm_on_one_clock_and_the_answers_facts(answers, patient_client):
     response = answers["csv"]
     assert response.headers["content-type"].startswith("text/csv")
-    samples = answers["samples"].json()
+    samples = answers["periods"].json()
     text = response.text
     header = text.splitlines()[0].split(",")
     names = samples["arms"][0]["joint_names"]
@@ -87,7 +101,11 @@ def test_csv_holds_every_arm_on_one_clock_and_the_answers_facts(answers, patient
         [samples["t"]] + [np.array(arm["samples"][key]) for arm in samples["arms"] for key in ("q", "qd", "qdd", "tau")]
     )
     assert np.array_equal(table, expected)
-    assert f"# duration: {samples['duration']!r} s" in text and f"# time_lost: {samples['time_lost']!r} s" in text
+    assert (
+        f"# duration: {samples['duration']!r} s" in text
+        and f"# sampled_duration: {samples['sampled_duration']!r} s" in text
+        and f"# time_lost: {samples['time_lost']!r} s" in text
+    )
     assert "# peak_utilization.arms[1].torque: " in text
     by_accept = patient_client.post("/v1/cells", json=_body("samples"), headers={"Accept": "text/csv"})
     assert by_accept.status_code == 200 and by_accept.text == text

@@ -29,7 +29,7 @@ def _points(arm: dict) -> tuple[np.ndarray, np.ndarray]:
 
 def test_both_arms_are_sampled_on_one_clock_from_start_to_end(answer):
     (t1, q1), (t2, q2) = (_points(arm) for arm in answer["arms"])
-    assert np.array_equal(t1, t2) and t1[0] == 0.0 and t1[-1] == pytest.approx(answer["duration"], abs=1e-9)
+    assert np.array_equal(t1, t2) and t1[0] == 0.0 and t1[-1] == pytest.approx(answer["sampled_duration"], abs=1e-9)
     assert np.allclose(t1, answer["t"], atol=1e-9)
     for q, arm in ((q1, EXAMPLE["arms"][0]), (q2, EXAMPLE["arms"][1])):
         assert np.allclose(q[0], arm["waypoints"][0], atol=1e-9) and np.allclose(q[-1], arm["waypoints"][-1], atol=1e-9)
