@@ -2,8 +2,10 @@
 limits, and the clearance they must keep from each other (path-velocity decomposition, Kant &
 Zucker 1986: each path is fixed, only the timing along it is chosen).
 
-Geometry: every arm is its link capsules (``toptraj.robots.collision``) placed by its base pose,
-p_world = R p_base + t (R (3, 3) the base's axes in the world, t (3,) in m). The distance
+Geometry and dynamics: every arm's robot is mounted by its base pose (``toptraj.robots.equipment``:
+p_world = R p_base + t, R (3, 3) the base's axes in the world, t (3,) in m, gravity as the base
+feels it) and carries its payload, so that its link capsules (``toptraj.robots.collision``) are
+in the world and its torques include both. The distance
 between two arms is the smallest capsule-to-capsule distance (segments as in Ericson,
 *Real-Time Collision Detection*, §5.1.9, minus both radii), in m, negative when they overlap.
 """
@@ -20,8 +22,10 @@ from toptraj.planners.paths.base import GeometricPath
 from toptraj.robots import JointLimits, Robot
 from toptraj.robots.collision import robot_capsules, world_capsules
 
-#: Arms a cell holds (the coordination space is the square of the two path parameters).
-MAX_ARMS = 2
+#: Arms a cell holds: two coordinated in full (the square of their path parameters), more by
+#: prioritized planning over every order of the arms (``prioritized``: 4! = 24 orders, 6 pairwise
+#: diagrams).
+MAX_ARMS = 4
 #: How far R R^T may be from the identity, entry by entry, for R to count as a rotation.
 ROTATION_TOLERANCE = 1e-6
 
@@ -44,23 +48,32 @@ def checked_rotation(rotation, where: str) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CellArm:
-    """One arm of a cell: its ``robot``, its given ``path`` (s in [0, 1]), its ``limits`` and
-    its base pose, ``base_rotation`` (3, 3) and ``base_position`` (3,) in m."""
+    """One arm of a cell: its ``robot`` (mounted by its base pose in the world and carrying its
+    payload, ``toptraj.robots.equipment.equip``), its given ``path`` (s in [0, 1]) and its
+    ``limits``."""
 
     robot: Robot
     path: GeometricPath
     limits: JointLimits
-    base_rotation: np.ndarray
-    base_position: np.ndarray
+
+    @property
+    def base_rotation(self) -> np.ndarray:
+        """The base's axes in the world (3, 3)."""
+        mounting = self.robot.mounting
+        return np.eye(3) if mounting is None else np.array(mounting.rotation, dtype=float).reshape(3, 3)
+
+    @property
+    def base_position(self) -> np.ndarray:
+        """The base's origin in the world (3,), m."""
+        mounting = self.robot.mounting
+        return np.zeros(3) if mounting is None else np.array(mounting.position, dtype=float)
 
     def capsules_at(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """World end points a, b (n, k, 3) of the arm's k capsules at joint positions ``q``
-        (n, n_dof), and their radii (k,), in m."""
+        (n, n_dof), and their radii (k,), in m (the mounted model's kinematics are the world's)."""
         capsules = robot_capsules(self.robot)
         a, b = world_capsules(self.robot.model, self.robot.data, capsules, self.robot.configuration(q))
-        rotation, position = self.base_rotation, self.base_position
-        radius = np.array([capsule.radius for capsule in capsules])
-        return a @ rotation.T + position, b @ rotation.T + position, radius
+        return a, b, np.array([capsule.radius for capsule in capsules])
 
     def link_names(self) -> list[str]:
         """The names of the arm's capsules, in the order of ``capsules_at``."""
@@ -71,14 +84,15 @@ class CellArm:
         joint motion dq moves no point by more than reach * sum |dq_j|."""
         model = self.robot.model
         chain = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(2, model.njoints))
-        tip = max(max(np.linalg.norm(c.a), np.linalg.norm(c.b)) + c.radius for c in robot_capsules(self.robot))
+        moving = [c for c in robot_capsules(self.robot) if c.joint != 0]  # the base's capsules never move
+        tip = max(max(np.linalg.norm(c.a), np.linalg.norm(c.b)) + c.radius for c in moving)
         return chain + float(tip)
 
 
 @dataclass(frozen=True)
 class Cell:
     """Arms sharing a workspace, to be kept ``clearance`` (m) apart, under the limit ``kinds``
-    (velocity, acceleration) of each."""
+    (velocity, acceleration, torque) of each."""
 
     arms: tuple[CellArm, ...]
     clearance: float

@@ -1,4 +1,4 @@
-"""Two arms timed along their given paths so that they keep their clearance, as early as
+"""Arms timed along their given paths so that they keep their clearance, as early as
 possible on one clock (path-velocity decomposition: Kant & Zucker 1986; O'Donnell &
 Lozano-Pérez 1989).
 
@@ -11,8 +11,12 @@ Candidates, each checked against the coordination diagram, the quickest kept:
 * the quickest monotone curve through the free diagram (``curve``), smoothed, both arms timed
   along it by one time-optimal solve (``timing.pair_timing``).
 
+Three or more arms: prioritized planning over every order of the arms (``prioritized``, its
+optimality loss stated there).
+
 The one kept is verified at fine samples (``verify.schedule_clearance``) and slowed uniformly
-where a dense resampling finds a limit exceeded between the solver's grid points.
+where a dense resampling finds a limit (velocity, acceleration, torque) exceeded between the
+solver's grid points (``limits.within_limits``).
 """
 
 from __future__ import annotations
@@ -21,11 +25,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from toptraj.planners.collision.self_collision import SelfCollision, check_self_collision
 from toptraj.planners.coordination.cell import MAX_ARMS, Cell
 from toptraj.planners.coordination.curve import SmoothCurve, resampled, shortcut, shortest_curve, widened
 from toptraj.planners.coordination.diagram import Diagram, check_ends, coordination_diagram
+from toptraj.planners.coordination.limits import within_limits
+from toptraj.planners.coordination.prioritized import pair_diagrams, prioritized
 from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
-from toptraj.planners.coordination.verify import PairClearance, peak_utilization, schedule_clearance
+from toptraj.planners.coordination.verify import PairClearance, schedule_clearance
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import TimeScaling
@@ -42,18 +49,24 @@ SPACINGS = (0.2, 0.1, 0.05, 0.02, 0.01)
 
 @dataclass(frozen=True)
 class Coordination:
-    """The timed pair: its ``schedule``, each arm's own optimum ``solo`` (s), the ``diagram``,
-    the (s1, s2) the schedule passes through (``curve``, (n, 2)), and its ``clearance``."""
+    """The timed arms: their ``schedule``, each arm's own optimum ``solo`` (s), the
+    coordination ``diagrams`` of every pair (a, b), a < b (``diagram``: that of arms 0 and 1),
+    the (s_1, ..., s_N) the schedule passes through (``curve``, (n, N)), and its ``clearance``."""
 
     schedule: Schedule
-    solo: tuple[float, float]
-    diagram: Diagram
+    solo: tuple[float, ...]
+    diagrams: dict[tuple[int, int], Diagram]
     curve: np.ndarray
     clearance: PairClearance
 
     @property
+    def diagram(self) -> Diagram:
+        """The coordination diagram of arms 0 and 1."""
+        return self.diagrams[(0, 1)]
+
+    @property
     def time_lost(self) -> float:
-        """Seconds beyond the slower arm's own optimum, spent keeping the arms apart."""
+        """Seconds beyond the slowest arm's own optimum, spent keeping the arms apart."""
         return self.schedule.duration - max(self.solo)
 
 
@@ -84,7 +97,7 @@ def _smoothed(cell: Cell, diagram: Diagram, points: np.ndarray, deadline: Deadli
         if not diagram.free_at(s[:, 0], s[:, 1]).all():
             continue
         scaling = pair_timing(cell, curve, deadline=deadline)
-        schedule = _within_limits(cell, Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated"))
+        schedule = within_limits(cell, Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated"))
         if (best is None or schedule.duration < best.duration) and _free(diagram, schedule):
             best = schedule
     return best
@@ -107,38 +120,67 @@ def curve_schedule(cell: Cell, diagram: Diagram, solo: list[TimeScaling], deadli
     return min(found, key=lambda schedule: schedule.duration, default=None)
 
 
-def _within_limits(cell: Cell, schedule: Schedule) -> Schedule:
-    """``schedule`` slowed uniformly where the dense peak of a limit exceeds 1 (velocity
-    scales as 1 / stretch, acceleration as 1 / stretch^2)."""
-    velocity, acceleration = peak_utilization(cell, schedule)
-    stretch = max(1.0, velocity, float(np.sqrt(acceleration)))
-    return schedule if stretch == 1.0 else Schedule(schedule.motions, schedule.kind, stretch)
-
-
 def _check_cell(cell: Cell) -> None:
-    if len(cell.arms) != MAX_ARMS:
-        raise InvalidRequest(f"a cell has {len(cell.arms)} arms; {MAX_ARMS} are served: give exactly two arms")
+    if not 2 <= len(cell.arms) <= MAX_ARMS:
+        raise InvalidRequest(
+            f"a cell has {len(cell.arms)} arms; from 2 to {MAX_ARMS} are served (every order of the arms is tried): "
+            f"give between 2 and {MAX_ARMS} arms, or split the cell"
+        )
+
+
+def _candidates(cell: Cell, solo: list[TimeScaling], deadline: Deadline) -> tuple[dict, list[Schedule]]:
+    """The pairwise diagrams and the schedules to try: for two arms a late start of either and
+    the coordinated curve; for more, the prioritized schedule (``prioritized``)."""
+    if len(cell.arms) > 2:
+        diagrams = pair_diagrams(cell, deadline)
+        return diagrams, [prioritized(cell, solo, diagrams, deadline)]
+    diagram = coordination_diagram(cell, deadline=deadline)
+    candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), curve_schedule(cell, diagram, solo, deadline)]
+    return {(0, 1): diagram}, [candidate for candidate in candidates if candidate is not None]
+
+
+def _arms_alone(cell: Cell, deadline: Deadline) -> list[TimeScaling]:
+    """Each arm's own path checked for self-collision, then timed alone; an arm's failure
+    raised again naming the arm (``arms[i]``)."""
+    solo = []
+    for index, arm in enumerate(cell.arms):
+        where = f"arms[{index}] ({arm.robot.name})"
+        try:
+            check_self_collision(arm.path, arm.robot, deadline=deadline)
+            solo.append(solo_timing(arm, cell.kinds, deadline=deadline))
+        except SelfCollision as error:
+            s = float(getattr(error, "s", 0.0))
+            raise SelfCollision(f"{where}: {error.detail}", s, error.link_a, error.link_b, error.distance) from error
+        except InfeasiblePath as error:
+            facts = {key: getattr(error, key, None) for key in ("s", "joint", "limit")}
+            raise InfeasiblePath(f"{where} cannot follow its own path alone: {error.detail}", **facts) from error
+    return solo
 
 
 def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
-    """Time the cell's two arms along their paths, kept ``cell.clearance`` apart, both done as
-    early as possible (module docstring).
+    """Time the cell's arms along their paths, kept ``cell.clearance`` apart, all done as early
+    as possible (module docstring; three or more arms: ``prioritized``).
 
     Raises:
-        InvalidRequest: not two arms, or arms that collide at their start.
-        InfeasiblePath: no timing keeps the arms apart along these paths.
+        InvalidRequest: fewer than 2 or more than ``MAX_ARMS`` arms, or arms that collide at
+            their start.
+        SelfCollision: an arm's own path makes two of its links touch (naming the arm, the
+            links and s).
+        InfeasiblePath: an arm cannot follow its path within its limits (naming the arm, the
+            joint, the limit and s), or no timing keeps the arms apart along these paths.
     """
     _check_cell(cell)
     check_ends(cell)
-    solo = [solo_timing(arm, cell.kinds, deadline=deadline) for arm in cell.arms]
-    diagram = coordination_diagram(cell, deadline=deadline)
-    candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), curve_schedule(cell, diagram, solo, deadline)]
-    found = sorted((_within_limits(cell, c) for c in candidates if c is not None), key=lambda c: c.duration)
+    solo = _arms_alone(cell, deadline)
+    diagrams, candidates = _candidates(cell, solo, deadline)
+    found = sorted((within_limits(cell, c) for c in candidates), key=lambda c: c.duration)
     for schedule in found:
         clearance = schedule_clearance(cell, schedule, deadline)
         if clearance.bound >= cell.clearance:
             t = np.linspace(0.0, schedule.duration, DIAGRAM_SAMPLES + 1)
-            return Coordination(schedule, (solo[0].duration, solo[1].duration), diagram, schedule.path_parameters(t), clearance)
+            return Coordination(
+                schedule, tuple(motion.duration for motion in solo), diagrams, schedule.path_parameters(t), clearance
+            )
     raise InfeasiblePath(
         "no timing keeps the arms apart along these paths (neither waiting nor a coordinated curve through the "
         "coordination diagram is free): move a base apart, change a path or lower clearance"

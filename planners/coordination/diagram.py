@@ -13,6 +13,7 @@ farther. The schedule finally chosen is verified apart, at fine samples, with a 
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,28 +68,25 @@ def motion_steps(capsules) -> np.ndarray:
     return STEP_SAFETY * ends.max(axis=1)
 
 
-def _check_start(cell: Cell, distance: float, links: tuple[str, str]) -> None:
-    if distance < cell.clearance:
-        first, second = cell.arms
-        raise InvalidRequest(
-            f"the arms collide at their start: link {links[0]!r} of arms[0] ({first.robot.name}) is {distance:.4g} m from "
-            f"link {links[1]!r} of arms[1] ({second.robot.name}) at s1 = s2 = 0 (the clearance is {cell.clearance:g} m): "
-            "move a base apart, change the first waypoints or lower clearance"
-        )
-
-
 def check_ends(cell: Cell) -> None:
-    """InvalidRequest when the arms are closer than the clearance at their starts (where no
-    timing can help), naming the two links."""
-    first, second = cell.arms
-    distance, i, j = pair_distances(arm_capsules(first, np.zeros(1)), arm_capsules(second, np.zeros(1)))
-    _check_start(cell, float(distance[0]), (first.link_names()[int(i[0])], second.link_names()[int(j[0])]))
+    """InvalidRequest when two arms are closer than the clearance at their starts (where no
+    timing can help), naming the arms and the two links."""
+    for a, b in itertools.combinations(range(len(cell.arms)), 2):
+        first, second = cell.arms[a], cell.arms[b]
+        distance, i, j = pair_distances(arm_capsules(first, np.zeros(1)), arm_capsules(second, np.zeros(1)))
+        if distance[0] < cell.clearance:
+            links = (first.link_names()[int(i[0])], second.link_names()[int(j[0])])
+            raise InvalidRequest(
+                f"the arms collide at their start: link {links[0]!r} of arms[{a}] ({first.robot.name}) is {distance[0]:.4g} m "
+                f"from link {links[1]!r} of arms[{b}] ({second.robot.name}) at s = 0 (the clearance is {cell.clearance:g} m): "
+                "move a base apart, change the first waypoints or lower clearance"
+            )
 
 
 def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE) -> Diagram:
-    """The diagram of the cell's two arms on ``grid`` intervals per axis (memory checked
+    """The diagram of the cell's first two arms on ``grid`` intervals per axis (memory checked
     first: one row of (grid + 1) nodes, k1 x k2 capsule pairs, about 40 arrays of 8 bytes)."""
-    first, second = cell.arms
+    first, second = cell.arms[:2]
     s = np.linspace(0.0, 1.0, grid + 1)
     one, two = arm_capsules(first, s), arm_capsules(second, s)
     row_bytes = 40 * 8 * (grid + 1) * one[0].shape[1] * two[0].shape[1] * 3

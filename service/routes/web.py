@@ -13,7 +13,13 @@ from toptraj.service.web import STATIC
 router = APIRouter(include_in_schema=False)
 
 #: Files of the page, by the name it loads them under, and their media types.
-_FILES = {"app.js": "text/javascript", "draw.js": "text/javascript", "exports.js": "text/javascript", "style.css": "text/css"}
+_FILES = {
+    "app.js": "text/javascript",
+    "cell.js": "text/javascript",
+    "draw.js": "text/javascript",
+    "exports.js": "text/javascript",
+    "style.css": "text/css",
+}
 _CACHE = {"Cache-Control": "public, max-age=3600"}
 
 

@@ -7,10 +7,13 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
-from toptraj.service.schemas.common import Schema
+from toptraj.robots.ranges import GRAVITY
+from toptraj.service.schemas.common import Schema, signed
+from toptraj.service.schemas.equipment import PayloadRequest
 from toptraj.service.schemas.trajectories import JointVector, Name, Point
 
-#: Arms a request may list (the planner serves two; more are refused with a 422 saying so).
+#: Arms a request may list (the planner serves up to ``coordination.cell.MAX_ARMS``; more are
+#: refused with a 422 saying so).
 MAX_CELL_ARMS = 8
 #: Waypoints per arm.
 MAX_CELL_WAYPOINTS = 100
@@ -45,16 +48,47 @@ class CellArmRequest(Schema):
     acceleration_scale: Annotated[float, Field(gt=0.0, le=1.0)] = Field(
         default=1.0, description="Factor on the robot's acceleration limits."
     )
+    torque_scale: Annotated[float, Field(gt=0.0, le=1.0)] = Field(default=1.0, description="Factor on the robot's torque limits.")
+    payload: PayloadRequest | None = Field(
+        default=None,
+        description="What the arm carries at its tool (mass, centre of mass, inertia): its torques, torque limits "
+        "and `tau` include it; default the upload's payload, else none.",
+    )
 
 
 class CellRequest(Schema):
-    """Two arms in one workspace, each along its own path, to be timed together."""
+    """Arms in one workspace, each along its own path, to be timed together."""
 
-    arms: list[CellArmRequest] = Field(min_length=1, max_length=MAX_CELL_ARMS, description="The arms (two are served).")
+    arms: list[CellArmRequest] = Field(
+        min_length=1,
+        max_length=MAX_CELL_ARMS,
+        description="The arms: two coordinated in full, three or four by prioritized planning (each arm on its own "
+        "optimum, waiting at its start; every order tried); more are refused.",
+    )
     clearance: Annotated[float, Field(ge=0.0, le=1.0)] = Field(
         default=0.01, description="Smallest distance (m) the arms' link capsules keep from each other at all times."
     )
-    constraints: list[Literal["velocity", "acceleration"]] = Field(
-        default=["velocity", "acceleration"], min_length=1, max_length=2, description="Limits each arm keeps."
+    constraints: list[Literal["velocity", "acceleration", "torque"]] = Field(
+        default=["velocity", "acceleration", "torque"],
+        min_length=1,
+        max_length=3,
+        description="Limits each arm keeps (held on a dense resampling of the answer).",
+    )
+    gravity: Annotated[list[Annotated[float, signed(GRAVITY)]], Field(min_length=3, max_length=3)] | None = Field(
+        default=None, description="Gravity in the world (m/s^2); default the robots' own, [0, 0, -9.81] for the catalog arms."
     )
     dt: Annotated[float, Field(ge=1e-3, le=1.0)] = Field(default=0.01, description="Sample period (s) of the answer.")
+    format: Literal["samples", "joint_trajectory", "csv"] = Field(
+        default="samples",
+        description="The answer's shape, as the trajectory endpoint's `output.format`: `samples` (each arm's arrays "
+        "t, q, qd, qdd, tau), `joint_trajectory` (one trajectory_msgs/JointTrajectory per arm, with effort), `csv` "
+        "(text/csv: a header `t,arms[i].q.<joint>,…`, the answer's facts as `# key: value` lines, a row per "
+        "sample; also chosen by `Accept: text/csv`). Every arm on the same times.",
+    )
+    exact_period: bool | None = Field(
+        default=None,
+        description="Samples on whole periods `dt`, the final state included: the cell's motion is slowed uniformly "
+        "(by less than one period) to end on a sample; `duration` stays the planned one, `sampled_duration` is the "
+        "last sample's time. Default: true for `joint_trajectory` and `csv`, false for `samples` (samples every dt "
+        "plus the final instant).",
+    )

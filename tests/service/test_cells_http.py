@@ -16,24 +16,24 @@ EXAMPLE = json.loads((ROOT / "examples" / "cell_two_ur5.json").read_text())
 
 @pytest.fixture(scope="module")
 def answer(patient_client):
-    response = patient_client.post("/v1/cells", json=EXAMPLE)
+    response = patient_client.post("/v1/cells", json=EXAMPLE | {"format": "joint_trajectory"})
     assert response.status_code == 200, response.text
     return response.json()
 
 
 def _points(arm: dict) -> tuple[np.ndarray, np.ndarray]:
-    points = arm["trajectory"]["points"]
+    points = arm["joint_trajectory"]["points"]
     t = np.array([p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in points])
     return t, np.array([p["positions"] for p in points])
 
 
 def test_both_arms_are_sampled_on_one_clock_from_start_to_end(answer):
     (t1, q1), (t2, q2) = (_points(arm) for arm in answer["arms"])
-    assert np.array_equal(t1, t2) and t1[0] == 0.0 and t1[-1] == pytest.approx(answer["duration"], abs=1e-9)
+    assert np.array_equal(t1, t2) and t1[0] == 0.0 and t1[-1] == pytest.approx(answer["sampled_duration"], abs=1e-9)
     assert np.allclose(t1, answer["t"], atol=1e-9)
     for q, arm in ((q1, EXAMPLE["arms"][0]), (q2, EXAMPLE["arms"][1])):
         assert np.allclose(q[0], arm["waypoints"][0], atol=1e-9) and np.allclose(q[-1], arm["waypoints"][-1], atol=1e-9)
-    assert answer["arms"][0]["trajectory"]["joint_names"][0] == "shoulder_pan_joint"
+    assert answer["arms"][0]["joint_trajectory"]["joint_names"][0] == "shoulder_pan_joint"
 
 
 def test_the_answer_reports_the_time_lost_and_the_diagram(answer):
@@ -79,11 +79,28 @@ def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_cli
     assert "collide at their start" in response.json()["detail"] and "link '" in response.json()["detail"]
 
 
-def test_three_arms_are_a_422_asking_for_two(patient_client):
-    body = copy.deepcopy(EXAMPLE)
-    body["arms"].append(copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.0, 3.0, 0.0]}})
+def test_three_arms_are_answered_on_one_clock_with_every_pairs_diagram(patient_client):
+    body = copy.deepcopy(EXAMPLE) | {"format": "joint_trajectory"}
+    quarter = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    body["arms"].append(copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.6, 1.1, 0.0], "rotation": quarter}})
     response = patient_client.post("/v1/cells", json=body)
-    assert response.status_code == 422 and "give exactly two arms" in response.json()["detail"]
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    times = [_points(arm)[0] for arm in answer["arms"]]
+    assert len(times) == 3 and all(np.array_equal(t, times[0]) for t in times)
+    assert [d["arms"] for d in answer["diagrams"]] == [[0, 1], [0, 2], [1, 2]]
+    assert max(answer["solo_durations"]) <= answer["duration"] <= answer["sequential_duration"]
+    assert answer["min_distance"]["guaranteed"] >= body["clearance"] and answer["schedule"].startswith("prioritized")
+
+
+def test_five_arms_are_a_422_naming_the_bound(patient_client):
+    body = copy.deepcopy(EXAMPLE)
+    body["arms"] += [copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.0, 3.0 * k, 0.0]}} for k in range(1, 4)]
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 422 and "a cell has 5 arms; from 2 to 4 are served" in response.json()["detail"]
+    nine = copy.deepcopy(EXAMPLE)
+    nine["arms"] = (nine["arms"] * 5)[:9]  # past the schema's bound of 8
+    assert patient_client.post("/v1/cells", json=nine).status_code == 422
 
 
 def test_a_waypoint_of_the_wrong_length_is_a_422_naming_the_arm(patient_client):

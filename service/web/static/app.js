@@ -36,6 +36,7 @@ const PRESETS = {
   },
 };
 
+const CELL_PRESET_NAME = "Two ur5 across a table, crossing paths (a cell: POST /v1/cells)";
 const $ = (id) => document.getElementById(id);
 const robotLimits = {};
 // the job being planned: its id, and whether the page asked to cancel it
@@ -79,6 +80,14 @@ function checked(container) {
 }
 
 function applyPreset(name) {
+  if (name === CELL_PRESET_NAME) {
+    // one line per arm
+    const lines = Object.entries(CELL_PRESET).map(([key, value]) => (Array.isArray(value)
+      ? `  ${JSON.stringify(key)}: [\n    ${value.map((item) => JSON.stringify(item)).join(",\n    ")}\n  ]`
+      : `  ${JSON.stringify(key)}: ${JSON.stringify(value)}`));
+    $("path").value = "{\n" + lines.join(",\n") + "\n}";
+    return;
+  }
   const preset = PRESETS[name];
   if (!preset) return;
   $("robot").value = preset.robot;
@@ -108,7 +117,7 @@ async function init() {
   const method = openapi.components.schemas.TimingRequest.properties.method;
   const methods = (method && method.enum) || FALLBACK_METHODS;
   checkboxes($("methods"), methods, []);
-  for (const name of Object.keys(PRESETS)) $("preset").append(new Option(name, name));
+  for (const name of [...Object.keys(PRESETS), CELL_PRESET_NAME]) $("preset").append(new Option(name, name));
   $("preset").addEventListener("change", () => applyPreset($("preset").value));
   applyPreset(Object.keys(PRESETS)[0]);
   $("plan").addEventListener("click", plan);
@@ -204,6 +213,11 @@ async function plan() {
     showError(`The path is not valid JSON: ${e.message}`);
     return;
   }
+  if (isCell(path)) {
+    await planAsCell(path);
+    return;
+  }
+  document.body.dataset.view = "trajectory";
   const methods = checked($("methods"));
   if (!methods.length) {
     showError("Choose at least one method.");
@@ -228,6 +242,21 @@ async function plan() {
   } catch (error) {
     $("status").textContent = error instanceof Cancelled ? error.message : "";
     if (!(error instanceof Cancelled)) showError(error.message);
+  } finally {
+    $("plan").disabled = false;
+  }
+}
+
+async function planAsCell(request) {
+  $("plan").disabled = true;
+  $("status").textContent = "planning the cell…";
+  try {
+    const answer = await planCell(request, Number($("dt").value));
+    $("status").textContent = `planned: ${answer.arms.length} arms on one clock`;
+    document.body.dataset.planned = "true";
+  } catch (error) {
+    $("status").textContent = "";
+    showError(error.message);
   } finally {
     $("plan").disabled = false;
   }

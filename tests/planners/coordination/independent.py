@@ -11,13 +11,14 @@ from toptraj.robots.collision import robot_capsules
 
 
 def _coal_capsules(arm, q: np.ndarray) -> list[tuple[coal.Capsule, coal.Transform3s]]:
-    """The arm's capsules at joint positions ``q`` (n_dof,) as coal shapes placed in the world."""
-    robot = arm.robot
+    """The arm's capsules at joint positions ``q`` (n_dof,) as coal shapes placed in the world:
+    the bare robot's kinematics, then its base pose applied here."""
+    robot = arm.robot.bare or arm.robot
     data = robot.model.createData()
     pin.forwardKinematics(robot.model, data, robot.configuration(q[None])[0])
     placed = []
     for capsule in robot_capsules(robot):
-        pose = data.oMi[capsule.joint]
+        pose = data.oMi[capsule.joint]  # the base's own capsules at joint 0: the universe
         a = arm.base_rotation @ (pose.rotation @ capsule.a + pose.translation) + arm.base_position
         b = arm.base_rotation @ (pose.rotation @ capsule.b + pose.translation) + arm.base_position
         axis = b - a

@@ -90,10 +90,11 @@ def test_arms_that_collide_at_their_start_are_refused_naming_the_links():
         coordinate(close)
 
 
-def test_a_third_arm_is_refused():
+def test_a_fifth_arm_is_refused_naming_the_bound():
     cell = facing_cell()
-    with pytest.raises(InvalidRequest, match="give exactly two arms"):
-        coordinate(Cell(cell.arms + cell.arms[:1], cell.clearance))
+    far = tuple(ur5_arm(FIRST, [0.0, 3.0 * k, 0.0]) for k in range(1, 4))
+    with pytest.raises(InvalidRequest, match=r"a cell has 5 arms; from 2 to 4 are served"):
+        coordinate(Cell(cell.arms + far, cell.clearance))
 
 
 def test_the_coordinated_curve_keeps_clearance_and_limits(crossing):

@@ -1,0 +1,90 @@
+"""Three or more arms: prioritized planning (Erdmann & Lozano-Pérez, "On multiple moving
+objects", Algorithmica 2, 1987): the arms taken in an order, each on its own time-optimal motion
+started after the least delay (of ``DELAYS`` evenly up to the end of the arms before it) that
+keeps it clear of every arm before it, checked on the pairwise coordination diagrams
+(O'Donnell & Lozano-Pérez 1989: arm a and arm b at (s_a(t), s_b(t)) in the free part of their
+diagram). Every order of the arms is tried (at most 4! = 24), the quickest kept.
+
+Optimality loss, stated: an arm only waits at its start, it never slows or waits on its way,
+and the N-dimensional coordination space (s_1, ..., s_N) is not searched; so the cell can take
+longer than the best coordination of all the arms (by at most the wait a slowing on the way
+would save). It is never slower than the slowest arm's own optimum and, when moving the arms one
+after the other is free, never slower than that. Two arms are coordinated in full
+(``toptraj.planners.coordination.coordinate``).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from toptraj.planners.coordination.cell import Cell
+from toptraj.planners.coordination.diagram import Diagram, coordination_diagram
+from toptraj.planners.coordination.timing import Schedule, SoloMotion
+from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.timing.base import TimeScaling
+
+#: Late starts tried per arm, evenly up to the end of the arms before it.
+DELAYS = 64
+#: Samples in time at which a delay is checked against the diagrams.
+SAMPLES = 1_000
+
+
+def pair_diagrams(cell: Cell, deadline: Deadline) -> dict[tuple[int, int], Diagram]:
+    """The coordination diagram of every pair of arms (a, b), a < b (rows s_a)."""
+    out = {}
+    for a, b in itertools.combinations(range(len(cell.arms)), 2):
+        out[(a, b)] = coordination_diagram(Cell((cell.arms[a], cell.arms[b]), cell.clearance, cell.kinds), deadline=deadline)
+    return out
+
+
+def _clear(diagrams, placed: dict[int, SoloMotion], arm: int, motion: SoloMotion) -> bool:
+    """Whether ``arm`` on ``motion`` stays in the free part of its diagram with each placed arm."""
+    end = max([motion.duration] + [other.duration for other in placed.values()])
+    t = np.linspace(0.0, end, SAMPLES + 1)
+    s = motion.at(t)[0]
+    for other, placed_motion in placed.items():
+        s_other = placed_motion.at(t)[0]
+        if other < arm:
+            free = diagrams[(other, arm)].free_at(s_other, s)
+        else:
+            free = diagrams[(arm, other)].free_at(s, s_other)
+        if not free.all():
+            return False
+    return True
+
+
+def _in_order(diagrams, solo: list[TimeScaling], order: tuple[int, ...], deadline: Deadline) -> Schedule | None:
+    """The arms placed in ``order``, each at its least free delay; None when one finds none."""
+    placed = {order[0]: SoloMotion(solo[order[0]])}
+    for arm in order[1:]:
+        deadline.check()
+        horizon = max(motion.duration for motion in placed.values())
+        for delay in np.linspace(0.0, horizon, DELAYS + 1):
+            motion = SoloMotion(solo[arm], float(delay))
+            if _clear(diagrams, placed, arm, motion):
+                placed[arm] = motion
+                break
+        else:
+            return None
+    waits = [f"arms[{arm}] waits" for arm in order if placed[arm].delay > 0.0]
+    kind = "simultaneous" if not waits else "prioritized: " + ", ".join(waits)
+    return Schedule(tuple(placed[arm] for arm in range(len(solo))), kind)
+
+
+def prioritized(cell: Cell, solo: list[TimeScaling], diagrams, deadline: Deadline) -> Schedule:
+    """The quickest prioritized schedule over every order of the arms (module docstring).
+
+    Raises:
+        InfeasiblePath: no order lets every arm pass the others by waiting at its start.
+    """
+    found = [_in_order(diagrams, solo, order, deadline) for order in itertools.permutations(range(len(cell.arms)))]
+    best = min((schedule for schedule in found if schedule is not None), key=lambda schedule: schedule.duration, default=None)
+    if best is None:
+        raise InfeasiblePath(
+            "no order of the arms lets each pass the others by waiting at its start (an arm's path crosses where "
+            "another arm rests at its start or end): move a base apart, change a path or lower clearance"
+        )
+    return best

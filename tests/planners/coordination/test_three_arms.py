@@ -1,0 +1,62 @@
+"""Three arms in one cell by prioritized planning (``coordination.prioritized``): the two ur5
+facing each other with crossing paths and a third at the table's side reaching across the same
+middle. Every pair keeps its clearance by an independent distance check (coal); the cell is
+never slower than the arms one after the other, nor quicker than the slowest arm's own optimum;
+every arm's limits hold on a dense resampling; and every pairwise diagram is blocked where the
+arms meet."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from tests.planners.coordination.cells import FIRST, facing_cell, ur5_arm
+from tests.planners.coordination.independent import coal_distance
+from toptraj.planners.coordination import Cell, coordinate
+from toptraj.planners.coordination.timing import Schedule, SoloMotion, solo_timing
+
+#: A quarter turn about z: the third base faces -y, towards the middle of the table.
+QUARTER = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+
+
+@pytest.fixture(scope="module")
+def three():
+    pair = facing_cell()
+    cell = Cell(pair.arms + (ur5_arm(FIRST, [0.6, 1.1, 0.0], QUARTER),), pair.clearance)
+    return cell, coordinate(cell)
+
+
+def _pair_minimum(cell: Cell, schedule: Schedule, a: int, b: int, samples: int) -> float:
+    states = schedule.states(cell, np.linspace(0.0, schedule.duration, samples + 1))
+    pair = Cell((cell.arms[a], cell.arms[b]), cell.clearance)
+    return min(coal_distance(pair, qa, qb) for qa, qb in zip(states[a][0], states[b][0]))
+
+
+def test_every_pair_keeps_the_clearance_by_an_independent_check(three):
+    cell, found = three
+    simultaneous = Schedule(tuple(SoloMotion(solo_timing(arm, cell.kinds)) for arm in cell.arms), "simultaneous")
+    met = [_pair_minimum(cell, simultaneous, a, b, 150) < cell.clearance for a, b in itertools.combinations(range(3), 2)]
+    assert sum(met) >= 2  # at once, the third arm meets at least one other, and the facing pair each other
+    for a, b in itertools.combinations(range(3), 2):
+        assert _pair_minimum(cell, found.schedule, a, b, 300) >= cell.clearance
+    assert found.clearance.bound >= cell.clearance and set(found.diagrams) == {(0, 1), (0, 2), (1, 2)}
+    assert all(diagram.blocked.any() for diagram in found.diagrams.values())
+
+
+def test_never_slower_than_one_arm_after_the_other_nor_quicker_than_the_slowest(three):
+    _, found = three
+    assert max(found.solo) <= found.schedule.duration <= sum(found.solo) * 1.005
+    assert found.schedule.kind.startswith("prioritized") and found.time_lost > 0.05
+
+
+def test_every_arms_limits_hold_on_a_dense_resampling(three):
+    cell, found = three
+    schedule = found.schedule
+    t = np.linspace(0.0, schedule.duration, 20_001)
+    for arm, (q, qd, qdd) in zip(cell.arms, schedule.states(cell, t)):
+        assert (np.abs(qd) <= arm.limits.velocity * 1.005).all()
+        assert (np.abs(qdd) <= arm.limits.acceleration * 1.005).all()
+        assert np.abs(q[0] - arm.path.evaluate(np.zeros(1)).q[0]).max() < 1e-12
+        assert np.abs(q[-1] - arm.path.evaluate(np.ones(1)).q[0]).max() < 1e-12
