@@ -18,7 +18,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal, NamedTuple
 
 from toptraj.planners.checks.gate import TimedStretch
+from toptraj.planners.errors import ToptrajError
 from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.execution.memory import method_grid_cap
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.timing.base import PathTiming, TimingMethod
 from toptraj.planners.trajectory import SwitchingTimes
@@ -84,11 +86,27 @@ class MotionGenerator(abc.ABC):
     required_kinds: frozenset[str] = frozenset()
     two_waypoints_only: bool = False
     continuous_acceleration: bool = False
-    grid_budget: int = 140_000
+    bytes_per_interval_joint: int = 2_300
+    interruptible: bool = True
 
     def max_grid_intervals(self, n_dof: int) -> int:
         """The most grid intervals the generator's paths are timed on, on ``n_dof`` joints."""
-        return self.grid_budget // max(n_dof, 1)
+        return method_grid_cap(self.bytes_per_interval_joint, n_dof)
+
+    def estimate(self, problem: Problem) -> int:
+        """Bytes the generator holds besides the grid its path is timed on (the search's graph),
+        estimated from the problem before any work; 0 by default."""
+        return 0
+
+    def allowance(self, problem: Problem) -> int:
+        """Bytes the generator's options allow its own estimate beside the one cap (the search's
+        ``memory_bytes``); 0 by default."""
+        return 0
+
+    def refuse(self, problem: Problem, room: int) -> ToptrajError | None:
+        """Why the generator's own estimate does not fit in ``room`` bytes, with the largest
+        setting that does (``None``: no setting of its own lowers it)."""
+        return None
 
     @property
     @abc.abstractmethod

@@ -24,6 +24,7 @@ from toptraj.planners.problem.problem import Problem
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.problem.zones import zone_limits
 from toptraj.planners.results import PlannedTrajectory
+from toptraj.planners.runner.admission import admit
 from toptraj.planners.runner.answer import answer
 from toptraj.planners.runner.given_path import timed_path
 
@@ -32,14 +33,18 @@ def run(problem: Problem) -> PlannedTrajectory:
     """The timed trajectory of ``problem``, sampled, checked and with its stated accuracy.
 
     Raises:
-        InvalidRequest: a ``dt`` that gives more samples than the problem allows (the message
-            names the smallest that fits), or what only the built path shows.
+        TooLarge: before any work, a problem whose memory estimate exceeds the cap (the largest
+            grid that fits is named: ``toptraj.planners.runner.admission``); after the timing, a
+            ``dt`` that gives more samples than the problem allows (the smallest that fits).
+        OverMemory: before any work, a search whose graph exceeds its allowance.
+        InvalidRequest: what only the built path shows.
         InfeasiblePath: no timing can follow the path within the limits (says where, which
             joint and which limit).
         TimingFailed: the method failed.
         BudgetExceeded: the problem's deadline passed.
     """
     started = time.perf_counter()
+    admit(problem)
     method, part = problem.method, problem.deadline.within(0.0, 0.9)
     checked_first = None
     with numerical_breakdown_is_failure(method.name):
