@@ -13,13 +13,15 @@ generator calls the gate's pipeline or the runner itself.
 from __future__ import annotations
 
 import abc
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, Literal, NamedTuple
+from typing import TYPE_CHECKING, ClassVar, Literal, NamedTuple, TypeVar
 
 from toptraj.planners.checks.gate import TimedStretch
 from toptraj.planners.errors import ToptrajError
 from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.execution.memory import method_grid_cap
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.timing.base import PathTiming, TimingMethod
@@ -29,6 +31,8 @@ from toptraj.robots import JointLimits, Robot
 if TYPE_CHECKING:
     from toptraj.planners.problem.problem import MotionSpec, Problem
     from toptraj.planners.problem.requests import Timing
+
+T = TypeVar("T")
 
 
 class Report:
@@ -64,11 +68,34 @@ TimePath = Callable[[Robot, GeometricPath, TimingMethod, "Timing", tuple, JointL
 @dataclass(frozen=True)
 class Execution:
     """What the runner lends a generator: its share of the deadline (budget, cancellation,
-    progress) and the given-path pipeline for the paths it finds. ``time_path`` is a module-level
-    function, so an ``Execution`` crosses into a worker process."""
+    progress), the given-path pipeline for the paths it finds, and the way to run a step that
+    cannot check the deadline (``uninterruptible``). ``time_path`` is a module-level function,
+    so an ``Execution`` crosses into a worker process.
+
+    Attributes:
+        isolate: Whether ``uninterruptible`` runs its step in a worker process killed at the
+            deadline (``run_isolated``): the runner's choice, for a method whose capabilities
+            say it is not ``interruptible``, under a deadline, outside a worker process (which
+            is killed whole). Else the step runs inline.
+    """
 
     deadline: Deadline
     time_path: TimePath
+    isolate: bool = False
+
+    def within(self, start: float, end: float, label: str = "") -> Execution:
+        """The same execution for a part of the work (``Deadline.within``)."""
+        return dataclasses.replace(self, deadline=self.deadline.within(start, end, label))
+
+    def uninterruptible(self, function: Callable[..., T], *args, progress: bool = False, memory_bytes: int | None = None) -> T:
+        """``function(*args)`` (a module-level function of plain, picklable arguments), in a
+        worker process at a lower CPU priority when ``isolate``, else inline; with ``progress``,
+        called with ``progress=report`` relayed to the deadline's progress. ``memory_bytes``:
+        the most its process may grow by (``OverMemory`` beyond)."""
+        return run_isolated(
+            function, *args, deadline=self.deadline, progress=progress, memory_bytes=memory_bytes, nice=LOW_PRIORITY,
+            inline=not self.isolate,
+        )
 
 
 class MotionGenerator(abc.ABC):

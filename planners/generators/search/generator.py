@@ -6,8 +6,8 @@ The grid path's own curve stands in where its optimization finds nothing.
 
 The search's memory is estimated from its settings (``estimate``, ``toptraj.planners.generators.search.memory``)
 and admitted by the runner before any work (``OverMemory`` beyond ``timing.search.memory_bytes``). Under a deadline the whole search runs in
-a worker process (``toptraj.planners.execution.isolated``) at a lower CPU priority
-(``LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
+a worker process (``Execution.uninterruptible``, ``toptraj.planners.execution.isolated``) at a lower
+CPU priority, its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
 killed when the budget is spent or the caller cancels, its memory gone with it.
 """
 
@@ -21,7 +21,6 @@ from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.errors import Conflicting, InfeasiblePath, NotServed, OverMemory
 from toptraj.planners.execution.deadline import Deadline
-from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.generators.search.curve import GridSplinePath
 from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
 from toptraj.planners.generators.search.local import optimize_locally
@@ -89,17 +88,17 @@ class Search(MotionGenerator):
         return over_memory(problem.robot, spec.start, spec.goal, self.options, spec.revolutions, room)
 
     def generate(self, problem: Problem, execution: Execution) -> Timed:
-        """The search's motion, in a worker process under a budget (``run_isolated``); its
-        memory was admitted by the runner (``estimate``)."""
+        """The search's motion: the whole search is its uninterruptible step, in a worker process
+        under a budget (``Execution.uninterruptible``); its memory was admitted by the runner
+        (``estimate``)."""
         spec, robot, deadline = problem.motion, problem.robot, execution.deadline
         assert isinstance(spec, FreeMotion)  # validated
         need = self.estimate(problem)
         work = _Work(robot, spec, problem.options, self.options, problem.kinds, problem.limits, problem.threshold,
                      problem.obstacles, problem.clearance, execution.time_path)
         try:
-            return run_isolated(
-                _searched, work, deadline.end, deadline.budget_s,
-                deadline=deadline, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK, nice=LOW_PRIORITY,
+            return execution.uninterruptible(
+                _searched, work, deadline.end, deadline.budget_s, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK,
             )
         except OverMemory as error:
             raise OverMemory(

@@ -24,6 +24,7 @@ from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.memory import search_bytes
 from toptraj.planners.problem.build import build_problem
 from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.planners.results import Accuracy
 from toptraj.planners.runner.admission import admit
 from toptraj.planners.runner.choice import method_for
 
@@ -87,6 +88,7 @@ def test_each_method_is_refused_before_any_work_with_a_grid_that_then_plans(arm,
     assert error.estimate > error.cap
     answer = plan(arm, spec, dataclasses.replace(timing, grid_points=error.largest), max_samples=MAX_SAMPLES)
     assert answer.duration > 0.0 and len(answer.samples.t) >= 2
+    assert isinstance(answer.accuracy, Accuracy) and answer.accuracy.basis  # stated by the runner
 
 
 def test_a_search_over_its_memory_is_refused_before_any_work_with_a_roadmap_that_is_admitted():
