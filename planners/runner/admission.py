@@ -5,10 +5,10 @@ period, that fits.
 The estimate: the method's bytes per grid interval and joint times the grid (the one asked
 for, else the largest the method thins its default grid to), plus the samples at the most the
 answer may hold (``Sampling.max_samples``, at most half the cap: ``most_samples``;
-``SAMPLE_ARRAYS`` eight-byte arrays per sample and joint), plus a motion generator's own estimate (the search's graph). The cap is
-``MEMORY_CAP_BYTES``, widened by a generator's own allowance where its options carry one (the
-search's ``memory_bytes``): over it, ``TooLarge`` naming the largest grid that fits, or the
-generator's refusal naming its largest setting.
+``SAMPLE_ARRAYS`` eight-byte arrays per sample and joint), plus a motion generator's own
+estimate (the search's graph). The cap is ``MEMORY_CAP_BYTES``, widened by a generator's own
+allowance where its options carry one (the search's ``memory_bytes``): over it, ``TooLarge``
+naming the largest grid that fits, or the generator's refusal naming its largest setting.
 
 The samples' number is known only once the timing gives the duration: ``admit_samples`` then
 refuses a period that gives more than that most, naming the smallest that fits (the samples'
@@ -27,36 +27,25 @@ from toptraj.planners.problem.problem import Problem
 from toptraj.planners.problem.ranges import DT
 
 
-def estimate(problem: Problem) -> tuple[int, int]:
-    """The problem's estimated bytes, and the bytes its method's grid may take beside the rest
-    (the samples reserved, a generator's own)."""
-    method, dof = problem.method, problem.robot.dof
-    reserved = memory.samples_bytes(memory.most_samples(problem.sampling.max_samples, dof), dof)
-    if isinstance(method, MotionGenerator):
-        reserved += method.estimate(problem)
-    intervals = _intervals(problem)
-    return memory.grid_bytes(intervals, dof, method.bytes_per_interval_joint) + reserved, reserved
-
-
 def admit(problem: Problem) -> None:
     """Refuse ``problem`` before any work when its estimate exceeds the cap.
 
     Raises:
         TooLarge: the grid asked for does not fit (``largest``: the most intervals that do,
-            in the grid's own range), or a generator's own estimate does not.
+            in the grid's own range; ``estimate`` and ``cap`` in bytes).
         OverMemory: the search's graph does not fit its allowance (the largest setting that
             does is named).
     """
     method, dof = problem.method, problem.robot.dof
-    cap = memory.MEMORY_CAP_BYTES
+    own = allowance = 0
     if isinstance(method, MotionGenerator):
         own, allowance = method.estimate(problem), method.allowance(problem)
-        if own > allowance:
-            refusal = method.refuse(problem, allowance)
-            if refusal is not None:
-                raise refusal
-        cap += allowance
-    need, reserved = estimate(problem)
+        refusal = method.refuse(problem, allowance) if own > allowance else None
+        if refusal is not None:
+            raise refusal
+    reserved = memory.samples_bytes(memory.most_samples(problem.sampling.max_samples, dof), dof) + own
+    need = memory.grid_bytes(_intervals(problem), dof, method.bytes_per_interval_joint) + reserved
+    cap = memory.MEMORY_CAP_BYTES + allowance
     if need <= cap:
         return
     largest = min(memory.largest_grid(method.bytes_per_interval_joint, dof, reserved, cap), MAX_POINTS)
