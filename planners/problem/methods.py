@@ -102,9 +102,11 @@ class MotionGenerator(abc.ABC):
     """A method that finds the motion itself and returns it timed.
 
     Its capabilities are read as a timing method's are (``kinds``, ``required_kinds``,
-    ``two_waypoints_only``, ``continuous_acceleration``, ``max_grid_intervals``); ``timed_by``
-    is the timing method whose accuracy the answer states when the generator states none of its
-    own (``Timed.motion_gap``).
+    ``two_waypoints_only``, ``continuous_acceleration``, ``bytes_per_interval_joint``,
+    ``interruptible``, ``max_grid_intervals``); ``estimate``, ``allowance`` and ``refuse`` give
+    the runner's memory admission what the generator holds besides its grid
+    (``toptraj.planners.runner.admission``). ``timed_by`` is the timing method whose accuracy
+    the answer states when the generator states none of its own (``Timed.motion_gap``).
     """
 
     family: ClassVar[Literal["generator"]] = "generator"
