@@ -6,8 +6,10 @@
    each 504, the CPU time of the server's process tree (worker processes included) is sampled
    every 100 ms for 2 s. Printed: CPU-s in those 2 s, and the end of the last 100 ms window
    (after the 504) in which the tree used more than 20 % of a core.
-2. Memory of min_cost: peak RSS growth of one inline solve (a fresh process per grid size), and
-   the server's RSS before and after three requests at the largest grid.
+2. Memory per grid interval and joint of min_cost, jerk_limited, toppra and phase_plane: peak RSS
+   growth of one inline solve (a fresh process per grid size), which the runner's memory
+   admission uses (``bytes_per_interval_joint``); and the server's RSS before and after three
+   min_cost requests at grid 4000.
 3. /health while a large body is produced: a server with the default budget and body cap gets
    the request with the smallest output.dt that fits the cap; /health is polled meanwhile.
 
@@ -157,26 +159,34 @@ def idle_after_504(budget_s: float) -> None:
 
 
 _PEAK = """
-import resource, sys, numpy as np, robots
+import resource, sys, numpy as np
+from toptraj import robots
 from toptraj.planners import plan, Timing, WaypointPath
 robot, path = robots.load("ur5"), WaypointPath(np.array({waypoints}))
-plan(robot, path, Timing(method="min_cost", grid_points=100))
+timing = Timing(method={method!r}, constraints={constraints!r}, limit_overrides={{"jerk": [40.0] * 6}})
+plan(robot, path, Timing(**{{**timing.__dict__, "grid_points": 100}}))
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-plan(robot, path, Timing(method="min_cost", grid_points={grid}))
+plan(robot, path, Timing(**{{**timing.__dict__, "grid_points": {grid}}}))
 print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) / 1024)
 """
+#: The methods whose memory per grid interval and joint the runner's admission uses
+#: (``bytes_per_interval_joint``), with the grids they are measured on.
+MEMORY_GRIDS = {"min_cost": [1000, 2000, 4000], "jerk_limited": [1000, 2000], "toppra": [10_000], "phase_plane": [10_000]}
 
 
 def min_cost_memory(grids: list[int]) -> None:
-    print("\nmin_cost on ur5 (4 waypoints): peak RSS growth of one solve, in a fresh process")
-    print(f"{'grid_points':>11s} {'+MB':>8s} {'s':>7s}")
-    for grid in grids:
-        started = time.monotonic()
-        out = subprocess.run(
-            [sys.executable, "-c", _PEAK.format(waypoints=UR5, grid=grid)],
-            cwd=ROOT, capture_output=True, text=True, check=True,
-        )
-        print(f"{grid:11d} {float(out.stdout.split()[-1]):8.0f} {time.monotonic() - started:7.1f}")
+    print("\nur5 (4 waypoints): peak RSS growth of one solve, in a fresh process, and per interval and joint")
+    print(f"{'method':>13s} {'grid_points':>11s} {'+MB':>8s} {'B/int.joint':>11s} {'s':>7s}")
+    for method, method_grids in MEMORY_GRIDS.items():
+        constraints = ["velocity", "acceleration", "torque"] + (["jerk"] if method == "jerk_limited" else [])
+        for grid in method_grids if method != "min_cost" else grids:
+            started = time.monotonic()
+            out = subprocess.run(
+                [sys.executable, "-c", _PEAK.format(waypoints=UR5, grid=grid, method=method, constraints=constraints)],
+                cwd=ROOT, capture_output=True, text=True, check=True,
+            )
+            grown = float(out.stdout.split()[-1])
+            print(f"{method:>13s} {grid:11d} {grown:8.0f} {grown * 2**20 / (grid * 6):11.0f} {time.monotonic() - started:7.1f}")
     server = Server(TOPTRAJ_PRELOAD_ROBOTS="false")
     try:
         server.request("GET", "/v1/robots/ur5")

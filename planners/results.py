@@ -73,6 +73,8 @@ class PlannedTrajectory:
     peak_utilization: dict[str, np.ndarray]
     solve_ms: float
     warnings: tuple[str, ...]
+    #: The stated accuracy, which the runner gives every answer of either family of methods.
+    accuracy: Accuracy
     binding: Binding | None = None
     conditioning: Conditioning | None = None
     cost: float | None = None
@@ -84,7 +86,6 @@ class PlannedTrajectory:
     switching_times: SwitchingTimes | None = None
     #: What the global search did (timing method ``search``).
     search: SearchReport | None = None
-    accuracy: Accuracy | None = None
     zones: tuple[ZoneReport, ...] | None = None
 
 

@@ -58,8 +58,21 @@ def module_name(path: pathlib.Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def import_graph() -> dict[str, set[str]]:
-    """Module -> the project modules it imports (at its top or inside functions)."""
+def _imports(tree: ast.AST, type_checking: bool):
+    """The import statements of ``tree``; without those under ``if TYPE_CHECKING:`` unless
+    ``type_checking``."""
+    for node in ast.iter_child_nodes(tree):
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            yield node
+        elif isinstance(node, ast.If) and not type_checking and "TYPE_CHECKING" in ast.unparse(node.test):
+            yield from (child for branch in node.orelse for child in _imports(ast.Module([branch], []), type_checking))
+        else:
+            yield from _imports(node, type_checking)
+
+
+def import_graph(type_checking: bool = True) -> dict[str, set[str]]:
+    """Module -> the project modules it imports (at its top or inside functions; with
+    ``type_checking``, those imported for annotations only too)."""
     modules = {module_name(p): p for root in ROOTS for p in pathlib.Path(root).rglob("*.py")}
 
     def resolve(name: str) -> str | None:
@@ -70,7 +83,7 @@ def import_graph() -> dict[str, set[str]]:
     graph: dict[str, set[str]] = {}
     for module, path in modules.items():
         targets = set()
-        for node in ast.walk(ast.parse(path.read_text())):
+        for node in _imports(ast.parse(path.read_text()), type_checking):
             if isinstance(node, ast.Import):
                 names = [alias.name.removeprefix("toptraj.") for alias in node.names]
             elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
@@ -129,6 +142,7 @@ def main() -> None:
     graph = import_graph()
     print(f"{len(graph)} modules, {sum(map(len, graph.values()))} imports between them")
     print("module cycles:", cycles(graph) or "none")
+    print("module cycles at run time (imports for annotations only left out):", cycles(import_graph(type_checking=False)) or "none")
     folders: dict[str, set[str]] = collections.defaultdict(set)
     for module, targets in graph.items():
         folders[folder(module)] |= {folder(t) for t in targets if folder(t) != folder(module)}

@@ -11,6 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from toptraj.planners.checks.accuracy import REFINE_ROUNDS, estimated, finer_constraints
 from toptraj.planners.checks.limit_check import Excess, LimitCheck, check_limits
 from toptraj.planners.checks.limit_kernels import utilization_pass
 from toptraj.planners.constraints.path_constraints import PathConstraints
@@ -18,7 +19,6 @@ from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from toptraj.planners.constraints.zones import tool_speed_at, zone_factors
 from toptraj.planners.errors import InfeasiblePath, LimitExceeded, TimingFailed
 from toptraj.planners.paths.base import GeometricPath
-from toptraj.planners.runner.accuracy import REFINE_ROUNDS, estimated, finer_constraints
 from toptraj.planners.timing.base import PathTiming, TimeScaling
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.scaled import solve_well_scaled
@@ -60,8 +60,8 @@ def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
 def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
     """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
     exceeded by more than ``threshold``, refine the grid there and time the path again. Every
-    timing carries its estimated gap to the converged optimum (``toptraj.planners.runner.accuracy``); a
-    time-optimal one above ``toptraj.planners.runner.accuracy.GAP_TARGET`` on a grid the request did not name
+    timing carries its estimated gap to the converged optimum (``toptraj.planners.checks.accuracy``); a
+    time-optimal one above ``GAP_TARGET`` on a grid the request did not name
     (``grid_given``) is timed again on a finer grid, which replaces it only when it too holds
     the limits.
 

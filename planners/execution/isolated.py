@@ -97,6 +97,12 @@ def _get_context():
         return _context
 
 
+def in_worker() -> bool:
+    """Whether this process is a worker (a job's, a child's): its calls run inline, the whole
+    process being killed when its work runs over."""
+    return _in_worker
+
+
 def run_inline_here() -> None:
     """Make every later call of this process run inline, as in a job's worker: for a process
     that is itself killed as a whole when its work runs over (a batch's Ray worker, stopped by
@@ -243,12 +249,15 @@ def _inline_within(memory_bytes: int, function, *args, **kwargs):
 
 
 def run_isolated(
-    function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0
+    function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0,
+    inline: bool = False,
 ):
     """``function(*args)`` computed in a child process, killed once ``deadline`` passes; with
     ``progress``, ``function(*args, progress=report)``, its reports relayed to
     ``deadline.progress``. ``memory_bytes``: the most the child's address space may grow;
     ``nice``: how much lower its CPU priority is (both ignored where it runs inline).
+    ``inline``: run in the calling thread whatever the deadline (the caller decided that
+    nothing needs stopping from outside: ``toptraj.planners.problem.methods.Execution``).
 
     Raises:
         OverMemory: the child needed more than ``memory_bytes``.
@@ -256,7 +265,7 @@ def run_isolated(
         TimingFailed: the child died without an answer (e.g. killed by the system for memory).
         Whatever ``function`` raised, re-raised here.
     """
-    if deadline is NO_DEADLINE or _in_worker:
+    if inline or deadline is NO_DEADLINE or _in_worker:
         kwargs = {"progress": deadline.progress} if progress else {}
         if not (_in_worker and memory_bytes is not None):
             return function(*args, **kwargs)

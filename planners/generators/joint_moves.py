@@ -33,7 +33,8 @@ class _LawMotion(MotionGenerator):
         self.required_kinds = law.required_kinds
         self.two_waypoints_only = law.two_waypoints_only
         self.continuous_acceleration = law.continuous_acceleration
-        self.grid_budget = law.grid_budget
+        self.bytes_per_interval_joint = law.bytes_per_interval_joint
+        self.interruptible = law.interruptible
 
     @property
     def timed_by(self) -> TimingMethod:

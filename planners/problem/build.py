@@ -21,7 +21,7 @@ from toptraj.planners.checks.gate import gate_threshold
 from toptraj.planners.collision import Obstacle
 from toptraj.planners.collision.obstacles import check_obstacles
 from toptraj.planners.constraints.tool_speed import tool_speed_limit
-from toptraj.planners.errors import Conflicting, NotServed, OutOfRange, TooLarge
+from toptraj.planners.errors import Conflicting, NotServed, OutOfRange
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -96,10 +96,6 @@ def _check_grid(timing: Timing, method: TimingMethod | MotionGenerator, robot: R
     """The grid asked for, within the grid's range and the method's memory on this robot."""
     if timing.grid_points is not None and not 2 <= timing.grid_points <= MAX_POINTS:
         raise OutOfRange("grid.intervals", timing.grid_points, 2, MAX_POINTS, rule="grid_out_of_range")
-    if timing.grid_points is not None and timing.grid_points > method.max_grid_intervals(robot.dof):
-        cap = method.max_grid_intervals(robot.dof)
-        raise TooLarge("grid.intervals", timing.grid_points, timing.grid_points, cap, "intervals", largest=cap,
-                       rule="grid_over_method_cap", method=method.name, dof=robot.dof)
 
 
 def _limits(robot: Robot, motion: MotionSpec, method: TimingMethod | MotionGenerator, timing: Timing) -> JointLimits:

@@ -4,7 +4,6 @@ times, the phase plane, and the notes that tell what the numbers alone do not.""
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -14,7 +13,7 @@ from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.zones import BINDING_SHARE
-from toptraj.planners.errors import TimingFailed, TooLarge
+from toptraj.planners.errors import TimingFailed
 from toptraj.planners.generators.collocation.bang_bang import collocation_switches, switching_times
 from toptraj.planners.generators.collocation.report import CollocationReport
 from toptraj.planners.generators.search.report import SearchReport
@@ -23,10 +22,9 @@ from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
 from toptraj.planners.paths.grid import spread_indices
 from toptraj.planners.problem.methods import MotionGenerator, Timed
 from toptraj.planners.problem.problem import Problem
-from toptraj.planners.problem.ranges import DT
-from toptraj.planners.problem.requests import Timing
 from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, ZoneReport, require_finite
 from toptraj.planners.runner.accuracy import answer_accuracy
+from toptraj.planners.runner.admission import admit_samples
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.laws.method import ClassicalMethod
@@ -115,8 +113,7 @@ def _samples(problem: Problem, timed: Timed) -> Samples:
     threshold; a continuous acceleration's jerk too)."""
     robot, result, sampling, method = problem.robot, timed.timing, problem.sampling, problem.method
     require_finite(timed.method, duration=result.duration)
-    if result.duration / sampling.dt > sampling.max_samples - 2:
-        raise _too_many_samples(result.duration, sampling.dt, sampling.max_samples, problem.options)
+    admit_samples(problem, result.duration)
     problem.deadline.expect((result.duration / sampling.dt + 2) * robot.dof * SAMPLE_SECONDS)
     samples = sample_trajectory(timed.path, result, robot, sampling.dt, sampling.exact_period)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
@@ -214,30 +211,3 @@ def _unasked_limits(
         remedy = f"add {kind!r} to the constraints to hold it" if kind in method.kinds else f"{method.name} cannot hold {kind} limits"
         notes.append(f"the {kind} of joint {name!r} reaches {peak[joint]:.4g} times its limit, which was not asked for: {remedy}")
     return notes
-
-
-def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> TooLarge:
-    """Why ``duration`` (s) sampled every ``dt`` (s) is not served, with advice that can be
-    followed: ``smallest_dt``, the smallest sample period that fits when it lies in ``DT`` (else
-    ``None``, and ``longest_s``, the longest motion the largest period serves, with the tool
-    limits given, ``fields``, among what makes the motion this slow): no period beyond its own
-    range is ever advised."""
-    needed = _round_up(duration / (max_samples - 2))
-    return TooLarge(
-        "sampling.dt", dt, math.ceil(duration / dt) + 1, max_samples, "samples", rule="too_many_samples",
-        duration=duration, smallest_dt=needed if needed <= DT.high else None, largest_dt=DT.high,
-        longest_s=_round_down(DT.high * (max_samples - 2)),
-        fields=tuple(f"limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None),
-    )
-
-
-def _round_down(value: float, digits: int = 3) -> float:
-    """``value`` rounded down to ``digits`` significant digits."""
-    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
-    return math.floor(value / scale) * scale
-
-
-def _round_up(value: float, digits: int = 3) -> float:
-    """``value`` rounded up to ``digits`` significant digits."""
-    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
-    return math.ceil(value / scale) * scale

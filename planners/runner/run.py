@@ -17,39 +17,55 @@ from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.errors import numerical_breakdown_is_failure
-from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.execution.isolated import in_worker
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.problem.zones import zone_limits
 from toptraj.planners.results import PlannedTrajectory
+from toptraj.planners.runner.admission import admit
 from toptraj.planners.runner.answer import answer
 from toptraj.planners.runner.given_path import timed_path
+from toptraj.planners.timing.base import TimingMethod
 
 
 def run(problem: Problem) -> PlannedTrajectory:
     """The timed trajectory of ``problem``, sampled, checked and with its stated accuracy.
 
     Raises:
-        InvalidRequest: a ``dt`` that gives more samples than the problem allows (the message
-            names the smallest that fits), or what only the built path shows.
+        TooLarge: before any work, a problem whose memory estimate exceeds the cap (the largest
+            grid that fits is named: ``toptraj.planners.runner.admission``); after the timing, a
+            ``dt`` that gives more samples than the problem allows (the smallest that fits).
+        OverMemory: before any work, a search whose graph exceeds its allowance.
+        InvalidRequest: what only the built path shows.
         InfeasiblePath: no timing can follow the path within the limits (says where, which
             joint and which limit).
         TimingFailed: the method failed.
         BudgetExceeded: the problem's deadline passed.
     """
     started = time.perf_counter()
+    admit(problem)
     method, part = problem.method, problem.deadline.within(0.0, 0.9)
     checked_first = None
     with numerical_breakdown_is_failure(method.name):
         if isinstance(method, MotionGenerator):
-            timed = method.generate(problem, Execution(part, timed_path))
+            timed = method.generate(problem, Execution(part, timed_path, isolate=isolates(method, problem.deadline)))
             if problem.self_collision and method.name != "search":  # the search checks its own paths
                 check_self_collision(timed.path, problem.robot, deadline=problem.deadline)
         else:
             timed, checked_first, problem = _given_path(problem, part)
     return answer(problem, timed, checked_first, started)
+
+
+def isolates(method: TimingMethod | MotionGenerator, deadline: Deadline) -> bool:
+    """Whether ``method``'s uninterruptible step runs in a worker process (``Execution.isolate``):
+    for a method that cannot check its deadline (``interruptible`` false), when there is a
+    deadline to stop it at (a budget, or a caller that may cancel) and this is no worker process
+    already (a job's, killed whole). Interruptible methods, the typical request's among them,
+    never start one."""
+    return not method.interruptible and deadline is not NO_DEADLINE and not in_worker()
 
 
 def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | None, Problem]:

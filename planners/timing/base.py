@@ -14,6 +14,7 @@ import numpy as np
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.errors import TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.execution.memory import method_grid_cap
 from toptraj.planners.timing.state_kernels import grid_states
 
 #: Largest estimated relative gap to the converged optimum that a time-optimal answer carries
@@ -219,10 +220,13 @@ class TimingMethod(abc.ABC):
             the jerk of its samples (by finite differences) is checked against a jerk limit too.
         absolute_tolerances: Whether the method's solver works with absolute tolerances, so
             that it needs path speeds of order one (``toptraj.planners.timing.scaled``).
-        grid_budget: The largest grid the method serves, in grid intervals times joints: its
-            memory grows with both (about 1.3 kB per interval and joint for phase_plane,
-            2.3 kB for toppra, 9 kB for min_cost; ``benchmarks/budgets.py``). 140,000 is
-            20,000 intervals on a 7-joint arm, about 300 MB at most.
+        bytes_per_interval_joint: The method's memory per grid interval and joint (about
+            1.3 kB for phase_plane, 2.3 kB for toppra, 9 kB for min_cost;
+            ``benchmarks/budgets.py``): the runner admits a grid by it against the one memory
+            cap (``toptraj.planners.execution.memory``).
+        interruptible: Whether the method checks its deadline between steps; one that cannot
+            (a convex solver's single call) runs that step through ``Isolation`` (a worker
+            process killed at the deadline) when the runner isolates the planning.
     """
 
     family: ClassVar[Literal["timing"]] = "timing"
@@ -234,11 +238,13 @@ class TimingMethod(abc.ABC):
     two_waypoints_only: bool = False
     continuous_acceleration: bool = False
     absolute_tolerances: bool = False
-    grid_budget: int = 140_000
+    bytes_per_interval_joint: int = 2_300
+    interruptible: bool = True
 
     def max_grid_intervals(self, n_dof: int) -> int:
-        """The most grid intervals the method serves on a robot with ``n_dof`` joints."""
-        return self.grid_budget // max(n_dof, 1)
+        """The most grid intervals the method serves on a robot with ``n_dof`` joints: its
+        default grid is thinned to it, its refinements stay within it."""
+        return method_grid_cap(self.bytes_per_interval_joint, n_dof)
 
     @abc.abstractmethod
     def solve(

@@ -48,8 +48,10 @@ class MinCostMethod(TimingMethod):
     required_kinds = frozenset({"torque"})
     takes_cost = True
     #: cvxpy and Clarabel take about 9 kB per grid interval and joint: 4,000 intervals on a
-    #: 6-joint arm is about 210 MB (and some 10 s).
-    grid_budget = 24_000
+    #: 6-joint arm is about 210 MB (and some 10 s; 3,000 intervals 153 MB). They cannot check
+    #: a deadline: the solve is the method's uninterruptible step.
+    bytes_per_interval_joint = 9_000
+    interruptible = False
 
     def __init__(self, torque_weight: float = 0.0):
         self.torque_weight = torque_weight

@@ -37,6 +37,7 @@ from toptraj.planners.errors import (
     TooLarge,
     WrongLength,
 )
+from toptraj.planners.execution.memory import MEMORY_CAP_BYTES
 from toptraj.planners.paths import SplinePath
 from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.planners.problem.ranges import DT, SCALE
@@ -115,7 +116,8 @@ def test_a_grid_beyond_the_method_cap_advises_the_largest_served():
     cap = METHODS["jerk_limited"].max_grid_intervals(UR5.dof)
     error = _refused(TWO, Timing(method="jerk_limited", constraints=("velocity", "acceleration", "jerk"), grid_points=cap + 1))
     assert isinstance(error, TooLarge)
-    assert (error.field, error.value, error.cap, error.largest) == ("grid.intervals", cap + 1, cap, cap)
+    assert (error.field, error.value, error.largest, error.unit) == ("grid.intervals", cap + 1, cap, "bytes")
+    assert error.estimate > error.cap == MEMORY_CAP_BYTES  # the one cap of every planning's memory
     assert 2 <= error.largest <= MAX_POINTS  # the advice lies in the field's own range
     assert detail(error).endswith(f"use timing.grid_points <= {cap}")
 

@@ -1,10 +1,11 @@
-"""Memory per request and in total is bounded: each method's grid is capped by its measured
-memory (422 suggesting a value), and at most ``plan_workers`` plannings run at once, with
+"""Memory per request and in total is bounded: each method's grid is admitted by its measured
+memory against one cap (422 naming the largest grid that fits), and at most ``plan_workers`` plannings run at once, with
 ``plan_queue`` more waiting; beyond that a request gets 503 with ``Retry-After``."""
 
 from __future__ import annotations
 
 import asyncio
+import re
 
 import httpx
 import pytest
@@ -12,7 +13,9 @@ from fastapi.testclient import TestClient
 
 from tests.conftest import UR5_WAYPOINTS
 from tests.planners.execution.test_budget_stops_work import SLOW
+from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.service.app import create_app
+from toptraj.service.planning import samples_within
 from toptraj.service.settings import Settings
 
 YAMAMOTO_LINE = [[0.0, 0.0], [0.5, 0.3]]
@@ -24,27 +27,35 @@ def client():
         yield test_client
 
 
-@pytest.mark.parametrize(
-    "robot, waypoints, method, grid_points, largest",
-    [
-        ("ur5", UR5_WAYPOINTS, "min_cost", 5000, 4000),  # 6 joints
-        ("yamamoto_2r", YAMAMOTO_LINE, "min_cost", 12_001, 12_000),  # 2 joints
-    ],
-)
-def test_a_grid_over_the_method_memory_cap_gets_422_with_a_value(client, robot, waypoints, method, grid_points, largest):
-    body = {"robot": robot, "path": {"waypoints": waypoints}, "timing": {"method": method, "grid_points": grid_points}}
-    response = client.post("/v1/trajectories", json=body)
+ADVICE = re.compile(r"use timing\.grid_points <= (\d+)")
+
+
+def _min_cost(robot, waypoints, grid_points):
+    return {"robot": robot, "path": {"waypoints": waypoints}, "timing": {"method": "min_cost", "grid_points": grid_points}}
+
+
+@pytest.mark.parametrize("robot, waypoints, dof", [("ur5", UR5_WAYPOINTS, 6), ("yamamoto_2r", YAMAMOTO_LINE, 2)])
+def test_a_grid_over_the_memory_cap_gets_422_naming_the_largest_that_fits(client, robot, waypoints, dof):
+    """The grid field's own largest value (20,000 intervals) is over min_cost's memory on both
+    arms: the 422 names the largest grid that fits, which one more interval exceeds. The rule's
+    figures written out: 9,000 bytes per interval and joint, a cap of 140,000 x 2,300 bytes,
+    less the samples the answer may hold (those the response cap allows), 5 x 8 bytes per
+    sample and joint."""
+    response = client.post("/v1/trajectories", json=_min_cost(robot, waypoints, MAX_POINTS))
     assert response.status_code == 422, response.text[:300]
-    detail = response.json()["detail"]
-    assert f"timing.grid_points = {grid_points}" in detail and f"use timing.grid_points <= {largest}" in detail
+    largest = int(ADVICE.search(response.json()["detail"]).group(1))
+    samples = min(200_000, samples_within(Settings().max_response_bytes, dof))
+    assert largest == (140_000 * 2_300 - samples * dof * 5 * 8) // (9_000 * dof)
+    beyond = client.post("/v1/trajectories", json=_min_cost(robot, waypoints, largest + 1))
+    assert beyond.status_code == 422 and f"<= {largest}" in beyond.json()["detail"], beyond.text[:300]
 
 
-def test_min_cost_at_its_largest_grid_on_a_small_arm_is_served(patient_client):
-    """The largest grid the cap allows a 2-joint arm (12,000 points, one fewer than the refused
-    12,001 above) is planned, within its memory estimate, and served (a budget that a loaded
-    machine does not spend: the solve takes about 5 s on 2 busy cores)."""
-    body = {"robot": "yamamoto_2r", "path": {"waypoints": YAMAMOTO_LINE}, "timing": {"method": "min_cost", "grid_points": 12_000}}
-    response = patient_client.post("/v1/trajectories", json=body)
+def test_min_cost_at_its_largest_grid_on_a_small_arm_is_served(client, patient_client):
+    """The largest grid the 422 advises for a 2-joint arm (the real largest, about 17,000
+    intervals) is planned and served (a budget that a loaded machine does not spend)."""
+    refused = client.post("/v1/trajectories", json=_min_cost("yamamoto_2r", YAMAMOTO_LINE, MAX_POINTS))
+    largest = int(ADVICE.search(refused.json()["detail"]).group(1))
+    response = patient_client.post("/v1/trajectories", json=_min_cost("yamamoto_2r", YAMAMOTO_LINE, largest))
     assert response.status_code == 200, response.text[:300]
     assert response.json()["method"] == "min_cost"
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import time
+from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
@@ -278,6 +279,7 @@ def optimize_motion(
     torque_weight: float = 0.0,
     deadline: Deadline = NO_DEADLINE,
     max_iterations: int = 1000,
+    uninterruptible: Callable[..., CollocationResult] | None = None,
 ) -> CollocationResult:
     """Minimize T (``torque_weight`` = 0) or the integral of (1 + beta |tau|^2) dt from start to
     goal. Every initial guess (goal shifts times bends) is first solved on a coarse grid of
@@ -285,14 +287,18 @@ def optimize_motion(
 
     SLSQP holds the interpreter for seconds at a time and cannot check a deadline, so under a
     ``deadline`` the optimization runs in a worker process that is killed when it passes
-    (``toptraj.planners.execution.isolated``), at a lower CPU priority. It reports its progress to ``deadline.progress``: each initial
-    guess ("collocation: guess 3 of 15"), then the refinement.
+    (``toptraj.planners.execution.isolated``), at a lower CPU priority; with ``uninterruptible``
+    (the runner's ``Execution.uninterruptible``) the runner decides where it runs. It reports its
+    progress to ``deadline.progress``: each initial guess ("collocation: guess 3 of 15"), then
+    the refinement.
 
     Raises:
         InvalidRequest: a start or goal outside the joint limits.
         InfeasiblePath: no initial guess leads to a feasible motion.
         BudgetExceeded: ``deadline`` passed.
     """
+    if uninterruptible is not None:
+        return uninterruptible(_optimize_motion, robot, limits, motion, torque_weight, max_iterations, progress=True)
     return run_isolated(
         _optimize_motion, robot, limits, motion, torque_weight, max_iterations, deadline=deadline, progress=True,
         nice=LOW_PRIORITY,

@@ -4,10 +4,10 @@ within its share of the budget; the fastest optimized path that keeps the cleara
 phase_plane through the limit gate (the runner's given-path pipeline, ``Execution.time_path``).
 The grid path's own curve stands in where its optimization finds nothing.
 
-The search's memory is estimated from its settings first (``toptraj.planners.generators.search.memory``,
-``OverMemory`` beyond ``timing.search.memory_bytes``). Under a deadline the whole search runs in
-a worker process (``toptraj.planners.execution.isolated``) at a lower CPU priority
-(``LOW_PRIORITY``), its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
+The search's memory is estimated from its settings (``estimate``, ``toptraj.planners.generators.search.memory``)
+and admitted by the runner before any work (``OverMemory`` beyond ``timing.search.memory_bytes``). Under a deadline the whole search runs in
+a worker process (``Execution.uninterruptible``, ``toptraj.planners.execution.isolated``) at a lower
+CPU priority, its address space capped at ``SEARCH_MEMORY_ROOM`` times the estimate:
 killed when the budget is spent or the caller cancels, its memory gone with it.
 """
 
@@ -21,12 +21,11 @@ from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.errors import Conflicting, InfeasiblePath, NotServed, OverMemory
 from toptraj.planners.execution.deadline import Deadline
-from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.generators.search.curve import GridSplinePath
 from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
 from toptraj.planners.generators.search.local import optimize_locally
 from toptraj.planners.generators.search.local_outcome import LocalOptimum
-from toptraj.planners.generators.search.memory import check_search_memory
+from toptraj.planners.generators.search.memory import over_memory, search_bytes
 from toptraj.planners.generators.search.method import global_search
 from toptraj.planners.generators.search.report import LocalReport
 from toptraj.planners.paths import GeometricPath
@@ -52,6 +51,8 @@ class Search(MotionGenerator):
 
     name = "search"
     kinds = frozenset({"velocity", "acceleration", "torque"})
+    #: The whole search runs in its worker process under a deadline.
+    interruptible = False
 
     def __init__(self, options: SearchOptions | None = None):
         self.options = options or DEFAULT_OPTIONS
@@ -67,20 +68,37 @@ class Search(MotionGenerator):
         if moving or options.duration is not None:
             raise Conflicting("method", "search", ("boundary", "duration"), rule="search_from_rest")
 
+    def estimate(self, problem: Problem) -> int:
+        """The bytes of the search's graph (``toptraj.planners.generators.search.memory``); 0 for
+        an end outside the joint range, which the search itself refuses with the joint named."""
+        spec, robot = problem.motion, problem.robot
+        assert isinstance(spec, FreeMotion)  # validated
+        if robot.outside_position_limits(spec.start) is not None or robot.outside_position_limits(spec.goal) is not None:
+            return 0
+        return search_bytes(robot, spec.start, spec.goal, self.options, spec.revolutions)
+
+    def allowance(self, problem: Problem) -> int:
+        """The search's own memory setting (``SearchOptions.memory_bytes``)."""
+        return int(self.options.memory_bytes)
+
+    def refuse(self, problem: Problem, room: int) -> OverMemory:
+        """The graph over ``room`` bytes, with the largest roadmap or lattice that fits."""
+        spec = problem.motion
+        assert isinstance(spec, FreeMotion)  # validated
+        return over_memory(problem.robot, spec.start, spec.goal, self.options, spec.revolutions, room)
+
     def generate(self, problem: Problem, execution: Execution) -> Timed:
-        """The search's motion, in a worker process under a budget (``run_isolated``)."""
+        """The search's motion: the whole search is its uninterruptible step, in a worker process
+        under a budget (``Execution.uninterruptible``); its memory was admitted by the runner
+        (``estimate``)."""
         spec, robot, deadline = problem.motion, problem.robot, execution.deadline
         assert isinstance(spec, FreeMotion)  # validated
-        if robot.outside_position_limits(spec.start) is None and robot.outside_position_limits(spec.goal) is None:
-            need = check_search_memory(robot, spec.start, spec.goal, self.options, spec.revolutions)
-        else:  # refused by the search itself, with the joint named
-            need = 0
+        need = self.estimate(problem)
         work = _Work(robot, spec, problem.options, self.options, problem.kinds, problem.limits, problem.threshold,
                      problem.obstacles, problem.clearance, execution.time_path)
         try:
-            return run_isolated(
-                _searched, work, deadline.end, deadline.budget_s,
-                deadline=deadline, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK, nice=LOW_PRIORITY,
+            return execution.uninterruptible(
+                _searched, work, deadline.end, deadline.budget_s, progress=True, memory_bytes=SEARCH_MEMORY_ROOM * need + SEARCH_MEMORY_SLACK,
             )
         except OverMemory as error:
             raise OverMemory(

@@ -30,7 +30,7 @@ roadmap's distance matrix (3 P^2 eight-byte numbers, built row block by row bloc
 The estimate is conservative: ur5's default search (150 points, 10 neighbours) is estimated at
 0.86 GiB for a measured 0.52-0.59 GB peak, the three-joint lattice's default at 1.59 GiB for
 1.45 GB. A search estimated above its cap (``DEFAULT_SEARCH_MEMORY``, 2 GiB) is refused before
-it starts (``check_search_memory``: ``OverMemory`` naming the setting and the largest value
+it starts (the runner's admission, ``over_memory``: ``OverMemory`` naming the setting and the largest value
 served with the others unchanged); a worker process running one is also capped by the system
 (``toptraj.planners.generators.search.generator``: twice the estimate and 1 GiB), so that an estimate that is too low
 is a clear error rather than the system killing a process.
@@ -165,21 +165,17 @@ def _largest(fits, low: int, high: int) -> int | None:
     return low
 
 
-def check_search_memory(
-    robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool, cap_bytes: int | None = None
-) -> int:
-    """The search's estimated bytes (``search_bytes``) when within ``cap_bytes`` (default
-    ``options.memory_bytes``, itself ``DEFAULT_SEARCH_MEMORY`` unless set).
+def over_memory(
+    robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool, cap_bytes: int
+) -> OverMemory:
+    """Why a search whose estimate (``search_bytes``) exceeds ``cap_bytes`` is refused: the
+    detail names the settings and the largest value of one of them served with the others
+    unchanged (the runner's admission raises it, ``toptraj.planners.runner.admission``).
 
     Raises:
-        OverMemory: the estimate exceeds the cap; the detail names the settings and the largest
-            value of one of them served with the others unchanged.
         InvalidRequest: settings the graph refuses (``toptraj.planners.generators.search.graph``).
     """
-    cap_bytes = options.memory_bytes if cap_bytes is None else cap_bytes
     need = search_bytes(robot, start, goal, options, revolutions)
-    if need <= cap_bytes:
-        return need
     n = robot.dof
     kind = _graph_kind(robot, options)
     max_turn = _max_turn(kind, options)
@@ -193,7 +189,7 @@ def check_search_memory(
             return lattice_bytes(tuple(len(axis) for axis in grid), max_turn) <= cap_bytes
 
         cells = _largest(lattice_fits, 1, 1_000)
-        raise OverMemory(
+        return OverMemory(
             f"a lattice of {shape} grid points on a {n}-joint arm needs {about}", rule="lattice_over_memory",
             field="search.cells", shape=shape, dof=n, estimate=need, cap=cap_bytes, largest=cells,
         )
@@ -201,7 +197,7 @@ def check_search_memory(
     points, neighbors = int(options.roadmap_points), int(options.neighbors)
     most_points = _largest(lambda p: roadmap_bytes(n, p + extra, neighbors, max_turn) <= cap_bytes, 1, MAX_ROADMAP_POINTS)
     most_neighbors = _largest(lambda k: roadmap_bytes(n, points + extra, k, max_turn) <= cap_bytes, 1, max(1, neighbors))
-    raise OverMemory(
+    return OverMemory(
         f"a roadmap of {points} points with {neighbors} neighbors on a {n}-joint arm needs {about}", rule="roadmap_over_memory",
         field="search.roadmap_points", points=points, neighbors=neighbors, dof=n, estimate=need, cap=cap_bytes,
         most_points=most_points, most_neighbors=most_neighbors,

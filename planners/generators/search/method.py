@@ -13,7 +13,6 @@ from toptraj.planners.collision import Obstacle
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.branch_and_bound import branch_and_bound
 from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
-from toptraj.planners.generators.search.memory import check_search_memory
 from toptraj.planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
 from toptraj.planners.generators.search.problem import build_problem, toward_goal
 from toptraj.planners.generators.search.report import LocalReport, SearchReport
@@ -71,17 +70,15 @@ def global_search(
     the time left, each stopping at its part with the grid paths it found: that is what ends
     a variant no grid path reaches, which would otherwise run until ``max_expansions``.
 
-    Before any work, the search's memory is estimated from ``options`` and compared with
-    ``options.memory_bytes`` (``toptraj.planners.generators.search.memory``).
+    The search's memory is admitted before it by the runner (``Search.estimate``, against
+    ``options.memory_bytes``: ``toptraj.planners.runner.admission``).
 
     Raises:
-        OverMemory: the estimate exceeds the cap (the detail names the largest value served).
         InvalidRequest, InfeasiblePath: see ``build_problem`` and ``branch_and_bound`` (the
             latter when no variant has a grid path).
         BudgetExceeded: ``deadline`` passed.
     """
     options = options or DEFAULT_OPTIONS
-    check_search_memory(robot, start, goal, options, revolutions)
     problem = build_problem(
         robot, limits, kinds, start, goal, options, revolutions, obstacles, clearance, deadline.within(0.0, 0.4)
     )

@@ -95,6 +95,11 @@ WARM_TOLERANCE = 1e-2 * GAP_TARGET
 #: (ur5, 2,000 to 4,000 intervals: 9 to 12 times the last grid's sequence, itself started from
 #: the grids below it), and a refinement begun but not finished costs the whole answer.
 REFINEMENT_COST = 20.0
+#: Memory per grid interval and joint: 37 MB of peak RSS growth for 2,000 intervals on ur5 (4
+#: waypoints), its refinements included (about 3.3 kB), rounded up.
+JERK_BYTES = 3_500
+#: Most intervals a doubling of the grid may reach: each LP's time grows with its grid.
+MAX_REFINED_INTERVALS = 12_000
 #: Fewest intervals of a grid that starts the LPs of a finer one (``JerkLimitedMethod._seed``).
 SEED_INTERVALS = 60
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
@@ -119,7 +124,7 @@ class JerkLimitedMethod(TimingMethod):
     continuous_acceleration = True
     #: Each LP holds some 2 (N + 1) columns and 40 rows per grid interval on a 6-joint arm:
     #: 2,000 intervals solve in about a second per LP.
-    grid_budget = 12_000
+    bytes_per_interval_joint = JERK_BYTES
 
     def __init__(self, tolerance: float = 1e-7, max_iterations: int = 60, polish: bool = True, max_refinements: int = 2):
         self.tolerance = tolerance
@@ -249,7 +254,7 @@ class JerkLimitedMethod(TimingMethod):
     def _affordable(self, constraints: PathConstraints, elapsed: float, deadline: Deadline) -> bool:
         """Whether a grid twice as fine fits the grid budget and (at ``REFINEMENT_COST`` times the
         last solve's time) the time left, on constraints that can be evaluated at new points."""
-        if not constraints.can_refine or 2 * (len(constraints.s) - 1) > self.grid_budget:
+        if not constraints.can_refine or 2 * (len(constraints.s) - 1) > MAX_REFINED_INTERVALS:
             return False
         remaining = deadline.remaining()
         return remaining is None or remaining > REFINEMENT_COST * elapsed + 1.0

@@ -116,6 +116,8 @@ class PhasePlaneMethod(TimingMethod):
     """
 
     name = "phase_plane"
+    #: About 1.3 kB per grid interval and joint (``benchmarks/budgets.py``).
+    bytes_per_interval_joint = 1_300
 
     def __init__(self, tolerance: float = 6e-4, max_refinements: int = 3, excursion: float | None = _EXCURSION):
         self.tolerance = tolerance

@@ -16,9 +16,8 @@ from fastapi.testclient import TestClient
 from toptraj import robots
 from toptraj.planners import BudgetExceeded, Deadline
 from toptraj.planners.collision import BoxObstacle
-from toptraj.planners.errors import OverMemory
 from toptraj.planners.generators.search.graph import SearchOptions, lattice_graph, roadmap_graph
-from toptraj.planners.generators.search.memory import check_search_memory, search_spans
+from toptraj.planners.generators.search.memory import search_bytes, search_spans
 from toptraj.planners.generators.search.method import global_search
 from toptraj.planners.generators.search.pieces import span_keys
 from toptraj.service.app import create_app
@@ -107,11 +106,7 @@ def test_a_search_beyond_the_memory_cap_gets_422_naming_the_largest_setting_serv
     cap = Settings().search_memory_bytes
 
     def served(points, neighbors):
-        try:
-            check_search_memory(robot, start, goal, SearchOptions(roadmap_points=points, neighbors=neighbors), True, cap)
-        except OverMemory:
-            return False
-        return True
+        return search_bytes(robot, start, goal, SearchOptions(roadmap_points=points, neighbors=neighbors), True) <= cap
 
     # the advice is followable, and the largest: one more is refused
     assert 1 <= most < 2000 and served(most, 50) and not served(most + 1, 50)
@@ -119,7 +114,7 @@ def test_a_search_beyond_the_memory_cap_gets_422_naming_the_largest_setting_serv
     # the default searches are served: ur5's roadmap, and the three-joint lattice (1.45 GB)
     assert served(150, 10)
     lecture = robots.load("lecture_3r")
-    check_search_memory(lecture, np.zeros(3), np.array([1.5, 0.0, 0.0]), SearchOptions(), True, cap)
+    assert search_bytes(lecture, np.zeros(3), np.array([1.5, 0.0, 0.0]), SearchOptions(), True) <= cap
 
 
 def test_the_memory_of_a_search_goes_back_when_its_request_ends(monkeypatch):
@@ -157,7 +152,7 @@ def test_an_estimate_too_low_is_a_clear_error_not_the_system_killing_a_process(m
     # while it builds its spans (about 0.5 GB), and the answer says so
     import toptraj.planners.generators.search.generator as search_generator
 
-    monkeypatch.setattr(search_generator, "check_search_memory", lambda *args, **kwargs: 1)
+    monkeypatch.setattr(search_generator, "search_bytes", lambda *args, **kwargs: 1)
     monkeypatch.setattr(search_generator, "SEARCH_MEMORY_SLACK", 64 * 2**20)
     with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=30.0))) as client:
         response = client.post("/v1/trajectories", json=_ur5_search({}, 30.0, ()))
