@@ -124,6 +124,7 @@ def _held(robot, path, method, constraints, result, boundary, duration, kinds, l
             break
         constraints = constraints.with_points(extra)
         result, _, _ = _solved(method, constraints, boundary, duration, deadline)
+    assert check.worst is not None  # each round that ends the loop found a limit exceeded
     raise limit_exceeded(method.name, check.worst, robot, path)
 
 

@@ -78,7 +78,7 @@ PRELOAD = [
     "toptraj.planners.generators.collocation.warm",
 ]
 
-_context = None
+_context: multiprocessing.context.BaseContext | None = None
 _lock = threading.Lock()
 #: True in a worker process: calls nested in it run inline (the whole process is killed).
 _in_worker = False
@@ -89,11 +89,11 @@ def _get_context():
     with _lock:
         if _context is None:
             if "forkserver" in multiprocessing.get_all_start_methods():
-                context = multiprocessing.get_context("forkserver")
-                context.set_forkserver_preload(PRELOAD)
+                forkserver = multiprocessing.get_context("forkserver")
+                forkserver.set_forkserver_preload(PRELOAD)
+                _context = forkserver
             else:
-                context = multiprocessing.get_context("spawn")
-            _context = context
+                _context = multiprocessing.get_context("spawn")
         return _context
 
 
