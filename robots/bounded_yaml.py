@@ -73,7 +73,7 @@ class BoundedLoader(yaml.SafeLoader):
                 f"the document stands for more than {MAX_NODES} values once its aliases are expanded", mark
             )
 
-    def compose_node(self, parent, index):
+    def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node:
         if self.check_event(yaml.AliasEvent):
             event = self.peek_event()
             self._aliases += 1
@@ -102,7 +102,7 @@ class BoundedLoader(yaml.SafeLoader):
             )
         return node
 
-    def compose_mapping_node(self, anchor):
+    def compose_mapping_node(self, anchor: str | None) -> yaml.MappingNode:
         node = super().compose_mapping_node(anchor)
         seen = set()
         for key, _ in node.value:
@@ -118,7 +118,7 @@ class BoundedLoader(yaml.SafeLoader):
             seen.add(key.value)
         return node
 
-    def construct_yaml_int(self, node):
+    def construct_yaml_int(self, node: yaml.ScalarNode) -> int:
         if len(node.value) > MAX_INTEGER_DIGITS:
             raise yaml.constructor.ConstructorError(
                 None, None, f"an integer of {len(node.value)} characters; at most {MAX_INTEGER_DIGITS} are read",

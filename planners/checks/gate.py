@@ -57,7 +57,7 @@ def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
     return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
 
 
-def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
+def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False) -> tuple[PathTiming, PathConstraints, LimitCheck]:
     """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
     exceeded by more than ``threshold``, refine the grid there and time the path again. Every
     timing carries its estimated gap to the converged optimum (``toptraj.planners.runner.accuracy``); a
@@ -129,6 +129,8 @@ def _held(robot, path, method, constraints, result, boundary, duration, kinds, l
 
 
 def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> LimitExceeded:
+    """The error of ``method``'s timing over a limit: the ``worst`` excess, at its s along the
+    path given (a stretch's s mapped back to its parent), its joint named."""
     s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
     joint = None if worst.joint < 0 else robot.joint_names[worst.joint]
     what = f"{worst.kind} limit of joint {joint!r}" if joint is not None else f"{worst.kind.replace('_', ' ')} limit"

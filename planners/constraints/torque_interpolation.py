@@ -135,7 +135,7 @@ def _row_at(coefficients, row, j, products):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit, s, sd, sdd, from_left, interpolate, tolerance, tau, exact):  # pragma: no cover - compiled
+def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit, s, sd, sdd, from_left, interpolate, tolerance, tau, exact) -> None:  # pragma: no cover - compiled
     """Write a u + b x + c + d sd, the torques of n states (s, sd, u = sdd, x = sd^2), into
     ``tau`` (n, n_dof), and mark in ``exact`` (n,) the states left to RNEA (their rows of
     ``tau`` unset). A moving state on a grid point reads the rows there, on its side; a state

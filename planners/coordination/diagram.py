@@ -52,7 +52,7 @@ class Diagram:
         return ~(b[i, j] | b[i + 1, j] | b[i, j + 1] | b[i + 1, j + 1])
 
 
-def arm_capsules(arm: CellArm, s: np.ndarray):
+def arm_capsules(arm: CellArm, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The arm's world capsules at path parameters ``s`` (n,): a, b (n, k, 3), radius (k,)."""
     return arm.capsules_at(arm.path.evaluate(s).q)
 

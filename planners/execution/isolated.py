@@ -44,6 +44,7 @@ import signal
 import threading
 import time
 from collections.abc import Sequence
+from typing import Any
 
 from toptraj.planners.errors import OverMemory, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -123,9 +124,10 @@ def start_worker_server(preload: Sequence[str] = ()) -> None:
 class _PipeProgress:
     """``progress(fraction, stage)`` in a child: sent to the parent, throttled per stage."""
 
-    def __init__(self, connection):
+    def __init__(self, connection) -> None:
         self._connection = connection
-        self._stage, self._sent = None, 0.0
+        self._stage: str | None = None
+        self._sent = 0.0
 
     def __call__(self, fraction: float, stage: str) -> None:
         now = time.monotonic()
@@ -244,7 +246,7 @@ def _inline_within(memory_bytes: int, function, *args, **kwargs):
 
 def run_isolated(
     function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0
-):
+) -> Any:
     """``function(*args)`` computed in a child process, killed once ``deadline`` passes; with
     ``progress``, ``function(*args, progress=report)``, its reports relayed to
     ``deadline.progress``. ``memory_bytes``: the most the child's address space may grow;

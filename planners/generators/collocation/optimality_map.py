@@ -134,4 +134,5 @@ def sweep(families: list[Family], phis) -> list[tuple[float, dict[str, float | N
 
 
 def key(family: Family) -> str:
+    """The map's key of ``family``: its elbow angle psi_b (rad) and its label."""
     return f"psi_b {family.elbow:+.4f}: {family.label}"

@@ -185,7 +185,7 @@ def _ahead(i, x, ds, q, r):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def forward_time(lo, hi, ds, q, r, cap_start, cap_end, x_in):  # pragma: no cover - compiled
+def forward_time(lo, hi, ds, q, r, cap_start, cap_end, x_in) -> tuple[float, float]:  # pragma: no cover - compiled
     """t3 over the intervals lo .. hi - 1 (one piece) entered with x at most ``x_in``: the time
     with x on the maximum-acceleration curve, capped by the velocity limit curve. Returns the
     time (s) and the bound on x at the piece's end."""
@@ -204,7 +204,7 @@ def forward_time(lo, hi, ds, q, r, cap_start, cap_end, x_in):  # pragma: no cove
 
 
 @njit(cache=True, nogil=True)
-def path_time(intervals, ds, p, q, r, cap_start, cap_end):  # pragma: no cover - compiled
+def path_time(intervals, ds, p, q, r, cap_start, cap_end) -> float:  # pragma: no cover - compiled
     """t3 of a complete grid path over ``intervals`` (indices, in order), from rest to rest: x
     below the maximum-acceleration curve from the start, the velocity limit curve and the
     maximum-deceleration curve into the goal (eq. 2.8)."""

@@ -28,6 +28,7 @@ import numpy as np
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.timing.base import PathTiming
 from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming, segment_starts
 
 #: Most segments polished: a time-optimal motion under limits that do not change along the
@@ -200,7 +201,9 @@ def _points(durations, jerks, start, checks):
     return s, v, a, sigma, Dp, starts, D
 
 
-def polish(constraints: PathConstraints, grid_timing, sd_start: float, sd_end: float, deadline: Deadline):
+def polish(
+    constraints: PathConstraints, grid_timing: PathTiming, sd_start: float, sd_end: float, deadline: Deadline
+) -> JerkSegmentsTiming | None:
     """The polished timing (``JerkSegmentsTiming``), or ``None`` when the polish does not find a
     motion that holds the limits and is shorter than ``grid_timing``: each segmentation of
     ``MERGE_FRACTIONS`` polished in turn, the shortest result kept."""
