@@ -49,7 +49,7 @@ class BoundedYAMLError(yaml.YAMLError):
         problem_mark: Where (``line``, ``column``, from 0), when known.
     """
 
-    def __init__(self, problem: str, mark=None):
+    def __init__(self, problem: str, mark: yaml.Mark | None = None) -> None:
         super().__init__(problem)
         self.problem = problem
         self.problem_mark = mark

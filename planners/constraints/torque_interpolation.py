@@ -29,8 +29,13 @@ smooth grid points surround it, or where an interval among them moves the joints
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numba import njit
+
+if TYPE_CHECKING:
+    from toptraj.planners.constraints.path_constraints import PathConstraints
 
 #: Largest joint travel (rad, summed over the joints) of a grid interval whose rows are
 #: interpolated: the rows are trigonometric in q, and a grid coarser than this does not resolve
@@ -40,7 +45,7 @@ from numba import njit
 MAX_TRAVEL = 0.1
 
 
-def smooth_points(constraints) -> np.ndarray:
+def smooth_points(constraints: PathConstraints) -> np.ndarray:
     """(N + 1,): the grid points of ``constraints`` (a ``PathConstraints``) through which the
     rows are smooth, so that a polynomial through them interpolates the rows: interior, no knot
     of the path, the same rows from both sides (also where ``phase_plane``'s excursion estimate,
@@ -59,7 +64,7 @@ def smooth_points(constraints) -> np.ndarray:
     return smooth
 
 
-def grid_travel(constraints) -> np.ndarray | None:
+def grid_travel(constraints: PathConstraints) -> np.ndarray | None:
     """(N,): the joints' travel over each grid interval of ``constraints``, the sum over the
     joints of |q(s_i+1) - q(s_i)| (rad); ``None`` when its grid's points are unknown."""
     return None if constraints.q is None else np.abs(np.diff(constraints.q, axis=0)).sum(axis=1)

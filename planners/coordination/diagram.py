@@ -57,7 +57,7 @@ def arm_capsules(arm: CellArm, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     return arm.capsules_at(arm.path.evaluate(s).q)
 
 
-def motion_steps(capsules) -> np.ndarray:
+def motion_steps(capsules: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
     """How far (m) the arm's capsules move between successive samples, from their world end
     points a, b (n, k, 3): (n - 1,). A capsule moved rigidly moves each point of its axis by a
     convex combination of its ends' displacements, so by at most the larger; ``STEP_SAFETY``

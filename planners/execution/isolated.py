@@ -43,7 +43,7 @@ import select
 import signal
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from toptraj.planners.errors import OverMemory, TimingFailed
@@ -245,7 +245,7 @@ def _inline_within(memory_bytes: int, function, *args, **kwargs):
 
 
 def run_isolated(
-    function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0
+    function: Callable[..., Any], *args: Any, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0
 ) -> Any:
     """``function(*args)`` computed in a child process, killed once ``deadline`` passes; with
     ``progress``, ``function(*args, progress=report)``, its reports relayed to

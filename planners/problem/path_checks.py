@@ -36,7 +36,7 @@ def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -
         )
 
 
-def check_jerk_finite(path: GeometricPath, kinds) -> None:
+def check_jerk_finite(path: GeometricPath, kinds: tuple[str, ...]) -> None:
     """A jerk limit needs a path whose d2q/ds2 is continuous where the motion goes on: at a
     break (a straight segment meeting a circular blend) the joint acceleration q'' sd^2 jumps
     unless the motion stops there, an infinite jerk."""

@@ -26,6 +26,7 @@ is not known), the complete path's both.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -36,6 +37,9 @@ from toptraj.planners.generators.search.curve import GridSplinePath
 from toptraj.planners.generators.search.pieces import INTERVALS, Pieces
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.robots import JointLimits, Robot
+
+if TYPE_CHECKING:
+    from toptraj.planners.execution.deadline import Deadline
 
 _INF = np.inf
 #: Rows of limits evaluated between two deadline checks.
@@ -89,7 +93,7 @@ def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
     return np.ascontiguousarray(a), np.ascontiguousarray(b), np.ascontiguousarray(c), d, lower, upper, x_bound
 
 
-def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds, deadline) -> PieceBounds:
+def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds: tuple[str, ...], deadline: Deadline) -> PieceBounds:
     """The bounds of every piece (t1, t2 and the arrays t3 runs on)."""
     count = len(pieces.ds)
     p = q = r = np.empty((count, 0))
@@ -243,7 +247,7 @@ def path_time(intervals, ds, p, q, r, cap_start, cap_end) -> float:  # pragma: n
     return total
 
 
-def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds) -> float:
+def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds: tuple[str, ...]) -> float:
     """t4 (s): the phase-plane method (``toptraj.planners.timing.phase_plane.method``, without refinement) on
     the curve of the grid path through ``points`` (``toptraj.planners.generators.search.curve``), on the grid of
     its pieces (``INTERVALS`` per span)."""

@@ -108,7 +108,10 @@ def span_keys(
     )
 
 
-def build_pieces(points, edge_from, edge_to, start: int, goals, turn_in, turn_out) -> Pieces:
+def build_pieces(
+    points: np.ndarray, edge_from: np.ndarray, edge_to: np.ndarray, start: int, goals: np.ndarray, turn_in: np.ndarray,
+    turn_out: np.ndarray,
+) -> Pieces:
     """Every span of ``span_keys``, its control points and its samples."""
     kind, t_in, t_out, edge = span_keys(edge_from, edge_to, start, goals, turn_in, turn_out)
     n = points.shape[1]
