@@ -8,6 +8,7 @@ breaks; the service words them in its request's vocabulary and picks the status.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -122,7 +123,7 @@ class BudgetExceeded(ToptrajError):
 
 
 @contextmanager
-def numerical_breakdown_is_failure(method: str):
+def numerical_breakdown_is_failure(method: str) -> Iterator[None]:
     """Turn a numerical breakdown inside a timing method (an overflow or division by zero in
     Python floats, a singular or non-converging linear-algebra routine) into ``TimingFailed``
     naming the method, instead of an unexplained error."""

@@ -12,6 +12,8 @@ from toptraj.planners.timing.base import Binding
 from toptraj.planners.trajectory import Samples, SwitchingTimes
 
 if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
     from toptraj.planners.collision import Clearance
     from toptraj.planners.generators.collocation.report import CollocationReport
     from toptraj.planners.generators.search.report import SearchReport
@@ -89,7 +91,7 @@ class PlannedTrajectory:
     zones: tuple[ZoneReport, ...] | None = None
 
 
-def require_finite(method: str, **quantities) -> None:
+def require_finite(method: str, **quantities: ArrayLike | None) -> None:
     """NonFinite (a TimingFailed) unless every number of every named quantity (arrays, scalars or ``None``)
     is finite: a timing whose numbers overflowed is a failure of the method, never an answer."""
     for name, values in quantities.items():

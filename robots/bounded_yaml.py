@@ -49,7 +49,7 @@ class BoundedYAMLError(yaml.YAMLError):
         problem_mark: Where (``line``, ``column``, from 0), when known.
     """
 
-    def __init__(self, problem: str, mark=None):
+    def __init__(self, problem: str, mark: yaml.Mark | None = None) -> None:
         super().__init__(problem)
         self.problem = problem
         self.problem_mark = mark
@@ -73,7 +73,7 @@ class BoundedLoader(yaml.SafeLoader):
                 f"the document stands for more than {MAX_NODES} values once its aliases are expanded", mark
             )
 
-    def compose_node(self, parent, index):
+    def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node:
         if self.check_event(yaml.AliasEvent):
             event = self.peek_event()
             self._aliases += 1
@@ -102,7 +102,7 @@ class BoundedLoader(yaml.SafeLoader):
             )
         return node
 
-    def compose_mapping_node(self, anchor):
+    def compose_mapping_node(self, anchor: str | None) -> yaml.MappingNode:
         node = super().compose_mapping_node(anchor)
         seen = set()
         for key, _ in node.value:
@@ -118,7 +118,7 @@ class BoundedLoader(yaml.SafeLoader):
             seen.add(key.value)
         return node
 
-    def construct_yaml_int(self, node):
+    def construct_yaml_int(self, node: yaml.ScalarNode) -> int:
         if len(node.value) > MAX_INTEGER_DIGITS:
             raise yaml.constructor.ConstructorError(
                 None, None, f"an integer of {len(node.value)} characters; at most {MAX_INTEGER_DIGITS} are read",

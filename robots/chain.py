@@ -88,7 +88,7 @@ def chain_of(model: pin.Model) -> Chain | None:
 
 
 @njit(cache=True, nogil=True)
-def axis_rotation(axis, angle, out):  # pragma: no cover - compiled
+def axis_rotation(axis, angle, out) -> None:  # pragma: no cover - compiled
     """Rot(axis, angle) = I + sin(angle) [axis]x + (1 - cos(angle)) [axis]x^2 (Rodrigues) of the
     unit ``axis`` (3,) by ``angle`` (rad) into ``out`` (3, 3)."""
     sine, versine = np.sin(angle), 1.0 - np.cos(angle)

@@ -91,7 +91,7 @@ def _placements(q_row, prismatic, axis, rotation, translation, coordinate, turn,
 
 
 @njit(cache=True, nogil=True)
-def rnea_sets(q, qd, qdd, parent, prismatic, axis, rotation, translation, coordinate, mass, lever, inertia, armature, gravity, tau):  # pragma: no cover - compiled
+def rnea_sets(q, qd, qdd, parent, prismatic, axis, rotation, translation, coordinate, mass, lever, inertia, armature, gravity, tau) -> None:  # pragma: no cover - compiled
     """The torques of every set at every configuration into ``tau`` (n_sets, n, n_dof); the
     chain's arrays as ``toptraj.robots.chain.Chain`` holds them (joints ordered parents first). Leading
     sets whose velocities are all zero (the build's g and M q' + g) take Table 5.1 without the

@@ -20,9 +20,13 @@ The links against each other (self-collision) are checked by
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
+
+if TYPE_CHECKING:
+    from toptraj.robots.robot import Robot
 
 #: Radius (m) of the capsules of arms without collision geometry.
 LINK_RADIUS = 0.03
@@ -169,7 +173,7 @@ def _example_arm_capsules(name: str) -> list[LinkCapsule] | None:
 _CATALOG_CAPSULES: dict[str, list[LinkCapsule]] = {}
 
 
-def robot_capsules(robot) -> list[LinkCapsule]:
+def robot_capsules(robot: Robot) -> list[LinkCapsule]:
     """The capsules of ``robot`` (a ``robots.Robot``), built once per catalog robot: from the
     collision meshes of example-robot-data's arms, else along the links (``LINK_RADIUS``); those
     of the fixed base placed by the robot's mounting."""

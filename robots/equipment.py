@@ -24,6 +24,7 @@ import math
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -31,6 +32,9 @@ import pinocchio as pin
 from toptraj.robots.errors import ToptrajError
 from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS, Range
 from toptraj.robots.robot import Robot
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 #: Largest |R^T R - I| (entrywise) of a rotation matrix accepted; it is then made exactly orthonormal.
 ROTATION_TOLERANCE = 1e-6
@@ -103,7 +107,7 @@ def _vector(values, field: str, accepted: Range, length: int = 3, signed: bool =
     return tuple(float(value) for value in array)
 
 
-def inertia_matrix(values) -> np.ndarray:
+def inertia_matrix(values: ArrayLike) -> np.ndarray:
     """The (3, 3) rotational inertia (kg m^2) from 9 values (a matrix, row by row) or 6 values
     [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]. A physical inertia is symmetric, positive definite, and its
     principal moments satisfy the triangle inequality (each at most the sum of the other two).
@@ -135,7 +139,7 @@ def inertia_matrix(values) -> np.ndarray:
     return matrix
 
 
-def payload(mass: float, center_of_mass=(0.0, 0.0, 0.0), inertia=None, frame: str | None = None) -> Payload:
+def payload(mass: float, center_of_mass: ArrayLike = (0.0, 0.0, 0.0), inertia: ArrayLike | None = None, frame: str | None = None) -> Payload:
     """A checked ``Payload``: ``mass`` in ``PAYLOAD_MASS``, each coordinate of
     ``center_of_mass`` (3,) in ``CENTER_OF_MASS``, ``inertia`` as ``inertia_matrix`` reads it
     (``None``: a point mass).
@@ -149,7 +153,7 @@ def payload(mass: float, center_of_mass=(0.0, 0.0, 0.0), inertia=None, frame: st
     return Payload(float(mass), _vector(center_of_mass, "center_of_mass", CENTER_OF_MASS), tuple(matrix.ravel().tolist()), frame)
 
 
-def rotation_matrix(rotation=None, orientation=None) -> np.ndarray:
+def rotation_matrix(rotation: ArrayLike | None = None, orientation: ArrayLike | None = None) -> np.ndarray:
     """The (3, 3) rotation from a matrix (3x3, orthonormal within ``ROTATION_TOLERANCE``,
     determinant +1) or a unit quaternion [qx, qy, qz, qw] (norm 1 within
     ``QUATERNION_TOLERANCE``); identity when neither is given. The result is made exactly
@@ -194,7 +198,10 @@ def rotation_matrix(rotation=None, orientation=None) -> np.ndarray:
     return u @ vt
 
 
-def mounting(position=(0.0, 0.0, 0.0), rotation=None, orientation=None, gravity=None) -> Mounting:
+def mounting(
+    position: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None, orientation: ArrayLike | None = None,
+    gravity: ArrayLike | None = None,
+) -> Mounting:
     """A checked ``Mounting``: ``position`` (3,) within ``BASE_POSITION``, the rotation as
     ``rotation_matrix`` reads it, ``gravity`` (3,) within ``GRAVITY`` (``None``: the model's).
 

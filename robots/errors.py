@@ -60,7 +60,7 @@ class ToptrajError(Exception):
         facts = ", ".join(f"{key} = {excerpt(value)}" for key, value in vars(self).items())
         return f"{type(self).__name__}: {facts}"
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Any, ...]:
         """Pickled with its attributes, without calling ``__init__`` again: an error raised in
         a worker process (``toptraj.planners.execution.isolated``) reaches its caller whole, whatever the
         subclass's constructor takes (``Exception``'s own pickling calls ``cls(*args)``, which

@@ -12,7 +12,7 @@ import dataclasses
 import threading
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -144,7 +144,7 @@ class Robot:
             bare=bare,
         )
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Any, ...]:
         """Pickled as its model and metadata (the per-thread workspaces are rebuilt), so that a
         robot can be sent to a worker process."""
         return _rebuilt, (
@@ -190,7 +190,7 @@ class Robot:
         return data
 
     def configuration(self, q: np.ndarray) -> np.ndarray:
-        """Pinocchio configuration(s) of shape (..., nq) from joint coordinates (..., n_dof)."""
+        """Pinocchio's configurations, shape (..., nq), from joint coordinates (..., n_dof)."""
         if self._identity_configuration:  # Pinocchio's q is the joint coordinates in order
             return np.array(q, dtype=float)
         q = np.asarray(q, dtype=float)

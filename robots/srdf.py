@@ -81,7 +81,7 @@ def srdf_pairs(text: str) -> frozenset[tuple[str, str]]:
     return frozenset(pairs)
 
 
-def allowed_pairs(given) -> frozenset[tuple[str, str]]:
+def allowed_pairs(given: object) -> frozenset[tuple[str, str]]:
     """The allowed pairs of ``given``: SRDF text, or a list of [link, link] pairs.
 
     Raises:

@@ -216,8 +216,8 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
     return limits, notes
 
 
-def upload_options(locked_joints: dict | None = None, joint_limits=None, payload: Payload | None = None,
-                   allowed_collisions=None) -> UploadOptions:
+def upload_options(locked_joints: dict | None = None, joint_limits: object = None, payload: Payload | None = None,
+                   allowed_collisions: object = None) -> UploadOptions:
     """Options from an upload request, checked for form (names are checked against the model
     by ``apply_locks``, ``toptraj.robots.limits`` and ``toptraj.robots.srdf.check_links``);
     ``payload`` (checked by ``toptraj.robots.equipment.payload``) is the robot's default payload;

@@ -20,6 +20,7 @@ import threading
 from collections import deque
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
 from toptraj.planners import Deadline
 from toptraj.planners.errors import BudgetExceeded
@@ -140,6 +141,7 @@ class PlanningWorkers:
         frees its slot when it ends and settles ``answer`` with (result, error)."""
 
         def work():
+            outcome: tuple[Any, BaseException | None]
             try:
                 outcome = (function(deadline), None)
             except BaseException as error:  # delivered to the request, as an executor would

@@ -7,7 +7,7 @@ place, the joint and the limit.
 from __future__ import annotations
 
 import time
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -19,10 +19,14 @@ from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from toptraj.planners.constraints.zones import tool_speed_at, zone_factors
 from toptraj.planners.errors import InfeasiblePath, LimitExceeded, TimingFailed
 from toptraj.planners.paths.base import GeometricPath
-from toptraj.planners.timing.base import PathTiming, TimeScaling
+from toptraj.planners.timing.base import Boundary, PathTiming, TimeScaling, TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.scaled import solve_well_scaled
 from toptraj.robots import JointLimits, Robot
+
+if TYPE_CHECKING:
+    from toptraj.planners.execution.deadline import Deadline
+    from toptraj.planners.trajectory import Samples
 
 #: Largest |value| / limit a returned trajectory may reach on the dense check. The promise is
 #: 0.5 %; the gate is tighter, since a client's own resampling falls between the check's states.
@@ -57,7 +61,10 @@ def _refinement(timing: TimeScaling, intervals: np.ndarray) -> np.ndarray:
     return (s[intervals, None] + quarters * (s[intervals + 1] - s[intervals])[:, None]).ravel()
 
 
-def gated(robot, path, method, constraints, boundary, duration, kinds, limits, threshold, deadline, grid_given=False):
+def gated(
+    robot: Robot, path: GeometricPath, method: TimingMethod, constraints: PathConstraints, boundary: Boundary,
+    duration: float | None, kinds: tuple[str, ...], limits: JointLimits, threshold: float, deadline: Deadline, grid_given: bool = False,
+) -> tuple[PathTiming, PathConstraints, LimitCheck]:
     """Time ``path`` with ``method`` and check every limit on the dense states; where a limit is
     exceeded by more than ``threshold``, refine the grid there and time the path again. Every
     timing carries its estimated gap to the converged optimum (``toptraj.planners.checks.accuracy``); a
@@ -124,10 +131,13 @@ def _held(robot, path, method, constraints, result, boundary, duration, kinds, l
             break
         constraints = constraints.with_points(extra)
         result, _, _ = _solved(method, constraints, boundary, duration, deadline)
+    assert check.worst is not None  # each round that ends the loop found a limit exceeded
     raise limit_exceeded(method.name, check.worst, robot, path)
 
 
 def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> LimitExceeded:
+    """The error of ``method``'s timing over a limit: the ``worst`` excess, at its s along the
+    path given (a stretch's s mapped back to its parent), its joint named."""
     s = float(getattr(path, "to_parent", lambda x: x)(worst.s))
     joint = None if worst.joint < 0 else robot.joint_names[worst.joint]
     what = f"{worst.kind} limit of joint {joint!r}" if joint is not None else f"{worst.kind.replace('_', ' ')} limit"
@@ -143,7 +153,10 @@ def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath
     )
 
 
-def checked(robot, path, result, method, kinds, limits, threshold, constraints) -> TimedStretch:
+def checked(
+    robot: Robot, path: GeometricPath, result: PathTiming, method: str, kinds: tuple[str, ...], limits: JointLimits,
+    threshold: float, constraints: PathConstraints,
+) -> TimedStretch:
     """A timing that cannot be refined, through the limit gate: kept when it holds the limits,
     refused (with where, which joint and which limit) when it does not."""
     check = check_limits(path, result, robot, limits, kinds, threshold, constraints.s)
@@ -170,7 +183,7 @@ def _zoned(checks: list, limits: JointLimits, s: np.ndarray) -> list:
 
 
 def samples_exceed(
-    samples, limits: JointLimits, threshold: float, kinds, robot: Robot | None = None, jerk: bool = False
+    samples: Samples, limits: JointLimits, threshold: float, kinds: tuple[str, ...], robot: Robot | None = None, jerk: bool = False
 ) -> tuple[str, int, int] | None:
     """(kind, sample, joint) of a returned sample beyond ``threshold`` of a gated limit (joint
     -1 for a tool limit, checked when ``robot`` is given). With ``jerk`` (for timings whose

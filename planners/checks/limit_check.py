@@ -30,7 +30,7 @@ from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from toptraj.planners.constraints.torque_interpolation import MAX_TRAVEL, dense_torques, grid_travel
 from toptraj.planners.constraints.zones import has_tool_zone, tool_speed_at, zone_factors, zone_peaks
 from toptraj.planners.paths.base import GeometricPath
-from toptraj.planners.timing.base import PathTiming, TimeScaling
+from toptraj.planners.timing.base import DenseStates, PathTiming, TimeScaling
 from toptraj.robots import JointLimits, Robot
 
 #: States per grid interval for the check, both ends included: the ends and the quarter points.
@@ -78,7 +78,7 @@ class LimitCheck:
     zones: dict[int, float] = field(default_factory=dict)
 
 
-def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+def joint_motion(path: GeometricPath, states: DenseStates) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """q, qd, qdd and (when the states carry sddd) qddd at ``states``, each (n, n_dof), with the
     path's one-sided derivatives from the left for ``states.left`` states at a corner or a break
     (and, for the third derivative, at any knot)."""
@@ -100,7 +100,7 @@ def joint_motion(path: GeometricPath, states) -> tuple[np.ndarray, np.ndarray, n
     sd, sdd = states.sd[:, None], states.sdd[:, None]
     qd = dq * sd
     qdd = dq * sdd + ddq * (sd * sd)
-    jerk = None if third is None else third * sd**3 + 3.0 * ddq * (sd * sdd) + dq * states.sddd[:, None]
+    jerk = None if third is None or states.sddd is None else third * sd**3 + 3.0 * ddq * (sd * sdd) + dq * states.sddd[:, None]
     return q, qd, qdd, jerk
 
 

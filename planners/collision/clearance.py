@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,6 +23,9 @@ from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.robots import Robot
 from toptraj.robots.collision import robot_capsules, world_capsules
+
+if TYPE_CHECKING:
+    from toptraj.planners.paths.base import GeometricPath
 
 #: Largest motion (m) of any point of the arm between two configurations of the first pass.
 COARSE_STEP = 0.02
@@ -108,7 +111,7 @@ def _too_close(s, distances, capsule, obstacle, capsules, clearance: float, foun
 
 
 def check_clearance(
-    path, robot: Robot, obstacles: list[Obstacle], clearance: float, deadline: Deadline = NO_DEADLINE
+    path: GeometricPath, robot: Robot, obstacles: list[Obstacle], clearance: float, deadline: Deadline = NO_DEADLINE
 ) -> Clearance:
     """The clearance of ``path`` (a ``GeometricPath``) from ``obstacles``, checked where it
     matters: configurations at most ``COARSE_STEP`` of arm motion apart, and those intervals

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +35,9 @@ from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.robots import Robot
 from toptraj.robots.collision import LinkCapsule, robot_capsules, world_capsules
 from toptraj.robots.srdf import pair, shipped_pairs
+
+if TYPE_CHECKING:
+    from toptraj.planners.paths.base import GeometricPath
 
 #: Largest motion (m) of any point of the arm across an interval still uncertain.
 RESOLUTION = 1e-3
@@ -188,7 +192,7 @@ def _split(s: np.ndarray, unsure: np.ndarray) -> np.ndarray:
 
 
 def check_self_collision(
-    path, robot: Robot, allowed: frozenset[tuple[str, str]] | None = None, deadline: Deadline = NO_DEADLINE
+    path: GeometricPath, robot: Robot, allowed: frozenset[tuple[str, str]] | None = None, deadline: Deadline = NO_DEADLINE
 ) -> SelfClearance:
     """The links' smallest distance to each other along ``path`` (a ``GeometricPath``):
     configurations at most ``COARSE_STEP`` of pair motion apart, the intervals whose bound falls

@@ -12,11 +12,15 @@ form one interval per grid point (``toptraj.planners.constraints.admissible_kern
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from toptraj.planners.constraints.admissible_kernels import ZERO_INERTIA, point_bounds
 from toptraj.planners.constraints.linear_rows import LinearRows
+
+if TYPE_CHECKING:
+    from toptraj.planners.constraints.path_constraints import PathConstraints
 
 
 @dataclass(frozen=True)
@@ -96,7 +100,7 @@ def _blocking_pair(point, bounds, x_min, static_fail, singular, rows):
     return int(np.argmax(low)), int(np.argmin(high))
 
 
-def friction_reference(constraints) -> np.ndarray:
+def friction_reference(constraints: PathConstraints) -> np.ndarray:
     """A first guess of the optimal x = sd^2 (N + 1,) around which viscous friction is
     linearized (``PathConstraints.linearized``): the maximum velocity curve without friction,
     capped by the first-order bound; without friction, that bound itself (it is not used)."""
@@ -108,7 +112,7 @@ def friction_reference(constraints) -> np.ndarray:
     return np.where(np.isfinite(x_max) & (x_max > 0), x_max, 1.0)
 
 
-def speed_scale(constraints) -> float:
+def speed_scale(constraints: PathConstraints) -> float:
     """A typical x = sd^2 of the path (1/s^2), or 1 when the limits give none: the median over
     the grid of the smaller of the maximum velocity curve (without friction) and the largest
     path acceleration u available from rest, which bounds the x reachable over a stretch of

@@ -235,7 +235,8 @@ def _rnea_terms(robot: Robot, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) ->
 CHUNK_POINTS = 1024
 
 
-def grid_rows(robot: Robot, limits: JointLimits, kinds, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, deadline: Deadline = NO_DEADLINE):
+def grid_rows(robot: Robot, limits: JointLimits, kinds: tuple[str, ...], q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, deadline: Deadline = NO_DEADLINE
+) -> tuple[tuple[np.ndarray, ...], tuple[tuple[str, int], ...]]:
     """The second-order rows ``(a, b, c, d, lower, upper)`` at n points of a path (``q, dq,
     ddq``, each (n, n_dof)) and their (kind, joint) labels: each array (n, m), acceleration rows
     then torque rows, of the joints whose limit is finite (a row with an infinite limit

@@ -29,8 +29,13 @@ smooth grid points surround it, or where an interval among them moves the joints
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numba import njit
+
+if TYPE_CHECKING:
+    from toptraj.planners.constraints.path_constraints import PathConstraints
 
 #: Largest joint travel (rad, summed over the joints) of a grid interval whose rows are
 #: interpolated: the rows are trigonometric in q, and a grid coarser than this does not resolve
@@ -40,7 +45,7 @@ from numba import njit
 MAX_TRAVEL = 0.1
 
 
-def smooth_points(constraints) -> np.ndarray:
+def smooth_points(constraints: PathConstraints) -> np.ndarray:
     """(N + 1,): the grid points of ``constraints`` (a ``PathConstraints``) through which the
     rows are smooth, so that a polynomial through them interpolates the rows: interior, no knot
     of the path, the same rows from both sides (also where ``phase_plane``'s excursion estimate,
@@ -59,7 +64,7 @@ def smooth_points(constraints) -> np.ndarray:
     return smooth
 
 
-def grid_travel(constraints) -> np.ndarray | None:
+def grid_travel(constraints: PathConstraints) -> np.ndarray | None:
     """(N,): the joints' travel over each grid interval of ``constraints``, the sum over the
     joints of |q(s_i+1) - q(s_i)| (rad); ``None`` when its grid's points are unknown."""
     return None if constraints.q is None else np.abs(np.diff(constraints.q, axis=0)).sum(axis=1)
@@ -135,7 +140,7 @@ def _row_at(coefficients, row, j, products):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit, s, sd, sdd, from_left, interpolate, tolerance, tau, exact):  # pragma: no cover - compiled
+def dense_torques(grid, smooth, right, left, columns, travel, max_travel, limit, s, sd, sdd, from_left, interpolate, tolerance, tau, exact) -> None:  # pragma: no cover - compiled
     """Write a u + b x + c + d sd, the torques of n states (s, sd, u = sdd, x = sd^2), into
     ``tau`` (n, n_dof), and mark in ``exact`` (n,) the states left to RNEA (their rows of
     ``tau`` unset). A moving state on a grid point reads the rows there, on its side; a state

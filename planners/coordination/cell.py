@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toptraj.planners.collision.distance import segment_distance
 from toptraj.planners.errors import InvalidRequest
@@ -30,7 +31,7 @@ MAX_ARMS = 4
 ROTATION_TOLERANCE = 1e-6
 
 
-def checked_rotation(rotation, where: str) -> np.ndarray:
+def checked_rotation(rotation: ArrayLike, where: str) -> np.ndarray:
     """``rotation`` as a (3, 3) rotation matrix, or InvalidRequest naming ``where`` and why."""
     matrix = np.asarray(rotation, dtype=float)
     if matrix.shape != (3, 3) or not np.isfinite(matrix).all():
@@ -99,7 +100,7 @@ class Cell:
     kinds: tuple[str, ...] = ("velocity", "acceleration")
 
 
-def pair_distances(first, second) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def pair_distances(first: tuple[np.ndarray, np.ndarray, np.ndarray], second: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Smallest distance (m) between two arms' capsules, pairwise over leading axes: ``first``
     = (a, b, radius) with a, b of shape (..., k1, 3) and ``second`` likewise (..., k2, 3);
     returns the distances (...) and the indices of the two capsules that give them."""

@@ -53,12 +53,12 @@ class Diagram:
         return ~(b[i, j] | b[i + 1, j] | b[i, j + 1] | b[i + 1, j + 1])
 
 
-def arm_capsules(arm: CellArm, s: np.ndarray):
+def arm_capsules(arm: CellArm, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The arm's world capsules at path parameters ``s`` (n,): a, b (n, k, 3), radius (k,)."""
     return arm.capsules_at(arm.path.evaluate(s).q)
 
 
-def motion_steps(capsules) -> np.ndarray:
+def motion_steps(capsules: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
     """How far (m) the arm's capsules move between successive samples, from their world end
     points a, b (n, k, 3): (n - 1,). A capsule moved rigidly moves each point of its axis by a
     convex combination of its ends' displacements, so by at most the larger; ``STEP_SAFETY``

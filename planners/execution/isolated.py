@@ -43,7 +43,8 @@ import select
 import signal
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from toptraj.planners.errors import OverMemory, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -78,7 +79,7 @@ PRELOAD = [
     "toptraj.planners.generators.collocation.warm",
 ]
 
-_context = None
+_context: multiprocessing.context.BaseContext | None = None
 _lock = threading.Lock()
 #: True in a worker process: calls nested in it run inline (the whole process is killed).
 _in_worker = False
@@ -89,11 +90,11 @@ def _get_context():
     with _lock:
         if _context is None:
             if "forkserver" in multiprocessing.get_all_start_methods():
-                context = multiprocessing.get_context("forkserver")
-                context.set_forkserver_preload(PRELOAD)
+                forkserver = multiprocessing.get_context("forkserver")
+                forkserver.set_forkserver_preload(PRELOAD)
+                _context = forkserver
             else:
-                context = multiprocessing.get_context("spawn")
-            _context = context
+                _context = multiprocessing.get_context("spawn")
         return _context
 
 
@@ -129,9 +130,10 @@ def start_worker_server(preload: Sequence[str] = ()) -> None:
 class _PipeProgress:
     """``progress(fraction, stage)`` in a child: sent to the parent, throttled per stage."""
 
-    def __init__(self, connection):
+    def __init__(self, connection) -> None:
         self._connection = connection
-        self._stage, self._sent = None, 0.0
+        self._stage: str | None = None
+        self._sent = 0.0
 
     def __call__(self, fraction: float, stage: str) -> None:
         now = time.monotonic()
@@ -249,9 +251,9 @@ def _inline_within(memory_bytes: int, function, *args, **kwargs):
 
 
 def run_isolated(
-    function, *args, deadline: Deadline = NO_DEADLINE, progress: bool = False, memory_bytes: int | None = None, nice: int = 0,
-    inline: bool = False,
-):
+    function: Callable[..., Any], *args: Any, deadline: Deadline = NO_DEADLINE, progress: bool = False,
+    memory_bytes: int | None = None, nice: int = 0, inline: bool = False,
+) -> Any:
     """``function(*args)`` computed in a child process, killed once ``deadline`` passes; with
     ``progress``, ``function(*args, progress=report)``, its reports relayed to
     ``deadline.progress``. ``memory_bytes``: the most the child's address space may grow;

@@ -99,7 +99,7 @@ def _peaks(profile: NormalizedProfile) -> tuple[np.ndarray, np.ndarray]:
     return values.max(axis=1), tau[values.argmax(axis=1)]
 
 
-def own_durations(profile: NormalizedProfile, span: np.ndarray, limits: JointLimits, kinds, joint_names) -> tuple[np.ndarray, list[str]]:
+def own_durations(profile: NormalizedProfile, span: np.ndarray, limits: JointLimits, kinds: tuple[str, ...], joint_names: tuple[str, ...]) -> tuple[np.ndarray, list[str]]:
     """Each joint's shortest duration T_j (s) for moving by ``span`` (n_dof,) under the
     velocity, acceleration and jerk limits among ``kinds``, and the kind that sets each one."""
     peaks = _peaks(profile)[0]

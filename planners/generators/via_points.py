@@ -80,7 +80,7 @@ class ConstantSpeedTiming(PathTiming):
     def duration(self) -> float:
         return self.total
 
-    def at_times(self, t):
+    def at_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.total)
         return t / self.total, np.full_like(t, 1.0 / self.total), np.zeros_like(t)
 
@@ -92,7 +92,7 @@ class ConstantSpeedTiming(PathTiming):
         ones = np.full_like(s, 1.0 / self.total)
         return DenseStates(s, ones, np.zeros_like(s), np.zeros_like(s), flags)
 
-    def speed_at(self, s):
+    def speed_at(self, s: np.ndarray) -> np.ndarray:
         return np.full_like(np.asarray(s, dtype=float), 1.0 / self.total)
 
 

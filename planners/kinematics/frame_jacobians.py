@@ -51,7 +51,7 @@ def frame_jacobians(robot: Robot, frame_id: int, q: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def chain_jacobians(q, parent, prismatic, axis, rotation, translation, coordinate, frame_joint, frame_translation, out):  # pragma: no cover - compiled
+def chain_jacobians(q, parent, prismatic, axis, rotation, translation, coordinate, frame_joint, frame_translation, out) -> None:  # pragma: no cover - compiled
     """The Jacobians (n, 6, n_dof) of the frame at ``frame_translation`` (3,) in joint
     ``frame_joint``'s frame, at the rows of ``q`` (n, n_dof), into ``out``; the chain's arrays
     as ``toptraj.robots.chain.Chain`` holds them."""

@@ -77,7 +77,7 @@ class SplinePath(_ThroughWaypoints):
 
 
 @njit(cache=True, nogil=True)
-def natural_spline_coefficients(knots, values):  # pragma: no cover - compiled
+def natural_spline_coefficients(knots, values) -> np.ndarray:  # pragma: no cover - compiled
     """Power-basis coefficients (4, n_knots - 1, n_dof) of the C2 cubic spline through
     ``values`` (n_knots, n_dof) at ``knots`` (n_knots,) with natural ends (d2q/ds2 = 0).
 
@@ -127,7 +127,7 @@ def natural_spline_coefficients(knots, values):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def cubic_pieces(knots, coefficients, s):  # pragma: no cover - compiled
+def cubic_pieces(knots, coefficients, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
     """q, dq/ds and d2q/ds2 (each (n, n_dof)) at ``s`` (n,) of the piecewise cubic with
     power-basis ``coefficients`` (4, n_knots - 1, n_dof) on ``knots``, in one pass (Horner);
     a knot belongs to the piece that starts there."""
@@ -154,7 +154,7 @@ def cubic_pieces(knots, coefficients, s):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def cubic_farthest_outside(knots, coefficients, lower, upper, slack):  # pragma: no cover - compiled
+def cubic_farthest_outside(knots, coefficients, lower, upper, slack) -> tuple[float, int, float]:  # pragma: no cover - compiled
     """(s, joint, q) where the piecewise cubic (power-basis ``coefficients`` (4, n_knots - 1,
     n_dof) on ``knots``) lies farthest beyond [``lower``, ``upper``] (n_dof,), by more than
     ``slack``; joint -1 where it stays within. Each piece's extremes lie at its ends or where

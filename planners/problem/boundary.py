@@ -9,12 +9,13 @@ to the curvature term.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toptraj.planners.errors import InvalidRequest, WrongLength
 from toptraj.planners.paths.base import GeometricPath
 
 
-def finite_vector(value, name: str, length: int) -> np.ndarray:
+def finite_vector(value: ArrayLike, name: str, length: int) -> np.ndarray:
     """``value`` as a float vector of ``length`` finite numbers (InvalidRequest naming the
     library's field ``name`` otherwise)."""
     try:
@@ -33,7 +34,7 @@ def _tolerance(vector: np.ndarray) -> float:
     return 1e-6 * max(1.0, float(np.linalg.norm(vector)))
 
 
-def path_speed(path: GeometricPath, velocity, s_end: float, name: str) -> float:
+def path_speed(path: GeometricPath, velocity: ArrayLike | None, s_end: float, name: str) -> float:
     """sd >= 0 with q'(s_end) sd equal to the joint ``velocity`` (0 when ``None``)."""
     if velocity is None:
         return 0.0
@@ -46,7 +47,7 @@ def path_speed(path: GeometricPath, velocity, s_end: float, name: str) -> float:
     return sd
 
 
-def path_acceleration(path: GeometricPath, acceleration, sd: float, s_end: float, name: str) -> float | None:
+def path_acceleration(path: GeometricPath, acceleration: ArrayLike | None, sd: float, s_end: float, name: str) -> float | None:
     """sdd with q' sdd + q'' sd^2 equal to the joint ``acceleration`` (None when not given)."""
     if acceleration is None:
         return None

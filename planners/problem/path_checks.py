@@ -5,6 +5,7 @@ velocities tangent to the path (as path speeds), a grid within the method's memo
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toptraj.planners.errors import InfeasiblePath, NotServed, OutsideJointRange
 from toptraj.planners.paths import GeometricPath
@@ -35,7 +36,7 @@ def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -
         )
 
 
-def check_jerk_finite(path: GeometricPath, kinds) -> None:
+def check_jerk_finite(path: GeometricPath, kinds: tuple[str, ...]) -> None:
     """A jerk limit needs a path whose d2q/ds2 is continuous where the motion goes on: at a
     break (a straight segment meeting a circular blend) the joint acceleration q'' sd^2 jumps
     unless the motion stops there, an infinite jerk."""
@@ -51,7 +52,7 @@ def check_jerk_finite(path: GeometricPath, kinds) -> None:
     )
 
 
-def moving_velocity(velocity):
+def moving_velocity(velocity: ArrayLike | None) -> ArrayLike | None:
     """A boundary velocity, or ``None`` for rest (a zero vector included)."""
     if velocity is None or not np.any(np.asarray(velocity) != 0.0):
         return None
@@ -59,6 +60,9 @@ def moving_velocity(velocity):
 
 
 def path_boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
+    """The path's boundary states (sd, sdd at s = 0 and 1) from the joint velocities and
+    accelerations of ``timing``, once ``method`` is known to take the accelerations and the
+    duration given."""
     if (timing.start_acceleration is not None or timing.end_acceleration is not None) and not method.takes_acceleration_boundary:
         raise NotServed("boundary", None, method.name, rule="boundary_accelerations_not_used", alternatives=("quintic",))
     if timing.duration is not None and not method.takes_duration:

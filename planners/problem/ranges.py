@@ -14,6 +14,7 @@ A ``Range`` bounds a magnitude: positive quantities (limits, durations, scale fa
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,6 +25,12 @@ from toptraj.robots.ranges import LIMITS as LIMITS
 from toptraj.robots.ranges import TORQUE as TORQUE
 from toptraj.robots.ranges import VELOCITY as VELOCITY
 from toptraj.robots.ranges import Range as Range
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from toptraj.planners.problem.requests import Timing
+    from toptraj.robots import JointLimits
 
 #: Joint coordinates (rad or m): a continuous joint may turn many times, not 1e300.
 COORDINATE = Range(0.0, 1e4, "rad or m")
@@ -51,7 +58,7 @@ def check(value: float, field: str, accepted: Range) -> None:
         raise OutOfRange(field, value, accepted.low, accepted.high, accepted.unit)
 
 
-def check_vector(values, field: str, accepted: Range, signed: bool = False) -> None:
+def check_vector(values: ArrayLike, field: str, accepted: Range, signed: bool = False) -> None:
     """OutOfRange (``field[i]``) unless every entry of ``values`` lies in ``accepted`` (by
     magnitude, and any sign, when ``signed``: [-high, high])."""
     try:
@@ -65,7 +72,7 @@ def check_vector(values, field: str, accepted: Range, signed: bool = False) -> N
         raise OutOfRange(f"{field}[{bad[0]}]", array[bad[0]], low, accepted.high, accepted.unit, signed=signed)
 
 
-def check_timing(timing, dt: float) -> None:
+def check_timing(timing: Timing, dt: float) -> None:
     """Hold every number of a ``toptraj.planners.problem.requests.Timing`` and the sample period ``dt`` to its
     range (OutOfRange naming the field and the range otherwise)."""
     check(dt, "sampling.dt", DT)
@@ -78,9 +85,9 @@ def check_timing(timing, dt: float) -> None:
         if values is not None and kind in LIMITS:
             check_vector(values, f"limits.{kind}", LIMITS[kind])
     for name, accepted in (("tool_speed", TOOL_SPEED), ("tool_angular_speed", TOOL_ANGULAR_SPEED)):
-        value = getattr(timing, name, None)
-        if value is not None:
-            check(value, f"limits.{name}", accepted)
+        speed = getattr(timing, name, None)
+        if speed is not None:
+            check(speed, f"limits.{name}", accepted)
     for kind, factor in (timing.limit_scales or {}).items():
         if factor is not None:
             check(factor, f"limits.{kind}_scale", SCALE)
@@ -108,7 +115,7 @@ def _round_inward(low: float, high: float) -> tuple[float, float]:
     return rounded(low, True), rounded(high, False)
 
 
-def check_scaled_limits(limits, scales: dict[str, float | None] | None, joint_names: tuple[str, ...]) -> None:
+def check_scaled_limits(limits: JointLimits, scales: dict[str, float | None] | None, joint_names: tuple[str, ...]) -> None:
     """InvalidRequest unless every finite limit of ``limits`` (a ``JointLimits`` with the
     request's overrides, before its scales) times its ``scales`` factor lies in the range of its
     kind: a scale is one more source of a limit, and outside the range a limit (1e-9 rad/s^3 from

@@ -3,6 +3,7 @@ live with their planners) and the timing, and the timing method that a request n
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -109,7 +110,9 @@ class Timing:
     zones: tuple[Zone, ...] = ()
 
 
-def check_constraint_kinds(kinds, method: TimingMethod | MotionGenerator) -> tuple[str, ...]:
+def check_constraint_kinds(kinds: Iterable[str], method: TimingMethod | MotionGenerator) -> tuple[str, ...]:
+    """``kinds`` checked (each a known constraint kind that ``method`` serves), with the kinds
+    ``method`` requires added, in order and without repeats."""
     unknown = [kind for kind in kinds if kind not in CONSTRAINT_KINDS]
     if unknown:
         raise NotOneOf("constraints", unknown[0], CONSTRAINT_KINDS, rule="unknown_constraint")

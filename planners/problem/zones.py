@@ -119,7 +119,7 @@ def tool_points(robot: Robot, path: GeometricPath, frame_id: int, s: np.ndarray)
     return out
 
 
-def region_ranges(robot: Robot, path: GeometricPath, frame_id: int, region, deadline: Deadline = NO_DEADLINE) -> tuple[tuple[float, float], ...]:
+def region_ranges(robot: Robot, path: GeometricPath, frame_id: int, region: SphereObstacle | BoxObstacle, deadline: Deadline = NO_DEADLINE) -> tuple[tuple[float, float], ...]:
     """The closed s-ranges over which the tool point lies in ``region``: scanned at
     ``SCAN_POINTS`` values of s, each edge located by bisection to ``EDGE_TOLERANCE``. A visit
     shorter than the scan's step (1 / 2000 of s) may be missed."""
@@ -151,6 +151,7 @@ def zone_limits(robot: Robot, path: GeometricPath, zones: tuple[Zone, ...], fram
         if zone.s_range is not None:
             ranges: tuple[tuple[float, float], ...] = ((float(zone.s_range[0]), float(zone.s_range[1])),)
         else:
+            assert zone.region is not None  # check_zones: an s-range or a region, exactly one
             ranges = region_ranges(robot, path, frame_id, zone.region, deadline)
         if sum(len(item.ranges) for item in limited) + len(ranges) > MAX_RANGES:
             raise InvalidRequest(

@@ -6,6 +6,8 @@ the stretches joined into one timing. Motion generators time the paths they find
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from toptraj.planners.checks.gate import TimedStretch, gated
@@ -15,8 +17,14 @@ from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.stretch import Stretch, stretches
 from toptraj.planners.problem.methods import Timed
 from toptraj.planners.problem.path_checks import check_jerk_finite, check_path_within_limits, path_boundary, timing_grid
-from toptraj.planners.timing.base import Boundary
+from toptraj.planners.timing.base import Boundary, TimingMethod
 from toptraj.planners.timing.segmented import SegmentedTiming
+
+if TYPE_CHECKING:
+    from toptraj.planners.execution.deadline import Deadline
+    from toptraj.planners.paths.base import GeometricPath
+    from toptraj.planners.problem.requests import Timing
+    from toptraj.robots import JointLimits, Robot
 
 
 def _stretch_boundary(boundary: Boundary, width: float, first: bool, last: bool) -> Boundary:
@@ -49,7 +57,10 @@ def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, 
     return TimedStretch(stretch, timing, constraints, check)
 
 
-def timed_path(robot, path, method, timing, kinds, limits, deadline, threshold) -> Timed:
+def timed_path(
+    robot: Robot, path: GeometricPath, method: TimingMethod, timing: Timing, kinds: tuple[str, ...], limits: JointLimits,
+    deadline: Deadline, threshold: float,
+) -> Timed:
     """A given path timed by ``method``; each stretch between corners (where the motion stops)
     on its own, as its own rest-to-rest problem, and every one through the limit gate."""
     grid = path_grid(path, timing.grid_points)
@@ -63,7 +74,7 @@ def timed_path(robot, path, method, timing, kinds, limits, deadline, threshold) 
         _stretch_boundary(boundary, w, k == 0, k == len(parts) - 1) if len(parts) > 1 else boundary
         for k, w in enumerate(widths)
     ]
-    durations = [None] * len(parts)
+    durations: list[float | None] = [None] * len(parts)
     if timing.duration is not None and len(parts) > 1:
         shortest = [
             method.solve(build_path_constraints(part, robot, limits, kinds, path_grid(part, n), deadline), b, None, deadline).duration

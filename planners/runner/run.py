@@ -83,6 +83,7 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
     if problem.self_collision:
         part.progress(0.07, "self-collision")
         check_self_collision(path, problem.robot, deadline=problem.deadline)
+    assert isinstance(problem.method, TimingMethod)  # run gives the generators' problems to them
     timed = timed_path(
         problem.robot, path, problem.method, problem.options, problem.kinds, problem.limits, part.within(0.1, 1.0),
         problem.threshold,

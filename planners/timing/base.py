@@ -137,7 +137,7 @@ class TimeScaling(PathTiming):
     optimality_gap: float | None = None
     gap_basis: str = ""
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         sd = np.asarray(self.sd)
         # NaN and -inf fail the first comparison, +inf the second.
         if sd.size and not (sd.min() >= 0.0 and sd.max() < np.inf):

@@ -58,7 +58,7 @@ class RuckigTiming(PathTiming):
         phase = np.clip(np.searchsorted(ends, t, side="right"), 0, len(ends) - 1)
         return s, sd, sdd, self.phase_jerks[phase]
 
-    def at_times(self, t):
+    def at_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         s, sd, sdd, _ = self._states(t)
         return s, sd, sdd
 

@@ -89,7 +89,7 @@ class SegmentedTiming(PathTiming):
         known = [cost for cost in costs if cost is not None]
         return None if len(known) < len(costs) else float(sum(known))
 
-    def at_times(self, t: np.ndarray):
+    def at_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
         starts = self.starts
         index = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.parts) - 1)

@@ -52,7 +52,7 @@ def _toppra_classes():
         def waypoints(self):
             return self._s
 
-        def __call__(self, path_positions, order=0):
+        def __call__(self, path_positions, order=0) -> np.ndarray:
             raise TimingFailed("toppra asked for path geometry, which the adapter does not hold")
 
     class PrecomputedRows(toppra.constraint.LinearConstraint):

@@ -6,8 +6,12 @@ got there.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath
 
 
 @dataclass(frozen=True)
@@ -51,7 +55,7 @@ class CollocationResult:
         return f"second grid: the cost on {self.coarse_intervals} intervals against {len(self.t) - 1}"
 
 
-def collocation_path(result: CollocationResult):
+def collocation_path(result: CollocationResult) -> tuple[ViaPath, ConstantSpeedTiming]:
     """The optimized motion as a path with constant-speed timing: on each interval the exact
     cubic q_k + v_k t + a_k t^2 / 2 + (a_k+1 - a_k) t^3 / (6 h)."""
     from toptraj.planners.generators.via_points import ConstantSpeedTiming, ViaPath

@@ -15,6 +15,7 @@ winners is located by bisection.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -69,7 +70,7 @@ def _structure(controls: BangBang) -> str:
     return controls.label()
 
 
-def discover(robot: Robot, anchors) -> list[Family]:
+def discover(robot: Robot, anchors: Iterable[float]) -> list[Family]:
     """The families of the free-path answers (collocation with ``revolutions``, refined) at the
     shoulder goals ``anchors`` (rad), one per distinct elbow goal and switching structure."""
     families: list[Family] = []
@@ -119,7 +120,7 @@ def boundary(families: list[Family], below: Family, lower: float, upper: float, 
     return lower, upper
 
 
-def sweep(families: list[Family], phis) -> list[tuple[float, dict[str, float | None], str | None]]:
+def sweep(families: list[Family], phis: Iterable[float]) -> list[tuple[float, dict[str, float | None], str | None]]:
     """Per shoulder goal (rad): each family's duration (s, ``None`` where it does not exist),
     keyed by elbow goal and structure, and the fastest family's key."""
     rows = []
@@ -134,4 +135,5 @@ def sweep(families: list[Family], phis) -> list[tuple[float, dict[str, float | N
 
 
 def key(family: Family) -> str:
+    """The map's key of ``family``: its elbow angle psi_b (rad) and its label."""
     return f"psi_b {family.elbow:+.4f}: {family.label}"

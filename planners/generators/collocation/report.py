@@ -5,8 +5,13 @@ the estimated gap of the motion to the optimum of its own problem (Jeong & Lee s
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from toptraj.planners.problem.methods import Report
+
+if TYPE_CHECKING:
+    from toptraj.planners.generators.collocation.motion import CollocationResult
+    from toptraj.planners.timing.base import PathTiming
 
 
 @dataclass(frozen=True)
@@ -39,7 +44,7 @@ class CollocationReport(Report):
     gap_basis: str
 
     @classmethod
-    def of(cls, collocation, switching: str | None, gap) -> CollocationReport:
+    def of(cls, collocation: CollocationResult, switching: str | None, gap: CollocationResult | PathTiming) -> CollocationReport:
         """The report of ``collocation`` (a ``CollocationResult``) whose motion is returned,
         with the gap of ``gap`` (the collocation itself, or the refined motion that replaced it:
         anything with ``optimality_gap`` and ``gap_basis``)."""

@@ -8,10 +8,12 @@ implicit function theorem.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 
-def jacobian(function, x: np.ndarray, value: np.ndarray, step: float = 1e-6) -> np.ndarray:
+def jacobian(function: Callable[[np.ndarray], np.ndarray], x: np.ndarray, value: np.ndarray, step: float = 1e-6) -> np.ndarray:
     """Forward differences of ``function`` at ``x`` (where it is ``value``)."""
     columns = []
     for i in range(len(x)):
@@ -21,7 +23,7 @@ def jacobian(function, x: np.ndarray, value: np.ndarray, step: float = 1e-6) -> 
     return np.array(columns).T
 
 
-def newton(function, x: np.ndarray, tolerance: float, iterations: int = 30) -> np.ndarray:
+def newton(function: Callable[[np.ndarray], np.ndarray], x: np.ndarray, tolerance: float, iterations: int = 30) -> np.ndarray:
     """Gauss-Newton steps of least norm (the pseudo-inverse: square or with more unknowns than
     equations) towards function(x) = 0, halved while they do not reduce the residual."""
     value = function(x)
@@ -42,7 +44,7 @@ def newton(function, x: np.ndarray, tolerance: float, iterations: int = 30) -> n
     return x
 
 
-def held_newton(function, theta: np.ndarray, held: np.ndarray, tolerance: float) -> np.ndarray:
+def held_newton(function: Callable[..., np.ndarray], theta: np.ndarray, held: np.ndarray, tolerance: float) -> np.ndarray:
     """Newton's method on the unknowns other than ``held`` (indices), which keep their values."""
     others = np.setdiff1d(np.arange(len(theta)), held)
 
@@ -60,7 +62,7 @@ def held_newton(function, theta: np.ndarray, held: np.ndarray, tolerance: float)
 SECANT_FIRST, SECANT_LONGEST, SECANT_TOLERANCE = 2e-3, 2e-2, 1e-8
 
 
-def secant_minimum(residual, theta: np.ndarray, iterations: int = 30) -> tuple[np.ndarray, int]:
+def secant_minimum(residual: Callable[[np.ndarray], np.ndarray], theta: np.ndarray, iterations: int = 30) -> tuple[np.ndarray, int]:
     """The shortest T along the one-dimensional family of solutions through ``theta``: the
     switching time p that the family's tangent moves most is held, and dT/dp = 0 is solved by
     the secant method, each trial corrected back onto the family by Newton's method."""

@@ -15,11 +15,15 @@ intervals, and much finer meshes, become affordable (``benchmarks/free_path.py``
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
 
 from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
+
+if TYPE_CHECKING:
+    from toptraj.planners.generators.collocation.collocation import _Problem
 
 
 @dataclass(frozen=True)
@@ -48,7 +52,7 @@ class SparseCollocation:
         dynamics: The robot's ``inverse_dynamics_function``, when already built.
     """
 
-    def __init__(self, problem, max_iterations: int, dynamics: ca.Function | None = None):
+    def __init__(self, problem: _Problem, max_iterations: int, dynamics: ca.Function | None = None):
         n, K = problem.n, problem.K
         self.n, self.K = n, K
         size = (K + 1) * n
@@ -89,7 +93,7 @@ class SparseCollocation:
         }
         self.solver = ca.nlpsol("collocation", "ipopt", {"x": z, "f": cost, "g": ca.vertcat(equalities, ca.vec(tau))}, options)
 
-    def solve(self, problem, z0: np.ndarray) -> SparseResult:
+    def solve(self, problem: _Problem, z0: np.ndarray) -> SparseResult:
         """The optimum from ``z0`` for the boundary states of ``problem`` (same shape)."""
         n, K = self.n, self.K
         size = (K + 1) * n
@@ -108,6 +112,6 @@ class SparseCollocation:
         )
 
 
-def solve_sparse(problem, z0: np.ndarray, max_iterations: int, dynamics: ca.Function | None = None) -> SparseResult:
+def solve_sparse(problem: _Problem, z0: np.ndarray, max_iterations: int, dynamics: ca.Function | None = None) -> SparseResult:
     """Solve ``problem`` (a ``collocation._Problem``) from ``z0`` with IPOPT."""
     return SparseCollocation(problem, max_iterations, dynamics).solve(problem, z0)

@@ -26,6 +26,7 @@ is not known), the complete path's both.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -36,6 +37,9 @@ from toptraj.planners.generators.search.curve import GridSplinePath
 from toptraj.planners.generators.search.pieces import INTERVALS, Pieces
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.robots import JointLimits, Robot
+
+if TYPE_CHECKING:
+    from toptraj.planners.execution.deadline import Deadline
 
 _INF = np.inf
 #: Rows of limits evaluated between two deadline checks.
@@ -89,7 +93,7 @@ def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
     return np.ascontiguousarray(a), np.ascontiguousarray(b), np.ascontiguousarray(c), d, lower, upper, x_bound
 
 
-def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds, deadline) -> PieceBounds:
+def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds: tuple[str, ...], deadline: Deadline) -> PieceBounds:
     """The bounds of every piece (t1, t2 and the arrays t3 runs on)."""
     count = len(pieces.ds)
     p = q = r = np.empty((count, 0))
@@ -185,7 +189,7 @@ def _ahead(i, x, ds, q, r):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def forward_time(lo, hi, ds, q, r, cap_start, cap_end, x_in):  # pragma: no cover - compiled
+def forward_time(lo, hi, ds, q, r, cap_start, cap_end, x_in) -> tuple[float, float]:  # pragma: no cover - compiled
     """t3 over the intervals lo .. hi - 1 (one piece) entered with x at most ``x_in``: the time
     with x on the maximum-acceleration curve, capped by the velocity limit curve. Returns the
     time (s) and the bound on x at the piece's end."""
@@ -204,7 +208,7 @@ def forward_time(lo, hi, ds, q, r, cap_start, cap_end, x_in):  # pragma: no cove
 
 
 @njit(cache=True, nogil=True)
-def path_time(intervals, ds, p, q, r, cap_start, cap_end):  # pragma: no cover - compiled
+def path_time(intervals, ds, p, q, r, cap_start, cap_end) -> float:  # pragma: no cover - compiled
     """t3 of a complete grid path over ``intervals`` (indices, in order), from rest to rest: x
     below the maximum-acceleration curve from the start, the velocity limit curve and the
     maximum-deceleration curve into the goal (eq. 2.8)."""
@@ -243,7 +247,7 @@ def path_time(intervals, ds, p, q, r, cap_start, cap_end):  # pragma: no cover -
     return total
 
 
-def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds) -> float:
+def grid_path_time(points: np.ndarray, robot: Robot, limits: JointLimits, kinds: tuple[str, ...]) -> float:
     """t4 (s): the phase-plane method (``toptraj.planners.timing.phase_plane.method``, without refinement) on
     the curve of the grid path through ``points`` (``toptraj.planners.generators.search.curve``), on the grid of
     its pieces (``INTERVALS`` per span)."""

@@ -44,7 +44,7 @@ class _Node:
 
     __slots__ = ("state", "edge", "g1", "g2", "g3", "x", "visited", "parent", "piece", "complete", "t3", "t4")
 
-    def __init__(self, state, edge, g1, g2, g3, x, visited, parent, piece, complete=False):
+    def __init__(self, state, edge, g1, g2, g3, x, visited, parent, piece, complete=False) -> None:
         self.state, self.edge = state, edge
         self.g1, self.g2, self.g3, self.x = g1, g2, g3, x
         self.visited, self.parent, self.piece, self.complete = visited, parent, piece, complete

@@ -49,7 +49,7 @@ def _joint_motion(joint) -> tuple[str, np.ndarray] | None:
     return None
 
 
-def joint_placements(robot: Robot, q: np.ndarray):
+def joint_placements(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """World rotations (k, J, 3, 3) and translations (k, J, 3) of every joint frame at the
     configurations q (k, n_dof), computed for all configurations at once; None when a joint is
     of a kind this does not handle (``_joint_motion``)."""

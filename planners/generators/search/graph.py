@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -288,7 +289,7 @@ def _find(points: np.ndarray, q: np.ndarray, what: str) -> int:
 
 
 def roadmap_graph(
-    robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool, free,
+    robot: Robot, start: np.ndarray, goal: np.ndarray, options: SearchOptions, revolutions: bool, free: Callable[[np.ndarray], np.ndarray],
     deadline: Deadline = NO_DEADLINE,
 ) -> SearchGraph:
     """A sparse graph for arms with many joints: start, goals and ``options.roadmap_points``

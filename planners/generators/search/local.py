@@ -114,7 +114,7 @@ class _Objective:
     """J(P) of the module docstring on the interior control points x (flattened (k - 2) n),
     counting its evaluations and checking the deadline at each."""
 
-    def __init__(self, robot, limits, kinds, start, goal, obstacles, clearance, settings, deadline):
+    def __init__(self, robot, limits, kinds, start, goal, obstacles, clearance, settings, deadline) -> None:
         self.robot, self.limits, self.kinds = robot, limits, kinds
         self.start, self.goal = start, goal
         self.obstacles, self.clearance, self.settings = list(obstacles), clearance, settings
@@ -242,7 +242,6 @@ def optimize_locally(
             clearance and the joint ranges (a ``PathInCollision`` when it is the clearance).
         BudgetExceeded: ``deadline`` passed.
     """
-
     started = time.perf_counter()
     seed = _seed_points(seed, robot.dof)
     counts = _schedule(max(settings.first_control_points, DEGREE + 1), settings.max_control_points)

@@ -79,7 +79,9 @@ class Pieces:
         return q.reshape(-1, q.shape[2]), np.repeat(piece_ids, count + 1)
 
 
-def span_keys(edge_from, edge_to, start: int, goals: np.ndarray, turn_in: np.ndarray, turn_out: np.ndarray):
+def span_keys(
+    edge_from: np.ndarray, edge_to: np.ndarray, start: int, goals: np.ndarray, turn_in: np.ndarray, turn_out: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The spans the augmented graph allows: (kind, turn_in, turn_out, edge) per span, as arrays,
     from the graph's moves and its turns (pairs of moves at grid points that are no goal)."""
     into_goal = np.isin(edge_to, goals)
@@ -106,7 +108,10 @@ def span_keys(edge_from, edge_to, start: int, goals: np.ndarray, turn_in: np.nda
     )
 
 
-def build_pieces(points, edge_from, edge_to, start: int, goals, turn_in, turn_out) -> Pieces:
+def build_pieces(
+    points: np.ndarray, edge_from: np.ndarray, edge_to: np.ndarray, start: int, goals: np.ndarray, turn_in: np.ndarray,
+    turn_out: np.ndarray,
+) -> Pieces:
     """Every span of ``span_keys``, its control points and its samples."""
     kind, t_in, t_out, edge = span_keys(edge_from, edge_to, start, goals, turn_in, turn_out)
     n = points.shape[1]

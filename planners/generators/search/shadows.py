@@ -67,7 +67,9 @@ def obstacle_shadows(robot: Robot, obstacles: list[Obstacle], clearance: float, 
     blocked = grid[occupied]
     shadows = []
     if blocked.size:
-        rotation, translation = joint_placements(robot, blocked)
+        placements = joint_placements(robot, blocked)
+        assert placements is not None  # ``_plane`` found every joint of a kind it handles
+        rotation, translation = placements
         joint = frame.parentJoint
         tip = np.einsum("kij,j->ki", rotation[:, joint], frame.placement.translation) + translation[:, joint]
         flat = np.column_stack([tip @ plane[0], tip @ plane[1]])

@@ -24,11 +24,16 @@ solution; for limits constant along the path it is the exact optimum.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming, segment_starts
+
+if TYPE_CHECKING:
+    from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
 
 #: Most segments polished: a time-optimal motion under limits that do not change along the
 #: path has at most seven; many more phases mean limits that change along it, where segments
@@ -54,7 +59,7 @@ DENSE_FRACTIONS = np.linspace(0.0, 1.0, 65)
 MERGE_FRACTIONS = (0.02, 1e-3)
 
 
-def phases(grid_timing, merge_below: float = 1e-3) -> tuple[np.ndarray, np.ndarray] | None:
+def phases(grid_timing: JerkTimeScaling, merge_below: float = 1e-3) -> tuple[np.ndarray, np.ndarray] | None:
     """Initial durations and jerks of the segments: the runs of grid intervals whose path jerk
     is above a quarter of its largest magnitude, below minus that, or in between; runs shorter
     than ``merge_below`` times the duration join the run before them. ``None`` when there are
@@ -200,7 +205,9 @@ def _points(durations, jerks, start, checks):
     return s, v, a, sigma, Dp, starts, D
 
 
-def polish(constraints: PathConstraints, grid_timing, sd_start: float, sd_end: float, deadline: Deadline):
+def polish(
+    constraints: PathConstraints, grid_timing: JerkTimeScaling, sd_start: float, sd_end: float, deadline: Deadline
+) -> JerkSegmentsTiming | None:
     """The polished timing (``JerkSegmentsTiming``), or ``None`` when the polish does not find a
     motion that holds the limits and is shorter than ``grid_timing``: each segmentation of
     ``MERGE_FRACTIONS`` polished in turn, the shortest result kept."""

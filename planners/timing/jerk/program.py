@@ -274,7 +274,7 @@ class RestrictedProgram:
         """Durations (M,) in s of the motions x, u (M, N + 1) on this grid."""
         return interval_times(self.constraints.s, np.maximum(x, 0.0), u, self.rest_start, self.rest_end).sum(axis=1)
 
-    def timing(self, x, u) -> JerkTimeScaling:
+    def timing(self, x: np.ndarray, u: np.ndarray) -> JerkTimeScaling:
         return JerkTimeScaling(
             self.constraints.s, np.sqrt(np.maximum(x, 0.0)), u=np.asarray(u, dtype=float),
             rest_start=self.rest_start, rest_end=self.rest_end,

@@ -75,7 +75,7 @@ class JerkSegmentsTiming(PathTiming):
         sdd = a0 + sigma * local
         return np.clip(s, 0.0, 1.0), np.maximum(sd, 0.0), sdd, sigma
 
-    def at_times(self, t):
+    def at_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         s, sd, sdd, _ = self._states(t)
         return s, sd, sdd
 

@@ -64,7 +64,9 @@ class WorkingSetLP:
         self.basis = None
         self.total = 0
 
-    def solve(self, objective, matrix: sparse.csr_matrix, lower, upper, low, high, seed: np.ndarray | None = None) -> np.ndarray:
+    def solve(
+        self, objective: np.ndarray, matrix: sparse.csr_matrix, lower: np.ndarray, upper: np.ndarray, low: np.ndarray,
+        high: np.ndarray, seed: np.ndarray | None = None) -> np.ndarray:
         """The optimal column values of min objective.x, lower <= matrix x <= upper,
         low <= x <= high (``matrix`` (rows, columns), CSR). The first LP's working set holds
         the rows with equal bounds and, given a ``seed`` (column values near the optimum), the

@@ -89,7 +89,7 @@ class LawTiming(PathTiming):
     def _starts(self) -> np.ndarray:
         return np.concatenate(([0.0], np.cumsum([segment.duration for segment in self.segments])))
 
-    def at_times(self, t: np.ndarray):
+    def at_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
         starts = self._starts
         index = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.segments) - 1)

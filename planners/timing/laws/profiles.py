@@ -102,7 +102,7 @@ class CubicProfile(NormalizedProfile):
 
     name = "cubic"
 
-    def derivatives(self, tau):
+    def derivatives(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         tau = np.asarray(tau, dtype=float)
         return (
             tau * tau * (3 - 2 * tau),
@@ -117,10 +117,10 @@ class QuinticProfile(NormalizedProfile):
 
     name = "quintic"
 
-    def knots(self):
+    def knots(self) -> np.ndarray:
         return np.array([0.0, (3 - np.sqrt(3)) / 6, 0.5, (3 + np.sqrt(3)) / 6, 1.0])
 
-    def derivatives(self, tau):
+    def derivatives(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         tau = np.asarray(tau, dtype=float)
         return (
             tau**3 * (10 - 15 * tau + 6 * tau**2),
@@ -142,13 +142,13 @@ class TrapezoidalProfile(NormalizedProfile):
         self.tau1, self.tau2 = tau1, tau2
         self.peak_speed = 2.0 / (1.0 - tau1 + tau2)
 
-    def knots(self):
+    def knots(self) -> np.ndarray:
         return np.array([0.0, self.tau1, self.tau2, 1.0])
 
-    def inner_acceleration_steps(self):
+    def inner_acceleration_steps(self) -> np.ndarray:
         return np.unique([self.tau1, self.tau2])
 
-    def derivatives(self, tau):
+    def derivatives(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         tau = np.asarray(tau, dtype=float)
         t1, t2, v = self.tau1, self.tau2, self.peak_speed
         rising = tau <= t1
@@ -186,13 +186,13 @@ class CycloidalBlendProfile(TrapezoidalProfile):
 
     name = "trapezoidal"
 
-    def knots(self):
+    def knots(self) -> np.ndarray:
         return np.array([0.0, 0.5 * self.tau1, self.tau1, self.tau2, 0.5 * (1.0 + self.tau2), 1.0])
 
-    def inner_acceleration_steps(self):
+    def inner_acceleration_steps(self) -> np.ndarray:
         return np.empty(0)
 
-    def derivatives(self, tau):
+    def derivatives(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         tau = np.asarray(tau, dtype=float)
         t1, t2, v = self.tau1, self.tau2, self.peak_speed
         rising, falling = tau <= t1, tau >= t2
@@ -222,10 +222,10 @@ class CycloidalProfile(NormalizedProfile):
 
     name = "cycloidal"
 
-    def knots(self):
+    def knots(self) -> np.ndarray:
         return np.array([0.0, 0.25, 0.5, 0.75, 1.0])
 
-    def derivatives(self, tau):
+    def derivatives(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         tau = np.asarray(tau, dtype=float)
         angle = 2 * np.pi * tau
         return (

@@ -1,4 +1,4 @@
-"""Cubic splines through equally spaced supporting points (Angeles, *Fundamentals of Robotic
+r"""Cubic splines through equally spaced supporting points (Angeles, *Fundamentals of Robotic
 Mechanical Systems*, sec. 6.6 and the solutions to problems 6.1 (c) and 6.2).
 
 On the supporting points x_k = k / (N - 1), k = 0 .. N - 1 (spacing h = 1 / (N - 1)), a cubic
@@ -6,8 +6,8 @@ spline is fixed by its values s_k and its second derivatives s''_k; on [x_k, x_{
 u = x - x_k (eqs. 6.55a-d),
 
 .. math::
-    s(x) = A_k u^3 + B_k u^2 + C_k u + D_k,\\quad A_k = (s''_{k+1} - s''_k) / (6 h),\\quad
-    B_k = s''_k / 2,\\quad C_k = (s_{k+1} - s_k) / h - h (s''_{k+1} + 2 s''_k) / 6,\\quad D_k = s_k,
+    s(x) = A_k u^3 + B_k u^2 + C_k u + D_k,\quad A_k = (s''_{k+1} - s''_k) / (6 h),\quad
+    B_k = s''_k / 2,\quad C_k = (s_{k+1} - s_k) / h - h (s''_{k+1} + 2 s''_k) / 6,\quad D_k = s_k,
 
 and continuity of s' at the interior points gives the equations (6.58a) A s'' = 6 C s, rows
 h s''_{k-1} + 4 h s''_k + h s''_{k+1} = 6 (s_{k-1} - 2 s_k + s_{k+1}) / h.
@@ -170,8 +170,8 @@ class SplineProfile(NormalizedProfile):
     def description(self) -> str:
         return f"cubic spline through {self.supporting_points} points of the {self.law.name} law"
 
-    def knots(self):
+    def knots(self) -> np.ndarray:
         return np.union1d(self.spline.points, [0.5])
 
-    def derivatives(self, tau):
+    def derivatives(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         return self.spline.derivatives(tau)

@@ -114,6 +114,8 @@ class Profile(NamedTuple):
 
 
 def interval_times(s: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The time (s) of each interval of the grid ``s`` (n,) crossed at x = sd^2 (n,) given at its
+    points: 2 ds / (sqrt(x_i) + sqrt(x_i+1)), exact for a constant acceleration."""
     root = np.sqrt(x)
     return 2.0 * np.diff(s) / np.maximum(root[:-1] + root[1:], 1e-300)
 
