@@ -40,7 +40,7 @@ def pair_diagrams(cell: Cell, deadline: Deadline) -> dict[tuple[int, int], Diagr
     return out
 
 
-def _clear(diagrams, placed: dict[int, SoloMotion], arm: int, motion: SoloMotion) -> bool:
+def _clear(diagrams: dict[tuple[int, int], Diagram], placed: dict[int, SoloMotion], arm: int, motion: SoloMotion) -> bool:
     """Whether ``arm`` on ``motion`` stays in the free part of its diagram with each placed arm."""
     end = max([motion.duration] + [other.duration for other in placed.values()])
     t = np.linspace(0.0, end, SAMPLES + 1)
@@ -74,7 +74,7 @@ def _in_order(diagrams, solo: list[TimeScaling], order: tuple[int, ...], deadlin
     return Schedule(tuple(placed[arm] for arm in range(len(solo))), kind)
 
 
-def prioritized(cell: Cell, solo: list[TimeScaling], diagrams, deadline: Deadline) -> Schedule:
+def prioritized(cell: Cell, solo: list[TimeScaling], diagrams: dict[tuple[int, int], Diagram], deadline: Deadline) -> Schedule:
     """The quickest prioritized schedule over every order of the arms (module docstring).
 
     Raises:

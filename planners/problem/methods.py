@@ -87,7 +87,7 @@ class Execution:
         """The same execution for a part of the work (``Deadline.within``)."""
         return dataclasses.replace(self, deadline=self.deadline.within(start, end, label))
 
-    def uninterruptible(self, function: Callable[..., T], *args, progress: bool = False, memory_bytes: int | None = None) -> T:
+    def uninterruptible(self, function: Callable[..., T], *args: object, progress: bool = False, memory_bytes: int | None = None) -> T:
         """``function(*args)`` (a module-level function of plain, picklable arguments), in a
         worker process at a lower CPU priority when ``isolate``, else inline; with ``progress``,
         called with ``progress=report`` relayed to the deadline's progress. ``memory_bytes``:
