@@ -127,7 +127,7 @@ class _Objective:
         self.evaluations = 0
         self.interior = np.empty(0)
         self.stop_at = np.inf  # time.monotonic() beyond which a round ends early
-        self.best = (np.inf, None)  # (objective, x) of the round under way
+        self.best: tuple[float, np.ndarray | None] = (np.inf, None)  # (objective, x) of the round under way
 
     def round_begins(self) -> None:
         self.best = (np.inf, None)
