@@ -89,7 +89,8 @@ def _forward_pass(model, kinds, q, qd, qdd) -> tuple[list, list]:
     forces: list = []
     for i in range(1, model.njoints):
         k = model.joints[i].idx_v
-        (R, p), (S_lin, S_ang) = _joint_placement(model, i, *kinds[i - 1], q[k])
+        kind, axis = kinds[i - 1]
+        (R, p), (S_lin, S_ang) = _joint_placement(model, i, kind, axis, q[k])
         placements.append((R, p))
         vp_lin, vp_ang = v[parents[i]]
         ap_lin, ap_ang = a[parents[i]]
