@@ -112,13 +112,13 @@ def main() -> int:
         wall, anchor = statistics.median(walls), statistics.median(anchors)
         if answer is None:
             continue
-        search = answer.search or {}
-        local = search.get("local") or [{}]
+        report = answer.search  # a SearchReport
+        stats, local = report.statistics, report.local[0] if report.local else None
+        local_text = "none" if local is None else f"{local.evaluations} ({local.stopped}, {local.wall_s:.2f} s)"
         print(
             f"{name:<8} wall {wall:7.3f} s  ratio {wall / anchor:7.0f}x (goal <= {goal}x; toppra {1e3 * anchor:.2f} ms)  "
-            f"duration {statistics.median(durations):.5f} s (rounds {', '.join(f'{d:.5f}' for d in durations)})  build {search.get('prepare_s', 0.0):.3f} s  "
-            f"B&B {search.get('search_s', 0.0):.3f} s  expanded {search.get('expanded')}  "
-            f"local evaluations {local[0].get('evaluations')} ({local[0].get('stopped')}, {local[0].get('wall_s') or 0.0:.2f} s)",
+            f"duration {statistics.median(durations):.5f} s (rounds {', '.join(f'{d:.5f}' for d in durations)})  build {stats.prepare_s:.3f} s  "
+            f"B&B {stats.search_s:.3f} s  expanded {stats.expanded}  local evaluations {local_text}",
             flush=True,
         )
         if name in BEFORE:

@@ -27,6 +27,7 @@ import dataclasses
 import itertools
 import time
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -35,6 +36,7 @@ from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline, Progress
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
+from toptraj.planners.generators.collocation.guesses import bend_guesses, goal_guesses
 from toptraj.planners.generators.collocation.motion import CollocationResult
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.waypoints import SplinePath
@@ -167,11 +169,13 @@ class _Problem:
             J[r : r + n, 1 + 2 * size + k * n : 1 + 2 * size + (k + 1) * n] = da[k]
         return np.vstack([-J, J])
 
-    def bounds(self):
+    def bounds(self) -> list[tuple[float | None, float | None]]:
+        """SciPy's bounds of z: T in [1e-3, 1e3] s, then the joint ranges, velocities and
+        accelerations at every grid point (``None``: unbounded)."""
         K = self.K
         lower, upper = self.limits.position_lower, self.limits.position_upper
         velocity = self.limits.velocity
-        box = [(1e-3, 1e3)]
+        box: list[tuple[float | None, float | None]] = [(1e-3, 1e3)]
         box += [(lo if np.isfinite(lo) else None, hi if np.isfinite(hi) else None) for lo, hi in zip(np.tile(lower, K + 1), np.tile(upper, K + 1))]
         box += [(-v if np.isfinite(v) else None, v if np.isfinite(v) else None) for v in np.tile(velocity, K + 1)]
         acceleration = self.limits.acceleration
@@ -184,8 +188,6 @@ COARSE_INTERVALS = 12
 #: refined on the fine grid too (at most ``MAX_RIVALS`` of them).
 RIVAL_MARGIN = 0.02
 MAX_RIVALS = 2
-#: Amplitude (rad or m) of the bends added to the straight line in the initial guesses.
-BEND = 1.0
 
 
 def _timed_guess(problem: _Problem, bend: np.ndarray) -> np.ndarray:
@@ -222,31 +224,6 @@ def _refined(coarse: _Problem, z: np.ndarray, fine: _Problem) -> np.ndarray:
         v[k] + a[k] * r + jerk * r**2 / 2,
         a[k] + jerk * r,
     )
-
-
-def _goals(robot: Robot, motion: FreeMotion) -> list[tuple[str, np.ndarray]]:
-    """The straight-line goal and, for continuous joints, the goal one revolution either way."""
-    options = [("straight line", motion.goal)]
-    continuous = np.flatnonzero(robot.continuous) if motion.revolutions else np.empty(0, dtype=int)
-    for shifts in itertools.product((-2 * np.pi, 0.0, 2 * np.pi), repeat=len(continuous)):
-        if not any(shifts):
-            continue
-        goal = motion.goal.copy()
-        goal[continuous] += shifts
-        label = ", ".join(f"{robot.joint_names[j]} {shift:+.4f} rad" for j, shift in zip(continuous, shifts) if shift)
-        options.append((f"goal shifted: {label}", goal))
-    return options
-
-
-def _bends(n_dof: int) -> list[tuple[str, np.ndarray]]:
-    """Straight, and bent one joint at a time both ways (all joints together beyond three)."""
-    options = [("", np.zeros(n_dof))]
-    directions = np.eye(n_dof) if n_dof <= 3 else np.ones((1, n_dof))
-    for direction in directions:
-        for sign in (1.0, -1.0):
-            joints = "all joints" if n_dof > 3 else f"joint {int(np.argmax(direction))}"
-            options.append((f", bent {'+' if sign > 0 else '-'}{BEND:g} at {joints}", sign * BEND * direction))
-    return options
 
 
 def _solve(problem: _Problem, z0: np.ndarray, max_iterations: int):
@@ -313,27 +290,65 @@ def _optimize_motion(
     max_iterations: int,
     progress: Progress = NO_DEADLINE.progress,
 ) -> CollocationResult:
-    # here: casadi and its solvers take a second to import, for this method only
-    from toptraj.planners.generators.collocation.sparse import SparseCollocation, solve_sparse
-    from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
-
+    """``optimize_motion``'s work, in the calling process: every initial guess on the coarse
+    grid, then the best of each goal within ``RIVAL_MARGIN`` of the best refined on
+    ``motion.intervals``; the cheapest refined motion, the others as its ``rivals``."""
     if robot.outside_position_limits(motion.start) is not None:
         raise InvalidRequest("start", motion.start, rule="outside_the_joint_limits")
     if robot.outside_position_limits(motion.goal) is not None:
         raise InvalidRequest("goal", motion.goal, rule="outside_the_joint_limits")
     started = time.perf_counter()
+    coarse = _coarse_solutions(robot, limits, motion, torque_weight, max_iterations, progress)
+    finished: list[CollocationResult] = []
+    failures = []
+    for rank, contender in enumerate(coarse.contenders):
+        progress((coarse.guesses + rank / len(coarse.contenders)) * coarse.share, "collocation: refining the best guess")
+        refined = _refine(robot, limits, motion, torque_weight, max_iterations, coarse.dynamics, contender)
+        if isinstance(refined, str):
+            failures.append(refined)
+        else:
+            finished.append(dataclasses.replace(refined, solve_s=time.perf_counter() - started))
+    if not finished:
+        raise InfeasiblePath("the collocation did not converge on the fine grid from its best guess " + "; ".join(failures))
+    finished.sort(key=lambda result: result.cost)
+    return dataclasses.replace(finished[0], rivals=tuple(finished[1:]))
+
+
+class _Coarse(NamedTuple):
+    """The coarse grid's outcome: the ``contenders`` to refine, each (result, problem, label,
+    goal), best first; the CasADi inverse dynamics built for them; the number of guesses and
+    the share of the progress each took."""
+
+    contenders: list[tuple]
+    dynamics: object
+    guesses: int
+    share: float
+
+
+def _coarse_solutions(
+    robot: Robot, limits: JointLimits, motion: FreeMotion, torque_weight: float, max_iterations: int, progress: Progress
+) -> _Coarse:
+    """Every initial guess (goals times bends) solved on ``COARSE_INTERVALS`` by the sparse
+    solver; the best feasible one of each goal, those within ``RIVAL_MARGIN`` of the best kept
+    (at most ``1 + MAX_RIVALS``).
+
+    Raises:
+        InfeasiblePath: no guess leads to a feasible coarse motion (the detail lists each).
+    """
+    # here: casadi and its solvers take a second to import, for this method only
+    from toptraj.planners.generators.collocation.sparse import SparseCollocation
+    from toptraj.planners.generators.collocation.symbolic_dynamics import inverse_dynamics_function
+
     tried: list[str] = []
-    coarse_solver = None
-    dynamics = None
+    coarse_solver, dynamics = None, None
     coarse_motion = FreeMotion(
         motion.start, motion.goal, motion.start_velocity, motion.end_velocity, min(COARSE_INTERVALS, motion.intervals)
     )
-    guesses = list(itertools.product(_goals(robot, motion), _bends(robot.dof)))
+    guesses = list(itertools.product(goal_guesses(robot, motion), bend_guesses(robot.dof)))
     # Progress: a dense SQP step costs about the cube of the variables, so the refinement
     # weighs (fine / coarse intervals)^3 coarse guesses.
     share = 1.0 / (len(guesses) + (motion.intervals / coarse_motion.intervals) ** 3)
-    # The best coarse solution per goal: (result, problem, label, goal).
-    per_goal: dict[str, tuple] = {}
+    per_goal: dict[str, tuple] = {}  # the best coarse solution per goal: (result, problem, label, goal)
     for index, ((goal_label, goal), (bend_label, bend)) in enumerate(guesses):
         progress(index * share, f"collocation: guess {index + 1} of {len(guesses)}")
         label = goal_label + bend_label
@@ -347,9 +362,8 @@ def _optimize_motion(
             dynamics = inverse_dynamics_function(robot)
             coarse_solver = SparseCollocation(coarse, max_iterations, dynamics)
         result = coarse_solver.solve(coarse, z0)
-        feasible = _feasible(coarse, result.x)
         tried.append(f"{label}: {result.message} (cost {result.fun:.6g})")
-        if feasible and (goal_label not in per_goal or result.fun < per_goal[goal_label][0].fun):
+        if _feasible(coarse, result.x) and (goal_label not in per_goal or result.fun < per_goal[goal_label][0].fun):
             per_goal[goal_label] = (result, coarse, label, goal)
     if not per_goal:
         raise InfeasiblePath("the collocation found no feasible motion from any initial guess: " + "; ".join(tried))
@@ -359,37 +373,31 @@ def _optimize_motion(
     # fine grid decides among them.
     ranked = sorted(per_goal.values(), key=lambda entry: entry[0].fun)
     contenders = [entry for entry in ranked if entry[0].fun <= ranked[0][0].fun * (1.0 + RIVAL_MARGIN)][: 1 + MAX_RIVALS]
-    finished: list[CollocationResult] = []
-    failures = []
-    for rank, (coarse_result, coarse, label, goal) in enumerate(contenders):
-        progress((len(guesses) + rank / len(contenders)) * share, "collocation: refining the best guess")
-        problem = _Problem(robot, limits, motion, goal, torque_weight)
-        z0 = _refined(coarse, coarse_result.x, problem)
-        result = solve_sparse(problem, z0, max_iterations, dynamics)
-        feasible = _feasible(problem, result.x)
-        if not feasible:  # the dense SQP, from the same start
-            result, feasible = _solve(problem, z0, max_iterations)
-        if not feasible:
-            failures.append(f"({label}): {result.message}")
-            continue
-        T, q, v, a = problem.unpack(result.x)
-        tau = problem._dynamics(result.x)[0]
-        finished.append(CollocationResult(
-            t=np.linspace(0.0, T, problem.K + 1),
-            q=q.copy(),
-            v=v.copy(),
-            a=a.copy(),
-            tau=tau.copy(),
-            cost=float(result.fun),
-            status=str(result.message),
-            iterations=int(coarse_result.nit + result.nit),
-            initial_guess=label,
-            solve_s=time.perf_counter() - started,
-            coarse_cost=float(coarse_result.fun),
-            coarse_intervals=coarse.K,
-        ))
-    if not finished:
-        raise InfeasiblePath("the collocation did not converge on the fine grid from its best guess " + "; ".join(failures))
-    finished.sort(key=lambda result: result.cost)
-    return dataclasses.replace(finished[0], rivals=tuple(finished[1:]))
+    return _Coarse(contenders, dynamics, len(guesses), share)
+
+
+def _refine(
+    robot: Robot, limits: JointLimits, motion: FreeMotion, torque_weight: float, max_iterations: int, dynamics, contender: tuple
+) -> CollocationResult | str:
+    """The coarse ``contender`` (result, problem, label, goal) resampled on ``motion.intervals``
+    and solved by IPOPT (by SLSQP from the same start should IPOPT end infeasible): the motion,
+    or why it failed."""
+    from toptraj.planners.generators.collocation.sparse import solve_sparse
+
+    coarse_result, coarse, label, goal = contender
+    problem = _Problem(robot, limits, motion, goal, torque_weight)
+    z0 = _refined(coarse, coarse_result.x, problem)
+    result = solve_sparse(problem, z0, max_iterations, dynamics)
+    feasible = _feasible(problem, result.x)
+    if not feasible:  # the dense SQP, from the same start
+        result, feasible = _solve(problem, z0, max_iterations)
+    if not feasible:
+        return f"({label}): {result.message}"
+    T, q, v, a = problem.unpack(result.x)
+    tau = problem._dynamics(result.x)[0]
+    return CollocationResult(
+        t=np.linspace(0.0, T, problem.K + 1), q=q.copy(), v=v.copy(), a=a.copy(), tau=tau.copy(),
+        cost=float(result.fun), status=str(result.message), iterations=int(coarse_result.nit + result.nit),
+        initial_guess=label, solve_s=0.0, coarse_cost=float(coarse_result.fun), coarse_intervals=coarse.K,
+    )
 

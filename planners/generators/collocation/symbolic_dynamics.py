@@ -60,30 +60,37 @@ def inverse_dynamics_function(robot: Robot) -> ca.Function:
     """``tau = f(q, qd, qdd)`` for ``robot``: a CasADi function of three (n_dof,) vectors in the
     robot's joint coordinates (angles for continuous joints), returning (n_dof,) torques
     without friction (Pinocchio's ``rnea``)."""
-    model = robot.model
-    n = model.nv
+    n = robot.model.nv
     q, qd, qdd = ca.SX.sym("q", n), ca.SX.sym("qd", n), ca.SX.sym("qdd", n)
     kinds = _subspaces(robot)
-    gravity = np.array(model.gravity.linear)
+    placements, forces = _forward_pass(robot.model, kinds, q, qd, qdd)
+    tau = _backward_pass(robot.model, kinds, placements, forces)
+    return ca.Function("rnea", [q, qd, qdd], [ca.vertcat(*tau)])
+
+
+def _joint_placement(model, i: int, kind: str, axis: np.ndarray, angle):
+    """(R, p) of joint ``i`` in its parent's frame moved by ``angle`` (rad or m) about or along
+    ``axis``, and its motion subspace (S_lin, S_ang) (3,) each."""
+    fixed = model.jointPlacements[i]
+    R0, p0 = ca.DM(fixed.rotation), ca.DM(fixed.translation)
+    if kind == "revolute":
+        return (R0 @ _rotation(axis, angle), p0), (ca.DM.zeros(3), ca.DM(axis))
+    return (R0, p0 + R0 @ ca.DM(axis) * angle), (ca.DM(axis), ca.DM.zeros(3))
+
+
+def _forward_pass(model, kinds, q, qd, qdd) -> tuple[list, list]:
+    """The outward recursion (module docstring): each joint's placement (R, p) in its parent
+    and the force [f, n] (3,) each its body needs, f_i = I_i a_i + v_i x* I_i v_i."""
     parents = [model.parents[i] for i in range(model.njoints)]
     zero = ca.SX.zeros(3)
     placements: list = []  # (R, p) of each joint in its parent's frame, moved by the joint
     v: list = [(zero, zero)]  # (linear, angular) per body, body 0 the base
-    a: list = [(ca.SX(ca.DM(-gravity)), zero)]
+    a: list = [(ca.SX(ca.DM(-np.array(model.gravity.linear))), zero)]
     forces: list = []
     for i in range(1, model.njoints):
         k = model.joints[i].idx_v
         kind, axis = kinds[i - 1]
-        fixed = model.jointPlacements[i]
-        R0, p0 = ca.DM(fixed.rotation), ca.DM(fixed.translation)
-        R: ca.SX | ca.DM
-        p: ca.SX | ca.DM
-        if kind == "revolute":
-            R, p = R0 @ _rotation(axis, q[k]), p0
-            S_lin, S_ang = ca.DM.zeros(3), ca.DM(axis)
-        else:
-            R, p = R0, p0 + R0 @ ca.DM(axis) * q[k]
-            S_lin, S_ang = ca.DM(axis), ca.DM.zeros(3)
+        (R, p), (S_lin, S_ang) = _joint_placement(model, i, kind, axis, q[k])
         placements.append((R, p))
         vp_lin, vp_ang = v[parents[i]]
         ap_lin, ap_ang = a[parents[i]]
@@ -108,17 +115,23 @@ def inverse_dynamics_function(robot: Robot) -> ca.Function:
         f_v, n_v = apply(lin, w)
         # v x* (I v): f' = w x f, n' = w x n + v x f
         forces.append([f_a + ca.cross(w, f_v), n_a + ca.cross(w, n_v) + ca.cross(lin, f_v)])
-    tau: list = [ca.SX(0)] * n
+    return placements, forces
+
+
+def _backward_pass(model, kinds, placements: list, forces: list) -> list:
+    """The inward recursion (module docstring): tau_i = S_i^T f_i, each body's force added to
+    its parent's, children first; the (n_dof,) torques as a list. ``forces`` is updated."""
+    tau: list = [ca.SX(0)] * model.nv
     for i in range(model.njoints - 1, 0, -1):
         k = model.joints[i].idx_v
         kind, axis = kinds[i - 1]
         f, moment = forces[i - 1]
         tau[k] = ca.dot(ca.DM(axis), moment) if kind == "revolute" else ca.dot(ca.DM(axis), f)
-        parent = parents[i]
+        parent = model.parents[i]
         if parent > 0:
             R, p = placements[i - 1]
             # X applied to the force: f' = R f, n' = R n + p x (R f)
             Rf = R @ f
             forces[parent - 1][0] = forces[parent - 1][0] + Rf
             forces[parent - 1][1] = forces[parent - 1][1] + R @ moment + ca.cross(p, Rf)
-    return ca.Function("rnea", [q, qd, qdd], [ca.vertcat(*tau)])
+    return tau
