@@ -22,9 +22,8 @@ from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, condit
 from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
 from toptraj.planners.paths.grid import spread_indices
 from toptraj.planners.problem.methods import MotionGenerator, Timed
-from toptraj.planners.problem.problem import Problem
+from toptraj.planners.problem.problem import LimitRequest, Problem
 from toptraj.planners.problem.ranges import DT
-from toptraj.planners.problem.requests import Timing
 from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, ZoneReport, require_finite
 from toptraj.planners.runner.accuracy import answer_accuracy
 from toptraj.planners.timing.base import TimingMethod
@@ -68,7 +67,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
     notes.extend(_singularity_notes(kappa_max, samples.t[worst]))
     switching = timed.switching_times
-    if switching is None and timed.method == "collocation" and problem.options.torque_weight == 0.0:
+    if switching is None and timed.method == "collocation" and getattr(problem.method, "torque_weight", None) == 0.0:
         read = collocation_switches(samples.t, samples.tau, problem.limits.torque, level=SATURATION_READ)
         switching = switching_times(read, robot.joint_names)
     s, sd, mvc = _phase_plane(timed.stretches)
@@ -82,7 +81,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
         solve_ms=(time.perf_counter() - started) * 1e3, warnings=tuple(notes), binding=result.binding,
         conditioning=Conditioning(kappa_min, kappa_max, length), cost=timed.cost, solver=solver,
         switching_times=switching, clearance=found_clearance, search=search, accuracy=accuracy,
-        zones=_zone_reports(problem.limits.zones, timed.stretches, problem.margin) if problem.options.zones else None,
+        zones=_zone_reports(problem.limits.zones, timed.stretches, problem.margin) if problem.requested.zones else None,
     )
 
 
@@ -116,7 +115,7 @@ def _samples(problem: Problem, timed: Timed) -> Samples:
     robot, result, sampling, method = problem.robot, timed.timing, problem.sampling, problem.method
     require_finite(timed.method, duration=result.duration)
     if result.duration / sampling.dt > sampling.max_samples - 2:
-        raise _too_many_samples(result.duration, sampling.dt, sampling.max_samples, problem.options)
+        raise _too_many_samples(result.duration, sampling.dt, sampling.max_samples, problem.requested)
     problem.deadline.expect((result.duration / sampling.dt + 2) * robot.dof * SAMPLE_SECONDS)
     samples = sample_trajectory(timed.path, result, robot, sampling.dt, sampling.exact_period)
     require_finite(timed.method, samples=[samples.q, samples.qd, samples.qdd, samples.tau])
@@ -154,8 +153,8 @@ def _accuracy(problem: Problem, timed: Timed) -> tuple[Accuracy, str | None]:
     ]
     intervals = sum(len(item.constraints.s) - 1 for item in timed.stretches)
     return answer_accuracy(
-        timed.timing, timed_by, timed.method, intervals, problem.robot.dof, grid_given=problem.options.grid_points is not None,
-        duration_given=problem.options.duration is not None, law_utilization=laws if len(laws) == len(timed.stretches) else None,
+        timed.timing, timed_by, timed.method, intervals, problem.robot.dof, grid_given=problem.grid is not None,
+        duration_given=problem.duration is not None, law_utilization=laws if len(laws) == len(timed.stretches) else None,
     )
 
 
@@ -216,7 +215,7 @@ def _unasked_limits(
     return notes
 
 
-def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timing) -> TooLarge:
+def _too_many_samples(duration: float, dt: float, max_samples: int, asked: LimitRequest) -> TooLarge:
     """Why ``duration`` (s) sampled every ``dt`` (s) is not served, with advice that can be
     followed: ``smallest_dt``, the smallest sample period that fits when it lies in ``DT`` (else
     ``None``, and ``longest_s``, the longest motion the largest period serves, with the tool
@@ -227,7 +226,7 @@ def _too_many_samples(duration: float, dt: float, max_samples: int, timing: Timi
         "sampling.dt", dt, math.ceil(duration / dt) + 1, max_samples, "samples", rule="too_many_samples",
         duration=duration, smallest_dt=needed if needed <= DT.high else None, largest_dt=DT.high,
         longest_s=_round_down(DT.high * (max_samples - 2)),
-        fields=tuple(f"limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None),
+        fields=tuple(f"limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(asked, name) is not None),
     )
 
 

@@ -223,6 +223,9 @@ class TimingMethod(abc.ABC):
             memory grows with both (about 1.3 kB per interval and joint for phase_plane,
             2.3 kB for toppra, 9 kB for min_cost; ``benchmarks/budgets.py``). 140,000 is
             20,000 intervals on a 7-joint arm, about 300 MB at most.
+        supporting_points: For a time law replaced by its spline through this many points
+            (``toptraj.planners.timing.laws.splines.SplineProfile``): the spline leaves and
+            reaches rest, so the method takes no moving boundary. ``None`` otherwise.
     """
 
     family: ClassVar[Literal["timing"]] = "timing"
@@ -235,6 +238,7 @@ class TimingMethod(abc.ABC):
     continuous_acceleration: bool = False
     absolute_tolerances: bool = False
     grid_budget: int = 140_000
+    supporting_points: int | None = None
 
     def max_grid_intervals(self, n_dof: int) -> int:
         """The most grid intervals the method serves on a robot with ``n_dof`` joints."""
