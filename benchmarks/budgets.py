@@ -158,11 +158,11 @@ def idle_after_504(budget_s: float) -> None:
 
 _PEAK = """
 import resource, sys, numpy as np, robots
-from toptraj.planners import plan, Timing, WaypointPath
+from toptraj.planners import METHODS, WaypointPath, build_problem, plan
 robot, path = robots.load("ur5"), WaypointPath(np.array({waypoints}))
-plan(robot, path, Timing(method="min_cost", grid_points=100))
+plan(build_problem(robot, path, METHODS["min_cost"], grid=100))
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-plan(robot, path, Timing(method="min_cost", grid_points={grid}))
+plan(build_problem(robot, path, METHODS["min_cost"], grid={grid}))
 print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) / 1024)
 """
 

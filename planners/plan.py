@@ -15,7 +15,7 @@ from toptraj.planners.runner.run import run
 
 
 def plan(problem: Problem) -> PlannedTrajectory:
-    """The timed trajectory of ``problem`` (``toptraj.planners.problem.build.build_problem``),
+    """Plan the timed trajectory of ``problem`` (``toptraj.planners.problem.build.build_problem``),
     sampled every ``problem.sampling.dt`` seconds into at most ``max_samples`` samples. With
     ``exact_period`` the samples lie on whole periods ``dt``, the final state included: the
     motion is slowed uniformly to end on one (``toptraj.planners.trajectory.sample_trajectory``);

@@ -152,6 +152,8 @@ def _check_method_serves(problem: Problem) -> None:
         raise NotServed("waypoints", count, method.name, rule="needs_two_waypoints", alternatives=("phase_plane",))
     if problem.obstacles and isinstance(motion, FreeMotion) and method.name != "search":
         raise NotServed("obstacles", len(problem.obstacles), method.name, rule="obstacles_need_search", alternatives=("search",))
+    if isinstance(motion, WaypointPath) and motion.interpolation == "via" and not isinstance(method, MotionGenerator):
+        raise NotServed("interpolation", "via", method.name, rule="via_points_need_their_generator", alternatives=("cubic", "quintic"))
     if isinstance(method, MotionGenerator):
         method.validate(problem)
     elif isinstance(motion, FreeMotion):

@@ -9,7 +9,6 @@ sampled how, among which obstacles and within which deadline.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -52,8 +51,8 @@ class LimitRequest:
     """
 
     kinds: tuple[str, ...] = ("velocity", "acceleration", "torque")
-    overrides: Mapping[str, ArrayLike | None] = field(default_factory=dict)
-    scales: Mapping[str, float | None] = field(default_factory=dict)
+    overrides: dict[str, list[float] | None] = field(default_factory=dict)
+    scales: dict[str, float | None] = field(default_factory=dict)
     margin: float = 0.0
     tool_speed: float | None = None
     tool_angular_speed: float | None = None
