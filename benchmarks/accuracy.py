@@ -30,7 +30,7 @@ import numpy as np
 from benchmarks.converged import converged_duration as converged_spline
 from benchmarks.converged import random_path
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.kinematics.ik import frame_pose
@@ -75,7 +75,7 @@ def recorded_waypoints(robot, rng, count: int = 5) -> np.ndarray:
 
 
 def _cases(family: str, robot_names: list[str], paths: int, seed: int):
-    """(label, robot, path spec, timing options, reference duration) for one family."""
+    """(label, robot, path spec, tool speed (m/s, or None), reference duration) for one family."""
     if family == "weld":
         arm = robots.load("ur5")
         rng = np.random.default_rng(seed)
@@ -85,10 +85,12 @@ def _cases(family: str, robot_names: list[str], paths: int, seed: int):
             speed = float(rng.choice([0.05, 0.1, 0.25, 0.5]))
             line = CartesianLine(start=UR5_START, positions=np.array([p0 + offset]))
             try:
-                reference = plan(arm, line, Timing(method="toppra", constraints=KINDS, tool_speed=speed, grid_points=MAX_POINTS), dt=1.0).duration
+                asked = LimitRequest(kinds=KINDS, tool_speed=speed)
+                problem = build_problem(arm, line, METHODS["toppra"], limits=asked, grid=MAX_POINTS, sampling=Sampling(1.0))
+                reference = plan(problem).duration
             except (InfeasiblePath, TimingFailed):
                 continue
-            yield f"weld {k} at {speed:g} m/s", arm, line, {"tool_speed": speed}, reference
+            yield f"weld {k} at {speed:g} m/s", arm, line, speed, reference
         return
     for name in robot_names:
         robot = robots.load(name)
@@ -103,7 +105,7 @@ def _cases(family: str, robot_names: list[str], paths: int, seed: int):
                 reference, _ = converged_spline(path, robot)
             except (InfeasiblePath, TimingFailed):
                 continue
-            yield f"{name} {family} {k}", robot, WaypointPath(waypoints), {}, reference
+            yield f"{name} {family} {k}", robot, WaypointPath(waypoints), None, reference
 
 
 def main() -> None:
@@ -122,11 +124,12 @@ def main() -> None:
         names = args.robots.split(",") if family == "spline" else [n for n in args.robots.split(",") if n in ("ur5", "panda")]
         rows: dict[str, list] = {method: [] for method in methods}
         failed = dict.fromkeys(methods, 0)
-        for label, robot, spec, options, reference in _cases(family, names, args.paths, args.seed):
+        for label, robot, spec, tool_speed, reference in _cases(family, names, args.paths, args.seed):
             for method in methods:
                 started = time.perf_counter()
                 try:
-                    result = plan(robot, spec, Timing(method=method, constraints=KINDS, **options), dt=0.05)
+                    asked = LimitRequest(kinds=KINDS, tool_speed=tool_speed)
+                    result = plan(build_problem(robot, spec, METHODS[method], limits=asked, sampling=Sampling(0.05)))
                 except (InfeasiblePath, TimingFailed) as error:
                     failed[method] += 1
                     if args.verbose:

@@ -161,12 +161,12 @@ def idle_after_504(budget_s: float) -> None:
 _PEAK = """
 import resource, sys, numpy as np
 from toptraj import robots
-from toptraj.planners import plan, Timing, WaypointPath
+from toptraj.planners import METHODS, LimitRequest, WaypointPath, build_problem, plan
 robot, path = robots.load("ur5"), WaypointPath(np.array({waypoints}))
-timing = Timing(method={method!r}, constraints={constraints!r}, limit_overrides={{"jerk": [40.0] * 6}})
-plan(robot, path, Timing(**{{**timing.__dict__, "grid_points": 100}}))
+limits = LimitRequest(kinds={constraints!r}, overrides={{"jerk": [40.0] * 6}})
+plan(build_problem(robot, path, METHODS[{method!r}], limits=limits, grid=100))
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-plan(robot, path, Timing(**{{**timing.__dict__, "grid_points": {grid}}}))
+plan(build_problem(robot, path, METHODS[{method!r}], limits=limits, grid={grid}))
 print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) / 1024)
 """
 #: The methods whose memory per grid interval and joint the runner's admission uses

@@ -93,15 +93,12 @@ STAGES = (
 )
 
 
-def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int]:
+def timing_grid_points(problem) -> tuple[int, int]:
     """(points of the grids the answer was timed on, points of the grids its constraints were
     first built on), over its stretches: what ``toptraj.planners.plan`` times, without the sampling."""
-    from toptraj.planners.problem.build import build_problem
-    from toptraj.planners.runner.choice import method_for
     from toptraj.planners.runner.run import _given_path
 
-    problem = build_problem(robot, path_spec, method_for(timing, path_spec), timing)
-    timed, _ = _given_path(problem, problem.deadline)
+    timed, _, _ = _given_path(problem, problem.deadline)
     return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 
@@ -193,11 +190,14 @@ def main() -> int:
     request = TrajectoryRequest.model_validate(TYPICAL)
     payload = json.dumps(TYPICAL).encode()
     from toptraj.planners import plan
-    from toptraj.service.planning import _path, _timing
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+    from toptraj.planners.problem.build import MAX_SAMPLES
+    from toptraj.service.mapping import problem_of
 
-    timing, path_spec = _timing(request), _path(request.path, robot, request)
-    answer = plan(robot, path_spec, timing, 0.01)
-    grid_points, built_points = timing_grid_points(robot, path_spec, timing)
+    problem = problem_of(request, robot, NO_DEADLINE, MAX_SAMPLES, False, DEFAULT_SEARCH_MEMORY)
+    answer = plan(problem)
+    grid_points, built_points = timing_grid_points(problem)
     rng = np.random.default_rng(0)
     states = [np.asfortranarray(rng.uniform(-1.0, 1.0, (robot.dof, 3 * grid_points))) for _ in range(3)]
     pool = pin.ModelPool(robot.model, 1)
@@ -219,7 +219,7 @@ def main() -> int:
             "bare toppra": lambda: bare_toppra(robot, waypoints),
             **({"drake": drake} if drake is not None else {}),
             "RNEA floor": lambda: rnea_floor(pool, states),
-            "library": lambda: plan(robot, path_spec, timing, 0.01),
+            "library": lambda: plan(problem_of(request, robot, NO_DEADLINE, MAX_SAMPLES, False, DEFAULT_SEARCH_MEMORY)),
             "planning thread": lambda: encode_json(trajectory_body(plan_request(request))),
             "HTTP": http_call,
         }

@@ -20,7 +20,7 @@ import numpy as np
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.robots import equipment
 
 
@@ -37,18 +37,18 @@ def main() -> None:
     ur5 = robots.load("ur5")
     base = equipment.mounting(position=(0.0, 0.0, 2.2), orientation=(1.0, 0.0, 0.0, 0.0))
     path = WaypointPath(np.array(UR5_WAYPOINTS), "spline")
-    timing = Timing(method="phase_plane", constraints=("velocity", "acceleration", "torque"))
+    timing = dict(method=METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration", "torque")))
     cached = equipment.equip(ur5, mounting=equipment.mounting(position=(1.0, 0.0, 0.0)))  # the same dynamics
-    plan(cached, path, timing, 0.01)  # compile and warm
+    plan(build_problem(cached, path, **timing, sampling=Sampling(dt=0.01)))  # compile and warm
     built, found, planned, planned_equipped, planned_fresh = [], [], [], [], []
     for k in range(rounds):
         load = equipment.payload(1.0 + k * 1e-3, (0.0, 0.0, 0.1))  # a new payload each round: a cache miss
         built.append(_ms(lambda load=load: equipment.equip(ur5, load, base)))
         found.append(_ms(lambda: equipment.equip(ur5, equipment.payload(2.0, (0.0, 0.0, 0.1)), base)))
-        planned.append(_ms(lambda: plan(ur5, path, timing, 0.01)))
-        planned_equipped.append(_ms(lambda: plan(cached, path, timing, 0.01)))
+        planned.append(_ms(lambda: plan(build_problem(ur5, path, **timing, sampling=Sampling(dt=0.01)))))
+        planned_equipped.append(_ms(lambda: plan(build_problem(cached, path, **timing, sampling=Sampling(dt=0.01)))))
         moved = equipment.mounting(position=(2.0 + k * 1e-3, 0.0, 0.0))  # a new robot, the same dynamics
-        planned_fresh.append(_ms(lambda moved=moved: plan(equipment.equip(ur5, mounting=moved), path, timing, 0.01)))
+        planned_fresh.append(_ms(lambda moved=moved: plan(build_problem(equipment.equip(ur5, mounting=moved), path, **timing, sampling=Sampling(dt=0.01)))))
     anchor = statistics.median(planned)
     for name, times in (("equip, cache miss", built), ("equip, cache hit", found), ("plan, bare ur5", planned),
                         ("plan, moved ur5", planned_equipped), ("move anew and plan", planned_fresh)):

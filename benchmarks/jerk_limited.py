@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.problem.waypoints import make_path
 
@@ -56,7 +56,7 @@ def _utilization(robot, samples, scales) -> dict[str, float]:
 
 def _timed(robot, waypoints, method, kinds, scales):
     started = time.perf_counter()
-    result = plan(robot, WaypointPath(waypoints), Timing(method=method, constraints=kinds, limit_scales=scales), dt=1e-3)
+    result = plan(build_problem(robot, WaypointPath(waypoints), METHODS[method], limits=LimitRequest(kinds=kinds, scales=scales), sampling=Sampling(dt=1e-3)))
     return time.perf_counter() - started, result
 
 

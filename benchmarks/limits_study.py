@@ -19,7 +19,8 @@ import numpy as np
 import pinocchio as pin
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS as TIMING_METHODS
+from toptraj.planners import LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.robots.catalog import robot_from_model
 
@@ -76,7 +77,7 @@ def main() -> None:
             margin = 0.002 if case % 3 == 0 else 0.0
             spec = WaypointPath(waypoints(robot, rng, case % 2 == 0), "linear" if case % 5 == 0 else "spline")
             try:
-                result = plan(robot, spec, Timing(method=method, constraints=KINDS, limit_margin=margin, grid_points=args.grid_points), dt=1e-3)
+                result = plan(build_problem(robot, spec, TIMING_METHODS[method], limits=LimitRequest(kinds=KINDS, margin=margin), grid=args.grid_points, sampling=Sampling(dt=1e-3)))
             except (InfeasiblePath, TimingFailed):
                 stats[method]["refused"] += 1
                 continue

@@ -22,16 +22,17 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from toptraj import robots  # noqa: E402
-from toptraj.planners import Timing, plan  # noqa: E402
+from toptraj.planners import LimitRequest, Sampling, build_problem, plan  # noqa: E402
 from toptraj.planners.generators.collocation.bang_bang import BangBang, collocation_switches, mirrored  # noqa: E402
 from toptraj.planners.generators.collocation.collocation import _optimize_motion  # noqa: E402
+from toptraj.planners.generators.collocation.generator import Collocation
 from toptraj.planners.generators.collocation.switching import refine_switching  # noqa: E402
 from toptraj.planners.problem.free_motion import FreeMotion  # noqa: E402
 
 
 def answer(arm, phi_b: float, revolutions: bool):
     motion = FreeMotion(np.zeros(2), np.array([phi_b, 0.0]), revolutions=revolutions)
-    return plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002)
+    return plan(build_problem(arm, motion, Collocation(), limits=LimitRequest(kinds=("torque",)), sampling=Sampling(dt=0.002)))
 
 
 def controls_of(answer, arm) -> BangBang:

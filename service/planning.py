@@ -4,27 +4,22 @@ loop under a short leash for a small request: ``worth_a_leash``)."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
 import orjson
 
 from toptraj import robots
-from toptraj.planners import CartesianLine, Deadline, PlannedTrajectory, Timing, WaypointPath, plan
-from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed, WrongLength
+from toptraj.planners import Deadline, PlannedTrajectory, plan
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE
-from toptraj.planners.generators.search import SearchOptions
 from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-from toptraj.planners.problem.boundary import finite_vector
-from toptraj.planners.problem.build import DEFAULT_CLEARANCE, MAX_SAMPLES
-from toptraj.planners.problem.free_motion import FreeMotion
-from toptraj.planners.problem.zones import Zone
+from toptraj.planners.problem.build import MAX_SAMPLES
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
 from toptraj.service.equipping import equipped_robot, payload_named
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
+from toptraj.service.mapping import problem_of
 from toptraj.service.problems import detail, non_finite_answer, note_text, status_of, title_of
 from toptraj.service.reports import search_body, solver_body, switching_body
 from toptraj.service.schemas.trajectories import CompareRequest, OutputRequest, TrajectoryRequest, WaypointsPath
@@ -90,55 +85,6 @@ def heavy_request(request: TrajectoryRequest | CompareRequest) -> bool:
     return any(heavy(method, request.path.kind, request.timing.grid_points) for method in methods)
 
 
-def _timing(request: TrajectoryRequest) -> Timing:
-    timing = request.timing
-    limits = timing.limits
-    kinds = ("velocity", "acceleration", "jerk", "torque")
-    return Timing(
-        method=timing.method,
-        constraints=tuple(timing.constraints),
-        limit_overrides={kind: getattr(limits, kind) for kind in kinds},
-        limit_scales={kind: getattr(limits, f"{kind}_scale") for kind in kinds},
-        grid_points=timing.grid_points,
-        start_velocity=timing.boundary.start_velocity,
-        end_velocity=timing.boundary.end_velocity,
-        start_acceleration=timing.boundary.start_acceleration,
-        end_acceleration=timing.boundary.end_acceleration,
-        duration=timing.duration,
-        trapezoid_fractions=(timing.trapezoid.tau1, timing.trapezoid.tau2),
-        trapezoid_blend=timing.trapezoid.blend,
-        supporting_points=timing.supporting_points,
-        synchronization=timing.synchronization,
-        torque_weight=timing.cost.torque_weight,
-        limit_margin=timing.limit_margin,
-        tool_speed=limits.tool_speed,
-        tool_angular_speed=limits.tool_angular_speed,
-        tool_frame=limits.tool_frame,
-        search=None if timing.search is None else SearchOptions(
-            cells=None if timing.search.cells is None else tuple(timing.search.cells),
-            **timing.search.model_dump(exclude={"cells"}),
-        ),
-        zones=tuple(_zone(spec) for spec in timing.zones),
-    )
-
-
-def _zone(spec) -> Zone:
-    """A zone of ``timing.zones`` as the library's ``Zone``."""
-    region: SphereObstacle | BoxObstacle | None = None
-    if spec.sphere is not None:
-        region = SphereObstacle(np.array(spec.sphere.center, dtype=float), spec.sphere.radius)
-    elif spec.box is not None:
-        region = BoxObstacle(np.array(spec.box.center, dtype=float), np.array(spec.box.size, dtype=float), np.array(spec.box.orientation, dtype=float))
-    return Zone(
-        s_range=None if spec.s_range is None else (spec.s_range[0], spec.s_range[1]),
-        region=region,
-        velocity=spec.velocity_scale,
-        acceleration=spec.acceleration_scale,
-        torque=spec.torque_scale,
-        tool_speed=spec.tool_speed,
-    )
-
-
 def samples_within(body_bytes: int, n_dof: int, format_: str = "samples") -> int:
     """The most time samples a trajectory body of at most ``body_bytes`` bytes can hold for a
     robot with ``n_dof`` joints: each sample is t and a row of q, qd, qdd and tau, every number
@@ -162,46 +108,11 @@ def plan_request(
     on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
     (``toptraj.planners.generators.search.memory``)."""
     robot = equipped_robot(request)
-    timing = _timing(request)
-    if timing.method == "search":
-        timing = dataclasses.replace(timing, search=dataclasses.replace(timing.search or SearchOptions(), memory_bytes=search_memory_bytes))
-    if request.path.kind == "free":
-        timing = dataclasses.replace(timing, start_velocity=None, end_velocity=None)
-    output = request.output
-    format_ = chosen_format(output.format, accept)
+    format_ = chosen_format(request.output.format, accept)
     max_samples = MAX_SAMPLES if max_body_bytes is None else min(MAX_SAMPLES, samples_within(max_body_bytes, robot.dof, format_))
+    exact_period = exact_period_for(format_, request.output.exact_period)
     with payload_named(robot):
-        return _planned(request, robot, timing, deadline, max_samples, format_)
-
-
-def _planned(request: TrajectoryRequest, robot: robots.Robot, timing: Timing, deadline, max_samples: int, format_: str) -> PlannedTrajectory:
-    """``plan`` on the request's path, obstacles and output for ``robot`` and ``timing``."""
-    output = request.output
-    return plan(
-        robot,
-        _path(request.path, robot, request),
-        timing,
-        output.dt,
-        deadline or NO_DEADLINE,
-        max_samples,
-        exact_period=exact_period_for(format_, output.exact_period),
-        obstacles=_obstacles(getattr(request.path, "obstacles", [])),
-        clearance=getattr(request.path, "clearance", DEFAULT_CLEARANCE),
-        self_collision=getattr(request.path, "self_collision", False),
-    )
-
-
-def _obstacles(specs) -> tuple:
-    """The request's obstacles as the library's domain objects."""
-    made: list[Obstacle] = []
-    for spec in specs:
-        if spec.kind == "sphere":
-            made.append(SphereObstacle(np.array(spec.center, dtype=float), spec.radius))
-        elif spec.kind == "box":
-            made.append(BoxObstacle(np.array(spec.center, dtype=float), np.array(spec.size, dtype=float), np.array(spec.orientation, dtype=float)))
-        else:
-            made.append(CapsuleObstacle(np.array(spec.a, dtype=float), np.array(spec.b, dtype=float), spec.radius))
-    return tuple(made)
+        return plan(problem_of(request, robot, deadline or NO_DEADLINE, max_samples, exact_period, search_memory_bytes))
 
 
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
@@ -214,39 +125,6 @@ def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | 
         del body["samples"]
         body["joint_trajectory"] = joint_trajectory(result)
     return encode_json(body), "application/json"
-
-
-def _path(spec, robot: robots.Robot, request: TrajectoryRequest) -> WaypointPath | CartesianLine | FreeMotion:
-    if spec.kind == "free":
-        for name in ("start", "goal"):
-            if len(getattr(spec, name)) != robot.dof:
-                raise WrongLength(name, getattr(spec, name), len(getattr(spec, name)), robot.dof, robot=robot.name)
-        boundary = request.timing.boundary
-
-        def velocity(name):
-            value = getattr(boundary, name)
-            return None if value is None else finite_vector(value, f"boundary.{name}", robot.dof)
-
-        return FreeMotion(
-            start=np.asarray(spec.start, dtype=float),
-            goal=np.asarray(spec.goal, dtype=float),
-            start_velocity=velocity("start_velocity"),
-            end_velocity=velocity("end_velocity"),
-            revolutions=spec.revolutions,
-        )
-    if spec.kind == "cartesian":
-        if len(spec.start) != robot.dof:
-            raise WrongLength("start", spec.start, len(spec.start), robot.dof, robot=robot.name)
-        return CartesianLine(
-            start=np.asarray(spec.start, dtype=float),
-            positions=None if spec.positions is None else np.asarray(spec.positions, dtype=float),
-            poses=None if spec.poses is None else np.asarray(spec.poses, dtype=float),
-            frame=spec.frame,
-        )
-    for index, row in enumerate(spec.waypoints):
-        if len(row) != robot.dof:
-            raise WrongLength(f"waypoints[{index}]", row, len(row), robot.dof, robot=robot.name, joint_names=robot.joint_names)
-    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous)
 
 
 def method_request(request: CompareRequest, method: str, dt: float = 1.0) -> TrajectoryRequest:

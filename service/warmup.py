@@ -83,10 +83,11 @@ def _phase_plane() -> None:
     import numpy as np
 
     from toptraj import robots
-    from toptraj.planners import Timing, WaypointPath, plan
+    from toptraj.planners import METHODS, LimitRequest, WaypointPath, build_problem, plan
 
     arm = robots.load("yamamoto_2r")
-    plan(arm, WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
+    path = WaypointPath(np.array([[0.0, 0.0], [0.1, 0.0]]))
+    plan(build_problem(arm, path, METHODS["phase_plane"], limits=LimitRequest(kinds=("torque",))))
 
 
 def _conditioning() -> None:

@@ -232,6 +232,10 @@ WORDING: dict[str, Wording] = {
         "{field} is not used by timing.method {method!r}, which finds the shortest "
         "duration itself; leave it out or use a time law"
     ),
+    "via_points_need_their_generator": (
+        "{field} 'via' is shaped by a time law through the via points (cubic or quintic), not timed along "
+        "a given path by {method!r}"
+    ),
     "via_points_from_rest": "via-point trajectories start and end at rest: leave {field} out",
     "via_points_are_polynomials": "via-point segments are polynomials: leave {field} out, or use 'spline' or 'linear'",
     "unsynchronized_needs_two_waypoints": (

@@ -29,8 +29,7 @@ from toptraj.planners.trajectory import SwitchingTimes
 from toptraj.robots import JointLimits, Robot
 
 if TYPE_CHECKING:
-    from toptraj.planners.problem.problem import MotionSpec, Problem
-    from toptraj.planners.problem.requests import Timing
+    from toptraj.planners.problem.problem import BoundaryStates, Problem
 
 T = TypeVar("T")
 
@@ -60,9 +59,12 @@ class Timed(NamedTuple):
     motion_gap: tuple[float | None, str] | None = None
 
 
-#: The runner's given-path pipeline: (robot, path, method, options, kinds, limits, deadline,
-#: threshold) -> Timed, each stretch between corners timed and passed through the limit gate.
-TimePath = Callable[[Robot, GeometricPath, TimingMethod, "Timing", tuple, JointLimits, Deadline, float], Timed]
+#: The runner's given-path pipeline: (robot, path, method, grid intervals, boundary states,
+#: duration, kinds, limits, deadline, threshold) -> Timed, each stretch between corners timed and
+#: passed through the limit gate.
+TimePath = Callable[
+    [Robot, GeometricPath, TimingMethod, "int | None", "BoundaryStates", "float | None", tuple, JointLimits, Deadline, float], Timed
+]
 
 
 @dataclass(frozen=True)
@@ -117,6 +119,8 @@ class MotionGenerator(abc.ABC):
     continuous_acceleration: bool = False
     bytes_per_interval_joint: int = 2_300
     interruptible: bool = True
+    #: The supporting points of the time law that shapes the motion, when it is a spline.
+    supporting_points: int | None = None
 
     def max_grid_intervals(self, n_dof: int) -> int:
         """The most grid intervals the generator's paths are timed on, on ``n_dof`` joints."""
@@ -143,9 +147,9 @@ class MotionGenerator(abc.ABC):
         """The timing method that times the motion's path (for the answer's accuracy)."""
 
     @abc.abstractmethod
-    def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
-        """Refuse a motion or options the generator does not serve (``InvalidRequest``), before
-        any work."""
+    def validate(self, problem: Problem) -> None:
+        """Refuse a problem the generator does not serve (``InvalidRequest``), before any
+        work."""
 
     @abc.abstractmethod
     def generate(self, problem: Problem, execution: Execution) -> Timed:

@@ -11,7 +11,7 @@ from toptraj.planners.errors import InfeasiblePath, NotServed, OutsideJointRange
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.boundary import path_acceleration, path_speed
-from toptraj.planners.problem.requests import Timing
+from toptraj.planners.problem.problem import BoundaryStates
 from toptraj.planners.timing.base import Boundary, TimingMethod
 from toptraj.robots import Robot
 
@@ -59,21 +59,20 @@ def moving_velocity(velocity: ArrayLike | None) -> ArrayLike | None:
     return velocity
 
 
-def path_boundary(path: GeometricPath, timing: Timing, method: TimingMethod) -> Boundary:
-    """The path's boundary states (sd, sdd at s = 0 and 1) from the joint velocities and
-    accelerations of ``timing``, once ``method`` is known to take the accelerations and the
-    duration given."""
-    if (timing.start_acceleration is not None or timing.end_acceleration is not None) and not method.takes_acceleration_boundary:
+def path_boundary(path: GeometricPath, states: BoundaryStates, duration: float | None, method: TimingMethod) -> Boundary:
+    """The joint boundary ``states`` as path speeds and accelerations along ``path``, for
+    ``method`` (which must take the accelerations and the ``duration`` given)."""
+    if (states.start_acceleration is not None or states.end_acceleration is not None) and not method.takes_acceleration_boundary:
         raise NotServed("boundary", None, method.name, rule="boundary_accelerations_not_used", alternatives=("quintic",))
-    if timing.duration is not None and not method.takes_duration:
-        raise NotServed("duration", timing.duration, method.name, rule="duration_not_used")
-    sd_start = path_speed(path, timing.start_velocity, 0.0, "boundary.start_velocity")
-    sd_end = path_speed(path, timing.end_velocity, 1.0, "boundary.end_velocity")
+    if duration is not None and not method.takes_duration:
+        raise NotServed("duration", duration, method.name, rule="duration_not_used")
+    sd_start = path_speed(path, states.start_velocity, 0.0, "boundary.start_velocity")
+    sd_end = path_speed(path, states.end_velocity, 1.0, "boundary.end_velocity")
     return Boundary(
         sd_start=sd_start,
         sd_end=sd_end,
-        sdd_start=path_acceleration(path, timing.start_acceleration, sd_start, 0.0, "boundary.start_acceleration"),
-        sdd_end=path_acceleration(path, timing.end_acceleration, sd_end, 1.0, "boundary.end_acceleration"),
+        sdd_start=path_acceleration(path, states.start_acceleration, sd_start, 0.0, "boundary.start_acceleration"),
+        sdd_end=path_acceleration(path, states.end_acceleration, sd_end, 1.0, "boundary.end_acceleration"),
     )
 
 

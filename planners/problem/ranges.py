@@ -29,7 +29,7 @@ from toptraj.robots.ranges import Range as Range
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-    from toptraj.planners.problem.requests import Timing
+    from toptraj.planners.problem.problem import BoundaryStates, LimitRequest
     from toptraj.robots import JointLimits
 
 #: Joint coordinates (rad or m): a continuous joint may turn many times, not 1e300.
@@ -72,23 +72,21 @@ def check_vector(values: ArrayLike, field: str, accepted: Range, signed: bool = 
         raise OutOfRange(f"{field}[{bad[0]}]", array[bad[0]], low, accepted.high, accepted.unit, signed=signed)
 
 
-def check_timing(timing: Timing, dt: float) -> None:
-    """Hold every number of a ``toptraj.planners.problem.requests.Timing`` and the sample period ``dt`` to its
+def check_numbers(limits: LimitRequest, boundary: BoundaryStates, duration: float | None, dt: float) -> None:
+    """Hold every number of a problem's ``LimitRequest`` and ``BoundaryStates``
+    (``toptraj.planners.problem.problem``), its ``duration`` and the sample period ``dt`` to its
     range (OutOfRange naming the field and the range otherwise)."""
     check(dt, "sampling.dt", DT)
-    if timing.duration is not None:
-        check(timing.duration, "duration", DURATION)
-    if timing.method == "trapezoidal":
-        for name, value in zip(("tau1", "tau2"), timing.trapezoid_fractions):
-            check(value, f"law.trapezoid.{name}", TRAPEZOID_FRACTION)
-    for kind, values in (timing.limit_overrides or {}).items():
+    if duration is not None:
+        check(duration, "duration", DURATION)
+    for kind, values in (limits.overrides or {}).items():
         if values is not None and kind in LIMITS:
             check_vector(values, f"limits.{kind}", LIMITS[kind])
     for name, accepted in (("tool_speed", TOOL_SPEED), ("tool_angular_speed", TOOL_ANGULAR_SPEED)):
-        speed = getattr(timing, name, None)
-        if speed is not None:
-            check(speed, f"limits.{name}", accepted)
-    for kind, factor in (timing.limit_scales or {}).items():
+        value = getattr(limits, name, None)
+        if value is not None:
+            check(value, f"limits.{name}", accepted)
+    for kind, factor in (limits.scales or {}).items():
         if factor is not None:
             check(factor, f"limits.{kind}_scale", SCALE)
     for name, accepted in (
@@ -97,7 +95,7 @@ def check_timing(timing: Timing, dt: float) -> None:
         ("start_acceleration", ACCELERATION),
         ("end_acceleration", ACCELERATION),
     ):
-        values = getattr(timing, name)
+        values = getattr(boundary, name)
         if values is not None:
             check_vector(values, f"boundary.{name}", accepted, signed=True)
 

@@ -50,7 +50,7 @@ def admit(problem: Problem) -> None:
         return
     largest = min(memory.largest_grid(method.bytes_per_interval_joint, dof, reserved, cap), MAX_POINTS)
     raise TooLarge(
-        "grid.intervals", problem.options.grid_points, need, cap, "bytes", largest=largest if largest >= 2 else None,
+        "grid.intervals", problem.grid, need, cap, "bytes", largest=largest if largest >= 2 else None,
         rule="grid_over_method_cap", method=method.name, dof=dof,
     )
 
@@ -58,7 +58,7 @@ def admit(problem: Problem) -> None:
 def _intervals(problem: Problem) -> int:
     """The grid the method times on: the one asked for (a collocation's own intervals), else
     the largest its default grid is thinned to."""
-    asked = problem.options.grid_points
+    asked = problem.grid
     if asked is not None:
         return asked
     return min(problem.method.max_grid_intervals(problem.robot.dof), MAX_POINTS)
@@ -73,7 +73,7 @@ def admit_samples(problem: Problem, duration: float) -> None:
             (else ``None``, and ``longest_s``, the longest motion the largest period serves;
             ``fields``: the tool limits given, among what makes the motion this slow).
     """
-    dt, timing = problem.sampling.dt, problem.options
+    dt, asked = problem.sampling.dt, problem.requested
     max_samples = memory.most_samples(problem.sampling.max_samples, problem.robot.dof)
     if duration / dt <= max_samples - 2:
         return
@@ -82,7 +82,7 @@ def admit_samples(problem: Problem, duration: float) -> None:
         "sampling.dt", dt, math.ceil(duration / dt) + 1, max_samples, "samples", rule="too_many_samples",
         duration=duration, smallest_dt=needed if needed <= DT.high else None, largest_dt=DT.high,
         longest_s=_round_down(DT.high * max(max_samples - 2, 1)),
-        fields=tuple(f"limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(timing, name) is not None),
+        fields=tuple(f"limits.{name}" for name in ("tool_speed", "tool_angular_speed") if getattr(asked, name) is not None),
     )
 
 

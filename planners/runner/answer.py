@@ -66,7 +66,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
     notes.extend(_singularity_notes(kappa_max, samples.t[worst]))
     switching = timed.switching_times
-    if switching is None and timed.method == "collocation" and problem.options.torque_weight == 0.0:
+    if switching is None and timed.method == "collocation" and getattr(problem.method, "torque_weight", None) == 0.0:
         read = collocation_switches(samples.t, samples.tau, problem.limits.torque, level=SATURATION_READ)
         switching = switching_times(read, robot.joint_names)
     s, sd, mvc = _phase_plane(timed.stretches)
@@ -80,7 +80,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
         solve_ms=(time.perf_counter() - started) * 1e3, warnings=tuple(notes), binding=result.binding,
         conditioning=Conditioning(kappa_min, kappa_max, length), cost=timed.cost, solver=solver,
         switching_times=switching, clearance=found_clearance, search=search, accuracy=accuracy,
-        zones=_zone_reports(problem.limits.zones, timed.stretches, problem.margin) if problem.options.zones else None,
+        zones=_zone_reports(problem.limits.zones, timed.stretches, problem.margin) if problem.requested.zones else None,
     )
 
 
@@ -151,8 +151,8 @@ def _accuracy(problem: Problem, timed: Timed) -> tuple[Accuracy, str | None]:
     ]
     intervals = sum(len(item.constraints.s) - 1 for item in timed.stretches)
     return answer_accuracy(
-        timed.timing, timed_by, timed.method, intervals, problem.robot.dof, grid_given=problem.options.grid_points is not None,
-        duration_given=problem.options.duration is not None, law_utilization=laws if len(laws) == len(timed.stretches) else None,
+        timed.timing, timed_by, timed.method, intervals, problem.robot.dof, grid_given=problem.grid is not None,
+        duration_given=problem.duration is not None, law_utilization=laws if len(laws) == len(timed.stretches) else None,
     )
 
 

@@ -23,7 +23,7 @@ from toptraj.planners.timing.segmented import SegmentedTiming
 if TYPE_CHECKING:
     from toptraj.planners.execution.deadline import Deadline
     from toptraj.planners.paths.base import GeometricPath
-    from toptraj.planners.problem.requests import Timing
+    from toptraj.planners.problem.problem import BoundaryStates
     from toptraj.robots import JointLimits, Robot
 
 
@@ -58,31 +58,33 @@ def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, 
 
 
 def timed_path(
-    robot: Robot, path: GeometricPath, method: TimingMethod, timing: Timing, kinds: tuple[str, ...], limits: JointLimits,
-    deadline: Deadline, threshold: float,
+    robot: Robot, path: GeometricPath, method: TimingMethod, grid_points: int | None, states: BoundaryStates,
+    duration: float | None, kinds: tuple[str, ...], limits: JointLimits, deadline: Deadline, threshold: float,
 ) -> Timed:
-    """A given path timed by ``method``; each stretch between corners (where the motion stops)
-    on its own, as its own rest-to-rest problem, and every one through the limit gate."""
-    grid = path_grid(path, timing.grid_points)
+    """A given path timed by ``method`` on ``grid_points`` intervals (``None``: from the path),
+    between the boundary ``states`` (``BoundaryStates``), in ``duration`` seconds (``None``: the
+    shortest); each stretch between corners (where the motion stops) on its own, as its own
+    rest-to-rest problem, and every one through the limit gate."""
+    grid = path_grid(path, grid_points)
     check_path_within_limits(robot, path, grid)
     check_jerk_finite(path, kinds)
-    boundary = path_boundary(path, timing, method)
+    boundary = path_boundary(path, states, duration, method)
     parts = stretches(path)
     widths = [getattr(part, "width", 1.0) for part in parts]
-    counts = [None if timing.grid_points is None else max(1, round(timing.grid_points * w)) for w in widths]
+    counts = [None if grid_points is None else max(1, round(grid_points * w)) for w in widths]
     boundaries = [
         _stretch_boundary(boundary, w, k == 0, k == len(parts) - 1) if len(parts) > 1 else boundary
         for k, w in enumerate(widths)
     ]
     durations: list[float | None] = [None] * len(parts)
-    if timing.duration is not None and len(parts) > 1:
+    if duration is not None and len(parts) > 1:
         shortest = [
             method.solve(build_path_constraints(part, robot, limits, kinds, path_grid(part, n), deadline), b, None, deadline).duration
             for part, n, b in zip(parts, counts, boundaries)
         ]
-        durations = [timing.duration * T / sum(shortest) for T in shortest]
-    elif timing.duration is not None:
-        durations = [timing.duration]
+        durations = [duration * T / sum(shortest) for T in shortest]
+    elif duration is not None:
+        durations = [duration]
     shares = [deadline.within(k / len(parts), (k + 1) / len(parts)) for k in range(len(parts))]
     timed = [
         _time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, share, grid if part is path else None)

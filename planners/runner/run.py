@@ -85,8 +85,8 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
         check_self_collision(path, problem.robot, deadline=problem.deadline)
     assert isinstance(problem.method, TimingMethod)  # run gives the generators' problems to them
     timed = timed_path(
-        problem.robot, path, problem.method, problem.options, problem.kinds, problem.limits, part.within(0.1, 1.0),
-        problem.threshold,
+        problem.robot, path, problem.method, problem.grid, problem.boundary, problem.duration, problem.kinds, problem.limits,
+        part.within(0.1, 1.0), problem.threshold,
     )
     return timed, checked, problem
 
@@ -94,7 +94,7 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
 def _with_zones(problem: Problem, path) -> Problem:
     """The problem with its zones located on ``path`` (a region where the tool frame's origin,
     the end effector's without a tool limit, lies in it), tightened by the margin."""
-    zones, limits, robot = problem.options.zones, problem.limits, problem.robot
+    zones, limits, robot = problem.requested.zones, problem.limits, problem.robot
     if not zones:
         return problem
     frame_id = robot.frame_id(robot.end_effector) if limits.tool is None else limits.tool.frame_id

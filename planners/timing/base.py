@@ -227,6 +227,9 @@ class TimingMethod(abc.ABC):
         interruptible: Whether the method checks its deadline between steps; one that cannot
             (a convex solver's single call) runs that step through ``Isolation`` (a worker
             process killed at the deadline) when the runner isolates the planning.
+        supporting_points: For a time law replaced by its spline through this many points
+            (``toptraj.planners.timing.laws.splines.SplineProfile``): the spline leaves and
+            reaches rest, so the method takes no moving boundary. ``None`` otherwise.
     """
 
     family: ClassVar[Literal["timing"]] = "timing"
@@ -240,6 +243,7 @@ class TimingMethod(abc.ABC):
     absolute_tolerances: bool = False
     bytes_per_interval_joint: int = 2_300
     interruptible: bool = True
+    supporting_points: int | None = None
 
     def max_grid_intervals(self, n_dof: int) -> int:
         """The most grid intervals the method serves on a robot with ``n_dof`` joints: its

@@ -26,7 +26,7 @@ import numpy as np
 from toptraj.planners.constraints.admissible import friction_reference
 from toptraj.planners.constraints.linear_rows import LinearRows
 from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import InfeasiblePath, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, OutOfRange, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
@@ -54,6 +54,8 @@ class MinCostMethod(TimingMethod):
     interruptible = False
 
     def __init__(self, torque_weight: float = 0.0):
+        if not (np.isfinite(torque_weight) and torque_weight >= 0.0):
+            raise OutOfRange("method.torque_weight", torque_weight, 0.0, float("inf"), "1/(N m)^2", rule="negative_weight")
         self.torque_weight = torque_weight
 
     def solve(

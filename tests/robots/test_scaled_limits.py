@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InvalidRequest
 from toptraj.service.problems import detail
 
@@ -33,22 +33,22 @@ def test_a_scale_that_leaves_the_range_is_refused_with_followable_advice(method,
     constraints = JERK_KINDS
     overrides = {kind: [value] * UR5.dof}
     with pytest.raises(InvalidRequest) as refused:
-        plan(UR5, TWO, Timing(method=method, constraints=constraints, limit_overrides=overrides, limit_scales={kind: factor}), dt=10.0)
+        plan(build_problem(UR5, TWO, METHODS[method], limits=LimitRequest(kinds=constraints, overrides=overrides, scales={kind: factor}), sampling=Sampling(dt=10.0)))
     error = refused.value
     assert (error.field, error.value, error.joint_name) == (f"limits.{kind}_scale", factor, "shoulder_pan_joint")
     assert error.advised == pytest.approx((low, high))
     advised = re.search(rf"use timing.limits.{kind}_scale in \[([^,]+), ([^\]]+)\]", detail(error))
     assert advised is not None and (float(advised[1]), float(advised[2])) == error.advised, detail(error)
     for advice in error.advised:
-        timing = Timing(method=method, constraints=constraints, limit_overrides=overrides, limit_scales={kind: advice})
-        assert plan(UR5, TWO, timing, dt=10.0).duration > 0.0
+        timing = dict(method=METHODS[method], limits=LimitRequest(kinds=constraints, overrides=overrides, scales={kind: advice}))
+        assert plan(build_problem(UR5, TWO, **timing, sampling=Sampling(dt=10.0))).duration > 0.0
 
 
 def test_unlimited_joints_take_any_scale():
     """``inf`` (no limit) times a factor is still no limit: geering_2r has no velocity limits."""
     arm = robots.load("geering_2r")
     path = WaypointPath(np.array([[0.0, 0.0], [0.5, 0.3]]))
-    result = plan(arm, path, Timing(constraints=("velocity", "torque"), limit_scales={"velocity": 1e-3}), dt=0.01)
+    result = plan(build_problem(arm, path, METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "torque"), scales={"velocity": 1e-3}), sampling=Sampling(dt=0.01)))
     assert result.duration > 0.0
 
 

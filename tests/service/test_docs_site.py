@@ -85,7 +85,7 @@ def test_every_page_is_built_with_its_content(site):
 def test_the_reference_comes_from_the_docstrings(site):
     html = (site / "reference" / "planners" / "index.html").read_text()
     # plan's own docstring and its signature, rendered by mkdocstrings
-    assert 'id="toptraj.planners.plan.plan"' in html and 'id="toptraj.planners.Timing"' in html
+    assert 'id="toptraj.planners.plan.plan"' in html and 'id="toptraj.planners.LimitRequest"' in html
     assert "Plan the timed trajectory of" in html
     robots_html = (site / "reference" / "robots" / "index.html").read_text()
     assert 'id="toptraj.robots.Robot"' in robots_html and 'id="toptraj.robots.load"' in robots_html

@@ -21,7 +21,16 @@ import pytest
 
 from tests.paths import ROOT
 from toptraj import robots
-from toptraj.planners import Deadline, Timing, WaypointPath, plan
+from toptraj.planners import (
+    BoundaryStates,
+    Deadline,
+    LimitRequest,
+    Sampling,
+    TimeLaw,
+    WaypointPath,
+    build_problem,
+    plan,
+)
 from toptraj.planners.checks.gate import limit_exceeded
 from toptraj.planners.checks.limit_check import Excess
 from toptraj.planners.errors import (
@@ -38,13 +47,16 @@ from toptraj.planners.errors import (
     WrongLength,
 )
 from toptraj.planners.execution.memory import MEMORY_CAP_BYTES
+from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from toptraj.planners.paths import SplinePath
 from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.planners.problem.ranges import DT, SCALE
 from toptraj.planners.timing import METHODS
 from toptraj.robots.errors import InvalidInput, ToptrajError, UnknownRobot
 from toptraj.robots.notes import Note
+from toptraj.service.mapping import method_of
 from toptraj.service.problems import REQUEST_FIELD, STATUS, detail, note_text, request_field, status_of
+from toptraj.service.schemas.trajectories import TimingRequest
 from toptraj.service.wordings import WORDING
 
 UR5 = robots.load("ur5")
@@ -54,12 +66,12 @@ TWO = WaypointPath(np.array([START, START + 0.4]))
 
 def _refused(path, timing, dt=0.01, **kwargs) -> ToptrajError:
     with pytest.raises(ToptrajError) as caught:
-        plan(UR5, path, timing, dt, **kwargs)
+        plan(build_problem(UR5, path, **timing, sampling=Sampling(dt=dt), **kwargs))
     return caught.value
 
 
 def test_a_value_out_of_range_carries_field_value_and_bounds():
-    error = _refused(TWO, Timing(), dt=5e-324)
+    error = _refused(TWO, dict(method=METHODS["phase_plane"]), dt=5e-324)
     assert type(error) is OutOfRange
     assert (error.field, error.value, error.low, error.high, error.unit) == ("sampling.dt", 5e-324, DT.low, DT.high, "s")
     assert detail(error) == "output.dt = 5e-324 is outside the accepted range [1e-06, 10] s"
@@ -68,7 +80,7 @@ def test_a_value_out_of_range_carries_field_value_and_bounds():
 def test_a_boundary_entry_out_of_range_names_its_index_and_sign():
     velocity = np.zeros(6)
     velocity[3] = -2e3
-    error = _refused(TWO, Timing(method="quintic", start_velocity=velocity))
+    error = _refused(TWO, dict(method=METHODS["quintic"], boundary=BoundaryStates(start_velocity=velocity)))
     assert isinstance(error, OutOfRange)
     assert (error.field, error.value, error.signed) == ("boundary.start_velocity[3]", -2e3, True)
     assert error.low == -error.high
@@ -78,7 +90,7 @@ def test_a_boundary_entry_out_of_range_names_its_index_and_sign():
 def test_a_waypoint_outside_its_joint_range_names_the_entry_and_the_joint():
     waypoints = np.array([START, START + 0.4])
     waypoints[1, 2] = 10.0  # elbow_joint: [-pi, pi]
-    error = _refused(WaypointPath(waypoints), Timing())
+    error = _refused(WaypointPath(waypoints), dict(method=METHODS["phase_plane"]))
     assert isinstance(error, OutOfRange)
     assert (error.field, error.value, error.joint_name) == ("waypoints[1][2]", 10.0, "elbow_joint")
     assert (error.low, error.high) == pytest.approx((-np.pi, np.pi))
@@ -86,27 +98,34 @@ def test_a_waypoint_outside_its_joint_range_names_the_entry_and_the_joint():
 
 
 def test_a_waypoint_of_the_wrong_length_says_given_and_expected():
-    error = _refused(WaypointPath(np.array([[0.0, 0.1, 0.2, 0.3], [0.5, 0.1, 0.2, 0.3]])), Timing())
+    error = _refused(WaypointPath(np.array([[0.0, 0.1, 0.2, 0.3], [0.5, 0.1, 0.2, 0.3]])), dict(method=METHODS["phase_plane"]))
     assert isinstance(error, WrongLength)
     assert (error.field, error.given, error.expected) == ("waypoints[0]", 4, 6)
 
 
+def _mapped(timing: TimingRequest) -> ToptrajError:
+    """The error of mapping ``timing`` into the library's method object."""
+    with pytest.raises(ToptrajError) as caught:
+        method_of(timing, TWO, DEFAULT_SEARCH_MEMORY)
+    return caught.value
+
+
 def test_an_unknown_method_lists_the_names_served():
-    error = _refused(TWO, Timing(method="fastest"))
+    error = _mapped(TimingRequest.model_construct(method="fastest"))
     assert isinstance(error, NotOneOf)
     assert (error.field, error.value) == ("method", "fastest")
     assert {"phase_plane", "toppra", "search", "collocation"} <= set(error.allowed)
 
 
 def test_an_option_of_another_method_says_which_serves_it():
-    error = _refused(TWO, Timing(method="toppra", torque_weight=1e-3))
+    error = _mapped(TimingRequest.model_validate({"method": "toppra", "cost": {"torque_weight": 1e-3}}))
     assert isinstance(error, NotServed)
     assert (error.field, error.value, error.method, error.alternatives) == ("method.torque_weight", 1e-3, "toppra", ("min_cost",))
     assert detail(error) == "timing.cost.torque_weight is not used by timing.method 'toppra'; use min_cost"
 
 
 def test_conflicting_inputs_name_each_other():
-    timing = Timing(method="quintic", supporting_points=8, start_velocity=np.full(6, 0.1))
+    timing = dict(method=TimeLaw("quintic", supporting_points=8).method(), boundary=BoundaryStates(start_velocity=np.full(6, 0.1)))
     error = _refused(TWO, timing)
     assert isinstance(error, Conflicting)
     assert (error.field, error.value, error.fields, error.rule) == ("law.supporting_points", 8, ("boundary",), "law_from_rest")
@@ -114,7 +133,7 @@ def test_conflicting_inputs_name_each_other():
 
 def test_a_grid_beyond_the_method_cap_advises_the_largest_served():
     cap = METHODS["jerk_limited"].max_grid_intervals(UR5.dof)
-    error = _refused(TWO, Timing(method="jerk_limited", constraints=("velocity", "acceleration", "jerk"), grid_points=cap + 1))
+    error = _refused(TWO, dict(method=METHODS["jerk_limited"], limits=LimitRequest(kinds=("velocity", "acceleration", "jerk")), grid=cap + 1))
     assert isinstance(error, TooLarge)
     assert (error.field, error.value, error.largest, error.unit) == ("grid.intervals", cap + 1, cap, "bytes")
     assert error.estimate > error.cap == MEMORY_CAP_BYTES  # the one cap of every planning's memory
@@ -123,7 +142,7 @@ def test_a_grid_beyond_the_method_cap_advises_the_largest_served():
 
 
 def test_too_many_samples_advises_a_period_in_range():
-    error = _refused(TWO, Timing(method="cubic", duration=1e4), dt=1e-6)
+    error = _refused(TWO, dict(method=METHODS["cubic"], duration=1e4), dt=1e-6)
     assert isinstance(error, TooLarge)
     assert (error.field, error.value, error.unit) == ("sampling.dt", 1e-6, "samples")
     assert error.estimate > error.cap
@@ -133,8 +152,7 @@ def test_too_many_samples_advises_a_period_in_range():
 
 
 def test_a_scale_out_of_range_advises_factors_in_range():
-    timing = Timing(method="ruckig", constraints=("velocity", "acceleration", "jerk"),
-                    limit_overrides={"velocity": [1e3] * 6}, limit_scales={"velocity": 2.0})
+    timing = dict(method=METHODS["ruckig"], limits=LimitRequest(kinds=("velocity", "acceleration", "jerk"), overrides={"velocity": [1e3] * 6}, scales={"velocity": 2.0}))
     error = _refused(TWO, timing, dt=10.0)
     assert isinstance(error, OutOfRange)
     assert (error.field, error.value, error.kind, error.scaled) == ("limits.velocity_scale", 2.0, "velocity", 2e3)
@@ -145,9 +163,9 @@ def test_a_scale_out_of_range_advises_factors_in_range():
 
 def test_infeasible_keeps_where_and_which_limit():
     arm = robots.load("yamamoto_2r")
-    timing = Timing(constraints=("torque",), limit_scales={"torque": 0.1})
+    timing = dict(method=METHODS["phase_plane"], limits=LimitRequest(kinds=("torque",), scales={"torque": 0.1}))
     with pytest.raises(InfeasiblePath) as caught:
-        plan(arm, WaypointPath(np.array([[0.0, 0.0], [1.5, 0.0]])), timing, 0.01)
+        plan(build_problem(arm, WaypointPath(np.array([[0.0, 0.0], [1.5, 0.0]])), **timing, sampling=Sampling(dt=0.01)))
     assert (caught.value.joint, caught.value.limit) == ("theta1", "torque")
     assert 0.0 <= caught.value.s <= 1.0
 
@@ -200,11 +218,12 @@ def test_request_fields(library, request_):
 
 
 def _raised_rules() -> set[str]:
-    """Every ``rule="..."`` given to a constructor in ``planners/`` and ``robots/``, every
-    class's own ``rule_of_class`` and the rule of every ``Note(text, rule, ...)``."""
+    """Every ``rule="..."`` given to a constructor in ``planners/`` and ``robots/`` and in the
+    service's mapping of a request into the library's objects, every class's own
+    ``rule_of_class`` and the rule of every ``Note(text, rule, ...)``."""
     rules = set()
-    for folder in ("planners", "robots"):
-        for path in (ROOT / folder).rglob("*.py"):
+    for folder, pattern in (("planners", "*.py"), ("robots", "*.py"), ("service", "mapping.py")):
+        for path in (ROOT / folder).rglob(pattern):
             for node in ast.walk(ast.parse(path.read_text())):
                 if isinstance(node, ast.keyword) and node.arg == "rule" and isinstance(node.value, ast.Constant):
                     rules.add(node.value.value)
@@ -234,7 +253,7 @@ def test_every_rule_has_a_wording_and_every_wording_a_rule():
 
 def test_library_sentences_name_no_request_field():
     """``str(error)`` is in the library's words; ``detail`` in the request's."""
-    error = _refused(TWO, Timing(method="toppra", torque_weight=1e-3))
+    error = _mapped(TimingRequest.model_validate({"method": "toppra", "cost": {"torque_weight": 1e-3}}))
     assert "timing." not in str(error) and "method.torque_weight" in str(error)
     assert isinstance(error, InvalidInput) and isinstance(error, InvalidRequest)
 
@@ -259,7 +278,7 @@ def test_the_library_holds_no_request_vocabulary_and_no_status():
 
 def test_a_spline_leaving_the_joint_range_says_where_and_by_how_much():
     waypoints = np.array([[0, 0, 0, 0, 0, 0], [0, 0, 3.1, 0, 0, 0], [0, 0, 3.14, 0, 0, 0], [0, 0, 0, 0, 0, 0]], dtype=float)
-    error = _refused(WaypointPath(waypoints), Timing())
+    error = _refused(WaypointPath(waypoints), dict(method=METHODS["phase_plane"]))
     assert isinstance(error, OutsideJointRange) and isinstance(error, InfeasiblePath)
     assert error.joint == "elbow_joint" and 0.0 < error.s < 1.0
     assert (error.lower, error.upper) == pytest.approx((-np.pi, np.pi))

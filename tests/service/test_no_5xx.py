@@ -15,7 +15,18 @@ import uvicorn
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Deadline, Timing, TimingFailed, WaypointPath, plan
+from toptraj.planners import (
+    METHODS,
+    BoundaryStates,
+    Deadline,
+    LimitRequest,
+    Sampling,
+    TimeLaw,
+    TimingFailed,
+    WaypointPath,
+    build_problem,
+    plan,
+)
 from toptraj.planners.errors import OutOfRange
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.results import require_finite
@@ -85,19 +96,23 @@ def test_compare_whose_durations_overflowed_the_grid_is_a_422(client):
 
 
 def test_the_library_holds_the_same_ranges():
-    """``plan`` called without the service checks the ranges too."""
+    """The library's option objects and ``build_problem``, called without the service, check the
+    ranges too."""
     arm = robots.load("geering_2r")
     path = WaypointPath(np.array([[0.0, 0.0], [1.0, 1.0]]))
-    for timing, dt, field, words in [
-        (Timing(method="cubic", duration=1e-300), 0.01, "duration", "timing.duration = 1e-300"),
-        (Timing(method="trapezoidal", trapezoid_fractions=(5e-324, 0.5)), 0.01, "law.trapezoid.tau1", "timing.trapezoid.tau1"),
-        (Timing(method="quintic", start_acceleration=np.array([1e308, 1e308])), 0.01, "boundary.start_acceleration[0]",
-         "timing.boundary.start_acceleration[0]"),
-        (Timing(limit_scales={"torque": 1e-300}), 0.01, "limits.torque_scale", "timing.limits.torque_scale"),
-        (Timing(), 5e-324, "sampling.dt", "output.dt"),
+    for problem, field, words in [
+        (lambda: build_problem(arm, path, METHODS["cubic"], duration=1e-300), "duration", "timing.duration = 1e-300"),
+        (lambda: build_problem(arm, path, TimeLaw("trapezoidal", fractions=(5e-324, 0.5)).method()), "law.trapezoid.tau1",
+         "timing.trapezoid.tau1"),
+        (lambda: build_problem(arm, path, METHODS["quintic"], boundary=BoundaryStates(start_acceleration=np.array([1e308, 1e308]))),
+         "boundary.start_acceleration[0]", "timing.boundary.start_acceleration[0]"),
+        (lambda: build_problem(arm, path, METHODS["phase_plane"], limits=LimitRequest(scales={"torque": 1e-300})), "limits.torque_scale",
+         "timing.limits.torque_scale"),
+        (lambda: build_problem(arm, path, METHODS["phase_plane"], sampling=Sampling(dt=5e-324), deadline=Deadline()), "sampling.dt",
+         "output.dt"),
     ]:
         with pytest.raises(OutOfRange) as caught:
-            plan(arm, path, timing, dt, Deadline())
+            plan(problem())
         assert caught.value.field == field and not caught.value.low <= abs(caught.value.value) <= caught.value.high
         assert words in detail(caught.value) and "accepted range" in detail(caught.value)
 

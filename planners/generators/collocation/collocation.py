@@ -250,13 +250,8 @@ def _feasible(problem: _Problem, z: np.ndarray) -> bool:
 
 
 def optimize_motion(
-    robot: Robot,
-    limits: JointLimits,
-    motion: FreeMotion,
-    torque_weight: float = 0.0,
-    deadline: Deadline = NO_DEADLINE,
-    max_iterations: int = 1000,
-    uninterruptible: Callable[..., CollocationResult] | None = None,
+    robot: Robot, limits: JointLimits, motion: FreeMotion, torque_weight: float = 0.0, deadline: Deadline = NO_DEADLINE,
+    max_iterations: int = 1000, uninterruptible: Callable[..., CollocationResult] | None = None,
 ) -> CollocationResult:
     """Minimize T (``torque_weight`` = 0) or the integral of (1 + beta |tau|^2) dt from start to
     goal. Every initial guess (goal shifts times bends) is first solved on a coarse grid of

@@ -21,12 +21,10 @@ from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
 from toptraj.planners.problem.path_checks import moving_velocity, path_boundary, timing_grid
-from toptraj.planners.problem.problem import MotionSpec, Problem
-from toptraj.planners.problem.requests import Timing
+from toptraj.planners.problem.problem import Problem
 from toptraj.planners.timing.base import GAP_TARGET, TimingMethod
 from toptraj.planners.timing.min_cost import MinCostMethod
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
-from toptraj.robots import JointLimits, Robot
 from toptraj.robots.notes import Note
 
 #: Most collocation intervals a request may ask for (timing.grid_points).
@@ -56,11 +54,11 @@ class Collocation(MotionGenerator):
     def timed_by(self) -> TimingMethod:
         return PhasePlaneMethod() if self.torque_weight == 0.0 else MinCostMethod(self.torque_weight)
 
-    def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
-        if not isinstance(motion, FreeMotion):
+    def validate(self, problem: Problem) -> None:
+        if not isinstance(problem.motion, FreeMotion):
             raise NotServed("method", self.name, self.name, rule="free_path_needs_collocation", alternatives=("collocation", "search"))
-        if options.grid_points is not None and not 4 <= options.grid_points <= MAX_INTERVALS:
-            raise OutOfRange("grid.intervals", options.grid_points, 4, MAX_INTERVALS, rule="collocation_intervals")
+        if problem.grid is not None and not 4 <= problem.grid <= MAX_INTERVALS:
+            raise OutOfRange("grid.intervals", problem.grid, 4, MAX_INTERVALS, rule="collocation_intervals")
 
     def generate(self, problem: Problem, execution: Execution) -> Timed:
         """The collocation's path, re-timed exactly along itself, its switching times refined."""
@@ -74,13 +72,12 @@ class Collocation(MotionGenerator):
         retiming.progress(0.0, "constraints")
         constraints = build_path_constraints(path, robot, limits, kinds, timing_grid(path, None, retimer, robot), deadline)
         moving = dataclasses.replace(
-            problem.options, start_velocity=moving_velocity(spec.start_velocity), end_velocity=moving_velocity(spec.end_velocity),
-            duration=None,
+            problem.boundary, start_velocity=moving_velocity(spec.start_velocity), end_velocity=moving_velocity(spec.end_velocity),
         )
         notes: tuple[str, ...] = ()
         try:
             result, constraints, check = gated(
-                robot, path, retimer, constraints, path_boundary(path, moving, retimer), None, kinds, limits, threshold,
+                robot, path, retimer, constraints, path_boundary(path, moving, None, retimer), None, kinds, limits, threshold,
                 retiming.within(0.1, 1.0),
             )
             stretch = TimedStretch(path, result, constraints, check)
@@ -121,17 +118,18 @@ def _optimized(problem: Problem, execution: Execution):
     """The collocation's optimum on the requested intervals, under the velocity and acceleration
     limits only when they are asked for; the optimization is the uninterruptible step
     (``Execution.uninterruptible``)."""
-    spec, options, robot, limits = problem.motion, problem.options, problem.robot, problem.limits
-    assert isinstance(spec, FreeMotion)
-    if options.grid_points is not None:
-        spec = dataclasses.replace(spec, intervals=options.grid_points)
+    spec, kinds, robot, limits = problem.motion, problem.kinds, problem.robot, problem.limits
+    method = problem.method
+    assert isinstance(spec, FreeMotion) and isinstance(method, Collocation)
+    if problem.grid is not None:
+        spec = dataclasses.replace(spec, intervals=problem.grid)
     unlimited = np.full(robot.dof, np.inf)
     limits = dataclasses.replace(
         limits,
-        velocity=limits.velocity if "velocity" in options.constraints else unlimited,
-        acceleration=limits.acceleration if "acceleration" in options.constraints else unlimited,
+        velocity=limits.velocity if "velocity" in kinds else unlimited,
+        acceleration=limits.acceleration if "acceleration" in kinds else unlimited,
     )
-    return optimize_motion(robot, limits, spec, options.torque_weight, execution.deadline, uninterruptible=execution.uninterruptible)
+    return optimize_motion(robot, limits, spec, method.torque_weight, execution.deadline, uninterruptible=execution.uninterruptible)
 
 
 def _switched(problem: Problem, collocation, timed, notes, deadline):

@@ -32,8 +32,7 @@ from toptraj.planners.paths import GeometricPath
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed, TimePath
 from toptraj.planners.problem.path_checks import moving_velocity
-from toptraj.planners.problem.problem import MotionSpec, Problem
-from toptraj.planners.problem.requests import Timing
+from toptraj.planners.problem.problem import BoundaryStates, Problem
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.robots import JointLimits, Robot
@@ -61,11 +60,12 @@ class Search(MotionGenerator):
     def timed_by(self) -> TimingMethod:
         return PhasePlaneMethod()
 
-    def validate(self, robot: Robot, motion: MotionSpec, options: Timing, kinds: tuple[str, ...], limits: JointLimits) -> None:
+    def validate(self, problem: Problem) -> None:
+        motion = problem.motion
         if not isinstance(motion, FreeMotion):
             raise NotServed("method", "search", "search", rule="search_needs_free_path")
         moving = moving_velocity(motion.start_velocity) is not None or moving_velocity(motion.end_velocity) is not None
-        if moving or options.duration is not None:
+        if moving or problem.duration is not None:
             raise Conflicting("method", "search", ("boundary", "duration"), rule="search_from_rest")
 
     def estimate(self, problem: Problem) -> int:
@@ -94,7 +94,7 @@ class Search(MotionGenerator):
         spec, robot, deadline = problem.motion, problem.robot, execution.deadline
         assert isinstance(spec, FreeMotion)  # validated
         need = self.estimate(problem)
-        work = _Work(robot, spec, problem.options, self.options, problem.kinds, problem.limits, problem.threshold,
+        work = _Work(robot, spec, problem.boundary, problem.grid, self.options, problem.kinds, problem.limits, problem.threshold,
                      problem.obstacles, problem.clearance, execution.time_path)
         try:
             return execution.uninterruptible(
@@ -113,7 +113,8 @@ class _Work:
 
     robot: Robot
     spec: FreeMotion
-    options: Timing
+    boundary: BoundaryStates
+    grid: int | None
     search: SearchOptions
     kinds: tuple[str, ...]
     limits: JointLimits
@@ -163,7 +164,7 @@ def _search(work: _Work, deadline: Deadline) -> Timed:
     )
     tubes = found.result.tubes
     optimized, failures = _optimized_tubes(work, tubes, deadline)
-    plain = dataclasses.replace(work.options, method="phase_plane", search=None, start_velocity=None, end_velocity=None)
+    plain = dataclasses.replace(work.boundary, start_velocity=None, end_velocity=None)
     candidates: list[tuple[GeometricPath, int, LocalOptimum | None]] = [
         (item.path, index, item) for _, index, item in sorted(optimized, key=lambda item: item[:2])
     ]
@@ -173,7 +174,7 @@ def _search(work: _Work, deadline: Deadline) -> Timed:
             if work.obstacles:
                 check_clearance(path, robot, list(work.obstacles), work.clearance, deadline)
             check_self_collision(path, robot, deadline=deadline)
-            timed = work.time_path(robot, path, PhasePlaneMethod(), plain, work.kinds, work.limits, deadline.within(0.9, 1.0), work.threshold)
+            timed = work.time_path(robot, path, PhasePlaneMethod(), work.grid, plain, None, work.kinds, work.limits, deadline.within(0.9, 1.0), work.threshold)
         except InfeasiblePath as error:
             failures.append(f"tube {index + 1}{' (optimized)' if optimum is not None else ''}: {error.detail}")
             continue

@@ -101,6 +101,7 @@ class ClassicalMethod(TimingMethod):
         self.profile = profile
         self.name = profile.name
         self.boundary_law = boundary_law
+        self.supporting_points = getattr(profile, "supporting_points", None)
         self.takes_acceleration_boundary = boundary_law == "quintic"
         # The samples' jerk (finite differences) is checked too where the law has no jumps.
         self.continuous_acceleration = not len(profile.acceleration_steps())

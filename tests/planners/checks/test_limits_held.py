@@ -15,7 +15,8 @@ import pytest
 from tests.conftest import UR5_WAYPOINTS
 from tests.paths import DATA
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath
+from toptraj.planners import METHODS as TIMING_METHODS
+from toptraj.planners import LimitRequest, Sampling, WaypointPath, build_problem
 from toptraj.planners import plan as plan_library
 
 KINDS = ("velocity", "acceleration", "torque")
@@ -207,12 +208,16 @@ def test_a_limit_not_asked_for_that_the_answer_exceeds_is_said():
     motion needs: the answer holds what was asked and says which joint's torque exceeds its
     limit, by how much, and how to hold it."""
     arm = robots.load("ur5")
-    timing = Timing(method="phase_plane", constraints=("velocity", "acceleration"), limit_overrides={"torque": [1e-3] * 6})
-    result = plan_library(arm, WaypointPath(np.array(UR5_WAYPOINTS[:2])), timing, dt=0.05)
+    limits = LimitRequest(kinds=("velocity", "acceleration"), overrides={"torque": [1e-3] * 6})
+    path = WaypointPath(np.array(UR5_WAYPOINTS[:2]))
+    result = plan_library(build_problem(arm, path, TIMING_METHODS["phase_plane"], limits=limits, sampling=Sampling(0.05)))
     worst = int(np.argmax(result.peak_utilization["torque"]))
     (note,) = [w for w in result.warnings if "not asked for" in w]
     assert f"torque of joint {arm.joint_names[worst]!r}" in note
     assert f"{result.peak_utilization['torque'][worst]:.4g} times its limit" in note
     assert "add 'torque' to the constraints" in note
-    asked = plan_library(arm, WaypointPath(np.array(UR5_WAYPOINTS[:2])), Timing(method="phase_plane", constraints=("velocity", "acceleration")), dt=0.05)
+    asked = plan_library(build_problem(
+        arm, WaypointPath(np.array(UR5_WAYPOINTS[:2])), TIMING_METHODS["phase_plane"],
+        limits=LimitRequest(kinds=("velocity", "acceleration")), sampling=Sampling(0.05),
+    ))
     assert not [w for w in asked.warnings if "not asked for" in w]

@@ -15,7 +15,7 @@ from scipy.spatial import cKDTree
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import CartesianLine, Timing, WaypointPath, plan
+from toptraj.planners import METHODS, CartesianLine, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.checks.gate import samples_exceed
 from toptraj.planners.collision import SphereObstacle
 from toptraj.planners.constraints.zones import with_edges
@@ -70,7 +70,7 @@ def _path_s(arm, q: np.ndarray) -> np.ndarray:
 
 @pytest.mark.parametrize("method", ["phase_plane", "toppra"])
 def test_a_tool_speed_zone_binds_at_its_limit_there_and_nowhere_else(ur5, method):
-    result = plan(ur5, WELD, Timing(method=method, tool_speed=SPEED, zones=(MIDDLE,)), dt=DT)
+    result = plan(build_problem(ur5, WELD, METHODS[method], limits=LimitRequest(tool_speed=SPEED, zones=(MIDDLE,)), sampling=Sampling(dt=DT)))
     samples = result.samples
     speed = _tool_speeds(ur5, samples.q, samples.qd)
     s = _path_s(ur5, samples.q)
@@ -87,7 +87,7 @@ def test_a_tool_speed_zone_binds_at_its_limit_there_and_nowhere_else(ur5, method
 
 def test_the_zoned_duration_lies_between_the_unzoned_one_and_the_zone_everywhere(ur5):
     durations = [
-        plan(ur5, WELD, Timing(tool_speed=speed, zones=zones), dt=0.01).duration
+        plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=speed, zones=zones), sampling=Sampling(dt=0.01))).duration
         for speed, zones in ((SPEED, ()), (SPEED, (MIDDLE,)), (ZONE_SPEED, ()))
     ]
     unzoned, zoned, everywhere = durations
@@ -97,7 +97,7 @@ def test_the_zoned_duration_lies_between_the_unzoned_one_and_the_zone_everywhere
 
 
 def test_a_zone_above_the_speed_reached_there_does_not_bind(ur5):
-    result = plan(ur5, WELD, Timing(tool_speed=SPEED, zones=(Zone(s_range=(0.4, 0.6), tool_speed=0.08),)), dt=0.01)
+    result = plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=SPEED, zones=(Zone(s_range=(0.4, 0.6), tool_speed=0.08),)), sampling=Sampling(dt=0.01)))
     (report,) = result.zones
     assert not report.binding and report.peak == pytest.approx(SPEED / 0.08, rel=0.005)
 
@@ -106,7 +106,7 @@ def test_a_workspace_sphere_is_found_where_the_tool_point_enters_and_leaves_it(u
     path = make_path(ur5, WELD)
     middle = _tool_points(ur5, path.evaluate(np.array([0.5])).q)[0]
     sphere = SphereObstacle(center=middle + np.array([0.0, 0.0, 0.01]), radius=0.05)
-    result = plan(ur5, WELD, Timing(tool_speed=SPEED, zones=(Zone(region=sphere, tool_speed=ZONE_SPEED),)), dt=0.01)
+    result = plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=SPEED, zones=(Zone(region=sphere, tool_speed=ZONE_SPEED),)), sampling=Sampling(dt=0.01)))
     ((enter, leave),) = result.zones[0].ranges
     assert 0.2 < enter < 0.5 < leave < 0.8
     # Independently: the tool point by Pinocchio at the path's points is on the sphere at both
@@ -125,9 +125,9 @@ def test_a_zone_scales_the_joint_limits_of_its_kind_inside_it(ur5, kind, factor)
     there (each sample's s: its nearest point of the path, on a grid of 1e-5) stay within the
     factor times the robot's limits and reach them; the motion slows."""
     spec = WaypointPath(np.array(UR5_WAYPOINTS))
-    free = plan(ur5, spec, Timing(), dt=0.01)
+    free = plan(build_problem(ur5, spec, METHODS["phase_plane"], sampling=Sampling(dt=0.01)))
     zone = dataclasses.replace(Zone(s_range=(0.4, 0.6)), **{kind: factor})
-    result = plan(ur5, spec, Timing(zones=(zone,)), dt=0.002)
+    result = plan(build_problem(ur5, spec, METHODS["phase_plane"], limits=LimitRequest(zones=(zone,)), sampling=Sampling(dt=0.002)))
     assert result.duration > free.duration * 1.005
     grid = np.linspace(0.0, 1.0, 100_001)
     _, nearest = cKDTree(make_path(ur5, spec).evaluate(grid).q).query(result.samples.q)
@@ -155,12 +155,12 @@ def test_a_zone_scales_the_joint_limits_of_its_kind_inside_it(ur5, kind, factor)
 )
 def test_bad_zones_are_refused_naming_the_zone(ur5, zones, words):
     with pytest.raises(InvalidRequest, match=words):
-        plan(ur5, WELD, Timing(tool_speed=SPEED, zones=zones), dt=0.01)
+        plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=SPEED, zones=zones), sampling=Sampling(dt=0.01)))
 
 
 def test_methods_that_do_not_hold_zones_refuse_them(ur5):
     with pytest.raises(InvalidRequest, match="zones are held by the timing methods phase_plane, toppra"):
-        plan(ur5, WaypointPath(np.array(UR5_WAYPOINTS)), Timing(method="quintic", zones=(MIDDLE,)), dt=0.01)
+        plan(build_problem(ur5, WaypointPath(np.array(UR5_WAYPOINTS)), METHODS["quintic"], limits=LimitRequest(zones=(MIDDLE,)), sampling=Sampling(dt=0.01)))
 
 
 def test_the_grid_holds_every_zone_edge_and_keeps_its_knots():
@@ -192,4 +192,4 @@ def test_zones_that_cover_too_many_stretches_of_the_path_are_refused(ur5, monkey
     sphere = SphereObstacle(center=np.array([0.413, 0.39, 0.34]), radius=0.05)  # the line's middle
     zones = (Zone(region=sphere, tool_speed=ZONE_SPEED), MIDDLE)
     with pytest.raises(InvalidRequest, match="more than 1 stretches of the path from zone 1 on"):
-        plan(ur5, WELD, Timing(tool_speed=SPEED, zones=zones), dt=0.01)
+        plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=SPEED, zones=zones), sampling=Sampling(dt=0.01)))

@@ -11,13 +11,14 @@ import pytest
 from tests.planners.coordination.cells import FIRST, SECOND, TURNED, facing_cell, ur5_arm
 from tests.planners.coordination.independent import coal_distance
 from toptraj import robots
+from toptraj.planners import METHODS, LimitRequest, build_problem
 from toptraj.planners.coordination import Cell, coordinate
 from toptraj.planners.coordination.coordinate import curve_schedule
 from toptraj.planners.coordination.timing import Schedule, SoloMotion, solo_timing
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.plan import plan
-from toptraj.planners.problem.requests import Timing, WaypointPath
+from toptraj.planners.problem.requests import WaypointPath
 
 KINDS = ("velocity", "acceleration")
 
@@ -56,7 +57,7 @@ def test_never_slower_than_one_arm_after_the_other(crossing):
 
 def _planned(waypoints) -> float:
     """The arm's own optimum by the project's planner (phase plane, gate included)."""
-    result = plan(robots.load("ur5"), WaypointPath(np.array(waypoints)), Timing(method="phase_plane", constraints=KINDS))
+    result = plan(build_problem(robots.load("ur5"), WaypointPath(np.array(waypoints)), METHODS["phase_plane"], limits=LimitRequest(kinds=KINDS)))
     return result.duration
 
 

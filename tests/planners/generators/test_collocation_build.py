@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, plan
+from toptraj.planners import LimitRequest, Sampling, build_problem, plan
 from toptraj.planners.generators.collocation import collocation
 from toptraj.planners.generators.collocation import generator as collocation_generator
+from toptraj.planners.generators.collocation.generator import Collocation
 from toptraj.planners.generators.collocation.sparse import SparseCollocation
 from toptraj.planners.problem.free_motion import FreeMotion
 
@@ -55,8 +56,7 @@ def test_a_motion_shaped_by_its_acceleration_limits_is_not_refined_to_bang_bang(
     calls = []
     monkeypatch.setattr(collocation_generator, "refine_collocation", lambda *args, **kwargs: calls.append(args))
     arm = robots.load("ur5")
-    result = plan(arm, FreeMotion(START, GOAL, intervals=12, revolutions=False),
-                  Timing(method="collocation", constraints=("velocity", "acceleration", "torque")), dt=0.01)
+    result = plan(build_problem(arm, FreeMotion(START, GOAL, intervals=12, revolutions=False), Collocation(), limits=LimitRequest(kinds=("velocity", "acceleration", "torque")), sampling=Sampling(dt=0.01)))
     assert calls == []
     assert result.solver.switching == "read off the samples"
     assert max(result.peak_utilization["torque"]) < 0.5

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, plan
+from toptraj.planners import LimitRequest, Sampling, build_problem, plan
 from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.generators.collocation.generator import Collocation
 from toptraj.planners.problem.free_motion import FreeMotion
 
 #: The converged optima of Yamamoto's free path (torque limits only), from its own
@@ -28,7 +29,7 @@ def client(patient_client):
 def _geering(goal, revolutions=True):
     arm = robots.load("geering_2r")
     motion = FreeMotion(np.zeros(2), np.array(goal, dtype=float), revolutions=revolutions)
-    return arm, plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002)
+    return arm, plan(build_problem(arm, motion, Collocation(), limits=LimitRequest(kinds=("torque",)), sampling=Sampling(dt=0.002)))
 
 
 @pytest.mark.parametrize(
@@ -63,7 +64,7 @@ def test_free_motion_progress_never_goes_back():
     arm = robots.load("geering_2r")
     motion = FreeMotion(np.zeros(2), np.array([0.98, 0.0]), revolutions=False)
     deadline = Deadline(progress=lambda fraction, stage: reports.append((fraction, stage)))
-    plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002, deadline=deadline)
+    plan(build_problem(arm, motion, Collocation(), limits=LimitRequest(kinds=("torque",)), sampling=Sampling(dt=0.002), deadline=deadline))
     fractions = [fraction for fraction, _ in reports]
     assert fractions == sorted(fractions), reports
     stages = [stage for _, stage in reports]
@@ -82,7 +83,7 @@ def test_geering_larger_moves_prefer_the_revolution():
 def test_yamamoto_free_path_cost_and_minimum_time():
     arm = robots.load("yamamoto_2r")
     motion = FreeMotion(np.radians([45.0, -90.0]), np.radians([-90.0, 0.0]))
-    cheap = plan(arm, motion, Timing(method="collocation", constraints=("torque",), torque_weight=0.03))
+    cheap = plan(build_problem(arm, motion, Collocation(0.03), limits=LimitRequest(kinds=("torque",))))
     assert cheap.solver.cost <= 0.5777  # the paper's sixth iterate, 0.57766, bounds the optimum
     assert cheap.cost <= 0.5777 * 1.01  # re-timed along the returned path by min_cost
     # The converged beta = 0.03 cost (YAMAMOTO_COST); the collocation's own and the re-timed one
@@ -97,7 +98,7 @@ def test_yamamoto_free_path_cost_and_minimum_time():
     assert cheap.accuracy.relative_gap == cheap.solver.optimality_gap
     assert cheap.accuracy.basis == cheap.solver.gap_basis
     assert cheap.peak_utilization["torque"].max() <= 1.005
-    fast = plan(arm, motion, Timing(method="collocation", constraints=("torque",)))
+    fast = plan(build_problem(arm, motion, Collocation(), limits=LimitRequest(kinds=("torque",))))
     assert fast.duration < cheap.duration
     # refined to exact bang-bang torques (toptraj.planners.generators.collocation.switching): never longer than the
     # collocation's own duration, and within 1e-4 (the largest gap it may state) of the

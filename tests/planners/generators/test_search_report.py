@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, plan
+from toptraj.planners import LimitRequest, Sampling, build_problem, plan
+from toptraj.planners.generators.search.generator import Search
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.report import SearchReport
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -19,7 +20,7 @@ def test_the_search_reports_its_tubes_local_optimization_and_final_time():
     arm = robots.load("geering_2r")
     goal = np.array([0.76, 0.0])
     motion = FreeMotion(np.zeros(2), goal)
-    result = plan(arm, motion, Timing(method="search", constraints=("torque",), search=SearchOptions(tubes=1)), dt=0.002)
+    result = plan(build_problem(arm, motion, Search(SearchOptions(tubes=1)), limits=LimitRequest(kinds=("torque",)), sampling=Sampling(dt=0.002)))
     report = result.search
     assert isinstance(report, SearchReport)
     assert report.final_time == result.duration

@@ -22,8 +22,9 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, plan
+from toptraj.planners import LimitRequest, Sampling, build_problem, plan
 from toptraj.planners.generators.collocation.bang_bang import BangBang, collocation_switches, mirrored
+from toptraj.planners.generators.collocation.generator import Collocation
 from toptraj.planners.generators.collocation.switching import refine_switching
 from toptraj.planners.problem.free_motion import FreeMotion
 
@@ -37,7 +38,7 @@ def arm():
 
 def _answer(arm, phi_b, revolutions, elbow=0.0):
     motion = FreeMotion(np.zeros(2), np.array([phi_b, elbow]), revolutions=revolutions)
-    return plan(arm, motion, Timing(method="collocation", constraints=("torque",)), dt=0.002)
+    return plan(build_problem(arm, motion, Collocation(), limits=LimitRequest(kinds=("torque",)), sampling=Sampling(dt=0.002)))
 
 
 @pytest.fixture(scope="module")

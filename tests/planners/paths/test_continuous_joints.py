@@ -7,14 +7,14 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, WaypointPath, build_problem, plan
 from toptraj.service.problems import note_text
 
 TURN = np.array([[0.0, 0.2], [0.3, 6.0]])  # psi: 0.2 -> 6.0 rad, 5.8 rad as given, 0.483 the short way
 
 
 def _planned(mode: str):
-    return plan(robots.load("geering_2r"), WaypointPath(TURN, continuous=mode), Timing(constraints=("torque",)))
+    return plan(build_problem(robots.load("geering_2r"), WaypointPath(TURN, continuous=mode), METHODS["phase_plane"], limits=LimitRequest(kinds=("torque",))))
 
 
 def test_as_given_follows_the_numbers_and_warns():
@@ -33,7 +33,7 @@ def test_shortest_turns_the_short_way_to_the_equivalent_angle():
     assert end[1] == pytest.approx(6.0 - 2 * np.pi, abs=1e-9)  # the same angle, whole turns apart
     assert np.ptp(short.samples.q[:, 1]) == pytest.approx(0.2 - (6.0 - 2 * np.pi), abs=1e-9)  # no detour
     # the same move done the short way, stated directly, takes the same time
-    direct = plan(robots.load("geering_2r"), WaypointPath(np.array([[0.0, 0.2], [0.3, 6.0 - 2 * np.pi]])), Timing(constraints=("torque",)))
+    direct = plan(build_problem(robots.load("geering_2r"), WaypointPath(np.array([[0.0, 0.2], [0.3, 6.0 - 2 * np.pi]])), METHODS["phase_plane"], limits=LimitRequest(kinds=("torque",))))
     assert short.duration == pytest.approx(direct.duration, rel=1e-12)
     assert short.duration < 0.5 * given.duration
 

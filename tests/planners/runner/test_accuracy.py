@@ -4,7 +4,6 @@ panda and the two-link paper arms. ``benchmarks/accuracy.py`` runs the larger st
 
 from __future__ import annotations
 
-import dataclasses
 import re
 
 import numpy as np
@@ -15,8 +14,9 @@ from benchmarks.converged import converged_duration as converged
 from benchmarks.converged import random_path
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.generators.joint_moves import Unsynchronized, ViaPoints
 from toptraj.planners.paths import SplinePath
 from toptraj.planners.timing.min_cost import MinCostMethod
 from toptraj.service.problems import note_text
@@ -33,7 +33,7 @@ def test_default_durations_are_within_a_tenth_of_a_percent_of_the_converged_opti
             reference = converged_duration(robot, waypoints)
         except InfeasiblePath:
             continue
-        result = plan(robot, WaypointPath(waypoints), Timing(method="phase_plane", constraints=KINDS), dt=0.01)
+        result = plan(build_problem(robot, WaypointPath(waypoints), METHODS["phase_plane"], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.01)))
         # Both are conservative discretizations of the same problem: the refined grid may
         # come out a hair below the 20,000-interval one, never far.
         assert 0.9995 <= result.duration / reference <= 1.001, (waypoints.tolist(), result.duration, reference)
@@ -110,7 +110,7 @@ def test_min_cost_on_a_recorded_path_is_within_a_tenth_of_a_percent():
     robot = robots.load("ur5")
     waypoints = recorded_waypoints(robot, np.random.default_rng(0), 5)
     reference, _ = converged(SplinePath(waypoints), robot)
-    result = plan(robot, WaypointPath(waypoints), Timing(method="min_cost", constraints=KINDS), dt=0.05)
+    result = plan(build_problem(robot, WaypointPath(waypoints), METHODS["min_cost"], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.05)))
     true_gap = result.duration / reference - 1.0
     assert -1e-4 <= true_gap <= 1e-3
     assert result.accuracy is not None
@@ -126,7 +126,7 @@ def test_the_stated_gap_of_a_spline_matches_the_converged_reference(name, method
     robot = robots.load(name)
     waypoints, path = random_path(robot, np.random.default_rng(3))
     reference, _ = converged(path, robot)
-    result = plan(robot, WaypointPath(waypoints), Timing(method=method, constraints=KINDS), dt=0.01)
+    result = plan(build_problem(robot, WaypointPath(waypoints), METHODS[method], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.01)))
     true_gap = result.duration / reference - 1.0
     assert result.accuracy is not None and result.accuracy.relative_gap is not None
     assert result.accuracy.relative_gap >= abs(true_gap) - 1e-4, (result.accuracy, true_gap)
@@ -140,9 +140,9 @@ def test_min_cost_with_a_torque_weight_states_its_cost_gap():
     overstating it more than a few times (the scheme converges faster than first order here)."""
     robot = robots.load("geering_2r")
     waypoints = np.array([[0.0, 0.0], [1.0, 0.6], [1.6, -0.4]])
-    timing = Timing(method="min_cost", constraints=KINDS, torque_weight=0.01)
-    result = plan(robot, WaypointPath(waypoints), timing, dt=0.01)
-    fine = plan(robot, WaypointPath(waypoints), dataclasses.replace(timing, grid_points=800), dt=0.01)
+    timing = dict(method=MinCostMethod(0.01), limits=LimitRequest(kinds=KINDS))
+    result = plan(build_problem(robot, WaypointPath(waypoints), **timing, sampling=Sampling(dt=0.01)))
+    fine = plan(build_problem(robot, WaypointPath(waypoints), **timing, grid=800, sampling=Sampling(dt=0.01)))
     true_gap = result.cost / fine.cost - 1.0
     assert result.accuracy is not None and "half the intervals" in result.accuracy.basis
     assert 1e-5 < true_gap <= result.accuracy.relative_gap <= 5.0 * true_gap
@@ -178,14 +178,14 @@ def test_a_time_law_states_its_gap_to_its_own_shortest_duration(method):
     0.2 % less does not."""
     robot = robots.load("ur5")
     path = WaypointPath(np.array(UR5_WAYPOINTS))
-    result = plan(robot, path, Timing(method=method, constraints=KINDS), dt=0.01)
+    result = plan(build_problem(robot, path, METHODS[method], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.01)))
     gap = result.accuracy.relative_gap
     assert gap is not None and "peak utilization" in result.accuracy.basis
     shortest = result.duration / (1.0 + gap)
-    held = plan(robot, path, Timing(method=method, constraints=KINDS, duration=shortest * (1 + 1e-4)), dt=0.01)
+    held = plan(build_problem(robot, path, METHODS[method], limits=LimitRequest(kinds=KINDS), duration=shortest * (1 + 1e-4), sampling=Sampling(dt=0.01)))
     assert max(float(np.max(peak)) for peak in held.peak_utilization.values()) == pytest.approx(1.0, abs=1.5e-3)
     with pytest.raises(InfeasiblePath):
-        plan(robot, path, Timing(method=method, constraints=KINDS, duration=shortest * (1 - 2e-3)), dt=0.01)
+        plan(build_problem(robot, path, METHODS[method], limits=LimitRequest(kinds=KINDS), duration=shortest * (1 - 2e-3), sampling=Sampling(dt=0.01)))
 
 
 def test_the_typical_request_states_its_accuracy_without_a_second_solve(monkeypatch):
@@ -196,7 +196,7 @@ def test_the_typical_request_states_its_accuracy_without_a_second_solve(monkeypa
     calls = []
     solve = PhasePlaneMethod.solve
     monkeypatch.setattr(PhasePlaneMethod, "solve", lambda self, *args, **kwargs: calls.append(1) or solve(self, *args, **kwargs))
-    result = plan(robots.load("ur5"), WaypointPath(np.array(UR5_WAYPOINTS)), Timing(), dt=0.01)
+    result = plan(build_problem(robots.load("ur5"), WaypointPath(np.array(UR5_WAYPOINTS)), METHODS["phase_plane"], sampling=Sampling(dt=0.01)))
     assert len(calls) == 1
     assert result.accuracy is not None and 0.0 <= result.accuracy.relative_gap <= 6e-4
 
@@ -240,7 +240,7 @@ def test_a_finer_grid_that_breaks_a_limit_leaves_the_default_answer_with_a_warni
     for _ in range(10):
         waypoints = recorded_waypoints(robot, rng, 5)
     reference, _ = converged(SplinePath(waypoints), robot)
-    result = plan(robot, WaypointPath(waypoints), Timing(method="toppra", constraints=KINDS), dt=0.05)
+    result = plan(build_problem(robot, WaypointPath(waypoints), METHODS["toppra"], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.05)))
     true_gap = result.duration / reference - 1.0
     assert true_gap > 1e-3
     assert result.accuracy is not None and result.accuracy.relative_gap == pytest.approx(true_gap, abs=1e-4)
@@ -259,10 +259,9 @@ def test_time_laws_through_via_points_or_joint_by_joint_state_their_gap(interpol
     profile: about zero, since its most used limit binds (peak utilization 1)."""
     arm = robots.load("ur5")
     waypoints = np.array(UR5_WAYPOINTS[:3] if interpolation == "via" else UR5_WAYPOINTS[:2])
-    result = plan(
-        arm, WaypointPath(waypoints, interpolation),
-        Timing(method=law, constraints=("velocity", "acceleration"), synchronization=synchronization), dt=0.05,
-    )
+    method = Unsynchronized(METHODS[law]) if synchronization == "none" else ViaPoints(METHODS[law])
+    limits = LimitRequest(kinds=("velocity", "acceleration"))
+    result = plan(build_problem(arm, WaypointPath(waypoints, interpolation), method, limits=limits, sampling=Sampling(dt=0.05)))
     assert result.accuracy.relative_gap is not None
     assert result.accuracy.relative_gap <= 1e-6
     assert "peak utilization" in result.accuracy.basis

@@ -16,17 +16,21 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Deadline, Timing, WaypointPath, plan
+from toptraj.planners import METHODS as BY_NAME
+from toptraj.planners import Deadline, WaypointPath, plan
 from toptraj.planners.errors import OverMemory, TooLarge
 from toptraj.planners.execution import memory
+from toptraj.planners.generators.collocation.generator import Collocation
+from toptraj.planners.generators.joint_moves import Unsynchronized, ViaPoints
 from toptraj.planners.generators.search.generator import Search
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.memory import search_bytes
 from toptraj.planners.problem.build import build_problem
 from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.planners.problem.problem import LimitRequest, Sampling
 from toptraj.planners.results import Accuracy
 from toptraj.planners.runner.admission import admit
-from toptraj.planners.runner.choice import method_for
+from toptraj.planners.timing.min_cost import MinCostMethod
 
 LINE = np.array([[0.0, 0.0], [0.5, 0.3]])
 VIA = np.array([[0.0, 0.0], [0.3, 0.1], [0.5, 0.3]])
@@ -38,20 +42,21 @@ WITH_JERK = ("velocity", "acceleration", "jerk")
 #: The arm's catalog limits only its torques: the other limits are the request's.
 LIMITS = {"velocity": [2.0, 2.0], "acceleration": [8.0, 8.0], "jerk": [50.0, 50.0]}
 
-#: (label, path, timing): every method of both families on the two-joint arm.
+#: (label, path, method, kinds): every method of both families on the two-joint arm.
+ALL_KINDS = ("velocity", "acceleration", "torque")
 METHODS = [
-    ("phase_plane", LINE, Timing(method="phase_plane")),
-    ("toppra", LINE, Timing(method="toppra")),
-    ("min_cost", LINE, Timing(method="min_cost", torque_weight=1e-3)),
-    ("jerk_limited", LINE, Timing(method="jerk_limited", constraints=WITH_JERK)),
-    ("cubic", LINE, Timing(method="cubic")),
-    ("quintic", LINE, Timing(method="quintic")),
-    ("trapezoidal", LINE, Timing(method="trapezoidal", constraints=("velocity", "acceleration"))),
-    ("cycloidal", LINE, Timing(method="cycloidal")),
-    ("ruckig", LINE, Timing(method="ruckig", constraints=WITH_JERK)),
-    ("via points", VIA, Timing(method="quintic")),
-    ("unsynchronized", LINE, Timing(method="cubic", synchronization="none")),
-    ("collocation", FREE, Timing(method="collocation")),
+    ("phase_plane", LINE, BY_NAME["phase_plane"], ALL_KINDS),
+    ("toppra", LINE, BY_NAME["toppra"], ALL_KINDS),
+    ("min_cost", LINE, MinCostMethod(1e-3), ALL_KINDS),
+    ("jerk_limited", LINE, BY_NAME["jerk_limited"], WITH_JERK),
+    ("cubic", LINE, BY_NAME["cubic"], ALL_KINDS),
+    ("quintic", LINE, BY_NAME["quintic"], ALL_KINDS),
+    ("trapezoidal", LINE, BY_NAME["trapezoidal"], ("velocity", "acceleration")),
+    ("cycloidal", LINE, BY_NAME["cycloidal"], ALL_KINDS),
+    ("ruckig", LINE, BY_NAME["ruckig"], WITH_JERK),
+    ("via points", VIA, ViaPoints(BY_NAME["quintic"]), ALL_KINDS),
+    ("unsynchronized", LINE, Unsynchronized(BY_NAME["cubic"]), ALL_KINDS),
+    ("collocation", FREE, Collocation(), ALL_KINDS),
 ]
 
 
@@ -73,20 +78,20 @@ def arm():
     return robots.load("yamamoto_2r")
 
 
-@pytest.mark.parametrize("label, path, timing", METHODS, ids=[m[0] for m in METHODS])
-def test_each_method_is_refused_before_any_work_with_a_grid_that_then_plans(arm, monkeypatch, label, path, timing):
-    spec, timing = _path(path), dataclasses.replace(timing, limit_overrides=LIMITS)
-    method = method_for(timing, spec)
+@pytest.mark.parametrize("label, path, method, kinds", METHODS, ids=[m[0] for m in METHODS])
+def test_each_method_is_refused_before_any_work_with_a_grid_that_then_plans(arm, monkeypatch, label, path, method, kinds):
+    spec, limits = _path(path), LimitRequest(kinds=kinds, overrides=LIMITS)
     monkeypatch.setattr(memory, "MEMORY_CAP_BYTES", _cap_for(method.bytes_per_interval_joint, arm.dof))
     stages: list[str] = []
     deadline = Deadline(progress=lambda fraction, stage: stages.append(stage))
+    sampling = Sampling(max_samples=MAX_SAMPLES)
     with pytest.raises(TooLarge) as refused:
-        plan(arm, spec, dataclasses.replace(timing, grid_points=LARGEST + 1), deadline=deadline, max_samples=MAX_SAMPLES)
+        plan(build_problem(arm, spec, method, limits=limits, grid=LARGEST + 1, sampling=sampling, deadline=deadline))
     error = refused.value
     assert stages == []  # nothing started: no stage reported its progress
     assert (error.field, error.value, error.largest, error.method) == ("grid.intervals", LARGEST + 1, LARGEST, method.name)
     assert error.estimate > error.cap
-    answer = plan(arm, spec, dataclasses.replace(timing, grid_points=error.largest), max_samples=MAX_SAMPLES)
+    answer = plan(build_problem(arm, spec, method, limits=limits, grid=error.largest, sampling=sampling))
     assert answer.duration > 0.0 and len(answer.samples.t) >= 2
     assert isinstance(answer.accuracy, Accuracy) and answer.accuracy.basis  # stated by the runner
 
@@ -102,15 +107,15 @@ def test_a_search_over_its_memory_is_refused_before_any_work_with_a_roadmap_that
     allowance = search_bytes(arm, start, goal, options, True) // 3
     spec = FreeMotion(start=start, goal=goal)
     stages: list[str] = []
-    timing = Timing(method="search", search=dataclasses.replace(options, memory_bytes=allowance))
+    method = Search(dataclasses.replace(options, memory_bytes=allowance))
     with pytest.raises(OverMemory) as refused:
-        plan(arm, spec, timing, deadline=Deadline(progress=lambda fraction, stage: stages.append(stage)))
+        plan(build_problem(arm, spec, method, deadline=Deadline(progress=lambda fraction, stage: stages.append(stage))))
     assert stages == []
     points = refused.value.most_points
 
     def problem(roadmap_points):
         search = dataclasses.replace(options, roadmap_points=roadmap_points, memory_bytes=allowance)
-        return build_problem(arm, spec, Search(search), Timing(method="search", search=search))
+        return build_problem(arm, spec, Search(search))
 
     admit(problem(points))
     with pytest.raises(OverMemory):

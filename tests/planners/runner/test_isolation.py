@@ -9,12 +9,13 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Deadline, Timing, WaypointPath, plan
+from toptraj.planners import Deadline, WaypointPath, plan
 from toptraj.planners.execution import isolated
 from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.generators.collocation.generator import Collocation
 from toptraj.planners.generators.joint_moves import ViaPoints
 from toptraj.planners.generators.search.generator import Search
+from toptraj.planners.problem.build import build_problem
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.runner.run import isolates
 from toptraj.planners.timing import METHODS
@@ -56,12 +57,12 @@ def started(monkeypatch):
 
 
 def test_the_typical_request_starts_no_worker_process(started):
-    answer = plan(robots.load("ur5"), WaypointPath(UR5_LINE), Timing(method="phase_plane"), deadline=Deadline(60.0))
+    answer = plan(build_problem(robots.load("ur5"), WaypointPath(UR5_LINE), METHODS["phase_plane"], deadline=Deadline(60.0)))
     assert answer.duration > 0.0 and started == []
 
 
 def test_the_collocation_optimizes_in_a_worker_process_under_a_deadline(started):
     arm = robots.load("yamamoto_2r")
     motion = FreeMotion(start=np.zeros(2), goal=np.array([0.5, 0.3]))
-    answer = plan(arm, motion, Timing(method="collocation", grid_points=10), deadline=Deadline(120.0))
+    answer = plan(build_problem(arm, motion, Collocation(), grid=10, deadline=Deadline(120.0)))
     assert answer.method == "collocation" and len(started) == 1

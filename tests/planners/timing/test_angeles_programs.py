@@ -10,8 +10,9 @@ from scipy.interpolate import CubicSpline
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, BoundaryStates, LimitRequest, TimeLaw, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.generators.joint_moves import ViaPoints
 from toptraj.planners.timing.laws.profiles import CycloidalBlendProfile, CycloidalProfile, QuinticProfile, TrapezoidalProfile
 from toptraj.planners.timing.laws.splines import SplineProfile, clamped_spline, periodic_spline, spline_from_accelerations
 from toptraj.service.problems import detail
@@ -165,10 +166,10 @@ def test_spline_law_refuses_too_few_points_for_a_sharp_law():
 
 UR5 = robots.load("ur5")
 SERVED = [
-    pytest.param({"method": "trapezoidal", "trapezoid_blend": "cycloidal"}, id="trapezoidal-cycloidal"),
-    pytest.param({"method": "trapezoidal", "trapezoid_fractions": (TAU1, TAU2), "supporting_points": 8}, id="trapezoidal-spline8"),
-    pytest.param({"method": "cycloidal", "supporting_points": 6}, id="cycloidal-spline6"),
-    pytest.param({"method": "quintic", "supporting_points": 12}, id="quintic-spline12"),
+    pytest.param({"name": "trapezoidal", "blend": "cycloidal"}, id="trapezoidal-cycloidal"),
+    pytest.param({"name": "trapezoidal", "fractions": (TAU1, TAU2), "supporting_points": 8}, id="trapezoidal-spline8"),
+    pytest.param({"name": "cycloidal", "supporting_points": 6}, id="cycloidal-spline6"),
+    pytest.param({"name": "quintic", "supporting_points": 12}, id="quintic-spline12"),
 ]
 
 
@@ -181,10 +182,10 @@ def test_shortest_new_laws_hold_every_limit_and_are_not_faster_than_optimal(opti
     path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
     if not smooth:
         with pytest.raises(InfeasiblePath) as refused:
-            plan(UR5, path, Timing(constraints=(*kinds, "jerk"), **options))
+            plan(build_problem(UR5, path, TimeLaw(**options).method(), limits=LimitRequest(kinds=(*kinds, "jerk"))))
         assert refused.value.limit == "jerk"
-    result = plan(UR5, path, Timing(constraints=kinds, **options))
-    optimal = plan(UR5, path, Timing(method="phase_plane", constraints=kinds[:3]))
+    result = plan(build_problem(UR5, path, TimeLaw(**options).method(), limits=LimitRequest(kinds=kinds)))
+    optimal = plan(build_problem(UR5, path, METHODS["phase_plane"], limits=LimitRequest(kinds=kinds[:3])))
     assert result.duration >= optimal.duration
     for kind in kinds:
         assert result.peak_utilization[kind].max() <= 1.005, kind
@@ -202,26 +203,26 @@ def test_single_joint_closed_form_of_the_cycloidal_blend():
     start = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
     goal = start + np.array([1.2, 0, 0, 0, 0, 0])
     a = UR5.limits.acceleration[0]
-    result = plan(UR5, WaypointPath(np.array([start, goal])),
-                  Timing(method="trapezoidal", trapezoid_blend="cycloidal", constraints=("acceleration",)))
+    law = TimeLaw("trapezoidal", blend="cycloidal").method()
+    result = plan(build_problem(UR5, WaypointPath(np.array([start, goal])), law, limits=LimitRequest(kinds=("acceleration",))))
     assert result.duration == pytest.approx(np.sqrt(1.2 * np.pi * 1.5 / (2 * a / 3)), rel=1e-6)
 
 
 @pytest.mark.parametrize(
-    "options, field, rule, fragment",
+    "law, boundary, field, rule, fragment",
     [
-        ({"method": "cubic", "trapezoid_blend": "cycloidal"}, "law.blend", "blend_needs_trapezoidal", "timing.trapezoid.blend"),
-        ({"method": "phase_plane", "supporting_points": 8}, "law.supporting_points", "needs_time_law", "timing.supporting_points"),
-        ({"method": "trapezoidal", "trapezoid_fractions": (0.001, 0.001), "trapezoid_blend": "cycloidal",
-          "supporting_points": 5}, "law.supporting_points", "law_spline_failed", "backwards"),
-        ({"method": "quintic", "supporting_points": 8, "start_velocity": np.full(6, 0.1)}, "law.supporting_points",
+        ({"name": "cubic", "blend": "cycloidal"}, {}, "law.blend", "blend_needs_trapezoidal", "timing.trapezoid.blend"),
+        ({"name": "phase_plane", "supporting_points": 8}, {}, "law.supporting_points", "needs_time_law", "timing.supporting_points"),
+        ({"name": "trapezoidal", "fractions": (0.001, 0.001), "blend": "cycloidal", "supporting_points": 5}, {},
+         "law.supporting_points", "law_spline_failed", "backwards"),
+        ({"name": "quintic", "supporting_points": 8}, {"start_velocity": np.full(6, 0.1)}, "law.supporting_points",
          "law_from_rest", "rest to rest"),
     ],
 )
-def test_law_options_refused_where_they_do_not_apply(options, field, rule, fragment):
+def test_law_options_refused_where_they_do_not_apply(law, boundary, field, rule, fragment):
     path = WaypointPath(np.array(UR5_WAYPOINTS[:2]))
     with pytest.raises(InvalidRequest) as refused:
-        plan(UR5, path, Timing(**options))
+        plan(build_problem(UR5, path, TimeLaw(**law).method(), boundary=BoundaryStates(**boundary)))
     assert (refused.value.field, refused.value.rule) == (field, rule)
     assert fragment in detail(refused.value)
 
@@ -260,6 +261,6 @@ def test_laws_over_http(client):
 def test_supporting_points_refused_with_via_points():
     path = WaypointPath(np.array(UR5_WAYPOINTS), "via")
     with pytest.raises(InvalidRequest) as refused:
-        plan(UR5, path, Timing(method="cubic", supporting_points=8))
+        plan(build_problem(UR5, path, ViaPoints(TimeLaw("cubic", supporting_points=8).method())))
     assert (refused.value.field, refused.value.rule) == ("law.supporting_points", "via_points_are_polynomials")
     assert "leave timing.supporting_points out" in detail(refused.value)

@@ -22,7 +22,7 @@ import pytest
 from ruckig import InputParameter, Ruckig, Synchronization, Trajectory
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.waypoints import make_path
@@ -77,10 +77,7 @@ def _one_joint(length, v, a, j, joint=0):
         vector = getattr(arm.limits, kind).copy()
         vector[joint] = value
         overrides[kind] = vector.tolist()
-    result = plan(
-        arm, WaypointPath(np.array([start, goal])),
-        Timing(method="jerk_limited", constraints=JERK_KINDS, limit_overrides=overrides), dt=1e-3,
-    )
+    result = plan(build_problem(arm, WaypointPath(np.array([start, goal])), METHODS["jerk_limited"], limits=LimitRequest(kinds=JERK_KINDS, overrides=overrides), sampling=Sampling(dt=1e-3)))
     return result, goal
 
 
@@ -106,10 +103,7 @@ def test_straight_ur5_lines_are_ruckig_exactly(seed):
     rng = np.random.default_rng(seed)
     start, goal = rng.uniform(-2.0, 2.0, size=(2, arm.dof))
     scale = rng.uniform(0.3, 1.0)
-    result = plan(
-        arm, WaypointPath(np.array([start, goal])),
-        Timing(method="jerk_limited", constraints=JERK_KINDS, limit_scales={"jerk": scale}), dt=0.01,
-    )
+    result = plan(build_problem(arm, WaypointPath(np.array([start, goal])), METHODS["jerk_limited"], limits=LimitRequest(kinds=JERK_KINDS, scales={"jerk": scale}), sampling=Sampling(dt=0.01)))
     limits = arm.limits.with_request(scales={"jerk": scale})
     reference = _ruckig(start, goal, limits.velocity, limits.acceleration, limits.jerk)
     assert result.duration == pytest.approx(reference, rel=1e-6)
@@ -129,7 +123,7 @@ SPLINE = np.array([[0.0, -1.2, 1.0, 0.0, 0.5, 0.0], [0.6, -1.0, 1.4, 0.3, 0.2, 0
 def _spline(jerk):
     arm = robots.load("ur5")
     overrides = {"velocity": [1.0] * 6, "acceleration": [1.0] * 6, "jerk": [jerk] * 6}
-    return plan(arm, WaypointPath(SPLINE), Timing(method="jerk_limited", constraints=JERK_KINDS, limit_overrides=overrides), dt=1e-3)
+    return plan(build_problem(arm, WaypointPath(SPLINE), METHODS["jerk_limited"], limits=LimitRequest(kinds=JERK_KINDS, overrides=overrides), sampling=Sampling(dt=1e-3)))
 
 
 def test_a_huge_jerk_limit_on_a_spline_is_no_slower_than_a_small_one():
@@ -140,11 +134,7 @@ def test_a_huge_jerk_limit_on_a_spline_is_no_slower_than_a_small_one():
     assert moderate.duration <= small.duration
     assert huge.peak_utilization["jerk"].max() <= 1.005
     arm = robots.load("ur5")
-    jerk_free = plan(
-        arm, WaypointPath(SPLINE),
-        Timing(method="phase_plane", constraints=("velocity", "acceleration"), limit_overrides={"velocity": [1.0] * 6, "acceleration": [1.0] * 6}),
-        dt=1e-3,
-    )
+    jerk_free = plan(build_problem(arm, WaypointPath(SPLINE), METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [1.0] * 6, "acceleration": [1.0] * 6}), sampling=Sampling(dt=1e-3)))
     # No faster than the jerk-free optimum (to its accuracy), and a jerk of 1e8 costs nothing.
     assert huge.duration >= jerk_free.duration * (1 - 1e-3)
     assert huge.duration <= jerk_free.duration * (1 + 2e-3)
@@ -202,7 +192,7 @@ def test_a_coarse_grid_answer_states_its_gap_and_advises_a_grid_that_holds_a_ten
     arm = robots.load("ur5")
     waypoints = np.array([[0, -1.2, 1, 0, 0, 0], [0.8, -1, 1.4, -0.5, 0.6, 0.3], [2, -1.3, 1.2, 0.2, 0.4, 1.2]])
     kinds = ("velocity", "acceleration", "jerk")
-    coarse = plan(arm, WaypointPath(waypoints), Timing(method="jerk_limited", constraints=kinds, grid_points=20), dt=0.05)
+    coarse = plan(build_problem(arm, WaypointPath(waypoints), METHODS["jerk_limited"], limits=LimitRequest(kinds=kinds), grid=20, sampling=Sampling(dt=0.05)))
     assert coarse.accuracy.relative_gap > 1e-3
     assert "second grid" in coarse.accuracy.basis
     (warning,) = [w for w in coarse.warnings if "time-optimal one" in w]
@@ -213,6 +203,6 @@ def test_a_coarse_grid_answer_states_its_gap_and_advises_a_grid_that_holds_a_ten
     advised = int(re.search(r"timing\.grid_points (\d+)", text).group(1))
     assert advised == warning.facts["wanted"]
     assert advised <= JerkLimitedMethod().max_grid_intervals(arm.dof)
-    fine = plan(arm, WaypointPath(waypoints), Timing(method="jerk_limited", constraints=kinds, grid_points=advised), dt=0.05)
+    fine = plan(build_problem(arm, WaypointPath(waypoints), METHODS["jerk_limited"], limits=LimitRequest(kinds=kinds), grid=advised, sampling=Sampling(dt=0.05)))
     assert fine.accuracy.relative_gap <= 1e-3
     assert not [w for w in fine.warnings if "time-optimal one" in w]

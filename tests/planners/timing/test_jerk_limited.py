@@ -11,7 +11,7 @@ from ruckig import InputParameter, Ruckig, Trajectory
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.errors import TimingFailed
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.timing.jerk.method import JerkLimitedMethod
@@ -48,12 +48,7 @@ def test_one_joint_rest_to_rest_is_the_closed_form_profile(robot, joint, length,
     requested = arm.limits.with_request(overrides)
     v, a, j = requested.velocity[joint], requested.acceleration[joint], requested.jerk[joint]
     assert v > a * a / j and abs(length) > v * (v / a + a / j)  # both limits are reached
-    result = plan(
-        arm,
-        WaypointPath(np.array([start, goal])),
-        Timing(method="jerk_limited", constraints=JERK_KINDS, limit_overrides=overrides),
-        dt=1e-3,
-    )
+    result = plan(build_problem(arm, WaypointPath(np.array([start, goal])), METHODS["jerk_limited"], limits=LimitRequest(kinds=JERK_KINDS, overrides=overrides), sampling=Sampling(dt=1e-3)))
     expected = abs(length) / v + v / a + a / j
     assert result.duration == pytest.approx(expected, rel=1e-6)
     assert result.samples.q[-1] == pytest.approx(goal, abs=1e-9)
@@ -84,12 +79,7 @@ def test_straight_ur5_lines_match_ruckig(seed):
     rng = np.random.default_rng(seed)
     start, goal = rng.uniform(-2.0, 2.0, size=(2, arm.dof))
     scale = rng.uniform(0.3, 1.0)
-    result = plan(
-        arm,
-        WaypointPath(np.array([start, goal])),
-        Timing(method="jerk_limited", constraints=JERK_KINDS, limit_scales={"jerk": scale}),
-        dt=0.01,
-    )
+    result = plan(build_problem(arm, WaypointPath(np.array([start, goal])), METHODS["jerk_limited"], limits=LimitRequest(kinds=JERK_KINDS, scales={"jerk": scale}), sampling=Sampling(dt=0.01)))
     reference = _ruckig_duration(arm, start, goal, arm.limits.with_request(scales={"jerk": scale}))
     assert result.duration == pytest.approx(reference, rel=RUCKIG_AGREEMENT)
     assert result.duration >= reference * (1 - 1e-9)
@@ -133,11 +123,7 @@ def test_random_splines_hold_torque_and_jerk_limits(robot, seed):
     arm = robots.load(robot)
     waypoints = _random_spline(arm, np.random.default_rng(100 + seed))
     scales = {"torque": _torque_scale(arm, waypoints)}
-    result = plan(
-        arm, WaypointPath(waypoints),
-        Timing(method="jerk_limited", constraints=("velocity", "acceleration", "torque", "jerk"), limit_scales=scales),
-        dt=2.5e-4,
-    )
+    result = plan(build_problem(arm, WaypointPath(waypoints), METHODS["jerk_limited"], limits=LimitRequest(kinds=("velocity", "acceleration", "torque", "jerk"), scales=scales), sampling=Sampling(dt=2.5e-4)))
     limits = arm.limits.with_request(scales=scales)
     peaks = _recomputed_peaks(arm, result.samples)
     for kind, peak in peaks.items():
@@ -152,10 +138,7 @@ def test_random_splines_hold_torque_and_jerk_limits(robot, seed):
     assert result.peak_utilization["torque"].max() > 0.9
     assert np.all(peaks["jerk"] <= reported * (1 + 1e-3))
     assert np.all(peaks["jerk"] >= 0.98 * reported)
-    jerk_free = plan(
-        arm, WaypointPath(waypoints),
-        Timing(method="phase_plane", constraints=("velocity", "acceleration", "torque"), limit_scales=scales), dt=0.01,
-    )
+    jerk_free = plan(build_problem(arm, WaypointPath(waypoints), METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration", "torque"), scales=scales), sampling=Sampling(dt=0.01)))
     assert result.duration >= jerk_free.duration * (1 - 1e-3)
 
 
@@ -214,7 +197,7 @@ def test_the_gate_refuses_samples_whose_accelerations_jump(monkeypatch):
     monkeypatch.setattr(JerkLimitedMethod, "solve", bang_bang)
     arm = robots.load("ur5")
     with pytest.raises(TimingFailed, match="jerk limit of joint") as raised:
-        plan(arm, WaypointPath(np.array(UR5_WAYPOINTS[:2])), Timing(method="jerk_limited"), dt=1e-3)
+        plan(build_problem(arm, WaypointPath(np.array(UR5_WAYPOINTS[:2])), METHODS["jerk_limited"], sampling=Sampling(dt=1e-3)))
     assert status_of(raised.value) == 422
     assert "t = " in raised.value.detail
 
@@ -262,11 +245,7 @@ def test_a_start_whose_constant_jerk_phase_is_tiny_holds_the_jerk_limit():
         [1.8497, -0.1966, -1.1331, -1.0701, 1.8604, 1.6073, -0.769],
     ])
     scales = {"torque": _torque_scale(arm, waypoints)}
-    result = plan(
-        arm, WaypointPath(waypoints),
-        Timing(method="jerk_limited", constraints=("velocity", "acceleration", "torque", "jerk"), limit_scales=scales),
-        dt=1e-3,
-    )
+    result = plan(build_problem(arm, WaypointPath(waypoints), METHODS["jerk_limited"], limits=LimitRequest(kinds=("velocity", "acceleration", "torque", "jerk"), scales=scales), sampling=Sampling(dt=1e-3)))
     limits = arm.limits.with_request(scales=scales)
     peaks = _recomputed_peaks(arm, result.samples)
     for kind, peak in peaks.items():

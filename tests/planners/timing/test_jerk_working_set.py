@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import quad
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, BoundaryStates, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.waypoints import make_path
@@ -138,12 +138,7 @@ def test_a_straight_ur5_line_from_motion_is_ruckig_through_the_lps_and_the_polis
     limits = arm.limits.with_request(scales={"jerk": 0.6})
     direction = (goal - start) / np.abs(goal - start).max()
     entry = 0.3 * float(np.min(limits.velocity / np.abs(direction)))
-    result = plan(
-        arm, WaypointPath(np.array([start, goal])),
-        Timing(method="jerk_limited", constraints=("velocity", "acceleration", "jerk"), limit_scales={"jerk": 0.6},
-               start_velocity=entry * direction),
-        dt=0.01,
-    )
+    result = plan(build_problem(arm, WaypointPath(np.array([start, goal])), METHODS["jerk_limited"], limits=LimitRequest(kinds=("velocity", "acceleration", "jerk"), scales={"jerk": 0.6}), boundary=BoundaryStates(start_velocity=entry * direction), sampling=Sampling(dt=0.01)))
     inputs = InputParameter(arm.dof)
     inputs.current_position, inputs.target_position = start.tolist(), goal.tolist()
     inputs.current_velocity = (entry * direction).tolist()

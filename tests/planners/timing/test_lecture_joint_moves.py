@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, BoundaryStates, LimitRequest, Sampling, TimeLaw, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.generators.joint_moves import Unsynchronized
 from toptraj.planners.timing.laws.profiles import QuinticProfile, polynomial_derivatives, quintic_coefficients
 from toptraj.service.problems import detail
 
@@ -25,17 +26,14 @@ B = np.radians([40.0, 80.0])
 SPEED = np.radians(10.0)
 
 
-def lecture_timing(synchronization, **options):
+def lecture_problem(path, synchronization, dt, **options):
     """The lecture's constant-speed moves: a trapezoid that accelerates in 0.1 % of the time under
-    a high acceleration limit (1000 rad/s^2)."""
-    return Timing(
-        method="trapezoidal",
-        constraints=("velocity", "acceleration"),
-        trapezoid_fractions=(0.001, 0.999),
-        limit_overrides={"velocity": [SPEED, SPEED], "acceleration": [1000.0, 1000.0]},
-        **({} if synchronization is None else {"synchronization": synchronization}),
-        **options,
-    )
+    a high acceleration limit (1000 rad/s^2); every joint on its own with ``synchronization``
+    ``"none"``, in step otherwise."""
+    law = TimeLaw("trapezoidal", fractions=(0.001, 0.999)).method()
+    limits = LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [SPEED, SPEED], "acceleration": [1000.0, 1000.0]})
+    method = Unsynchronized(law) if synchronization == "none" else law
+    return build_problem(ARM, path, method, limits=limits, sampling=Sampling(dt), **options)
 
 
 def finish_times(result, goal):
@@ -47,7 +45,7 @@ def finish_times(result, goal):
 def test_non_normalized_each_joint_at_its_own_full_speed():
     """Alpha is done at 2 s, beta at 5 s, both at 10 deg/s (the trapezoid's cruise is 1.001 times
     the mean speed and its ramps 0.1 % of the time: within 0.2 % of the constant-speed times)."""
-    result = plan(ARM, WaypointPath(np.array([A, B])), lecture_timing("none"), dt=0.001)
+    result = plan(lecture_problem(WaypointPath(np.array([A, B])), "none", 0.001))
     assert result.duration == pytest.approx(5.0, rel=2e-3)
     assert finish_times(result, B) == pytest.approx([2.0, 5.0], rel=2e-3)
     mid = np.searchsorted(result.samples.t, 1.0)
@@ -65,9 +63,12 @@ def test_non_normalized_each_joint_at_its_own_full_speed():
 def test_normalized_both_joints_stop_together():
     """Alpha at 4 deg/s, beta at 10 deg/s, both done at 5 s, along the straight joint line; the
     default, as before."""
-    normalized = plan(ARM, WaypointPath(np.array([A, B])), lecture_timing("normalized"), dt=0.001)
-    default = plan(ARM, WaypointPath(np.array([A, B])), lecture_timing(None), dt=0.001)
-    assert Timing().synchronization == "normalized"
+    normalized = plan(lecture_problem(WaypointPath(np.array([A, B])), "normalized", 0.001))
+    default = plan(build_problem(
+        ARM, WaypointPath(np.array([A, B])), TimeLaw("trapezoidal", fractions=(0.001, 0.999)).method(),
+        limits=LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [SPEED, SPEED], "acceleration": [1000.0, 1000.0]}),
+        sampling=Sampling(0.001),
+    ))
     assert normalized.duration == pytest.approx(5.0, rel=2e-3)
     assert finish_times(normalized, B) == pytest.approx([normalized.duration] * 2, abs=1e-3)
     mid = np.searchsorted(normalized.samples.t, 1.0)
@@ -85,15 +86,15 @@ def test_non_normalized_laws_hold_every_limit_and_end_at_rest(law):
     # The cubic and the trapezoid have acceleration steps, so no jerk limit for them.
     kinds = ("velocity", "acceleration", "jerk", "torque") if law in ("quintic", "cycloidal") else ("velocity", "acceleration", "torque")
     limits = {"velocity": [SPEED, 2 * SPEED], "acceleration": [0.5, 0.3], "jerk": [5.0, 5.0]}
-    timing = Timing(method=law, constraints=kinds, limit_overrides=limits, synchronization="none")
-    result = plan(ARM, WaypointPath(np.array([A, B])), timing, dt=0.002)
+    asked = LimitRequest(kinds=kinds, overrides=limits)
+    result = plan(build_problem(ARM, WaypointPath(np.array([A, B])), Unsynchronized(METHODS[law]), limits=asked, sampling=Sampling(0.002)))
     assert result.samples.qd[0] == pytest.approx([0, 0], abs=1e-12)
     assert result.samples.qd[-1] == pytest.approx([0, 0], abs=1e-9)
     assert result.samples.q[-1] == pytest.approx(B, abs=1e-12)
     for kind in kinds:
         assert max(result.peak_utilization[kind]) <= 1.005, kind
     assert max(result.peak_utilization[result.binding.kind]) >= 0.995
-    normalized = plan(ARM, WaypointPath(np.array([A, B])), Timing(method=law, constraints=kinds, limit_overrides=limits))
+    normalized = plan(build_problem(ARM, WaypointPath(np.array([A, B])), METHODS[law], limits=asked))
     # Moving alone, the slowest joint is never slower than with the other one in step.
     assert result.duration <= normalized.duration * (1 + 1e-6)
 
@@ -101,45 +102,44 @@ def test_non_normalized_laws_hold_every_limit_and_end_at_rest(law):
 def test_torque_stretches_the_joints_together():
     """Torque couples the joints: 1 N m on the shoulder stretches both own durations by one
     factor, until the torque binds."""
-    timing = Timing(method="cycloidal", constraints=("velocity", "torque"), synchronization="none",
-                    limit_overrides={"velocity": [SPEED, SPEED], "torque": [1.0, 1.0]})
-    result = plan(ARM, WaypointPath(np.array([A, B])), timing, dt=0.002)
+    limits = LimitRequest(kinds=("velocity", "torque"), overrides={"velocity": [SPEED, SPEED], "torque": [1.0, 1.0]})
+    method = Unsynchronized(METHODS["cycloidal"])
+    result = plan(build_problem(ARM, WaypointPath(np.array([A, B])), method, limits=limits, sampling=Sampling(0.002)))
     assert result.binding.kind == "torque"
     assert max(result.peak_utilization["torque"]) == pytest.approx(1.0, abs=5e-3)
     assert result.duration > 2 * 50 / 10  # beyond the cycloid's 2 D / v = 10 s at full speed
 
 
 def test_given_duration_sets_the_slowest_joint():
-    timing = lecture_timing("none", duration=10.0)
-    result = plan(ARM, WaypointPath(np.array([A, B])), timing, dt=0.001)
+    result = plan(lecture_problem(WaypointPath(np.array([A, B])), "none", 0.001, duration=10.0))
     assert result.duration == pytest.approx(10.0, abs=1e-12)
     assert finish_times(result, B) == pytest.approx([4.0, 10.0], abs=2e-3)
     assert result.binding is None
 
 
 @pytest.mark.parametrize(
-    "path, options, rule, fragment",
+    "path, method, options, rule, fragment",
     [
-        (np.array([A, (A + B) / 2, B]), {}, "unsynchronized_needs_two_waypoints", "exactly 2 waypoints"),
-        (np.array([A, B]), {"start_velocity": B - A}, "unsynchronized_from_rest", "rest to rest"),
-        (np.array([A, B]), {"method": "phase_plane"}, "unsynchronized_needs_law", "time law"),
-        (np.array([A, B]), {"constraints": ("torque",)}, "unsynchronized_needs_a_limit", "velocity, acceleration or jerk"),
+        (np.array([A, (A + B) / 2, B]), "trapezoidal", {}, "unsynchronized_needs_two_waypoints", "exactly 2 waypoints"),
+        (np.array([A, B]), "trapezoidal", {"boundary": BoundaryStates(start_velocity=B - A)}, "unsynchronized_from_rest", "rest to rest"),
+        (np.array([A, B]), "phase_plane", {}, "unsynchronized_needs_law", "time law"),
+        (np.array([A, B]), "trapezoidal", {"kinds": ("torque",)}, "unsynchronized_needs_a_limit", "velocity, acceleration or jerk"),
     ],
 )
-def test_non_normalized_refusals(path, options, rule, fragment):
-    settings = {"method": "trapezoidal", "synchronization": "none", "limit_overrides": {"velocity": [SPEED, SPEED]}}
-    settings.update(options)
+def test_non_normalized_refusals(path, method, options, rule, fragment):
+    kinds = options.pop("kinds", ("velocity", "acceleration", "torque"))
+    limits = LimitRequest(kinds=kinds, overrides={"velocity": [SPEED, SPEED]})
     with pytest.raises(InvalidRequest) as refused:
-        plan(ARM, WaypointPath(path), Timing(**settings))
+        plan(build_problem(ARM, WaypointPath(path), Unsynchronized(METHODS[method]), limits=limits, **options))
     assert (refused.value.field, refused.value.value, refused.value.rule) == ("law.synchronization", "none", rule)
     assert fragment in detail(refused.value)
 
 
 def test_unlimited_joint_is_named():
     """geering_2r has no velocity limit of its own: the error names the joint that lacks one."""
-    timing = Timing(method="trapezoidal", constraints=("velocity",), synchronization="none")
+    limits = LimitRequest(kinds=("velocity",))
     with pytest.raises(InvalidRequest) as refused:
-        plan(ARM, WaypointPath(np.array([A, B])), timing)
+        plan(build_problem(ARM, WaypointPath(np.array([A, B])), Unsynchronized(METHODS["trapezoidal"]), limits=limits))
     assert (refused.value.rule, refused.value.joint_name) == ("unsynchronized_joint_unlimited", "phi")
     assert "'phi'" in detail(refused.value)
 
@@ -196,8 +196,9 @@ def test_example_2_quintic_peak_acceleration():
     start = np.radians([30.0, 0.0])
     goal = np.radians([75.0, 0.0])
     direction = np.array([1.0, 0.0])
-    timing = Timing(method="quintic", duration=5.0, constraints=("velocity",),
-                    limit_overrides={"velocity": [1.0, 1.0]},
-                    start_acceleration=np.radians(5.0) * direction, end_acceleration=np.radians(-5.0) * direction)
-    result = plan(ARM, WaypointPath(np.array([start, goal])), timing, dt=0.001)
+    boundary = BoundaryStates(start_acceleration=np.radians(5.0) * direction, end_acceleration=np.radians(-5.0) * direction)
+    result = plan(build_problem(
+        ARM, WaypointPath(np.array([start, goal])), METHODS["quintic"], limits=LimitRequest(kinds=("velocity",), overrides={"velocity": [1.0, 1.0]}),
+        boundary=boundary, duration=5.0, sampling=Sampling(0.001),
+    ))
     assert np.degrees(result.samples.qdd[:, 0]).max() == pytest.approx(8.703943, abs=1e-4)

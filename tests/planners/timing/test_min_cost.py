@@ -7,7 +7,8 @@ import pytest
 from scipy.optimize import minimize
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
+from toptraj.planners.timing.min_cost import MinCostMethod
 
 YAMAMOTO_LINE = np.radians([[45.0, -90.0], [-90.0, 0.0]])
 BETA = 0.03
@@ -72,13 +73,13 @@ def test_yamamoto_straight_line_cost():
     same discretized problem, and a time-domain collocation with the paper's equations agrees."""
     arm = robots.load("yamamoto_2r")
     path = WaypointPath(YAMAMOTO_LINE)
-    result = plan(arm, path, Timing(method="min_cost", constraints=("torque",), torque_weight=BETA, grid_points=600))
+    result = plan(build_problem(arm, path, MinCostMethod(BETA), limits=LimitRequest(kinds=("torque",)), grid=600))
     assert result.cost <= 0.95859
     independent = _cost_by_time_collocation(BETA)
     assert result.cost == pytest.approx(independent, rel=2e-3)
     assert result.peak_utilization["torque"].max() <= 1.005
     # The cost integral, recomputed from the returned samples by the trapezoidal rule.
-    samples = plan(arm, path, Timing(method="min_cost", constraints=("torque",), torque_weight=BETA, grid_points=600), dt=0.0005).samples
+    samples = plan(build_problem(arm, path, MinCostMethod(BETA), limits=LimitRequest(kinds=("torque",)), grid=600, sampling=Sampling(dt=0.0005))).samples
     integrand = 1 + BETA * np.sum(samples.tau**2, axis=1)
     assert np.trapezoid(integrand, samples.t) == pytest.approx(result.cost, rel=2e-3)
 
@@ -90,7 +91,7 @@ def test_beta_zero_is_time_optimal(name, waypoints):
     robot = robots.load(name)
     path = WaypointPath(np.array(waypoints, dtype=float))
     durations = {
-        method: plan(robot, path, Timing(method=method, constraints=("velocity", "acceleration", "torque"))).duration
+        method: plan(build_problem(robot, path, METHODS[method], limits=LimitRequest(kinds=("velocity", "acceleration", "torque")))).duration
         for method in ("min_cost", "phase_plane", "toppra")
     }
     assert durations["min_cost"] == pytest.approx(durations["phase_plane"], rel=5e-3)
@@ -100,8 +101,8 @@ def test_beta_zero_is_time_optimal(name, waypoints):
 def test_energy_weight_slows_the_motion_and_lowers_torque():
     arm = robots.load("yamamoto_2r")
     path = WaypointPath(YAMAMOTO_LINE)
-    fast = plan(arm, path, Timing(method="min_cost", constraints=("torque",)))
-    gentle = plan(arm, path, Timing(method="min_cost", constraints=("torque",), torque_weight=BETA))
+    fast = plan(build_problem(arm, path, METHODS["min_cost"], limits=LimitRequest(kinds=("torque",))))
+    gentle = plan(build_problem(arm, path, MinCostMethod(BETA), limits=LimitRequest(kinds=("torque",))))
     assert gentle.duration > fast.duration
     assert gentle.peak_utilization["torque"].max() < fast.peak_utilization["torque"].max()
     assert gentle.cost < fast.duration * (1 + BETA * 0) + BETA * np.trapezoid(np.sum(fast.samples.tau**2, axis=1), fast.samples.t)

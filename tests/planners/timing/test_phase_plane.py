@@ -8,7 +8,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, BoundaryStates, LimitRequest, WaypointPath, build_problem, plan
 from toptraj.planners.checks.limit_check import check_limits
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath
@@ -34,7 +34,7 @@ def _single_joint(length, robot=UR5, start=START, joint=0):
 def test_acceleration_only(length):
     """T = 2 sqrt(L / a): the grid holds the single switching point exactly in the middle."""
     accel = UR5.limits.acceleration[0]
-    result = plan(UR5, _single_joint(length), Timing(method="phase_plane", constraints=("acceleration",)))
+    result = plan(build_problem(UR5, _single_joint(length), METHODS["phase_plane"], limits=LimitRequest(kinds=("acceleration",))))
     assert result.duration == pytest.approx(2 * np.sqrt(length / accel), rel=1e-9)
 
 
@@ -42,12 +42,8 @@ def test_acceleration_only(length):
 def test_velocity_and_acceleration_long_move(length):
     """T = L / v + v / a when L > v^2 / a."""
     v, a = 0.5, 4.0
-    timing = Timing(
-        method="phase_plane",
-        constraints=("velocity", "acceleration"),
-        limit_overrides={"velocity": [v] * 6, "acceleration": [a] * 6},
-    )
-    result = plan(UR5, _single_joint(length), timing)
+    timing = dict(method=METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [v] * 6, "acceleration": [a] * 6}))
+    result = plan(build_problem(UR5, _single_joint(length), **timing))
     exact = length / v + v / a
     assert result.duration >= exact * (1 - 1e-12)
     assert result.duration == pytest.approx(exact, rel=2e-4)
@@ -60,7 +56,7 @@ def test_rigid_horizontal_arm_closed_form():
     arm = robots.load("geering_2r")
     m11, m21 = 4.96 + 0.815 + 2 * 1.35, 0.815 + 1.35
     accel = min(25.0 / m11, 9.0 / m21)
-    result = plan(arm, WaypointPath(np.array([[0.0, 0.0], [1.2, 0.0]])), Timing(method="phase_plane", constraints=("torque",)))
+    result = plan(build_problem(arm, WaypointPath(np.array([[0.0, 0.0], [1.2, 0.0]])), METHODS["phase_plane"], limits=LimitRequest(kinds=("torque",))))
     assert result.duration == pytest.approx(2 * np.sqrt(1.2 / accel), rel=1e-9)
 
 
@@ -97,7 +93,7 @@ def test_torque_limited_pendulum_against_quadrature(theta_goal):
     arm = robots.load("yamamoto_2r")
     exact = _pendulum_time_by_quadrature(theta_goal)
     path = WaypointPath(np.array([[0.0, 0.0], [theta_goal, 0.0]]))
-    result = plan(arm, path, Timing(method="phase_plane", constraints=("torque",)))
+    result = plan(build_problem(arm, path, METHODS["phase_plane"], limits=LimitRequest(kinds=("torque",))))
     assert exact <= result.duration <= exact * (1 + 1e-3)  # the 0.1 % standard of DESIGN.md
     constraints = build_path_constraints(path_of(path), arm, arm.limits, ("torque",), path_grid(path_of(path)))
     tight = PhasePlaneMethod(tolerance=2e-5, max_refinements=8).solve(constraints)
@@ -170,33 +166,22 @@ def test_nonzero_boundary_speeds_and_the_limit_above_the_mvc():
     path = _single_joint(2.0)
     tangent = np.zeros(6)
     tangent[0] = 1.0
-    timing = Timing(
-        method="phase_plane",
-        constraints=("velocity", "acceleration"),
-        limit_overrides={"velocity": [1.0] * 6, "acceleration": [4.0] * 6},
-        start_velocity=0.5 * tangent,
-        end_velocity=0.25 * tangent,
-    )
-    result = plan(UR5, path, timing)
+    timing = dict(method=METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [1.0] * 6, "acceleration": [4.0] * 6}), boundary=BoundaryStates(start_velocity=0.5 * tangent, end_velocity=0.25 * tangent))
+    result = plan(build_problem(UR5, path, **timing))
     assert result.samples.qd[0] == pytest.approx(0.5 * tangent, abs=1e-9)
     assert result.samples.qd[-1] == pytest.approx(0.25 * tangent, abs=1e-9)
     # Closed form: accelerate 0.5 -> 1, cruise, decelerate 1 -> 0.25 at 4 rad/s^2.
     accelerate, decelerate = (1 - 0.5**2) / (2 * 4), (1 - 0.25**2) / (2 * 4)  # distances
     exact = (1 - 0.5) / 4 + (1 - 0.25) / 4 + (2.0 - accelerate - decelerate) / 1.0
     assert result.duration == pytest.approx(exact, rel=2e-4)
-    too_fast = Timing(
-        method="phase_plane",
-        constraints=("velocity", "acceleration"),
-        limit_overrides={"velocity": [1.0] * 6, "acceleration": [4.0] * 6},
-        start_velocity=1.5 * tangent,
-    )
+    too_fast = dict(method=METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [1.0] * 6, "acceleration": [4.0] * 6}), boundary=BoundaryStates(start_velocity=1.5 * tangent))
     with pytest.raises(InfeasiblePath, match="start path speed"):
-        plan(UR5, path, too_fast)
+        plan(build_problem(UR5, path, **too_fast))
 
 
 def test_switching_points_are_reported_with_their_kind():
     path = WaypointPath(np.array([[0, -1.2, 1.0, 0, 0, 0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3], [2.0, -1.3, 1.2, 0.2, 0.4, 1.2]]))
-    result = plan(UR5, path, Timing(method="phase_plane"))
+    result = plan(build_problem(UR5, path, METHODS["phase_plane"]))
     kinds = {kind for _, kind in result.phase_plane.switch_points}
     assert "deceleration" in kinds
     assert kinds & {"tangent", "singular", "discontinuity"}

@@ -7,7 +7,8 @@ import pytest
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
+from toptraj.planners.generators.joint_moves import ViaPoints
 
 UR5 = robots.load("ur5")
 START = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
@@ -16,12 +17,8 @@ START = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
 def test_ruckig_long_move_closed_form():
     """One joint, L = 2 rad with v = 1, a = 2, j = 10 (cruise reached): T = L/v + v/a + a/j."""
     goal = START + np.array([2.0, 0, 0, 0, 0, 0])
-    timing = Timing(
-        method="ruckig",
-        constraints=("velocity", "acceleration", "jerk"),
-        limit_overrides={"velocity": [1.0] * 6, "acceleration": [2.0] * 6, "jerk": [10.0] * 6},
-    )
-    result = plan(UR5, WaypointPath(np.array([START, goal])), timing)
+    timing = dict(method=METHODS["ruckig"], limits=LimitRequest(kinds=("velocity", "acceleration", "jerk"), overrides={"velocity": [1.0] * 6, "acceleration": [2.0] * 6, "jerk": [10.0] * 6}))
+    result = plan(build_problem(UR5, WaypointPath(np.array([START, goal])), **timing))
     assert result.duration == pytest.approx(2.0 / 1.0 + 1.0 / 2.0 + 2.0 / 10.0, rel=1e-9)
     for kind in ("velocity", "acceleration", "jerk"):
         assert result.peak_utilization[kind].max() == pytest.approx(1.0, abs=2e-3)
@@ -33,8 +30,8 @@ def test_ruckig_long_move_closed_form():
 
 def test_ruckig_is_never_faster_than_time_optimal():
     path = WaypointPath(np.array(UR5_WAYPOINTS[:2]))
-    jerky = plan(UR5, path, Timing(method="ruckig", constraints=("velocity", "acceleration", "jerk")))
-    optimal = plan(UR5, path, Timing(method="phase_plane", constraints=("velocity", "acceleration")))
+    jerky = plan(build_problem(UR5, path, METHODS["ruckig"], limits=LimitRequest(kinds=("velocity", "acceleration", "jerk"))))
+    optimal = plan(build_problem(UR5, path, METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration"))))
     assert jerky.duration >= optimal.duration
     assert jerky.peak_utilization["jerk"].max() <= 1.005
 
@@ -51,7 +48,7 @@ def test_via_points(law):
     """Through every waypoint, continuous velocity (and acceleration for the quintic), every
     limit held, at rest at both ends."""
     waypoints = np.array(UR5_WAYPOINTS)
-    result = plan(UR5, WaypointPath(waypoints, "via"), Timing(method=law), dt=0.0005)
+    result = plan(build_problem(UR5, WaypointPath(waypoints, "via"), ViaPoints(METHODS[law]), sampling=Sampling(dt=0.0005)))
     samples = result.samples
     for waypoint in waypoints[1:-1]:
         assert np.min(np.linalg.norm(samples.q - waypoint, axis=1)) < 0.5 * 0.0005 * np.abs(samples.qd).max() * 3
@@ -87,5 +84,5 @@ def test_compare_endpoint(client):
 def test_ruckig_with_jerk_alone():
     """ruckig always limits jerk, even when the request lists no limit at all."""
     path = WaypointPath(np.array(UR5_WAYPOINTS[:2]))
-    result = plan(UR5, path, Timing(method="ruckig", constraints=()))
+    result = plan(build_problem(UR5, path, METHODS["ruckig"], limits=LimitRequest(kinds=())))
     assert result.peak_utilization["jerk"].max() == pytest.approx(1.0, abs=5e-3)

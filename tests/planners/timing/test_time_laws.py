@@ -7,8 +7,9 @@ import pytest
 
 from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, BoundaryStates, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest
+from toptraj.planners.generators.joint_moves import ViaPoints
 from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.timing.laws.profiles import (
     PROFILES,
@@ -89,8 +90,8 @@ def test_shortest_law_respects_every_limit_and_is_not_faster_than_optimal(law, i
     smooth = law in ("quintic", "cycloidal")
     kinds = ("velocity", "acceleration", "torque", "jerk")[: 4 if smooth else 3]
     path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
-    result = plan(UR5, path, Timing(method=law, constraints=kinds), dt=0.001)
-    optimal = plan(UR5, path, Timing(method="phase_plane", constraints=kinds[:3]))
+    result = plan(build_problem(UR5, path, METHODS[law], limits=LimitRequest(kinds=kinds), sampling=Sampling(dt=0.001)))
+    optimal = plan(build_problem(UR5, path, METHODS["phase_plane"], limits=LimitRequest(kinds=kinds[:3])))
     assert result.duration >= optimal.duration
     for kind in kinds:
         assert result.peak_utilization[kind].max() <= 1.005, kind
@@ -126,8 +127,9 @@ def test_laws_with_acceleration_steps_refuse_a_jerk_limit(law, steps, interpolat
     the unchecked law the jerk reaches 30 to 100 times ur5's limit). Via points take cubic or
     quintic segments only: the trapezoid there is refused before any limit (next test)."""
     path = WaypointPath(np.array(UR5_WAYPOINTS), interpolation)
+    method = ViaPoints(METHODS[law]) if interpolation == "via" else METHODS[law]
     with pytest.raises(InfeasiblePath) as refused:
-        plan(UR5, path, Timing(method=law, constraints=("velocity", "acceleration", "jerk")))
+        plan(build_problem(UR5, path, method, limits=LimitRequest(kinds=("velocity", "acceleration", "jerk"))))
     assert (refused.value.limit, refused.value.rule) == ("jerk", "law_acceleration_steps")
     assert refused.value.steps == pytest.approx(ClassicalMethod(PROFILES[law]()).profile.acceleration_steps())
     assert "quintic" in detail(refused.value)
@@ -140,7 +142,7 @@ def test_via_points_refuse_the_trapezoid_whatever_the_limits(kinds):
     is refused (422) naming the methods that take them, with or without a jerk limit."""
     path = WaypointPath(np.array(UR5_WAYPOINTS), "via")
     with pytest.raises(InvalidRequest) as refused:
-        plan(UR5, path, Timing(method="trapezoidal", constraints=kinds))
+        plan(build_problem(UR5, path, ViaPoints(METHODS["trapezoidal"]), limits=LimitRequest(kinds=kinds)))
     assert status_of(refused.value) == 422
     assert (refused.value.field, refused.value.value, refused.value.alternatives) == ("method", "trapezoidal", ("cubic", "quintic"))
     assert "'cubic' or 'quintic'" in detail(refused.value) and "trapezoidal" in detail(refused.value)
@@ -160,7 +162,7 @@ def test_single_joint_closed_forms():
         "quintic": np.sqrt(10 / np.sqrt(3) * 1.2 / a),
     }
     for law, duration in expected.items():
-        result = plan(UR5, path, Timing(method=law, constraints=("acceleration",)))
+        result = plan(build_problem(UR5, path, METHODS[law], limits=LimitRequest(kinds=("acceleration",))))
         assert result.duration == pytest.approx(duration, rel=1e-6), law
         assert result.binding.kind == "acceleration" and result.binding.joint == "shoulder_pan_joint"
 
@@ -169,19 +171,14 @@ def test_given_duration_and_boundary_states():
     start = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
     goal = start + np.array([1.0, 0, 0, 0, 0, 0])
     path = WaypointPath(np.array([start, goal]))
-    slow = plan(UR5, path, Timing(method="quintic", duration=5.0))
+    slow = plan(build_problem(UR5, path, METHODS["quintic"], duration=5.0))
     assert slow.duration == pytest.approx(5.0, abs=1e-12)
     assert slow.binding is None
     # The lecture's example 2 as a joint move: 5 deg/s^2 in, -5 deg/s^2 out, 45 deg in 5 s.
     goal = start + np.radians([45.0, 0, 0, 0, 0, 0])
     direction = np.array([1.0, 0, 0, 0, 0, 0])
-    timing = Timing(
-        method="quintic",
-        duration=5.0,
-        start_acceleration=np.radians(5.0) * direction,
-        end_acceleration=np.radians(-5.0) * direction,
-    )
-    result = plan(UR5, WaypointPath(np.array([start, goal])), timing, dt=1.0)
+    timing = dict(method=METHODS["quintic"], boundary=BoundaryStates(start_acceleration=np.radians(5.0) * direction, end_acceleration=np.radians(-5.0) * direction), duration=5.0)
+    result = plan(build_problem(UR5, WaypointPath(np.array([start, goal])), **timing, sampling=Sampling(dt=1.0)))
     theta = np.degrees(result.samples.q[:, 0] - start[0]) + 30.0
     expected = polynomial_derivatives(np.array([30.0, 0.0, 2.5, 1.6, -0.58, 0.0464]), np.arange(6.0), 1)[0]
     assert theta == pytest.approx(expected, abs=1e-9)
@@ -194,8 +191,8 @@ def test_shortest_law_with_boundary_velocity(law):
     start = np.array([0.0, -1.5, 1.0, 0.0, 0.5, 0.0])
     goal = start + np.array([1.0, 0.5, 0, 0, 0, 0])
     direction = (goal - start) / np.linalg.norm(goal - start)
-    timing = Timing(method=law, constraints=("velocity", "acceleration"), start_velocity=0.5 * direction)
-    result = plan(UR5, WaypointPath(np.array([start, goal])), timing)
+    timing = dict(method=METHODS[law], limits=LimitRequest(kinds=("velocity", "acceleration")), boundary=BoundaryStates(start_velocity=0.5 * direction))
+    result = plan(build_problem(UR5, WaypointPath(np.array([start, goal])), **timing))
     assert result.samples.qd[0] == pytest.approx(0.5 * direction, abs=1e-9)
     assert result.samples.qd[-1] == pytest.approx(np.zeros(6), abs=1e-9)
     top = max(result.peak_utilization[kind].max() for kind in ("velocity", "acceleration"))

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, Sampling, WaypointPath, build_problem, plan
 
 UR5 = robots.load("ur5")
 SPLINE = WaypointPath(
@@ -26,7 +26,7 @@ CONSTRAINTS = ("velocity", "acceleration", "torque")
 
 
 def _duration(robot, path, method: str, overrides: dict) -> float:
-    return plan(robot, path, Timing(method=method, constraints=CONSTRAINTS, limit_overrides=overrides), dt=10.0).duration
+    return plan(build_problem(robot, path, METHODS[method], limits=LimitRequest(kinds=CONSTRAINTS, overrides=overrides), sampling=Sampling(dt=10.0))).duration
 
 
 @pytest.mark.parametrize("method", ["toppra", "min_cost"])
@@ -40,7 +40,7 @@ def test_a_tiny_acceleration_limit_is_a_slow_motion(method):
 def test_limits_orders_apart_on_one_arm_are_a_slow_motion(method):
     """About 1.04e6 s; within 0.1 % of the phase-plane method's duration."""
     overrides = {"velocity": [1e3, 1e-6] * 3, "acceleration": [1e5, 1e-6] * 3}
-    timing = Timing(method=method, constraints=CONSTRAINTS, limit_overrides=overrides)
-    reference = Timing(method="phase_plane", constraints=CONSTRAINTS, limit_overrides=overrides)
-    duration = plan(UR5, SPLINE, timing, dt=10.0, max_samples=200_000).duration
-    assert duration == pytest.approx(plan(UR5, SPLINE, reference, dt=10.0, max_samples=200_000).duration, rel=1e-3)
+    timing = dict(method=METHODS[method], limits=LimitRequest(kinds=CONSTRAINTS, overrides=overrides))
+    reference = dict(method=METHODS["phase_plane"], limits=LimitRequest(kinds=CONSTRAINTS, overrides=overrides))
+    duration = plan(build_problem(UR5, SPLINE, **timing, sampling=Sampling(dt=10.0, max_samples=200_000))).duration
+    assert duration == pytest.approx(plan(build_problem(UR5, SPLINE, **reference, sampling=Sampling(dt=10.0, max_samples=200_000))).duration, rel=1e-3)

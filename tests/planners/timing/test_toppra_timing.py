@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, LimitRequest, WaypointPath, build_problem, plan
 
 UR5 = robots.load("ur5")
 
@@ -22,7 +22,7 @@ def _single_joint_move(length):
 def test_acceleration_only_bang_bang(length):
     """One joint, |qdd| <= a: T = 2 sqrt(L / a)."""
     accel = UR5.limits.acceleration[0]
-    result = plan(UR5, _single_joint_move(length), Timing(constraints=("acceleration",)))
+    result = plan(build_problem(UR5, _single_joint_move(length), METHODS["phase_plane"], limits=LimitRequest(kinds=("acceleration",))))
     assert result.duration == pytest.approx(2 * np.sqrt(length / accel), rel=1e-6)
 
 
@@ -32,20 +32,14 @@ def test_velocity_and_acceleration_long_move(grid_points, tolerance):
     acceleration to cruise falls inside a grid interval, so the grid answer is longer by O(ds^2)."""
     length = 3.0
     v, a = 1.0, 4.0
-    timing = Timing(
-        constraints=("velocity", "acceleration"),
-        limit_overrides={"velocity": [v] * 6, "acceleration": [a] * 6},
-        grid_points=grid_points,
-    )
-    result = plan(UR5, _single_joint_move(length), timing)
+    timing = dict(method=METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [v] * 6, "acceleration": [a] * 6}), grid=grid_points)
+    result = plan(build_problem(UR5, _single_joint_move(length), **timing))
     assert result.duration >= length / v + v / a
     assert result.duration == pytest.approx(length / v + v / a, rel=tolerance)
 
 
 def test_limit_scales_slow_the_motion_as_expected():
     """Acceleration-limited motion: a quarter of the acceleration doubles the time."""
-    base = plan(UR5, _single_joint_move(1.0), Timing(constraints=("acceleration",)))
-    slow = plan(
-        UR5, _single_joint_move(1.0), Timing(constraints=("acceleration",), limit_scales={"acceleration": 0.25})
-    )
+    base = plan(build_problem(UR5, _single_joint_move(1.0), METHODS["phase_plane"], limits=LimitRequest(kinds=("acceleration",))))
+    slow = plan(build_problem(UR5, _single_joint_move(1.0), METHODS["phase_plane"], limits=LimitRequest(kinds=("acceleration",), scales={"acceleration": 0.25})))
     assert slow.duration == pytest.approx(2 * base.duration, rel=1e-6)
