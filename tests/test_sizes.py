@@ -10,14 +10,11 @@ from tests.paths import ROOT
 PACKAGES = ("robots", "planners", "service", "client")
 MAX_MODULE_LINES = 400
 MAX_FUNCTION_LINES = 60
-#: Functions still over the limit, in modules reworked elsewhere (the jerk method's programs,
-#: the collocation's sparse formulation): each leaves this list when it is split.
+#: Functions still over the limit, in modules reworked elsewhere (the collocation's sparse
+#: formulation): each leaves this list when it is split.
 PENDING = {
     "planners/generators/collocation/collocation.py:_optimize_motion",
     "planners/generators/collocation/symbolic_dynamics.py:inverse_dynamics_function",
-    "planners/timing/jerk/program.py:_equalities_and_rows",
-    "planners/timing/jerk/program.py:_jerk_rows",
-    "planners/timing/jerk/polish.py:_solve",
 }
 
 
