@@ -20,6 +20,7 @@ import dataclasses
 import numpy as np
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
+from toptraj.planners.timing.base import Boundary
 
 
 def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstraints | None:
@@ -63,6 +64,21 @@ def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstrain
         jerk_left=jerk_left,
         q=take(constraints.q),
     )
+
+
+def refined(constraints: PathConstraints, boundary: Boundary) -> PathConstraints:
+    """``constraints`` with every interval halved except one that starts or ends at rest: that
+    interval holds the motion of constant path jerk from (to) rest exactly (u = 2 x / (3 s)),
+    which intervals of linear u cannot follow (u grows as s^(1/3) there); halving it would
+    leave half of that phase to them and lengthen the answer (0.24 % on the ur5 example, the
+    error shrinking only as about h^(1/3) over further halvings), where the intervals away
+    from rest converge at first order."""
+    s = constraints.s
+    middles = 0.5 * (s[:-1] + s[1:])
+    keep = np.ones(len(middles), dtype=bool)
+    keep[0] &= boundary.sd_start != 0.0
+    keep[-1] &= boundary.sd_end != 0.0
+    return constraints.with_points(middles[keep])
 
 
 def relative_gap(coarse_duration: float, fine_duration: float) -> float:

@@ -76,7 +76,7 @@ from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
-from toptraj.planners.timing.jerk.accuracy import coarser, relative_gap
+from toptraj.planners.timing.jerk.accuracy import coarser, refined, relative_gap
 from toptraj.planners.timing.jerk.closed_form import closed_form_timing
 from toptraj.planners.timing.jerk.polish import polish
 from toptraj.planners.timing.jerk.program import RestrictedProgram
@@ -95,6 +95,13 @@ WARM_TOLERANCE = 1e-2 * GAP_TARGET
 #: (ur5, 2,000 to 4,000 intervals: 9 to 12 times the last grid's sequence, itself started from
 #: the grids below it), and a refinement begun but not finished costs the whole answer.
 REFINEMENT_COST = 20.0
+#: Doublings of the grid made whatever the second grid's estimate: the difference between the
+#: second grid and the first answer's is not yet first order on the default grid (ur5 example,
+#: the intervals at rest kept: 6.5e-4 from 102 to 200 intervals, then 8.4e-4, 3.4e-4, 1.7e-4
+#: and 7.8e-5 over each further halving), so it understates the error (1.4e-3 there); one
+#: halving further, the difference from the grid before bounds the answer's error (8.0e-4
+#: against 6.4e-4).
+MIN_REFINEMENTS = 1
 #: Fewest intervals of a grid that starts the LPs of a finer one (``JerkLimitedMethod._seed``).
 SEED_INTERVALS = 60
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
@@ -153,14 +160,16 @@ class JerkLimitedMethod(TimingMethod):
         if coarse is not None:
             gap = relative_gap(coarse.duration, best.duration)
         for done in range(self.max_refinements):
-            if gap is None or gap <= GAP_TARGET or not self._affordable(constraints, elapsed, deadline):
+            if gap is None or not self._affordable(constraints, elapsed, deadline):
+                break
+            if done >= MIN_REFINEMENTS and gap <= GAP_TARGET:
                 break
             # The error about halves with each doubling (first order; the LPs cost ten times or more
             # as much): where the doublings left would not bring it to the target, the answer
             # states its gap instead.
             if gap / 2 ** (self.max_refinements - done) > GAP_TARGET:
                 break
-            finer = constraints.with_points(0.5 * (constraints.s[:-1] + constraints.s[1:]))
+            finer = refined(constraints, boundary)
             started = time.perf_counter()
             finer_best = self._grid_solution(finer, boundary, deadline, start=best, tolerance=WARM_TOLERANCE)
             elapsed = time.perf_counter() - started
