@@ -55,6 +55,8 @@ class RestrictedProgram:
 
         self._lp = WorkingSetLP(deadline)
         self._fixed: tuple[sparse.csr_matrix, np.ndarray, np.ndarray] | None = None
+        self._pattern: _Pattern | None = None
+        self._jerk_terms: tuple | None = None
 
     # Variables: X_0..X_n at columns 0..n, U_0..U_n at columns n+1..2n+1.
     def _x(self, i):
@@ -171,18 +173,20 @@ class RestrictedProgram:
             i.size * m,
         )]
 
-    def _jerk_rows(self, x_tangent: np.ndarray) -> list:
+    def _jerk_rows(self, x_tangent: np.ndarray, pattern: bool = True) -> list:
         """The jerk rows (1) at both ends of every interval, their right-hand side J / sqrt(X)
         replaced by its tangent at ``x_tangent`` (scaled), J (alpha - beta X): two one-sided
-        rows ``+-G + J beta X <= J alpha`` each (blocks of ``_stacked``)."""
-        limit = self._jerk[3]
-        limited = np.flatnonzero(np.isfinite(limit))
-        if limited.size == 0:
-            return []
-        J = limit[limited] / self.kappa**1.5  # scaled: |G| <= J / sqrt(X)
+        rows ``+-G + J beta X <= J alpha`` each (blocks of ``_stacked``; without ``pattern``,
+        their rows and columns left out: the tangent changes values only)."""
+        if self._jerk_terms is None:  # G's coefficients do not depend on the tangent
+            limit = self._jerk[3]
+            limited = np.flatnonzero(np.isfinite(limit))
+            terms = (*self._regular_jerk_terms(limited), *self._rest_jerk_terms(limited)) if limited.size else ()
+            self._jerk_terms = (terms, limit[limited] / self.kappa**1.5)  # scaled: |G| <= J / sqrt(X)
+        terms, J = self._jerk_terms
         blocks: list = []
-        for u_terms, x_coefficient, point in (*self._regular_jerk_terms(limited), *self._rest_jerk_terms(limited)):
-            blocks.extend(_tangent_rows(u_terms, x_coefficient, self._x(point), x_tangent[point], J))
+        for u_terms, x_coefficient, point in terms:
+            blocks.extend(_tangent_rows(u_terms, x_coefficient, self._x(point), x_tangent[point], J, pattern))
         return blocks
 
     @property
@@ -240,14 +244,7 @@ class RestrictedProgram:
         (``toptraj.planners.timing.jerk.working_set``)."""
         kappa, n = self.kappa, self.n
         X_tangent = np.asarray(x_tangent) / kappa
-        if self._fixed is None:  # the rows that do not depend on the restriction, built once
-            self._fixed = _stacked(self._fixed_rows, 2 * n + 2)
-        jerk, jerk_lower, jerk_upper = _stacked(self._jerk_rows(X_tangent), 2 * n + 2)
-        from scipy import sparse
-
-        matrix = sparse.vstack([self._fixed[0], jerk], format="csr")
-        lower = np.concatenate([self._fixed[1], jerk_lower])
-        upper = np.concatenate([self._fixed[2], jerk_upper])
+        matrix, lower, upper = self._rows(X_tangent)
         x_high = self.constraints.sd_max**2 / kappa
         low = np.concatenate([np.zeros(n + 1), np.full(n + 1, -np.inf)])
         high = np.concatenate([x_high, np.full(n + 1, np.inf)])
@@ -259,6 +256,30 @@ class RestrictedProgram:
         values = self._lp.solve(objective, matrix, lower, upper, low, high, scaled)
         X, U = values[: n + 1], values[n + 1 :]
         return np.maximum(X, 0.0) * kappa, U * kappa
+
+    def _rows(self, X_tangent: np.ndarray) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:
+        """Every row of the LP around ``X_tangent``: (matrix (CSR), lower, upper), the rows that
+        do not depend on the restriction first. Both parts' patterns are built at the first
+        restriction (``_Pattern``); a later one computes the jerk rows' values only."""
+        from scipy import sparse
+
+        columns = 2 * self.n + 2
+        if self._fixed is None:  # the rows that do not depend on the restriction, built once
+            self._fixed = _stacked(self._fixed_rows, columns)
+        blocks = self._jerk_rows(X_tangent, pattern=self._pattern is None)
+        if self._pattern is None:
+            self._pattern = _Pattern(self._fixed[0], blocks, columns)
+        fixed, fixed_lower, fixed_upper = self._fixed
+        if blocks:
+            values = np.concatenate([block[2] for block in blocks])
+            jerk_lower = np.concatenate([block[3] for block in blocks])
+            jerk_upper = np.concatenate([block[4] for block in blocks])
+        else:
+            values, jerk_lower, jerk_upper = np.zeros(0), np.zeros(0), np.zeros(0)
+        pattern = self._pattern
+        data = np.concatenate([fixed.data, np.bincount(pattern.entry, weights=values, minlength=pattern.jerk_nnz)])
+        matrix = sparse.csr_matrix((data, pattern.indices, pattern.indptr), shape=(pattern.rows, columns))
+        return matrix, np.concatenate([fixed_lower, jerk_lower]), np.concatenate([fixed_upper, jerk_upper])
 
     def _time_gradient(self, X):
         """d/dX of sum 2 h / (sqrt(X_i) + sqrt(X_i+1)) (3 h / sqrt(X) for an interval at rest)."""
@@ -286,16 +307,21 @@ class RestrictedProgram:
         )
 
 
-def _tangent_rows(u_terms, x_coefficient, x_columns, x_tangent, J):
+def _tangent_rows(u_terms, x_coefficient, x_columns, x_tangent, J, pattern: bool = True):
     """The two one-sided rows +-G + J beta X <= J alpha of each point and limited joint, G's U
     part ``u_terms`` (columns (k,), coefficients (k, m)) and its X coefficient ``x_coefficient``
     (k, m) at the columns ``x_columns`` (k,); alpha = 1.5 / sqrt(X_t), beta = 0.5 / X_t^1.5
-    (the tangent of X^-1/2 at ``x_tangent``, (k,)): blocks of ``_stacked``."""
+    (the tangent of X^-1/2 at ``x_tangent``, (k,)): blocks of ``_stacked`` (without
+    ``pattern``, their rows and columns ``None``)."""
     X = np.maximum(x_tangent, 1e-12)
     alpha, beta = 1.5 / np.sqrt(X), 0.5 / X**1.5
     k, m = x_coefficient.shape
-    x_col = np.broadcast_to(x_columns[:, None], (k, m))
-    columns = np.stack([*(np.broadcast_to(col[:, None], (k, m)) for col, _ in u_terms), x_col], axis=-1)
+    width = len(u_terms) + 1
+    rows = columns = None
+    if pattern:
+        x_col = np.broadcast_to(x_columns[:, None], (k, m))
+        columns = np.stack([*(np.broadcast_to(col[:, None], (k, m)) for col, _ in u_terms), x_col], axis=-1).reshape(-1)
+        rows = np.repeat(np.arange(k * m), width)
     blocks = []
     for sign in (1.0, -1.0):
         values = np.stack(
@@ -303,14 +329,36 @@ def _tangent_rows(u_terms, x_coefficient, x_columns, x_tangent, J):
         )
         scale = np.maximum(np.abs(values).max(axis=-1), 1e-300)
         blocks.append((
-            np.repeat(np.arange(k * m), columns.shape[-1]),
-            columns.reshape(-1),
+            rows,
+            columns,
             (values / scale[..., None]).reshape(-1),
             np.full(k * m, -np.inf),
             (J * alpha[:, None] / scale).ravel(),
             k * m,
         ))
     return blocks
+
+
+class _Pattern:
+    """The sparsity pattern of an LP's rows, the fixed rows (a CSR matrix) over the jerk rows
+    (blocks of ``_stacked``): the whole matrix's ``indptr`` and ``indices`` (CSR, rows sorted,
+    repeated entries summed, as ``_stacked`` builds them), and for each value of the jerk
+    blocks, in their order, the entry of the jerk part it adds to (``entry``, of
+    ``jerk_nnz``)."""
+
+    def __init__(self, fixed: sparse.csr_matrix, blocks: list, columns: int):
+        offsets = np.cumsum([0] + [block[5] for block in blocks])
+        if blocks:
+            row = np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)])
+            column = np.concatenate([block[1] for block in blocks])
+        else:
+            row = column = np.zeros(0, dtype=np.int64)
+        keys, self.entry = np.unique(row.astype(np.int64) * columns + column, return_inverse=True)
+        self.jerk_nnz = keys.size
+        counts = np.bincount(keys // columns, minlength=int(offsets[-1]))
+        self.rows = fixed.shape[0] + int(offsets[-1])
+        self.indptr = np.concatenate([fixed.indptr, fixed.indptr[-1] + np.cumsum(counts)]).astype(fixed.indptr.dtype)
+        self.indices = np.concatenate([fixed.indices, keys % columns]).astype(fixed.indices.dtype)
 
 
 def _stacked(blocks, columns: int) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:
