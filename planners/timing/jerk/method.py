@@ -87,8 +87,10 @@ from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 #: Where the limits give no constant-jerk phase at an end at rest, the first interval is
 #: this fraction of the grid's own first interval.
 FALLBACK_FIRST_INTERVAL = 1e-3
-#: Relative gain below which the LPs on a refined grid, started from the coarser solution,
-#: stop: a hundredth of the gap the refinement aims at.
+#: Relative gain below which the LPs on every grid stop: a hundredth of the gap the refinement
+#: aims at. A sequence stopped early ends above its grid's fixed point (each LP step shortens
+#: the motion), which overstates the gap it estimates on the coarser grid of a pair; the
+#: answer's own grid stops there too.
 WARM_TOLERANCE = 1e-2 * GAP_TARGET
 #: Time of the LPs on a grid twice as fine as the last, as a multiple of the last's, with room:
 #: the first LP starts from no basis, its simplex iterations and their cost each about doubling
@@ -155,7 +157,7 @@ class JerkLimitedMethod(TimingMethod):
         # need few iterations over few rows (``toptraj.planners.timing.jerk.working_set``).
         coarse, gap, how = self._second_grid(constraints, original, boundary, deadline)
         started = time.perf_counter()
-        best = self._grid_solution(constraints, boundary, deadline, start=coarse)
+        best = self._grid_solution(constraints, boundary, deadline, start=coarse, tolerance=WARM_TOLERANCE)
         elapsed = time.perf_counter() - started
         if coarse is not None:
             gap = relative_gap(coarse.duration, best.duration)
@@ -231,7 +233,9 @@ class JerkLimitedMethod(TimingMethod):
         if coarse is None:
             return None, None, "none: the grid is too coarse for a second one"
         try:
-            coarse_best = self._grid_solution(coarse, boundary, deadline, start=self._seed(coarse, original, boundary, deadline))
+            coarse_best = self._grid_solution(
+                coarse, boundary, deadline, start=self._seed(coarse, original, boundary, deadline), tolerance=WARM_TOLERANCE,
+            )
         except (InfeasiblePath, TimingFailed) as error:
             return None, None, f"none: the second grid's solve failed ({error.detail})"
         return (
