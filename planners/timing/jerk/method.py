@@ -97,13 +97,12 @@ WARM_TOLERANCE = 1e-2 * GAP_TARGET
 #: (ur5, 2,000 to 4,000 intervals: 9 to 12 times the last grid's sequence, itself started from
 #: the grids below it), and a refinement begun but not finished costs the whole answer.
 REFINEMENT_COST = 20.0
-#: Doublings of the grid made whatever the second grid's estimate: the difference between the
-#: second grid and the first answer's is not yet first order on the default grid (ur5 example,
-#: the intervals at rest kept: 6.5e-4 from 102 to 200 intervals, then 8.4e-4, 3.4e-4, 1.7e-4
-#: and 7.8e-5 over each further halving), so it understates the error (1.4e-3 there); one
-#: halving further, the difference from the grid before bounds the answer's error (8.0e-4
-#: against 6.4e-4).
-MIN_REFINEMENTS = 1
+#: Grids of fewer intervals are doubled whatever their estimate: below it the difference
+#: between the second grid and the answer's is not yet first order (ur5 example, the intervals
+#: at rest kept: 6.5e-4 from 102 to 200 intervals, then 8.4e-4, 3.4e-4, 1.7e-4 and 7.8e-5 over
+#: each further halving), and understates the error (1.4e-3 on 200 intervals); one halving
+#: further, the difference from the grid before bounds the answer's (8.0e-4 against 6.4e-4).
+ASYMPTOTIC_INTERVALS = 300
 #: Fewest intervals of a grid that starts the LPs of a finer one (``JerkLimitedMethod._seed``).
 SEED_INTERVALS = 60
 #: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
@@ -164,7 +163,7 @@ class JerkLimitedMethod(TimingMethod):
         for done in range(self.max_refinements):
             if gap is None or not self._affordable(constraints, elapsed, deadline):
                 break
-            if done >= MIN_REFINEMENTS and gap <= GAP_TARGET:
+            if len(constraints.s) - 1 >= ASYMPTOTIC_INTERVALS and gap <= GAP_TARGET:
                 break
             # The error about halves with each doubling (first order; the LPs cost ten times or more
             # as much): where the doublings left would not bring it to the target, the answer

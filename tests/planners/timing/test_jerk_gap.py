@@ -12,9 +12,11 @@ the first-order convergence observed there (the differences halve with each halv
 
 from __future__ import annotations
 
+import functools
 import json
 
 import numpy as np
+import pytest
 
 from tests.paths import ROOT
 from toptraj import robots
@@ -32,8 +34,11 @@ EXAMPLE = json.loads((ROOT / "examples" / "ur5_jerk_limited.json").read_text())
 WITHIN = 1e-3
 
 
-def _converged_optimum(robot, path, limits) -> float:
+@functools.cache
+def _converged_optimum() -> float:
     """T* from the grids 4 and 8 times as fine as the default one (module docstring)."""
+    robot, limits, waypoints = _example()
+    path = make_path(robot, WaypointPath(waypoints))
     kinds = tuple(EXAMPLE["timing"]["constraints"])
     constraints = build_path_constraints(path, robot, limits, kinds, path_grid(path))
     # The LPs on the finer grids start from the method's own solution on its default grid
@@ -50,13 +55,21 @@ def _converged_optimum(robot, path, limits) -> float:
     return 2.0 * durations[-1] - durations[-2]
 
 
-def test_the_stated_gap_of_the_ur5_jerk_example_holds_against_the_converged_optimum():
+def _example():
     robot = robots.load(EXAMPLE["robot"])
-    scales = {"jerk": EXAMPLE["timing"]["limits"]["jerk_scale"]}
-    waypoints = np.array(EXAMPLE["path"]["waypoints"])
-    answer = plan(robot, WaypointPath(waypoints), Timing(method="jerk_limited", constraints=tuple(EXAMPLE["timing"]["constraints"]),
-                                                          limit_scales=scales), dt=EXAMPLE["output"]["dt"])
-    optimum = _converged_optimum(robot, make_path(robot, WaypointPath(waypoints)), robot.limits.with_request(scales=scales))
+    limits = robot.limits.with_request(scales={"jerk": EXAMPLE["timing"]["limits"]["jerk_scale"]})
+    return robot, limits, np.array(EXAMPLE["path"]["waypoints"])
+
+
+#: The default grid, and a grid the request names (on which a gap of 0 used to be stated 0.24 %
+#: above the optimum: halving its interval at rest made the finer grid's answer longer).
+@pytest.mark.parametrize("grid_points", [None, 201])
+def test_the_stated_gap_of_the_ur5_jerk_example_holds_against_the_converged_optimum(grid_points):
+    robot, _, waypoints = _example()
+    timing = Timing(method="jerk_limited", constraints=tuple(EXAMPLE["timing"]["constraints"]),
+                    limit_scales={"jerk": EXAMPLE["timing"]["limits"]["jerk_scale"]}, grid_points=grid_points)
+    answer = plan(robot, WaypointPath(waypoints), timing, dt=EXAMPLE["output"]["dt"])
+    optimum = _converged_optimum()
     actual = (answer.duration - optimum) / optimum
     stated = answer.accuracy.relative_gap
     assert stated is not None
