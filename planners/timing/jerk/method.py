@@ -55,8 +55,10 @@ polish is a local method started from the grid solution's phases, and misses the
 Every answer carries an estimate of its distance from the optimum (``optimality_gap``): zero
 for the closed form, else the difference from the solution on a second grid of half as many
 points (``toptraj.planners.timing.jerk.accuracy``), which is solved first and starts the LPs of the
-answer's grid; above ``GAP_TARGET`` the grid is doubled, at most ``max_refinements`` times,
-while the grid budget and the time left allow.
+answer's grid; a grid of fewer than ``ASYMPTOTIC_INTERVALS`` (where that difference is not
+yet first order), or one above ``GAP_TARGET``, is doubled (every interval halved but those at
+rest), at most ``max_refinements`` times, while the grid budget and the time left allow, the
+gap then the difference between the last two grids.
 
 Each LP is solved over a working set of its rows (``toptraj.planners.timing.jerk.working_set``): of
 some 50 rows per interval only about two per point are active at the optimum. On fine grids the
