@@ -28,6 +28,7 @@ from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.timing.base import AT_REST
 from toptraj.planners.timing.jerk.accuracy import refined
 from toptraj.planners.timing.jerk.method import JerkLimitedMethod
+from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
 
 EXAMPLE = json.loads((ROOT / "examples" / "ur5_jerk_limited.json").read_text())
 #: The issue's bound on the distance of the answer from the optimum.
@@ -44,6 +45,7 @@ def _converged_optimum() -> float:
     # The LPs on the finer grids start from the method's own solution on its default grid
     # (the same discretization; the limit they converge to does not depend on where they start).
     start = JerkLimitedMethod(polish=False, max_refinements=0).solve(constraints)
+    assert isinstance(start, JerkTimeScaling)  # a spline path: no closed form, no polish
     constraints = constraints.with_points(np.setdiff1d(start.s, constraints.s))
     method = JerkLimitedMethod(tolerance=1e-10, max_iterations=300, polish=False)
     durations = []
@@ -71,7 +73,7 @@ def test_the_stated_gap_of_the_ur5_jerk_example_holds_against_the_converged_opti
     answer = plan(robot, WaypointPath(waypoints), timing, dt=EXAMPLE["output"]["dt"])
     optimum = _converged_optimum()
     actual = (answer.duration - optimum) / optimum
+    assert answer.accuracy is not None and answer.accuracy.relative_gap is not None
     stated = answer.accuracy.relative_gap
-    assert stated is not None
     assert -1e-4 <= actual <= stated, (answer.duration, optimum, actual, stated)
     assert actual <= WITHIN
