@@ -44,6 +44,11 @@ def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstrain
         keep |= np.isin(s, constraints.knots)
     if keep.all() or keep.sum() < 6:
         return None
+    return kept(constraints, keep)
+
+
+def kept(constraints: PathConstraints, keep: np.ndarray) -> PathConstraints:
+    """``constraints`` on the grid points where ``keep`` (bool, one per point) holds."""
 
     def take(array):
         return None if array is None else np.asarray(array)[keep]
@@ -59,7 +64,7 @@ def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstrain
     jerk_left = None if constraints.jerk_left is None else tuple(take(array) for array in constraints.jerk_left)
     return dataclasses.replace(
         constraints,
-        s=take(s),
+        s=take(constraints.s),
         sd_max=take(constraints.sd_max),
         **right,
         **left,

@@ -78,7 +78,7 @@ from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
-from toptraj.planners.timing.jerk.accuracy import coarser, refined, relative_gap
+from toptraj.planners.timing.jerk.accuracy import coarser, kept, refined, relative_gap
 from toptraj.planners.timing.jerk.closed_form import closed_form_timing
 from toptraj.planners.timing.jerk.polish import polish
 from toptraj.planners.timing.jerk.program import RestrictedProgram
@@ -152,6 +152,8 @@ class JerkLimitedMethod(TimingMethod):
             exact = closed_form_timing(constraints)
             if exact is not None:
                 return exact
+        if constraints.can_refine:
+            constraints = _opened(constraints, boundary)
         original = constraints.s
         constraints = _graded(constraints, boundary)
         # The second grid first: its solution starts the LPs on the answer's grid, which then
@@ -317,10 +319,30 @@ def _start_phase(constraints: PathConstraints, point: int) -> float:
 _REST_POINTS = np.array([0.5, 0.7, 0.85, 1.0, 1.15, 1.3, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0])
 
 
+def _opened(constraints: PathConstraints, boundary: Boundary) -> PathConstraints:
+    """The grid without its points closer to an end at rest than half the constant-jerk phase
+    there (``_start_phase``; the path's knots kept): the interval at rest holds that phase's
+    motion exactly, where intervals of linear u cannot follow it (u grows as s^(1/3)). A grid
+    finer than the phase put them there: on the ur5 example, a named grid of 2,000 intervals
+    answered 0.39 % above the optimum (0.08 % with them dropped)."""
+    s = constraints.s
+    knots = np.asarray(constraints.knots if constraints.knots is not None else [], dtype=float)
+    keep = np.ones(len(s), dtype=bool)
+    for at_rest, point, distance in ((boundary.sd_start == 0.0, 0, s - s[0]), (boundary.sd_end == 0.0, -1, s[-1] - s)):
+        phase = _start_phase(constraints, point) if at_rest else np.inf
+        # Not across a knot: the path's coefficients change there, and the phase with them.
+        if np.isfinite(phase) and not np.any((np.abs(knots - s[point]) > 0.0) & (np.abs(knots - s[point]) < 0.5 * phase)):
+            keep &= (distance == 0.0) | (distance >= 0.5 * phase)
+    if keep.all() or keep.sum() < 8:
+        return constraints
+    return kept(constraints, keep)
+
+
 def _graded(constraints: PathConstraints, boundary: Boundary) -> PathConstraints:
     """The grid with points added toward each end at rest around the end of the constant-jerk
     phase there (``_start_phase``): the first interval, which holds the motion of constant
-    jerk from rest, then ends within that phase."""
+    jerk from rest, then ends within that phase (the points closer to the end than half of it
+    are dropped before, ``_opened``)."""
     if not constraints.can_refine:
         return constraints
     s = constraints.s
