@@ -27,6 +27,7 @@ from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.timing.base import AT_REST
+from toptraj.planners.timing.jerk.accuracy import refined
 from toptraj.planners.timing.jerk.method import JerkLimitedMethod
 
 KINDS = ("velocity", "acceleration", "torque", "jerk")
@@ -45,8 +46,9 @@ def _case(name: str, seed: int):
 
 
 def _refined(constraints, times: int):
+    """Every interval halved ``times`` times, but the two at rest (``refined``)."""
     for _ in range(times):
-        constraints = constraints.with_points(0.5 * (constraints.s[:-1] + constraints.s[1:]))
+        constraints = refined(constraints, AT_REST)
     return constraints
 
 

@@ -31,6 +31,7 @@ import numpy as np
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming, segment_starts
+from toptraj.planners.timing.jerk.trust_region import solve_penalized
 
 if TYPE_CHECKING:
     from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
@@ -104,7 +105,9 @@ class _Checks:
         self.jerk_limit = limit[self.jerk_joints]
 
     def _coefficients(self, s):
+        assert self.constraints.evaluate is not None  # polished only where the rows can be evaluated
         rows = self.constraints.evaluate(np.clip(s, 0.0, 1.0))
+        assert rows.jerk is not None
         dq, ddq, dddq, _ = rows.jerk
         j = self.jerk_joints
         return rows.sd_max, rows.a, rows.b, rows.c, rows.d, rows.lower, rows.upper, dq[:, j], ddq[:, j], dddq[:, j]
@@ -198,10 +201,10 @@ def _points(durations, jerks, start, checks):
     Dp[rows, :, M + segment] += np.column_stack([t**3 / 6, t**2 / 2, t])
     if inside.any():
         # The extremum moves with the variables: dt = -(da0 + t dsigma) / sigma.
-        k = np.flatnonzero(inside)
-        dt = -D[segment[k], 2, :] / sigma[k, None]
-        dt[np.arange(k.size), M + segment[k]] -= t[k] / sigma[k]
-        Dp[k] += rate[k, :, None] * dt[:, None, :]
+        moving = np.flatnonzero(inside)
+        dt = -D[segment[moving], 2, :] / sigma[moving, None]
+        dt[np.arange(moving.size), M + segment[moving]] -= t[moving] / sigma[moving]
+        Dp[moving] += rate[moving, :, None] * dt[:, None, :]
     return s, v, a, sigma, Dp, starts, D
 
 
@@ -257,7 +260,7 @@ def _polished(constraints, grid_timing, initial, sd_start: float, sd_end: float,
             )
             return h, H, g.ravel(), G.reshape(-1, 2 * M) * scales[None, :]
 
-        z = _solve(z, evaluate, M)
+        z = solve_penalized(z, evaluate, M, MAX_ITERATIONS, GIVE_UP_AFTER)
         if z is None:
             return None
         durations, jerks = np.maximum(z[:M] * scales[:M], 0.0), z[M:] * scales[M:]
@@ -275,107 +278,6 @@ def _polished(constraints, grid_timing, initial, sd_start: float, sd_end: float,
         segment = np.concatenate([segment, worst[0]])
         fraction = np.concatenate([fraction, worst[1]])
     return None
-
-
-def _solve(z, evaluate, M, deadline=None):
-    """Minimize the sum of the (scaled) durations z[:M] subject to h(z) = 0 and g(z) >= 0:
-    sequential linear programming in a trust region with an exact (l1) penalty merit, each LP
-    step followed by a second-order correction onto the rows it holds with equality (a
-    least-norm Newton step), which keeps the steps on the curved constraint surfaces, so that
-    they are not rejected for their second-order violation. Rows of g that repeat another row
-    (a jerk row along a segment whose limits do not change, a limit at the state two segments
-    share) are kept once. ``None`` when it does not end at a feasible point."""
-    import highspy
-    from scipy import sparse  # here: scipy.sparse is imported by jerk_limited only
-
-    h, H, g, G = evaluate(z)
-    keep = _distinct_rows(np.column_stack([g, G]))
-    n = 2 * M
-    radius, penalty = 0.5, 100.0
-    cost = np.concatenate([np.ones(M), np.zeros(M)])
-
-    def state(z):
-        h, H, g, G = evaluate(z)
-        return h, H, g[keep], G[keep]
-
-    def merit(h, g, z):
-        return float(cost @ z + penalty * (np.abs(h).sum() + np.maximum(-g, 0.0).sum()))
-
-    h, H, g, G = state(z)
-    current = merit(h, g, z)
-    for iteration in range(MAX_ITERATIONS):
-        violation = max(np.abs(h).max(), -g.min() if len(g) else 0.0)
-        if iteration >= GIVE_UP_AFTER and violation > 1e-3:
-            return None  # the segments cannot follow these limits: keep the grid solution
-        m_eq, m_in = len(h), len(g)
-        # Columns: dz (n), e_plus (m_eq), e_minus (m_eq), e_g (m_in).
-        objective = np.concatenate([cost, np.full(2 * m_eq + m_in, penalty)])
-        # The jerk of a segment that has shrunk to nothing is left where it is: it no longer
-        # acts on the motion, and a free variable that does nothing makes the LPs degenerate.
-        frozen = np.concatenate([np.zeros(M, dtype=bool), z[:M] <= 1e-9])
-        lower = np.concatenate([np.maximum(-radius, -z[:M]), np.full(M, -radius), np.zeros(2 * m_eq + m_in)])
-        upper = np.concatenate([np.full(n, radius), np.full(2 * m_eq + m_in, np.inf)])
-        lower[:n][frozen] = upper[:n][frozen] = 0.0
-        csc = sparse.bmat([
-            [sparse.csr_matrix(H), -sparse.identity(m_eq), sparse.identity(m_eq), None],
-            [sparse.csr_matrix(G), None, None, sparse.identity(m_in)],
-        ], format="csc")
-        solver = highspy.Highs()
-        solver.setOptionValue("output_flag", False)
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = len(objective), csc.shape[0]
-        lp.col_cost_, lp.col_lower_, lp.col_upper_ = objective, lower, upper
-        lp.row_lower_ = np.concatenate([-h, -g])
-        lp.row_upper_ = np.concatenate([-h, np.full(m_in, np.inf)])
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = csc.indptr, csc.indices, csc.data
-        solver.passModel(lp)
-        solver.run()
-        if solver.getModelStatus() != highspy.HighsModelStatus.kOptimal:
-            return None
-        solution = np.asarray(solver.getSolution().col_value)
-        step = solution[:n]
-        predicted = current - float(objective @ solution + cost @ z)
-        if predicted <= 1e-14 * max(1.0, abs(current)):
-            break
-        # Rows the LP step holds with equality, and the correction back onto them.
-        active = np.flatnonzero(np.abs(g + G @ step) <= 1e-9 * (1.0 + np.abs(G).max(axis=1) * radius))
-        trial = z + step
-        h_t, _, g_t, _ = state(trial)
-        system = np.vstack([H, G[active]])
-        if system.shape[0]:
-            correction = np.linalg.lstsq(system, -np.concatenate([h_t, g_t[active]]), rcond=None)[0]
-            if np.abs(correction).max() <= radius:
-                trial = trial + correction
-        trial[:M] = np.maximum(trial[:M], 0.0)
-        h_t, H_t, g_t, G_t = state(trial)
-        actual = current - merit(h_t, g_t, trial)
-        if actual >= 0.1 * predicted:
-            z, h, H, g, G, current = trial, h_t, H_t, g_t, G_t, merit(h_t, g_t, trial)
-            if actual >= 0.75 * predicted and np.abs(step).max() >= 0.99 * radius:
-                radius = min(2.0 * radius, 10.0)
-        else:
-            radius *= 0.25
-            if radius < 1e-13:
-                break
-    if np.abs(h).max() > 1e-9 or (len(g) and g.min() < -1e-9):
-        return None
-    return z
-
-
-def _distinct_rows(rows: np.ndarray, tolerance: float = 1e-9) -> np.ndarray:
-    """Indices of the rows of ``rows`` (m, k) that repeat no earlier row within ``tolerance``
-    (relative to the larger magnitude of the two)."""
-    scale = np.maximum(np.abs(rows).max(axis=1), 1e-300)
-    keep: list[int] = []
-    for i in range(len(rows)):
-        if keep:
-            kept = np.asarray(keep)
-            gap = np.abs(rows[kept] - rows[i]).max(axis=1) / np.maximum(scale[kept], scale[i])
-            if gap.min() <= tolerance:
-                continue
-        keep.append(i)
-    return np.asarray(keep, dtype=int)
 
 
 def _dense_excess(checks_model: _Checks, timing: JerkSegmentsTiming):

@@ -55,6 +55,8 @@ class RestrictedProgram:
 
         self._lp = WorkingSetLP(deadline)
         self._fixed: tuple[sparse.csr_matrix, np.ndarray, np.ndarray] | None = None
+        self._pattern: _Pattern | None = None
+        self._jerk_terms: tuple | None = None
 
     # Variables: X_0..X_n at columns 0..n, U_0..U_n at columns n+1..2n+1.
     def _x(self, i):
@@ -67,56 +69,67 @@ class RestrictedProgram:
 
     def _equalities_and_rows(self, x_ref):
         """Continuity of x, the intervals at rest, and the second-order rows (which do not
-        depend on the restriction, except through friction linearized at ``x_ref``)."""
-        n, h, kappa = self.n, self.h, self.kappa
-        rows, cols, vals, lower, upper = [], [], [], [], []
-        count = 0
+        depend on the restriction, except through friction linearized at ``x_ref``): blocks of
+        ``_stacked``."""
+        regular = np.arange(1 if self.rest_start else 0, self.n - 1 if self.rest_end else self.n)
+        right = self.constraints.linearized(np.maximum(x_ref, 1e-12))
+        left = self.constraints.linearized(np.maximum(x_ref, 1e-12), "left")
+        return [
+            self._continuity(),
+            *self._quarter_speed_rows(regular),
+            *self._point_rows(right, left),
+            *self._middle_rows(right, left, regular),
+        ]
 
-        def add(columns, values, low, high):
-            nonlocal count
-            rows.extend([count] * len(columns))
-            cols.extend(columns)
-            vals.extend(values)
-            lower.append(low)
-            upper.append(high)
-            count += 1
+    def _continuity(self):
+        """x_i+1 = x_i + (u_i + u_i+1) h_i on every regular interval; u = 2 x / (3 h) at the
+        inner point of an interval at rest (constant path jerk from or to rest)."""
+        n, h = self.n, self.h
+        interval = np.arange(n)
+        columns = np.column_stack([self._x(interval + 1), self._x(interval), self._u(interval), self._u(interval + 1)])
+        values = np.column_stack([np.ones(n), -np.ones(n), -h, -h])
+        width = np.full(n, 4)
+        if self.rest_start:
+            columns[0, :2], values[0, :2], width[0] = (self._u(1), self._x(1)), (1.0, -2.0 / (3.0 * h[0])), 2
+        if self.rest_end:
+            columns[-1, :2], values[-1, :2], width[-1] = (self._u(n - 1), self._x(n - 1)), (1.0, 2.0 / (3.0 * h[-1])), 2
+        used = np.arange(4)[None, :] < width[:, None]
+        return (
+            np.repeat(interval, width), columns[used], values[used], np.zeros(n), np.zeros(n), n,
+        )
 
-        for i in range(n):
-            if i == 0 and self.rest_start:
-                add([self._u(1), self._x(1)], [1.0, -2.0 / (3.0 * h[0])], 0.0, 0.0)
-            elif i == n - 1 and self.rest_end:
-                add([self._u(n - 1), self._x(n - 1)], [1.0, 2.0 / (3.0 * h[-1])], 0.0, 0.0)
-            else:
-                add([self._x(i + 1), self._x(i), self._u(i), self._u(i + 1)], [1.0, -1.0, -h[i], -h[i]], 0.0, 0.0)
-        equality = (np.array(rows), np.array(cols), np.array(vals), np.array(lower), np.array(upper), count)
-        blocks = [equality]
-        # x at the quarters of each regular interval, x_i + 2 u_i f h + (u_i+1 - u_i) f^2 h
-        # (f = 1/4, 1/2, 3/4), below the velocity bound of both ends: without them, u could
-        # zigzag (u_i+1 = -u_i) along a stretch of constant x, its x bulging between the grid
-        # points.
-        x_bound = self.constraints.sd_max**2 / kappa
-        regular = np.arange(1 if self.rest_start else 0, n - 1 if self.rest_end else n)
+    def _quarter_speed_rows(self, regular: np.ndarray):
+        """x at the quarters of each regular interval, x_i + 2 u_i f h + (u_i+1 - u_i) f^2 h
+        (f = 1/4, 1/2, 3/4), below the velocity bound of both ends: without them, u could
+        zigzag (u_i+1 = -u_i) along a stretch of constant x, its x bulging between the grid
+        points."""
+        x_bound = self.constraints.sd_max**2 / self.kappa
         bound = np.minimum(x_bound[regular], x_bound[regular + 1])
         keep = np.isfinite(bound)
         bounded, bound = regular[keep], bound[keep]
-        for f in (0.25, 0.5, 0.75) if bounded.size else ():
-            hb = h[bounded]
-            blocks.append((
+        if bounded.size == 0:
+            return []
+        hb = self.h[bounded]
+        return [
+            (
                 np.repeat(np.arange(bounded.size), 3),
                 np.column_stack([self._x(bounded), self._u(bounded), self._u(bounded + 1)]).ravel(),
                 np.column_stack([np.ones(bounded.size), (2.0 * f - f * f) * hb, f * f * hb]).ravel(),
                 np.full(bounded.size, -np.inf),
                 bound,
                 bounded.size,
-            ))
+            )
+            for f in (0.25, 0.5, 0.75)
+        ]
 
-        c = self.constraints
-        right = c.linearized(np.maximum(x_ref, 1e-12))
-        left = c.linearized(np.maximum(x_ref, 1e-12), "left")
+    def _point_rows(self, right, left):
+        """The second-order rows a u + b x + c within [lower, upper] at every inner grid point,
+        with the coefficients of both sides where the path's derivatives jump there."""
+        kappa, free = self.kappa, np.arange(1, self.n)
         differs = np.flatnonzero(
             np.any(left.a != right.a, axis=1) | np.any(left.b != right.b, axis=1) | np.any(left.c != right.c, axis=1)
         )
-        free = np.arange(1, n)
+        blocks = []
         for side, points in ((right, free), (left, np.intersect1d(differs, free))):
             if side.a.shape[1] == 0 or points.size == 0:
                 continue
@@ -133,73 +146,68 @@ class RestrictedProgram:
                 (hi / scale).ravel(),
                 points.size * m,
             ))
-        if right.a.shape[1] and regular.size:
-            # The same rows at the middle of each regular interval, where u = (u_i + u_i+1) / 2
-            # and x = x_i + (3 u_i + u_i+1) h / 4 (x is quadratic in s between the grid points),
-            # with the coefficients of the two ends averaged.
-            i = regular
-            a = 0.5 * (right.a[i] + left.a[i + 1])
-            b = 0.5 * (right.b[i] + left.b[i + 1])
-            cc = 0.5 * (right.c[i] + left.c[i + 1])
-            lo, hi = right.lower[i] - cc, right.upper[i] - cc
-            hm = h[i][:, None]
-            coefficients = np.stack([0.5 * a + 0.75 * hm * b, 0.5 * a + 0.25 * hm * b, b], axis=-1) * kappa
-            scale = np.maximum(np.abs(coefficients).max(axis=-1), 1e-300)
-            m = a.shape[1]
-            index = np.repeat(i, m)
-            blocks.append((
-                np.repeat(np.arange(i.size * m), 3),
-                np.column_stack([self._u(index), self._u(index + 1), self._x(index)]).ravel(),
-                (coefficients / scale[..., None]).reshape(-1),
-                (lo / scale).ravel(),
-                (hi / scale).ravel(),
-                i.size * m,
-            ))
         return blocks
 
-    def _jerk_rows(self, x_tangent):
+    def _middle_rows(self, right, left, regular: np.ndarray):
+        """The second-order rows at the middle of each regular interval, where
+        u = (u_i + u_i+1) / 2 and x = x_i + (3 u_i + u_i+1) h / 4 (x is quadratic in s between
+        the grid points), with the coefficients of the two ends averaged."""
+        if not (right.a.shape[1] and regular.size):
+            return []
+        i = regular
+        a = 0.5 * (right.a[i] + left.a[i + 1])
+        b = 0.5 * (right.b[i] + left.b[i + 1])
+        cc = 0.5 * (right.c[i] + left.c[i + 1])
+        lo, hi = right.lower[i] - cc, right.upper[i] - cc
+        hm = self.h[i][:, None]
+        coefficients = np.stack([0.5 * a + 0.75 * hm * b, 0.5 * a + 0.25 * hm * b, b], axis=-1) * self.kappa
+        scale = np.maximum(np.abs(coefficients).max(axis=-1), 1e-300)
+        m = a.shape[1]
+        index = np.repeat(i, m)
+        return [(
+            np.repeat(np.arange(i.size * m), 3),
+            np.column_stack([self._u(index), self._u(index + 1), self._x(index)]).ravel(),
+            (coefficients / scale[..., None]).reshape(-1),
+            (lo / scale).ravel(),
+            (hi / scale).ravel(),
+            i.size * m,
+        )]
+
+    def _jerk_rows(self, x_tangent: np.ndarray, pattern: bool = True) -> list:
         """The jerk rows (1) at both ends of every interval, their right-hand side J / sqrt(X)
         replaced by its tangent at ``x_tangent`` (scaled), J (alpha - beta X): two one-sided
-        rows ``+-G + J beta X <= J alpha`` each."""
-        c = self.constraints
-        dq, ddq, dddq, limit = c.jerk
-        dq_l, ddq_l, dddq_l = c.jerk_left
-        n, h, kappa = self.n, self.h, self.kappa
-        limited = np.flatnonzero(np.isfinite(limit))
-        if limited.size == 0:
-            return []
-        J = limit[limited] / kappa**1.5  # scaled: |G| <= J / sqrt(X)
-        m = limited.size
-        blocks = []
+        rows ``+-G + J beta X <= J alpha`` each (blocks of ``_stacked``; without ``pattern``,
+        their rows and columns left out: the tangent changes values only)."""
+        if self._jerk_terms is None:  # G's coefficients do not depend on the tangent
+            limit = self._jerk[3]
+            limited = np.flatnonzero(np.isfinite(limit))
+            terms = (*self._regular_jerk_terms(limited), *self._rest_jerk_terms(limited)) if limited.size else ()
+            self._jerk_terms = (terms, limit[limited] / self.kappa**1.5)  # scaled: |G| <= J / sqrt(X)
+        terms, J = self._jerk_terms
+        blocks: list = []
+        for u_terms, x_coefficient, point in terms:
+            blocks.extend(_tangent_rows(u_terms, x_coefficient, self._x(point), x_tangent[point], J, pattern))
+        return blocks
 
-        def emit(u_terms, x_coefficient, point):
-            """u_terms: (columns (k,), coefficients (k, m)) of the U part of G; x_coefficient
-            (k, m) of X at ``point`` (k,)."""
-            X = np.maximum(x_tangent[point], 1e-12)
-            alpha, beta = 1.5 / np.sqrt(X), 0.5 / X**1.5
-            k = point.size
-            x_col = np.broadcast_to(self._x(point)[:, None], (k, m))
-            columns = np.stack([*(np.broadcast_to(col[:, None], (k, m)) for col, _ in u_terms), x_col], axis=-1)
-            for sign in (1.0, -1.0):
-                values = np.stack(
-                    [*(sign * coefficient for _, coefficient in u_terms), sign * x_coefficient + J * beta[:, None]], axis=-1
-                )
-                scale = np.maximum(np.abs(values).max(axis=-1), 1e-300)
-                blocks.append((
-                    np.repeat(np.arange(k * m), columns.shape[-1]),
-                    columns.reshape(-1),
-                    (values / scale[..., None]).reshape(-1),
-                    np.full(k * m, -np.inf),
-                    (J * alpha[:, None] / scale).ravel(),
-                    k * m,
-                ))
+    @property
+    def _jerk(self):
+        """The path's jerk coefficients (q', q'', q''', J) on the right of each point."""
+        assert self.constraints.jerk is not None  # jerk_limited always builds the jerk rows
+        return self.constraints.jerk
 
-        regular = np.arange(n)
-        if self.rest_start:
-            regular = regular[1:]
-        if self.rest_end:
-            regular = regular[:-1]
-        for end, (d1, d2, d3) in ((0, (dq, ddq, dddq)), (1, (dq_l, ddq_l, dddq_l))):
+    @property
+    def _jerk_left(self):
+        """The path's jerk coefficients (q', q'', q''') on the left of each point."""
+        assert self.constraints.jerk_left is not None  # built with the jerk rows
+        return self.constraints.jerk_left
+
+    def _regular_jerk_terms(self, limited: np.ndarray):
+        """(u terms, X coefficient, points) of G = d1 (U_i+1 - U_i) / h_i + 3 d2 U_p + d3 X_p
+        at both ends p of every regular interval i, the points at rest left out."""
+        n, h = self.n, self.h
+        regular = np.arange(1 if self.rest_start else 0, n - 1 if self.rest_end else n)
+        terms = []
+        for end, (d1, d2, d3) in ((0, self._jerk[:3]), (1, self._jerk_left)):
             point = regular + end
             moving = ~(((point == 0) & self.rest_start) | ((point == n) & self.rest_end))
             point = point[moving]
@@ -208,26 +216,27 @@ class RestrictedProgram:
             interval = point - end
             hw = h[interval][:, None]
             a1, a2, a3 = d1[point][:, limited], d2[point][:, limited], d3[point][:, limited]
-            # G = d1 (U_i+1 - U_i) / h_i + 3 d2 U_point + d3 X_point
-            emit(
-                [(self._u(interval + 1), a1 / hw), (self._u(interval), -a1 / hw), (self._u(point), 3.0 * a2)],
-                a3,
-                point,
-            )
-        for at_rest, inner, outer, sign in ((self.rest_start, 1, 0, 1.0), (self.rest_end, n - 1, n, -1.0)):
+            u_terms = [(self._u(interval + 1), a1 / hw), (self._u(interval), -a1 / hw), (self._u(point), 3.0 * a2)]
+            terms.append((u_terms, a3, point))
+        return terms
+
+    def _rest_jerk_terms(self, limited: np.ndarray):
+        """(u terms, X coefficient, points) of the jerk of an interval at rest, at its inner
+        point, where u = sign 2 x / (3 h) and du/ds = 2 x / (9 h^2):
+        G = X (d1 2 / (9 h^2) + sign 2 d2 / h + d3); and at the rest point, where the jerk is
+        q' sigma, sigma = du/ds sqrt(x): G = X d1 2 / (9 h^2)."""
+        dq, ddq, dddq, _ = self._jerk
+        terms: list = []
+        for at_rest, inner, outer, sign in ((self.rest_start, 1, 0, 1.0), (self.rest_end, self.n - 1, self.n, -1.0)):
             if not at_rest:
                 continue
-            width = h[0] if outer == 0 else h[-1]
-            d1, d2, d3 = (dq_l, ddq_l, dddq_l) if outer == 0 else (dq, ddq, dddq)
+            width = self.h[0] if outer == 0 else self.h[-1]
+            d1, d2, d3 = self._jerk_left if outer == 0 else (dq, ddq, dddq)
             point = np.array([inner])
-            # At the inner point, u = sign 2 x / (3 h) and du/ds = 2 x / (9 h^2):
-            # G = X (d1 2 / (9 h^2) + sign 2 d2 / h + d3).
             inner_g = d1[inner] * 2.0 / (9.0 * width**2) + sign * d2[inner] * 2.0 / width + d3[inner]
-            # At the rest point the jerk is q' sigma, sigma = du/ds sqrt(x): G = X d1 2 / (9 h^2).
             outer_g = dq[outer] * 2.0 / (9.0 * width**2)
-            for g in (inner_g, outer_g):
-                emit([], g[limited][None, :], point)
-        return blocks
+            terms.extend(([], g[limited][None, :], point) for g in (inner_g, outer_g))
+        return terms
 
     def solve_restricted(self, x_tangent: np.ndarray, seed: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The LP of the restriction around ``x_tangent`` (1/s^2): x and u (unscaled). ``seed``,
@@ -235,14 +244,7 @@ class RestrictedProgram:
         (``toptraj.planners.timing.jerk.working_set``)."""
         kappa, n = self.kappa, self.n
         X_tangent = np.asarray(x_tangent) / kappa
-        if self._fixed is None:  # the rows that do not depend on the restriction, built once
-            self._fixed = _stacked(self._fixed_rows, 2 * n + 2)
-        jerk, jerk_lower, jerk_upper = _stacked(self._jerk_rows(X_tangent), 2 * n + 2)
-        from scipy import sparse
-
-        matrix = sparse.vstack([self._fixed[0], jerk], format="csr")
-        lower = np.concatenate([self._fixed[1], jerk_lower])
-        upper = np.concatenate([self._fixed[2], jerk_upper])
+        matrix, lower, upper = self._rows(X_tangent)
         x_high = self.constraints.sd_max**2 / kappa
         low = np.concatenate([np.zeros(n + 1), np.full(n + 1, -np.inf)])
         high = np.concatenate([x_high, np.full(n + 1, np.inf)])
@@ -254,6 +256,30 @@ class RestrictedProgram:
         values = self._lp.solve(objective, matrix, lower, upper, low, high, scaled)
         X, U = values[: n + 1], values[n + 1 :]
         return np.maximum(X, 0.0) * kappa, U * kappa
+
+    def _rows(self, X_tangent: np.ndarray) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:
+        """Every row of the LP around ``X_tangent``: (matrix (CSR), lower, upper), the rows that
+        do not depend on the restriction first. Both parts' patterns are built at the first
+        restriction (``_Pattern``); a later one computes the jerk rows' values only."""
+        from scipy import sparse
+
+        columns = 2 * self.n + 2
+        if self._fixed is None:  # the rows that do not depend on the restriction, built once
+            self._fixed = _stacked(self._fixed_rows, columns)
+        blocks = self._jerk_rows(X_tangent, pattern=self._pattern is None)
+        if self._pattern is None:
+            self._pattern = _Pattern(self._fixed[0], blocks, columns)
+        fixed, fixed_lower, fixed_upper = self._fixed
+        if blocks:
+            values = np.concatenate([block[2] for block in blocks])
+            jerk_lower = np.concatenate([block[3] for block in blocks])
+            jerk_upper = np.concatenate([block[4] for block in blocks])
+        else:
+            values, jerk_lower, jerk_upper = np.zeros(0), np.zeros(0), np.zeros(0)
+        pattern = self._pattern
+        data = np.concatenate([fixed.data, np.bincount(pattern.entry, weights=values, minlength=pattern.jerk_nnz)])
+        matrix = sparse.csr_matrix((data, pattern.indices, pattern.indptr), shape=(pattern.rows, columns))
+        return matrix, np.concatenate([fixed_lower, jerk_lower]), np.concatenate([fixed_upper, jerk_upper])
 
     def _time_gradient(self, X):
         """d/dX of sum 2 h / (sqrt(X_i) + sqrt(X_i+1)) (3 h / sqrt(X) for an interval at rest)."""
@@ -279,6 +305,60 @@ class RestrictedProgram:
             self.constraints.s, np.sqrt(np.maximum(x, 0.0)), u=np.asarray(u, dtype=float),
             rest_start=self.rest_start, rest_end=self.rest_end,
         )
+
+
+def _tangent_rows(u_terms, x_coefficient, x_columns, x_tangent, J, pattern: bool = True):
+    """The two one-sided rows +-G + J beta X <= J alpha of each point and limited joint, G's U
+    part ``u_terms`` (columns (k,), coefficients (k, m)) and its X coefficient ``x_coefficient``
+    (k, m) at the columns ``x_columns`` (k,); alpha = 1.5 / sqrt(X_t), beta = 0.5 / X_t^1.5
+    (the tangent of X^-1/2 at ``x_tangent``, (k,)): blocks of ``_stacked`` (without
+    ``pattern``, their rows and columns ``None``)."""
+    X = np.maximum(x_tangent, 1e-12)
+    alpha, beta = 1.5 / np.sqrt(X), 0.5 / X**1.5
+    k, m = x_coefficient.shape
+    width = len(u_terms) + 1
+    rows = columns = None
+    if pattern:
+        x_col = np.broadcast_to(x_columns[:, None], (k, m))
+        columns = np.stack([*(np.broadcast_to(col[:, None], (k, m)) for col, _ in u_terms), x_col], axis=-1).reshape(-1)
+        rows = np.repeat(np.arange(k * m), width)
+    blocks = []
+    for sign in (1.0, -1.0):
+        values = np.stack(
+            [*(sign * coefficient for _, coefficient in u_terms), sign * x_coefficient + J * beta[:, None]], axis=-1
+        )
+        scale = np.maximum(np.abs(values).max(axis=-1), 1e-300)
+        blocks.append((
+            rows,
+            columns,
+            (values / scale[..., None]).reshape(-1),
+            np.full(k * m, -np.inf),
+            (J * alpha[:, None] / scale).ravel(),
+            k * m,
+        ))
+    return blocks
+
+
+class _Pattern:
+    """The sparsity pattern of an LP's rows, the fixed rows (a CSR matrix) over the jerk rows
+    (blocks of ``_stacked``): the whole matrix's ``indptr`` and ``indices`` (CSR, rows sorted,
+    repeated entries summed, as ``_stacked`` builds them), and for each value of the jerk
+    blocks, in their order, the entry of the jerk part it adds to (``entry``, of
+    ``jerk_nnz``)."""
+
+    def __init__(self, fixed: sparse.csr_matrix, blocks: list, columns: int):
+        offsets = np.cumsum([0] + [block[5] for block in blocks])
+        if blocks:
+            row = np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)])
+            column = np.concatenate([block[1] for block in blocks])
+        else:
+            row = column = np.zeros(0, dtype=np.int64)
+        keys, self.entry = np.unique(row.astype(np.int64) * columns + column, return_inverse=True)
+        self.jerk_nnz = keys.size
+        counts = np.bincount(keys // columns, minlength=int(offsets[-1]))
+        self.rows = fixed.shape[0] + int(offsets[-1])
+        self.indptr = np.concatenate([fixed.indptr, fixed.indptr[-1] + np.cumsum(counts)]).astype(fixed.indptr.dtype)
+        self.indices = np.concatenate([fixed.indices, keys % columns]).astype(fixed.indices.dtype)
 
 
 def _stacked(blocks, columns: int) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:

@@ -187,20 +187,25 @@ class JerkTimeScaling(TimeScaling):
         interval = np.clip(np.searchsorted(grid_t, t, side="right") - 1, 0, len(self.s) - 2)
         target = t - grid_t[interval]
         h = np.diff(self.s)[interval]
-        # Newton on the time to an offset (dt/ds = 1 / sd), kept inside the interval.
+        # Newton on the time to an offset (dt/ds = 1 / sd), kept inside the interval; a sample
+        # leaves the iteration where it has converged.
         low, high = np.zeros_like(h), h.copy()
         offset = np.clip(target * np.sqrt(np.maximum(self._x[interval], 1e-300)), 0.0, h)
+        active = np.arange(len(t))
         for _ in range(60):
+            where, at = interval[active], offset[active]
             with np.errstate(invalid="ignore"):
-                error = np.nan_to_num(self._times_to(interval, offset) - target, nan=0.0)
-            low = np.where(error < 0, offset, low)
-            high = np.where(error > 0, offset, high)
-            x, _, _ = self._state(interval, offset)
+                error = np.nan_to_num(self._times_to(where, at) - target[active], nan=0.0)
+            low[active] = np.where(error < 0, at, low[active])
+            high[active] = np.where(error > 0, at, high[active])
+            x, _, _ = self._state(where, at)
             with np.errstate(invalid="ignore"):
-                step = offset - error * np.sqrt(x)
-            inside = (step > low) & (step < high)
-            offset = np.where(inside, step, 0.5 * (low + high))
-            if np.all(np.abs(error) <= 1e-13 * max(1.0, grid_t[-1])):
+                step = at - error * np.sqrt(x)
+            inside = (step > low[active]) & (step < high[active])
+            moving = np.abs(error) > 1e-13 * max(1.0, grid_t[-1])
+            offset[active] = np.where(moving, np.where(inside, step, 0.5 * (low[active] + high[active])), at)
+            active = active[moving]
+            if active.size == 0:
                 break
         x, u, _ = self._state(interval, offset)
         return np.minimum(self.s[interval] + offset, self.s[interval + 1]), np.sqrt(x), u
