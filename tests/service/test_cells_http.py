@@ -62,6 +62,37 @@ def _cell(**change) -> dict:
 def test_an_unknown_robot_is_a_404_naming_it(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a1={"robot": "ur55"}))
     assert response.status_code == 404 and "ur55" in response.json()["detail"]
+    assert response.json()["detail"].startswith("arms[1].robot: no robot named 'ur55'")
+
+
+@pytest.mark.parametrize("other", [{"path": {"kind": "cartesian", "points": [[0.4, 0.0, 0.3]]}}, {"kind": "free"}])
+def test_a_path_of_another_kind_is_a_422_saying_what_is_served(patient_client, other):
+    response = patient_client.post("/v1/cells", json=_cell(a1=other))
+    assert response.status_code == 422
+    detail = response.json()["detail"]
+    assert detail.startswith("arms[1]") and "joint waypoints only" in detail and "POST /v1/trajectories" in detail
+    assert next(iter(other)) in detail
+
+
+@pytest.mark.parametrize(
+    ("waypoints", "words"),
+    [
+        (
+            [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]],
+            "arms[1].waypoints[0] has 3 values; ur5 has 6 joints (shoulder_pan_joint, shoulder_lift_joint, elbow_joint, "
+            "wrist_1_joint, wrist_2_joint, wrist_3_joint)",
+        ),
+        ([[1.5, -0.5, 0.5, 0.0, 0.0, 0.0]] * 2, "arms[1].waypoints[0] and arms[1].waypoints[1] coincide"),
+        (
+            [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0], [99.0, -0.5, 0.5, 0.0, 0.0, 0.0]],
+            "arms[1].waypoints[1][0] = 99 is outside the limits [-6.28319, 6.28319] of joint 'shoulder_pan_joint'",
+        ),
+    ],
+)
+def test_bad_waypoints_of_an_arm_are_a_422_in_the_request_words(patient_client, waypoints, words):
+    response = patient_client.post("/v1/cells", json=_cell(a1={"waypoints": waypoints}))
+    assert response.status_code == 422
+    assert response.json()["detail"] == words
 
 
 def test_a_base_that_is_not_a_rotation_is_a_422_saying_where(patient_client):
@@ -69,14 +100,17 @@ def test_a_base_that_is_not_a_rotation_is_a_422_saying_where(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a1={"base": mirrored}))
     assert response.status_code == 422
     detail = response.json()["detail"]
-    assert "arms[1].base.rotation is not a rotation" in detail and "det R = -1" in detail
+    assert detail.startswith("arms[1].base.rotation is not a rotation") and "det R = -1" in detail
+    assert "breaks the rule" not in detail and detail.endswith("for a base turned half a turn about z)")
     assert response.headers["content-type"].startswith("application/problem+json")
 
 
 def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a1={"base": {"position": [0.1, 0.0, 0.0]}}))
     assert response.status_code == 422
-    assert "collide at their start" in response.json()["detail"] and "link '" in response.json()["detail"]
+    detail = response.json()["detail"]
+    assert detail.startswith("the arms collide at their start") and "link '" in detail
+    assert detail.endswith("move a base apart, change the first waypoints or lower clearance")
 
 
 def test_three_arms_are_answered_on_one_clock_with_every_pairs_diagram(patient_client):
