@@ -36,6 +36,23 @@ def test_both_arms_are_sampled_on_one_clock_from_start_to_end(answer):
     assert answer["arms"][0]["joint_trajectory"]["joint_names"][0] == "shoulder_pan_joint"
 
 
+def test_each_arm_echoes_its_payload_and_base_with_units(patient_client, answer):
+    first, second = answer["arms"]
+    assert first["payload"] is None and second["payload"] is None
+    assert first["base"]["position"] == [0.0, 0.0, 0.0] and second["base"]["position"] == [1.2, 0.0, 0.0]
+    np.testing.assert_allclose(second["base"]["rotation"], EXAMPLE["arms"][1]["base"]["rotation"], atol=1e-12)
+    np.testing.assert_allclose(second["base"]["gravity"], [0.0, 0.0, -9.81], atol=1e-12)
+    assert second["base"]["units"]["position"] == "m"
+    body = _cell(a1={"payload": {"mass": 2.0, "center_of_mass": [0.0, 0.0, 0.05]}}) | {"gravity": [0.0, 0.0, -9.8]}
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 200, response.text
+    arms = response.json()["arms"]
+    assert arms[0]["payload"] is None and arms[0]["base"]["gravity"] == pytest.approx([0.0, 0.0, -9.8], abs=1e-12)
+    payload = arms[1]["payload"]
+    assert (payload["mass"], payload["center_of_mass"], payload["frame"]) == (2.0, [0.0, 0.0, 0.05], "tool0")
+    assert payload["inertia"] == [[0.0] * 3] * 3 and payload["units"]["mass"] == "kg"
+
+
 def test_the_answer_reports_the_time_lost_and_the_diagram(answer):
     assert answer["time_lost"] == pytest.approx(answer["duration"] - max(answer["solo_durations"]))
     assert max(answer["solo_durations"]) < answer["duration"] <= answer["sequential_duration"]

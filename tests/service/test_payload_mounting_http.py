@@ -71,6 +71,34 @@ def test_a_ceiling_mounted_arm_feels_the_floor_arms_gravity_reversed(client):
     assert np.abs(tau - _rnea(floor_reversed, q, qd, qdd)).max() <= 1e-9
 
 
+def test_the_answer_echoes_the_payload_and_mounting_it_applied_with_units(client):
+    code, bare = _plan(client, timing={})
+    assert code == 200, bare
+    assert bare["payload"] is None and bare["mounting"] is None
+    inertia = [0.02, 0.025, 0.03, 0.001, 0.0, 0.002]
+    code, answer = _plan(
+        client, timing={}, payload={"mass": 2.0, "center_of_mass": [0.0, 0.01, 0.1], "inertia": inertia},
+        mounting={"position": [0.0, 0.3, 2.5], "orientation": [1.0, 0.0, 0.0, 0.0]},
+    )
+    assert code == 200, answer
+    assert answer["payload"] == {
+        "mass": 2.0,
+        "center_of_mass": [0.0, 0.01, 0.1],
+        "inertia": [[0.02, 0.001, 0.0], [0.001, 0.025, 0.002], [0.0, 0.002, 0.03]],
+        "frame": "tool0",
+        "units": {"mass": "kg", "center_of_mass": "m", "inertia": "kg m^2"},
+    }
+    mounting = answer["mounting"]
+    assert mounting["position"] == [0.0, 0.3, 2.5]
+    # the quaternion [1, 0, 0, 0]: half a turn about x
+    np.testing.assert_allclose(mounting["rotation"], [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]], atol=1e-12)
+    np.testing.assert_allclose(mounting["gravity"], [0.0, 0.0, -9.81], atol=1e-12)  # the world's, not the base's
+    assert mounting["units"]["position"] == "m" and mounting["units"]["gravity"] == "m/s^2"
+    code, walled = _plan(client, timing={}, mounting={"gravity": [0.0, -9.81, 0.0]})
+    assert code == 200, walled
+    assert walled["mounting"]["gravity"] == [0.0, -9.81, 0.0] and walled["payload"] is None
+
+
 @pytest.mark.parametrize(
     ("mounting", "field", "words"),
     [
@@ -151,6 +179,8 @@ def test_an_uploads_default_payload_applies_unless_a_request_gives_its_own(clien
         response = client.post("/v1/trajectories", json=body)
         assert response.status_code == 200, response.text
         q, qd, qdd, tau = _samples(response.json())
+        echoed = response.json()["payload"]
+        assert (echoed is None) if expected is None else (echoed["mass"], echoed["frame"]) == (expected["mass"], "hand")
         carried = catalog if expected is None else equipment.equip(catalog, equipment.payload(**expected, frame=BUNDLED["lecture_3r"]))
         assert np.abs(tau - carried.inverse_dynamics(q, qd, qdd)).max() <= 1e-9
 
