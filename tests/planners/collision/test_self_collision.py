@@ -13,8 +13,10 @@ import pytest
 from tests.planners.collision.test_obstacles import _coal_capsule
 from toptraj import robots
 from toptraj.planners.collision.self_collision import (
+    PADDING,
     SelfCollision,
     check_self_collision,
+    pair_distances,
     self_pairs,
 )
 from toptraj.planners.generators.search.free_space import free_distances
@@ -126,3 +128,29 @@ def test_the_search_keeps_links_apart_and_refuses_a_folded_start():
     with pytest.raises(SelfCollision) as refused:
         build_problem(robot, robot.limits, ("velocity", "acceleration"), FOLDED, UPRIGHT)
     assert "path.start" in refused.value.detail and refused.value.s == 0.0
+
+
+def test_the_capsules_never_accept_links_whose_meshes_touch(meshes):
+    """Each pair's capsule distance is at most its meshes' distance (coal), at the fold and at
+    sampled configurations: where the check accepts (capsules apart), the meshes are apart."""
+    robot = robots.load("ur5")
+    pairs = self_pairs(robot)
+    q = np.vstack([SplinePath(FOLDING).evaluate(np.linspace(0.0, 1.0, 21)).q, np.random.default_rng(0).uniform(-np.pi, np.pi, (30, 6))])
+    capsule = pair_distances(robot, pairs, q)
+    for k, row in enumerate(q):
+        configuration = robot.configuration(row[None, :])[0]
+        for p, (link_a, link_b) in enumerate(pairs.links):
+            assert meshes(configuration, link_a, link_b) >= capsule[k, p] - 1e-9
+
+
+def test_the_capsules_refuse_a_fold_early_by_at_most_their_stated_padding(meshes):
+    robot = robots.load("ur5")
+    path = SplinePath(FOLDING)
+    with pytest.raises(SelfCollision) as refused:
+        check_self_collision(path, robot)
+    q_at = path.evaluate(np.array([refused.value.s])).q[0]
+    early = meshes(robot.configuration(q_at[None, :])[0], refused.value.link_a, refused.value.link_b)
+    # the meshes are still 0.078 m apart where the capsules touch: within the padding the refusal states
+    assert early == pytest.approx(0.078, abs=0.002)
+    assert early <= PADDING
+    assert f"padding of up to about {PADDING:g} m" in refused.value.detail
