@@ -44,20 +44,22 @@ def payload_named(robot: robots.Robot) -> Iterator[None]:
 
 
 #: Units of the echoed payload and mounting, stated in the answer beside them.
-PAYLOAD_UNITS = {"mass": "kg", "center_of_mass": "m", "inertia": "kg m^2"}
+PAYLOAD_UNITS = {"mass": "kg", "center_of_mass": "m", "inertia": "kg m^2", "radius": "m"}
 MOUNTING_UNITS = {"position": "m", "rotation": "1 (base axes to world axes, rows)", "gravity": "m/s^2"}
 
 
 def payload_body(payload: Payload | None, end_effector: str) -> dict | None:
     """The payload a plan's torques include (``None``: none, or a mass of 0): mass, centre of mass in ``frame``,
-    the 3x3 inertia about it in the frame's axes, the frame (the end effector by default)."""
-    if payload is None or payload.mass == 0.0:
+    the 3x3 inertia about it in the frame's axes, the frame (the end effector by default), the
+    radius of its collision sphere (0: none)."""
+    if payload is None or (payload.mass == 0.0 and payload.radius == 0.0):
         return None
     return {
         "mass": payload.mass,
         "center_of_mass": list(payload.center_of_mass),
         "inertia": np.asarray(payload.inertia, dtype=float).reshape(3, 3).tolist(),
         "frame": payload.frame or end_effector,
+        "radius": payload.radius,
         "units": PAYLOAD_UNITS,
     }
 

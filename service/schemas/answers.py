@@ -160,6 +160,7 @@ class PayloadPublic(BaseModel):
     center_of_mass: list[float] = Field(description="Centre of mass [x, y, z] (m) in `frame`.")
     inertia: list[list[float]] = Field(description="Rotational inertia about the centre of mass in `frame`'s axes (kg m^2), 3x3; zeros for a point mass.")
     frame: str = Field(description="The frame holding it.")
+    radius: float = Field(description="Radius (m) of its collision sphere about the centre of mass (0: it does not collide).")
     units: dict[str, str] = Field(description="The unit of each quantity.")
 
 

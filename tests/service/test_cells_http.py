@@ -127,6 +127,7 @@ def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_cli
     assert response.status_code == 422
     detail = response.json()["detail"]
     assert detail.startswith("the arms collide at their start") and "link '" in detail
+    assert "_0' of arms" not in detail  # the URDF's link names, not the capsules' names
     assert detail.endswith("move a base apart, change the first waypoints or lower clearance")
 
 

@@ -86,7 +86,8 @@ def test_the_answer_echoes_the_payload_and_mounting_it_applied_with_units(client
         "center_of_mass": [0.0, 0.01, 0.1],
         "inertia": [[0.02, 0.001, 0.0], [0.001, 0.025, 0.002], [0.0, 0.002, 0.03]],
         "frame": "tool0",
-        "units": {"mass": "kg", "center_of_mass": "m", "inertia": "kg m^2"},
+        "radius": 0.0,
+        "units": {"mass": "kg", "center_of_mass": "m", "inertia": "kg m^2", "radius": "m"},
     }
     mounting = answer["mounting"]
     assert mounting["position"] == [0.0, 0.3, 2.5]
@@ -243,3 +244,20 @@ def test_the_skeleton_of_a_mounted_arm_is_placed_in_the_world(client):
     moved = client.post("/v1/robots/ur5/skeleton", json={"q": q, "mounting": mounting}).json()["positions"]
     expected = np.array(bare) @ base.rotation.T + base.translation
     assert np.abs(np.array(moved) - expected).max() <= 1e-12
+
+
+def test_a_payload_with_a_radius_is_kept_from_obstacles_like_a_link(client):
+    # a small sphere 0.25 m beyond tool0 along its z axis at the second waypoint: clear of the arm
+    robot = robots.load("ur5")
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, robot.configuration(np.array([UR5_WAYPOINTS[1]]))[0])
+    tool = data.oMf[robot.model.getFrameId("tool0")]
+    center = tool.translation + 0.25 * tool.rotation[:, 2]
+    path = {"waypoints": UR5_WAYPOINTS, "obstacles": [{"kind": "sphere", "center": center.tolist(), "radius": 0.03}]}
+    code, answer = _plan(client, timing={}, path=path, payload={"mass": 1.0, "center_of_mass": [0.0, 0.0, 0.15]})
+    assert code == 200, answer
+    assert answer["min_clearance"]["distance"] > 0.03 and answer["min_clearance"]["link"] != "payload"
+    # the payload a sphere of 0.1 m about its centre of mass, 0.15 m along tool0's z: it reaches 0.25 m
+    code, problem = _plan(client, timing={}, path=path, payload={"mass": 1.0, "center_of_mass": [0.0, 0.0, 0.15], "radius": 0.1})
+    assert code == 422, problem
+    assert "payload" in problem["detail"] and "obstacles[0]" in problem["detail"]
