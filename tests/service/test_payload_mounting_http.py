@@ -166,11 +166,11 @@ def test_an_uploads_default_payload_applies_unless_a_request_gives_its_own(clien
     from importlib import resources
 
     urdf = resources.files("toptraj.robots").joinpath("urdf/lecture_3r.urdf").read_text()
-    default = {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0]}
+    default = {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0], "radius": 0.04}
     created = client.post("/v1/robots", json={"name": "lecture_loaded", "urdf": urdf, "payload": default})
     assert created.status_code == 201, created.text
     described = client.get("/v1/robots/lecture_loaded").json()["payload"]
-    assert described == {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0], "inertia": [[0.0] * 3] * 3, "frame": "hand"}
+    assert described == {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0], "inertia": [[0.0] * 3] * 3, "frame": "hand", "radius": 0.04}
     catalog = robots.load("lecture_3r")
     path = {"waypoints": [[0.0, 0.2, -0.3], [0.8, -0.4, 0.5]]}
     for payload, expected in ((None, default), ({"mass": 0.0}, None), ({"mass": 0.5}, {"mass": 0.5})):
@@ -181,7 +181,10 @@ def test_an_uploads_default_payload_applies_unless_a_request_gives_its_own(clien
         assert response.status_code == 200, response.text
         q, qd, qdd, tau = _samples(response.json())
         echoed = response.json()["payload"]
-        assert (echoed is None) if expected is None else (echoed["mass"], echoed["frame"]) == (expected["mass"], "hand")
+        if expected is None:
+            assert echoed is None
+        else:  # the stored default keeps its collision radius; a request's own payload replaces it
+            assert (echoed["mass"], echoed["frame"], echoed["radius"]) == (expected["mass"], "hand", expected.get("radius", 0.0))
         carried = catalog if expected is None else equipment.equip(catalog, equipment.payload(**expected, frame=BUNDLED["lecture_3r"]))
         assert np.abs(tau - carried.inverse_dynamics(q, qd, qdd)).max() <= 1e-9
 
