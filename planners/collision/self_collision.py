@@ -187,9 +187,15 @@ def _refuse(s: float, pairs: SelfPairs, which: int, distance: float, certain: bo
         )
     else:
         how = f"may touch after s = {s:.4g} (the check could not tell within {MAX_CONFIGURATIONS} configurations)"
+    if "payload" in (link_a, link_b):  # the payload's sphere (``toptraj.robots.collision``) is no link to allow
+        advice = "move the waypoints there so that the payload stays clear of the arm, or give the payload a smaller collision radius"
+    else:
+        advice = (
+            "move the waypoints there so that the arm does not fold onto itself, "
+            "or allow the pair in the robot's allowed collisions if the links may touch"
+        )
     return SelfCollision(
-        f"links {link_a!r} and {link_b!r} {how}: move the waypoints there so that the arm does not fold onto itself, "
-        "or allow the pair in the robot's allowed collisions if the links may touch",
+        f"links {link_a!r} and {link_b!r} {how}: {advice}",
         s=s, link_a=link_a, link_b=link_b, distance=distance,
     )
 

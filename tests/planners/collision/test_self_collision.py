@@ -168,6 +168,7 @@ def test_a_payload_with_a_radius_is_kept_from_the_arms_own_links():
     with pytest.raises(SelfCollision) as refused:
         check_self_collision(path, carrying)
     assert {refused.value.link_a, refused.value.link_b} == {"upper_arm_link", "payload"}
+    assert refused.value.detail.endswith("or give the payload a smaller collision radius")
     # independently: coal between a sphere at tool0's placement of the centre of mass (Pinocchio) and
     # the upper arm's capsule; they first touch at the s reported
     data = robot.model.createData()
