@@ -13,6 +13,10 @@ A capsule is a segment [a, b] in the frame of the joint that moves it (Pinocchio
   a capsule along each link, from its joint to the next joint (the last to the end effector),
   of radius ``LINK_RADIUS`` (0.03 m; the papers give none).
 
+A payload with a collision ``radius`` (``toptraj.robots.equipment.Payload``) adds a sphere about
+its centre of mass, held by the joint of its frame: obstacles, other arms and the robot's own
+links are kept from it as from a link.
+
 The links against each other (self-collision) are checked by
 ``toptraj.planners.collision.self_collision`` on the same capsules.
 """
@@ -179,13 +183,24 @@ def robot_capsules(robot: Robot) -> list[LinkCapsule]:
     of the fixed base placed by the robot's mounting."""
     cached = _CATALOG_CAPSULES.get(robot.name) if robot.source != "upload" else None
     if cached is not None:
-        return _mounted(cached, robot.mounting)
+        return _mounted(cached, robot.mounting) + _payload_capsules(robot)
     capsules = _example_arm_capsules(robot.name) if robot.source == "example-robot-data" else None
     if capsules is None:
         capsules = skeleton_capsules(robot.model, robot.frame_id(robot.end_effector))
     if robot.source != "upload":
         _CATALOG_CAPSULES[robot.name] = capsules
-    return _mounted(capsules, robot.mounting)
+    return _mounted(capsules, robot.mounting) + _payload_capsules(robot)
+
+
+def _payload_capsules(robot) -> list[LinkCapsule]:
+    """The payload's collision sphere (``Payload.radius`` > 0) about its centre of mass, as a
+    capsule of zero length in the frame of the joint holding it; the link is named "payload"."""
+    payload = robot.payload
+    if payload is None or payload.radius <= 0.0:
+        return []
+    frame = robot.model.frames[robot.frame_id(payload.frame or robot.end_effector)]
+    center = frame.placement.act(np.array(payload.center_of_mass, dtype=float))
+    return [LinkCapsule("payload", int(frame.parentJoint), center, center.copy(), float(payload.radius), "payload")]
 
 
 def _mounted(capsules: list[LinkCapsule], mounting) -> list[LinkCapsule]:
@@ -196,6 +211,6 @@ def _mounted(capsules: list[LinkCapsule], mounting) -> list[LinkCapsule]:
     rotation = np.array(mounting.rotation, dtype=float).reshape(3, 3)
     position = np.array(mounting.position, dtype=float)
     return [
-        LinkCapsule(c.name, 0, rotation @ c.a + position, rotation @ c.b + position, c.radius) if c.joint == 0 else c
+        LinkCapsule(c.name, 0, rotation @ c.a + position, rotation @ c.b + position, c.radius, c.link) if c.joint == 0 else c
         for c in capsules
     ]

@@ -30,7 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from toptraj.robots.errors import ToptrajError
-from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS, Range
+from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS, PAYLOAD_RADIUS, Range
 from toptraj.robots.robot import Robot
 
 if TYPE_CHECKING:
@@ -66,12 +66,15 @@ class Payload:
         inertia: (9,) tuple, the rotational inertia about the centre of mass in ``frame``'s
             axes, row by row (kg m^2); zeros for a point mass.
         frame: The frame holding it; ``None``: the robot's end effector.
+        radius: Radius (m) of a sphere about the centre of mass that collides with obstacles,
+            other arms and the robot's own links (``toptraj.robots.collision``); 0: none.
     """
 
     mass: float
     center_of_mass: tuple[float, ...] = (0.0, 0.0, 0.0)
     inertia: tuple[float, ...] = (0.0,) * 9
     frame: str | None = None
+    radius: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -139,18 +142,24 @@ def inertia_matrix(values: ArrayLike) -> np.ndarray:
     return matrix
 
 
-def payload(mass: float, center_of_mass: ArrayLike = (0.0, 0.0, 0.0), inertia: ArrayLike | None = None, frame: str | None = None) -> Payload:
+def payload(
+    mass: float, center_of_mass: ArrayLike = (0.0, 0.0, 0.0), inertia: ArrayLike | None = None, frame: str | None = None,
+    radius: float = 0.0,
+) -> Payload:
     """A checked ``Payload``: ``mass`` in ``PAYLOAD_MASS``, each coordinate of
     ``center_of_mass`` (3,) in ``CENTER_OF_MASS``, ``inertia`` as ``inertia_matrix`` reads it
-    (``None``: a point mass).
+    (``None``: a point mass), the collision sphere's ``radius`` in ``PAYLOAD_RADIUS``.
 
     Raises:
         InvalidEquipment: a quantity out of its range or not physical.
     """
     if not (isinstance(mass, int | float) and math.isfinite(mass) and PAYLOAD_MASS.holds(mass)):
         raise InvalidEquipment(f"mass = {mass!r} is outside the accepted range {PAYLOAD_MASS.describe()}", "mass")
+    if not (isinstance(radius, int | float) and math.isfinite(radius) and PAYLOAD_RADIUS.holds(radius)):
+        raise InvalidEquipment(f"radius = {radius!r} is outside the accepted range {PAYLOAD_RADIUS.describe()}", "radius")
     matrix = np.zeros((3, 3)) if inertia is None else inertia_matrix(inertia)
-    return Payload(float(mass), _vector(center_of_mass, "center_of_mass", CENTER_OF_MASS), tuple(matrix.ravel().tolist()), frame)
+    center = _vector(center_of_mass, "center_of_mass", CENTER_OF_MASS)
+    return Payload(float(mass), center, tuple(matrix.ravel().tolist()), frame, float(radius))
 
 
 def rotation_matrix(rotation: ArrayLike | None = None, orientation: ArrayLike | None = None) -> np.ndarray:
@@ -223,7 +232,8 @@ _equipped: OrderedDict[tuple, tuple[Robot, Robot]] = OrderedDict()
 def equip(robot: Robot, payload: Payload | None = None, mounting: Mounting | None = None) -> Robot:
     """``robot`` carrying ``payload`` (default: the one it carries already, as an upload's
     default) and mounted by ``mounting`` (default: its own). The variant is built from the bare
-    robot once and cached (``CACHE_SIZE`` most recent); a payload of mass 0 is none.
+    robot once and cached (``CACHE_SIZE`` most recent); a payload of mass 0 without a collision
+    sphere is none.
 
     Raises:
         InvalidEquipment: the payload's frame is not a frame of the robot.
@@ -231,7 +241,7 @@ def equip(robot: Robot, payload: Payload | None = None, mounting: Mounting | Non
     bare = robot.bare or robot
     payload = payload if payload is not None else robot.payload
     mounting = mounting if mounting is not None else robot.mounting
-    if payload is not None and payload.mass == 0.0:
+    if payload is not None and payload.mass == 0.0 and payload.radius == 0.0:
         payload = None
     if payload == robot.payload and mounting == robot.mounting:
         return robot

@@ -71,6 +71,8 @@ def limit_problem(kind: str, value: float, joint: str, source: str) -> str | Non
 PAYLOAD_MASS = Range(0.0, 1e3, "kg")
 #: Each coordinate of a payload's centre of mass in its frame (signed): a tool is within a few metres.
 CENTER_OF_MASS = Range(0.0, 10.0, "m")
+#: Radius of a payload's collision sphere about its centre of mass (0: not a collision body).
+PAYLOAD_RADIUS = Range(0.0, 2.0, "m")
 #: Each entry of a payload's rotational inertia about its centre of mass (principal moments in
 #: [0, high], products of inertia in [-high, high]): a 1,000 kg box 3 m wide holds 1.5e3 kg m^2.
 PAYLOAD_INERTIA = Range(0.0, 1e4, "kg m^2")

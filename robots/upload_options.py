@@ -107,7 +107,7 @@ class UploadOptions:
         data = json.loads(text)
         held = data.get("payload")
         payload = None if held is None else Payload(
-            held["mass"], tuple(held["center_of_mass"]), tuple(held["inertia"]), held.get("frame")
+            held["mass"], tuple(held["center_of_mass"]), tuple(held["inertia"]), held.get("frame"), float(held.get("radius", 0.0))
         )
         return cls(
             dict(data.get("locked_joints", {})), dict(data.get("joint_limits", {})), tuple(data.get("notes", ())), payload,

@@ -28,6 +28,7 @@ from toptraj.planners.coordination import Cell, Coordination
 from toptraj.planners.coordination.limits import dense_loads, peak_utilization
 from toptraj.planners.coordination.timing import Schedule
 from toptraj.planners.errors import InvalidRequest
+from toptraj.service.equipping import mounting_body, payload_body
 from toptraj.service.formats import time_from_start
 
 #: Most samples per arm in an answer.
@@ -60,7 +61,13 @@ def _joint_trajectory(names, t: np.ndarray, samples: dict) -> dict:
 def _arm_body(arm, t: np.ndarray, states, peaks: dict, format_: str) -> dict:
     q, qd, qdd = states
     samples = {"t": t, "q": q, "qd": qd, "qdd": qdd, "tau": arm.robot.inverse_dynamics(q, qd, qdd)}
-    body = {"robot": arm.robot.name, "joint_names": list(arm.robot.joint_names), "peak_utilization": peaks}
+    body = {
+        "robot": arm.robot.name,
+        "joint_names": list(arm.robot.joint_names),
+        "peak_utilization": peaks,
+        "payload": payload_body(arm.robot.payload, arm.robot.end_effector),
+        "base": mounting_body(arm.robot.mounting, arm.robot.model.gravity.linear),
+    }
     if format_ == "joint_trajectory":
         body["joint_trajectory"] = _joint_trajectory(arm.robot.joint_names, t, samples)
     else:

@@ -14,21 +14,36 @@ from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.problem.requests import WaypointPath
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.robots.equipment import InvalidEquipment, equip, mounting
+from toptraj.robots.errors import UnknownRobot
 from toptraj.service.cell_answers import cell_body
 from toptraj.service.formats import exact_period_for
+from toptraj.service.problems import detail
 from toptraj.service.schemas.cells import CellArmRequest, CellRequest
 
 
 def _robot(index: int, request: CellArmRequest, gravity) -> robots.Robot:
     """The arm's robot mounted by its base pose under ``gravity`` and carrying its payload."""
-    robot = robots.load(request.robot)
+    try:
+        robot = robots.load(request.robot)
+    except UnknownRobot as error:  # the same error, with the field that names the robot
+        vars(error)["field"] = f"arms[{index}].robot"
+        raise
     rotation = checked_rotation(request.base.rotation, f"arms[{index}].base.rotation")
     try:
         payload = None if request.payload is None else request.payload.payload()
         return equip(robot, payload, mounting(request.base.position, rotation, gravity=gravity))
     except InvalidEquipment as error:
         where = "payload" if error.field in ("mass", "center_of_mass", "inertia", "frame") else "base"
-        raise InvalidRequest(f"arms[{index}].{where}: {error.detail}") from error
+        raise InvalidRequest(f"arms[{index}].{where}", detail=f"arms[{index}].{where}: {error.detail}") from error
+
+
+def _in_arm(index: int, error: InvalidRequest) -> InvalidRequest:
+    """``error`` of an arm's waypoints in the service's words (``problems.detail``), its fields
+    named within the arm (``arms[i].waypoints``)."""
+    text = detail(error).replace("path.waypoints", f"arms[{index}].waypoints")
+    if f"arms[{index}]" not in text:
+        text = f"arms[{index}]: {text}"
+    return InvalidRequest(f"arms[{index}].waypoints", detail=text)
 
 
 def _arm(index: int, request: CellArmRequest, gravity, deadline: Deadline) -> CellArm:
@@ -36,7 +51,7 @@ def _arm(index: int, request: CellArmRequest, gravity, deadline: Deadline) -> Ce
     try:
         path = make_path(robot, WaypointPath(np.asarray(request.waypoints, dtype=float)), deadline)
     except InvalidRequest as error:
-        raise InvalidRequest(f"arms[{index}]: {error}") from error
+        raise _in_arm(index, error) from error
     scales: dict[str, float | None] = {
         "velocity": request.velocity_scale,
         "acceleration": request.acceleration_scale,

@@ -17,7 +17,7 @@ from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
 from toptraj.planners.problem.build import MAX_SAMPLES
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
-from toptraj.service.equipping import equipped_robot, payload_named
+from toptraj.service.equipping import equipment_body, equipped_robot, payload_named
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes, exact_period_for, joint_trajectory
 from toptraj.service.mapping import problem_of
 from toptraj.service.problems import detail, non_finite_answer, note_text, status_of, title_of
@@ -118,7 +118,7 @@ def plan_request(
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:
     """The answer's bytes and media type in the format asked (``toptraj.service.formats``)."""
     format_ = chosen_format(request.output.format, accept)
-    body = trajectory_body(result)
+    body = trajectory_body(result) | equipment_body(request)
     if format_ == "csv":
         return csv_bytes(body), CSV_MEDIA_TYPE
     if format_ == "joint_trajectory":

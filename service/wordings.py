@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from toptraj.robots.errors import excerpt
 from toptraj.robots.ranges import Range
 from toptraj.service.note_wordings import NOTE_WORDING
 
@@ -168,6 +169,14 @@ def _unknown_tool_frame(facts: dict) -> str:
 Wording = str | Callable[[dict], str]
 
 #: Wording by rule.
+def _unknown_robot(facts: dict) -> str:
+    where = f"{facts['field']}: " if isinstance(facts.get("field"), str) else ""  # a cell's arm names it
+    return (
+        f"{where}no robot named {excerpt(facts['name'])}; catalog robots: {', '.join(facts['known'])}; "
+        "uploaded robots are listed by GET /v1/robots"
+    )
+
+
 WORDING: dict[str, Wording] = {
     "out_of_range": _out_of_range,
     "scaled_limit_out_of_range": _scaled_limit,
@@ -337,7 +346,7 @@ WORDING: dict[str, Wording] = {
     ),
     "limit_not_positive": "{field} must be positive, got {value}",
     "scale_not_positive": "{field} must be positive and finite, got {value}",
-    "unknown_robot": "no robot named {name!e}; catalog robots: {known!j}; uploaded robots are listed by GET /v1/robots",
+    "unknown_robot": _unknown_robot,
     "name_taken": "name {name!e} already holds a different {what}; choose another name, or DELETE /v1/robots/{{name}} first",
     "store_full": (
         "the upload store holds {count} uploads and {size} bytes; its caps are {max_uploads} uploads and "

@@ -35,14 +35,18 @@ def checked_rotation(rotation: ArrayLike, where: str) -> np.ndarray:
     """``rotation`` as a (3, 3) rotation matrix, or InvalidRequest naming ``where`` and why."""
     matrix = np.asarray(rotation, dtype=float)
     if matrix.shape != (3, 3) or not np.isfinite(matrix).all():
-        raise InvalidRequest(f"{where} must be a 3x3 matrix of finite numbers (the base's axes as columns, in the world)")
+        raise InvalidRequest(
+            where, rotation, rule="not_a_rotation",
+            detail=f"{where} must be a 3x3 matrix of finite numbers (the base's axes as columns, in the world)",
+        )
     error = float(np.abs(matrix @ matrix.T - np.eye(3)).max())
     determinant = float(np.linalg.det(matrix))
     if error > ROTATION_TOLERANCE or determinant <= 0.0:
         raise InvalidRequest(
-            f"{where} is not a rotation: R R^T differs from the identity by {error:.3g} and det R = {determinant:.4g}; "
+            where, rotation, rule="not_a_rotation",
+            detail=f"{where} is not a rotation: R R^T differs from the identity by {error:.3g} and det R = {determinant:.4g}; "
             "give an orthonormal matrix with determinant +1 (e.g. [[1,0,0],[0,1,0],[0,0,1]], or [[-1,0,0],[0,-1,0],[0,0,1]] "
-            "for a base turned half a turn about z)"
+            "for a base turned half a turn about z)",
         )
     return matrix
 
@@ -78,7 +82,7 @@ class CellArm:
 
     def link_names(self) -> list[str]:
         """The names of the arm's capsules, in the order of ``capsules_at``."""
-        return [capsule.name for capsule in robot_capsules(self.robot)]
+        return [capsule.link or capsule.name for capsule in robot_capsules(self.robot)]
 
     def reach(self) -> float:
         """A bound (m) on how far any point of the arm lies from any of its joints, so that a

@@ -77,9 +77,10 @@ def check_ends(cell: Cell) -> None:
         if distance[0] < cell.clearance:
             links = (first.link_names()[int(i[0])], second.link_names()[int(j[0])])
             raise InvalidRequest(
-                f"the arms collide at their start: link {links[0]!r} of arms[{a}] ({first.robot.name}) is {distance[0]:.4g} m "
+                f"arms[{b}]", None, rule="arms_collide_at_start",
+                detail=f"the arms collide at their start: link {links[0]!r} of arms[{a}] ({first.robot.name}) is {distance[0]:.4g} m "
                 f"from link {links[1]!r} of arms[{b}] ({second.robot.name}) at s = 0 (the clearance is {cell.clearance:g} m): "
-                "move a base apart, change the first waypoints or lower clearance"
+                "move a base apart, change the first waypoints or lower clearance",
             )
 
 

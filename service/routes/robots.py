@@ -52,6 +52,7 @@ def robot_public(robot: robots.Robot) -> RobotPublic:
             center_of_mass=list(robot.payload.center_of_mass),
             inertia=np.reshape(robot.payload.inertia, (3, 3)).tolist(),
             frame=robot.payload.frame or robot.end_effector,
+            radius=robot.payload.radius,
         ),
     )
 

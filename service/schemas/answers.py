@@ -153,6 +153,26 @@ class ZonePublic(BaseModel):
     binding: bool = Field(description="Whether its limits bound the timing (its peak within 0.5 % of the limits it was planned under).")
 
 
+class PayloadPublic(BaseModel):
+    """The payload the torques include, as applied (the request's, else the upload's default)."""
+
+    mass: float = Field(description="Mass (kg).")
+    center_of_mass: list[float] = Field(description="Centre of mass [x, y, z] (m) in `frame`.")
+    inertia: list[list[float]] = Field(description="Rotational inertia about the centre of mass in `frame`'s axes (kg m^2), 3x3; zeros for a point mass.")
+    frame: str = Field(description="The frame holding it.")
+    radius: float = Field(description="Radius (m) of its collision sphere about the centre of mass (0: it does not collide).")
+    units: dict[str, str] = Field(description="The unit of each quantity.")
+
+
+class MountingPublic(BaseModel):
+    """The base pose in the world and the gravity the torques follow, as applied."""
+
+    position: list[float] = Field(description="The base frame's origin in the world (m).")
+    rotation: list[list[float]] = Field(description="Rotation from the base's axes to the world's, 3x3 (rows).")
+    gravity: list[float] = Field(description="Gravity in the world (m/s^2).")
+    units: dict[str, str] = Field(description="The unit of each quantity.")
+
+
 class TrajectoryResponse(BaseModel):
     """A timed joint trajectory with its torques."""
 
@@ -185,6 +205,8 @@ class TrajectoryResponse(BaseModel):
     warnings: list[str] = Field(description="What the answer should be read with: dropped waypoints, singularities, turns of continuous joints, an accuracy above 0.1 %.")
     accuracy: AccuracyPublic = Field(description="The answer's estimated relative distance from the converged optimum of its method's problem.")
     zones: list[ZonePublic] | None = Field(default=None, description="With timing.zones: where each lies on the path and whether it bound the timing.")
+    payload: PayloadPublic | None = Field(default=None, description="The payload the torques include (null: none).")
+    mounting: MountingPublic | None = Field(default=None, description="With `mounting`: the base pose and the world's gravity applied (null: the model's own base and gravity).")
 
 
 class CompareResult(BaseModel):

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from toptraj.robots.ranges import GRAVITY
 from toptraj.service.schemas.common import Schema, signed
@@ -19,6 +19,8 @@ MAX_CELL_ARMS = 8
 MAX_CELL_WAYPOINTS = 100
 RotationRow = Annotated[list[Annotated[float, Field(ge=-2.0, le=2.0)]], Field(min_length=3, max_length=3)]
 IDENTITY = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+#: Fields of other kinds of path (the trajectory endpoint's ``path``), refused with advice.
+OTHER_PATH_KEYS = ("path", "kind", "points", "poses", "line", "start", "goal", "frame")
 
 
 class BasePose(Schema):
@@ -54,6 +56,19 @@ class CellArmRequest(Schema):
         description="What the arm carries at its tool (mass, centre of mass, inertia): its torques, torque limits "
         "and `tau` include it; default the upload's payload, else none.",
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _joint_waypoints_only(cls, data):
+        given = sorted(key for key in OTHER_PATH_KEYS if isinstance(data, dict) and key in data)
+        if given:
+            raise ValueError(
+                f"{', '.join(given)}: an arm of a cell follows joint waypoints only (a C2 cubic spline through "
+                "`waypoints`); Cartesian lines, free motions and other path kinds are served by POST /v1/trajectories. "
+                "Give each arm `waypoints` (joint values, rad or m), e.g. an inverse kinematics solution at points "
+                "along the line"
+            )
+        return data
 
 
 class CellRequest(Schema):

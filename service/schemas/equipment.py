@@ -10,7 +10,7 @@ from typing import Annotated
 from pydantic import Field, field_validator, model_validator
 
 from toptraj.robots import equipment
-from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS
+from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS, PAYLOAD_RADIUS
 from toptraj.service.schemas.common import Schema, bounded, signed
 
 _Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
@@ -47,6 +47,11 @@ class PayloadRequest(Schema):
     frame: Annotated[str, Field(max_length=256)] | None = Field(
         default=None, description="Frame holding the payload (its centre of mass and inertia are in it); default the robot's end effector."
     )
+    radius: Annotated[float, bounded(PAYLOAD_RADIUS)] = Field(
+        default=0.0,
+        description="Radius (m) of a sphere about the centre of mass that is kept from the obstacles, the other arms of a "
+        "cell and the robot's own links (path.self_collision, the search) like a link; 0: the payload does not collide.",
+    )
 
     @field_validator("inertia")
     @classmethod
@@ -57,7 +62,7 @@ class PayloadRequest(Schema):
 
     def payload(self) -> equipment.Payload:
         """The library's ``Payload``."""
-        return equipment.payload(self.mass, self.center_of_mass, self.inertia, self.frame)
+        return equipment.payload(self.mass, self.center_of_mass, self.inertia, self.frame, self.radius)
 
 
 class MountingRequest(Schema):

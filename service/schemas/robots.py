@@ -54,6 +54,7 @@ class PayloadPublic(BaseModel):
     center_of_mass: list[float] = Field(description="Centre of mass [x, y, z] (m) in `frame`.")
     inertia: list[list[float]] = Field(description="Rotational inertia about the centre of mass, in `frame`'s axes (kg m^2), 3x3.")
     frame: str = Field(description="The frame holding it.")
+    radius: float = Field(default=0.0, description="Radius (m) of its collision sphere about the centre of mass (0: it does not collide).")
 
 
 class RobotPublic(BaseModel):

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 from pydantic import Discriminator, Field, Tag
 
+from toptraj.planners.collision.self_collision import PADDING
 from toptraj.planners.problem import ranges
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
@@ -75,7 +76,9 @@ CLEARANCE = Field(default=0.01, ge=0.0, le=1.0, description="Distance (m) every 
 SELF_COLLISION = Field(
     default=False,
     description="Whether to check that no two links of the arm touch along the path (adjacent links and the "
-    "robot's allowed pairs excepted), else 422 naming the two links and s. timing.method `search` checks it always.",
+    "robot's allowed pairs excepted), else 422 naming the two links and s. timing.method `search` checks it always. "
+    "Checked on capsules that contain the links' collision meshes: conservative, a path is refused where the meshes "
+    f"may still be up to about {PADDING:g} m apart (ur5: 0.1 m), never accepted where they touch.",
 )
 
 

@@ -197,3 +197,11 @@ def test_a_store_written_before_options_existed_still_loads_and_is_migrated(tmp_
         assert robots.load("old_ur5").dof == 6 and robots.load("new_panda").dof == 7
     finally:
         robots.configure_uploads(previous.data_dir, max_uploads=previous.max_uploads, max_bytes=previous.max_bytes)
+
+
+def test_a_stored_default_payload_keeps_its_collision_radius():
+    from toptraj.robots.equipment import payload
+    from toptraj.robots.upload_options import UploadOptions
+
+    options = UploadOptions(payload=payload(1.5, [0.05, 0.0, 0.0], frame="hand", radius=0.04))
+    assert UploadOptions.from_json(options.to_json()).payload == options.payload

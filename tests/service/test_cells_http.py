@@ -36,6 +36,23 @@ def test_both_arms_are_sampled_on_one_clock_from_start_to_end(answer):
     assert answer["arms"][0]["joint_trajectory"]["joint_names"][0] == "shoulder_pan_joint"
 
 
+def test_each_arm_echoes_its_payload_and_base_with_units(patient_client, answer):
+    first, second = answer["arms"]
+    assert first["payload"] is None and second["payload"] is None
+    assert first["base"]["position"] == [0.0, 0.0, 0.0] and second["base"]["position"] == [1.2, 0.0, 0.0]
+    np.testing.assert_allclose(second["base"]["rotation"], EXAMPLE["arms"][1]["base"]["rotation"], atol=1e-12)
+    np.testing.assert_allclose(second["base"]["gravity"], [0.0, 0.0, -9.81], atol=1e-12)
+    assert second["base"]["units"]["position"] == "m"
+    body = _cell(a1={"payload": {"mass": 2.0, "center_of_mass": [0.0, 0.0, 0.05]}}) | {"gravity": [0.0, 0.0, -9.8]}
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 200, response.text
+    arms = response.json()["arms"]
+    assert arms[0]["payload"] is None and arms[0]["base"]["gravity"] == pytest.approx([0.0, 0.0, -9.8], abs=1e-12)
+    payload = arms[1]["payload"]
+    assert (payload["mass"], payload["center_of_mass"], payload["frame"]) == (2.0, [0.0, 0.0, 0.05], "tool0")
+    assert payload["inertia"] == [[0.0] * 3] * 3 and payload["units"]["mass"] == "kg"
+
+
 def test_the_answer_reports_the_time_lost_and_the_diagram(answer):
     assert answer["time_lost"] == pytest.approx(answer["duration"] - max(answer["solo_durations"]))
     assert max(answer["solo_durations"]) < answer["duration"] <= answer["sequential_duration"]
@@ -62,6 +79,37 @@ def _cell(**change) -> dict:
 def test_an_unknown_robot_is_a_404_naming_it(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a1={"robot": "ur55"}))
     assert response.status_code == 404 and "ur55" in response.json()["detail"]
+    assert response.json()["detail"].startswith("arms[1].robot: no robot named 'ur55'")
+
+
+@pytest.mark.parametrize("other", [{"path": {"kind": "cartesian", "points": [[0.4, 0.0, 0.3]]}}, {"kind": "free"}])
+def test_a_path_of_another_kind_is_a_422_saying_what_is_served(patient_client, other):
+    response = patient_client.post("/v1/cells", json=_cell(a1=other))
+    assert response.status_code == 422
+    detail = response.json()["detail"]
+    assert detail.startswith("arms[1]") and "joint waypoints only" in detail and "POST /v1/trajectories" in detail
+    assert next(iter(other)) in detail
+
+
+@pytest.mark.parametrize(
+    ("waypoints", "words"),
+    [
+        (
+            [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]],
+            "arms[1].waypoints[0] has 3 values; ur5 has 6 joints (shoulder_pan_joint, shoulder_lift_joint, elbow_joint, "
+            "wrist_1_joint, wrist_2_joint, wrist_3_joint)",
+        ),
+        ([[1.5, -0.5, 0.5, 0.0, 0.0, 0.0]] * 2, "arms[1].waypoints[0] and arms[1].waypoints[1] coincide"),
+        (
+            [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0], [99.0, -0.5, 0.5, 0.0, 0.0, 0.0]],
+            "arms[1].waypoints[1][0] = 99 is outside the limits [-6.28319, 6.28319] of joint 'shoulder_pan_joint'",
+        ),
+    ],
+)
+def test_bad_waypoints_of_an_arm_are_a_422_in_the_request_words(patient_client, waypoints, words):
+    response = patient_client.post("/v1/cells", json=_cell(a1={"waypoints": waypoints}))
+    assert response.status_code == 422
+    assert response.json()["detail"] == words
 
 
 def test_a_base_that_is_not_a_rotation_is_a_422_saying_where(patient_client):
@@ -69,14 +117,18 @@ def test_a_base_that_is_not_a_rotation_is_a_422_saying_where(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a1={"base": mirrored}))
     assert response.status_code == 422
     detail = response.json()["detail"]
-    assert "arms[1].base.rotation is not a rotation" in detail and "det R = -1" in detail
+    assert detail.startswith("arms[1].base.rotation is not a rotation") and "det R = -1" in detail
+    assert "breaks the rule" not in detail and detail.endswith("for a base turned half a turn about z)")
     assert response.headers["content-type"].startswith("application/problem+json")
 
 
 def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a1={"base": {"position": [0.1, 0.0, 0.0]}}))
     assert response.status_code == 422
-    assert "collide at their start" in response.json()["detail"] and "link '" in response.json()["detail"]
+    detail = response.json()["detail"]
+    assert detail.startswith("the arms collide at their start") and "link '" in detail
+    assert "_0' of arms" not in detail  # the URDF's link names, not the capsules' names
+    assert detail.endswith("move a base apart, change the first waypoints or lower clearance")
 
 
 def test_three_arms_are_answered_on_one_clock_with_every_pairs_diagram(patient_client):

@@ -71,6 +71,35 @@ def test_a_ceiling_mounted_arm_feels_the_floor_arms_gravity_reversed(client):
     assert np.abs(tau - _rnea(floor_reversed, q, qd, qdd)).max() <= 1e-9
 
 
+def test_the_answer_echoes_the_payload_and_mounting_it_applied_with_units(client):
+    code, bare = _plan(client, timing={})
+    assert code == 200, bare
+    assert bare["payload"] is None and bare["mounting"] is None
+    inertia = [0.02, 0.025, 0.03, 0.001, 0.0, 0.002]
+    code, answer = _plan(
+        client, timing={}, payload={"mass": 2.0, "center_of_mass": [0.0, 0.01, 0.1], "inertia": inertia},
+        mounting={"position": [0.0, 0.3, 2.5], "orientation": [1.0, 0.0, 0.0, 0.0]},
+    )
+    assert code == 200, answer
+    assert answer["payload"] == {
+        "mass": 2.0,
+        "center_of_mass": [0.0, 0.01, 0.1],
+        "inertia": [[0.02, 0.001, 0.0], [0.001, 0.025, 0.002], [0.0, 0.002, 0.03]],
+        "frame": "tool0",
+        "radius": 0.0,
+        "units": {"mass": "kg", "center_of_mass": "m", "inertia": "kg m^2", "radius": "m"},
+    }
+    mounting = answer["mounting"]
+    assert mounting["position"] == [0.0, 0.3, 2.5]
+    # the quaternion [1, 0, 0, 0]: half a turn about x
+    np.testing.assert_allclose(mounting["rotation"], [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]], atol=1e-12)
+    np.testing.assert_allclose(mounting["gravity"], [0.0, 0.0, -9.81], atol=1e-12)  # the world's, not the base's
+    assert mounting["units"]["position"] == "m" and mounting["units"]["gravity"] == "m/s^2"
+    code, walled = _plan(client, timing={}, mounting={"gravity": [0.0, -9.81, 0.0]})
+    assert code == 200, walled
+    assert walled["mounting"]["gravity"] == [0.0, -9.81, 0.0] and walled["payload"] is None
+
+
 @pytest.mark.parametrize(
     ("mounting", "field", "words"),
     [
@@ -137,11 +166,11 @@ def test_an_uploads_default_payload_applies_unless_a_request_gives_its_own(clien
     from importlib import resources
 
     urdf = resources.files("toptraj.robots").joinpath("urdf/lecture_3r.urdf").read_text()
-    default = {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0]}
+    default = {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0], "radius": 0.04}
     created = client.post("/v1/robots", json={"name": "lecture_loaded", "urdf": urdf, "payload": default})
     assert created.status_code == 201, created.text
     described = client.get("/v1/robots/lecture_loaded").json()["payload"]
-    assert described == {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0], "inertia": [[0.0] * 3] * 3, "frame": "hand"}
+    assert described == {"mass": 1.5, "center_of_mass": [0.05, 0.0, 0.0], "inertia": [[0.0] * 3] * 3, "frame": "hand", "radius": 0.04}
     catalog = robots.load("lecture_3r")
     path = {"waypoints": [[0.0, 0.2, -0.3], [0.8, -0.4, 0.5]]}
     for payload, expected in ((None, default), ({"mass": 0.0}, None), ({"mass": 0.5}, {"mass": 0.5})):
@@ -151,6 +180,11 @@ def test_an_uploads_default_payload_applies_unless_a_request_gives_its_own(clien
         response = client.post("/v1/trajectories", json=body)
         assert response.status_code == 200, response.text
         q, qd, qdd, tau = _samples(response.json())
+        echoed = response.json()["payload"]
+        if expected is None:
+            assert echoed is None
+        else:  # the stored default keeps its collision radius; a request's own payload replaces it
+            assert (echoed["mass"], echoed["frame"], echoed["radius"]) == (expected["mass"], "hand", expected.get("radius", 0.0))
         carried = catalog if expected is None else equipment.equip(catalog, equipment.payload(**expected, frame=BUNDLED["lecture_3r"]))
         assert np.abs(tau - carried.inverse_dynamics(q, qd, qdd)).max() <= 1e-9
 
@@ -213,3 +247,20 @@ def test_the_skeleton_of_a_mounted_arm_is_placed_in_the_world(client):
     moved = client.post("/v1/robots/ur5/skeleton", json={"q": q, "mounting": mounting}).json()["positions"]
     expected = np.array(bare) @ base.rotation.T + base.translation
     assert np.abs(np.array(moved) - expected).max() <= 1e-12
+
+
+def test_a_payload_with_a_radius_is_kept_from_obstacles_like_a_link(client):
+    # a small sphere 0.25 m beyond tool0 along its z axis at the second waypoint: clear of the arm
+    robot = robots.load("ur5")
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, robot.configuration(np.array([UR5_WAYPOINTS[1]]))[0])
+    tool = data.oMf[robot.model.getFrameId("tool0")]
+    center = tool.translation + 0.25 * tool.rotation[:, 2]
+    path = {"waypoints": UR5_WAYPOINTS, "obstacles": [{"kind": "sphere", "center": center.tolist(), "radius": 0.03}]}
+    code, answer = _plan(client, timing={}, path=path, payload={"mass": 1.0, "center_of_mass": [0.0, 0.0, 0.15]})
+    assert code == 200, answer
+    assert answer["min_clearance"]["distance"] > 0.03 and answer["min_clearance"]["link"] != "payload"
+    # the payload a sphere of 0.1 m about its centre of mass, 0.15 m along tool0's z: it reaches 0.25 m
+    code, problem = _plan(client, timing={}, path=path, payload={"mass": 1.0, "center_of_mass": [0.0, 0.0, 0.15], "radius": 0.1})
+    assert code == 422, problem
+    assert "payload" in problem["detail"] and "obstacles[0]" in problem["detail"]

@@ -13,13 +13,16 @@ import pytest
 from tests.planners.collision.test_obstacles import _coal_capsule
 from toptraj import robots
 from toptraj.planners.collision.self_collision import (
+    PADDING,
     SelfCollision,
     check_self_collision,
+    pair_distances,
     self_pairs,
 )
 from toptraj.planners.generators.search.free_space import free_distances
 from toptraj.planners.paths import SplinePath
 from toptraj.robots.catalog import example_urdf_path
+from toptraj.robots.collision import robot_capsules as robot_capsules_of
 from toptraj.robots.collision import world_capsules
 
 UPRIGHT = np.array([0.0, -1.57, 0.0, -1.57, 0.0, 0.0])
@@ -126,3 +129,59 @@ def test_the_search_keeps_links_apart_and_refuses_a_folded_start():
     with pytest.raises(SelfCollision) as refused:
         build_problem(robot, robot.limits, ("velocity", "acceleration"), FOLDED, UPRIGHT)
     assert "path.start" in refused.value.detail and refused.value.s == 0.0
+
+
+def test_the_capsules_never_accept_links_whose_meshes_touch(meshes):
+    """Each pair's capsule distance is at most its meshes' distance (coal), at the fold and at
+    sampled configurations: where the check accepts (capsules apart), the meshes are apart."""
+    robot = robots.load("ur5")
+    pairs = self_pairs(robot)
+    q = np.vstack([SplinePath(FOLDING).evaluate(np.linspace(0.0, 1.0, 21)).q, np.random.default_rng(0).uniform(-np.pi, np.pi, (30, 6))])
+    capsule = pair_distances(robot, pairs, q)
+    for k, row in enumerate(q):
+        configuration = robot.configuration(row[None, :])[0]
+        for p, (link_a, link_b) in enumerate(pairs.links):
+            assert meshes(configuration, link_a, link_b) >= capsule[k, p] - 1e-9
+
+
+def test_the_capsules_refuse_a_fold_early_by_at_most_their_stated_padding(meshes):
+    robot = robots.load("ur5")
+    path = SplinePath(FOLDING)
+    with pytest.raises(SelfCollision) as refused:
+        check_self_collision(path, robot)
+    q_at = path.evaluate(np.array([refused.value.s])).q[0]
+    early = meshes(robot.configuration(q_at[None, :])[0], refused.value.link_a, refused.value.link_b)
+    # the meshes are still 0.078 m apart where the capsules touch: within the padding the refusal states
+    assert early == pytest.approx(0.078, abs=0.002)
+    assert early <= PADDING
+    assert f"padding of up to about {PADDING:g} m" in refused.value.detail
+
+
+def test_a_payload_with_a_radius_is_kept_from_the_arms_own_links():
+    from toptraj.robots import equipment
+
+    robot = robots.load("ur5")
+    start, goal = [3.03, -1.68, -1.5, -1.67, 1.27, 1.6], [3.03, -1.68, -2.5, -1.67, 1.27, 1.6]
+    path = SplinePath(np.array([start, goal]))
+    assert check_self_collision(path, robot).distance > 0.0  # the bare arm folds its elbow freely
+    carrying = equipment.equip(robot, equipment.payload(1.0, [0.0, 0.0, 0.1], radius=0.08))
+    with pytest.raises(SelfCollision) as refused:
+        check_self_collision(path, carrying)
+    assert {refused.value.link_a, refused.value.link_b} == {"upper_arm_link", "payload"}
+    assert refused.value.detail.endswith("or give the payload a smaller collision radius")
+    # independently: coal between a sphere at tool0's placement of the centre of mass (Pinocchio) and
+    # the upper arm's capsule; they first touch at the s reported
+    data = robot.model.createData()
+    capsules = robot_capsules_of(robot)
+    upper = next(c for c in capsules if c.link == "upper_arm_link")
+
+    def apart(s):
+        q = robot.configuration(path.evaluate(np.array([s])).q)
+        pin.framesForwardKinematics(robot.model, data, q[0])
+        center = data.oMf[robot.model.getFrameId("tool0")].act(np.array([0.0, 0.0, 0.1]))
+        a, b = world_capsules(robot.model, data, [upper], q)
+        capsule = _coal_capsule(a[0, 0], b[0, 0], upper.radius)
+        sphere = (coal.Sphere(0.08), coal.Transform3s(np.eye(3), center))
+        return coal.distance(capsule[0], capsule[1], sphere[0], sphere[1], coal.DistanceRequest(), coal.DistanceResult())
+
+    assert -1e-3 <= apart(refused.value.s) <= 1e-9 and apart(refused.value.s - 0.01) > 0.0
