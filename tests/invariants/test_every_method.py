@@ -22,7 +22,8 @@ alone, must:
 * where cheap to check, be as close to the optimum as it says (``accuracy.relative_gap``
   against the same method on a four times finer grid).
 
-Combinations a method does not serve are not generated; every generated case runs and asserts.
+Combinations a method does not serve are not generated; every generated case runs and asserts
+(one known refusal is a strict xfail that says why).
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from scipy.interpolate import CubicSpline
 
 from tests.paths import DATA
 from toptraj import robots
-from toptraj.planners import CartesianLine, InfeasiblePath, Timing, TimingFailed, WaypointPath, plan
+from toptraj.planners import CartesianLine, Timing, TimingFailed, WaypointPath, plan
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.results import PlannedTrajectory
@@ -274,9 +275,7 @@ def _given_path_cases() -> list:
                 # one arm only (its solver takes seconds on a blend).
                 blend = Case(robot, method, "blend")
                 cases.append(pytest.param(blend, marks=LAW_ON_BLEND) if (robot, method) == ("lift_rp", "quintic") else blend)
-        for law in ("quintic", "cubic"):
-            case = Case(robot, law, "via")
-            cases.append(case if joint_limited(robot) else pytest.param(case, marks=VIA_TORQUE_ONLY))
+        cases += [Case(robot, law, "via") for law in ("quintic", "cubic")]
         if joint_limited(robot):
             cases.append(Case(robot, "ruckig", "straight"))
             cases += [Case(robot, law, "unsynchronized") for law in ("quintic", "trapezoidal")]
@@ -287,10 +286,6 @@ def _given_path_cases() -> list:
     return cases
 
 
-#: Via points under torque limits alone: every segment duration is refused ("no segment
-#: duration meets the limits between these via points") although stopping at every via point,
-#: as phase_plane does on the straight segments, meets them.
-VIA_TORQUE_ONLY = pytest.mark.xfail(reason="via points are refused under torque limits alone", strict=True, raises=InfeasiblePath)
 #: The quintic law on the lift arm's blend (a 23 s motion) is refused by the runner's own sample
 #: check ("exceeds the acceleration limit of joint 'lift' although its dense check holds").
 LAW_ON_BLEND = pytest.mark.xfail(reason="the quintic law's blend answer fails its sample check", strict=True, raises=TimingFailed)
