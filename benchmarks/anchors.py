@@ -20,12 +20,25 @@ from toptraj.planners.errors import TimingFailed
 from toptraj.planners.paths.grid import path_grid
 
 
+def typical_spline(waypoints: np.ndarray):
+    """toppra's ``SplineInterpolator`` of the path the service builds from ``waypoints``
+    (n_waypoints, n_dof): knots at chord-length values of s in [0, 1] (cumulative joint distance
+    over its total) and natural ends (zero second derivative), as ``SplinePath``."""
+    import toppra
+
+    lengths = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
+    knots = np.concatenate(([0.0], np.cumsum(lengths))) / lengths.sum()
+    return toppra.SplineInterpolator(knots, waypoints, bc_type="natural")
+
+
 def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100) -> float:
-    """One toppra solve through its public API; returns the duration (s)."""
+    """One toppra solve through its public API along the service's spline (``typical_spline``)
+    on ``intervals`` evenly spaced grid intervals (the service chooses its own grid); returns
+    the duration (s)."""
     import toppra
 
     model, data, limits = robot.model, robot.model.createData(), robot.limits
-    path = toppra.SplineInterpolator(np.linspace(0.0, 1.0, len(waypoints)), waypoints)
+    path = typical_spline(waypoints)
     constraints = [
         toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])),
         toppra.constraint.JointAccelerationConstraint(np.column_stack([-limits.acceleration, limits.acceleration])),
@@ -42,19 +55,18 @@ def bare_toppra(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100
 
 
 def drake_solver(robot: robots.Robot, waypoints: np.ndarray, intervals: int = 100):
-    """One solve of Drake's Toppra on toppra's spline through ``waypoints`` (the bare toppra
-    probe's path) and the robot's limits, as a function returning the duration (s); ``None``
+    """One solve of Drake's Toppra on the cubic Hermite interpolation of the service's spline
+    through ``waypoints`` (``typical_spline``, the bare toppra probe's path) and the robot's limits, as a function returning the duration (s); ``None``
     when pydrake is absent. The plant and the spline are built here, once."""
-    import toppra
-
     plant = drake_plant(robot)
     if plant is None:
         return None
     from pydrake.multibody.optimization import Toppra
     from pydrake.trajectories import PiecewisePolynomial
 
-    knots = np.linspace(0.0, 1.0, len(waypoints))
-    slopes = toppra.SplineInterpolator(knots, waypoints)(knots, 1)
+    path = typical_spline(waypoints)
+    knots = path.ss_waypoints
+    slopes = path(knots, 1)
     spline = PiecewisePolynomial.CubicHermite(knots, waypoints.T, slopes.T)
     grid, limits = np.linspace(0.0, 1.0, intervals + 1), robot.limits
 

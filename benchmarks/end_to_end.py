@@ -4,9 +4,10 @@ The typical request: ur5, 4 spline waypoints, velocity + acceleration + torque, 
 samples every 10 ms. Each round times, in a shuffled order:
 
 * **bare toppra**: one solve of the same path and limits through toppra's own public API, as a
-  toppra user writes it: ``SplineInterpolator`` over the waypoints (knots evenly spaced in s, as
-  ours), ``JointVelocityConstraint``, ``JointAccelerationConstraint`` and
-  ``JointTorqueConstraint`` with a ``pin.rnea`` callback, ``TOPPRA`` on 100 grid intervals,
+  toppra user writes it: ``SplineInterpolator`` on the service's spline (chord-length knots,
+  natural ends: ``anchors.typical_spline``), ``JointVelocityConstraint``,
+  ``JointAccelerationConstraint`` and ``JointTorqueConstraint`` with a ``pin.rnea`` callback,
+  ``TOPPRA`` on 100 evenly spaced grid intervals (the service chooses its own grid),
   ``compute_trajectory`` (its constraint evaluation, both passes and the parameterization);
 * **drake** (when ``pydrake`` imports: ``pip install toptraj[bench]``): Drake's ``Toppra`` on
   the same cubic (a ``PiecewisePolynomial.CubicHermite`` with toppra's spline's values and

@@ -265,6 +265,10 @@ WORDING: dict[str, Wording] = {
         "{field} 'none' runs each joint at its own full speed, which a velocity, "
         "acceleration or jerk limit sets: add one to timing.constraints"
     ),
+    "ruckig_needs_a_limit": (
+        "{field} 'ruckig' needs a finite velocity, acceleration or jerk limit on the joints that "
+        "move, and this robot has none among timing.constraints: set one in timing.limits"
+    ),
     "unsynchronized_joint_unlimited": (
         "{field} 'none': joint {joint_name!r} has no finite velocity, "
         "acceleration or jerk limit among timing.constraints, so its own full-speed duration is "

@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -155,6 +156,18 @@ def _shortest(robot, limits, kinds, law, states, guess, deadline: Deadline) -> f
     return high
 
 
+def _torque_time(robot: Robot, waypoints: np.ndarray, steps: np.ndarray, limits: JointLimits) -> np.ndarray:
+    """A first duration (s) of each segment under torque limits, shape (n_segments,): a rest to
+    rest cubic's peak acceleration 6 |step| / T^2 met with each joint's torque limit over its
+    inertia M_jj at the segment's start (gravity and coupling left to the bisection that
+    follows). Used where the velocity and acceleration guesses are zero (torque limits only):
+    the via velocities of 1 ms segments were beyond any torque, and every segment was refused."""
+    inertia = np.array([np.diag(pin.crba(robot.model, robot.data, robot.configuration(q))) for q in waypoints[:-1]])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reach = np.nan_to_num(limits.torque / inertia, nan=np.inf)
+        return np.sqrt(np.nan_to_num(6 * np.abs(steps) / reach, posinf=0.0).max(axis=1))
+
+
 def via_point_trajectory(
     robot: Robot,
     waypoints: np.ndarray,
@@ -179,7 +192,10 @@ def via_point_trajectory(
     with np.errstate(divide="ignore"):
         velocity_time = np.nan_to_num(np.abs(steps) / limits.velocity, posinf=0.0).max(axis=1) * 1.5
         accel_time = np.sqrt(np.nan_to_num(6 * np.abs(steps) / limits.acceleration, posinf=0.0).max(axis=1))
-    durations = np.maximum(np.maximum(velocity_time, accel_time), 1e-3)
+    durations = np.maximum(velocity_time, accel_time)
+    if "torque" in kinds and not durations.all():  # segments no joint limit bounds: the torques' guess
+        durations = np.where(durations > 0.0, durations, _torque_time(robot, waypoints, steps, limits))
+    durations = np.maximum(durations, 1e-3)
     for _ in range(ROUNDS + 1):
         slopes = steps / durations[:, None]
         velocities = np.zeros((n_segments + 1, n_dof))

@@ -18,7 +18,7 @@ import numpy as np
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 
 from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
+from toptraj.planners.errors import Conflicting, InfeasiblePath, NotServed, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Boundary, DenseStates, PathTiming, TimingMethod
 
@@ -107,6 +107,10 @@ class RuckigMethod(TimingMethod):
             jerk = float(np.min(jerk_limit[moving] / direction[moving]))
             accel = float(accel)
         speed = float(np.min(constraints.sd_max))
+        if not (np.isfinite(speed) or np.isfinite(accel) or np.isfinite(jerk)):
+            # Nothing bounds the move (an arm with torque limits only): ruckig would answer a
+            # jump of the largest number it takes, not a motion.
+            raise Conflicting("method", "ruckig", ("constraints", "limits"), rule="ruckig_needs_a_limit")
         inputs = InputParameter(1)
         inputs.current_position, inputs.target_position = [0.0], [1.0]
         inputs.current_velocity, inputs.target_velocity = [boundary.sd_start], [boundary.sd_end]

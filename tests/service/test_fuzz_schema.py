@@ -11,8 +11,10 @@ under a minute:
   them are planned instead of stopping at a 404 or a length error.
 * A hand-written Hypothesis strategy builds trajectory and compare requests the way a user
   would (waypoints within the joint limits, any method, random limits, scales, durations,
-  boundary states, sample periods) and asserts that every answer is below 500 and that every
-  number of a 200 is finite.
+  boundary states, sample periods) and asserts that every answer is below 500, that every
+  number of a 200 is finite, and that every 200 holds the limits it was asked to hold within
+  0.5 % (``assert_limits_held``: its samples, the differences between them, and the peak
+  utilization it states).
 * The same requests with one physical number replaced by any magnitude a double can hold, from
   5e-324 to 1.8e308: out of range they get a 422, in range a plan or a 4xx, never a 5xx.
 """
@@ -31,6 +33,7 @@ from fastapi.testclient import TestClient
 from hypothesis import HealthCheck, given, settings
 from schemathesis.generation.modes import GenerationMode
 
+from tests.service.answer_limits import assert_limits_held
 from toptraj import robots
 from toptraj.planners import METHODS
 from toptraj.planners.problem.ranges import ACCELERATION, DURATION, SCALE, TRAPEZOID_FRACTION, VELOCITY
@@ -143,10 +146,16 @@ def test_every_operation_answers_as_its_schema_says(case):
     """schemathesis' checks (no 5xx, declared status, content type, headers and body schema,
     invalid input refused), except positive_data_acceptance: a request can fit the schema and
     still ask the impossible (a waypoint outside the joint limits, a path gravity forbids),
-    which is a 422 by design."""
+    which is a 422 by design. A planned 200 in JSON holds the limits it was asked to hold."""
     from schemathesis.checks import positive_data_acceptance
 
-    case.call_and_validate(excluded_checks=[positive_data_acceptance])
+    response = case.call_and_validate(excluded_checks=[positive_data_acceptance])
+    planned = case.operation.path.startswith("/v1/trajectories") and case.method.upper() == "POST"
+    kind = response.headers.get("content-type") or [""]
+    if planned and response.status_code == 200 and (kind[0] if isinstance(kind, list) else kind).startswith("application/json"):
+        answers = response.json().get("results", [response.json()])
+        for answer in answers:
+            assert_limits_held(case.body, answer)
 
 
 # --- requests the way a user writes them ---------------------------------------------------
@@ -275,6 +284,7 @@ def test_trajectory_requests_never_answer_5xx(body):
     assert response.status_code < 500, (body, response.text)
     if response.status_code == 200:
         _assert_finite(response.json())
+        assert_limits_held(body, response.json())
     else:
         assert response.headers["content-type"] == "application/problem+json", response.text
 
@@ -287,22 +297,28 @@ def test_any_magnitude_is_planned_or_refused_never_a_5xx(body):
     assert response.status_code < 500, (body, response.text)
     if response.status_code == 200:
         _assert_finite(response.json())
+        assert_limits_held(body, response.json())
     compare = {"robot": body["robot"], "path": body["path"], "methods": ["cubic", "quintic", body["timing"]["method"]],
                "timing": dict(body["timing"], method="phase_plane")}
     response = CLIENT.post("/v1/trajectories/compare", json=compare)
     assert response.status_code < 500, (compare, response.text)
     if response.status_code == 200:
         _assert_finite(response.json())
+        for answer in response.json()["results"]:
+            assert_limits_held(compare, answer)
 
 
 @given(body=trajectory_bodies(), methods=st.lists(st.sampled_from(PLANNED_METHODS), min_size=1, max_size=3))
 @FUZZ_SETTINGS
 def test_compare_requests_never_answer_5xx(body, methods):
     timing = dict(body["timing"], method="phase_plane")
-    response = CLIENT.post("/v1/trajectories/compare", json={"robot": body["robot"], "path": body["path"], "methods": methods, "timing": timing})
+    compare = {"robot": body["robot"], "path": body["path"], "methods": methods, "timing": timing}
+    response = CLIENT.post("/v1/trajectories/compare", json=compare)
     assert response.status_code < 500, (body, methods, response.text)
     if response.status_code == 200:
         _assert_finite(response.json())
+        for answer in response.json()["results"]:
+            assert_limits_held(compare, answer)
 
 
 @pytest.fixture(scope="module", autouse=True)

@@ -14,6 +14,7 @@ import pytest
 import uvicorn
 
 from tests.conftest import UR5_WAYPOINTS
+from tests.service.answer_limits import assert_limits_held
 from toptraj import robots
 from toptraj.planners import (
     METHODS,
@@ -118,7 +119,8 @@ def test_the_library_holds_the_same_ranges():
 
 
 def test_extreme_numbers_inside_the_ranges_plan_or_fail_cleanly(client):
-    """The corners of the accepted ranges: every answer is a 200 with finite numbers or a 4xx."""
+    """The corners of the accepted ranges: every answer is a 200 with finite numbers within the
+    limits it was asked to hold, or a 4xx."""
     bodies = []
     for method in ("cubic", "quintic", "trapezoidal", "cycloidal"):
         for duration in (1e-3, 1e4):
@@ -140,6 +142,7 @@ def test_extreme_numbers_inside_the_ranges_plan_or_fail_cleanly(client):
         if response.status_code == 200:
             samples = response.json()["samples"]
             assert all(np.all(np.isfinite(np.asarray(samples[key], dtype=float))) for key in ("t", "q", "qd", "qdd", "tau"))
+            assert_limits_held({"robot": "ur5", **body}, response.json())
 
 
 # --- the guards behind the ranges ----------------------------------------------------------

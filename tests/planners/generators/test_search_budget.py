@@ -6,6 +6,7 @@ largest value served), and a request's memory goes back when it ends."""
 from __future__ import annotations
 
 import re
+import threading
 import time
 
 import numpy as np
@@ -45,18 +46,33 @@ def _ur5_search(search: dict, budget_s: float, obstacles=(UR5_BOX,)) -> dict:
 
 
 @pytest.mark.parametrize("budget_s", [1.0, 4.0])
-def test_the_search_stops_within_a_second_of_its_budget_in_process(budget_s):
-    # graph and free space at 1 s, the free space's refinement at 4 s: on the library's own
-    # thread (no worker process), so the checks inside the loops are what stops it
+def test_the_search_stops_within_a_cpu_second_of_its_budget_in_process(budget_s):
+    """Graph and free space at 1 s, the free space's refinement at 4 s: on the library's own
+    thread (no worker process), so the checks inside the loops are what stops it. The work
+    after the budget is counted in CPU-seconds of this process from the moment the budget
+    passed to the search's end (wall time would count a busy machine's waits)."""
     robot = robots.load("ur5")
-    began = time.monotonic()
-    with pytest.raises(BudgetExceeded):
-        global_search(
-            robot, robot.limits, ("velocity", "acceleration", "torque"), np.array(UR5_START), np.array(UR5_GOAL),
-            SearchOptions(tubes=1), True, ARC, 0.02, Deadline(budget_s),
-        )
-    overrun = time.monotonic() - began - budget_s
-    assert overrun < 1.0, f"the search ran {overrun:.2f} s past its budget of {budget_s} s"
+    deadline = Deadline(budget_s)
+    outcome: list[BaseException] = []
+
+    def search() -> None:
+        try:
+            global_search(
+                robot, robot.limits, ("velocity", "acceleration", "torque"), np.array(UR5_START), np.array(UR5_GOAL),
+                SearchOptions(tubes=1), True, ARC, 0.02, deadline,
+            )
+        except BaseException as error:  # noqa: BLE001 - examined below
+            outcome.append(error)
+
+    searching = threading.Thread(target=search)
+    searching.start()
+    searching.join(budget_s)
+    at_budget = time.process_time()
+    searching.join(120.0)  # a hang guard
+    overrun = time.process_time() - at_budget
+    assert not searching.is_alive()
+    assert len(outcome) == 1 and isinstance(outcome[0], BudgetExceeded), outcome
+    assert overrun < 1.0, f"the search computed {overrun:.2f} CPU-s past its budget of {budget_s} s"
 
 
 def _spans(robot, start, goal, options, max_turn) -> int:
