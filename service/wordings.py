@@ -177,7 +177,30 @@ def _unknown_robot(facts: dict) -> str:
     )
 
 
+def _not_a_rotation(facts: dict) -> str:
+    if facts["determinant"] is None:
+        return f"{facts['field']} must be a 3x3 matrix of finite numbers (the base's axes as columns, in the world)"
+    return (
+        f"{facts['field']} is not a rotation: R R^T differs from the identity by {facts['deviation']:.3g} and "
+        f"det R = {facts['determinant']:.4g}; give an orthonormal matrix with determinant +1 (e.g. [[1,0,0],[0,1,0],[0,0,1]], "
+        "or [[-1,0,0],[0,-1,0],[0,0,1]] for a base turned half a turn about z)"
+    )
+
+
+def _arms_collide_at_start(facts: dict) -> str:
+    (a, b), (link_a, link_b), (robot_a, robot_b) = (facts["first"], facts["second"]), facts["links"], facts["robots"]
+    return (
+        f"the arms collide at their start: link {link_a!r} of arms[{a}] ({robot_a}) is {facts['distance']:.4g} m "
+        f"from link {link_b!r} of arms[{b}] ({robot_b}) at s = 0 (the clearance is {facts['clearance']:g} m): "
+        "move a base apart, change the first waypoints or lower clearance"
+    )
+
+
 WORDING: dict[str, Wording] = {
+    "not_a_rotation": _not_a_rotation,
+    "arms_collide_at_start": _arms_collide_at_start,
+    "too_many_arms": "a cell has {value} arms; from {fewest} to {most} are served (every order of the arms is tried): "
+    "give between {fewest} and {most} arms, or split the cell",
     "out_of_range": _out_of_range,
     "scaled_limit_out_of_range": _scaled_limit,
     "not_numbers": "{field} must be a list of numbers",

@@ -36,17 +36,15 @@ def checked_rotation(rotation: ArrayLike, where: str) -> np.ndarray:
     matrix = np.asarray(rotation, dtype=float)
     if matrix.shape != (3, 3) or not np.isfinite(matrix).all():
         raise InvalidRequest(
-            where, rotation, rule="not_a_rotation",
-            detail=f"{where} must be a 3x3 matrix of finite numbers (the base's axes as columns, in the world)",
+            where, rotation, rule="not_a_rotation", deviation=None, determinant=None,
+            detail=f"{where} is not a 3x3 matrix of finite numbers",
         )
     error = float(np.abs(matrix @ matrix.T - np.eye(3)).max())
     determinant = float(np.linalg.det(matrix))
     if error > ROTATION_TOLERANCE or determinant <= 0.0:
         raise InvalidRequest(
-            where, rotation, rule="not_a_rotation",
-            detail=f"{where} is not a rotation: R R^T differs from the identity by {error:.3g} and det R = {determinant:.4g}; "
-            "give an orthonormal matrix with determinant +1 (e.g. [[1,0,0],[0,1,0],[0,0,1]], or [[-1,0,0],[0,-1,0],[0,0,1]] "
-            "for a base turned half a turn about z)",
+            where, rotation, rule="not_a_rotation", deviation=error, determinant=determinant,
+            detail=f"{where} is not a rotation: R R^T differs from the identity by {error:.3g} and det R = {determinant:.4g}",
         )
     return matrix
 

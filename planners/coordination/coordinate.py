@@ -123,9 +123,8 @@ def curve_schedule(cell: Cell, diagram: Diagram, solo: list[TimeScaling], deadli
 def _check_cell(cell: Cell) -> None:
     if not 2 <= len(cell.arms) <= MAX_ARMS:
         raise InvalidRequest(
-            "arms", len(cell.arms), rule="too_many_arms",
-            detail=f"a cell has {len(cell.arms)} arms; from 2 to {MAX_ARMS} are served (every order of the arms is tried): "
-            f"give between 2 and {MAX_ARMS} arms, or split the cell",
+            "arms", len(cell.arms), rule="too_many_arms", fewest=2, most=MAX_ARMS,
+            detail=f"a cell of {len(cell.arms)} arms; from 2 to {MAX_ARMS} are served",
         )
 
 

@@ -77,10 +77,9 @@ def check_ends(cell: Cell) -> None:
         if distance[0] < cell.clearance:
             links = (first.link_names()[int(i[0])], second.link_names()[int(j[0])])
             raise InvalidRequest(
-                f"arms[{b}]", None, rule="arms_collide_at_start",
-                detail=f"the arms collide at their start: link {links[0]!r} of arms[{a}] ({first.robot.name}) is {distance[0]:.4g} m "
-                f"from link {links[1]!r} of arms[{b}] ({second.robot.name}) at s = 0 (the clearance is {cell.clearance:g} m): "
-                "move a base apart, change the first waypoints or lower clearance",
+                f"arms[{b}]", None, rule="arms_collide_at_start", first=a, second=b, links=links,
+                robots=(first.robot.name, second.robot.name), distance=float(distance[0]), clearance=cell.clearance,
+                detail=f"arms {a} and {b} are {distance[0]:.4g} m apart at their start, closer than the clearance {cell.clearance:g} m",
             )
 
 

@@ -87,15 +87,21 @@ def test_each_arms_limits_hold_on_a_dense_resampling(crossing):
 
 def test_arms_that_collide_at_their_start_are_refused_naming_the_links():
     close = facing_cell(distance=0.1)  # the bases overlap
-    with pytest.raises(InvalidRequest, match=r"collide at their start: link '.+' of arms\[0\].*link '.+' of arms\[1\]"):
+    with pytest.raises(InvalidRequest) as refused:
         coordinate(close)
+    error = refused.value
+    assert (error.rule, error.field, error.first, error.second) == ("arms_collide_at_start", "arms[1]", 0, 1)
+    assert all(isinstance(link, str) and link for link in error.links)
+    assert error.distance < error.clearance
 
 
 def test_a_fifth_arm_is_refused_naming_the_bound():
     cell = facing_cell()
     far = tuple(ur5_arm(FIRST, [0.0, 3.0 * k, 0.0]) for k in range(1, 4))
-    with pytest.raises(InvalidRequest, match=r"a cell has 5 arms; from 2 to 4 are served"):
+    with pytest.raises(InvalidRequest) as refused:
         coordinate(Cell(cell.arms + far, cell.clearance))
+    error = refused.value
+    assert (error.rule, error.value, error.fewest, error.most) == ("too_many_arms", 5, 2, 4)
 
 
 def test_the_coordinated_curve_keeps_clearance_and_limits(crossing):
