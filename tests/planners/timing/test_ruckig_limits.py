@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from toptraj import robots
-from toptraj.planners import Timing, WaypointPath, plan
+from toptraj.planners import METHODS, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.problem.problem import LimitRequest, Sampling
 from toptraj.service.problems import detail
 
 MOVE = WaypointPath(np.array([[0.0, 0.0], [0.5, -0.4]]))
@@ -18,14 +19,17 @@ KINDS = ("velocity", "acceleration", "jerk")
 
 def test_ruckig_without_any_finite_limit_is_refused_with_advice():
     with pytest.raises(InvalidRequest) as refused:
-        plan(robots.load("yamamoto_2r"), MOVE, Timing(method="ruckig", constraints=KINDS))
+        plan(build_problem(robots.load("yamamoto_2r"), MOVE, METHODS["ruckig"], limits=LimitRequest(kinds=KINDS)))
     assert (refused.value.field, refused.value.rule) == ("method", "ruckig_needs_a_limit")
     assert "set one in timing.limits" in detail(refused.value)
 
 
 def test_the_advice_plans_a_motion_within_the_limit_set():
     jerk = 50.0
-    result = plan(robots.load("yamamoto_2r"), MOVE, Timing(method="ruckig", constraints=KINDS, limit_overrides={"jerk": [jerk, jerk]}), dt=1e-3)
+    result = plan(build_problem(
+        robots.load("yamamoto_2r"), MOVE, METHODS["ruckig"], limits=LimitRequest(kinds=KINDS, overrides={"jerk": [jerk, jerk]}),
+        sampling=Sampling(dt=1e-3),
+    ))
     # rest to rest over 0.5 rad at one jerk: the duration of the three-phase jerk profile,
     # T = 4 (distance / (2 jerk))^(1/3) for the leading joint (4 phases of equal length).
     distance = 0.5
