@@ -84,7 +84,7 @@ class InfeasiblePath(ToptrajError):
         joint: Name of the joint whose limit cannot be met there, if one is to blame.
         limit: The kind of limit that cannot be met ("velocity", "acceleration", "torque",
             "jerk"), when one is to blame.
-        held: A ``toptraj.planners.diagnostics.HeldLoad`` when holding still there already needs more
+        held: A ``toptraj.planners.constraints.held_load.HeldLoad`` when holding still there already needs more
             torque than a joint's limit (gravity and friction), else ``None``.
     """
 

@@ -28,7 +28,7 @@ ROOM = {
     "toptraj.planners.constraints": "constraints",
     "toptraj.planners.execution": "execution",
     "planners": "runner", "toptraj.planners.plan": "runner", "toptraj.planners.runner.given_path": "runner", "toptraj.planners.runner.run": "runner", "toptraj.planners.runner.answer": "runner",
-    "toptraj.planners.errors": "errors", "toptraj.planners.diagnostics": "errors",
+    "toptraj.planners.errors": "errors",
     "toptraj.planners.execution.deadline": "execution", "toptraj.planners.execution.isolated": "execution", "toptraj.planners.execution.threads": "execution",
     "toptraj.planners.kinematics": "kinematics", "toptraj.planners.paths": "paths", "toptraj.planners.paths.grid": "paths", "toptraj.planners.collision": "collision",
     "toptraj.planners.constraints.path_constraints": "constraints", "toptraj.planners.constraints.assembly_kernels": "constraints", "toptraj.planners.constraints.admissible": "constraints",

@@ -16,8 +16,8 @@ import logging
 import numpy as np
 
 from toptraj.planners.constraints.admissible import acceleration_bounds, admissible_set, friction_reference
+from toptraj.planners.constraints.held_load import static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
-from toptraj.planners.diagnostics import static_load
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod

@@ -23,9 +23,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from toptraj.planners.constraints.held_load import static_load
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.constraints.tool_speed import TOOL_KINDS
-from toptraj.planners.diagnostics import static_load
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Binding, Boundary, TimingMethod

@@ -47,8 +47,8 @@ import numpy as np
 
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, zero_inertia_intervals
+from toptraj.planners.constraints.held_load import static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
-from toptraj.planners.diagnostics import static_load
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
