@@ -18,7 +18,6 @@ from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.timing.laws.profiles import PROFILES, CycloidalBlendProfile, NormalizedProfile, TrapezoidalProfile
 from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS, SplineProfile
-from toptraj.planners.timing.min_cost import MinCostMethod
 
 if TYPE_CHECKING:
     from toptraj.planners.problem.methods import MotionGenerator
@@ -187,6 +186,8 @@ def timing_method(timing: Timing) -> TimingMethod | None:
     if timing.method == "min_cost":
         if not (np.isfinite(timing.torque_weight) and timing.torque_weight >= 0.0):
             raise OutOfRange("method.torque_weight", timing.torque_weight, 0.0, float("inf"), "1/(N m)^2", rule="negative_weight")
+        from toptraj.planners.timing.min_cost import MinCostMethod  # here: the other methods do without it
+
         return MinCostMethod(timing.torque_weight)
     if timing.method in GENERATORS:
         return None

@@ -21,6 +21,15 @@ NOT_FOR_PHASE_PLANE = (
     "cvxpy", "clarabel", "casadi", "ray", "toppra", "matplotlib", "plotly",
     "scipy.optimize", "scipy.sparse", "scipy.interpolate", "fastapi", "starlette", "uvicorn",
 )
+#: The project's own modules of the other methods (their modules, compiled kernels and the stacks
+#: they bring: ruckig, min_cost's process pool), none of which a phase-plane plan needs.
+OTHER_METHODS = (
+    "ruckig", "multiprocessing", "toptraj.planners.timing.ruckig_method", "toptraj.planners.timing.min_cost",
+    "toptraj.planners.timing.jerk.method", "toptraj.planners.execution.isolated",
+    "toptraj.planners.generators.search.generator", "toptraj.planners.generators.search.branch_and_bound",
+    "toptraj.planners.generators.search.search_kernels", "toptraj.planners.generators.search.distance_kernels",
+    "toptraj.planners.generators.collocation.generator", "toptraj.planners.generators.collocation.collocation",
+)
 TYPICAL = {
     "robot": "ur5",
     "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS, "interpolation": "spline"},
@@ -54,8 +63,9 @@ def _loaded(modules: list[str], names: tuple[str, ...]) -> list[str]:
 @pytest.mark.parametrize(
     ("request_body", "needed", "not_needed"),
     [
-        (TYPICAL, ("numba", "pinocchio"), NOT_FOR_PHASE_PLANE),
-        (TOPPRA, ("toppra",), ("cvxpy", "clarabel", "casadi", "ray", "plotly", "fastapi", "uvicorn")),
+        (TYPICAL, ("numba", "pinocchio", "toptraj.planners.timing.phase_plane.method"),
+         (*NOT_FOR_PHASE_PLANE, *OTHER_METHODS, "toptraj.planners.timing.toppra_method")),
+        (TOPPRA, ("toppra", "toptraj.planners.timing.toppra_method"), ("cvxpy", "clarabel", "casadi", "ray", "plotly", "fastapi", "uvicorn", *OTHER_METHODS)),
     ],
     ids=["phase_plane", "toppra"],
 )
