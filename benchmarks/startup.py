@@ -17,6 +17,10 @@ Printed beside each goal of the issue:
   as after a fresh clone) and then the first start ready within 15 s (<= 3,000x), with the
   longest silence of either.
 
+Then the CPU seconds (user and system) of the same, against the bare solve's: on a busy
+machine the wall seconds of a new interpreter vary twofold between rounds, its CPU seconds by a
+few percent. Each tree's bytecode is written first, as the install writes it.
+
 With ``--baseline DIR`` (another checkout, e.g. ``git archive main | tar -x -C DIR``, its
 kernels compiled once), the same ``toptraj plan`` and restart of that tree, interleaved.
 
