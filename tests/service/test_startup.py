@@ -26,8 +26,7 @@ NOT_FOR_PHASE_PLANE = (
 OTHER_METHODS = (
     "ruckig", "multiprocessing", "toptraj.planners.timing.ruckig_method", "toptraj.planners.timing.min_cost",
     "toptraj.planners.timing.jerk.method", "toptraj.planners.execution.isolated",
-    "toptraj.planners.generators.search.generator", "toptraj.planners.generators.search.branch_and_bound",
-    "toptraj.planners.generators.search.search_kernels", "toptraj.planners.generators.search.distance_kernels",
+    "toptraj.planners.generators.search.generator", "toptraj.planners.generators.search.local",
     "toptraj.planners.generators.collocation.generator", "toptraj.planners.generators.collocation.collocation",
 )
 TYPICAL = {
