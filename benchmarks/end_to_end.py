@@ -101,7 +101,7 @@ def timing_grid_points(robot: robots.Robot, path_spec, timing) -> tuple[int, int
     from toptraj.planners.runner.run import _given_path
 
     problem = build_problem(robot, path_spec, method_for(timing, path_spec), timing)
-    timed, _ = _given_path(problem, problem.deadline)
+    timed, _, _ = _given_path(problem, problem.deadline)
     return sum(len(item.timing.s) for item in timed.stretches), sum(len(item.constraints.s) for item in timed.stretches)
 
 
