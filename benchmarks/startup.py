@@ -17,6 +17,10 @@ Printed beside each goal of the issue:
   as after a fresh clone) and then the first start ready within 15 s (<= 3,000x), with the
   longest silence of either.
 
+Then the CPU seconds (user and system) of the same, against the bare solve's: on a busy
+machine the wall seconds of a new interpreter vary twofold between rounds, its CPU seconds by a
+few percent. Each tree's bytecode is written first, as the install writes it.
+
 With ``--baseline DIR`` (another checkout, e.g. ``git archive main | tar -x -C DIR``, its
 kernels compiled once), the same ``toptraj plan`` and restart of that tree, interleaved.
 
@@ -29,6 +33,7 @@ import argparse
 import http.client
 import json
 import os
+import resource
 import shutil
 import socket
 import subprocess
@@ -72,22 +77,36 @@ def kernel(x):
 """
 
 
-def _floor(folder: str) -> float:
-    """Wall seconds of a new interpreter importing numpy, Pinocchio and pydantic and calling one
-    cached numba kernel (``_FLOOR_KERNEL`` in ``folder``)."""
-    started = time.perf_counter()
+def _children_cpu() -> float:
+    """CPU seconds (user and system) of this process's ended children so far."""
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return used.ru_utime + used.ru_stime
+
+
+def _floor(folder: str) -> tuple[float, float]:
+    """Wall and CPU seconds of a new interpreter importing numpy, Pinocchio and pydantic and
+    calling one cached numba kernel (``_FLOOR_KERNEL`` in ``folder``)."""
+    started, cpu = time.perf_counter(), _children_cpu()
     subprocess.run(
         [sys.executable, "-c", "import numpy, pinocchio, pydantic, floor_kernel; floor_kernel.kernel(numpy.ones(3))"],
         cwd=folder, check=True,
     )
-    return time.perf_counter() - started
+    return time.perf_counter() - started, _children_cpu() - cpu
 
 
-def _cli_plan(request_file: str, env: dict, root: Path = ROOT) -> float:
-    """Wall seconds of ``toptraj plan FILE`` (a new interpreter), its answer checked."""
-    started = time.perf_counter()
+def _bytecode(root: Path) -> None:
+    """The bytecode of the tree at ``root`` written, as an install writes it (pip; ``make
+    install``'s warm-up), even where ``PYTHONDONTWRITEBYTECODE`` keeps Python from writing it on
+    import: otherwise each new interpreter would compile the project's sources again."""
+    folders = [str(root / part) for part in ("toptraj", "robots", "planners", "service", "client")]
+    subprocess.run([sys.executable, "-m", "compileall", "-q", *folders], check=True, stdout=subprocess.DEVNULL)
+
+
+def _cli_plan(request_file: str, env: dict, root: Path = ROOT) -> tuple[float, float]:
+    """Wall and CPU seconds of ``toptraj plan FILE`` (a new interpreter), its answer checked."""
+    started, cpu = time.perf_counter(), _children_cpu()
     done = subprocess.run([sys.executable, "-m", "toptraj.service.cli", "plan", request_file], cwd=root, env=env, capture_output=True)
-    seconds = time.perf_counter() - started
+    seconds = time.perf_counter() - started, _children_cpu() - cpu
     if done.returncode != 0 or not done.stdout.startswith(b'{"robot":"ur5"'):
         raise RuntimeError(f"toptraj plan failed: {done.stderr[-500:]!r}")
     return seconds
@@ -107,6 +126,8 @@ class _Server:
         )
         threading.Thread(target=self._read, daemon=True).start()
         self.ready_s = self._wait_ready()
+        used = psutil.Process(self.process.pid).cpu_times()
+        self.ready_cpu_s = used.user + used.system
 
     def _read(self) -> None:
         assert self.process.stdout is not None
@@ -161,14 +182,16 @@ class _Server:
             self.process.wait()
 
 
-def _anchor(robot, waypoints, solves: int) -> float:
-    return float(np.median([_timed(lambda: bare_toppra(robot, waypoints)) for _ in range(solves)]))
+def _anchor(robot, waypoints, solves: int) -> tuple[float, float]:
+    """Median wall and CPU seconds of ``solves`` bare toppra solves."""
+    timed = [_timed(lambda: bare_toppra(robot, waypoints)) for _ in range(solves)]
+    return float(np.median([wall for wall, _ in timed])), float(np.median([cpu for _, cpu in timed]))
 
 
-def _timed(function) -> float:
-    started = time.perf_counter()
+def _timed(function) -> tuple[float, float]:
+    started, cpu = time.perf_counter(), time.process_time()
     function()
-    return time.perf_counter() - started
+    return time.perf_counter() - started, time.process_time() - cpu
 
 
 def _goal(label: str, value: float, goal: float, unit: str = "x") -> None:
@@ -198,6 +221,35 @@ def _fresh(anchor_s: float) -> None:
             server.stop()
 
 
+def _report(trees, anchors, floors, plans, restarts, silences, memory, rounds: int) -> float:
+    """Print the medians and the goals (wall seconds), then the same in CPU seconds (less
+    sensitive to a busy machine than wall seconds); the anchor's median wall seconds."""
+    anchor, anchor_cpu = (float(np.median([a[k] for a in anchors])) for k in (0, 1))
+    wall = {key: [float(np.median([m[0] for m in values[name]])) for name in trees] for key, values in (("plan", plans), ("restart", restarts))}
+    print(f"typical request (ur5, 4 spline waypoints, velocity + acceleration + torque, phase_plane, dt 0.01); "
+          f"{rounds} interleaved rounds; bare toppra {1e3 * anchor:.2f} ms (median)")
+    floor = float(np.median([f[0] for f in floors]))
+    print(f"  floor (interpreter, numpy, pinocchio, pydantic, one cached numba kernel): {floor:.3f} s median, "
+          f"{floor / anchor:.1f}x bare toppra")
+    for k, (name, root) in enumerate(trees.items()):
+        print(f"{name} ({root}):")
+        print(f"  toptraj plan: {wall['plan'][k]:.3f} s median ({', '.join(f'{s:.2f}' for s, _ in plans[name])})")
+        print(f"  restart to /health: {wall['restart'][k]:.2f} s median ({', '.join(f'{s:.2f}' for s, _ in restarts[name])}); "
+              f"longest silence {max(silences[name]):.2f} s")
+        _goal("toptraj plan / bare toppra", wall["plan"][k] / anchor, 100)
+        _goal("restart ready / bare toppra", wall["restart"][k] / anchor, 600)
+        server_mb, fork_mb = memory[name]
+        _goal("server process resident at idle", server_mb, 300, " MB")
+        print(f"  {'its fork server (children share its pages)':44s} {fork_mb:9.1f} MB")
+    print(f"CPU seconds (user + system), medians: bare toppra {1e3 * anchor_cpu:.2f} ms; "
+          f"floor {np.median([f[1] for f in floors]):.3f} s ({np.median([f[1] for f in floors]) / anchor_cpu:.1f}x)")
+    for name in trees:
+        plan_cpu, restart_cpu = (float(np.median([m[1] for m in values[name]])) for values in (plans, restarts))
+        print(f"  {name}: toptraj plan {plan_cpu:.3f} s ({plan_cpu / anchor_cpu:.1f}x bare toppra); "
+              f"server process until ready {restart_cpu:.2f} s ({restart_cpu / anchor_cpu:.1f}x)")
+    return anchor
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--rounds", type=int, default=5)
@@ -218,14 +270,15 @@ def main() -> int:
     with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as handle:
         json.dump(TYPICAL, handle)
     for root in trees.values():
-        _cli_plan(handle.name, _env(root), root)  # numba's cache and the bytecode written, if they were not
+        _bytecode(root)
+        _cli_plan(handle.name, _env(root), root)  # numba's cache written, if it was not
     floor_folder = tempfile.mkdtemp(prefix="toptraj-floor-")
     Path(floor_folder, "floor_kernel.py").write_text(_FLOOR_KERNEL)
     _floor(floor_folder)  # compiled into its cache
-    floors: list[float] = []
-    anchors: list[float] = []
-    plans: dict[str, list[float]] = {name: [] for name in trees}
-    restarts: dict[str, list[float]] = {name: [] for name in trees}
+    floors: list[tuple[float, float]] = []
+    anchors: list[tuple[float, float]] = []
+    plans: dict[str, list[tuple[float, float]]] = {name: [] for name in trees}
+    restarts: dict[str, list[tuple[float, float]]] = {name: [] for name in trees}
     silences: dict[str, list[float]] = {name: [] for name in trees}
     memory: dict[str, tuple[float, float]] = {}
     try:
@@ -237,7 +290,7 @@ def main() -> int:
                 if round_ % args.restart_every == 0:
                     server = _Server(_env(root), root)
                     try:
-                        restarts[name].append(server.ready_s)
+                        restarts[name].append((server.ready_s, server.ready_cpu_s))
                         silences[name].append(server.longest_silence())
                         if name not in memory:
                             memory[name] = server.idle_rss_mb()
@@ -246,21 +299,7 @@ def main() -> int:
     finally:
         os.unlink(handle.name)
         shutil.rmtree(floor_folder, ignore_errors=True)
-    anchor = float(np.median(anchors))
-    print(f"typical request (ur5, 4 spline waypoints, velocity + acceleration + torque, phase_plane, dt 0.01); "
-          f"{args.rounds} interleaved rounds; bare toppra {1e3 * anchor:.2f} ms (median)")
-    print(f"  floor (interpreter, numpy, pinocchio, pydantic, one cached numba kernel): {np.median(floors):.3f} s median, "
-          f"{np.median(floors) / anchor:.1f}x bare toppra")
-    for name, root in trees.items():
-        print(f"{name} ({root}):")
-        print(f"  toptraj plan: {np.median(plans[name]):.3f} s median ({', '.join(f'{s:.2f}' for s in plans[name])})")
-        print(f"  restart to /health: {np.median(restarts[name]):.2f} s median ({', '.join(f'{s:.2f}' for s in restarts[name])}); "
-              f"longest silence {max(silences[name]):.2f} s")
-        _goal("toptraj plan / bare toppra", float(np.median(plans[name])) / anchor, 100)
-        _goal("restart ready / bare toppra", float(np.median(restarts[name])) / anchor, 600)
-        server_mb, fork_mb = memory[name]
-        _goal("server process resident at idle", server_mb, 300, " MB")
-        print(f"  {'its fork server (children share its pages)':44s} {fork_mb:9.1f} MB")
+    anchor = _report(trees, anchors, floors, plans, restarts, silences, memory, args.rounds)
     if args.fresh:
         _fresh(anchor)
     return 0

@@ -8,6 +8,8 @@ are its constructor's."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from toptraj import robots
@@ -15,10 +17,7 @@ from toptraj.planners import CartesianLine, WaypointPath
 from toptraj.planners.collision import BoxObstacle, CapsuleObstacle, Obstacle, SphereObstacle
 from toptraj.planners.errors import NotOneOf, NotServed, WrongLength
 from toptraj.planners.execution.deadline import Deadline
-from toptraj.planners.generators.collocation.generator import Collocation
 from toptraj.planners.generators.joint_moves import Unsynchronized, ViaPoints
-from toptraj.planners.generators.search import SearchOptions
-from toptraj.planners.generators.search.generator import Search
 from toptraj.planners.problem.boundary import finite_vector
 from toptraj.planners.problem.build import DEFAULT_CLEARANCE, build_problem
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -29,8 +28,10 @@ from toptraj.planners.problem.zones import Zone
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.profiles import PROFILES
-from toptraj.planners.timing.min_cost import MinCostMethod
 from toptraj.service.schemas.trajectories import TimingRequest, TrajectoryRequest
+
+if TYPE_CHECKING:
+    from toptraj.planners.generators.search import SearchOptions
 
 #: Limit kinds a request may override or scale.
 LIMIT_KINDS = ("velocity", "acceleration", "jerk", "torque")
@@ -68,14 +69,22 @@ def method_of(timing: TimingRequest, motion: MotionSpec, search_memory_bytes: in
         raise NotServed("method.torque_weight", weight, name, rule="weight_needs_min_cost", alternatives=("min_cost",))
     if timing.search is not None and name not in ("search", "collocation"):
         raise NotServed("search", None, name, rule="options_need_search", alternatives=("search",))
+    # The search, the collocation and min_cost are imported where they are named: the other
+    # requests do without their modules, solver stacks and compiled kernels.
     if name == "search":
+        from toptraj.planners.generators.search.generator import Search
+
         return Search(search_options(timing, search_memory_bytes))
     if name == "collocation":
+        from toptraj.planners.generators.collocation.generator import Collocation
+
         return Collocation(weight)
     method: TimingMethod
     if law is not None:
         method = law.method()
     elif name == "min_cost":
+        from toptraj.planners.timing.min_cost import MinCostMethod
+
         method = MinCostMethod(weight)
     elif name in METHODS:
         method = METHODS[name]
@@ -93,6 +102,8 @@ def method_of(timing: TimingRequest, motion: MotionSpec, search_memory_bytes: in
 def search_options(timing: TimingRequest, memory_bytes: int) -> SearchOptions:
     """The search's options (``toptraj.planners.generators.search.SearchOptions``), held within
     ``memory_bytes`` by its estimate."""
+    from toptraj.planners.generators.search import SearchOptions
+
     if timing.search is None:
         return SearchOptions(memory_bytes=memory_bytes)
     cells = None if timing.search.cells is None else tuple(timing.search.cells)

@@ -3,8 +3,9 @@ built, and the compiled kernels (numba, ``cache=True``) compiled into numba's ca
 from it.
 
 Compiling the kernels takes a minute or more on two cores; loading them from the cache, a
-second or two. So the install compiles them (``python -m toptraj.service.warmup``: ``make install``, the
-Dockerfile's build), each server process then only loads them (``server_steps``, from the app's
+second or two. So the install writes toptraj's bytecode (``write_bytecode``) and compiles them
+(``python -m toptraj.service.warmup``: ``make install``, the Dockerfile's build), each server
+process (and ``toptraj plan``) then only loads them (``server_steps``, from the app's
 lifespan), and neither is silent meanwhile: a line when a step begins, one every ``HEARTBEAT_S``
 while it lasts, and one when it ends with its seconds and how many kernels it compiled (0 when
 the cache held them all).
@@ -116,10 +117,33 @@ def server_steps() -> list[Step]:
     ]
 
 
+def write_bytecode() -> None:
+    """The bytecode of every module of toptraj written beside its source (``__pycache__``, or
+    under ``PYTHONPYCACHEPREFIX``), as pip writes it when it installs a package: each start then
+    reads it instead of compiling the sources again, even where the environment forbids Python
+    to write it as it imports (``PYTHONDONTWRITEBYTECODE``, set in the Dockerfile). Up-to-date
+    files are left as they are; a folder that cannot be written is left without."""
+    import compileall
+    from pathlib import Path
+
+    import toptraj
+
+    package = Path(toptraj.__file__).parent
+    compileall.compile_dir(package, maxlevels=0, quiet=2)
+    # The sub-packages one by one: in a checkout they are links, which compile_dir does not enter.
+    for folder in sorted(path for path in package.iterdir() if path.is_dir() and not path.name.startswith("__")):
+        compileall.compile_dir(folder, quiet=2)
+
+
 def install_steps() -> list[Step]:
-    """What the install does: the server's steps, then the kernels of the typical request
-    (velocity and acceleration rows, sampling, dense checks), compiled into the cache."""
-    return [*server_steps(), ("compiling the typical request's kernels (ur5, spline, velocity, acceleration, torque)", _typical)]
+    """What the install does: toptraj's bytecode written, the server's steps, then the kernels
+    of the typical request (velocity and acceleration rows, sampling, dense checks), compiled
+    into the cache."""
+    return [
+        ("writing the bytecode of toptraj's modules", write_bytecode),
+        *server_steps(),
+        ("compiling the typical request's kernels (ur5, spline, velocity, acceleration, torque)", _typical),
+    ]
 
 
 @contextmanager

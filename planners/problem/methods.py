@@ -21,7 +21,6 @@ from typing import TYPE_CHECKING, ClassVar, Literal, NamedTuple, TypeVar
 from toptraj.planners.checks.gate import TimedStretch
 from toptraj.planners.errors import ToptrajError
 from toptraj.planners.execution.deadline import Deadline
-from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.execution.memory import method_grid_cap
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.timing.base import PathTiming, TimingMethod
@@ -94,6 +93,8 @@ class Execution:
         worker process at a lower CPU priority when ``isolate``, else inline; with ``progress``,
         called with ``progress=report`` relayed to the deadline's progress. ``memory_bytes``:
         the most its process may grow by (``OverMemory`` beyond)."""
+        from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated  # only the methods that need it
+
         return run_isolated(
             function, *args, deadline=self.deadline, progress=progress, memory_bytes=memory_bytes, nice=LOW_PRIORITY,
             inline=not self.isolate,

@@ -18,7 +18,6 @@ from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.collision.self_collision import check_self_collision
 from toptraj.planners.errors import numerical_breakdown_is_failure
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
-from toptraj.planners.execution.isolated import in_worker
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
 from toptraj.planners.problem.problem import Problem
@@ -64,8 +63,12 @@ def isolates(method: TimingMethod | MotionGenerator, deadline: Deadline) -> bool
     for a method that cannot check its deadline (``interruptible`` false), when there is a
     deadline to stop it at (a budget, or a caller that may cancel) and this is no worker process
     already (a job's, killed whole). Interruptible methods, the typical request's among them,
-    never start one."""
-    return not method.interruptible and deadline is not NO_DEADLINE and not in_worker()
+    never start one (nor import the worker processes' module)."""
+    if method.interruptible or deadline is NO_DEADLINE:
+        return False
+    from toptraj.planners.execution.isolated import in_worker
+
+    return not in_worker()
 
 
 def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | None, Problem]:

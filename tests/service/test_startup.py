@@ -21,6 +21,14 @@ NOT_FOR_PHASE_PLANE = (
     "cvxpy", "clarabel", "casadi", "ray", "toppra", "matplotlib", "plotly",
     "scipy.optimize", "scipy.sparse", "scipy.interpolate", "fastapi", "starlette", "uvicorn",
 )
+#: The project's own modules of the other methods (their modules, compiled kernels and the stacks
+#: they bring: ruckig, min_cost's process pool), none of which a phase-plane plan needs.
+OTHER_METHODS = (
+    "ruckig", "multiprocessing", "toptraj.planners.timing.ruckig_method", "toptraj.planners.timing.min_cost",
+    "toptraj.planners.timing.jerk.method", "toptraj.planners.execution.isolated",
+    "toptraj.planners.generators.search.generator", "toptraj.planners.generators.search.local",
+    "toptraj.planners.generators.collocation.generator", "toptraj.planners.generators.collocation.collocation",
+)
 TYPICAL = {
     "robot": "ur5",
     "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS, "interpolation": "spline"},
@@ -54,8 +62,9 @@ def _loaded(modules: list[str], names: tuple[str, ...]) -> list[str]:
 @pytest.mark.parametrize(
     ("request_body", "needed", "not_needed"),
     [
-        (TYPICAL, ("numba", "pinocchio"), NOT_FOR_PHASE_PLANE),
-        (TOPPRA, ("toppra",), ("cvxpy", "clarabel", "casadi", "ray", "plotly", "fastapi", "uvicorn")),
+        (TYPICAL, ("numba", "pinocchio", "toptraj.planners.timing.phase_plane.method"),
+         (*NOT_FOR_PHASE_PLANE, *OTHER_METHODS, "toptraj.planners.timing.toppra_method")),
+        (TOPPRA, ("toppra", "toptraj.planners.timing.toppra_method"), ("cvxpy", "clarabel", "casadi", "ray", "plotly", "fastapi", "uvicorn", *OTHER_METHODS)),
     ],
     ids=["phase_plane", "toppra"],
 )
@@ -158,3 +167,25 @@ def test_a_long_start_up_step_is_said_again_until_it_ends(monkeypatch):
     said = len(lines)
     threading.Event().wait(0.1)  # the heartbeat ended with the step
     assert len(lines) == said
+
+
+_BYTECODE = """
+import importlib.util, json, os, sys
+from toptraj.service.warmup import write_bytecode
+write_bytecode()
+package = os.path.dirname(importlib.util.find_spec("toptraj").origin)
+sources = [os.path.join(folder, name) for folder, _, names in os.walk(package, followlinks=True)
+           for name in names if name.endswith(".py")]
+print(json.dumps({"sources": len(sources), "missing": [s for s in sources if not os.path.exists(importlib.util.cache_from_source(s))]}))
+"""
+
+
+def test_the_install_writes_the_bytecode_even_where_python_would_not(tmp_path):
+    """Where the environment forbids writing bytecode on import (the Dockerfile's
+    ``PYTHONDONTWRITEBYTECODE``), every start would compile toptraj's modules from their
+    sources: the install's step writes them all (here under a fresh ``PYTHONPYCACHEPREFIX``)."""
+    env = {**ENV, "PYTHONDONTWRITEBYTECODE": "1", "PYTHONPYCACHEPREFIX": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", _BYTECODE], cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-3000:]
+    written = json.loads(done.stdout.strip().splitlines()[-1])
+    assert written["sources"] > 150 and written["missing"] == []
