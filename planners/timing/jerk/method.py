@@ -84,6 +84,7 @@ from toptraj.planners.timing.jerk.polish import polish
 from toptraj.planners.timing.jerk.program import RestrictedProgram
 from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
 from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming
+from toptraj.planners.timing.jerk.stated_gap import stated_gap
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
 #: Where the limits give no constant-jerk phase at an end at rest, the first interval is
@@ -167,8 +168,10 @@ class JerkLimitedMethod(TimingMethod):
         started = time.perf_counter()
         best = self._grid_solution(constraints, boundary, deadline, start=coarse, tolerance=WARM_TOLERANCE)
         elapsed = time.perf_counter() - started
+        chain = [best.duration]
         if coarse is not None:
             gap = relative_gap(coarse.duration, best.duration)
+            chain.insert(0, coarse.duration)
         for done in range(self.max_refinements):
             if gap is None or not self._affordable(constraints, elapsed, deadline):
                 break
@@ -186,6 +189,9 @@ class JerkLimitedMethod(TimingMethod):
             gap = relative_gap(best.duration, finer_best.duration)
             how = f"second grid: the difference from the solution on a grid of half as many points ({len(constraints.s) - 1} intervals)"
             constraints, best = finer, finer_best
+            chain.append(best.duration)
+        if gap is not None:
+            gap, how = self._stated_gap(constraints, boundary, best, chain, how, elapsed, deadline)
         best = dataclasses.replace(best, optimality_gap=gap, gap_basis=how)
         if self.polish and _uniform(constraints):
             polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
@@ -232,6 +238,19 @@ class JerkLimitedMethod(TimingMethod):
             if gain <= tolerance * best.duration:
                 break
         return best
+
+    def _stated_gap(self, constraints, boundary, best, chain, how, elapsed, deadline) -> tuple[float, str]:
+        """The gap of ``best`` from its grid's, a finer grid's and the intervals at rest's
+        errors (``toptraj.planners.timing.jerk.stated_gap``), each solve started from ``best``."""
+        unfilled = tuple(
+            end for end, sd in ((0, boundary.sd_start), (-1, boundary.sd_end)) if sd == 0.0 and not np.isfinite(_start_phase(constraints, end))
+        )
+
+        def solve(grid, start):
+            return self._grid_solution(grid, boundary, deadline, start=start, tolerance=WARM_TOLERANCE)
+
+        affordable = self._affordable(constraints, elapsed, deadline)
+        return stated_gap(solve, affordable, constraints, boundary, best, chain, unfilled, how)
 
     def _second_grid(self, constraints, original, boundary, deadline) -> tuple[JerkTimeScaling | None, float | None, str]:
         """The solution on every other grid point (``toptraj.planners.timing.jerk.accuracy``), which
