@@ -58,7 +58,9 @@ points (``toptraj.planners.timing.jerk.accuracy``), which is solved first and st
 answer's grid; a grid of fewer than ``ASYMPTOTIC_INTERVALS`` (where that difference is not
 yet first order), or one above ``GAP_TARGET``, is doubled (every interval halved but those at
 rest), at most ``max_refinements`` times, while the grid budget and the time left allow, the
-gap then the difference between the last two grids.
+gap then the difference between the last two grids. Where the grid was not doubled, the answer's
+grid halved is solved for the estimate only; intervals at an end at rest that no constant-jerk
+phase fills are halved twice for it (``toptraj.planners.timing.jerk.stated_gap``).
 
 Each LP is solved over a working set of its rows (``toptraj.planners.timing.jerk.working_set``): of
 some 50 rows per interval only about two per point are active at the optimum. On fine grids the
