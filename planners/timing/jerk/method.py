@@ -86,7 +86,7 @@ from toptraj.planners.timing.jerk.polish import polish
 from toptraj.planners.timing.jerk.program import RestrictedProgram
 from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
 from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming
-from toptraj.planners.timing.jerk.stated_gap import stated_gap
+from toptraj.planners.timing.jerk.stated_gap import stated_gap, unfilled_ends
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
 #: Where the limits give no constant-jerk phase at an end at rest, the first interval is
@@ -241,12 +241,10 @@ class JerkLimitedMethod(TimingMethod):
                 break
         return best
 
-    def _stated_gap(self, constraints, boundary, best, chain, how, elapsed, deadline) -> tuple[float, str]:
+    def _stated_gap(self, constraints, boundary, best, chain, how, elapsed, deadline) -> tuple[float | None, str]:
         """The gap of ``best`` from its grid's, a finer grid's and the intervals at rest's
         errors (``toptraj.planners.timing.jerk.stated_gap``), each solve started from ``best``."""
-        unfilled = tuple(
-            end for end, sd in ((0, boundary.sd_start), (-1, boundary.sd_end)) if sd == 0.0 and not np.isfinite(_start_phase(constraints, end))
-        )
+        unfilled = unfilled_ends(constraints, boundary, _start_phase)
 
         def solve(grid, start):
             return self._grid_solution(grid, boundary, deadline, start=start, tolerance=WARM_TOLERANCE)
