@@ -29,6 +29,14 @@ import numpy as np
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.timing.base import Boundary
 
+#: Ratio of successive differences of a first-order sequence: the slowest convergence assumed
+#: where the differences shrink faster (before the grid is fine enough they may, and then
+#: understate the error: ur5 example, 6.5e-4 then 8.4e-4, 3.4e-4 over each halving).
+FIRST_ORDER_RATIO = 0.5
+#: Largest ratio taken as observed: above it (convergence slower than order 1/3) the order is
+#: not established, and the bound states this ratio's.
+SLOWEST_RATIO = 0.8
+
 
 def coarser(constraints: PathConstraints, original: np.ndarray) -> PathConstraints | None:
     """``constraints`` on every other point of their grid, the ends, the points inside the first
@@ -99,3 +107,27 @@ def relative_gap(coarse_duration: float, fine_duration: float) -> float:
     (before the intervals at rest were kept whole, halving them did that, and a gap of 0 was
     stated 0.4 % above the optimum), so the difference counts whatever its sign."""
     return abs(coarse_duration - fine_duration) / fine_duration
+
+
+def extrapolated_errors(durations: tuple[float, float, float]) -> tuple[float, float, float]:
+    """The errors (s) of three durations on nested grids, each twice as fine as the last, from
+    the ratio of their differences r = |d_2| / |d_1| (Richardson: a sequence converging as h^p
+    has r = 2^-p and the error of its finest member r |d_2| / (1 - r)), r clipped to
+    [``FIRST_ORDER_RATIO``, ``SLOWEST_RATIO``]: at least first order is assumed where the
+    differences fall faster, and order 1/3 where they fall slower or grow (the order is then not
+    established, and the bound is that of order 1/3)."""
+    d1, d2 = abs(durations[0] - durations[1]), abs(durations[1] - durations[2])
+    r = SLOWEST_RATIO if d1 == 0.0 else min(max(d2 / d1, FIRST_ORDER_RATIO), SLOWEST_RATIO)
+    finest = d2 * r / (1.0 - r)
+    return d1 + d2 + finest, d2 + finest, finest
+
+
+def at_rest_halved(constraints: PathConstraints, ends: tuple[int, ...]) -> PathConstraints:
+    """``constraints`` with the first (0) and last (-1) of their intervals listed in ``ends``
+    halved: the intervals at rest that ``refined`` keeps whole, where no constant-jerk phase
+    fills them (``toptraj.planners.timing.jerk.method._start_phase`` is infinite: no jerk limit
+    binds there, the acceleration then jumps at rest in the optimum, and the first interval's
+    linear u lags it by a time of order sqrt(h))."""
+    s = constraints.s
+    middles = [0.5 * (s[0] + s[1]) if end == 0 else 0.5 * (s[-2] + s[-1]) for end in ends]
+    return constraints.with_points(np.unique(middles))

@@ -58,7 +58,9 @@ points (``toptraj.planners.timing.jerk.accuracy``), which is solved first and st
 answer's grid; a grid of fewer than ``ASYMPTOTIC_INTERVALS`` (where that difference is not
 yet first order), or one above ``GAP_TARGET``, is doubled (every interval halved but those at
 rest), at most ``max_refinements`` times, while the grid budget and the time left allow, the
-gap then the difference between the last two grids.
+gap then the difference between the last two grids. Where the grid was not doubled, the answer's
+grid halved is solved for the estimate only; intervals at an end at rest that no constant-jerk
+phase fills are halved twice for it (``toptraj.planners.timing.jerk.stated_gap``).
 
 Each LP is solved over a working set of its rows (``toptraj.planners.timing.jerk.working_set``): of
 some 50 rows per interval only about two per point are active at the optimum. On fine grids the
@@ -84,6 +86,7 @@ from toptraj.planners.timing.jerk.polish import polish
 from toptraj.planners.timing.jerk.program import RestrictedProgram
 from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
 from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming
+from toptraj.planners.timing.jerk.stated_gap import stated_gap, unfilled_ends
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
 #: Where the limits give no constant-jerk phase at an end at rest, the first interval is
@@ -167,8 +170,10 @@ class JerkLimitedMethod(TimingMethod):
         started = time.perf_counter()
         best = self._grid_solution(constraints, boundary, deadline, start=coarse, tolerance=WARM_TOLERANCE)
         elapsed = time.perf_counter() - started
+        chain = [best.duration]
         if coarse is not None:
             gap = relative_gap(coarse.duration, best.duration)
+            chain.insert(0, coarse.duration)
         for done in range(self.max_refinements):
             if gap is None or not self._affordable(constraints, elapsed, deadline):
                 break
@@ -186,6 +191,9 @@ class JerkLimitedMethod(TimingMethod):
             gap = relative_gap(best.duration, finer_best.duration)
             how = f"second grid: the difference from the solution on a grid of half as many points ({len(constraints.s) - 1} intervals)"
             constraints, best = finer, finer_best
+            chain.append(best.duration)
+        if gap is not None:
+            gap, how = self._stated_gap(constraints, boundary, best, chain, how, elapsed, deadline)
         best = dataclasses.replace(best, optimality_gap=gap, gap_basis=how)
         if self.polish and _uniform(constraints):
             polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
@@ -232,6 +240,17 @@ class JerkLimitedMethod(TimingMethod):
             if gain <= tolerance * best.duration:
                 break
         return best
+
+    def _stated_gap(self, constraints, boundary, best, chain, how, elapsed, deadline) -> tuple[float | None, str]:
+        """The gap of ``best`` from its grid's, a finer grid's and the intervals at rest's
+        errors (``toptraj.planners.timing.jerk.stated_gap``), each solve started from ``best``."""
+        unfilled = unfilled_ends(constraints, boundary, _start_phase)
+
+        def solve(grid, start):
+            return self._grid_solution(grid, boundary, deadline, start=start, tolerance=WARM_TOLERANCE)
+
+        affordable = self._affordable(constraints, elapsed, deadline)
+        return stated_gap(solve, affordable, constraints, boundary, best, chain, unfilled, how)
 
     def _second_grid(self, constraints, original, boundary, deadline) -> tuple[JerkTimeScaling | None, float | None, str]:
         """The solution on every other grid point (``toptraj.planners.timing.jerk.accuracy``), which

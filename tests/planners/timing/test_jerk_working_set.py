@@ -16,6 +16,7 @@ from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.timing.base import AT_REST
 from toptraj.planners.timing.jerk import working_set
+from toptraj.planners.timing.jerk.accuracy import extrapolated_errors
 from toptraj.planners.timing.jerk.method import _graded
 from toptraj.planners.timing.jerk.program import RestrictedProgram
 from toptraj.planners.timing.jerk.scaling import JerkTimeScaling, interval_times
@@ -155,8 +156,9 @@ def test_a_straight_ur5_line_from_motion_is_ruckig_through_the_lps_and_the_polis
 def test_a_fine_grid_starts_from_the_grids_below_it(monkeypatch):
     """ur5's example path on 800 intervals: the LPs of every grid start from the solution on
     every other point of it, down to the coarsest (at most twice ``SEED_INTERVALS``), which
-    alone starts from the jerk-free optimum; the answer's gap is the difference from its second
-    grid's duration, each sequence converged from its own start."""
+    alone starts from the jerk-free optimum; the answer's gap is extrapolated from its second
+    grid's duration, its own and that on its grid halved (solved for the estimate only, started
+    from the answer), each sequence converged from its own start."""
     from toptraj.planners.timing.jerk import method as jerk_method
 
     calls = []
@@ -178,4 +180,6 @@ def test_a_fine_grid_starts_from_the_grids_below_it(monkeypatch):
     assert calls[0][1] is None and sizes[0] <= 2 * jerk_method.SEED_INTERVALS
     for (size, start, _), (below, _, _) in zip(calls[1:], calls[:-1]):
         assert start == below and size > 1.8 * below
-    assert answer.optimality_gap == pytest.approx((calls[-2][2] - calls[-1][2]) / calls[-1][2], rel=1e-12)
+    error = extrapolated_errors((calls[-3][2], calls[-2][2], calls[-1][2]))[1]
+    assert answer.duration == calls[-2][2]
+    assert answer.optimality_gap == pytest.approx(error / (calls[-2][2] - error), rel=1e-12)
