@@ -140,6 +140,28 @@ def test_a_huge_jerk_limit_on_a_spline_is_no_slower_than_a_small_one():
     assert huge.duration <= jerk_free.duration * (1 + 2e-3)
 
 
+#: The spline's duration under a jerk limit of 1 rad/s^3 on a grid of 8,000 intervals (stated gap
+#: 3.7e-5; its samples' jerk by third differences of q within 3e-4 of the limit): a feasible
+#: motion, so the optimum is no longer. The default grid used to answer 4.51 s and state a gap
+#: of 7e-4: its interval at rest held a constant path jerk over a stretch where the joint jerk's
+#: other terms reach a third of the limit, which a second grid keeping that interval cannot see.
+SPLINE_SLOW_JERK_FINE = 3.8729
+
+
+def test_a_low_jerk_limit_on_a_spline_answers_within_its_stated_gap_and_holds_the_limit():
+    answer = _spline(1.0)
+    stated = answer.accuracy.relative_gap
+    assert stated is not None and stated <= 1e-3
+    assert (answer.duration - SPLINE_SLOW_JERK_FINE) / SPLINE_SLOW_JERK_FINE <= stated
+    # The jerk by third differences of the positions sampled every millisecond, against the limit.
+    t, q = answer.samples.t, answer.samples.q
+    steps = np.diff(t)
+    uniform = np.flatnonzero(np.all(np.abs(np.lib.stride_tricks.sliding_window_view(steps, 3) - 1e-3) < 1e-9, axis=1))
+    jerk = (q[uniform + 3] - 3 * q[uniform + 2] + 3 * q[uniform + 1] - q[uniform]) / 1e-9
+    assert len(uniform) > 0.99 * len(steps)
+    assert np.abs(jerk).max() <= 1.005
+
+
 def test_the_closed_form_states_a_zero_gap():
     arm = robots.load("ur5")
     path = make_path(arm, WaypointPath(np.array([np.zeros(arm.dof), np.linspace(0.2, 1.2, arm.dof)])))
