@@ -125,7 +125,7 @@ def extrapolated_errors(durations: tuple[float, float, float]) -> tuple[float, f
 def at_rest_halved(constraints: PathConstraints, ends: tuple[int, ...]) -> PathConstraints:
     """``constraints`` with the first (0) and last (-1) of their intervals listed in ``ends``
     halved: the intervals at rest that ``refined`` keeps whole, where no constant-jerk phase
-    fills them (``toptraj.planners.timing.jerk.method._start_phase`` is infinite: no jerk limit
+    fills them (``toptraj.planners.timing.jerk.rest_phase.start_phase`` is infinite: no jerk limit
     binds there, the acceleration then jumps at rest in the optimum, and the first interval's
     linear u lags it by a time of order sqrt(h))."""
     s = constraints.s

@@ -80,18 +80,16 @@ from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.errors import InfeasiblePath, NotServed, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, GAP_TARGET, Boundary, TimingMethod
-from toptraj.planners.timing.jerk.accuracy import coarser, kept, refined, relative_gap
+from toptraj.planners.timing.jerk.accuracy import coarser, refined, relative_gap
 from toptraj.planners.timing.jerk.closed_form import closed_form_timing
 from toptraj.planners.timing.jerk.polish import polish
 from toptraj.planners.timing.jerk.program import RestrictedProgram
+from toptraj.planners.timing.jerk.rest_phase import graded, opened, start_phase
 from toptraj.planners.timing.jerk.scaling import JerkTimeScaling
 from toptraj.planners.timing.jerk.segments import JerkSegmentsTiming
 from toptraj.planners.timing.jerk.stated_gap import stated_gap, unfilled_ends
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
-#: Where the limits give no constant-jerk phase at an end at rest, the first interval is
-#: this fraction of the grid's own first interval.
-FALLBACK_FIRST_INTERVAL = 1e-3
 #: Relative gain below which the LPs on every grid stop: a hundredth of the gap the refinement
 #: aims at. A sequence stopped early ends above its grid's fixed point (each LP step shortens
 #: the motion), which overstates the gap it estimates on the coarser grid of a pair; the
@@ -115,8 +113,6 @@ MAX_REFINED_INTERVALS = 12_000
 ASYMPTOTIC_INTERVALS = 300
 #: Fewest intervals of a grid that starts the LPs of a finer one (``JerkLimitedMethod._seed``).
 SEED_INTERVALS = 60
-#: The shortest first interval at an end at rest, as a fraction of the grid's own first interval.
-MIN_FIRST_INTERVAL = 1e-5
 
 
 class JerkLimitedMethod(TimingMethod):
@@ -161,9 +157,9 @@ class JerkLimitedMethod(TimingMethod):
             if exact is not None:
                 return exact
         if constraints.can_refine:
-            constraints = _opened(constraints, boundary)
+            constraints = opened(constraints, boundary)
         original = constraints.s
-        constraints = _graded(constraints, boundary)
+        constraints = graded(constraints, boundary)
         # The second grid first: its solution starts the LPs on the answer's grid, which then
         # need few iterations over few rows (``toptraj.planners.timing.jerk.working_set``).
         coarse, gap, how = self._second_grid(constraints, original, boundary, deadline)
@@ -244,7 +240,7 @@ class JerkLimitedMethod(TimingMethod):
     def _stated_gap(self, constraints, boundary, best, chain, how, elapsed, deadline) -> tuple[float | None, str]:
         """The gap of ``best`` from its grid's, a finer grid's and the intervals at rest's
         errors (``toptraj.planners.timing.jerk.stated_gap``), each solve started from ``best``."""
-        unfilled = unfilled_ends(constraints, boundary, _start_phase)
+        unfilled = unfilled_ends(constraints, boundary, start_phase)
 
         def solve(grid, start):
             return self._grid_solution(grid, boundary, deadline, start=start, tolerance=WARM_TOLERANCE)
@@ -317,76 +313,3 @@ def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:
         if np.any(spread > tolerance * max(float(np.abs(values[finite]).max(initial=0.0)), reference, 1e-300)):
             return False
     return True
-
-
-def _start_phase(constraints: PathConstraints, point: int) -> float:
-    """Length in s of the constant-jerk phase that starts (ends) the motion at rest at grid
-    point ``point`` (0 or -1), were the path's coefficients constant: at the largest path jerk
-    sigma = min_k J_k / |q'_k| until the largest path acceleration u_max allowed at rest,
-    s = sigma t^3 / 6 with t = u_max / sigma."""
-    assert constraints.jerk is not None  # jerk_limited always builds the jerk rows
-    dq, _, _, limit = constraints.jerk
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sigma = np.nanmin(np.where(dq[point] != 0.0, limit / np.abs(dq[point]), np.inf))
-        a, c = constraints.a[point], constraints.c[point]
-        lower, upper = constraints.lower[point], constraints.upper[point]
-        u_bound = np.where(a > 0, (upper - c) / a, np.where(a < 0, (lower - c) / a, np.inf))
-    u_max = float(np.min(u_bound, initial=np.inf))
-    if not (np.isfinite(sigma) and sigma > 0.0 and np.isfinite(u_max) and u_max > 0.0):
-        return np.inf
-    t = u_max / sigma
-    return sigma * t**3 / 6.0
-
-
-#: Grid points near an end at rest, as multiples of the length of its constant-jerk phase: the
-#: first interval holds half the phase, the points around the phase's end resolve the switch.
-_REST_POINTS = np.array([0.5, 0.7, 0.85, 1.0, 1.15, 1.3, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0])
-
-
-def _opened(constraints: PathConstraints, boundary: Boundary) -> PathConstraints:
-    """The grid without its points closer to an end at rest than half the constant-jerk phase
-    there (``_start_phase``; the path's knots kept): the interval at rest holds that phase's
-    motion exactly, where intervals of linear u cannot follow it (u grows as s^(1/3)). A grid
-    finer than the phase put them there: on the ur5 example, a named grid of 2,000 intervals
-    answered 0.39 % above the optimum (0.08 % with them dropped)."""
-    s = constraints.s
-    knots = np.asarray(constraints.knots if constraints.knots is not None else [], dtype=float)
-    keep = np.ones(len(s), dtype=bool)
-    for at_rest, point, distance in ((boundary.sd_start == 0.0, 0, s - s[0]), (boundary.sd_end == 0.0, -1, s[-1] - s)):
-        phase = _start_phase(constraints, point) if at_rest else np.inf
-        # Not across a knot: the path's coefficients change there, and the phase with them.
-        if np.isfinite(phase) and not np.any((np.abs(knots - s[point]) > 0.0) & (np.abs(knots - s[point]) < 0.5 * phase)):
-            keep &= (distance == 0.0) | (distance >= 0.5 * phase)
-    if keep.all() or keep.sum() < 8:
-        return constraints
-    return kept(constraints, keep)
-
-
-def _graded(constraints: PathConstraints, boundary: Boundary) -> PathConstraints:
-    """The grid with points added toward each end at rest around the end of the constant-jerk
-    phase there (``_start_phase``): the first interval, which holds the motion of constant
-    jerk from rest, then ends within that phase (the points closer to the end than half of it
-    are dropped before, ``_opened``)."""
-    if not constraints.can_refine:
-        return constraints
-    s = constraints.s
-    pieces: list[np.ndarray] = []
-    for at_rest, point, sign, room in (
-        (boundary.sd_start == 0.0, 0, 1.0, s[1] - s[0]),
-        (boundary.sd_end == 0.0, -1, -1.0, s[-1] - s[-2]),
-    ):
-        if not at_rest:
-            continue
-        # A phase shorter than the floor (a jerk limit far above what the other limits let
-        # matter) would put grid points within rounding of the end, and rows of size 1 / h^2
-        # into the program: the first interval is then the floor, over which the jerk limit
-        # does not bind.
-        phase = max(_start_phase(constraints, point), room * MIN_FIRST_INTERVAL / _REST_POINTS[0])
-        if not np.isfinite(phase):
-            phase = room * FALLBACK_FIRST_INTERVAL / _REST_POINTS[0]
-        offsets = phase * _REST_POINTS
-        offsets = offsets[offsets < 0.9 * room]
-        pieces.append(s[point] + sign * offsets)
-    points = np.concatenate(pieces) if pieces else np.empty(0)
-    extra = np.unique(points[~np.isin(points, s)])
-    return constraints.with_points(extra) if extra.size else constraints

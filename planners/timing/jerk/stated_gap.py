@@ -86,7 +86,7 @@ def stated_gap(
 def unfilled_ends(constraints: PathConstraints, boundary: Boundary, phase: PhaseLength) -> tuple[int, ...]:
     """The ends (0, -1) at rest where no jerk limit binds (an infinite ``phase``), or whose
     constant-jerk phase is shorter than half their first interval (the floor of
-    ``toptraj.planners.timing.jerk.method._graded``): elsewhere the first interval holds half the
+    ``toptraj.planners.timing.jerk.rest_phase.graded``): elsewhere the first interval holds half the
     phase, and halving it would leave part of the phase to intervals of linear u."""
     s = constraints.s
     ends = []

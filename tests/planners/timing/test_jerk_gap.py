@@ -82,7 +82,7 @@ def test_the_stated_gap_of_the_ur5_jerk_example_holds_against_the_converged_opti
 
 def test_a_named_grid_finer_than_the_constant_jerk_phase_answers_within_the_bound_of_the_optimum():
     """On a named grid of 2,000 intervals, finer than the phase of constant jerk from rest, the
-    points within half of it are dropped (``toptraj.planners.timing.jerk.method._opened``): with
+    points within half of it are dropped (``toptraj.planners.timing.jerk.rest_phase.opened``): with
     them, the answer was 0.39 % above the optimum."""
     robot, _, waypoints = _example()
     answer = plan(build_problem(robot, WaypointPath(waypoints), METHODS["jerk_limited"], limits=_asked(), grid=2000,

@@ -17,8 +17,8 @@ from toptraj.planners.problem.waypoints import make_path
 from toptraj.planners.timing.base import AT_REST
 from toptraj.planners.timing.jerk import working_set
 from toptraj.planners.timing.jerk.accuracy import extrapolated_errors
-from toptraj.planners.timing.jerk.method import _graded
 from toptraj.planners.timing.jerk.program import RestrictedProgram
+from toptraj.planners.timing.jerk.rest_phase import graded
 from toptraj.planners.timing.jerk.scaling import JerkTimeScaling, interval_times
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 
@@ -31,7 +31,7 @@ def _example_program():
     arm = robots.load("ur5")
     path = make_path(arm, WaypointPath(EXAMPLE_WAYPOINTS))
     limits = arm.limits.with_request(scales={"jerk": 0.5})
-    constraints = _graded(build_path_constraints(path, arm, limits, KINDS, path_grid(path)), AT_REST)
+    constraints = graded(build_path_constraints(path, arm, limits, KINDS, path_grid(path)), AT_REST)
     reference = PhasePlaneMethod(max_refinements=0).solve(constraints)
     x_ref = reference.speed_at(constraints.s) ** 2
     return RestrictedProgram(constraints, AT_REST, x_ref), x_ref
