@@ -26,7 +26,7 @@ from starlette.routing import Match
 
 from toptraj.robots import ToptrajError
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
-from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of
+from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_message
 
 logger = logging.getLogger("toptraj")
 
@@ -61,19 +61,9 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     return problem(status_of(error), title_of(error), detail(error), headers, **extra)
 
 
-def _message(item: dict) -> str:
-    """pydantic's message, with the value given where the choice was among names (an enum):
-    short values only, so that no error echoes a large input."""
-    message = item["msg"]
-    value = item.get("input")
-    if item.get("type") == "literal_error" and isinstance(value, str) and len(value) <= 60:
-        message += f", not {value!r}"
-    return message
-
-
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:
     errors = [
-        {"field": _location(item["loc"]), "message": _message(item)} for item in error.errors()
+        {"field": _location(item["loc"]), "message": validation_message(item)} for item in error.errors()
     ]
     detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:5])
     if len(errors) > 5:
