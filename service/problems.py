@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import string
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -233,7 +233,7 @@ class RequestRefused(ToptrajError):
 _VALUE_ERROR_PREFIX = "Value error, "
 
 
-def validation_message(item: dict) -> str:
+def validation_message(item: Mapping[str, Any]) -> str:
     """pydantic's message of one error ``item`` (an entry of ``errors()``) as the service's own
     sentence: a schema validator's sentence without pydantic's "Value error, " before it, and the
     value given where the choice was among names (an enum), short values only, so that no error
