@@ -22,6 +22,7 @@ from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.robots import LimitZone, Robot
+from toptraj.robots.notes import Note
 
 #: Most zones of one request.
 MAX_ZONES = 32
@@ -108,6 +109,16 @@ def contains(region: SphereObstacle | BoxObstacle, points: np.ndarray) -> np.nda
     return np.all(np.abs(local) <= 0.5 * np.asarray(region.size, dtype=float), axis=1)
 
 
+def distance_outside(region: SphereObstacle | BoxObstacle, points: np.ndarray) -> np.ndarray:
+    """(n,) the Euclidean distance (m) of each of ``points`` (n, 3), world frame, from the closed
+    ``region``; 0 inside it."""
+    offset = np.atleast_2d(points) - np.asarray(region.center, dtype=float)
+    if isinstance(region, SphereObstacle):
+        return np.maximum(np.linalg.norm(offset, axis=1) - region.radius, 0.0)
+    beyond = np.maximum(np.abs(offset @ region.rotation) - 0.5 * np.asarray(region.size, dtype=float), 0.0)
+    return np.linalg.norm(beyond, axis=1)
+
+
 def tool_points(robot: Robot, path: GeometricPath, frame_id: int, s: np.ndarray) -> np.ndarray:
     """(n, 3): the origin of frame ``frame_id`` in the world at the path's points ``q(s)``."""
     q = path.evaluate(np.asarray(s, dtype=float), "right").q
@@ -142,17 +153,20 @@ def region_ranges(robot: Robot, path: GeometricPath, frame_id: int, region: Sphe
     return tuple((float(a), float(b)) for a, b in zip(bounds[::2], bounds[1::2]))
 
 
-def zone_limits(robot: Robot, path: GeometricPath, zones: tuple[Zone, ...], frame_id: int, deadline: Deadline = NO_DEADLINE) -> tuple[LimitZone, ...]:
+def zone_limits(robot: Robot, path: GeometricPath, zones: tuple[Zone, ...], frame_id: int, deadline: Deadline = NO_DEADLINE) -> tuple[tuple[LimitZone, ...], tuple[Note, ...]]:
     """The zones on ``path`` as the timing holds them: s-ranges as given, regions where the
     origin of frame ``frame_id`` lies in them (``region_ranges``); a region the path never enters
-    keeps no range and limits nothing."""
+    keeps no range and limits nothing, and a note says so (``missed_region``)."""
     limited: list[LimitZone] = []
+    notes: list[Note] = []
     for index, zone in enumerate(zones):
         if zone.s_range is not None:
             ranges: tuple[tuple[float, float], ...] = ((float(zone.s_range[0]), float(zone.s_range[1])),)
         else:
             assert zone.region is not None  # check_zones: an s-range or a region, exactly one
             ranges = region_ranges(robot, path, frame_id, zone.region, deadline)
+            if not ranges:
+                notes.append(missed_region(robot, path, frame_id, index, zone.region, deadline))
         if sum(len(item.ranges) for item in limited) + len(ranges) > MAX_RANGES:
             raise InvalidRequest(
                 f"the zones cover more than {MAX_RANGES} stretches of the path from zone {index} on (a region the "
@@ -166,7 +180,26 @@ def zone_limits(robot: Robot, path: GeometricPath, zones: tuple[Zone, ...], fram
             torque=1.0 if zone.torque is None else float(zone.torque),
             tool_speed=math.inf if zone.tool_speed is None else float(zone.tool_speed),
         ))
-    return tuple(limited)
+    return tuple(limited), tuple(notes)
+
+
+def missed_region(robot: Robot, path: GeometricPath, frame_id: int, index: int, region: SphereObstacle | BoxObstacle,
+                  deadline: Deadline = NO_DEADLINE) -> Note:
+    """The note of zone ``index``, whose ``region`` the origin of frame ``frame_id`` never enters
+    along ``path``: the frame, the region's kind and the closest approach, the smallest
+    ``distance_outside`` (m) at ``SCAN_POINTS`` values of s and the s where it lies."""
+    s = np.linspace(0.0, 1.0, SCAN_POINTS)
+    deadline.check()
+    deadline.expect(SCAN_POINTS * FK_SECONDS)
+    distances = distance_outside(region, tool_points(robot, path, frame_id, s))
+    closest = int(np.argmin(distances))
+    kind = "sphere" if isinstance(region, SphereObstacle) else "box"
+    frame = robot.model.frames[frame_id].name
+    return Note(
+        f"zone {index} limits nothing: the origin of frame {frame!r} never enters its {kind} (closest "
+        f"{distances[closest]:.4g} m outside, at s = {s[closest]:.4f})",
+        "missed_region", index=index, region=kind, frame=frame, distance=float(distances[closest]), at_s=float(s[closest]),
+    )
 
 
 def check_zones_served(method_name: str, given_path: bool) -> None:

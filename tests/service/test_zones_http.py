@@ -29,6 +29,11 @@ def test_the_answer_lists_where_each_zone_lies_and_whether_it_bound(client):
     assert middle["index"] == 0 and middle["ranges"] == [[1 / 3, 2 / 3]] and middle["binding"] is True
     assert abs(middle["peak"] - 1.0) <= 0.005
     assert away == {"index": 1, "ranges": [], "peak": 0.0, "binding": False}  # never entered
+    (missed,) = [note for note in response.json()["warnings"] if note.startswith("timing.zones[1]")]
+    assert missed.startswith("timing.zones[1] limits nothing: the tool point (origin of frame 'tool0') never enters its box")
+    assert "grow each edge of timing.zones[1].box.size by more than" in missed
+    assert "or move timing.zones[1].box.center towards the path" in missed
+    assert not [note for note in response.json()["warnings"] if note.startswith("timing.zones[0]")]
     plain = client.post("/v1/trajectories", json=_body([])).json()
     assert plain["zones"] is None and plain["duration"] < response.json()["duration"]
 
