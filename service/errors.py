@@ -42,10 +42,18 @@ def problem(status: int, title: str, detail: str, headers: dict[str, str] | None
 _PATH_TAGS = ("waypoints", "cartesian", "free")
 
 
+#: Tags of the payload's inertia (6 values or a matrix): payload.inertia.<tag>[i].
+_INERTIA_TAGS = ("values", "matrix")
+
+
 def _location(loc) -> str:
     parts = [str(part) for part in loc if part not in ("body",)]
     for index in range(len(parts) - 2):  # path.<tag>.<field>, at the top or in a job
         if parts[index] == "path" and parts[index + 1] in _PATH_TAGS:
+            del parts[index + 1]
+            break
+    for index in range(len(parts) - 1):
+        if parts[index] == "inertia" and parts[index + 1] in _INERTIA_TAGS:
             del parts[index + 1]
             break
     text = ""

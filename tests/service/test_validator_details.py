@@ -56,3 +56,25 @@ def test_the_framework_free_problem_drops_the_prefix_too():
         TrajectoryRequest.model_validate(_zone(s_range=[0.5, 0.2], velocity_scale=0.5))
     detail = validation_problem(refused.value)["detail"]
     assert detail == "timing.zones.0: s_range [0.5, 0.2] runs backwards; give [s0, s1] with s0 <= s1"
+
+
+SHAPES = "give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows of 3), in kg m^2"
+
+
+@pytest.mark.parametrize(
+    "inertia, detail",
+    [
+        ([[1, 0, 0], [0, 1, 0]], f"payload.inertia: {SHAPES}"),
+        ([1, 1, 1, 0, 0], f"payload.inertia: {SHAPES}"),
+        ("diagonal", f"payload.inertia: {SHAPES}"),
+        ([1e9, 1, 1, 0, 0, 0], "payload.inertia[0]: 1e+09 is not within the accepted range [-10000, 10000] kg m^2"),
+        ([[1, 0, 0], [0, 1, 0], [0, 0]], "payload.inertia[2]: List should have at least 3 items after validation, not 2"),
+        ([1, 1, "a", 0, 0, 0], "payload.inertia[2]: Input should be a valid number"),
+    ],
+)
+def test_an_inertia_of_neither_form_names_the_one_meant(client, inertia, detail):
+    """An inertia is 6 values or 3 rows of 3: the 422 names the form its count points to (or
+    both forms), never each form's failures under pydantic's names for them."""
+    response = client.post("/v1/trajectories", json={"robot": "ur5", "path": PATH, "payload": {"mass": 1.0, "inertia": inertia}})
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"] == detail
