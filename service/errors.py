@@ -40,22 +40,26 @@ def problem(status: int, title: str, detail: str, headers: dict[str, str] | None
 
 #: Tags of the path union that pydantic puts in error locations: path.<tag>.<field>.
 _PATH_TAGS = ("waypoints", "cartesian", "free")
-
-
 #: Tags of the payload's inertia (6 values or a matrix): payload.inertia.<tag>[i].
 _INERTIA_TAGS = ("values", "matrix")
+#: Tags of an obstacle (its kind): obstacles[i].<tag>.<field>.
+_OBSTACLE_TAGS = ("sphere", "box", "capsule")
+
+
+def _is_tag(parts: list[str], index: int) -> bool:
+    """Whether ``parts[index]`` is the tag of a union member that pydantic puts in a location,
+    not a field of the request."""
+    before, part = parts[:index], parts[index]
+    if before[-1:] == ["path"]:
+        return part in _PATH_TAGS and index + 1 < len(parts)  # path.<tag>.<field>, at the top or in a job
+    if before[-1:] == ["inertia"]:
+        return part in _INERTIA_TAGS
+    return before[-2:-1] == ["obstacles"] and before[-1].isdigit() and part in _OBSTACLE_TAGS
 
 
 def _location(loc) -> str:
     parts = [str(part) for part in loc if part not in ("body",)]
-    for index in range(len(parts) - 2):  # path.<tag>.<field>, at the top or in a job
-        if parts[index] == "path" and parts[index + 1] in _PATH_TAGS:
-            del parts[index + 1]
-            break
-    for index in range(len(parts) - 1):
-        if parts[index] == "inertia" and parts[index + 1] in _INERTIA_TAGS:
-            del parts[index + 1]
-            break
+    parts = [part for index, part in enumerate(parts) if not _is_tag(parts, index)]
     text = ""
     for part in parts:
         text += f"[{part}]" if part.isdigit() else (f".{part}" if text else part)

@@ -78,3 +78,20 @@ def test_an_inertia_of_neither_form_names_the_one_meant(client, inertia, detail)
     response = client.post("/v1/trajectories", json={"robot": "ur5", "path": PATH, "payload": {"mass": 1.0, "inertia": inertia}})
     assert response.status_code == 422, response.text
     assert response.json()["detail"] == detail
+
+
+@pytest.mark.parametrize(
+    "obstacle, field",
+    [
+        ({"kind": "sphere", "center": [0, 0], "radius": 0.1}, "path.obstacles[0].center"),
+        ({"kind": "box", "center": [0, 0, 0], "size": [0.1, 0.1, -1]}, "path.obstacles[0].size[2]"),
+    ],
+)
+def test_an_obstacle_field_is_named_as_the_request_names_it(client, obstacle, field):
+    """The obstacle's kind chooses its schema; the 422 names the field without the kind between
+    (``path.obstacles[0].center``, as the request writes it)."""
+    body = {"robot": "ur5", "path": {**PATH, "obstacles": [obstacle]}}
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 422, response.text
+    assert response.json()["errors"][0]["field"] == field
+    assert response.json()["detail"].startswith(f"{field}: ")
