@@ -235,12 +235,15 @@ _VALUE_ERROR_PREFIX = "Value error, "
 
 def validation_message(item: Mapping[str, Any]) -> str:
     """pydantic's message of one error ``item`` (an entry of ``errors()``) as the service's own
-    sentence: a schema validator's sentence without pydantic's "Value error, " before it, and the
+    sentence: a schema validator's sentence without pydantic's "Value error, " before it, a list's
+    count without "after validation" (the request's count is meant), and the
     value given where the choice was among names (an enum), short values only, so that no error
     echoes a large input."""
     message = item["msg"]
     if item.get("type") == "value_error" and message.startswith(_VALUE_ERROR_PREFIX):
         message = message[len(_VALUE_ERROR_PREFIX) :]
+    if item.get("type") in ("too_short", "too_long"):  # a list's count as the request gives it
+        message = message.replace(" after validation", "")
     value = item.get("input")
     if item.get("type") == "literal_error" and isinstance(value, str) and len(value) <= 60:
         message += f", not {value!r}"

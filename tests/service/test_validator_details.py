@@ -68,7 +68,7 @@ SHAPES = "give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows o
         ([1, 1, 1, 0, 0], f"payload.inertia: {SHAPES}"),
         ("diagonal", f"payload.inertia: {SHAPES}"),
         ([1e9, 1, 1, 0, 0, 0], "payload.inertia[0]: 1e+09 is not within the accepted range [-10000, 10000] kg m^2"),
-        ([[1, 0, 0], [0, 1, 0], [0, 0]], "payload.inertia[2]: List should have at least 3 items after validation, not 2"),
+        ([[1, 0, 0], [0, 1, 0], [0, 0]], "payload.inertia[2]: List should have at least 3 items, not 2"),
         ([1, 1, "a", 0, 0, 0], "payload.inertia[2]: Input should be a valid number"),
     ],
 )
@@ -95,3 +95,19 @@ def test_an_obstacle_field_is_named_as_the_request_names_it(client, obstacle, fi
     assert response.status_code == 422, response.text
     assert response.json()["errors"][0]["field"] == field
     assert response.json()["detail"].startswith(f"{field}: ")
+
+
+
+@pytest.mark.parametrize(
+    "path, detail",
+    [
+        ({"kind": "cartesian", "start": UR5_WAYPOINTS[0], "positions": [[0.4, 0.5]]}, "path.positions[0]: List should have at least 3 items, not 2"),
+        ({"waypoints": UR5_WAYPOINTS[:1]}, "path.waypoints: List should have at least 2 items, not 1"),
+    ],
+)
+def test_a_count_is_the_requests_own(client, path, detail):
+    """A list of the wrong count is told by the request's count, without pydantic's "after
+    validation"."""
+    response = client.post("/v1/trajectories", json={"robot": "ur5", "path": path})
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"] == detail
