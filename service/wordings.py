@@ -15,6 +15,7 @@ from collections.abc import Callable
 from toptraj.robots.errors import excerpt
 from toptraj.robots.ranges import Range
 from toptraj.service.note_wordings import NOTE_WORDING
+from toptraj.service.zone_wordings import ZONE_WORDING
 
 
 def _range(facts: dict) -> str:
@@ -390,4 +391,5 @@ WORDING: dict[str, Wording] = {
         "is to stay where it is needs no trajectory)"
     ),
     **NOTE_WORDING,
+    **ZONE_WORDING,
 }

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from toptraj.planners.collision.obstacles import BoxObstacle, SphereObstacle, check_obstacles
+from toptraj.planners.collision.obstacles import UNIT_TOLERANCE, BoxObstacle, SphereObstacle, check_obstacles
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.base import GeometricPath
@@ -60,29 +60,35 @@ class Zone:
     tool_speed: float | None = None
 
 
+def _refused(field: str, sentence: str, **facts) -> InvalidRequest:
+    """The refusal of a zone: ``field`` in the library's names (``zones[i]...``), the library's
+    ``sentence``; a ``rule`` among ``facts`` lets the service word it in its request's terms."""
+    return InvalidRequest(field, facts.pop("value", None), detail=sentence, **facts)
+
+
 def check_zones(zones: tuple[Zone, ...]) -> None:
     """InvalidRequest naming the zone unless there are at most ``MAX_ZONES``, each with exactly
     one of an s-range within [0, 1] (s0 <= s1) and a region, at least one limit, factors in
     (0, 1] and a positive finite tool speed."""
     if len(zones) > MAX_ZONES:
-        raise InvalidRequest(f"{len(zones)} zones are given; at most {MAX_ZONES} are served (merge neighbouring ones)")
+        raise _refused("zones", f"{len(zones)} zones are given; at most {MAX_ZONES} are served (merge neighbouring ones)")
     for index, zone in enumerate(zones):
         if (zone.s_range is None) == (zone.region is None):
-            raise InvalidRequest(f"zone {index} needs exactly one of an s-range and a region (sphere or box)")
+            raise _refused(f"zones[{index}]", f"zone {index} needs exactly one of an s-range and a region (sphere or box)")
         if zone.s_range is not None:
             s0, s1 = (float(value) for value in zone.s_range)
             if not (0.0 <= s0 <= s1 <= 1.0):
-                raise InvalidRequest(f"zone {index} has the s-range [{s0:g}, {s1:g}]; give 0 <= s0 <= s1 <= 1")
+                raise _refused(f"zones[{index}].s_range", f"zone {index} has the s-range [{s0:g}, {s1:g}]; give 0 <= s0 <= s1 <= 1")
         else:
             _check_region(index, zone.region)
         factors = {"velocity": zone.velocity, "acceleration": zone.acceleration, "torque": zone.torque}
         if all(value is None for value in (*factors.values(), zone.tool_speed)):
-            raise InvalidRequest(f"zone {index} sets no limit; give a velocity, acceleration or torque factor or a tool speed")
+            raise _refused(f"zones[{index}]", f"zone {index} sets no limit; give a velocity, acceleration or torque factor or a tool speed")
         for name, value in factors.items():
             if value is not None and not (0.0 < value <= 1.0):
-                raise InvalidRequest(f"zone {index} has a {name} factor of {value:g}; a zone's factors lie in (0, 1]")
+                raise _refused(f"zones[{index}].{name}", f"zone {index} has a {name} factor of {value:g}; a zone's factors lie in (0, 1]")
         if zone.tool_speed is not None and not (0.0 < zone.tool_speed < math.inf):
-            raise InvalidRequest(f"zone {index} has a tool speed of {zone.tool_speed:g} m/s; give a positive finite speed")
+            raise _refused(f"zones[{index}].tool_speed", f"zone {index} has a tool speed of {zone.tool_speed:g} m/s; give a positive finite speed")
 
 
 def _check_region(index: int, region) -> None:
@@ -90,14 +96,18 @@ def _check_region(index: int, region) -> None:
     box of positive edges with a unit orientation."""
     if isinstance(region, SphereObstacle):
         if not (0.0 < region.radius < math.inf and np.isfinite(region.center).all()):
-            raise InvalidRequest(f"zone {index}'s sphere needs a finite center and a positive radius, got {region.radius:g}")
+            raise _refused(f"zones[{index}].sphere", f"zone {index}'s sphere needs a finite center and a positive radius, got {region.radius:g}")
         return
     if not (np.shape(region.size) == (3,) and np.all(np.asarray(region.size) > 0.0) and np.isfinite(region.center).all()):
-        raise InvalidRequest(f"zone {index}'s box needs a finite center and three positive edge lengths")
+        raise _refused(f"zones[{index}].box", f"zone {index}'s box needs a finite center and three positive edge lengths")
     try:
         check_obstacles([region])
     except InvalidRequest:
-        raise InvalidRequest(f"zone {index}'s box orientation is not a unit quaternion [qx, qy, qz, qw]") from None
+        norm = float(np.linalg.norm(np.asarray(region.orientation, dtype=float)))
+        raise _refused(
+            f"zones[{index}].box.orientation", f"zone {index}'s box orientation has norm {norm:.6g}, not a unit quaternion [qx, qy, qz, qw]",
+            rule="zone_box_not_unit", index=index, norm=norm, tolerance=UNIT_TOLERANCE,
+        ) from None
 
 
 def contains(region: SphereObstacle | BoxObstacle, points: np.ndarray) -> np.ndarray:
@@ -168,9 +178,11 @@ def zone_limits(robot: Robot, path: GeometricPath, zones: tuple[Zone, ...], fram
             if not ranges:
                 notes.append(missed_region(robot, path, frame_id, index, zone.region, deadline))
         if sum(len(item.ranges) for item in limited) + len(ranges) > MAX_RANGES:
-            raise InvalidRequest(
+            raise _refused(
+                f"zones[{index}]",
                 f"the zones cover more than {MAX_RANGES} stretches of the path from zone {index} on (a region the "
-                "tool point enters and leaves many times); give fewer or larger regions, or s-ranges"
+                "tool point enters and leaves many times); give fewer or larger regions, or s-ranges",
+                rule="zone_ranges_too_many", index=index, most=MAX_RANGES,
             )
         limited.append(LimitZone(
             index=index,
@@ -205,8 +217,10 @@ def missed_region(robot: Robot, path: GeometricPath, frame_id: int, index: int, 
 def check_zones_served(method_name: str, given_path: bool) -> None:
     """InvalidRequest unless ``method_name`` holds zones on a given path (``ZONE_METHODS``)."""
     if method_name not in ZONE_METHODS or not given_path:
-        raise InvalidRequest(
+        raise _refused(
+            "zones",
             f"zones are held by the timing methods {', '.join(ZONE_METHODS)} along a given path (waypoints "
             f"interpolated by spline, linear or blend, or a cartesian line), not by {method_name!r} here; "
-            "use one of those, or leave the zones out"
+            "use one of those, or leave the zones out",
+            rule="zones_not_served", method=method_name, methods=ZONE_METHODS,
         )

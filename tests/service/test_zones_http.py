@@ -63,4 +63,18 @@ def test_a_method_that_does_not_hold_zones_is_422(client):
     path = {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}
     response = client.post("/v1/trajectories", json=_body([MIDDLE], method="quintic", path=path))
     assert response.status_code == 422, response.text
-    assert "zones are held by the timing methods phase_plane, toppra" in response.json()["detail"]
+    assert response.json()["detail"] == (
+        "timing.zones are held by timing.method phase_plane or toppra along a given path (path.kind 'waypoints' with "
+        "interpolation 'spline', 'linear' or 'blend', or 'cartesian'), not by 'quintic' here: choose one of those "
+        "methods, or leave timing.zones out"
+    )
+
+
+def test_a_box_turned_by_no_unit_quaternion_is_422_naming_its_orientation(client):
+    box = {"center": [0.4, 0.5, 0.3], "size": [0.1, 0.1, 0.1], "orientation": [0.0, 0.0, 0.0, 0.5]}
+    response = client.post("/v1/trajectories", json=_body([MIDDLE, {"box": box, "velocity_scale": 0.5}]))
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"] == (
+        "timing.zones[1].box.orientation has norm 0.5: it is no rotation; give a unit quaternion [qx, qy, qz, qw] "
+        "(norm 1 within 0.001), e.g. [0, 0, 0, 1] for a box along the world's axes"
+    )

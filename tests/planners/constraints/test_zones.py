@@ -17,7 +17,7 @@ from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
 from toptraj.planners import METHODS, CartesianLine, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.checks.gate import samples_exceed
-from toptraj.planners.collision import SphereObstacle
+from toptraj.planners.collision import BoxObstacle, SphereObstacle
 from toptraj.planners.constraints.zones import with_edges
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.problem import zones as zones_module
@@ -160,8 +160,22 @@ def test_bad_zones_are_refused_naming_the_zone(ur5, zones, words):
 
 
 def test_methods_that_do_not_hold_zones_refuse_them(ur5):
-    with pytest.raises(InvalidRequest, match="zones are held by the timing methods phase_plane, toppra"):
+    with pytest.raises(InvalidRequest) as refused:
         plan(build_problem(ur5, WaypointPath(np.array(UR5_WAYPOINTS)), METHODS["quintic"], limits=LimitRequest(zones=(MIDDLE,)), sampling=Sampling(dt=0.01)))
+    assert (refused.value.field, refused.value.rule, refused.value.method) == ("zones", "zones_not_served", "quintic")
+    assert str(refused.value) == (
+        "zones are held by the timing methods phase_plane, toppra along a given path (waypoints interpolated by spline, "
+        "linear or blend, or a cartesian line), not by 'quintic' here; use one of those, or leave the zones out"
+    )
+
+
+def test_a_box_that_is_not_turned_by_a_unit_quaternion_is_refused_in_a_sentence(ur5):
+    """The refusal is the library's sentence with the zone's field, not a field made of the sentence."""
+    box = BoxObstacle(center=(0.4, 0.5, 0.3), size=(0.1, 0.1, 0.1), orientation=(0.0, 0.0, 0.0, 0.5))
+    with pytest.raises(InvalidRequest) as refused:
+        plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(zones=(Zone(region=box, velocity=0.5),)), sampling=Sampling(dt=0.01)))
+    assert (refused.value.field, refused.value.rule, refused.value.norm) == ("zones[0].box.orientation", "zone_box_not_unit", 0.5)
+    assert str(refused.value) == "zone 0's box orientation has norm 0.5, not a unit quaternion [qx, qy, qz, qw]"
 
 
 def test_the_grid_holds_every_zone_edge_and_keeps_its_knots():
