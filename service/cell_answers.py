@@ -42,8 +42,11 @@ def sample_times(duration: float, dt: float) -> np.ndarray:
     """Every ``dt`` from 0, the last sample at ``duration`` (s); InvalidRequest past ``MAX_SAMPLES``."""
     count = int(np.ceil(duration / dt))
     if count > MAX_SAMPLES:
+        enough = math.ceil(duration / MAX_SAMPLES * 1e4) / 1e4  # the least dt on a 0.1 ms step
         raise InvalidRequest(
-            f"the cell's motion lasts {duration:.4g} s: {count} samples of dt = {dt:g} s exceed {MAX_SAMPLES}; raise dt"
+            "dt", dt,
+            detail=f"the cell's motion lasts {duration:.4g} s: {count} samples of dt = {dt:g} s exceed {MAX_SAMPLES}; "
+            f"give dt >= {enough:g} s",
         )
     return np.minimum(np.arange(count + 1) * dt, duration)
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from toptraj import robots
 from toptraj.planners.coordination import Cell, CellArm, checked_rotation, coordinate
-from toptraj.planners.errors import InvalidRequest
+from toptraj.planners.errors import InvalidRequest, WrongLength
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.problem.requests import WaypointPath
 from toptraj.planners.problem.waypoints import make_path
@@ -49,6 +49,9 @@ def _in_arm(index: int, error: InvalidRequest) -> InvalidRequest:
 def _arm(index: int, request: CellArmRequest, gravity, deadline: Deadline) -> CellArm:
     robot = _robot(index, request, gravity)
     try:
+        for row, waypoint in enumerate(request.waypoints):  # rows of other lengths make no array
+            if len(waypoint) != robot.dof:
+                raise WrongLength(f"waypoints[{row}]", waypoint, len(waypoint), robot.dof, robot=robot.name, joint_names=robot.joint_names)
         path = make_path(robot, WaypointPath(np.asarray(request.waypoints, dtype=float)), deadline)
     except InvalidRequest as error:
         raise _in_arm(index, error) from error

@@ -26,7 +26,7 @@ from starlette.routing import Match
 
 from toptraj.robots import ToptrajError
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
-from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of
+from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_message
 
 logger = logging.getLogger("toptraj")
 
@@ -40,14 +40,26 @@ def problem(status: int, title: str, detail: str, headers: dict[str, str] | None
 
 #: Tags of the path union that pydantic puts in error locations: path.<tag>.<field>.
 _PATH_TAGS = ("waypoints", "cartesian", "free")
+#: Tags of the payload's inertia (6 values or a matrix): payload.inertia.<tag>[i].
+_INERTIA_TAGS = ("values", "matrix")
+#: Tags of an obstacle (its kind): obstacles[i].<tag>.<field>.
+_OBSTACLE_TAGS = ("sphere", "box", "capsule")
+
+
+def _is_tag(parts: list[str], index: int) -> bool:
+    """Whether ``parts[index]`` is the tag of a union member that pydantic puts in a location,
+    not a field of the request."""
+    before, part = parts[:index], parts[index]
+    if before[-1:] == ["path"]:
+        return part in _PATH_TAGS and index + 1 < len(parts)  # path.<tag>.<field>, at the top or in a job
+    if before[-1:] == ["inertia"]:
+        return part in _INERTIA_TAGS
+    return before[-2:-1] == ["obstacles"] and before[-1].isdigit() and part in _OBSTACLE_TAGS
 
 
 def _location(loc) -> str:
     parts = [str(part) for part in loc if part not in ("body",)]
-    for index in range(len(parts) - 2):  # path.<tag>.<field>, at the top or in a job
-        if parts[index] == "path" and parts[index + 1] in _PATH_TAGS:
-            del parts[index + 1]
-            break
+    parts = [part for index, part in enumerate(parts) if not _is_tag(parts, index)]
     text = ""
     for part in parts:
         text += f"[{part}]" if part.isdigit() else (f".{part}" if text else part)
@@ -61,19 +73,9 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
     return problem(status_of(error), title_of(error), detail(error), headers, **extra)
 
 
-def _message(item: dict) -> str:
-    """pydantic's message, with the value given where the choice was among names (an enum):
-    short values only, so that no error echoes a large input."""
-    message = item["msg"]
-    value = item.get("input")
-    if item.get("type") == "literal_error" and isinstance(value, str) and len(value) <= 60:
-        message += f", not {value!r}"
-    return message
-
-
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:
     errors = [
-        {"field": _location(item["loc"]), "message": _message(item)} for item in error.errors()
+        {"field": _location(item["loc"]), "message": validation_message(item)} for item in error.errors()
     ]
     detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:5])
     if len(errors) > 5:

@@ -38,6 +38,20 @@ def _collocation_gap(facts: dict) -> str:
     return f"the duration may lie up to {100 * facts['gap']:.2g} % above the optimum ({facts['basis']}){advice}"
 
 
+def _missed_region(facts: dict) -> str:
+    zone, distance = f"timing.zones[{facts['index']}]", facts["distance"]
+    grow = (
+        f"{zone}.sphere.radius by more than {distance:.4g} m" if facts["region"] == "sphere"
+        else f"each edge of {zone}.box.size by more than {2 * distance:.4g} m"
+    )
+    return (
+        f"{zone} limits nothing: the tool point (origin of frame {facts['frame']!r}) never enters its {facts['region']} "
+        f"along the path; it passes {distance:.4g} m outside at its closest (s = {facts['at_s']:.4f}). To limit the "
+        f"motion there, grow {grow} or move {zone}.{facts['region']}.center towards the path (world frame, m); "
+        "timing.limits.tool_frame chooses the tool point"
+    )
+
+
 NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     "gap_above_target": _gap_above_target,
     "duration_given": "not estimated: timing.duration sets the duration, which is no optimum",
@@ -58,6 +72,7 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
         "stops there"
     ),
     "collocation_gap": _collocation_gap,
+    "missed_region": _missed_region,
     "urdf_limit_out_of_range": (
         "{where}: {kind} limit {value:g} {unit} in the URDF is outside the accepted range "
         "[{low:g}, {high:g}] (the range of every {kind} limit, a request's timing.limits too)"

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import string
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -229,9 +229,30 @@ class RequestRefused(ToptrajError):
     title = "Invalid request"
 
 
+#: What pydantic puts before the sentence of a ``ValueError`` raised by a schema's validator.
+_VALUE_ERROR_PREFIX = "Value error, "
+
+
+def validation_message(item: Mapping[str, Any]) -> str:
+    """pydantic's message of one error ``item`` (an entry of ``errors()``) as the service's own
+    sentence: a schema validator's sentence without pydantic's "Value error, " before it, a list's
+    count without "after validation" (the request's count is meant), and the
+    value given where the choice was among names (an enum), short values only, so that no error
+    echoes a large input."""
+    message = item["msg"]
+    if item.get("type") == "value_error" and message.startswith(_VALUE_ERROR_PREFIX):
+        message = message[len(_VALUE_ERROR_PREFIX) :]
+    if item.get("type") in ("too_short", "too_long"):  # a list's count as the request gives it
+        message = message.replace(" after validation", "")
+    value = item.get("input")
+    if item.get("type") == "literal_error" and isinstance(value, str) and len(value) <= 60:
+        message += f", not {value!r}"
+    return message
+
+
 def validation_problem(error: ValidationError) -> dict:
     """The problem+json of a request that does not fit its schema (as the HTTP API's 422)."""
-    detail = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in error.errors())
+    detail = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {validation_message(e)}" for e in error.errors())
     return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": detail}
 
 

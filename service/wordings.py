@@ -15,6 +15,7 @@ from collections.abc import Callable
 from toptraj.robots.errors import excerpt
 from toptraj.robots.ranges import Range
 from toptraj.service.note_wordings import NOTE_WORDING
+from toptraj.service.zone_wordings import ZONE_WORDING
 
 
 def _range(facts: dict) -> str:
@@ -298,7 +299,11 @@ WORDING: dict[str, Wording] = {
         "undefined; set one in timing.limits"
     ),
     "via_points_need_polynomials": "via points need {field} 'cubic' or 'quintic', not {value!r}",
-    "waypoints_coincide": lambda facts: f"path.waypoints[{facts['index']}] and path.waypoints[{facts['index'] + 1}] coincide",
+    "waypoints_coincide": lambda facts: (
+        f"path.waypoints[{facts['index']}] and path.waypoints[{facts['index'] + 1}] coincide (no joint differs by more "
+        f"than {facts['tolerance']:g} rad or m), so the path has no direction between them: remove "
+        f"path.waypoints[{facts['index'] + 1}], or change one of its joint values by more than {facts['tolerance']:g}"
+    ),
     "search_needs_free_path": "{field} 'search' finds the path itself: give a free path (path.kind 'free', start and goal)",
     "search_from_rest": "the search plans the fastest motion from rest to rest: leave timing.boundary and timing.duration out",
     "search_over_estimate": lambda facts: (
@@ -380,6 +385,11 @@ WORDING: dict[str, Wording] = {
         "{max_bytes} bytes, and this upload adds {added} bytes. Free space with DELETE /v1/robots/{{name}} "
         "(GET /v1/robots lists the uploads)."
     ),
-    "all_waypoints_coincide": "path.waypoints[0] and path.waypoints[1] coincide, as do all {count} waypoints: there is nothing to move",
+    "all_waypoints_coincide": (
+        "path.waypoints[0] and path.waypoints[1] coincide, as do all {count} waypoints: there is nothing to move; give "
+        "a waypoint that differs from path.waypoints[0] by more than {tolerance:g} rad or m in some joint (an arm that "
+        "is to stay where it is needs no trajectory)"
+    ),
     **NOTE_WORDING,
+    **ZONE_WORDING,
 }

@@ -23,6 +23,7 @@ import pinocchio as pin
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.base import GeometricPath, PathPoints
+from toptraj.planners.paths.waypoints import COINCIDENT
 from toptraj.planners.timing.base import DenseStates, PathTiming
 from toptraj.planners.timing.laws.profiles import cubic_coefficients, quintic_coefficients
 from toptraj.robots import JointLimits, Robot
@@ -185,9 +186,9 @@ def via_point_trajectory(
     if law not in ("cubic", "quintic"):
         raise NotServed("method", law, law, rule="via_points_need_polynomials", alternatives=("cubic", "quintic"))
     steps = np.diff(waypoints, axis=0)
-    if np.any(np.all(np.abs(steps) < 1e-12, axis=1)):
-        index = int(np.flatnonzero(np.all(np.abs(steps) < 1e-12, axis=1))[0])
-        raise InvalidRequest(f"waypoints[{index}]", waypoints[index], rule="waypoints_coincide", index=index)
+    if np.any(np.all(np.abs(steps) < COINCIDENT, axis=1)):
+        index = int(np.flatnonzero(np.all(np.abs(steps) < COINCIDENT, axis=1))[0])
+        raise InvalidRequest(f"waypoints[{index}]", waypoints[index], rule="waypoints_coincide", index=index, tolerance=COINCIDENT)
     n_segments, n_dof = steps.shape
     with np.errstate(divide="ignore"):
         velocity_time = np.nan_to_num(np.abs(steps) / limits.velocity, posinf=0.0).max(axis=1) * 1.5

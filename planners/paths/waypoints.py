@@ -16,6 +16,11 @@ from numba import njit
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.paths.base import RANGE_SLACK, GeometricPath, PathPoints
 
+#: Joint-space distance (rad or m) at or below which two consecutive waypoints coincide: the path
+#: would have no tangent between them. Two waypoints one of whose joint values differ by more are
+#: apart (their Euclidean distance is then larger too).
+COINCIDENT = 1e-12
+
 
 def chord_knots(waypoints: np.ndarray) -> np.ndarray:
     """s of each waypoint, shape (n_waypoints,): cumulative Euclidean joint distance over its total.
@@ -24,9 +29,9 @@ def chord_knots(waypoints: np.ndarray) -> np.ndarray:
         InvalidRequest: two consecutive waypoints coincide (the path would have no tangent there).
     """
     lengths = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
-    if np.any(lengths <= 1e-12):
-        index = int(np.flatnonzero(lengths <= 1e-12)[0])
-        raise InvalidRequest(f"waypoints[{index}]", waypoints[index], rule="waypoints_coincide", index=index)
+    if np.any(lengths <= COINCIDENT):
+        index = int(np.flatnonzero(lengths <= COINCIDENT)[0])
+        raise InvalidRequest(f"waypoints[{index}]", waypoints[index], rule="waypoints_coincide", index=index, tolerance=COINCIDENT)
     cumulative = np.concatenate(([0.0], np.cumsum(lengths)))
     knots = cumulative / cumulative[-1]
     knots[-1] = 1.0

@@ -13,6 +13,7 @@ from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from toptraj.planners.paths.blended import BlendedPath
 from toptraj.planners.paths.cartesian import CartesianLine, cartesian_path
+from toptraj.planners.paths.waypoints import COINCIDENT
 from toptraj.planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
 from toptraj.planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
 from toptraj.robots import Robot
@@ -22,8 +23,6 @@ INTERPOLATIONS = {"spline": SplinePath, "linear": StopAndGoPath, "blend": Blende
 MAX_WAYPOINTS = 1_000
 #: Largest joint coordinate accepted (rad or m): a continuous joint may turn many times, not 1e300.
 MAX_COORDINATE = COORDINATE.high
-#: Consecutive waypoints closer than this (joint-space norm, rad or m) are one waypoint.
-COINCIDENT = 1e-12
 
 
 def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
@@ -70,7 +69,7 @@ def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
     if repeats.size == 0:
         return spec, ()
     if repeats.size == len(waypoints) - 1:
-        raise InvalidRequest("waypoints", waypoints, rule="all_waypoints_coincide", count=len(waypoints))
+        raise InvalidRequest("waypoints", waypoints, rule="all_waypoints_coincide", count=len(waypoints), tolerance=COINCIDENT)
     shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
     note = Note(
         f"waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)",

@@ -96,11 +96,12 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
 
 def _with_zones(problem: Problem, path) -> Problem:
     """The problem with its zones located on ``path`` (a region where the tool frame's origin,
-    the end effector's without a tool limit, lies in it), tightened by the margin."""
+    the end effector's without a tool limit, lies in it), tightened by the margin, and a note for
+    each region the path never enters."""
     zones, limits, robot = problem.requested.zones, problem.limits, problem.robot
     if not zones:
         return problem
     frame_id = robot.frame_id(robot.end_effector) if limits.tool is None else limits.tool.frame_id
-    located = zone_limits(robot, path, zones, frame_id, problem.deadline)
+    located, missed = zone_limits(robot, path, zones, frame_id, problem.deadline)
     zoned = dataclasses.replace(limits, zones=tuple(zone.tightened(problem.margin) for zone in located))
-    return dataclasses.replace(problem, limits=zoned)
+    return dataclasses.replace(problem, limits=zoned, notes=(*problem.notes, *missed))

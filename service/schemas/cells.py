@@ -20,7 +20,8 @@ MAX_CELL_WAYPOINTS = 100
 RotationRow = Annotated[list[Annotated[float, Field(ge=-2.0, le=2.0)]], Field(min_length=3, max_length=3)]
 IDENTITY = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
 #: Fields of other kinds of path (the trajectory endpoint's ``path``), refused with advice.
-OTHER_PATH_KEYS = ("path", "kind", "points", "poses", "line", "start", "goal", "frame")
+_PATH_FIELDS = ("interpolation", "max_deviation", "continuous", "revolutions")
+OTHER_PATH_KEYS = ("path", "kind", "points", "positions", "poses", "line", "start", "goal", "frame", *_PATH_FIELDS)
 
 
 class BasePose(Schema):

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from toptraj.robots import equipment
 from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS, PAYLOAD_RADIUS
@@ -26,6 +26,27 @@ def _checked(check, *args, **kwargs):
         raise ValueError(error.detail) from None
 
 
+def _inertia_shape(value: object) -> str | None:
+    """Which form of an inertia ``value`` is: ``"values"`` (a list of 6), ``"matrix"`` (a list of
+    3) or ``None`` (neither: a 422 saying both forms)."""
+    if isinstance(value, list | tuple):
+        return {6: "values", 3: "matrix"}.get(len(value))
+    return None
+
+
+#: A payload's inertia: 6 values or 3 rows of 3, told apart by their count (so that a 422 names
+#: the one form meant, not each form's failures).
+_Inertia = Annotated[
+    Annotated[list[Annotated[float, signed(PAYLOAD_INERTIA)]], Field(min_length=6, max_length=6), Tag("values")]
+    | Annotated[list[_Row], Field(min_length=3, max_length=3), Tag("matrix")],
+    Discriminator(
+        _inertia_shape,
+        custom_error_type="inertia_shape",
+        custom_error_message="give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows of 3), in kg m^2",
+    ),
+]
+
+
 class PayloadRequest(Schema):
     """A rigid body held at the tool: its mass, centre of mass and, optionally, rotational
     inertia. Torques, torque limits and `tau` include it."""
@@ -34,11 +55,7 @@ class PayloadRequest(Schema):
     center_of_mass: Annotated[list[Annotated[float, signed(CENTER_OF_MASS)]], Field(min_length=3, max_length=3)] = Field(
         default=[0.0, 0.0, 0.0], description="Centre of mass [x, y, z] (m) in the payload's frame."
     )
-    inertia: (
-        Annotated[list[Annotated[float, signed(PAYLOAD_INERTIA)]], Field(min_length=6, max_length=6)]
-        | Annotated[list[_Row], Field(min_length=3, max_length=3)]
-        | None
-    ) = Field(
+    inertia: _Inertia | None = Field(
         default=None,
         description="Rotational inertia about the centre of mass in the frame's axes (kg m^2): 6 values "
         "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a symmetric 3x3 matrix, positive definite, its principal moments "

@@ -16,7 +16,10 @@ import pytest
 from tests.paths import ROOT
 from tests.planners.collision.test_self_collision import FOLDING
 from tests.robots.test_equipment import COM, INERTIA, MASS, _ur5_with_load_link
+from toptraj.planners.errors import InvalidRequest
 from toptraj.robots.catalog import example_urdf_path
+from toptraj.service import problems
+from toptraj.service.cell_answers import sample_times
 
 EXAMPLE = json.loads((ROOT / "examples" / "cell_two_ur5.json").read_text())
 #: Gravity tilted in the world: the second base, turned half a turn about z, feels it as [-1, 0, -9.7].
@@ -127,3 +130,15 @@ def test_an_arm_whose_path_folds_onto_itself_is_a_422_naming_the_links_and_s(pat
     assert response.status_code == 422, response.text
     detail = response.json()["detail"]
     assert detail.startswith("arms[1] (ur5): links 'shoulder_link' and 'forearm_link' touch at s = ")
+
+
+def test_too_many_samples_are_a_422_saying_the_least_dt():
+    """31.94 s at dt = 1 ms is 31,940 samples, above 20,000: the refusal names dt and the least
+    dt that serves (31.94 / 20,000 = 1.597 ms, up to the next 0.1 ms), and that dt serves."""
+    with pytest.raises(InvalidRequest) as refused:
+        sample_times(31.94, 0.001)
+    assert refused.value.field == "dt"
+    assert problems.detail(refused.value) == (
+        "the cell's motion lasts 31.94 s: 31940 samples of dt = 0.001 s exceed 20000; give dt >= 0.0016 s"
+    )
+    assert len(sample_times(31.94, 0.0016)) <= 20_001

@@ -99,7 +99,17 @@ def test_a_path_of_another_kind_is_a_422_saying_what_is_served(patient_client, o
             "arms[1].waypoints[0] has 3 values; ur5 has 6 joints (shoulder_pan_joint, shoulder_lift_joint, elbow_joint, "
             "wrist_1_joint, wrist_2_joint, wrist_3_joint)",
         ),
-        ([[1.5, -0.5, 0.5, 0.0, 0.0, 0.0]] * 2, "arms[1].waypoints[0] and arms[1].waypoints[1] coincide"),
+        (
+            [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0], [1.5, -0.5, 0.5, 0.0, 0.0]],
+            "arms[1].waypoints[1] has 5 values; ur5 has 6 joints (shoulder_pan_joint, shoulder_lift_joint, elbow_joint, "
+            "wrist_1_joint, wrist_2_joint, wrist_3_joint)",
+        ),
+        (
+            [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0]] * 2,
+            "arms[1].waypoints[0] and arms[1].waypoints[1] coincide (no joint differs by more than 1e-12 rad or m), so "
+            "the path has no direction between them: remove arms[1].waypoints[1], or change one of its joint values by "
+            "more than 1e-12",
+        ),
         (
             [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0], [99.0, -0.5, 0.5, 0.0, 0.0, 0.0]],
             "arms[1].waypoints[1][0] = 99 is outside the limits [-6.28319, 6.28319] of joint 'shoulder_pan_joint'",

@@ -28,7 +28,7 @@ def _post(client, body, **kwargs):
         ({"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.1] * 5]}}, 422, ["waypoints[1] has 5 values"]),
         ({"robot": "ur5", "path": {"waypoints": [[0.0] * 6]}}, 422, ["path.waypoints", "at least 2"]),
         ({"robot": "ur5", "path": {"waypoints": []}}, 422, ["path.waypoints", "at least 2"]),
-        ({"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.0] * 6]}}, 422, ["waypoints[0] and path.waypoints[1] coincide"]),
+        ({"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.0] * 6]}}, 422, ["waypoints[0] and path.waypoints[1] coincide", "give a waypoint that differs from path.waypoints[0] by more than 1e-12 rad or m in some joint"]),
         ({"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0, 0, 3.5, 0, 0, 0]]}}, 422, ["waypoints[1][2] = 3.5", "elbow_joint"]),
         ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "magic"}}, 422, ["timing.method", "not 'magic'", "toppra"]),
         ({"robot": "ur5", "path": GOOD_PATH, "timing": {"constraints": ["jerkiness"]}}, 422, ["timing.constraints[0]"]),

@@ -29,6 +29,11 @@ def test_the_answer_lists_where_each_zone_lies_and_whether_it_bound(client):
     assert middle["index"] == 0 and middle["ranges"] == [[1 / 3, 2 / 3]] and middle["binding"] is True
     assert abs(middle["peak"] - 1.0) <= 0.005
     assert away == {"index": 1, "ranges": [], "peak": 0.0, "binding": False}  # never entered
+    (missed,) = [note for note in response.json()["warnings"] if note.startswith("timing.zones[1]")]
+    assert missed.startswith("timing.zones[1] limits nothing: the tool point (origin of frame 'tool0') never enters its box")
+    assert "grow each edge of timing.zones[1].box.size by more than" in missed
+    assert "or move timing.zones[1].box.center towards the path" in missed
+    assert not [note for note in response.json()["warnings"] if note.startswith("timing.zones[0]")]
     plain = client.post("/v1/trajectories", json=_body([])).json()
     assert plain["zones"] is None and plain["duration"] < response.json()["duration"]
 
@@ -58,4 +63,18 @@ def test_a_method_that_does_not_hold_zones_is_422(client):
     path = {"kind": "waypoints", "waypoints": UR5_WAYPOINTS}
     response = client.post("/v1/trajectories", json=_body([MIDDLE], method="quintic", path=path))
     assert response.status_code == 422, response.text
-    assert "zones are held by the timing methods phase_plane, toppra" in response.json()["detail"]
+    assert response.json()["detail"] == (
+        "timing.zones are held by timing.method phase_plane or toppra along a given path (path.kind 'waypoints' with "
+        "interpolation 'spline', 'linear' or 'blend', or 'cartesian'), not by 'quintic' here: choose one of those "
+        "methods, or leave timing.zones out"
+    )
+
+
+def test_a_box_turned_by_no_unit_quaternion_is_422_naming_its_orientation(client):
+    box = {"center": [0.4, 0.5, 0.3], "size": [0.1, 0.1, 0.1], "orientation": [0.0, 0.0, 0.0, 0.5]}
+    response = client.post("/v1/trajectories", json=_body([MIDDLE, {"box": box, "velocity_scale": 0.5}]))
+    assert response.status_code == 422, response.text
+    assert response.json()["detail"] == (
+        "timing.zones[1].box.orientation has norm 0.5: it is no rotation; give a unit quaternion [qx, qy, qz, qw] "
+        "(norm 1 within 0.001), e.g. [0, 0, 0, 1] for a box along the world's axes"
+    )

@@ -17,7 +17,7 @@ from tests.conftest import UR5_WAYPOINTS
 from toptraj import robots
 from toptraj.planners import METHODS, CartesianLine, LimitRequest, Sampling, WaypointPath, build_problem, plan
 from toptraj.planners.checks.gate import samples_exceed
-from toptraj.planners.collision import SphereObstacle
+from toptraj.planners.collision import BoxObstacle, SphereObstacle
 from toptraj.planners.constraints.zones import with_edges
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.problem import zones as zones_module
@@ -160,8 +160,22 @@ def test_bad_zones_are_refused_naming_the_zone(ur5, zones, words):
 
 
 def test_methods_that_do_not_hold_zones_refuse_them(ur5):
-    with pytest.raises(InvalidRequest, match="zones are held by the timing methods phase_plane, toppra"):
+    with pytest.raises(InvalidRequest) as refused:
         plan(build_problem(ur5, WaypointPath(np.array(UR5_WAYPOINTS)), METHODS["quintic"], limits=LimitRequest(zones=(MIDDLE,)), sampling=Sampling(dt=0.01)))
+    assert (refused.value.field, refused.value.rule, refused.value.method) == ("zones", "zones_not_served", "quintic")
+    assert str(refused.value) == (
+        "zones are held by the timing methods phase_plane, toppra along a given path (waypoints interpolated by spline, "
+        "linear or blend, or a cartesian line), not by 'quintic' here; use one of those, or leave the zones out"
+    )
+
+
+def test_a_box_that_is_not_turned_by_a_unit_quaternion_is_refused_in_a_sentence(ur5):
+    """The refusal is the library's sentence with the zone's field, not a field made of the sentence."""
+    box = BoxObstacle(center=(0.4, 0.5, 0.3), size=(0.1, 0.1, 0.1), orientation=(0.0, 0.0, 0.0, 0.5))
+    with pytest.raises(InvalidRequest) as refused:
+        plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(zones=(Zone(region=box, velocity=0.5),)), sampling=Sampling(dt=0.01)))
+    assert (refused.value.field, refused.value.rule, refused.value.norm) == ("zones[0].box.orientation", "zone_box_not_unit", 0.5)
+    assert str(refused.value) == "zone 0's box orientation has norm 0.5, not a unit quaternion [qx, qy, qz, qw]"
 
 
 def test_the_grid_holds_every_zone_edge_and_keeps_its_knots():
@@ -194,3 +208,37 @@ def test_zones_that_cover_too_many_stretches_of_the_path_are_refused(ur5, monkey
     zones = (Zone(region=sphere, tool_speed=ZONE_SPEED), MIDDLE)
     with pytest.raises(InvalidRequest, match="more than 1 stretches of the path from zone 1 on"):
         plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=SPEED, zones=zones), sampling=Sampling(dt=0.01)))
+
+
+def _beside_the_weld(arm, gap: float) -> tuple[np.ndarray, np.ndarray]:
+    """The tool point at s = 0.5 of the weld line, and a point ``gap`` m from it at right angles
+    to the (straight) line."""
+    ends = _tool_points(arm, make_path(arm, WELD).evaluate(np.array([0.0, 0.5, 1.0])).q)
+    direction = (ends[2] - ends[0]) / np.linalg.norm(ends[2] - ends[0])
+    across = np.cross(direction, [0.0, 0.0, 1.0])
+    return ends[1], ends[1] + gap * across / np.linalg.norm(across)
+
+
+def test_a_region_the_path_never_enters_is_noted_with_its_closest_approach(ur5):
+    """A sphere of radius 0.05 m centred 0.15 m beside the middle of the straight weld line: the
+    tool point passes 0.10 m outside it at s = 0.5 (the line's nearest point to the centre)."""
+    _, center = _beside_the_weld(ur5, 0.15)
+    zones = (MIDDLE, Zone(region=SphereObstacle(center=center, radius=0.05), velocity=0.5))
+    result = plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=SPEED, zones=zones), sampling=Sampling(dt=0.01)))
+    assert result.zones[1].ranges == ()
+    (note,) = [item for item in result.warnings if getattr(item, "rule", None) == "missed_region"]
+    assert (note.facts["index"], note.facts["region"], note.facts["frame"]) == (1, "sphere", ur5.end_effector)
+    # The scan's step along the 0.32 m line is 1.6e-4 m: the sampled closest point is within it
+    # of s = 0.5, which moves the distance by (1.6e-4)^2 / (2 * 0.15) < 1e-7 m.
+    assert note.facts["distance"] == pytest.approx(0.10, abs=1e-6)
+    assert note.facts["at_s"] == pytest.approx(0.5, abs=1e-3)
+
+
+def test_a_region_grown_by_the_noted_distance_applies(ur5):
+    """The note's advice is followable: a radius above 0.05 m plus the noted distance makes the
+    zone apply, and no note is left."""
+    _, center = _beside_the_weld(ur5, 0.15)
+    zone = Zone(region=SphereObstacle(center=center, radius=0.05 + 0.10 + 1e-3), velocity=0.5)
+    result = plan(build_problem(ur5, WELD, METHODS["phase_plane"], limits=LimitRequest(tool_speed=SPEED, zones=(zone,)), sampling=Sampling(dt=0.01)))
+    assert result.zones[0].ranges != ()
+    assert not [item for item in result.warnings if getattr(item, "rule", None) == "missed_region"]

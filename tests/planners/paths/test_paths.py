@@ -65,7 +65,18 @@ def test_coincident_waypoints_are_refused():
     with pytest.raises(InvalidRequest) as refused:
         SplinePath(np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 1.0]]))
     assert (refused.value.field, refused.value.rule, refused.value.index) == ("waypoints[1]", "waypoints_coincide", 1)
-    assert detail(refused.value) == "path.waypoints[1] and path.waypoints[2] coincide"
+    assert refused.value.tolerance == 1e-12
+    assert detail(refused.value) == (
+        "path.waypoints[1] and path.waypoints[2] coincide (no joint differs by more than 1e-12 rad or m), so the path "
+        "has no direction between them: remove path.waypoints[2], or change one of its joint values by more than 1e-12"
+    )
+
+
+def test_waypoints_apart_by_the_advised_step_make_a_path():
+    """The advice of the refusal above is followable: one joint value moved by just more than the
+    tolerance makes a path."""
+    path = SplinePath(np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 1.0 + 2e-12]]))
+    assert path.knots[-1] == 1.0
 
 
 @pytest.mark.parametrize("count", [2, 3, 4, 7, 40])
