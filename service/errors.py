@@ -25,6 +25,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
 from toptraj.robots import ToptrajError
+from toptraj.service.field_hints import hint
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
 from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_message
 
@@ -74,9 +75,15 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
 
 
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:
-    errors = [
-        {"field": _location(item["loc"]), "message": validation_message(item)} for item in error.errors()
-    ]
+    body_field = getattr(request.scope.get("route"), "body_field", None)
+    model = getattr(getattr(body_field, "field_info", None), "annotation", None)
+    errors = []
+    for item in error.errors():
+        field = _location(item["loc"])
+        message = validation_message(item)
+        if item.get("type") == "extra_forbidden" and isinstance(model, type):
+            message += hint(model, field)
+        errors.append({"field": field, "message": message})
     detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:5])
     if len(errors) > 5:
         detail += f"; and {len(errors) - 5} more"
