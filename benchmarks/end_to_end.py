@@ -193,7 +193,7 @@ def main() -> int:
     from toptraj.planners import plan
     from toptraj.planners.execution.deadline import NO_DEADLINE
     from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
-    from toptraj.planners.problem.build import MAX_SAMPLES
+    from toptraj.planners.execution.memory import MAX_SAMPLES
     from toptraj.service.mapping import problem_of
 
     problem = problem_of(request, robot, NO_DEADLINE, MAX_SAMPLES, False, DEFAULT_SEARCH_MEMORY)

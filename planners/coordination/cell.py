@@ -22,13 +22,12 @@ from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.robots import JointLimits, Robot
 from toptraj.robots.collision import robot_capsules, world_capsules
+from toptraj.robots.equipment import ROTATION_TOLERANCE
 
 #: Arms a cell holds: two coordinated in full (the square of their path parameters), more by
 #: prioritized planning over every order of the arms (``prioritized``: 4! = 24 orders, 6 pairwise
 #: diagrams).
 MAX_ARMS = 4
-#: How far R R^T may be from the identity, entry by entry, for R to count as a rotation.
-ROTATION_TOLERANCE = 1e-6
 
 
 def checked_rotation(rotation: ArrayLike, where: str) -> np.ndarray:

@@ -37,8 +37,6 @@ from toptraj.planners.problem.zones import check_zones, check_zones_served
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.robots import JointLimits, Robot, ToolSpeedLimit
 
-#: Most samples an answer holds unless the caller says otherwise.
-MAX_SAMPLES = 200_000
 #: Largest limit margin (a fraction of every limit kept in reserve).
 MAX_LIMIT_MARGIN = 0.5
 #: Distance (m) every link keeps from the obstacles unless a request says otherwise.

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from toptraj.planners.collision import Obstacle
 from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.execution.memory import MAX_SAMPLES
 from toptraj.planners.paths.cartesian import CartesianLine
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.requests import WaypointPath
@@ -99,7 +100,7 @@ class Sampling:
     with ``exact_period`` on whole periods, the final state included."""
 
     dt: float = 0.01
-    max_samples: int = 200_000
+    max_samples: int = MAX_SAMPLES
     exact_period: bool = False
 
 
