@@ -192,8 +192,8 @@ def main() -> int:
     payload = json.dumps(TYPICAL).encode()
     from toptraj.planners import plan
     from toptraj.planners.execution.deadline import NO_DEADLINE
-    from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
     from toptraj.planners.execution.memory import MAX_SAMPLES
+    from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
     from toptraj.service.mapping import problem_of
 
     problem = problem_of(request, robot, NO_DEADLINE, MAX_SAMPLES, False, DEFAULT_SEARCH_MEMORY)
