@@ -193,8 +193,16 @@ def test_the_guide_works_in_a_browser_with_no_other_host(site):
         assert page.locator("header.md-header").bounding_box()["height"] > 20
         page.click("text=Methods")
         page.wait_for_url(base + "/guide/methods/")
-        page.fill("input.md-search__input", "jerk_limited")
-        page.wait_for_selector(".md-search-result__item", timeout=15_000)
+        # Material reads the query on keyup (and once when its search worker is ready): wait for the
+        # index, then type key by key as a person does; `fill` sends no keyup and races the worker
+        page.click("input.md-search__input")
+        page.wait_for_function(
+            "() => { const m = document.querySelector('.md-search-result__meta');"
+            " return m && m.textContent.trim() !== '' && !/Initializing/.test(m.textContent); }",
+            timeout=60_000,
+        )
+        page.locator("input.md-search__input").press_sequentially("jerk_limited")
+        page.wait_for_selector(".md-search-result__item", timeout=30_000)
         assert "jerk_limited" in page.inner_text(".md-search-result")
         browser.close()
         assert outside == []
