@@ -50,14 +50,15 @@ def answer(text: str, budget_s: float) -> tuple[int, bytes]:
         body = orjson.loads(text)
     except orjson.JSONDecodeError as error:
         return 400, problem_body(400, "Malformed JSON", f"the line is not JSON: {str(error)[:200]}")
+    schema = CompareRequest if isinstance(body, dict) and "methods" in body else TrajectoryRequest
     try:
-        if isinstance(body, dict) and "methods" in body:
+        if schema is CompareRequest:
             return 200, encode_json(compare_request(CompareRequest.model_validate_json(text), Deadline(budget_s)))
         request = TrajectoryRequest.model_validate_json(text)
         content, media_type = render(plan_request(request, Deadline(budget_s)), request)
         return 200, content if media_type == "application/json" else orjson.dumps(content.decode())
     except ValidationError as error:
-        return 422, orjson.dumps(validation_problem(error))
+        return 422, orjson.dumps(validation_problem(error, schema))
     except ToptrajError as error:
         extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
         status = status_of(error)
