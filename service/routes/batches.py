@@ -58,7 +58,10 @@ def _within(item: Mapping[str, Any], index: int, schema: type[BaseModel]) -> dic
 )
 async def create_batch(body: BatchCreate, request: Request) -> Response:
     """Plan every request (trajectory or compare bodies) in the background as one job; the
-    job's answer lists each request's status and body (its answer or its problem), in order."""
+    job's answer lists each request's status and body (its answer or its problem), in order.
+    The answers are kept up to the server's answer cap (20 MB by default): once an answer does
+    not fit, the job plans no more, and that request and the ones left each get a 422 saying
+    how to submit them again."""
     _checked(body.requests)
     settings = request.app.state.settings
     budget_s = settings.job_budget_s if body.budget_s is None else body.budget_s
