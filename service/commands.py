@@ -47,6 +47,20 @@ def _json(text: str):
         raise _Unreadable("the request is not JSON") from None
 
 
+def _unique_keys(text: str) -> str:
+    """``text``, once no object of it gives a key twice (``DuplicateKey`` otherwise); text
+    that is no JSON is left to the schema's reading, which says where."""
+    from toptraj.service.strict_json import DuplicateKey, loads
+
+    try:
+        loads(text)
+    except DuplicateKey:
+        raise
+    except (ValueError, RecursionError):
+        pass
+    return text
+
+
 def _is_compare(text: str) -> bool:
     """A compare body names its ``methods``."""
     body = _json(text)
@@ -82,19 +96,30 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     (standard output); errors to standard error as problem+json."""
     from toptraj.robots import ToptrajError
     from toptraj.service.problems import detail, status_of, title_of, validation_problem
+    from toptraj.service.strict_json import DuplicateKey
 
     try:
-        content = answer(_read(source))
+        content = answer(_unique_keys(_read(source)))
+    except DuplicateKey as error:
+        print(json.dumps(error.problem()), file=sys.stderr)
+        return 1
     except _Unreadable as error:
         print(json.dumps(_problem("Cannot read request", 400, str(error))), file=sys.stderr)
         return 2
     except ValidationError as error:
-        print(json.dumps(validation_problem(error)), file=sys.stderr)
+        print(json.dumps(validation_problem(error, _schema_named(error.title))), file=sys.stderr)
         return 1
     except ToptrajError as error:
         print(json.dumps(_problem(title_of(error), status_of(error), detail(error))), file=sys.stderr)
         return 1
     return _write(content, out)
+
+
+def _schema_named(title: str) -> type | None:
+    """The request schema a ``ValidationError`` of that title is about (for its hints)."""
+    from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
+
+    return {schema.__name__: schema for schema in (TrajectoryRequest, CompareRequest)}.get(title)
 
 
 def _write(content: bytes, out=None) -> int:

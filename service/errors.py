@@ -25,9 +25,9 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
 from toptraj.robots import ToptrajError
-from toptraj.service.field_hints import hint
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
-from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_message
+from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_detail, validation_errors
+from toptraj.service.strict_routes import DuplicateKeyRefused
 
 logger = logging.getLogger("toptraj")
 
@@ -37,34 +37,6 @@ def problem(status: int, title: str, detail: str, headers: dict[str, str] | None
     body = {"type": "about:blank", "title": title, "status": status, "detail": detail}
     body.update({key: value for key, value in extra.items() if value is not None})
     return JSONResponse(body, status_code=status, media_type=PROBLEM_JSON, headers=headers)
-
-
-#: Tags of the path union that pydantic puts in error locations: path.<tag>.<field>.
-_PATH_TAGS = ("waypoints", "cartesian", "free")
-#: Tags of the payload's inertia (6 values or a matrix): payload.inertia.<tag>[i].
-_INERTIA_TAGS = ("values", "matrix")
-#: Tags of an obstacle (its kind): obstacles[i].<tag>.<field>.
-_OBSTACLE_TAGS = ("sphere", "box", "capsule")
-
-
-def _is_tag(parts: list[str], index: int) -> bool:
-    """Whether ``parts[index]`` is the tag of a union member that pydantic puts in a location,
-    not a field of the request."""
-    before, part = parts[:index], parts[index]
-    if before[-1:] == ["path"]:
-        return part in _PATH_TAGS and index + 1 < len(parts)  # path.<tag>.<field>, at the top or in a job
-    if before[-1:] == ["inertia"]:
-        return part in _INERTIA_TAGS
-    return before[-2:-1] == ["obstacles"] and before[-1].isdigit() and part in _OBSTACLE_TAGS
-
-
-def _location(loc) -> str:
-    parts = [str(part) for part in loc if part not in ("body",)]
-    parts = [part for index, part in enumerate(parts) if not _is_tag(parts, index)]
-    text = ""
-    for part in parts:
-        text += f"[{part}]" if part.isdigit() else (f".{part}" if text else part)
-    return text or "body"
 
 
 def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
@@ -77,17 +49,12 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:
     body_field = getattr(request.scope.get("route"), "body_field", None)
     model = getattr(getattr(body_field, "field_info", None), "annotation", None)
-    errors = []
-    for item in error.errors():
-        field = _location(item["loc"])
-        message = validation_message(item)
-        if item.get("type") == "extra_forbidden" and isinstance(model, type):
-            message += hint(model, field)
-        errors.append({"field": field, "message": message})
-    detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:5])
-    if len(errors) > 5:
-        detail += f"; and {len(errors) - 5} more"
-    return problem(422, "Invalid request", detail, errors=errors[:20])
+    errors = validation_errors(error.errors(), model)
+    return problem(422, "Invalid request", validation_detail(errors), errors=errors[:20])
+
+
+def _duplicate_key(request: Request, error: DuplicateKeyRefused) -> JSONResponse:
+    return JSONResponse(error.duplicate.problem(), status_code=422, media_type=PROBLEM_JSON)
 
 
 def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
@@ -153,4 +120,5 @@ def install_problem_handlers(app: FastAPI) -> None:
     app.add_exception_handler(ToptrajError, _toptraj_error)  # type: ignore[arg-type]
     app.add_exception_handler(RequestValidationError, _validation_error)  # type: ignore[arg-type]
     app.add_exception_handler(StarletteHTTPException, _http_error)  # type: ignore[arg-type]
+    app.add_exception_handler(DuplicateKeyRefused, _duplicate_key)  # type: ignore[arg-type]
     declare_problems(app)

@@ -1,10 +1,12 @@
-"""Where a field put in the wrong place belongs: for a field a schema does not know
-(pydantic's ``extra_forbidden``), the places a field of that name has in the body's schema, so
-that the 422 can say where to move it (``format`` at the top of a trajectory request belongs in
-``output.format``)."""
+"""Hints for a field a schema does not know (pydantic's ``extra_forbidden``): where a field put in
+the wrong place belongs, the places a field of that name has in the body's schema, so that the 422
+can say where to move it (``format`` at the top of a trajectory request belongs in
+``output.format``); else the allowed name at that very place nearest to a misspelt one
+(``velocity_scal``: did you mean 'velocity_scale'?)."""
 
 from __future__ import annotations
 
+import difflib
 import functools
 import re
 import typing
@@ -16,6 +18,8 @@ from pydantic import BaseModel
 MAX_DEPTH = 8
 #: Most places named in one hint.
 MAX_PLACES = 3
+#: Least similarity (difflib's ratio, 2 M / T) of an unknown name to an allowed one for "did you mean".
+CLOSE = 0.75
 
 
 def _models(annotation: object, listed: bool = False) -> Iterator[tuple[type[BaseModel], bool]]:
@@ -65,3 +69,51 @@ def hint(model: type[BaseModel] | None, location: str) -> str:
         return ""
     return f": {name!r} belongs in " + " or ".join(places)
 
+
+def _tags(model: type[BaseModel]) -> set[str]:
+    """The names pydantic may put in a location for ``model`` as a member of a union: its class
+    name and the values of its ``Literal`` fields (a tagged union's tag: the path's ``kind``)."""
+    tags = {model.__name__}
+    for info in model.model_fields.values():
+        if typing.get_origin(info.annotation) is typing.Literal:
+            tags.update(str(value) for value in typing.get_args(info.annotation))
+    return tags
+
+
+def names_at(model: type[BaseModel], loc: tuple[str | int, ...]) -> tuple[str, ...]:
+    """The field names a body of ``model`` allows at ``loc`` (a pydantic location relative to
+    the body, union tags included: ``("path", "cartesian")``); () where ``loc`` leaves the
+    request models (a dict's keys, a number)."""
+    candidates = [model]
+    for part in loc[:MAX_DEPTH]:
+        if isinstance(part, int):
+            continue  # an item of a list: its models were taken when its field was
+        if len(candidates) > 1 and (tagged := [current for current in candidates if part in _tags(current)]):
+            candidates = tagged
+            continue
+        candidates = [
+            inner
+            for current in candidates
+            for name, info in current.model_fields.items()
+            if (info.alias or name) == part
+            for inner, _ in _models(info.annotation)
+        ]
+        if not candidates:
+            return ()
+    return tuple(dict.fromkeys(info.alias or name for current in candidates for name, info in current.model_fields.items()))
+
+
+def nearest(model: type[BaseModel] | None, loc: tuple[str | int, ...]) -> str:
+    """For the unknown field at ``loc``, the allowed name at its place most like it, as a clause
+    to add to pydantic's message (``: did you mean 'velocity_scale'?``); "" when none is close
+    (``CLOSE``)."""
+    if model is None or not loc or not isinstance(loc[-1], str):
+        return ""
+    close = difflib.get_close_matches(loc[-1], names_at(model, loc[:-1]), n=1, cutoff=CLOSE)
+    return f": did you mean {close[0]!r}?" if close else ""
+
+
+def unknown_field_hint(model: type[BaseModel] | None, loc: tuple[str | int, ...], location: str) -> str:
+    """The hint for the unknown field at ``loc`` (``location`` as the service writes it): where
+    a field of that name belongs (``hint``), else the nearest allowed name there (``nearest``)."""
+    return hint(model, location) or nearest(model, loc)

@@ -16,7 +16,7 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from toptraj.planners.collision.clearance import PathInCollision
 from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
@@ -35,6 +35,8 @@ from toptraj.robots.errors import (
 )
 from toptraj.robots.notes import Note
 from toptraj.robots.upload_options import InvalidUpload
+from toptraj.service.field_hints import unknown_field_hint
+from toptraj.service.locations import where
 from toptraj.service.wordings import WORDING
 
 HTTP_TITLES = {
@@ -250,10 +252,39 @@ def validation_message(item: Mapping[str, Any]) -> str:
     return message
 
 
-def validation_problem(error: ValidationError) -> dict:
-    """The problem+json of a request that does not fit its schema (as the HTTP API's 422)."""
-    detail = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {validation_message(e)}" for e in error.errors())
-    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": detail}
+#: Errors of a malformed request named in a problem's detail, and listed in its ``errors``.
+_DETAIL_ERRORS, _LISTED_ERRORS = 5, 20
+
+
+def validation_errors(items: Iterable[Mapping[str, Any]], model: object = None) -> list[dict[str, str]]:
+    """Each error of a request that does not fit its schema ``model`` (``errors()`` items, their
+    locations relative to the body, or under ``"body"``) as ``{"field", "message"}``: the place
+    as the service writes places (``timing.zones[0]``), the message in the service's words, and
+    for a field the schema does not know, where it belongs or the name it was likely meant as."""
+    schema = model if isinstance(model, type) and issubclass(model, BaseModel) else None
+    errors = []
+    for item in items:
+        loc = tuple(item["loc"])
+        field = where(loc)
+        message = validation_message(item)
+        if item.get("type") == "extra_forbidden":
+            message += unknown_field_hint(schema, loc[1:] if loc[:1] == ("body",) else loc, field)
+        errors.append({"field": field, "message": message})
+    return errors
+
+
+def validation_detail(errors: list[dict[str, str]]) -> str:
+    """The detail of a 422 with ``errors`` (``validation_errors``): the first few, then how many more."""
+    detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:_DETAIL_ERRORS])
+    if len(errors) > _DETAIL_ERRORS:
+        detail += f"; and {len(errors) - _DETAIL_ERRORS} more"
+    return detail
+
+
+def validation_problem(error: ValidationError, model: object = None) -> dict:
+    """The problem+json of a request that does not fit its schema ``model`` (as the HTTP API's 422)."""
+    errors = validation_errors(error.errors(include_url=False), model)
+    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": validation_detail(errors), "errors": errors[:_LISTED_ERRORS]}
 
 
 class NonFiniteAnswer(ToptrajError):

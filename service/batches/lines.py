@@ -14,8 +14,9 @@ lines are written in the order they finish; sort by ``line`` for the file's orde
 
 A line is read without trusting it: at most ``MAX_LINE_BYTES`` bytes are kept (the rest of a
 longer line is skipped unread), its nesting depth is counted by a scan that cannot recurse
-before any parser sees it, and a line that is empty, too long, too deep, not UTF-8, not JSON
-or not a JSON object becomes its own 4xx result line (``RequestLine.problem``).
+before any parser sees it, and a line that is empty, too long, too deep, not UTF-8, not JSON,
+not a JSON object or an object giving a key twice (``toptraj.service.strict_json``) becomes its
+own 4xx result line (``RequestLine.problem``).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ import numpy as np
 import orjson
 
 from toptraj.robots.errors import excerpt
+from toptraj.service.strict_json import DuplicateKey, loads
 
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000
@@ -88,8 +90,10 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
     if depth > MAX_DEPTH:
         return refused(400, "Too deeply nested", f"the line nests arrays and objects {depth} deep; a request nests at most {MAX_DEPTH}")
     try:
-        body = orjson.loads(data)
-    except orjson.JSONDecodeError as error:
+        body = loads(data, finite=True)
+    except DuplicateKey as error:
+        return refused(422, "Invalid request", str(error))
+    except ValueError as error:  # no JSON, or no UTF-8
         return refused(400, "Malformed JSON", f"the line is not JSON (UTF-8): {str(error)[:_MAX_DETAIL]}")
     if not isinstance(body, dict):
         return refused(

@@ -156,7 +156,7 @@ class RayPool:
 
     def submit(self, chunk: list[tuple[str, str]], budget_s: float) -> Any:
         """Start computing ``chunk`` of (key, text); a handle for ``wait`` and ``result``."""
-        return self._remote.remote(chunk, self._uploads, budget_s)
+        return self._remote.remote(chunk, self._uploads, budget_s, None)  # no body cap: a file's lines
 
     def wait(self, handles: list, timeout_s: float) -> tuple[list, list]:
         """(finished, still running) of ``handles``, once one finished or after ``timeout_s``."""

@@ -40,24 +40,25 @@ def _uploads_here(uploads: dict[str, tuple[str, str]]) -> None:
         robots.register_urdf(urdf, name, UploadOptions.from_json(options))
 
 
-def answer(text: str, budget_s: float) -> tuple[int, bytes]:
+def answer(text: str, budget_s: float, max_body_bytes: int | None = None) -> tuple[int, bytes]:
     """(status, body as JSON bytes) of one request line (a JSON object, ``lines.parse_line``):
     200 and the answer, or the problem's status and problem+json; anything unexpected is
     this line's 500, never the batch's. ``budget_s`` bounds the computation as the synchronous
-    budget does. The answer stays the bytes the endpoint would send (never decoded and
-    re-encoded)."""
+    budget does, and ``max_body_bytes`` the answer's samples as the synchronous body cap does.
+    The answer stays the bytes the endpoint would send (never decoded and re-encoded)."""
     try:
         body = orjson.loads(text)
     except orjson.JSONDecodeError as error:
         return 400, problem_body(400, "Malformed JSON", f"the line is not JSON: {str(error)[:200]}")
+    schema = CompareRequest if isinstance(body, dict) and "methods" in body else TrajectoryRequest
     try:
-        if isinstance(body, dict) and "methods" in body:
+        if schema is CompareRequest:
             return 200, encode_json(compare_request(CompareRequest.model_validate_json(text), Deadline(budget_s)))
         request = TrajectoryRequest.model_validate_json(text)
-        content, media_type = render(plan_request(request, Deadline(budget_s)), request)
+        content, media_type = render(plan_request(request, Deadline(budget_s), max_body_bytes), request)
         return 200, content if media_type == "application/json" else orjson.dumps(content.decode())
     except ValidationError as error:
-        return 422, orjson.dumps(validation_problem(error))
+        return 422, orjson.dumps(validation_problem(error, schema))
     except ToptrajError as error:
         extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle") if hasattr(error, key)}
         status = status_of(error)
@@ -67,14 +68,16 @@ def answer(text: str, budget_s: float) -> tuple[int, bytes]:
         return 500, problem_body(500, "Internal error", f"an unexpected {type(error).__name__} occurred while planning this line")
 
 
-def answer_chunk(chunk: list[tuple[str, str]], uploads: dict[str, tuple[str, str]], budget_s: float) -> list[tuple[str, int, bytes]]:
+def answer_chunk(
+    chunk: list[tuple[str, str]], uploads: dict[str, tuple[str, str]], budget_s: float, max_body_bytes: int | None = None
+) -> list[tuple[str, int, bytes]]:
     """(key, status, body) of each (key, request text) of a chunk."""
     _uploads_here(uploads)
-    return [(key, *answer(text, budget_s)) for key, text in chunk]
+    return [(key, *answer(text, budget_s, max_body_bytes)) for key, text in chunk]
 
 
 def answer_on_worker(
-    chunk: list[tuple[str, str]], uploads: dict[str, tuple[str, str]], budget_s: float
+    chunk: list[tuple[str, str]], uploads: dict[str, tuple[str, str]], budget_s: float, max_body_bytes: int | None
 ) -> tuple[str, list[tuple[str, int, bytes]]]:
     """What a Ray task of a batch runs: ``answer_chunk`` on a worker prepared once
     (``prepare.prepare_worker``, whose calls then run inline: never in another process), and
@@ -82,5 +85,5 @@ def answer_on_worker(
     import ray
 
     prepare_worker()
-    answers = answer_chunk(chunk, uploads, budget_s)
+    answers = answer_chunk(chunk, uploads, budget_s, max_body_bytes)
     return ray.get_runtime_context().get_node_id(), answers

@@ -20,6 +20,7 @@ from toptraj import robots
 from toptraj.planners import Deadline
 from toptraj.planners.execution.deadline import Progress
 from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.service.jobs.answer_room import AnswerRoom, kept_results
 from toptraj.service.planning import compare_request, encode_json, plan_request, render
 from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
@@ -58,14 +59,14 @@ def _batch(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
     """Every request of a batch (``POST /v1/batches``) answered as its own endpoint would: a
     line's failure, whatever it is, is that line's result (``batches.work.answer``), and a line
     the job's budget did not reach is a 504 of its own, so the job ends with every answer it
-    has. Here one after another, or on the Ray cluster at ``setup.ray_address``
-    (``TOPTRAJ_RAY_ADDRESS``)."""
+    has; the answers are kept within the job's answer cap (``answer_room``: once they fill it,
+    the requests left are not planned). Here one after another, or on the Ray cluster at
+    ``setup.ray_address`` (``TOPTRAJ_RAY_ADDRESS``)."""
     items = orjson.loads(request)["requests"]
     texts = [orjson.dumps(item).decode() for item in items]
-    answers = _on_ray(texts, setup, deadline) if setup.ray_address else _here(texts, deadline)
-    return encode_json(
-        {"results": [{"line": k + 1, "status": status, "body": orjson.loads(body)} for k, (status, body) in enumerate(answers)]}
-    )
+    room = AnswerRoom(setup.max_response_bytes, len(texts))
+    answers = _on_ray(texts, setup, deadline, room) if setup.ray_address else _here(texts, deadline, room)
+    return kept_results(answers)
 
 
 def _not_reached(budget_s: float | None) -> tuple[int, bytes]:
@@ -81,18 +82,23 @@ def _line_budget(deadline: Deadline) -> float:
     return BATCH_REQUEST_BUDGET_S if remaining is None else min(BATCH_REQUEST_BUDGET_S, remaining)
 
 
-def _here(texts: list[str], deadline: Deadline) -> list[tuple[int, bytes]]:
+def _here(texts: list[str], deadline: Deadline, room: AnswerRoom) -> list[tuple[int, bytes]]:
     from toptraj.service.batches.work import answer
 
     answers = []
     for k, text in enumerate(texts):
         deadline.progress(k / len(texts), f"batch: request {k + 1} of {len(texts)}")
         budget = _line_budget(deadline)
-        answers.append(answer(text, budget) if budget > MIN_LINE_BUDGET_S else _not_reached(deadline.budget_s))
+        if room.full():
+            answers.append(room.not_kept(k))
+        elif budget > MIN_LINE_BUDGET_S:
+            answers.append(room.keep(k, *answer(text, budget, room.cap_bytes)))
+        else:
+            answers.append(_not_reached(deadline.budget_s))
     return answers
 
 
-def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tuple[int, bytes]]:
+def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline, room: AnswerRoom) -> list[tuple[int, bytes]]:
     import ray
 
     from toptraj.service.batches.runner import _uploads_named
@@ -103,22 +109,25 @@ def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline) -> list[tu
     remote = ray.remote(num_cpus=1, scheduling_strategy="SPREAD")(answer_on_worker)
     uploads = ray.put(_uploads_named(texts))
     budget = _line_budget(deadline)
-    pending = {remote.remote([(str(k), text)], uploads, budget): k for k, text in enumerate(texts)}
+    pending = {remote.remote([(str(k), text)], uploads, budget, room.cap_bytes): k for k, text in enumerate(texts)}
     answers: list[tuple[int, bytes] | None] = [None] * len(texts)
-    while pending and _line_budget(deadline) > 0.0:
+    while pending and _line_budget(deadline) > 0.0 and not room.full():
         ready, _ = ray.wait(list(pending), num_returns=1, timeout=0.5)
         for ref in ready:
             k = pending.pop(ref)
             try:
                 _, [(_, status, body)] = ray.get(ref)
-                answers[k] = (status, body)
+                answers[k] = room.keep(k, status, body)
             except Exception as error:  # the task as a whole: its worker died
                 answers[k] = (500, _worker_failed(error))
         done = len(texts) - len(pending)
         deadline.progress(done / len(texts), f"batch: {done} of {len(texts)} on Ray")
     for ref in pending:
         ray.cancel(ref, force=True)
-    return [answer if answer is not None else _not_reached(deadline.budget_s) for answer in answers]
+    return [
+        answer if answer is not None else room.not_kept(k) if room.full() else _not_reached(deadline.budget_s)
+        for k, answer in enumerate(answers)
+    ]
 
 
 def _worker_failed(error: BaseException) -> bytes:

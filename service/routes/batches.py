@@ -5,18 +5,24 @@ cluster the server is configured with (``TOPTRAJ_RAY_ADDRESS``). For thousands o
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import orjson
 from fastapi import APIRouter, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
+from toptraj.service.field_hints import unknown_field_hint
+from toptraj.service.locations import where
 from toptraj.service.problems import RequestRefused
 from toptraj.service.routes.jobs import _job_response, _problem
 from toptraj.service.schemas.jobs import BatchCreate, JobPublic
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.strict_routes import StrictJSONRoute
 
-router = APIRouter(prefix="/v1/batches", tags=["jobs"])
+router = APIRouter(prefix="/v1/batches", tags=["jobs"], route_class=StrictJSONRoute)
 
 
 def _checked(requests: list[dict]) -> None:
@@ -27,9 +33,16 @@ def _checked(requests: list[dict]) -> None:
         try:
             schema.model_validate(item, strict=True)
         except ValidationError as error:
-            raise RequestValidationError(
-                [{**e, "loc": ("body", "requests", index, *e["loc"])} for e in error.errors(include_url=False, include_context=False)]
-            ) from None
+            raise RequestValidationError([_within(e, index, schema) for e in error.errors(include_url=False, include_context=False)]) from None
+
+
+def _within(item: Mapping[str, Any], index: int, schema: type[BaseModel]) -> dict:
+    """Error ``item`` of request ``index`` as an error of the batch's body; an unknown field's
+    message with its hint from the request's own schema (the batch's holds the requests as
+    objects of any shape)."""
+    if item["type"] == "extra_forbidden":
+        item = {**item, "msg": item["msg"] + unknown_field_hint(schema, item["loc"], where(item["loc"]))}
+    return {**item, "loc": ("body", "requests", index, *item["loc"])}
 
 
 @router.post(
@@ -45,7 +58,10 @@ def _checked(requests: list[dict]) -> None:
 )
 async def create_batch(body: BatchCreate, request: Request) -> Response:
     """Plan every request (trajectory or compare bodies) in the background as one job; the
-    job's answer lists each request's status and body (its answer or its problem), in order."""
+    job's answer lists each request's status and body (its answer or its problem), in order.
+    The answers are kept up to the server's answer cap (20 MB by default): once an answer does
+    not fit, the job plans no more, and that request and the ones left each get a 422 saying
+    how to submit them again."""
     _checked(body.requests)
     settings = request.app.state.settings
     budget_s = settings.job_budget_s if body.budget_s is None else body.budget_s

@@ -14,8 +14,9 @@ from toptraj.service.planning import encode_json
 from toptraj.service.problem_docs import problem_responses
 from toptraj.service.schemas.cells import CellRequest
 from toptraj.service.schemas.examples import cell_examples
+from toptraj.service.strict_routes import StrictJSONRoute
 
-router = APIRouter(prefix="/v1/cells", tags=["cells"])
+router = APIRouter(prefix="/v1/cells", tags=["cells"], route_class=StrictJSONRoute)
 CSV_EXAMPLE = "t,arms[0].q.shoulder_pan_joint,…\n# robots: ur5, ur5\n# duration: 3.1 s\n…\n0.0,1.5,…\n"
 
 

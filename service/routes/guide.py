@@ -13,7 +13,9 @@ from pathlib import Path
 from fastapi import APIRouter, HTTPException, Request
 from fastapi.responses import FileResponse, RedirectResponse
 
-router = APIRouter(include_in_schema=False)
+from toptraj.service.strict_routes import StrictJSONRoute
+
+router = APIRouter(include_in_schema=False, route_class=StrictJSONRoute)
 
 #: How to build the site, as the 404 of an absent one says it.
 BUILD_ADVICE = (

@@ -2,7 +2,9 @@
 
 from fastapi import APIRouter
 
-router = APIRouter(tags=["health"])
+from toptraj.service.strict_routes import StrictJSONRoute
+
+router = APIRouter(tags=["health"], route_class=StrictJSONRoute)
 
 
 @router.get("/health", summary="Liveness check")

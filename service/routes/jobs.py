@@ -21,8 +21,9 @@ from toptraj.service.jobs.store import JobStore
 from toptraj.service.problem_docs import PROBLEM_JSON, problem_responses
 from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
+from toptraj.service.strict_routes import StrictJSONRoute
 
-router = APIRouter(prefix="/v1/jobs", tags=["jobs"])
+router = APIRouter(prefix="/v1/jobs", tags=["jobs"], route_class=StrictJSONRoute)
 
 #: Most jobs on one page of ``GET /v1/jobs``.
 MAX_PAGE = 100

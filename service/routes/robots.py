@@ -26,8 +26,9 @@ from toptraj.service.schemas.robots import (
     SkeletonRequest,
     Source,
 )
+from toptraj.service.strict_routes import StrictJSONRoute
 
-router = APIRouter(prefix="/v1/robots", tags=["robots"])
+router = APIRouter(prefix="/v1/robots", tags=["robots"], route_class=StrictJSONRoute)
 
 
 def _problem(status: int, description: str) -> dict:

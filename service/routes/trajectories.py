@@ -12,8 +12,9 @@ from toptraj.service.problem_docs import problem_responses
 from toptraj.service.schemas.answers import CompareResponse, TrajectoryResponse
 from toptraj.service.schemas.examples import openapi_examples
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
+from toptraj.service.strict_routes import StrictJSONRoute
 
-router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"])
+router = APIRouter(prefix="/v1/trajectories", tags=["trajectories"], route_class=StrictJSONRoute)
 
 _ERRORS = problem_responses(404, 413, 422, 503, 504)
 

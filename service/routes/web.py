@@ -8,9 +8,10 @@ from importlib import resources
 from fastapi import APIRouter, HTTPException
 from fastapi.responses import FileResponse, HTMLResponse
 
+from toptraj.service.strict_routes import StrictJSONRoute
 from toptraj.service.web import STATIC
 
-router = APIRouter(include_in_schema=False)
+router = APIRouter(include_in_schema=False, route_class=StrictJSONRoute)
 
 #: Files of the page, by the name it loads them under, and their media types.
 _FILES = {

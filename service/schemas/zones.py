@@ -40,7 +40,7 @@ class ZoneRequest(Schema):
     `box`. The robot's limits hold elsewhere, in the same timing."""
 
     s_range: Annotated[list[Annotated[float, Field(ge=0.0, le=1.0)]], Field(min_length=2, max_length=2)] | None = Field(
-        default=None, description="[s0, s1] with 0 <= s0 <= s1 <= 1: the part of the path (s from 0 at the start to 1 at the end)."
+        default=None, description="[s0, s1] with 0 <= s0 < s1 <= 1: the part of the path (s from 0 at the start to 1 at the end)."
     )
     sphere: ZoneSphere | None = Field(default=None, description="A ball the tool point is inside (world frame).")
     box: ZoneBox | None = Field(default=None, description="An oriented box the tool point is inside (world frame).")
@@ -56,8 +56,10 @@ class ZoneRequest(Schema):
         places = [name for name in ("s_range", "sphere", "box") if getattr(self, name) is not None]
         if len(places) != 1:
             raise ValueError(f"give exactly one of s_range, sphere and box; got {' and '.join(places) or 'none'}")
-        if self.s_range is not None and self.s_range[0] > self.s_range[1]:
-            raise ValueError(f"s_range [{self.s_range[0]:g}, {self.s_range[1]:g}] runs backwards; give [s0, s1] with s0 <= s1")
+        if self.s_range is not None and self.s_range[0] >= self.s_range[1]:
+            s0, s1 = self.s_range
+            length = "runs backwards" if s0 > s1 else "has zero length"
+            raise ValueError(f"s_range [{s0:g}, {s1:g}] {length}: the zone covers no part of the path; give [s0, s1] with s1 > s0")
         limits = ("velocity_scale", "acceleration_scale", "torque_scale", "tool_speed")
         if all(getattr(self, name) is None for name in limits):
             raise ValueError(f"the zone sets no limit; give one of {', '.join(limits)}")

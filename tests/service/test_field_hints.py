@@ -3,6 +3,8 @@ schema (``toptraj.service.field_hints``), and nothing for a name the schema does
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from toptraj.service.field_hints import field_places
@@ -37,3 +39,59 @@ def test_places_inside_lists_are_written_with_an_index():
     places = field_places(TrajectoryRequest)
     assert "timing.zones[i].tool_speed" in places["tool_speed"]
     assert places["format"] == ("output.format",)
+
+
+def _set(body: dict, place: tuple, value) -> dict:
+    """``body`` with ``value`` at ``place`` (keys and indices), copied."""
+    body = json.loads(json.dumps(body))
+    holder = body
+    for part in place[:-1]:
+        holder = holder[part]
+    holder[place[-1]] = value
+    return body
+
+
+ZONED = {**WAYPOINTS, "timing": {"zones": [{"s_range": [0.2, 0.6], "velocity_scale": 0.5}]}}
+
+
+@pytest.mark.parametrize(
+    ("body", "typo", "meant"),
+    [
+        (WAYPOINTS, ("timng",), "timing"),
+        ({**WAYPOINTS, "timing": {}}, ("timing", "methd"), "method"),
+        ({**WAYPOINTS, "output": {}}, ("output", "formt"), "format"),
+        (ZONED, ("timing", "zones", 0, "velocity_scal"), "velocity_scale"),
+        ({"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.1] * 6]}}, ("path", "interpolaton"), "interpolation"),
+    ],
+)
+def test_a_misspelt_field_is_refused_with_the_name_meant_and_the_advice_works(client, body, typo, meant):
+    value = {"method": "toppra", "format": "csv", "interpolation": "linear", "velocity_scale": 0.4, "timing": {}}[meant]
+    if typo[-1] == "velocity_scal":
+        body = _set(body, typo[:-1], {"s_range": [0.2, 0.6]})
+    answer = client.post("/v1/trajectories", json=_set(body, typo, value))
+    assert answer.status_code == 422
+    place = ".".join(str(part) for part in typo).replace(".0.", "[0].")
+    assert answer.json()["detail"] == f"{place}: Extra inputs are not permitted: did you mean {meant!r}?"
+    followed = client.post("/v1/trajectories", json=_set(body, (*typo[:-1], meant), value))
+    assert followed.status_code == 200, followed.text
+
+
+def test_no_name_is_offered_when_none_is_close_or_none_is_allowed_there(client):
+    far = client.post("/v1/trajectories", json={**WAYPOINTS, "timing": {"frobnicate": 1}})
+    assert far.json()["detail"] == "timing.frobnicate: Extra inputs are not permitted"
+    # A cartesian path has points, not waypoints: the member of the path union is the one named.
+    cartesian = client.post("/v1/trajectories", json={"robot": "ur5", "path": {"kind": "cartesian", "points": [[0.4, 0, 0.4]], "waypont": 1}})
+    assert "did you mean" not in cartesian.text
+    assert "path.waypont: Extra inputs are not permitted" in cartesian.json()["detail"]
+
+
+def test_a_batch_request_and_the_cli_get_the_name_meant_too(client, tmp_path, capsys):
+    from toptraj.service.cli import main
+
+    body = {**WAYPOINTS, "timing": {"methd": "toppra"}}
+    answer = client.post("/v1/batches", json={"requests": [WAYPOINTS, body]})
+    assert answer.json()["detail"] == "requests[1].timing.methd: Extra inputs are not permitted: did you mean 'method'?"
+    request = tmp_path / "request.json"
+    request.write_text(json.dumps(body))
+    assert main(["plan", str(request)]) == 1
+    assert json.loads(capsys.readouterr().err)["detail"] == "timing.methd: Extra inputs are not permitted: did you mean 'method'?"

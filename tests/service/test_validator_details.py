@@ -3,6 +3,8 @@ service's own: the field, then the sentence, without pydantic's "Value error, " 
 
 from __future__ import annotations
 
+import json
+
 import pytest
 from pydantic import ValidationError
 
@@ -50,12 +52,30 @@ def test_a_validator_sentence_is_the_services_own(client, route, body, start):
     assert problem["errors"][0]["message"] == problem["detail"].split(": ", 1)[1]
 
 
-def test_the_framework_free_problem_drops_the_prefix_too():
-    """The CLI and the batches word a schema's refusal with ``validation_problem``."""
+def test_the_framework_free_problem_drops_the_prefix_and_writes_places_as_the_http_one():
+    """The CLI and the batches word a schema's refusal with ``validation_problem``: places as
+    the HTTP 422 writes them (``timing.zones[0]``, not pydantic's ``timing.zones.0``)."""
     with pytest.raises(ValidationError) as refused:
         TrajectoryRequest.model_validate(_zone(s_range=[0.5, 0.2], velocity_scale=0.5))
-    detail = validation_problem(refused.value)["detail"]
-    assert detail == "timing.zones.0: s_range [0.5, 0.2] runs backwards; give [s0, s1] with s0 <= s1"
+    problem = validation_problem(refused.value)
+    sentence = "s_range [0.5, 0.2] runs backwards: the zone covers no part of the path; give [s0, s1] with s1 > s0"
+    assert problem["detail"] == f"timing.zones[0]: {sentence}"
+    assert problem["errors"] == [{"field": "timing.zones[0]", "message": sentence}]
+
+
+def test_the_cli_and_a_batch_line_write_places_as_the_http_422(client, tmp_path, capsys):
+    from toptraj.service.batches.work import answer
+    from toptraj.service.cli import main
+
+    body = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS[:2], "obstacles": [{"kind": "sphere", "center": [0, 0], "radius": 0.1}]}}
+    expected = client.post("/v1/trajectories", json=body).json()
+    assert expected["errors"][0]["field"] == "path.obstacles[0].center"
+    status, line = answer(json.dumps(body), 10.0)
+    assert status == 422 and json.loads(line)["detail"] == expected["detail"]
+    request = tmp_path / "request.json"
+    request.write_text(json.dumps(body))
+    assert main(["plan", str(request)]) == 1
+    assert json.loads(capsys.readouterr().err)["detail"] == expected["detail"]
 
 
 SHAPES = "give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows of 3), in kg m^2"

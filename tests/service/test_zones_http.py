@@ -41,7 +41,9 @@ def test_the_answer_lists_where_each_zone_lies_and_whether_it_bound(client):
 @pytest.mark.parametrize(
     ("zones", "field", "words"),
     [
-        ([MIDDLE, {"s_range": [0.6, 0.4], "tool_speed": 0.1}], "timing.zones[1]", "runs backwards"),
+        ([MIDDLE, {"s_range": [0.6, 0.4], "tool_speed": 0.1}], "timing.zones[1]", "s_range [0.6, 0.4] runs backwards"),
+        ([MIDDLE, {"s_range": [0.4, 0.4], "tool_speed": 0.1}], "timing.zones[1]", "s_range [0.4, 0.4] has zero length"),
+        ([{"s_range": [1, 1], "velocity_scale": 0.5}], "timing.zones[0]", "give [s0, s1] with s1 > s0"),
         ([{"s_range": [0.2, 1.5], "tool_speed": 0.1}], "timing.zones[0].s_range[1]", "less than or equal to 1"),
         ([{"s_range": [-0.1, 0.5], "tool_speed": 0.1}], "timing.zones[0].s_range[0]", "greater than or equal to 0"),
         ([MIDDLE, MIDDLE, {"s_range": [0.2, 0.3], "tool_speed": -1.0}], "timing.zones[2].tool_speed", "not within"),

@@ -1,0 +1,91 @@
+"""JSON text read strictly: a key given twice in one object is refused (``DuplicateKey``, naming
+the key and its place) instead of the last one silently winning, as Python's ``json`` and
+orjson both let it. Every request body the service reads goes through ``loads``: the HTTP
+bodies (``toptraj.service.strict_routes``), the lines of a batch and the CLI's files.
+
+The text is parsed once, by ``json``'s C scanner, with a hook on each object; the place of a
+duplicate is looked for only when there is one, by a walk without recursion."""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+from typing import Any
+
+from toptraj.robots.errors import excerpt
+from toptraj.service.locations import joined
+
+#: Characters of a key shown in a place.
+MAX_KEY_CHARS = 60
+
+
+class DuplicateKey(ValueError):
+    """An object of a JSON text gives ``key`` ``count`` times; ``where`` is the key's place
+    (``timing.zones[0].tool_speed``)."""
+
+    def __init__(self, key: str, where: str, count: int):
+        self.key, self.where, self.count = key, where, count
+        self.message = (
+            f"the key {excerpt(key)} is given {count} times in one object; a JSON parser would silently keep the last: "
+            "give each field once"
+        )
+        super().__init__(f"{where}: {self.message}")
+
+    def problem(self) -> dict:
+        """The 422 problem+json of the refusal, its ``errors`` as a schema's refusals list theirs."""
+        return {
+            "type": "about:blank",
+            "title": "Invalid request",
+            "status": 422,
+            "detail": str(self),
+            "errors": [{"field": self.where, "message": self.message}],
+        }
+
+
+def _refuse_constant(name: str) -> float:
+    raise ValueError(f"{name} is no JSON number")
+
+
+def loads(data: str | bytes, finite: bool = False) -> Any:
+    """The value of the JSON text ``data``, every key of each object given once; with
+    ``finite``, ``NaN`` and ``Infinity`` are refused as no JSON.
+
+    Raises:
+        json.JSONDecodeError: ``data`` is no JSON (a ``ValueError``).
+        ValueError: with ``finite``, ``data`` holds ``NaN``, ``Infinity`` or ``-Infinity``.
+        DuplicateKey: an object gives a key more than once (the first such object to end).
+        RecursionError: ``data`` nests deeper than the interpreter's recursion limit.
+    """
+    duplicated: list[tuple[dict, str, int]] = []
+
+    def pairs(items: list[tuple[str, Any]]) -> dict:
+        value = dict(items)
+        if len(value) != len(items) and not duplicated:
+            key, count = Counter(key for key, _ in items).most_common(1)[0]
+            duplicated.append((value, key, count))
+        return value
+
+    value = json.loads(data, object_pairs_hook=pairs, parse_constant=_refuse_constant if finite else None)
+    if duplicated:
+        holder, key, count = duplicated[0]
+        raise DuplicateKey(key, joined(_short(part) for part in [*_place_of(value, holder), key]), count)
+    return value
+
+
+def _short(part: str | int) -> str | int:
+    """A key as a place shows it: its first ``MAX_KEY_CHARS`` characters."""
+    return part[:MAX_KEY_CHARS] + "..." if isinstance(part, str) and len(part) > MAX_KEY_CHARS else part
+
+
+def _place_of(root: Any, target: dict) -> list[str | int]:
+    """The keys and indices that lead from ``root`` to the object ``target`` (by identity)."""
+    stack: list[tuple[Any, list[str | int]]] = [(root, [])]
+    while stack:
+        value, place = stack.pop()
+        if value is target:
+            return place
+        if isinstance(value, dict):
+            stack.extend((item, [*place, key]) for key, item in value.items() if isinstance(item, dict | list))
+        elif isinstance(value, list):
+            stack.extend((item, [*place, index]) for index, item in enumerate(value) if isinstance(item, dict | list))
+    return []
