@@ -44,7 +44,7 @@ class Zone:
     """Limits of their own on part of the path.
 
     Attributes:
-        s_range: (s0, s1) with 0 <= s0 <= s1 <= 1, the part of the path; or ``None`` with a
+        s_range: (s0, s1) with 0 <= s0 < s1 <= 1, the part of the path; or ``None`` with a
             ``region``.
         region: A sphere or box (world frame) the tool point is inside; or ``None``.
         velocity, acceleration, torque: Factors in (0, 1] on the robot's limits of that kind
@@ -68,7 +68,7 @@ def _refused(field: str, sentence: str, **facts) -> InvalidRequest:
 
 def check_zones(zones: tuple[Zone, ...]) -> None:
     """InvalidRequest naming the zone unless there are at most ``MAX_ZONES``, each with exactly
-    one of an s-range within [0, 1] (s0 <= s1) and a region, at least one limit, factors in
+    one of an s-range within [0, 1] (s0 < s1) and a region, at least one limit, factors in
     (0, 1] and a positive finite tool speed."""
     if len(zones) > MAX_ZONES:
         raise _refused("zones", f"{len(zones)} zones are given; at most {MAX_ZONES} are served (merge neighbouring ones)")
@@ -77,8 +77,8 @@ def check_zones(zones: tuple[Zone, ...]) -> None:
             raise _refused(f"zones[{index}]", f"zone {index} needs exactly one of an s-range and a region (sphere or box)")
         if zone.s_range is not None:
             s0, s1 = (float(value) for value in zone.s_range)
-            if not (0.0 <= s0 <= s1 <= 1.0):
-                raise _refused(f"zones[{index}].s_range", f"zone {index} has the s-range [{s0:g}, {s1:g}]; give 0 <= s0 <= s1 <= 1")
+            if not (0.0 <= s0 < s1 <= 1.0):
+                raise _refused(f"zones[{index}].s_range", f"zone {index} has the s-range [{s0:g}, {s1:g}]; give 0 <= s0 < s1 <= 1")
         else:
             _check_region(index, zone.region)
         factors = {"velocity": zone.velocity, "acceleration": zone.acceleration, "torque": zone.torque}

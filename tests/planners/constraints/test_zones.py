@@ -147,6 +147,7 @@ def test_a_zone_scales_the_joint_limits_of_its_kind_inside_it(ur5, kind, factor)
     ("zones", "words"),
     [
         ((Zone(s_range=(0.6, 0.4), tool_speed=0.1),), "zone 0 has the s-range"),
+        ((Zone(s_range=(0.4, 0.4), tool_speed=0.1),), r"zone 0 has the s-range \[0.4, 0.4\]; give 0 <= s0 < s1"),
         ((MIDDLE, Zone(s_range=(0.2, 1.5), tool_speed=0.1)), "zone 1 has the s-range"),
         ((MIDDLE, MIDDLE, Zone(s_range=(0.2, 0.3), tool_speed=-1.0)), "zone 2 has a tool speed"),
         ((Zone(s_range=(0.2, 0.3), torque=-0.5),), "zone 0 has a torque factor"),
