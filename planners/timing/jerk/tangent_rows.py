@@ -14,7 +14,7 @@ one scale and one bound per row (``TangentRows.values``), in one pass over flat 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -40,7 +40,9 @@ class TangentRows:
         columns: The LP's columns.
     """
 
-    def __init__(self, terms: Sequence[Term], J: np.ndarray, x_column, fixed: sparse.csr_matrix, columns: int):
+    def __init__(
+        self, terms: Sequence[Term], J: np.ndarray, x_column: Callable[[np.ndarray], np.ndarray], fixed: sparse.csr_matrix, columns: int,
+    ):
         static, entry_row, entry_column, is_x = [], [], [], []
         self.offset, coefficient, largest, limit, point = 0, [], [], [], []
         for u_terms, x_coefficient, points in terms:
