@@ -28,6 +28,7 @@ from toptraj.planners.errors import TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import Boundary
 from toptraj.planners.timing.jerk.scaling import JerkTimeScaling, interval_times
+from toptraj.planners.timing.jerk.tangent_rows import TangentRows
 
 if TYPE_CHECKING:
     from scipy import sparse
@@ -55,8 +56,8 @@ class RestrictedProgram:
 
         self._lp = WorkingSetLP(deadline)
         self._fixed: tuple[sparse.csr_matrix, np.ndarray, np.ndarray] | None = None
-        self._pattern: _Pattern | None = None
-        self._jerk_terms: tuple | None = None
+        self._tangent: TangentRows | None = None
+        self._lower = np.zeros(0)
 
     # Variables: X_0..X_n at columns 0..n, U_0..U_n at columns n+1..2n+1.
     def _x(self, i):
@@ -173,21 +174,18 @@ class RestrictedProgram:
             i.size * m,
         )]
 
-    def _jerk_rows(self, x_tangent: np.ndarray, pattern: bool = True) -> list:
+    def _tangent_rows(self) -> TangentRows:
         """The jerk rows (1) at both ends of every interval, their right-hand side J / sqrt(X)
-        replaced by its tangent at ``x_tangent`` (scaled), J (alpha - beta X): two one-sided
-        rows ``+-G + J beta X <= J alpha`` each (blocks of ``_stacked``; without ``pattern``,
-        their rows and columns left out: the tangent changes values only)."""
-        if self._jerk_terms is None:  # G's coefficients do not depend on the tangent
+        replaced by its tangent (``toptraj.planners.timing.jerk.tangent_rows``): G's
+        coefficients do not depend on the tangent, and are gathered once per grid."""
+        if self._tangent is None:
             limit = self._jerk[3]
             limited = np.flatnonzero(np.isfinite(limit))
             terms = (*self._regular_jerk_terms(limited), *self._rest_jerk_terms(limited)) if limited.size else ()
-            self._jerk_terms = (terms, limit[limited] / self.kappa**1.5)  # scaled: |G| <= J / sqrt(X)
-        terms, J = self._jerk_terms
-        blocks: list = []
-        for u_terms, x_coefficient, point in terms:
-            blocks.extend(_tangent_rows(u_terms, x_coefficient, self._x(point), x_tangent[point], J, pattern))
-        return blocks
+            J = limit[limited] / self.kappa**1.5  # scaled: |G| <= J / sqrt(X)
+            assert self._fixed is not None
+            self._tangent = TangentRows(terms, J, self._x, self._fixed[0], 2 * self.n + 2)
+        return self._tangent
 
     @property
     def _jerk(self):
@@ -259,27 +257,21 @@ class RestrictedProgram:
 
     def _rows(self, X_tangent: np.ndarray) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:
         """Every row of the LP around ``X_tangent``: (matrix (CSR), lower, upper), the rows that
-        do not depend on the restriction first. Both parts' patterns are built at the first
-        restriction (``_Pattern``); a later one computes the jerk rows' values only."""
+        do not depend on the restriction first: the pattern is built at the first restriction,
+        a later one computes the jerk rows' values only (``TangentRows.values``)."""
         from scipy import sparse
 
         columns = 2 * self.n + 2
         if self._fixed is None:  # the rows that do not depend on the restriction, built once
             self._fixed = _stacked(self._fixed_rows, columns)
-        blocks = self._jerk_rows(X_tangent, pattern=self._pattern is None)
-        if self._pattern is None:
-            self._pattern = _Pattern(self._fixed[0], blocks, columns)
         fixed, fixed_lower, fixed_upper = self._fixed
-        if blocks:
-            values = np.concatenate([block[2] for block in blocks])
-            jerk_lower = np.concatenate([block[3] for block in blocks])
-            jerk_upper = np.concatenate([block[4] for block in blocks])
-        else:
-            values, jerk_lower, jerk_upper = np.zeros(0), np.zeros(0), np.zeros(0)
-        pattern = self._pattern
-        data = np.concatenate([fixed.data, np.bincount(pattern.entry, weights=values, minlength=pattern.jerk_nnz)])
-        matrix = sparse.csr_matrix((data, pattern.indices, pattern.indptr), shape=(pattern.rows, columns))
-        return matrix, np.concatenate([fixed_lower, jerk_lower]), np.concatenate([fixed_upper, jerk_upper])
+        tangent = self._tangent_rows()
+        values, jerk_upper = tangent.values(X_tangent)
+        if self._lower.size == 0:
+            self._lower = np.concatenate([fixed_lower, np.full(tangent.offset, -np.inf)])
+        data = np.concatenate([fixed.data, values])
+        matrix = sparse.csr_matrix((data, tangent.indices, tangent.indptr), shape=(tangent.rows, columns))
+        return matrix, self._lower, np.concatenate([fixed_upper, jerk_upper])
 
     def _time_gradient(self, X):
         """d/dX of sum 2 h / (sqrt(X_i) + sqrt(X_i+1)) (3 h / sqrt(X) for an interval at rest)."""
@@ -305,60 +297,6 @@ class RestrictedProgram:
             self.constraints.s, np.sqrt(np.maximum(x, 0.0)), u=np.asarray(u, dtype=float),
             rest_start=self.rest_start, rest_end=self.rest_end,
         )
-
-
-def _tangent_rows(u_terms, x_coefficient, x_columns, x_tangent, J, pattern: bool = True):
-    """The two one-sided rows +-G + J beta X <= J alpha of each point and limited joint, G's U
-    part ``u_terms`` (columns (k,), coefficients (k, m)) and its X coefficient ``x_coefficient``
-    (k, m) at the columns ``x_columns`` (k,); alpha = 1.5 / sqrt(X_t), beta = 0.5 / X_t^1.5
-    (the tangent of X^-1/2 at ``x_tangent``, (k,)): blocks of ``_stacked`` (without
-    ``pattern``, their rows and columns ``None``)."""
-    X = np.maximum(x_tangent, 1e-12)
-    alpha, beta = 1.5 / np.sqrt(X), 0.5 / X**1.5
-    k, m = x_coefficient.shape
-    width = len(u_terms) + 1
-    rows = columns = None
-    if pattern:
-        x_col = np.broadcast_to(x_columns[:, None], (k, m))
-        columns = np.stack([*(np.broadcast_to(col[:, None], (k, m)) for col, _ in u_terms), x_col], axis=-1).reshape(-1)
-        rows = np.repeat(np.arange(k * m), width)
-    blocks = []
-    for sign in (1.0, -1.0):
-        values = np.stack(
-            [*(sign * coefficient for _, coefficient in u_terms), sign * x_coefficient + J * beta[:, None]], axis=-1
-        )
-        scale = np.maximum(np.abs(values).max(axis=-1), 1e-300)
-        blocks.append((
-            rows,
-            columns,
-            (values / scale[..., None]).reshape(-1),
-            np.full(k * m, -np.inf),
-            (J * alpha[:, None] / scale).ravel(),
-            k * m,
-        ))
-    return blocks
-
-
-class _Pattern:
-    """The sparsity pattern of an LP's rows, the fixed rows (a CSR matrix) over the jerk rows
-    (blocks of ``_stacked``): the whole matrix's ``indptr`` and ``indices`` (CSR, rows sorted,
-    repeated entries summed, as ``_stacked`` builds them), and for each value of the jerk
-    blocks, in their order, the entry of the jerk part it adds to (``entry``, of
-    ``jerk_nnz``)."""
-
-    def __init__(self, fixed: sparse.csr_matrix, blocks: list, columns: int):
-        offsets = np.cumsum([0] + [block[5] for block in blocks])
-        if blocks:
-            row = np.concatenate([block[0] + offset for block, offset in zip(blocks, offsets)])
-            column = np.concatenate([block[1] for block in blocks])
-        else:
-            row = column = np.zeros(0, dtype=np.int64)
-        keys, self.entry = np.unique(row.astype(np.int64) * columns + column, return_inverse=True)
-        self.jerk_nnz = keys.size
-        counts = np.bincount(keys // columns, minlength=int(offsets[-1]))
-        self.rows = fixed.shape[0] + int(offsets[-1])
-        self.indptr = np.concatenate([fixed.indptr, fixed.indptr[-1] + np.cumsum(counts)]).astype(fixed.indptr.dtype)
-        self.indices = np.concatenate([fixed.indices, keys % columns]).astype(fixed.indices.dtype)
 
 
 def _stacked(blocks, columns: int) -> tuple[sparse.csr_matrix, np.ndarray, np.ndarray]:

@@ -63,6 +63,8 @@ class WorkingSetLP:
         self.rows: np.ndarray | None = None
         self.basis = None
         self.total = 0
+        self._part_of: np.ndarray | None = None
+        self._part_pattern: tuple[np.ndarray, np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0), np.zeros(0))
 
     def solve(
         self, objective: np.ndarray, matrix: sparse.csr_matrix, lower: np.ndarray, upper: np.ndarray, low: np.ndarray,
@@ -137,17 +139,30 @@ class WorkingSetLP:
             solver.setOptionValue("time_limit", max(remaining, 1e-3))
         rows = self.rows
         assert rows is not None
-        part = matrix[rows].tocsc()
+        start, index, taken = self._part(matrix, rows)
         lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = part.shape[1], part.shape[0]
+        lp.num_col_, lp.num_row_ = matrix.shape[1], rows.size
         lp.col_cost_, lp.col_lower_, lp.col_upper_ = objective, low, high
         lp.row_lower_, lp.row_upper_ = lower[rows], upper[rows]
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = part.indptr, part.indices, part.data
+        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = start, index, matrix.data[taken]
         solver.passModel(lp)
         if self.basis is not None:
             solver.setBasis(self.basis)
         return solver
+
+    def _part(self, matrix: sparse.csr_matrix, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The rows ``rows`` of ``matrix`` by columns (CSC): its ``indptr`` and ``indices``, and
+        the entries of ``matrix.data`` it takes, in order. Consecutive LPs share their pattern
+        (only the jerk rows' values change) and mostly their working set: kept while
+        ``rows`` is the same array."""
+        if self._part_of is not rows:
+            numbered = sparse.csr_matrix(
+                (np.arange(matrix.nnz, dtype=float), matrix.indices, matrix.indptr), shape=matrix.shape,
+            )
+            part = numbered[rows].tocsc()
+            self._part_of, self._part_pattern = rows, (part.indptr, part.indices, part.data.astype(np.int64))
+        return self._part_pattern
 
     def _run(self, solver) -> bool:
         """One simplex run: ``True`` at an optimum, ``False`` where the relaxation is unbounded
