@@ -101,6 +101,11 @@ def joint_trajectory(result: PlannedTrajectory) -> dict:
     }
 
 
+def _utilization_text(value) -> str:
+    """A peak utilization as the CSV writes it: ``null`` for a joint without a finite limit."""
+    return "null" if value is None or not np.isfinite(float(value)) else repr(float(value))
+
+
 def csv_metadata(body: Mapping) -> list[str]:
     """The ``# key: value`` lines of a trajectory body's CSV (``body`` as
     ``toptraj.service.planning.trajectory_body`` builds it, or as its JSON decodes): robot, method,
@@ -116,7 +121,7 @@ def csv_metadata(body: Mapping) -> list[str]:
         f"limits asked are held within {TOLERANCE_PERCENT:g} %",
     ]
     for kind, values in body["peak_utilization"].items():
-        lines.append(f"peak_utilization.{kind}: " + ",".join(repr(float(v)) for v in values))
+        lines.append(f"peak_utilization.{kind}: " + ",".join(_utilization_text(v) for v in np.atleast_1d(np.asarray(values, dtype=object))))
     binding = body.get("binding")
     if binding is not None:
         where = "the whole path" if binding["joint"] is None else f"joint {binding['joint']}"

@@ -29,6 +29,7 @@ from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.trajectory import Samples, sample_trajectory
+from toptraj.robots import JointLimits
 from toptraj.robots.notes import Note
 
 #: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
@@ -61,7 +62,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     accuracy, warning = _accuracy(problem, timed)
     if warning is not None:
         notes.append(warning)
-    utilization = _utilization(timed.stretches, problem.margin)
+    utilization = _utilization(timed.stretches, problem.margin, problem.limits)
     notes.extend(_unasked_limits(utilization, problem.kinds, problem.method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
     notes.extend(_singularity_notes(kappa_max, samples.t[worst]))
@@ -183,16 +184,17 @@ def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.n
     return s[keep], sd[keep], mvc[keep]
 
 
-def _utilization(stretches_: tuple[TimedStretch, ...], margin: float) -> dict[str, np.ndarray]:
+def _utilization(stretches_: tuple[TimedStretch, ...], margin: float, limits: JointLimits) -> dict[str, np.ndarray]:
     """Peak |value| / limit per kind and joint over every stretch, against the limits as
-    requested (before any margin)."""
+    requested (before any margin); ``nan`` for a joint and kind without a finite limit (in
+    ``limits``, (n_dof,) each) that no zone limited either (its peak stays 0)."""
     kinds = stretches_[0].check.utilization.keys()
-    if len(stretches_) == 1:
-        return {kind: (1.0 - margin) * peak for kind, peak in stretches_[0].check.utilization.items()}
-    return {
-        kind: (1.0 - margin) * np.max([item.check.utilization[kind] for item in stretches_], axis=0)
-        for kind in kinds
-    }
+    peaks = {kind: np.max([item.check.utilization[kind] for item in stretches_], axis=0) for kind in kinds}
+    for kind, peak in peaks.items():
+        limit = getattr(limits, kind, None)
+        if limit is not None and np.shape(limit) == np.shape(peak):
+            peaks[kind] = np.where(~np.isfinite(limit) & (peak == 0.0), np.nan, peak)
+    return {kind: (1.0 - margin) * peak for kind, peak in peaks.items()}
 
 
 def _unasked_limits(
@@ -204,7 +206,7 @@ def _unasked_limits(
     notes = []
     for kind, peak in utilization.items():
         peak = np.atleast_1d(np.asarray(peak, dtype=float))
-        if kind in kinds or kind.startswith("tool") or not peak.size or not np.nanmax(peak) > UNASKED_EXCESS:
+        if kind in kinds or kind.startswith("tool") or not np.any(peak > UNASKED_EXCESS):
             continue
         joint = int(np.nanargmax(peak))
         name = joint_names[joint] if peak.size == len(joint_names) else f"joint {joint}"
