@@ -25,6 +25,7 @@ from toptraj.planners.problem.problem import Problem
 from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, ZoneReport, require_finite
 from toptraj.planners.runner.accuracy import answer_accuracy
 from toptraj.planners.runner.admission import admit_samples
+from toptraj.planners.runner.sampling_notes import sampling_notes
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.laws.method import ClassicalMethod
@@ -66,6 +67,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     notes.extend(_unasked_limits(utilization, problem.kinds, problem.method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
     notes.extend(_singularity_notes(kappa_max, samples.t[worst]))
+    notes.extend(sampling_notes(result.duration, problem.sampling.dt, problem.sampling.exact_period, len(samples.t)))
     switching = timed.switching_times
     if switching is None and timed.method == "collocation" and getattr(problem.method, "torque_weight", None) == 0.0:
         read = collocation_switches(samples.t, samples.tau, problem.limits.torque, level=SATURATION_READ)
