@@ -15,7 +15,8 @@
   client that prefers CSV over JSON). The header comes first so that readers skipping comment
   lines read it as the header: ``pandas.read_csv(f, comment="#")``,
   ``numpy.loadtxt(f, delimiter=",", skiprows=1)``, ``numpy.genfromtxt(f, delimiter=",",
-  names=True)``.
+  names=True)``, ``csv.DictReader`` over the lines not starting with ``#`` (docs/http-api.md,
+  "Reading the CSV"; a reader that does not skip them takes them for rows).
 
 Controllers consume points at a fixed period, so ``joint_trajectory`` and ``csv`` put the
 samples on whole periods by default (``output.exact_period``, see
