@@ -31,12 +31,13 @@ from collections.abc import Mapping
 import numpy as np
 
 from toptraj.planners import PlannedTrajectory
-from toptraj.planners.checks.gate import LIMIT_TOLERANCE
+from toptraj.planners.checks.gate import PROMISED_TOLERANCE
 
 FORMATS = ("samples", "joint_trajectory", "csv")
 CSV_MEDIA_TYPE = "text/csv; charset=utf-8"
-#: How far past a limit asked an answer may go on a dense resampling, in percent of the limit.
-TOLERANCE_PERCENT = round((LIMIT_TOLERANCE - 1.0) * 100, 6)
+#: How far past a limit asked an answer may go on a dense resampling, in percent of the limit
+#: (the promise, ``toptraj.planners.checks.gate.PROMISED_TOLERANCE``).
+TOLERANCE_PERCENT = round((PROMISED_TOLERANCE - 1.0) * 100, 6)
 
 
 def _quality(accept: str, media: str) -> float:
