@@ -66,7 +66,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     utilization = _utilization(timed.stretches, problem.margin, problem.limits)
     notes.extend(_unasked_limits(utilization, problem.kinds, problem.method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
-    notes.extend(_singularity_notes(kappa_max, samples.t[worst]))
+    notes.extend(_singularity_notes(kappa_min, kappa_max, samples.t[worst]))
     notes.extend(sampling_notes(result.duration, problem.sampling.dt, problem.sampling.exact_period, len(samples.t)))
     switching = timed.switching_times
     if switching is None and timed.method == "collocation" and getattr(problem.method, "torque_weight", None) == 0.0:
@@ -159,15 +159,27 @@ def _accuracy(problem: Problem, timed: Timed) -> tuple[Accuracy, str | None]:
     )
 
 
-def _singularity_notes(kappa_max: float, at: float) -> list[str]:
-    """A note when the arm passes through or near a singularity (at ``at``, s)."""
+def _singularity_notes(kappa_min: float, kappa_max: float, at: float) -> list[str]:
+    """A note when the arm passes through or near a singularity (at ``at``, s), or stays in one
+    all along (``kappa_min`` infinite: no single instant to name), each with what to do."""
+    unaffected = "the timing is unaffected, but the tool's motion is poorly controlled near that pose"
+    remedy = f"to avoid it, move the path's waypoints near t = {at:.4g} s off that pose (a Cartesian path: give it in joint space there)"
+    if not np.isfinite(kappa_min):
+        return [
+            "the arm is at a singularity all along the motion: its end effector's Jacobian lacks full rank at every "
+            "sample conditioned (the condition number is infinite throughout, as for an end effector on a joint's "
+            "axis); the timing is unaffected, and a motion given in joint space needs no change"
+        ]
     if not np.isfinite(kappa_max):
         return [
-            f"the arm passes through a singularity at t = {at:.4g} s: its Jacobian loses rank "
-            "there (the condition number is infinite)"
+            f"the arm passes through a singularity at t = {at:.4g} s: its Jacobian loses rank there (the condition "
+            f"number is infinite); {unaffected}; {remedy}"
         ]
     if kappa_max > NEAR_SINGULAR_KAPPA:
-        return [f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} at t = {at:.4g} s"]
+        return [
+            f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} at t = {at:.4g} s; "
+            f"{unaffected}; {remedy}"
+        ]
     return []
 
 
