@@ -43,3 +43,13 @@ def test_the_csv_metadata_writes_null(client):
     assert lines["# peak_utilization.velocity"] == "# peak_utilization.velocity: null,null"
     assert lines["# peak_utilization.acceleration"] == "# peak_utilization.acceleration: null,null"
     assert "null" not in lines["# peak_utilization.torque"]
+
+
+def test_a_cell_arms_unlimited_joint_reads_null():
+    from types import SimpleNamespace
+
+    from toptraj.service.cell_answers import _reported
+
+    limits = SimpleNamespace(velocity=np.array([np.inf, 2.0]), torque=np.array([5.0, 5.0]))
+    reported = _reported({"velocity": np.array([0.0, 0.75]), "torque": np.array([1.0, 0.5])}, limits)
+    assert reported == {"velocity": [None, 0.75], "torque": [1.0, 0.5]}
