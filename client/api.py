@@ -241,12 +241,18 @@ class Client(JobCalls):
         return comparisons(self._call("POST", "/v1/trajectories/compare", body, timeout=timeout))
 
     def cell(self, body: dict | str | os.PathLike[str], *, timeout: float | None = None) -> dict:
-        """``POST /v1/cells``: two arms in one workspace timed together so that they keep a
-        clearance (``examples/cell_two_ur5.json``: a dict, JSON text or a file's path).
+        """``POST /v1/cells``: two to four arms in one workspace timed together so that their
+        links keep a clearance (``examples/cell_two_ur5.json``: a dict, JSON text or a file's
+        path; ``format`` ``samples`` or ``joint_trajectory``).
 
         Returns:
-            The answer as sent: ``duration``, ``solo_durations``, ``time_lost``, ``t``, one
-            ``trajectory`` (a JointTrajectory) per arm and the coordination ``diagram``.
+            The JSON answer as sent: ``duration``, ``sampled_duration``, ``solo_durations``,
+            ``sequential_duration``, ``time_lost`` (s), ``schedule``, ``t`` (the samples' times,
+            s, shared by every arm), ``arms`` (per arm: ``robot``, ``joint_names``, ``samples``
+            ``{t, q, qd, qdd, tau}``, or with ``format`` ``joint_trajectory`` a
+            ``joint_trajectory``, ``peak_utilization``, ``payload`` and ``base``),
+            ``min_distance``, the coordination ``diagram`` of arms 0 and 1 and ``diagrams``
+            of every pair.
         """
         request = body if isinstance(body, dict) else json.loads(_text(body))
         return self._call("POST", "/v1/cells", request, timeout=timeout)

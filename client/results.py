@@ -31,7 +31,8 @@ def _optional(kind: Any, value: dict | None) -> Any:
 @dataclass(frozen=True, eq=False)
 class Utilization:
     """Peak |value| / limit per joint on a dense resampling of the answer (1.0: the limit binds;
-    the service holds every limit within 0.5 %).
+    the service holds every limit within 0.5 %); ``nan`` for a joint without a finite limit of
+    that kind (the answer's null).
 
     Attributes:
         velocity: Peak |qd| / velocity limit, shape (n_dof,).

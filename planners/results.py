@@ -72,6 +72,8 @@ class PlannedTrajectory:
     duration: float
     samples: Samples
     phase_plane: PhasePlane
+    #: Peak |value| / limit per kind, (n_dof,) each (a tool limit's: shape ()); ``nan`` for a
+    #: joint and kind without a finite limit.
     peak_utilization: dict[str, np.ndarray]
     solve_ms: float
     warnings: tuple[str, ...]

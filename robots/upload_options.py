@@ -213,7 +213,24 @@ def _joint_limits(given) -> tuple[dict[str, dict[str, float]], list[str]]:
         limits[str(joint)] = values
     if positions:
         notes.append(f"joint_limits.yaml's position limits of {', '.join(positions)} not applied: the URDF's are used")
-    return limits, notes
+    return limits, notes + _ignored_maxima(given["joint_limits"])
+
+
+def _ignored_maxima(entries: dict) -> list[str]:
+    """A note per ``max_*`` key given where its ``has_*_limits`` is false or absent (MoveIt
+    ignores it there, and so does the upload), naming the joints and the values (at most 5)."""
+    notes = []
+    for key, kind in _MAXIMA.items():
+        flag = _FLAGS[kind]
+        ignored = [f"{_short(joint)} ({excerpt(entry[key], 20)})" for joint, entry in entries.items()
+                   if key in entry and entry.get(flag, False) is False]
+        if ignored:
+            shown = ", ".join(ignored[:5]) + (f" and {len(ignored) - 5} more" if len(ignored) > 5 else "")
+            notes.append(
+                f"joint_limits.yaml's {key} of {shown} not applied: {flag} is false or absent there (as in MoveIt); "
+                f"set {flag}: true to apply it"
+            )
+    return notes
 
 
 def upload_options(locked_joints: dict | None = None, joint_limits: object = None, payload: Payload | None = None,

@@ -87,6 +87,15 @@ def on_whole_periods(schedule: Schedule, dt: float) -> Schedule:
     return Schedule(schedule.motions, schedule.kind, schedule.stretch * periods * dt / schedule.duration)
 
 
+def _reported(peaks: dict[str, np.ndarray], limits) -> dict[str, list[float | None]]:
+    """An arm's peak utilization per kind and joint, null for a joint without a finite limit of
+    that kind (its peak, |value| / inf, reads 0)."""
+    return {
+        kind: [None if not math.isfinite(limit) else float(value) for value, limit in zip(values, np.asarray(getattr(limits, kind), dtype=float))]
+        for kind, values in peaks.items()
+    }
+
+
 def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_period: bool) -> dict:
     """The answer (module docstring); ``format_`` ``csv`` gives the ``samples`` body that
     ``csv_bytes`` writes. With ``exact_period`` the samples lie on whole periods ``dt``, the
@@ -107,7 +116,7 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_pe
         "schedule": schedule.kind,
         "t": t,
         "arms": [
-            _arm_body(arm, t, states, arm_peaks, format_)
+            _arm_body(arm, t, states, _reported(arm_peaks, arm.limits), format_)
             for arm, states, arm_peaks in zip(cell.arms, schedule.states(cell, t), peaks)
         ],
         "min_distance": {
@@ -147,7 +156,7 @@ def _metadata(body: dict) -> list[str]:
     ]
     for index, arm in enumerate(arms):
         for kind, values in arm["peak_utilization"].items():
-            lines.append(f"peak_utilization.arms[{index}].{kind}: " + ",".join(repr(float(v)) for v in values))
+            lines.append(f"peak_utilization.arms[{index}].{kind}: " + ",".join("null" if v is None else repr(float(v)) for v in values))
     return ["# " + " ".join(line.split()) for line in lines]
 
 

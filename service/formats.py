@@ -15,7 +15,8 @@
   client that prefers CSV over JSON). The header comes first so that readers skipping comment
   lines read it as the header: ``pandas.read_csv(f, comment="#")``,
   ``numpy.loadtxt(f, delimiter=",", skiprows=1)``, ``numpy.genfromtxt(f, delimiter=",",
-  names=True)``.
+  names=True)``, ``csv.DictReader`` over the lines not starting with ``#`` (docs/http-api.md,
+  "Reading the CSV"; a reader that does not skip them takes them for rows).
 
 Controllers consume points at a fixed period, so ``joint_trajectory`` and ``csv`` put the
 samples on whole periods by default (``output.exact_period``, see
@@ -30,12 +31,13 @@ from collections.abc import Mapping
 import numpy as np
 
 from toptraj.planners import PlannedTrajectory
-from toptraj.planners.checks.gate import LIMIT_TOLERANCE
+from toptraj.planners.checks.gate import PROMISED_TOLERANCE
 
 FORMATS = ("samples", "joint_trajectory", "csv")
 CSV_MEDIA_TYPE = "text/csv; charset=utf-8"
-#: How far past a limit asked an answer may go on a dense resampling, in percent of the limit.
-TOLERANCE_PERCENT = round((LIMIT_TOLERANCE - 1.0) * 100, 6)
+#: How far past a limit asked an answer may go on a dense resampling, in percent of the limit
+#: (the promise, ``toptraj.planners.checks.gate.PROMISED_TOLERANCE``).
+TOLERANCE_PERCENT = round((PROMISED_TOLERANCE - 1.0) * 100, 6)
 
 
 def _quality(accept: str, media: str) -> float:
@@ -101,6 +103,11 @@ def joint_trajectory(result: PlannedTrajectory) -> dict:
     }
 
 
+def _utilization_text(value) -> str:
+    """A peak utilization as the CSV writes it: ``null`` for a joint without a finite limit."""
+    return "null" if value is None or not np.isfinite(float(value)) else repr(float(value))
+
+
 def csv_metadata(body: Mapping) -> list[str]:
     """The ``# key: value`` lines of a trajectory body's CSV (``body`` as
     ``toptraj.service.planning.trajectory_body`` builds it, or as its JSON decodes): robot, method,
@@ -116,7 +123,7 @@ def csv_metadata(body: Mapping) -> list[str]:
         f"limits asked are held within {TOLERANCE_PERCENT:g} %",
     ]
     for kind, values in body["peak_utilization"].items():
-        lines.append(f"peak_utilization.{kind}: " + ",".join(repr(float(v)) for v in values))
+        lines.append(f"peak_utilization.{kind}: " + ",".join(_utilization_text(v) for v in np.atleast_1d(np.asarray(values, dtype=object))))
     binding = body.get("binding")
     if binding is not None:
         where = "the whole path" if binding["joint"] is None else f"joint {binding['joint']}"

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from toptraj.planners.runner.sampling_notes import percent
+
 
 def _gap_above_target(facts: dict) -> str:
     gap, intervals, method = facts["gap"], facts["intervals"], facts["method"]
@@ -52,6 +54,26 @@ def _missed_region(facts: dict) -> str:
     )
 
 
+def _too_few_samples(facts: dict) -> str:
+    return (
+        f"output.dt = {facts['value']:g} s is longer than the motion ({facts['duration']:.6g} s): its {facts['count']} "
+        f"samples do not follow the motion. output.dt is in seconds; output.dt <= {facts['advised']:.3g} s gives "
+        f"{facts['samples']} samples or more"
+    )
+
+
+def _slowed_to_whole_periods(facts: dict) -> str:
+    scale, duration = facts["scale"], facts["duration"]
+    return (
+        f"output.exact_period (the default of formats csv and joint_trajectory) slows the motion by "
+        f"{percent(scale - 1.0)} % so that it ends on a whole period of output.dt = {facts['dt']:g} s: the samples "
+        f"last {facts['stretched']:.6g} s instead of duration = {duration:.6g} s, with velocities {1 / scale:.3g}, "
+        f"accelerations {scale ** -2:.3g} and jerks {scale ** -3:.3g} times the planned ones. peak_utilization is that "
+        f"of the planned timing (duration), not of these samples. output.dt <= {facts['noted'] * duration:.3g} s keeps "
+        f"the slowing within {100 * facts['noted']:g} %; output.exact_period false keeps the planned timing"
+    )
+
+
 NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     "gap_above_target": _gap_above_target,
     "duration_given": "not estimated: timing.duration sets the duration, which is no optimum",
@@ -73,6 +95,8 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     ),
     "collocation_gap": _collocation_gap,
     "missed_region": _missed_region,
+    "too_few_samples": _too_few_samples,
+    "slowed_to_whole_periods": _slowed_to_whole_periods,
     "urdf_limit_out_of_range": (
         "{where}: {kind} limit {value:g} {unit} in the URDF is outside the accepted range "
         "[{low:g}, {high:g}] (the range of every {kind} limit, a request's timing.limits too)"

@@ -187,6 +187,14 @@ def _finite_scalar(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
+def _utilization_values(values: np.ndarray) -> list[float | None] | float | None:
+    """A peak utilization for JSON: a joint (or tool limit) without a finite limit as null."""
+    array = np.asarray(values, dtype=float)
+    if array.ndim == 0:
+        return _finite_scalar(float(array))
+    return [_finite_scalar(v) for v in array.tolist()]
+
+
 def trajectory_body(result: PlannedTrajectory) -> dict:
     """The JSON body of a planned trajectory (DESIGN.md contract); the samples stay numpy arrays
     until ``encode_json``."""
@@ -206,7 +214,7 @@ def trajectory_body(result: PlannedTrajectory) -> dict:
             "sd_max": _finite_or_none(result.phase_plane.sd_max),
             "switch_points": [{"s": s, "kind": kind} for s, kind in result.phase_plane.switch_points],
         },
-        "peak_utilization": {kind: values.tolist() for kind, values in result.peak_utilization.items()},
+        "peak_utilization": {kind: _utilization_values(values) for kind, values in result.peak_utilization.items()},
         "binding": None if result.binding is None else {
             "kind": result.binding.kind, "joint": result.binding.joint, "s": result.binding.s
         },

@@ -89,3 +89,14 @@ def test_the_upload_example_uses_files_that_exist(client):
     assert robot["limit_sources"]["acceleration"] == ["joint_limits.yaml"] * 7
     assert robot["limit_sources"]["jerk"] == ["joint_limits.yaml"] * 7
     assert robot["limits"]["acceleration"] == pytest.approx([15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0])
+
+
+def test_the_readme_says_where_uploads_and_jobs_live_and_how_to_move_them(monkeypatch, tmp_path):
+    from toptraj.robots.store import default_data_dir
+
+    assert "~/.local/share/toptraj" in README and "TOPTRAJ_DATA_DIR=" in README
+    monkeypatch.delenv("XDG_DATA_HOME", raising=False)
+    monkeypatch.delenv("TOPTRAJ_DATA_DIR", raising=False)
+    assert default_data_dir() == Path.home() / ".local" / "share" / "toptraj"
+    monkeypatch.setenv("TOPTRAJ_DATA_DIR", str(tmp_path))
+    assert default_data_dir() == tmp_path

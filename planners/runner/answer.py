@@ -25,10 +25,12 @@ from toptraj.planners.problem.problem import Problem
 from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, ZoneReport, require_finite
 from toptraj.planners.runner.accuracy import answer_accuracy
 from toptraj.planners.runner.admission import admit_samples
+from toptraj.planners.runner.sampling_notes import sampling_notes
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.trajectory import Samples, sample_trajectory
+from toptraj.robots import JointLimits
 from toptraj.robots.notes import Note
 
 #: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
@@ -61,10 +63,11 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     accuracy, warning = _accuracy(problem, timed)
     if warning is not None:
         notes.append(warning)
-    utilization = _utilization(timed.stretches, problem.margin)
+    utilization = _utilization(timed.stretches, problem.margin, problem.limits)
     notes.extend(_unasked_limits(utilization, problem.kinds, problem.method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
-    notes.extend(_singularity_notes(kappa_max, samples.t[worst]))
+    notes.extend(_singularity_notes(kappa_min, kappa_max, samples.t[worst]))
+    notes.extend(sampling_notes(result.duration, problem.sampling.dt, problem.sampling.exact_period, len(samples.t)))
     switching = timed.switching_times
     if switching is None and timed.method == "collocation" and getattr(problem.method, "torque_weight", None) == 0.0:
         read = collocation_switches(samples.t, samples.tau, problem.limits.torque, level=SATURATION_READ)
@@ -156,15 +159,27 @@ def _accuracy(problem: Problem, timed: Timed) -> tuple[Accuracy, str | None]:
     )
 
 
-def _singularity_notes(kappa_max: float, at: float) -> list[str]:
-    """A note when the arm passes through or near a singularity (at ``at``, s)."""
+def _singularity_notes(kappa_min: float, kappa_max: float, at: float) -> list[str]:
+    """A note when the arm passes through or near a singularity (at ``at``, s), or stays in one
+    all along (``kappa_min`` infinite: no single instant to name), each with what to do."""
+    unaffected = "the timing is unaffected, but the tool's motion is poorly controlled near that pose"
+    remedy = f"to avoid it, move the path's waypoints near t = {at:.4g} s off that pose (a Cartesian path: give it in joint space there)"
+    if not np.isfinite(kappa_min):
+        return [
+            "the arm is at a singularity all along the motion: its end effector's Jacobian lacks full rank at every "
+            "sample conditioned (the condition number is infinite throughout, as for an end effector on a joint's "
+            "axis); the timing is unaffected, and a motion given in joint space needs no change"
+        ]
     if not np.isfinite(kappa_max):
         return [
-            f"the arm passes through a singularity at t = {at:.4g} s: its Jacobian loses rank "
-            "there (the condition number is infinite)"
+            f"the arm passes through a singularity at t = {at:.4g} s: its Jacobian loses rank there (the condition "
+            f"number is infinite); {unaffected}; {remedy}"
         ]
     if kappa_max > NEAR_SINGULAR_KAPPA:
-        return [f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} at t = {at:.4g} s"]
+        return [
+            f"the arm passes near a singularity: the Jacobian's condition number reaches {kappa_max:.4g} at t = {at:.4g} s; "
+            f"{unaffected}; {remedy}"
+        ]
     return []
 
 
@@ -183,16 +198,17 @@ def _phase_plane(stretches_: tuple[TimedStretch, ...]) -> tuple[np.ndarray, np.n
     return s[keep], sd[keep], mvc[keep]
 
 
-def _utilization(stretches_: tuple[TimedStretch, ...], margin: float) -> dict[str, np.ndarray]:
+def _utilization(stretches_: tuple[TimedStretch, ...], margin: float, limits: JointLimits) -> dict[str, np.ndarray]:
     """Peak |value| / limit per kind and joint over every stretch, against the limits as
-    requested (before any margin)."""
+    requested (before any margin); ``nan`` for a joint and kind without a finite limit (in
+    ``limits``, (n_dof,) each) that no zone limited either (its peak stays 0)."""
     kinds = stretches_[0].check.utilization.keys()
-    if len(stretches_) == 1:
-        return {kind: (1.0 - margin) * peak for kind, peak in stretches_[0].check.utilization.items()}
-    return {
-        kind: (1.0 - margin) * np.max([item.check.utilization[kind] for item in stretches_], axis=0)
-        for kind in kinds
-    }
+    peaks = {kind: np.max([item.check.utilization[kind] for item in stretches_], axis=0) for kind in kinds}
+    for kind, peak in peaks.items():
+        limit = getattr(limits, kind, None)
+        if limit is not None and np.shape(limit) == np.shape(peak):
+            peaks[kind] = np.where(~np.isfinite(limit) & (peak == 0.0), np.nan, peak)
+    return {kind: (1.0 - margin) * peak for kind, peak in peaks.items()}
 
 
 def _unasked_limits(
@@ -204,7 +220,7 @@ def _unasked_limits(
     notes = []
     for kind, peak in utilization.items():
         peak = np.atleast_1d(np.asarray(peak, dtype=float))
-        if kind in kinds or kind.startswith("tool") or not peak.size or not np.nanmax(peak) > UNASKED_EXCESS:
+        if kind in kinds or kind.startswith("tool") or not np.any(peak > UNASKED_EXCESS):
             continue
         joint = int(np.nanargmax(peak))
         name = joint_names[joint] if peak.size == len(joint_names) else f"joint {joint}"

@@ -34,12 +34,14 @@ class PhasePlanePublic(BaseModel):
 class UtilizationPublic(BaseModel):
     """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds), against
     the limit in force at each state (a zone's inside it); jerk for timings with a finite jerk
-    (jerk_limited, time laws, ruckig)."""
+    (jerk_limited, time laws, ruckig); null where a joint has no finite limit of that kind."""
 
-    velocity: list[float] = Field(description="Peak |qd| / velocity limit per joint.")
-    acceleration: list[float] = Field(description="Peak |qdd| / acceleration limit per joint.")
-    torque: list[float] = Field(description="Peak |tau| / torque limit per joint.")
-    jerk: list[float] | None = Field(default=None, description="Peak |qddd| / jerk limit per joint, for timings with a finite jerk.")
+    velocity: list[float | None] = Field(description="Peak |qd| / velocity limit per joint; null for a joint without a finite velocity limit.")
+    acceleration: list[float | None] = Field(description="Peak |qdd| / acceleration limit per joint; null for a joint without a finite acceleration limit.")
+    torque: list[float | None] = Field(description="Peak |tau| / torque limit per joint; null for a joint without a finite torque limit.")
+    jerk: list[float | None] | None = Field(
+        default=None, description="Peak |qddd| / jerk limit per joint, for timings with a finite jerk; null for a joint without a finite jerk limit."
+    )
     tool_speed: float | None = Field(default=None, description="Peak tool speed / the tool-speed limit in force (timing.limits.tool_speed, or a zone's), when limited.")
     tool_angular_speed: float | None = Field(
         default=None, description="Peak angular tool speed / timing.limits.tool_angular_speed, when limited."

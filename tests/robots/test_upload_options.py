@@ -205,3 +205,18 @@ def test_a_stored_default_payload_keeps_its_collision_radius():
 
     options = UploadOptions(payload=payload(1.5, [0.05, 0.0, 0.0], frame="hand", radius=0.04))
     assert UploadOptions.from_json(options.to_json()).payload == options.payload
+
+
+def test_a_maximum_whose_flag_is_false_is_noted_as_not_applied(client):
+    """MoveIt applies a max_* only where its has_*_limits is true; the upload does the same and
+    its notes say which values were left aside."""
+    limits = {"joint_limits": {"shoulder_pan_joint": {"has_acceleration_limits": False, "max_acceleration": 3},
+                               "elbow_joint": {"max_jerk": 50.0}}}
+    response = client.post("/v1/robots", json={"name": "ur5_flag_off", "urdf": UR5, "joint_limits": limits})
+    assert response.status_code == 201, response.text
+    robot = response.json()
+    assert robot["limits"]["acceleration"][0] == pytest.approx(15.75)  # the default rule, not 3
+    assert robot["limit_sources"]["acceleration"][0] == "default: velocity limit / 0.2 s"
+    assert any("max_acceleration of shoulder_pan_joint (3) not applied: has_acceleration_limits is false" in note
+               for note in robot["notes"])
+    assert any("max_jerk of elbow_joint (50.0) not applied: has_jerk_limits is false or absent" in note for note in robot["notes"])

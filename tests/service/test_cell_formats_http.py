@@ -142,3 +142,14 @@ def test_too_many_samples_are_a_422_saying_the_least_dt():
         "the cell's motion lasts 31.94 s: 31940 samples of dt = 0.001 s exceed 20000; give dt >= 0.0016 s"
     )
     assert len(sample_times(31.94, 0.0016)) <= 20_001
+
+
+def test_the_clients_cell_docstring_names_what_the_answer_holds(answers):
+    """``Client.cell`` promises the answer's keys, each arm's too, and no ``trajectory`` key."""
+    from toptraj.client import Client
+
+    doc = Client.cell.__doc__ or ""
+    answer = answers["samples"].json()
+    keys = set(answer) | set(answer["arms"][0]) | set(answers["joint_trajectory"].json()["arms"][0])
+    assert [key for key in sorted(keys) if f"``{key}``" not in doc] == []
+    assert "``trajectory``" not in doc and "two to four arms" in doc

@@ -9,8 +9,8 @@ const TOLERANCE = 0.005;
 
 function showUtilization(answer, constraints) {
   // one row per joint, a column per limit kind the answer reports (a kind left out of the
-  // constraints only where some joint uses its limit: an infinite limit reads 0); in each row the
-  // largest utilization (the limit that binds that joint) is marked
+  // constraints only where some joint uses its limit; a joint without a finite limit reads null,
+  // shown as "no limit"); in each row the largest utilization (the limit that binds that joint) is marked
   const used = (kind) => constraints.includes(kind) || answer.peak_utilization[kind].some((value) => value > 0);
   const kinds = KINDS.filter((kind) => answer.peak_utilization[kind] && used(kind));
   const head = $("utilization").querySelector("thead tr");
@@ -25,11 +25,16 @@ function showUtilization(answer, constraints) {
     const row = body.insertRow();
     row.insertCell().textContent = name;
     const values = kinds.map((kind) => answer.peak_utilization[kind][joint]);
-    const top = Math.max(...values);
+    const top = Math.max(...values.filter((value) => value !== null));
     kinds.forEach((kind, k) => {
       const cell = row.insertCell();
       cell.dataset.kind = kind;
       cell.dataset.value = String(values[k]);
+      if (values[k] === null) {
+        cell.textContent = "no limit";
+        cell.title = "this joint has no finite limit of this kind";
+        return;
+      }
       cell.textContent = values[k].toFixed(4);
       if (values[k] === top) {
         cell.classList.add("binding");
