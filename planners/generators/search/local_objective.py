@@ -25,7 +25,7 @@ from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.generators.search.distance_kernels import obstacle_row
 from toptraj.planners.generators.search.free_space import _chain_tables, free_distances, joint_reaches
 from toptraj.planners.generators.search.objective_kernels import basis_weights, objective_value
-from toptraj.planners.paths.bspline import BSplinePath, clamped_knots
+from toptraj.planners.paths.bspline import BSplinePath
 from toptraj.planners.timing.phase_plane.method import _BOUNDARY_SLACK, _SLACK, midpoint_duration
 
 #: The objective of a path no timing can follow (s): above any duration served.
@@ -55,7 +55,7 @@ class Objective:
         self.ranged = np.isfinite(lower) | np.isfinite(upper)
         self.evaluations = 0
         self._interior = np.empty(0)
-        self._weights: tuple | None = None  # (grid, samples) basis weights of ``interior``
+        self._weights: tuple | None = None  # ``basis_weights`` of ``interior``
         self.stop_at = np.inf  # time.monotonic() beyond which a round ends early
         self.best: tuple[float, np.ndarray | None] = (np.inf, None)  # (objective, x) of the round under way
         self._fixed = self._fused_arguments()
@@ -115,12 +115,10 @@ class Objective:
         if self._fixed is None:
             return self.reference(x)
         if self._weights is None:
-            knots = clamped_knots(self._interior)
-            self._weights = (basis_weights(knots, self.grid), basis_weights(knots, self.samples))
-        (first, weights), samples = self._weights
+            self._weights = basis_weights(self._interior)
         chain, limits, velocity_limited, distances, settings = self._fixed
         return float(objective_value(
-            np.ascontiguousarray(x, dtype=float), self.start, self.goal, (self.grid, first, weights), samples, chain, limits,
+            np.ascontiguousarray(x, dtype=float), self.start, self.goal, self._weights, self.grid, self.samples, chain, limits,
             velocity_limited, distances, settings, INFEASIBLE, _SLACK, _BOUNDARY_SLACK, NOTHING_KEPT, NOTHING_BEFORE,
         ))
 

@@ -3,15 +3,18 @@ compiled call: from the interior control points to the midpoint duration plus th
 the same computation as the reference path (``BSplinePath``, ``build_path_constraints``,
 ``midpoint_duration``, ``free_distances``) without building any of its objects.
 
-The spline is evaluated from precomputed basis weights: at each grid point only four B-spline
-basis functions are nonzero (de Boor, *A Practical Guide to Splines*, 2001, ch. IX), so
-q^(nu)(s_i) = sum_{r<4} W_nu[i, r] P[first_i + r], with W_nu the nu-th derivatives of those four
-functions at s_i (``basis_weights``). The rows are then written by the same kernels as
+The spline's power-basis coefficients on each knot interval are those of ``BSplinePath``, to
+the last bit: at an interval's left end only four B-spline basis functions are nonzero (de
+Boor, *A Practical Guide to Splines*, 2001, ch. IX), so q^(nu) there is the sum of four control
+points times those functions' nu-th derivatives, which SciPy computes once per round of the
+optimization (``basis_weights``: the knots change only between rounds) and the kernel sums in
+SciPy's order (``power_coefficients``); ``paths.waypoints.cubic_pieces`` evaluates them as
+``BSplinePath`` does. The rows are then written by the same kernels as
 ``build_path_constraints`` (``robots.chain_dynamics.rnea_sets``, ``assembly_kernels``), swept by
 the phase-plane kernels as ``midpoint_duration`` sweeps them (the interpolation pass, twice with
 viscous friction, then the midpoint pass), and the distance lower bound of the penalty comes
 from ``distance_kernels`` as in ``free_space.point_distances``. The answers equal the reference
-path's to rounding (tests/planners/generators/test_search_objective.py).
+path's to rounding: the same inputs reach the same kernels (tests/planners/generators/test_search_objective.py).
 
 Shapes: control points (k, n_dof); grid N + 1 points; obstacle samples S + 1 points; m rows.
 """
@@ -24,34 +27,46 @@ from numba import njit
 from toptraj.planners.constraints.admissible_kernels import point_bounds
 from toptraj.planners.constraints.assembly_kernels import assemble_rows, velocity_bound
 from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, pair_minimum
+from toptraj.planners.paths.bspline import DEGREE, clamped_knots
+from toptraj.planners.paths.waypoints import cubic_pieces
 from toptraj.planners.timing.phase_plane.sweep_kernels import sweeps
 from toptraj.robots.chain_dynamics import rnea_sets
 
 
-def basis_weights(knots: np.ndarray, s: np.ndarray, degree: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    """The index of the first nonzero basis function at each s (len(s),) and the values and
-    first two derivatives of the ``degree + 1`` nonzero ones, (3, len(s), degree + 1), of the
-    clamped spline on the full knot vector ``knots``: the weights of ``objective_value``."""
+def basis_weights(interior: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct knots (pieces + 1,) of the clamped cubic with the ``interior`` knots and,
+    at the left end of each piece, the values and first three derivatives of the four basis
+    functions nonzero there, (4, pieces, 4): the weights of ``power_coefficients``. They are
+    SciPy's own (``BSpline`` on the identity), so the coefficients come out as
+    ``BSplinePath`` computes them, to the last bit."""
     from scipy.interpolate import BSpline  # here: the searches' paths only
 
-    count = len(knots) - degree - 1
-    basis = BSpline(knots, np.eye(count), degree)
-    span = np.clip(np.searchsorted(knots, s, side="right") - 1, degree, count - 1)
-    first = (span - degree).astype(np.int64)
-    columns = first[:, None] + np.arange(degree + 1)[None, :]
-    weights = np.stack([np.take_along_axis(basis(s, nu), columns, axis=1) for nu in range(3)])
-    return first, np.ascontiguousarray(weights)
+    interior = np.asarray(interior, dtype=float)
+    knots = clamped_knots(interior)
+    count = len(knots) - DEGREE - 1
+    left = np.concatenate([[0.0], interior])
+    basis = BSpline(knots, np.eye(count), DEGREE)
+    columns = np.arange(len(left))[:, None] + np.arange(DEGREE + 1)[None, :]
+    weights = np.stack([np.take_along_axis(basis(left, nu), columns, axis=1) for nu in range(DEGREE + 1)])
+    return np.concatenate([left, [1.0]]), np.ascontiguousarray(weights)
 
 
 @njit(cache=True, nogil=True)
-def _spline(control, first, weights, nu, out):  # pragma: no cover - compiled
-    """out (len(first), n_dof) = the nu-th derivative of the spline at the points of ``first``."""
-    for i in range(first.shape[0]):
-        for j in range(control.shape[1]):
-            total = 0.0
-            for r in range(weights.shape[2]):
-                total += weights[nu, i, r] * control[first[i] + r, j]
-            out[i, j] = total
+def power_coefficients(control, weights):  # pragma: no cover - compiled
+    """``BSplinePath``'s power-basis coefficients (4, pieces, n_dof) of the spline of
+    ``control`` (k, n_dof): d3q/6, d2q/2, dq and q at each piece's left end, each the sum
+    over the four nonzero basis functions in SciPy's order (``basis_weights``)."""
+    pieces, dof = weights.shape[1], control.shape[1]
+    out = np.empty((4, pieces, dof))
+    for nu in range(4):
+        scale = 6.0 if nu == 3 else (2.0 if nu == 2 else 1.0)
+        for i in range(pieces):
+            for j in range(dof):
+                total = 0.0
+                for r in range(4):
+                    total += control[i + r, j] * weights[nu, i, r]
+                out[3 - nu, i, j] = total / scale if nu >= 2 else total
+    return out
 
 
 @njit(cache=True, nogil=True)
@@ -100,20 +115,17 @@ def _midpoint_duration(s, rows, x_bound, friction, slack, boundary_slack, kept, 
 
 
 @njit(cache=True, nogil=True)
-def _duration(control, s, first, weights, chain, limits, velocity_limited, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
-    """The midpoint duration (s) along the spline of ``control`` on the grid s, -1 where no
-    timing follows it (``build_path_constraints`` then ``midpoint_duration``)."""
+def _duration(q, dq, ddq, s, chain, limits, velocity_limited, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
+    """The midpoint duration (s) on the grid s along the path of q, dq, ddq (N + 1, n_dof), -1
+    where no timing follows it (``build_path_constraints`` then ``midpoint_duration``)."""
     parent, prismatic, axis, rotation, translation, coordinate, mass, lever, inertia, armature, gravity = chain
     coulomb, viscous, accelerated, acceleration, torqued, torque, velocity = limits
-    n, dof = s.shape[0], control.shape[1]
+    n, dof = s.shape[0], q.shape[1]
     velocities = np.zeros((3, n, dof))
     accelerations = np.zeros((3, n, dof))
-    q = np.empty((n, dof))
-    _spline(control, first, weights, 0, q)
-    _spline(control, first, weights, 1, velocities[2])
-    _spline(control, first, weights, 1, accelerations[1])
-    _spline(control, first, weights, 2, accelerations[2])
-    dq, ddq = velocities[2], accelerations[2]
+    velocities[2] = dq
+    accelerations[1] = dq
+    accelerations[2] = ddq
     m = accelerated.shape[0] + torqued.shape[0]
     a, b, c, d = np.empty((n, m)), np.empty((n, m)), np.empty((n, m)), np.empty((n, m))
     lower, upper = np.empty((n, m)), np.empty((n, m))
@@ -177,11 +189,12 @@ def _penalty(q, capsules, radius, kinds, rows, pairs, reach, ranges, clearance, 
 
 
 @njit(cache=True, nogil=True)
-def objective_value(inner, start, goal, grid, samples, chain, limits, velocity_limited, distances, settings, infeasible, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
+def objective_value(inner, start, goal, spline, grid, samples, chain, limits, velocity_limited, distances, settings, infeasible, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
     """J(P) of ``local``'s module docstring for the interior control points ``inner``
-    (flattened (k - 2) n_dof) between ``start`` and ``goal`` (n_dof,): the midpoint duration
-    on ``grid`` (s, first, weights of ``basis_weights``; ``infeasible`` (s) where no timing
-    follows the path) plus the penalties at ``samples`` (first, weights).
+    (flattened (k - 2) n_dof) between ``start`` and ``goal`` (n_dof,), on the knots of
+    ``spline`` (knots and weights of ``basis_weights``): the midpoint duration on ``grid``
+    (N + 1,; ``infeasible`` (s) where no timing follows the path) plus the penalties at
+    ``samples`` (S + 1,), both in [0, 1].
 
     ``chain``: the arrays of ``toptraj.robots.chain.Chain``; ``limits``: (coulomb, viscous,
     acceleration joints, acceleration, torque joints, torque, velocity) as ``grid_rows`` and
@@ -198,11 +211,12 @@ def objective_value(inner, start, goal, grid, samples, chain, limits, velocity_l
     for i in range(count - 2):
         for j in range(dof):
             control[i + 1, j] = inner[i * dof + j]
-    s, first, weights = grid
-    duration = _duration(control, s, first, weights, chain, limits, velocity_limited, slack, boundary_slack, kept, before)
+    knots, weights = spline
+    coefficients = power_coefficients(control, weights)
+    q, dq, ddq = cubic_pieces(knots, coefficients, grid)
+    duration = _duration(q, dq, ddq, grid, chain, limits, velocity_limited, slack, boundary_slack, kept, before)
     if duration < 0.0:
         duration = infeasible
     capsules, radius, kinds, rows, pairs, reach, ranges, clearance = distances
-    q = np.empty((samples[0].shape[0], dof))
-    _spline(control, samples[0], samples[1], 0, q)
+    q = cubic_pieces(knots, coefficients, samples)[0]
     return duration + _penalty(q, capsules, radius, kinds, rows, pairs, reach, ranges, clearance, settings)
