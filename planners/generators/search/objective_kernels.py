@@ -12,7 +12,8 @@ SciPy's order (``power_coefficients``); ``paths.waypoints.cubic_pieces`` evaluat
 ``BSplinePath`` does. The rows are then written by the same kernels as
 ``build_path_constraints`` (``robots.chain_dynamics.rnea_sets``, ``assembly_kernels``), swept by
 the phase-plane kernels as ``midpoint_duration`` sweeps them (the interpolation pass, twice with
-viscous friction, then the midpoint pass), and the distance lower bound of the penalty comes
+viscous friction, then the midpoint pass; without friction, of the interpolation pass only
+the backward sweep, which decides whether it fails), and the distance lower bound of the penalty comes
 from ``distance_kernels`` as in ``free_space.point_distances``. The answers equal the reference
 path's to rounding: the same inputs reach the same kernels (tests/planners/generators/test_search_objective.py).
 
@@ -24,12 +25,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from toptraj.planners.constraints.admissible_kernels import point_bounds
+from toptraj.planners.constraints.admissible_kernels import interval_bounds, point_bounds
 from toptraj.planners.constraints.assembly_kernels import assemble_rows, velocity_bound
 from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, pair_minimum
 from toptraj.planners.paths.bspline import DEGREE, clamped_knots
 from toptraj.planners.paths.waypoints import cubic_pieces
-from toptraj.planners.timing.phase_plane.sweep_kernels import sweeps
+from toptraj.planners.timing.phase_plane.sweep_kernels import backward_envelope, sweeps
 from toptraj.robots.chain_dynamics import rnea_sets
 
 
@@ -90,21 +91,37 @@ def _solved(s, rows, x_bound, x_ref, friction, midpoint, slack, boundary_slack, 
 
 
 @njit(cache=True, nogil=True)
+def _interpolation_holds(s, rows, x_bound, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
+    """Whether ``_solved`` in the interpolation discretization, without friction, finds a
+    profile: its checks need only the backward sweep (``sweeps``' first half), the profile
+    itself being read only as friction's linearization point."""
+    a, b, c, d, lower, upper = rows
+    if 0.0 > x_bound[-1] * (1 + slack) + slack:
+        return False
+    p, q, r, x_low, x_high, _ = interval_bounds(s, a, b, c, d, a, b, c, d, lower, upper, x_bound, x_bound, False, False, kept, before)
+    ds = np.empty(s.shape[0] - 1)
+    for i in range(ds.shape[0]):
+        ds[i] = s[i + 1] - s[i]
+    envelope, floor, failed = backward_envelope(ds, p, q, r, x_low, x_high, 0.0, slack)
+    return failed < 0 and not 0.0 < floor[0] * (1 - 1e-7) - 1e-12 and not 0.0 > envelope[0] * (1 + boundary_slack) + 1e-12
+
+
+@njit(cache=True, nogil=True)
 def _midpoint_duration(s, rows, x_bound, friction, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
     """``phase_plane.method.midpoint_duration`` at rest (s), or -1 where no timing follows."""
     a, b, c, _, lower, upper = rows
-    passes = 1
     x_ref = x_bound
     if friction:
-        passes = 2
         x_max = point_bounds(a, b, c, lower, upper, x_bound)[4]
         x_ref = np.empty(x_max.shape[0])
         for i in range(x_max.shape[0]):
             x_ref[i] = x_max[i] if np.isfinite(x_max[i]) and x_max[i] > 0 else 1.0
-    for _ in range(passes):
-        x_ref = _solved(s, rows, x_bound, x_ref, friction, False, slack, boundary_slack, kept, before)
-        if x_ref.shape[0] == 0:
-            return -1.0
+        for _ in range(2):
+            x_ref = _solved(s, rows, x_bound, x_ref, friction, False, slack, boundary_slack, kept, before)
+            if x_ref.shape[0] == 0:
+                return -1.0
+    elif not _interpolation_holds(s, rows, x_bound, slack, boundary_slack, kept, before):
+        return -1.0
     x = _solved(s, rows, x_bound, x_ref, friction, True, slack, boundary_slack, kept, before)
     if x.shape[0] == 0:
         return -1.0
