@@ -6,7 +6,7 @@ Two ways to one number. The reference path builds the spline (``BSplinePath``), 
 constraints (``build_path_constraints``) and times them (``midpoint_duration``), and takes the
 distances with ``free_distances``. The fused path (``objective_kernels.objective_value``) does
 the same arithmetic in one compiled call from basis weights computed once per round (the
-knots change only between rounds): on the Geering arm an evaluation costs about a tenth of
+knots change only between rounds): on the Geering arm an evaluation costs about a third of
 the reference's, whose time went into building those objects, and answers the same J to
 rounding. It serves every arm with a kinematic chain (``Robot.chain``) and capsule tables,
 under velocity, acceleration and torque limits without zones or a tool-speed limit; the

@@ -93,3 +93,14 @@ def test_the_knots_of_a_new_round_give_new_basis_weights():
         values.append(objective.value(x))
         assert values[-1] == pytest.approx(objective.reference(x), rel=1e-12, abs=0.0)
     assert values[0] != values[1]
+
+
+def test_limits_the_kernel_does_not_compute_take_the_reference_path():
+    """A jerk limit (read by no midpoint timing, but a kind the kernel does not know) sends
+    every evaluation down the reference path."""
+    start, goal, _, obstacles, clearance = CASES["geering_2r"]
+    robot = robots.load("geering_2r")
+    objective = Objective(robot, robot.limits, ("torque", "jerk"), np.array(start), np.array(goal), obstacles, clearance, LocalSettings(), NO_DEADLINE)
+    assert not objective.fused
+    x = _random_points(objective, 4, 0.1, np.random.default_rng(2))
+    assert objective.value(x) == objective.reference(x)
