@@ -20,8 +20,10 @@ timings (``local``), which runs until it converges or its share of the budget is
 of them is now one compiled call too (``objective_kernels``: the spline from basis weights
 computed once per round, then the rows, the sweeps and the distances of the reference
 computation without its objects), equal to the reference to rounding, so the optimizer takes
-the same steps: the Geering example's 12,501 evaluations from 0.5 ms to 0.18 ms each, its
-request (``benchmarks/search_speed.py``) from about 1,870 to 1,040 times one bare TOPP-RA solve.
+the same steps: the Geering example's 12,501 evaluations from 0.5 ms to 0.18 ms each, and with
+the search's kernels preloaded in the workers' fork server (``warm``), its request
+(``benchmarks/search_speed.py``, alternating runs on the shared machine) from about 1,700 to
+about 950 times one bare TOPP-RA solve.
 """
 
 from toptraj.planners.generators.search.branch_and_bound import branch_and_bound, enumerate_grid_paths
