@@ -13,7 +13,8 @@ SciPy's order (``power_coefficients``); ``paths.waypoints.cubic_pieces`` evaluat
 ``build_path_constraints`` (``robots.chain_dynamics.rnea_sets``, ``assembly_kernels``), swept by
 the phase-plane kernels as ``midpoint_duration`` sweeps them (the interpolation pass, twice with
 viscous friction, then the midpoint pass; without friction, of the interpolation pass only
-the backward sweep, which decides whether it fails), and the distance lower bound of the penalty comes
+the backward sweep, which decides whether it fails; never the switching excesses, which only
+an exact timing's refinement reads), and the distance lower bound of the penalty comes
 from ``distance_kernels`` as in ``free_space.point_distances``. The answers equal the reference
 path's to rounding: the same inputs reach the same kernels (tests/planners/generators/test_search_objective.py).
 
@@ -30,7 +31,7 @@ from toptraj.planners.constraints.assembly_kernels import assemble_rows, velocit
 from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, pair_minimum
 from toptraj.planners.paths.bspline import DEGREE, clamped_knots
 from toptraj.planners.paths.waypoints import cubic_pieces
-from toptraj.planners.timing.phase_plane.sweep_kernels import backward_envelope, sweeps
+from toptraj.planners.timing.phase_plane.sweep_kernels import backward_envelope, forward_profile
 from toptraj.robots.chain_dynamics import rnea_sets
 
 
@@ -71,39 +72,36 @@ def power_coefficients(control, weights):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _envelope(s, rows, x_bound, x_ref, friction, midpoint, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
+    """The first half of ``phase_plane.method._integrate`` at rest at both ends (``sweeps``'
+    interval bounds and backward sweep, then ``_integrate``'s checks): ds (N,), q, r (N, k),
+    the envelope (N + 1,), and whether the checks pass (else the path cannot be timed)."""
+    a, b, c, d, lower, upper = rows
+    ds = np.empty(s.shape[0] - 1)
+    for i in range(ds.shape[0]):
+        ds[i] = s[i + 1] - s[i]
+    p, q, r, x_low, x_high, _ = interval_bounds(s, a, b, c, d, a, b, c, d, lower, upper, x_bound, x_ref, friction, midpoint, kept, before)
+    if 0.0 > x_bound[-1] * (1 + slack) + slack:
+        return ds, q, r, x_high, False
+    envelope, floor, failed = backward_envelope(ds, p, q, r, x_low, x_high, 0.0, slack)
+    holds = failed < 0 and not 0.0 < floor[0] * (1 - 1e-7) - 1e-12 and not 0.0 > envelope[0] * (1 + boundary_slack) + 1e-12
+    return ds, q, r, envelope, holds
+
+
+@njit(cache=True, nogil=True)
 def _solved(s, rows, x_bound, x_ref, friction, midpoint, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
     """``phase_plane.method._integrate`` at rest at both ends: x (N + 1,), or an empty array
-    where it raises (the path cannot be timed)."""
-    a, b, c, d, lower, upper = rows
-    x_start, x_end = 0.0, 0.0
-    if x_end > x_bound[-1] * (1 + slack) + slack:
+    where it raises (the path cannot be timed). ``sweeps`` but for its ``switch_excess``, which
+    only the refinement of an exact timing reads."""
+    ds, q, r, envelope, holds = _envelope(s, rows, x_bound, x_ref, friction, midpoint, slack, boundary_slack, kept, before)
+    if not holds:
         return np.empty(0)
-    x, _, envelope, floor, failed, _, _, _ = sweeps(
-        s, a, b, c, d, a, b, c, d, lower, upper, x_bound, x_ref, friction, x_start, x_end, midpoint, slack, kept, before
-    )
-    if failed >= 0 or x_start < floor[0] * (1 - 1e-7) - 1e-12 or x_start > envelope[0] * (1 + boundary_slack) + 1e-12:
-        return np.empty(0)
-    x[0], x[-1] = x_start, x_end
+    x, _ = forward_profile(ds, r, q, envelope, min(0.0, envelope[0]))
+    x[0], x[-1] = 0.0, 0.0
     for i in range(x.shape[0]):
         if x[i] < 0.0:
             x[i] = 0.0
     return x
-
-
-@njit(cache=True, nogil=True)
-def _interpolation_holds(s, rows, x_bound, slack, boundary_slack, kept, before):  # pragma: no cover - compiled
-    """Whether ``_solved`` in the interpolation discretization, without friction, finds a
-    profile: its checks need only the backward sweep (``sweeps``' first half), the profile
-    itself being read only as friction's linearization point."""
-    a, b, c, d, lower, upper = rows
-    if 0.0 > x_bound[-1] * (1 + slack) + slack:
-        return False
-    p, q, r, x_low, x_high, _ = interval_bounds(s, a, b, c, d, a, b, c, d, lower, upper, x_bound, x_bound, False, False, kept, before)
-    ds = np.empty(s.shape[0] - 1)
-    for i in range(ds.shape[0]):
-        ds[i] = s[i + 1] - s[i]
-    envelope, floor, failed = backward_envelope(ds, p, q, r, x_low, x_high, 0.0, slack)
-    return failed < 0 and not 0.0 < floor[0] * (1 - 1e-7) - 1e-12 and not 0.0 > envelope[0] * (1 + boundary_slack) + 1e-12
 
 
 @njit(cache=True, nogil=True)
@@ -120,8 +118,8 @@ def _midpoint_duration(s, rows, x_bound, friction, slack, boundary_slack, kept, 
             x_ref = _solved(s, rows, x_bound, x_ref, friction, False, slack, boundary_slack, kept, before)
             if x_ref.shape[0] == 0:
                 return -1.0
-    elif not _interpolation_holds(s, rows, x_bound, slack, boundary_slack, kept, before):
-        return -1.0
+    elif not _envelope(s, rows, x_bound, x_bound, False, False, slack, boundary_slack, kept, before)[4]:
+        return -1.0  # without friction the interpolation pass's profile is not read: its checks only
     x = _solved(s, rows, x_bound, x_ref, friction, True, slack, boundary_slack, kept, before)
     if x.shape[0] == 0:
         return -1.0
@@ -219,7 +217,7 @@ def objective_value(inner, start, goal, spline, grid, samples, chain, limits, ve
     obstacle rows (O, 19), self-collision pairs (first, second, radius), joint reaches,
     (position lower, upper, ranged), clearance); ``settings``: (margin, obstacle weight, range
     weight); ``slack``, ``boundary_slack``, ``kept``, ``before``: as ``phase_plane.method``
-    passes them to ``sweeps``."""
+    passes them to its sweeps."""
     dof = start.shape[0]
     count = inner.shape[0] // dof + 2
     control = np.empty((count, dof))
