@@ -108,6 +108,25 @@ def _typical() -> None:
     render(plan_request(request), request)
 
 
+def _search_objective() -> None:
+    """The search's local-optimization objective (``toptraj.planners.generators.search.objective_kernels``):
+    one evaluation on the Geering arm around a sphere, in the signature every search's takes
+    (compiling it takes half a minute on a busy two-core machine, which a first search would
+    otherwise spend of its budget)."""
+    import numpy as np
+
+    from toptraj import robots
+    from toptraj.planners.collision import SphereObstacle
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.planners.generators.search.local_objective import Objective
+    from toptraj.planners.generators.search.local_outcome import LocalSettings
+
+    arm = robots.load("geering_2r")
+    sphere = SphereObstacle(np.array([0.52, 0.28, 0.0]), 0.05)
+    objective = Objective(arm, arm.limits, ("torque",), np.zeros(2), np.array([0.76, 0.0]), (sphere,), 0.01, LocalSettings(), NO_DEADLINE)
+    objective.value(np.array([0.25, 0.0, 0.5, 0.0]))
+
+
 def server_steps() -> list[Step]:
     """What each server process does before it answers (kernels loaded from the cache)."""
     return [
@@ -137,12 +156,13 @@ def write_bytecode() -> None:
 
 def install_steps() -> list[Step]:
     """What the install does: toptraj's bytecode written, the server's steps, then the kernels
-    of the typical request (velocity and acceleration rows, sampling, dense checks), compiled
-    into the cache."""
+    of the typical request (velocity and acceleration rows, sampling, dense checks) and the
+    search's objective, compiled into the cache."""
     return [
         ("writing the bytecode of toptraj's modules", write_bytecode),
         *server_steps(),
         ("compiling the typical request's kernels (ur5, spline, velocity, acceleration, torque)", _typical),
+        ("compiling the search's local-optimization objective", _search_objective),
     ]
 
 

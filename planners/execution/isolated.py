@@ -62,7 +62,8 @@ LOW_PRIORITY = 5
 #: (``min_cost``: cvxpy and Clarabel; the collocation: casadi and scipy's optimizers; the
 #: search: scipy's sparse graphs, optimizers and B-splines), and the compiled kernels the
 #: collocation's first guess calls (``collocation.warm``: each worker would otherwise load them
-#: from numba's disk cache itself, 0.36 s a ur5 free motion). The server process imports none.
+#: from numba's disk cache itself, 0.36 s a ur5 free motion) and those of a small search and its
+#: local optimization (``search.warm``: 0.3 to 0.9 s a search). The server process imports none.
 PRELOAD = [
     "numpy",
     "threadpoolctl",
@@ -77,6 +78,7 @@ PRELOAD = [
     "toptraj.planners.generators.collocation.sparse",
     "toptraj.planners.generators.search.generator",
     "toptraj.planners.generators.collocation.warm",
+    "toptraj.planners.generators.search.warm",
 ]
 
 _context: multiprocessing.context.BaseContext | None = None
