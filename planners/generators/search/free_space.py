@@ -79,7 +79,7 @@ def joint_placements(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return rotation, translation
 
 
-def _chain_tables(robot: Robot):
+def chain_tables(robot: Robot) -> tuple | None:
     """The kinematic chain as arrays for ``distance_kernels.capsule_ends`` (parents, placements,
     prismatic flags, axes, q indices) and the capsules (joints, local ends, radii); None when a
     joint is of a kind the batched kinematics does not handle (``_joint_motion``)."""
@@ -130,7 +130,7 @@ def point_distances(
     smallest distance between two checked links (``toptraj.planners.collision.self_collision``).
     ``deadline`` is checked before each obstacle of each ``BATCH`` of configurations."""
     out = np.empty(len(q))
-    tables = _chain_tables(robot)
+    tables = chain_tables(robot)
     rows_of = [obstacle_row(obstacle) for obstacle in obstacles]
     pairs = self_pairs(robot) if self_offset is not None else None
     q = np.ascontiguousarray(q, dtype=float)

@@ -16,17 +16,26 @@ others take the reference path.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.generators.search.distance_kernels import obstacle_row
-from toptraj.planners.generators.search.free_space import _chain_tables, free_distances, joint_reaches
+from toptraj.planners.generators.search.free_space import chain_tables, free_distances, joint_reaches
 from toptraj.planners.generators.search.objective_kernels import basis_weights, objective_value
 from toptraj.planners.paths.bspline import BSplinePath
-from toptraj.planners.timing.phase_plane.method import _BOUNDARY_SLACK, _SLACK, midpoint_duration
+from toptraj.planners.timing.phase_plane.method import BOUNDARY_SLACK, SLACK, midpoint_duration
+
+if TYPE_CHECKING:
+    from toptraj.planners.collision.obstacles import Obstacle
+    from toptraj.planners.execution.deadline import Deadline
+    from toptraj.planners.generators.search.local_outcome import LocalSettings
+    from toptraj.robots import JointLimits, Robot
 
 #: The objective of a path no timing can follow (s): above any duration served.
 INFEASIBLE = 1e6
@@ -43,7 +52,10 @@ class Objective:
     evaluations and checking the deadline at each. ``interior`` (the interior knots) is set
     before each round; ``fused`` says whether evaluations take the compiled path."""
 
-    def __init__(self, robot, limits, kinds, start, goal, obstacles, clearance, settings, deadline) -> None:
+    def __init__(
+        self, robot: Robot, limits: JointLimits, kinds: tuple[str, ...], start: ArrayLike, goal: ArrayLike,
+        obstacles: Iterable[Obstacle], clearance: float, settings: LocalSettings, deadline: Deadline,
+    ) -> None:
         self.robot, self.limits, self.kinds = robot, limits, kinds
         self.start, self.goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
         self.obstacles, self.clearance, self.settings = list(obstacles), clearance, settings
@@ -119,7 +131,7 @@ class Objective:
         chain, limits, velocity_limited, distances, settings = self._fixed
         return float(objective_value(
             np.ascontiguousarray(x, dtype=float), self.start, self.goal, self._weights, self.grid, self.samples, chain, limits,
-            velocity_limited, distances, settings, INFEASIBLE, _SLACK, _BOUNDARY_SLACK, NOTHING_KEPT, NOTHING_BEFORE,
+            velocity_limited, distances, settings, INFEASIBLE, SLACK, BOUNDARY_SLACK, NOTHING_KEPT, NOTHING_BEFORE,
         ))
 
     def __call__(self, x: np.ndarray) -> float:
@@ -136,7 +148,7 @@ class Objective:
         """The fixed arguments of ``objective_value`` (chain, limits, whether velocity is
         limited, distances, penalty settings), or ``None`` where the fused path does not apply."""
         robot, limits, kinds = self.robot, self.limits, self.kinds
-        chain, tables = robot.chain, _chain_tables(robot)
+        chain, tables = robot.chain, chain_tables(robot)
         if chain is None or tables is None or limits.zones or limits.tool is not None or not set(kinds) <= FUSED_KINDS:
             return None
         from toptraj.planners.collision.self_collision import self_pairs

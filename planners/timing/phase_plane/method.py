@@ -65,12 +65,12 @@ from toptraj.planners.timing.phase_plane.split_kernels import split_points
 from toptraj.planners.timing.phase_plane.sweep_kernels import sweeps
 
 #: Relative slack when comparing x values computed along different routes.
-_SLACK = 1e-9
+SLACK = 1e-9
 #: Relative slack of a boundary speed above the reachable envelope. A time-optimal motion that
 #: starts at a limit (the re-timing of a free path from a moving start) starts on the envelope,
 #: which the discretization places a few 1e-7 lower; the first interval then absorbs the
 #: difference, a relative change of its acceleration of that order.
-_BOUNDARY_SLACK = 1e-5
+BOUNDARY_SLACK = 1e-5
 
 
 #: A switching point is singular where a row's u-coefficient in its interval is within this
@@ -238,7 +238,7 @@ def _integrate(grid: Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHI
     """One sweep pair (``toptraj.planners.timing.phase_plane.sweep_kernels.sweeps``) on ``grid``; a failure is explained from the
     rows linearized around ``x_ref``."""
     x_bound, constraints = grid.x_bound, grid.constraints
-    if x_end > x_bound[-1] * (1 + _SLACK) + _SLACK:
+    if x_end > x_bound[-1] * (1 + SLACK) + SLACK:
         raise InfeasiblePath(
             f"the end path speed {np.sqrt(x_end):.6g} 1/s is above the maximum velocity curve "
             f"({np.sqrt(x_bound[-1]):.6g} 1/s) at s = 1",
@@ -246,7 +246,7 @@ def _integrate(grid: Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHI
         )
     deadline.check()
     x, capped, envelope, floor, failed, x_high, switch_excess, bounds = sweeps(
-        grid.s, *grid.rows, x_bound, x_ref, grid.friction, float(x_start), float(x_end), midpoint, _SLACK, kept, before
+        grid.s, *grid.rows, x_bound, x_ref, grid.friction, float(x_start), float(x_end), midpoint, SLACK, kept, before
     )
     if failed >= 0:
         discretize = midpoint_stage_rows if midpoint else interval_rows
@@ -262,7 +262,7 @@ def _integrate(grid: Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHI
             limit=limit,
             held=held,
         )
-    if x_start > envelope[0] * (1 + _BOUNDARY_SLACK) + 1e-12:
+    if x_start > envelope[0] * (1 + BOUNDARY_SLACK) + 1e-12:
         raise InfeasiblePath(
             f"the start path speed {np.sqrt(x_start):.6g} 1/s is above what the limits allow at s = 0 "
             f"({np.sqrt(max(envelope[0], 0.0)):.6g} 1/s: the maximum velocity curve or the fastest "

@@ -51,7 +51,7 @@ def test_compiled_distances_equal_the_numpy_ones(arm, exact_below):
 
 def test_compiled_capsule_ends_equal_the_numpy_frames():
     from toptraj.planners.generators.search.distance_kernels import capsule_ends
-    from toptraj.planners.generators.search.free_space import _chain_tables
+    from toptraj.planners.generators.search.free_space import chain_tables
 
     robot = robots.load("panda")
     q = np.random.default_rng(3).uniform(-2.0, 2.0, (50, robot.dof))
@@ -59,6 +59,6 @@ def test_compiled_capsule_ends_equal_the_numpy_frames():
     joints = np.array([c.joint for c in capsules])
     rotation, translation = joint_placements(robot, q)
     expected = np.einsum("kcij,cj->kci", rotation[:, joints], np.array([c.b for c in capsules])) + translation[:, joints]
-    a, b = capsule_ends(q, *_chain_tables(robot)[0])
+    a, b = capsule_ends(q, *chain_tables(robot)[0])
     np.testing.assert_allclose(b, expected, rtol=0.0, atol=1e-12)
     assert a.shape == b.shape == (50, len(capsules), 3)

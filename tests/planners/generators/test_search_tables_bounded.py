@@ -11,7 +11,7 @@ from toptraj.robots import equipment
 def test_tables_of_many_equipped_robots_stay_bounded():
     arm = robots.load("geering_2r")
     for mass in range(1, free_space.MAX_TABLES + 10):
-        free_space._chain_tables(equipment.equip(arm, equipment.payload(float(mass))))
+        free_space.chain_tables(equipment.equip(arm, equipment.payload(float(mass))))
     assert len(free_space._TABLES) <= free_space.MAX_TABLES
     latest = equipment.equip(arm, equipment.payload(float(free_space.MAX_TABLES + 9)))
     assert free_space._TABLES[id(latest)][0] is latest
