@@ -47,15 +47,20 @@ def _json(text: str):
         raise _Unreadable("the request is not JSON") from None
 
 
-def _unique_keys(text: str) -> str:
-    """``text``, once no object of it gives a key twice (``DuplicateKey`` otherwise); text
-    that is no JSON is left to the schema's reading, which says where."""
-    from toptraj.service.strict_json import DuplicateKey, loads
+def _unique_keys(source: str, text: str) -> str:
+    """``text``, once it is JSON (``_Unreadable`` saying where it goes wrong otherwise) and no
+    object of it gives a key twice (``DuplicateKey`` otherwise); a text nested too deep is
+    left to the schema's reading."""
+    from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads
 
+    if not text.strip():
+        raise _Unreadable(f"{source}: {EMPTY_BODY}".replace("the body is", "the request is"))
     try:
         loads(text)
     except DuplicateKey:
         raise
+    except json.JSONDecodeError as error:
+        raise _Unreadable(f"{source}: {decode_error(error)}") from None
     except (ValueError, RecursionError):
         pass
     return text
@@ -99,7 +104,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     from toptraj.service.strict_json import DuplicateKey
 
     try:
-        content = answer(_unique_keys(_read(source)))
+        content = answer(_unique_keys(source, _read(source)))
     except DuplicateKey as error:
         print(json.dumps(error.problem()), file=sys.stderr)
         return 1

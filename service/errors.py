@@ -27,7 +27,7 @@ from starlette.routing import Match
 from toptraj.robots import ToptrajError
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
 from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_detail, validation_errors
-from toptraj.service.strict_routes import DuplicateKeyRefused
+from toptraj.service.strict_routes import BodyRefused
 
 logger = logging.getLogger("toptraj")
 
@@ -53,8 +53,8 @@ def _validation_error(request: Request, error: RequestValidationError) -> JSONRe
     return problem(422, "Invalid request", validation_detail(errors), errors=errors[:20])
 
 
-def _duplicate_key(request: Request, error: DuplicateKeyRefused) -> JSONResponse:
-    return JSONResponse(error.duplicate.problem(), status_code=422, media_type=PROBLEM_JSON)
+def _body_refused(request: Request, error: BodyRefused) -> JSONResponse:
+    return JSONResponse(error.problem, status_code=error.status_code, media_type=PROBLEM_JSON)
 
 
 def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
@@ -120,5 +120,5 @@ def install_problem_handlers(app: FastAPI) -> None:
     app.add_exception_handler(ToptrajError, _toptraj_error)  # type: ignore[arg-type]
     app.add_exception_handler(RequestValidationError, _validation_error)  # type: ignore[arg-type]
     app.add_exception_handler(StarletteHTTPException, _http_error)  # type: ignore[arg-type]
-    app.add_exception_handler(DuplicateKeyRefused, _duplicate_key)  # type: ignore[arg-type]
+    app.add_exception_handler(BodyRefused, _body_refused)  # type: ignore[arg-type]
     declare_problems(app)

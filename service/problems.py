@@ -45,6 +45,7 @@ HTTP_TITLES = {
     405: "Method not allowed",
     409: "Conflict",
     413: "Request body too large",
+    415: "Unsupported media type",
     422: "Invalid request",
     500: "Internal error",
     504: "Computation over its time budget",
