@@ -82,7 +82,7 @@ def compare_body(text: str, methods: list[str] | None = None) -> str:
     """The compare body (JSON) of ``text``: a compare body, its ``methods`` replaced by
     ``methods`` when given; or a trajectory body's robot, path and timing (its ``output`` left
     out) under ``methods``, by default its own method then ``DEFAULT_METHODS`` (``FREE_METHODS``
-    on a free path)."""
+    on a free path); its ``timing.method`` is taken out, the methods saying what runs."""
     body = _json(text)
     if not isinstance(body, dict):
         return text  # refused by the schema, which says what it expects
@@ -93,7 +93,10 @@ def compare_body(text: str, methods: list[str] | None = None) -> str:
     path = body.get("path")
     defaults = FREE_METHODS if isinstance(path, dict) and path.get("kind") == "free" else DEFAULT_METHODS
     chosen = methods or list(dict.fromkeys([own, *defaults] if isinstance(own, str) else defaults))
-    return json.dumps({**{key: value for key, value in body.items() if key != "output"}, "methods": chosen})
+    shared = {key: value for key, value in body.items() if key != "output"}
+    if isinstance(timing, dict):
+        shared["timing"] = {key: value for key, value in timing.items() if key != "method"}
+    return json.dumps({**shared, "methods": chosen})
 
 
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:

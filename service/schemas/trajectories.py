@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
-from pydantic import Discriminator, Field, Tag
+from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from toptraj.planners.collision.self_collision import PADDING
 from toptraj.planners.problem import ranges
@@ -386,4 +386,27 @@ class CompareRequest(Schema):
     methods: list[MethodName] = Field(
         min_length=1, max_length=10, description="Timing methods to run, e.g. [\"phase_plane\", \"quintic\"]."
     )
-    timing: TimingRequest = Field(default=TimingRequest(), description="Constraints and limits shared by every method (its `method` is ignored).")
+    timing: TimingRequest = Field(
+        default=TimingRequest(), description="Constraints and limits shared by every method (its `method`, if given, must be among `methods`)."
+    )
+
+    @field_validator("methods")
+    @classmethod
+    def _each_once(cls, methods: list[str]) -> list[str]:
+        """A method listed twice would be computed twice for the same answer: refused."""
+        twice = [method for index, method in enumerate(methods) if method in methods[:index]]
+        if twice:
+            raise ValueError(f"{twice[0]!r} is listed twice; list each method once: {list(dict.fromkeys(methods))}")
+        return methods
+
+    @model_validator(mode="after")
+    def _one_choice_of_methods(self) -> CompareRequest:
+        """``methods`` chooses what a comparison runs; a ``timing.method`` outside it would be
+        dropped without a word: refused, naming both."""
+        method = self.timing.method
+        if "method" in self.timing.model_fields_set and method not in self.methods:
+            raise ValueError(
+                f"timing.method {method!r} conflicts with methods {self.methods}: a comparison runs the methods of "
+                f"`methods`; add {method!r} to methods, or leave timing.method out"
+            )
+        return self
