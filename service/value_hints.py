@@ -63,18 +63,18 @@ def _path_kind(item: Mapping[str, Any]) -> Mapping[str, Any]:
     return {**item, "loc": (*item["loc"], "kind"), "msg": message + (f": did you mean {close!r}?" if close else ""), "input": kind}
 
 
-def collapsed(items: list[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
+def collapsed(items: list[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """``items`` (pydantic's ``errors()``) with the errors of one value that fits no member of
     a union made one, saying what is accepted, and the same error of every item of a list of
     more than one made one, saying the expected shape."""
-    out: list[Mapping[str, Any]] = []
+    out: list[dict[str, Any]] = []
     for item in items:
         item = _path_kind(item) if item.get("type") == "path_kind" else item
         loc = tuple(item["loc"])
         last = out[-1] if out else None
         if loc and isinstance(loc[-1], str) and _MEMBER.match(loc[-1]):
             if last is not None and last.get("members") and tuple(last["loc"]) == loc[:-1]:
-                last["members"].append(loc[-1])  # type: ignore[union-attr]
+                last["members"].append(loc[-1])
                 continue
             out.append({**item, "loc": loc[:-1], "members": [loc[-1]], "items": []})
             continue
@@ -85,7 +85,7 @@ def collapsed(items: list[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
             and last.get("type") == item.get("type")
             and type(last.get("input")) is type(item.get("input"))
         ):
-            last["items"].append(loc[-1])  # type: ignore[union-attr]
+            last["items"].append(loc[-1])
             continue
         out.append({**item, "items": [loc[-1]] if loc and isinstance(loc[-1], int) else []})
     return [_worded(item) for item in out]
@@ -94,7 +94,7 @@ def collapsed(items: list[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
 def _worded(item: dict) -> dict:
     """An error made of several (``collapsed``) as one sentence."""
     if "members" in item:
-        kinds = list(dict.fromkeys(_KINDS[_MEMBER.match(name).group(1)] for name in item.pop("members")))  # type: ignore[union-attr]
+        kinds = list(dict.fromkeys(_KINDS[name.partition("[")[0]] for name in item.pop("members")))
         if len(kinds) > 1:
             accepted = ", ".join(kinds[:-1]) + " or " + kinds[-1]
             return {**item, "type": "union", "msg": f"should be {accepted}; got {_got(item.get('input'))}"}
@@ -103,7 +103,7 @@ def _worded(item: dict) -> dict:
         loc = tuple(item["loc"])
         if item.get("type") == "list_type" and isinstance(item.get("input"), int | float):
             message = (
-                f"should be a list of lists (one list of values per item, e.g. [[0, 0], [1, 1]]); got a flat list of numbers: "
+                "should be a list of lists (one list of values per item, e.g. [[0, 0], [1, 1]]); got a flat list of numbers: "
                 "put each item's values in brackets of their own"
             )
         else:

@@ -17,7 +17,7 @@ BODY = {"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS[:2]}}
 def _with(change: dict) -> dict:
     body = copy.deepcopy(BODY)
     for place, value in change.items():
-        holder = body
+        holder: dict = body
         *parents, last = place.split(".")
         for parent in parents:
             holder = holder.setdefault(parent, {})
