@@ -7,8 +7,8 @@ service words them (``toptraj.service.problems.validation_errors``):
 * a number sent as a string (``"dt": "0.01"``): that a string was given, and to drop the quotes;
 * a value that fits none of a union's members (``joint_limits: 5``): one error saying what is
   accepted, instead of one per member under pydantic's member names (``joint_limits.str``);
-* the same refusal of every item of a list (a flat ``q`` where rows are expected): one error
-  saying the expected shape, instead of one per item.
+* the same shape refused in every item of a list (a flat ``q`` where rows are expected): one
+  error saying the expected shape, instead of one per item.
 """
 
 from __future__ import annotations
@@ -25,6 +25,9 @@ _KINDS = {"str": "a string", "int": "an integer", "float": "a number", "bool": "
 _MEMBER = re.compile(r"^(str|int|float|bool|dict|list)(\[.*\])?$")
 #: JSON's names of Python's values, for "got ...".
 _JSON_KIND = {str: "a string", int: "a number", float: "a number", bool: "a boolean", dict: "an object", list: "a list", type(None): "null"}
+#: Types of the errors of an item of the wrong shape (a number where a row goes), the same for
+#: every item of its list, so said once; a value's own refusal (a range) is said per item.
+_SHAPE_TYPES = ("list_type", "dict_type", "model_type")
 #: Types of the errors of a number given in another form.
 _NUMBER_TYPES = ("float_type", "int_type", "float_parsing", "int_parsing")
 
@@ -82,7 +85,7 @@ def collapsed(items: list[Mapping[str, Any]]) -> list[dict[str, Any]]:
             last is not None
             and loc and isinstance(loc[-1], int)
             and tuple(last["loc"])[:-1] == loc[:-1]
-            and last.get("type") == item.get("type")
+            and last.get("type") == item.get("type") in _SHAPE_TYPES
             and type(last.get("input")) is type(item.get("input"))
         ):
             last["items"].append(loc[-1])
