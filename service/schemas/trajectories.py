@@ -12,6 +12,7 @@ from toptraj.planners.problem import ranges
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
 from toptraj.service.schemas.common import Schema, bounded, signed
+from toptraj.service.schemas.compare_rules import each_method_once, timing_method_among_methods
 from toptraj.service.schemas.equipment import MOUNTING, PAYLOAD, MountingRequest, PayloadRequest
 from toptraj.service.schemas.zones import ZONES, ZoneRequest
 
@@ -390,23 +391,5 @@ class CompareRequest(Schema):
         default=TimingRequest(), description="Constraints and limits shared by every method (its `method`, if given, must be among `methods`)."
     )
 
-    @field_validator("methods")
-    @classmethod
-    def _each_once(cls, methods: list[str]) -> list[str]:
-        """A method listed twice would be computed twice for the same answer: refused."""
-        twice = [method for index, method in enumerate(methods) if method in methods[:index]]
-        if twice:
-            raise ValueError(f"{twice[0]!r} is listed twice; list each method once: {list(dict.fromkeys(methods))}")
-        return methods
-
-    @model_validator(mode="after")
-    def _one_choice_of_methods(self) -> CompareRequest:
-        """``methods`` chooses what a comparison runs; a ``timing.method`` outside it would be
-        dropped without a word: refused, naming both."""
-        method = self.timing.method
-        if "method" in self.timing.model_fields_set and method not in self.methods:
-            raise ValueError(
-                f"timing.method {method!r} conflicts with methods {self.methods}: a comparison runs the methods of "
-                f"`methods`; add {method!r} to methods, or leave timing.method out"
-            )
-        return self
+    check_each_method_once = field_validator("methods")(each_method_once)
+    check_timing_method = model_validator(mode="after")(timing_method_among_methods)
