@@ -20,7 +20,15 @@ def _path(path: dict | None, waypoints: Any) -> dict:
 
 
 def _timing(timing: dict | None, fields: dict[str, Any]) -> dict:
-    return {**(timing or {}), **{key: value for key, value in fields.items() if value is not None}}
+    """``timing`` with ``fields`` (the arguments given) added; a field given both ways with two
+    different values is refused, since one of them would be dropped without a word."""
+    given = {key: value for key, value in fields.items() if value is not None}
+    for key, value in given.items():
+        if timing is not None and key in timing and timing[key] != value:
+            raise ValueError(
+                f"{key}={value!r} conflicts with timing={{{key!r}: {timing[key]!r}}}: give {key} once, as the argument or in timing"
+            )
+    return {**(timing or {}), **given}
 
 
 def trajectory_request(
@@ -49,8 +57,8 @@ def trajectory_request(
         constraints: ``timing.constraints``, e.g. ``["velocity", "acceleration", "torque"]``.
         limits: ``timing.limits``: per-joint overrides, ``*_scale`` factors, tool speeds.
         duration: ``timing.duration`` (s), for the classical time laws.
-        timing: Any other ``timing`` fields (``boundary``, ``cost``, ``grid_points``, ...); the
-            arguments above take precedence.
+        timing: Any other ``timing`` fields (``boundary``, ``cost``, ``grid_points``, ...); a
+            field also given as an argument above must have the same value.
         dt: ``output.dt``, the sample period (s); 0.01 on the service.
         format: ``output.format``: ``samples``, ``joint_trajectory`` or ``csv``.
         exact_period: ``output.exact_period``: samples on whole periods of ``dt``.
@@ -59,7 +67,8 @@ def trajectory_request(
         The request as a JSON-ready dict.
 
     Raises:
-        ValueError: Neither or both of ``waypoints`` and ``path``, or an unknown ``format``.
+        ValueError: Neither or both of ``waypoints`` and ``path``, an unknown ``format``, or a
+            field given both as an argument and in ``timing`` with different values.
     """
     if format is not None and format not in OUTPUT_FORMATS:
         raise ValueError(f"format {format!r} is not one of {', '.join(OUTPUT_FORMATS)}")
@@ -86,7 +95,10 @@ def compare_request(
 ) -> dict:
     """The body of ``POST /v1/trajectories/compare``: one path under each of ``methods`` (e.g.
     ``["phase_plane", "quintic"]``), with the constraints and limits every method shares; the
-    other arguments are those of ``trajectory_request``."""
+    other arguments are those of ``trajectory_request``; a ``timing`` ``method`` must be among
+    ``methods`` (``ValueError`` otherwise: the service would refuse it)."""
+    if timing is not None and "method" in timing and timing["method"] not in methods:
+        raise ValueError(f"timing={{'method': {timing['method']!r}}} conflicts with methods={list(methods)}: add it to methods, or leave it out of timing")
     return {
         "robot": robot,
         "path": _path(path, waypoints),

@@ -6,6 +6,13 @@ from __future__ import annotations
 
 import json
 
+#: What to do about a body over the cap (the cap is the server's ``TOPTRAJ_MAX_BODY_BYTES``).
+REMEDY = (
+    "send fewer waypoints (the path is a spline through them, so a coarser list often gives the same motion), "
+    "split a batch into several POST /v1/batches, or plan a large file of requests with `toptraj batch` "
+    "(no body cap); the cap is the server's TOPTRAJ_MAX_BODY_BYTES"
+)
+
 
 class BodySizeLimit:
     """Wraps an ASGI app; bodies over ``max_bytes`` get a problem+json 413."""
@@ -50,7 +57,7 @@ class BodySizeLimit:
                 "type": "about:blank",
                 "title": "Request body too large",
                 "status": 413,
-                "detail": f"the request body exceeds {self.max_bytes} bytes",
+                "detail": f"the request body exceeds {self.max_bytes} bytes: {REMEDY}",
             }
         ).encode()
         await send(

@@ -26,6 +26,25 @@ def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
     return max(1, cores // workers)
 
 
+def port_in_use(host: str, port: int) -> bool:
+    """Whether another process listens on ``host``:``port``: a trial bind, with the
+    ``SO_REUSEADDR`` a server sets (so a port left in ``TIME_WAIT`` counts as free)."""
+    import errno
+    import socket
+
+    try:
+        family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
+    except OSError:
+        return False  # an unknown host: the server's own start says so
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(address)
+        except OSError as error:
+            return error.errno == errno.EADDRINUSE
+    return False
+
+
 def _serve(args) -> int:
     import uvicorn  # here, as the server's own modules: ``toptraj plan`` needs none of them
 
@@ -48,6 +67,11 @@ def _serve(args) -> int:
     # Said before the seconds each process spends importing, and every few seconds while it
     # does (toptraj.service.warmup); each then logs its start-up steps. A single process imports the app
     # here, before uvicorn configures its logging; more import it in their own processes.
+    if port_in_use(args.host, args.port):
+        free = next((port for port in range(args.port + 1, min(args.port + 50, 65536)) if not port_in_use(args.host, port)), None)
+        example = "" if free is None else f", e.g. --port {free} (free now)"
+        print(f"toptraj serve: port {args.port} is in use (another server?): pass --port N{example}", file=sys.stderr)
+        return 3
     print(f"toptraj serve: {args.workers} server process(es) on http://{args.host}:{args.port}", file=sys.stderr, flush=True)
     if args.workers == 1:
         process = os.getpid()

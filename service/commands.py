@@ -47,15 +47,20 @@ def _json(text: str):
         raise _Unreadable("the request is not JSON") from None
 
 
-def _unique_keys(text: str) -> str:
-    """``text``, once no object of it gives a key twice (``DuplicateKey`` otherwise); text
-    that is no JSON is left to the schema's reading, which says where."""
-    from toptraj.service.strict_json import DuplicateKey, loads
+def _unique_keys(source: str, text: str) -> str:
+    """``text``, once it is JSON (``_Unreadable`` saying where it goes wrong otherwise) and no
+    object of it gives a key twice (``DuplicateKey`` otherwise); a text nested too deep is
+    left to the schema's reading."""
+    from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads
 
+    if not text.strip():
+        raise _Unreadable(f"{source}: {EMPTY_BODY}".replace("the body is", "the request is"))
     try:
         loads(text)
     except DuplicateKey:
         raise
+    except json.JSONDecodeError as error:
+        raise _Unreadable(f"{source}: {decode_error(error)}") from None
     except (ValueError, RecursionError):
         pass
     return text
@@ -77,7 +82,7 @@ def compare_body(text: str, methods: list[str] | None = None) -> str:
     """The compare body (JSON) of ``text``: a compare body, its ``methods`` replaced by
     ``methods`` when given; or a trajectory body's robot, path and timing (its ``output`` left
     out) under ``methods``, by default its own method then ``DEFAULT_METHODS`` (``FREE_METHODS``
-    on a free path)."""
+    on a free path); its ``timing.method`` is taken out, the methods saying what runs."""
     body = _json(text)
     if not isinstance(body, dict):
         return text  # refused by the schema, which says what it expects
@@ -88,7 +93,10 @@ def compare_body(text: str, methods: list[str] | None = None) -> str:
     path = body.get("path")
     defaults = FREE_METHODS if isinstance(path, dict) and path.get("kind") == "free" else DEFAULT_METHODS
     chosen = methods or list(dict.fromkeys([own, *defaults] if isinstance(own, str) else defaults))
-    return json.dumps({**{key: value for key, value in body.items() if key != "output"}, "methods": chosen})
+    shared = {key: value for key, value in body.items() if key != "output"}
+    if isinstance(timing, dict):
+        shared["timing"] = {key: value for key, value in timing.items() if key != "method"}
+    return json.dumps({**shared, "methods": chosen})
 
 
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
@@ -99,7 +107,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     from toptraj.service.strict_json import DuplicateKey
 
     try:
-        content = answer(_unique_keys(_read(source)))
+        content = answer(_unique_keys(source, _read(source)))
     except DuplicateKey as error:
         print(json.dumps(error.problem()), file=sys.stderr)
         return 1

@@ -16,6 +16,7 @@ error, one handler per family and an outermost guard for the unexpected.
 
 from __future__ import annotations
 
+import difflib
 import logging
 
 from fastapi import FastAPI, Request
@@ -27,7 +28,7 @@ from starlette.routing import Match
 from toptraj.robots import ToptrajError
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
 from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_detail, validation_errors
-from toptraj.service.strict_routes import DuplicateKeyRefused
+from toptraj.service.strict_routes import BodyRefused
 
 logger = logging.getLogger("toptraj")
 
@@ -53,8 +54,8 @@ def _validation_error(request: Request, error: RequestValidationError) -> JSONRe
     return problem(422, "Invalid request", validation_detail(errors), errors=errors[:20])
 
 
-def _duplicate_key(request: Request, error: DuplicateKeyRefused) -> JSONResponse:
-    return JSONResponse(error.duplicate.problem(), status_code=422, media_type=PROBLEM_JSON)
+def _body_refused(request: Request, error: BodyRefused) -> JSONResponse:
+    return JSONResponse(error.problem, status_code=error.status_code, media_type=PROBLEM_JSON)
 
 
 def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
@@ -63,12 +64,34 @@ def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse
         allowed = _allowed_methods(request)
         headers = {**(headers or {}), "Allow": ", ".join(allowed)}
         detail = f"{request.method} is not allowed on {request.url.path}; use {' or '.join(allowed)}"
+    elif error.status_code == 404 and error.detail == "Not Found":  # no route at the path
+        detail = _no_route(request)
     else:
         detail = str(error.detail)
     return problem(error.status_code, HTTP_TITLES.get(error.status_code, "HTTP error"), detail, headers=headers)
 
 
 _METHODS = ("DELETE", "GET", "HEAD", "PATCH", "POST", "PUT")
+#: Least similarity (difflib's ratio) of a path to a route's for "did you mean".
+_CLOSE_ROUTE = 0.8
+
+
+def _paths(route: object) -> list[str]:
+    """The path of ``route``, or of each route of an included router (FastAPI keeps those as
+    one entry whose candidates are its routes)."""
+    if isinstance(path := getattr(route, "path", None), str):
+        return [path]
+    candidates = getattr(route, "effective_candidates", None)
+    return [path for candidate in (candidates() if callable(candidates) else []) if isinstance(path := getattr(candidate, "path", None), str)]
+
+
+def _no_route(request: Request) -> str:
+    """The 404 of a path no route serves, with the route path most like it (``/v1/trajectory``:
+    did you mean /v1/trajectories?)."""
+    path = request.url.path
+    routes = [path for route in request.app.router.routes for path in _paths(route)]
+    close = difflib.get_close_matches(path, routes, n=1, cutoff=_CLOSE_ROUTE)
+    return f"no route at {path[:200]}" + (f": did you mean {close[0]}?" if close else "") + "; the routes are listed at /docs"
 
 
 def _allowed_methods(request: Request) -> list[str]:
@@ -120,5 +143,5 @@ def install_problem_handlers(app: FastAPI) -> None:
     app.add_exception_handler(ToptrajError, _toptraj_error)  # type: ignore[arg-type]
     app.add_exception_handler(RequestValidationError, _validation_error)  # type: ignore[arg-type]
     app.add_exception_handler(StarletteHTTPException, _http_error)  # type: ignore[arg-type]
-    app.add_exception_handler(DuplicateKeyRefused, _duplicate_key)  # type: ignore[arg-type]
+    app.add_exception_handler(BodyRefused, _body_refused)  # type: ignore[arg-type]
     declare_problems(app)

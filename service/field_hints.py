@@ -109,11 +109,49 @@ def nearest(model: type[BaseModel] | None, loc: tuple[str | int, ...]) -> str:
     (``CLOSE``)."""
     if model is None or not loc or not isinstance(loc[-1], str):
         return ""
-    close = difflib.get_close_matches(loc[-1], names_at(model, loc[:-1]), n=1, cutoff=CLOSE)
-    return f": did you mean {close[0]!r}?" if close else ""
+    close = closest(loc[-1], names_at(model, loc[:-1]))
+    return f": did you mean {close!r}?" if close else ""
+
+
+def closest(given: str, allowed: typing.Iterable[str]) -> str | None:
+    """The allowed name ``given`` was most likely meant as: the one equal to it but for case,
+    else difflib's closest at ``CLOSE`` or more (``"URDF"`` -> ``"urdf"``, ``"topra"`` ->
+    ``"toppra"``); None when none is close."""
+    allowed = list(allowed)
+    same = [name for name in allowed if name.casefold() == given.casefold()]
+    if same:
+        return same[0]
+    close = difflib.get_close_matches(given, allowed, n=1, cutoff=CLOSE)
+    return close[0] if close else None
+
+
+#: What to do with a field that belongs to another route or to no body at all, by the body's
+#: schema and the field's place ("*": any unknown field at the top of that schema).
+ELSEWHERE = {
+    ("TrajectoryRequest", "methods"): ": several methods are compared by POST /v1/trajectories/compare (same body with "
+    "`methods`, no `output`); here give one method as timing.method",
+    ("CompareRequest", "output"): ": a comparison answers each method's duration, peak utilization and solve time, "
+    "without samples, so it takes no `output`; POST /v1/trajectories (one method, timing.method) returns the samples",
+    ("CompareRequest", "method"): ": a comparison runs the list `methods` (e.g. [\"phase_plane\", \"quintic\"])",
+    ("JobCreate", "*"): ": put the request under `trajectory` (a POST /v1/trajectories body) or `compare` "
+    "(a POST /v1/trajectories/compare body), e.g. {\"trajectory\": {\"robot\": \"ur5\", \"path\": ...}}",
+}
+
+
+def elsewhere(model: type[BaseModel] | None, location: str) -> str:
+    """What to do with the unknown field at ``location`` when it belongs to another route
+    (``ELSEWHERE``); "" otherwise."""
+    if model is None:
+        return ""
+    if (model.__name__, location) in ELSEWHERE:
+        return ELSEWHERE[model.__name__, location]
+    return ELSEWHERE.get((model.__name__, "*"), "") if "." not in location and "[" not in location else ""
 
 
 def unknown_field_hint(model: type[BaseModel] | None, loc: tuple[str | int, ...], location: str) -> str:
-    """The hint for the unknown field at ``loc`` (``location`` as the service writes it): where
-    a field of that name belongs (``hint``), else the nearest allowed name there (``nearest``)."""
-    return hint(model, location) or nearest(model, loc)
+    """The hint for the unknown field at ``loc`` (``location`` as the service writes it): what
+    to do with a field of another route (``elsewhere``), where a field of that name belongs
+    (``hint``), else the nearest allowed name there (``nearest``), else the top of a job's
+    body's advice."""
+    specific = ELSEWHERE.get((model.__name__, location), "") if model is not None else ""
+    return specific or hint(model, location) or nearest(model, loc) or elsewhere(model, location)

@@ -1,6 +1,6 @@
 """The OpenAPI of the error answers: ``problem_responses`` (a route's ``responses=``) and
 ``declare_problems`` make the schema say what the service answers: problem+json bodies
-(``Problem``) for 400, 404, 409, 413, 422, 503 and 504, in place of FastAPI's default 422."""
+(``Problem``) for 400, 404, 409, 413, 415, 422, 503 and 504, in place of FastAPI's default 422."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ _DESCRIPTIONS = {
     404: "No such resource (e.g. an unknown robot).",
     409: "The name is taken.",
     413: "The request body exceeds the size cap.",
+    415: "The body was sent without `Content-Type: application/json`.",
     422: "Malformed or impossible input: a field out of range, wrong lengths, NaN/inf, a path "
     "that no timing can follow (the detail says where).",
     503: "The service cannot do this now (e.g. its data directory cannot be written).",
@@ -25,7 +26,7 @@ _DESCRIPTIONS = {
 }
 #: What every operation with a body may answer, whatever it declares (FastAPI itself adds a
 #: 422 to operations with parameters; its content is replaced below).
-_WITH_BODY = (400, 413, 422)
+_WITH_BODY = (400, 413, 415, 422)
 
 
 def _problem_content() -> dict:

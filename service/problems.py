@@ -37,6 +37,7 @@ from toptraj.robots.notes import Note
 from toptraj.robots.upload_options import InvalidUpload
 from toptraj.service.field_hints import unknown_field_hint
 from toptraj.service.locations import where
+from toptraj.service.value_hints import collapsed, value_hint
 from toptraj.service.wordings import WORDING
 
 HTTP_TITLES = {
@@ -45,6 +46,7 @@ HTTP_TITLES = {
     405: "Method not allowed",
     409: "Conflict",
     413: "Request body too large",
+    415: "Unsupported media type",
     422: "Invalid request",
     500: "Internal error",
     504: "Computation over its time budget",
@@ -263,10 +265,10 @@ def validation_errors(items: Iterable[Mapping[str, Any]], model: object = None) 
     for a field the schema does not know, where it belongs or the name it was likely meant as."""
     schema = model if isinstance(model, type) and issubclass(model, BaseModel) else None
     errors = []
-    for item in items:
+    for item in collapsed(list(items)):
         loc = tuple(item["loc"])
         field = where(loc)
-        message = validation_message(item)
+        message = validation_message(item) + value_hint(item)
         if item.get("type") == "extra_forbidden":
             message += unknown_field_hint(schema, loc[1:] if loc[:1] == ("body",) else loc, field)
         errors.append({"field": field, "message": message})

@@ -19,6 +19,29 @@ from toptraj.service.locations import joined
 MAX_KEY_CHARS = 60
 
 
+#: The answer to an empty request body or file.
+EMPTY_BODY = 'the body is empty; send a JSON object (e.g. {"robot": "ur5", "path": ...})'
+
+
+def decode_error(error: json.JSONDecodeError) -> str:
+    """Where and why ``json`` could not read a text, in words a person can act on: the line
+    and column, the parser's own message and, for the usual slips (single quotes, a trailing
+    comma, a text cut short), what to change (``line 3, column 5: Expecting ',' delimiter``)."""
+    text = error.doc if isinstance(error.doc, str) else ""
+    found = text[error.pos : error.pos + 1]
+    before = text[: error.pos].rstrip()
+    if not text.strip():
+        return EMPTY_BODY
+    message = f"line {error.lineno}, column {error.colno}: {error.msg}"
+    if found == "'":
+        return message + " (JSON needs double quotes: write \"robot\", not 'robot')"
+    if found in "}]" and found and before.endswith(","):
+        return message + f" (a comma before {found!r}: JSON allows no trailing comma; remove it)"
+    if error.pos >= len(text.rstrip()):
+        return message + " (the text ends before the JSON does: is it cut short, a bracket or brace left open?)"
+    return message
+
+
 class DuplicateKey(ValueError):
     """An object of a JSON text gives ``key`` ``count`` times; ``where`` is the key's place
     (``timing.zones[0].tool_speed``)."""

@@ -1,33 +1,69 @@
 """The route class of every router: a request's JSON body is read by
 ``toptraj.service.strict_json.loads``, so that a key given twice is a 422 naming it and its
-place, where FastAPI's own reading (``json.loads``) would let the last one win silently. The
-body's size cap (``toptraj.service.body_limit``) and the parser's nesting limit (a 400) hold as
-before."""
+place, where FastAPI's own reading (``json.loads``) would let the last one win silently. A
+route that takes a JSON body refuses a body sent without ``Content-Type: application/json``
+(curl's default is form encoding) with a 415 that says which header to send, an empty body
+and a body that is no JSON with a 422 that says where the text goes wrong (line, column and
+the parser's message), where FastAPI would answer that the body is no object, or name the
+character offset as if it were an array index. The body's size cap
+(``toptraj.service.body_limit``) and the parser's nesting limit (a 400) hold as before."""
 
 from __future__ import annotations
 
+import email.message
+import json
 from collections.abc import Callable, Coroutine
 from typing import Any
 
-from fastapi import Request, Response
+from fastapi import Request, Response, params
 from fastapi.routing import APIRoute
 from starlette.exceptions import HTTPException
 
-from toptraj.service.strict_json import DuplicateKey, loads
+from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads
+
+#: The 415's advice.
+SEND_JSON = "send the header Content-Type: application/json (curl: -H 'Content-Type: application/json')"
 
 
-class DuplicateKeyRefused(HTTPException):
-    """A JSON body gives a key twice in one object: answered 422 by
-    ``toptraj.service.errors`` (an HTTP exception, the one kind FastAPI lets out of its reading
-    of a body)."""
+class BodyRefused(HTTPException):
+    """A JSON body the route cannot read: answered by ``toptraj.service.errors`` with
+    ``problem`` (an HTTP exception, the one kind FastAPI lets out of its reading of a body)."""
+
+    def __init__(self, problem: dict):
+        super().__init__(problem["status"], problem["detail"])
+        self.problem = problem
+
+
+class DuplicateKeyRefused(BodyRefused):
+    """A JSON body gives a key twice in one object: a 422 naming the key and its place."""
 
     def __init__(self, duplicate: DuplicateKey):
-        super().__init__(422, str(duplicate))
+        super().__init__(duplicate.problem())
         self.duplicate = duplicate
 
 
+def _unreadable(message: str) -> BodyRefused:
+    """The 422 of a body that is empty or no JSON, ``message`` saying where and why."""
+    return BodyRefused(
+        {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": f"body: {message}",
+         "errors": [{"field": "body", "message": message}]}
+    )
+
+
+def _is_json(content_type: str | None) -> bool:
+    """Whether a ``Content-Type`` header names JSON (``application/json``, ``application/*+json``,
+    parameters allowed), as FastAPI decides whether to read a body as JSON."""
+    if not content_type:
+        return False
+    message = email.message.Message()
+    message["content-type"] = content_type
+    subtype = message.get_content_subtype()
+    return message.get_content_maintype() == "application" and (subtype == "json" or subtype.endswith("+json"))
+
+
 class StrictJSONRequest(Request):
-    """A request whose ``json()`` refuses a key given twice."""
+    """A request whose ``json()`` refuses a key given twice and says where a text that is no
+    JSON goes wrong."""
 
     async def json(self) -> Any:
         if not hasattr(self, "_json"):
@@ -35,16 +71,31 @@ class StrictJSONRequest(Request):
                 self._json = loads(await self.body())
             except DuplicateKey as duplicate:
                 raise DuplicateKeyRefused(duplicate) from None
+            except json.JSONDecodeError as error:
+                raise _unreadable(decode_error(error)) from None
+            except UnicodeDecodeError:
+                raise _unreadable("the body is not UTF-8 text; send JSON encoded as UTF-8") from None
         return self._json
 
 
 class StrictJSONRoute(APIRoute):
-    """An ``APIRoute`` whose handler reads the body as a ``StrictJSONRequest``."""
+    """An ``APIRoute`` whose handler reads the body as a ``StrictJSONRequest``; a route with a
+    JSON body first checks the ``Content-Type`` (415) and that the body is not empty (422)."""
 
     def get_route_handler(self) -> Callable[[Request], Coroutine[Any, Any, Response]]:
         handler = super().get_route_handler()
+        takes_json = self.body_field is not None and not isinstance(self.body_field.field_info, params.Form)
 
         async def strict_handler(request: Request) -> Response:
-            return await handler(StrictJSONRequest(request.scope, request.receive, request._send))
+            strict = StrictJSONRequest(request.scope, request.receive, request._send)
+            if takes_json:
+                body = await strict.body()
+                if not body.strip():
+                    raise _unreadable(EMPTY_BODY)
+                if not _is_json(strict.headers.get("content-type")):
+                    raise BodyRefused(
+                        {"type": "about:blank", "title": "Unsupported media type", "status": 415, "detail": SEND_JSON}
+                    )
+            return await handler(strict)
 
         return strict_handler

@@ -14,6 +14,7 @@ from collections.abc import Callable
 
 from toptraj.robots.errors import excerpt
 from toptraj.robots.ranges import Range
+from toptraj.service.field_hints import closest
 from toptraj.service.note_wordings import NOTE_WORDING
 from toptraj.service.zone_wordings import ZONE_WORDING
 
@@ -172,9 +173,10 @@ Wording = str | Callable[[dict], str]
 #: Wording by rule.
 def _unknown_robot(facts: dict) -> str:
     where = f"{facts['field']}: " if isinstance(facts.get("field"), str) else ""  # a cell's arm names it
+    close = closest(facts["name"], facts["known"]) if isinstance(facts["name"], str) and len(facts["name"]) <= 60 else None
     return (
-        f"{where}no robot named {excerpt(facts['name'])}; catalog robots: {', '.join(facts['known'])}; "
-        "uploaded robots are listed by GET /v1/robots"
+        f"{where}no robot named {excerpt(facts['name'])}{f' (did you mean {close!r}?)' if close else ''}; catalog robots: "
+        f"{', '.join(facts['known'])}; uploaded robots are listed by GET /v1/robots"
     )
 
 

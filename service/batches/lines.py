@@ -22,6 +22,7 @@ own 4xx result line (``RequestLine.problem``).
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import re
 from collections.abc import Iterator
@@ -32,7 +33,7 @@ import numpy as np
 import orjson
 
 from toptraj.robots.errors import excerpt
-from toptraj.service.strict_json import DuplicateKey, loads
+from toptraj.service.strict_json import DuplicateKey, decode_error, loads
 
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000
@@ -93,6 +94,9 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
         body = loads(data, finite=True)
     except DuplicateKey as error:
         return refused(422, "Invalid request", str(error))
+    except json.JSONDecodeError as error:
+        # a line is one line of JSON text: its column is the place
+        return refused(400, "Malformed JSON", decode_error(error).replace("line 1, column", "column", 1)[:_MAX_DETAIL])
     except ValueError as error:  # no JSON, or no UTF-8
         return refused(400, "Malformed JSON", f"the line is not JSON (UTF-8): {str(error)[:_MAX_DETAIL]}")
     if not isinstance(body, dict):

@@ -99,10 +99,14 @@ def progress_bar(stream: TextIO = sys.stderr) -> Callable[[int, int, float], Non
     """A one-line progress display: count, rate and time left."""
 
     def show(done: int, total: int, seconds: float) -> None:
+        if total == 0:  # a resumed batch whose every line has its result
+            stream.write("nothing left to do: every request already has its result in the output\n")
+            stream.flush()
+            return
         rate = done / seconds if seconds > 0 else 0.0
-        left = (total - done) / rate if rate > 0 else float("nan")
+        left = f", {(total - done) / rate:.0f} s left" if rate > 0 else ""
         end = "\n" if done == total else ""
-        stream.write(f"\r{done}/{total} requests, {rate:.1f}/s, {left:.0f} s left   {end}")
+        stream.write(f"\r{done}/{total} requests, {rate:.1f}/s{left}   {end}")
         stream.flush()
 
     return show

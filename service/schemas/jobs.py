@@ -35,6 +35,18 @@ class JobCreate(Schema):
         "(`TOPTRAJ_JOB_MAX_BUDGET_S`; more gets 422 naming it).",
     )
 
+    @model_validator(mode="before")
+    @classmethod
+    def _not_both(cls, data: object) -> object:
+        """Both kinds given: refused as such before either is read (else a trajectory body
+        under ``compare`` would be reported as a compare missing its ``methods``)."""
+        if isinstance(data, dict) and "trajectory" in data and "compare" in data:
+            raise ValueError(
+                "give exactly one of `trajectory` (a POST /v1/trajectories body) or `compare` "
+                "(a POST /v1/trajectories/compare body), not both: a job computes one of them; submit two jobs for both"
+            )
+        return data
+
     @model_validator(mode="after")
     def _one_kind(self) -> JobCreate:
         given = [name for name in ("trajectory", "compare") if name in self.model_fields_set]

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
-from pydantic import Discriminator, Field, Tag
+from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from toptraj.planners.collision.self_collision import PADDING
 from toptraj.planners.problem import ranges
 from toptraj.planners.timing import METHODS
 from toptraj.planners.timing.laws.splines import MAX_SUPPORTING_POINTS, MIN_SUPPORTING_POINTS
 from toptraj.service.schemas.common import Schema, bounded, signed
+from toptraj.service.schemas.compare_rules import each_method_once, timing_method_among_methods
 from toptraj.service.schemas.equipment import MOUNTING, PAYLOAD, MountingRequest, PayloadRequest
 from toptraj.service.schemas.zones import ZONES, ZoneRequest
 
@@ -386,4 +387,9 @@ class CompareRequest(Schema):
     methods: list[MethodName] = Field(
         min_length=1, max_length=10, description="Timing methods to run, e.g. [\"phase_plane\", \"quintic\"]."
     )
-    timing: TimingRequest = Field(default=TimingRequest(), description="Constraints and limits shared by every method (its `method` is ignored).")
+    timing: TimingRequest = Field(
+        default=TimingRequest(), description="Constraints and limits shared by every method (its `method`, if given, must be among `methods`)."
+    )
+
+    check_each_method_once = field_validator("methods")(each_method_once)
+    check_timing_method = model_validator(mode="after")(timing_method_among_methods)

@@ -89,7 +89,7 @@ SHAPES = "give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows o
         ("diagonal", f"payload.inertia: {SHAPES}"),
         ([1e9, 1, 1, 0, 0, 0], "payload.inertia[0]: 1e+09 is not within the accepted range [-10000, 10000] kg m^2"),
         ([[1, 0, 0], [0, 1, 0], [0, 0]], "payload.inertia[2]: List should have at least 3 items, not 2"),
-        ([1, 1, "a", 0, 0, 0], "payload.inertia[2]: Input should be a valid number"),
+        ([1, 1, "a", 0, 0, 0], "payload.inertia[2]: Input should be a valid number; got the string 'a'"),
     ],
 )
 def test_an_inertia_of_neither_form_names_the_one_meant(client, inertia, detail):
