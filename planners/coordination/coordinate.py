@@ -124,7 +124,7 @@ def _check_cell(cell: Cell) -> None:
     if not 2 <= len(cell.arms) <= MAX_ARMS:
         raise InvalidRequest(
             "arms", len(cell.arms), rule="too_many_arms", fewest=2, most=MAX_ARMS,
-            detail=f"a cell of {len(cell.arms)} arms; from 2 to {MAX_ARMS} are served",
+            detail=f"a cell of {len(cell.arms)} arm{'' if len(cell.arms) == 1 else 's'}; from 2 to {MAX_ARMS} are served",
         )
 
 

@@ -175,3 +175,12 @@ def test_the_example_at_a_clearance_its_timings_keep_is_a_200(patient_client):
     response = patient_client.post("/v1/cells", json=EXAMPLE | {"clearance": 0.1})
     assert response.status_code == 200, response.text
     assert response.json()["min_distance"]["guaranteed"] >= 0.1
+
+
+def test_one_arm_or_one_value_is_counted_in_the_singular(patient_client):
+    one = copy.deepcopy(EXAMPLE)
+    one["arms"] = one["arms"][:1]
+    response = patient_client.post("/v1/cells", json=one)
+    assert response.status_code == 422 and "a cell has 1 arm; from 2 to 4 are served" in response.json()["detail"]
+    response = patient_client.post("/v1/cells", json=_cell(a1={"waypoints": [[0.0], [0.1]]}))
+    assert response.status_code == 422 and "arms[1].waypoints[0] has 1 value; ur5 has 6 joints" in response.json()["detail"]
