@@ -13,7 +13,9 @@ least the mean of the two edges' bounds minus m2 / 2. So over the cell:
 (capped by the smallest corner, in case the motion was underestimated). Cells whose bound is
 low only because the steps are long (their corners all clear) are refined: each cut into
 ``REFINE`` x ``REFINE`` sub-cells with their own corner distances and steps, its bound the
-smallest of theirs.
+smallest of theirs. Along the diagram's borders, where one arm rests at its start or end while
+the other moves (an arm that waits), only the segment bound applies (``edge_bounds``), refined
+likewise.
 """
 
 from __future__ import annotations
@@ -131,3 +133,26 @@ def refined_bounds(
             return out
     np.minimum.at(out, owner, -np.inf)  # still unsettled at the finest level: not proven
     return out
+
+
+def edge_bounds(moving: CellArm, still: Capsules, distance: np.ndarray, steps: np.ndarray, needed: float) -> np.ndarray:
+    """Lower bounds (m) over each step of one border of the diagram, where one arm rests (at its
+    start or end, capsules ``still``: a, b (1, k, 3), radius (k,)) and ``moving`` goes through
+    the grid's s: from the distances at the nodes ``distance`` (M + 1,) and the moving arm's
+    motion over each step ``steps`` (M,), (d_i + d_{i+1} - m) / 2 (module docstring); steps
+    below ``needed`` though both ends are clear are cut into ``REFINE ** LEVELS`` sub-steps.
+    Shape (M,)."""
+    low = np.minimum(distance[:-1], distance[1:])
+    bound = np.minimum((distance[:-1] + distance[1:] - steps) / 2.0, low)
+    refine = np.flatnonzero((bound < needed) & (low >= needed))
+    if len(refine):
+        count = REFINE**LEVELS
+        m = len(steps)
+        s = ((refine[:, None] + np.arange(count + 1)[None, :] / count) / m).ravel()
+        capsules = moving.capsules_at(moving.path.evaluate(np.clip(s, 0.0, 1.0)).q)
+        fine = pair_distances(capsules, still)[0].reshape(len(refine), count + 1)
+        jumps = motion_steps(capsules)
+        motion = np.delete(jumps, np.arange(count, len(jumps), count + 1)).reshape(len(refine), count)  # within each step
+        sub = np.minimum((fine[:, :-1] + fine[:, 1:] - motion) / 2.0, np.minimum(fine[:, :-1], fine[:, 1:]))
+        bound[refine] = sub.min(axis=1)
+    return bound

@@ -8,8 +8,10 @@ the capsules' displacement, ``bounds.motion_steps``). A cell is free when the di
 is proven at least the clearance plus ``FINE_STEP``: by the lower bound from its four corners
 and the steps (``bounds.cell_bounds``, the corners' mean minus half the motion), else, where
 only that margin blocks it (its corners all clear), by the bounds of its refined sub-cells
-(``bounds.refined_bounds``). A point (s1, s2) is free when its cell is; a node is blocked
-unless every cell around it is free (the nodes the quickest curve may pass). The schedule
+(``bounds.refined_bounds``). A point (s1, s2) is free when its cell is, or when it lies on
+a border (an arm at rest at its start or end) along a step proven clear by the segment bound
+(``bounds.edge_bounds``); a node is blocked unless every cell around it is free (the nodes the
+quickest curve may pass). The schedule
 finally chosen is verified apart, at fine samples, with a strict bound
 (``toptraj.planners.coordination.verify``).
 """
@@ -21,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.coordination.bounds import cell_bounds, motion_steps, refined_bounds
+from toptraj.planners.coordination.bounds import cell_bounds, edge_bounds, motion_steps, refined_bounds
 from toptraj.planners.coordination.cell import Cell, CellArm, pair_distances
 from toptraj.planners.errors import InvalidRequest, OverMemory
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -39,7 +41,9 @@ class Diagram:
     """The coordination diagram on ``s`` (M + 1,): ``distance`` (M + 1, M + 1) between the
     arms at (s1[i], s2[j]) in m, ``blocked`` (M + 1, M + 1) the nodes not surrounded by free
     cells, the arms' motion bound over each grid step, ``step1`` and ``step2`` (M,), in m, and
-    ``free`` (M, M) the cells proven clear (default: those with four free corners)."""
+    ``free`` (M, M) the cells proven clear (default: those with four free corners) and
+    ``edges``, the steps proven clear along the four borders, where one arm rests at its start
+    or end: s2 = 0 and s2 = 1 (each (M,) over s1), s1 = 0 and s1 = 1 (each (M,) over s2)."""
 
     s: np.ndarray
     distance: np.ndarray
@@ -47,6 +51,7 @@ class Diagram:
     step1: np.ndarray
     step2: np.ndarray
     free: np.ndarray | None = None
+    edges: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def region(self) -> np.ndarray:
@@ -64,7 +69,12 @@ class Diagram:
         i = np.clip(np.floor(np.asarray(s1) * m).astype(int), 0, m - 1)
         j = np.clip(np.floor(np.asarray(s2) * m).astype(int), 0, m - 1)
         if self.free is not None:
-            return self.free[i, j]
+            s1, s2 = np.asarray(s1), np.asarray(s2)
+            free = self.free[i, j]
+            if self.edges is not None:
+                low, high, first, last = self.edges
+                free = free | ((s2 == 0.0) & low[i]) | ((s2 == 1.0) & high[i]) | ((s1 == 0.0) & first[j]) | ((s1 == 1.0) & last[j])
+            return free
         b = self.blocked
         return ~(b[i, j] | b[i + 1, j] | b[i, j + 1] | b[i + 1, j + 1])
 
@@ -89,9 +99,10 @@ def check_ends(cell: Cell) -> None:
             )
 
 
-def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE) -> Diagram:
-    """The diagram of the cell's first two arms on ``grid`` intervals per axis (memory checked
-    first: one row of (grid + 1) nodes, k1 x k2 capsule pairs, about 40 arrays of 8 bytes)."""
+def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE, margin: float = FINE_STEP) -> Diagram:
+    """The diagram of the cell's first two arms on ``grid`` intervals per axis, its free cells
+    ``margin`` (m) above the clearance (memory checked first: one row of (grid + 1) nodes, k1 x k2
+    capsule pairs, about 40 arrays of 8 bytes)."""
     first, second = cell.arms[:2]
     s = np.linspace(0.0, 1.0, grid + 1)
     one, two = arm_capsules(first, s), arm_capsules(second, s)
@@ -103,22 +114,28 @@ def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_D
         deadline.check()
         distance[i] = pair_distances((one[0][i][None], one[1][i][None], one[2]), two)[0]
     step1, step2 = motion_steps(one), motion_steps(two)
-    free = _free_cells(cell, (first, second), (distance, step1, step2), deadline)
+    free = _free_cells(cell.clearance + margin, (first, second), (distance, step1, step2), deadline)
     closed = np.pad(~free, 1, constant_values=False)  # a node is blocked unless every cell around it is free
     blocked = closed[:-1, :-1] | closed[1:, :-1] | closed[:-1, 1:] | closed[1:, 1:]
-    return Diagram(s=s, distance=distance, blocked=blocked, step1=step1, step2=step2, free=free)
+    needed = cell.clearance + margin
+    edges = (
+        edge_bounds(first, (two[0][:1], two[1][:1], two[2]), distance[:, 0], step1, needed) >= needed,
+        edge_bounds(first, (two[0][-1:], two[1][-1:], two[2]), distance[:, -1], step1, needed) >= needed,
+        edge_bounds(second, (one[0][:1], one[1][:1], one[2]), distance[0, :], step2, needed) >= needed,
+        edge_bounds(second, (one[0][-1:], one[1][-1:], one[2]), distance[-1, :], step2, needed) >= needed,
+    )
+    return Diagram(s=s, distance=distance, blocked=blocked, step1=step1, step2=step2, free=free, edges=edges)
 
 
-def _free_cells(cell: Cell, arms: tuple[CellArm, CellArm], coarse: tuple[np.ndarray, ...], deadline: Deadline) -> np.ndarray:
-    """Which cells (M, M) are proven ``clearance + FINE_STEP`` apart: by the bound from their
+def _free_cells(needed: float, arms: tuple[CellArm, CellArm], coarse: tuple[np.ndarray, ...], deadline: Deadline) -> np.ndarray:
+    """Which cells (M, M) are proven ``needed`` (m) apart: by the bound from their
     corners, else, where every corner is clear, by the bound of their refined sub-cells
     (``bounds``)."""
     distance, step1, step2 = coarse
-    needed = cell.clearance + FINE_STEP
     free = cell_bounds(distance, step1, step2) >= needed
     corners = np.minimum(np.minimum(distance[:-1, :-1], distance[1:, :-1]), np.minimum(distance[:-1, 1:], distance[1:, 1:]))
-    margin = np.argwhere(~free & (corners >= needed))
-    if len(margin):
-        bounds = refined_bounds(margin, arms, len(step1), needed, deadline)
-        free[margin[:, 0], margin[:, 1]] = bounds >= needed
+    refine = np.argwhere(~free & (corners >= needed))
+    if len(refine):
+        bounds = refined_bounds(refine, arms, len(step1), needed, deadline)
+        free[refine[:, 0], refine[:, 1]] = bounds >= needed
     return free
