@@ -27,9 +27,9 @@ from toptraj.planners.errors import OverMemory
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 
 #: Sub-cells per side of a refined cell.
-REFINE = 8
+REFINE = 4
 #: Times a cell is refined at most (its sub-cells down to 1 / REFINE ** LEVELS of it).
-LEVELS = 2
+LEVELS = 3
 #: Memory (bytes) one batch of refined corners may take (about 40 arrays of 8 bytes a pair).
 BATCH_BYTES = 100_000_000
 #: Factor on the capsules' displacement between grid nodes for their motion in between.
