@@ -64,7 +64,7 @@ class Diagram:
 
     def free_at(self, s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
         """Whether each point (s1, s2) (n,) lies in a free cell (closed: a point on the edge
-        between cells counts in one of them)."""
+        between cells counts in one of them) or on a border along a free step (``edges``)."""
         m = len(self.s) - 1
         i = np.clip(np.floor(np.asarray(s1) * m).astype(int), 0, m - 1)
         j = np.clip(np.floor(np.asarray(s2) * m).astype(int), 0, m - 1)
