@@ -133,9 +133,10 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_pe
 
 def _diagram(found: Coordination, pair: tuple[int, int], pick: np.ndarray) -> dict:
     """The coordination diagram of arms ``pair`` = (a, b): the grid ``s``, ``blocked`` (rows
-    s_a) and the ``curve`` (s_a, s_b) the schedule passes through."""
+    s_a: the collision region's nodes, none a corner of a cell the curve enters) and the
+    ``curve`` (s_a, s_b) the schedule passes through."""
     diagram = found.diagrams[pair]
-    return {"arms": list(pair), "s": diagram.s, "blocked": diagram.blocked.astype(int), "curve": found.curve[pick][:, list(pair)]}
+    return {"arms": list(pair), "s": diagram.s, "blocked": diagram.region.astype(int), "curve": found.curve[pick][:, list(pair)]}
 
 
 def _metadata(body: dict) -> list[str]:

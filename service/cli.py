@@ -1,5 +1,5 @@
 """The ``toptraj`` command: ``toptraj serve [--host H] [--port P] [--workers N] [--access-log]``, and
-``toptraj plan|compare FILE|-`` and ``toptraj plot FILE|- -o OUT.html`` (``toptraj.service.commands``)."""
+``toptraj plan|compare FILE|-`` (a trajectory, comparison or cell body) and ``toptraj plot FILE|- -o OUT.html`` (``toptraj.service.commands``)."""
 
 from __future__ import annotations
 
@@ -104,9 +104,11 @@ def _request_commands(commands) -> None:
         "plan",
         help="plan one request and print the answer (errors on stderr)",
         description="Plan one request and print the answer, as POST /v1/trajectories (or, for a body naming methods, "
-        "POST /v1/trajectories/compare) would. " + exits,
+        "POST /v1/trajectories/compare; for a body naming arms, POST /v1/cells) would. " + exits,
     )
-    plan.add_argument("request", help="a JSON file shaped like the body of POST /v1/trajectories (or of a comparison), - for stdin")
+    plan.add_argument(
+        "request", help="a JSON file shaped like the body of POST /v1/trajectories (or of a comparison, or of a cell), - for stdin"
+    )
     plan.set_defaults(run=lambda args: commands_.plan(args.request))
     compare = commands.add_parser(
         "compare",
@@ -132,9 +134,10 @@ def _request_commands(commands) -> None:
         "plot",
         help="write the web page's plots of one request to a self-contained HTML file",
         description="Write the plots of one request to a self-contained HTML file (it opens offline): the phase plane, "
-        "the joints against their limits and the arm; for a comparison, every method drawn over the others. " + exits,
+        "the joints against their limits and the arm; for a comparison, every method drawn over the others; for a cell, "
+        "its coordination diagram, each arm's joints and the arms together. " + exits,
     )
-    plot.add_argument("request", help="a JSON file shaped like the body of POST /v1/trajectories or of a comparison; - for stdin")
+    plot.add_argument("request", help="a JSON file shaped like the body of POST /v1/trajectories, of a comparison or of a cell; - for stdin")
     plot.add_argument("-o", "--output", required=True, help="the HTML file to write")
     plot.add_argument("--methods", type=_methods, default=None, help="compare these timing methods, comma-separated, e.g. phase_plane,toppra")
     plot.set_defaults(run=lambda args: commands_.plot(args.request, args.output, args.methods))

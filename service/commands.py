@@ -66,6 +66,21 @@ def _unique_keys(source: str, text: str) -> str:
     return text
 
 
+def _is_cell(text: str) -> bool:
+    """A cell body (``POST /v1/cells``) names its ``arms``."""
+    body = _json(text)
+    return isinstance(body, dict) and "arms" in body
+
+
+def _no_cell(text: str, why: str) -> str:
+    """``text``, unless it is a cell body: then InvalidRequest saying ``why`` and what a cell takes."""
+    if _is_cell(text):
+        from toptraj.planners.errors import InvalidRequest
+
+        raise InvalidRequest("arms", detail=f"{why}; a cell (a body with arms) is planned by toptraj plan and drawn by toptraj plot (without --methods)")
+    return text
+
+
 def _is_compare(text: str) -> bool:
     """A compare body names its ``methods``."""
     body = _json(text)
@@ -125,9 +140,10 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
 
 def _schema_named(title: str) -> type | None:
     """The request schema a ``ValidationError`` of that title is about (for its hints)."""
+    from toptraj.service.schemas.cells import CellRequest
     from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
-    return {schema.__name__: schema for schema in (TrajectoryRequest, CompareRequest)}.get(title)
+    return {schema.__name__: schema for schema in (TrajectoryRequest, CompareRequest, CellRequest)}.get(title)
 
 
 def _write(content: bytes, out=None) -> int:
@@ -166,9 +182,35 @@ def _compare(text: str, as_table: bool = False) -> bytes:
     return encode_json(answer)
 
 
+def _cell(text: str, page: bool = False) -> bytes:
+    """A cell body's answer, as ``POST /v1/cells`` gives it (its ``format``; CSV included), or
+    with ``page`` its plots (``toptraj.service.cell_plots``)."""
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.service.cell_answers import csv_bytes
+    from toptraj.service.cells import plan_cell
+    from toptraj.service.planning import encode_json
+    from toptraj.service.schemas.cells import CellRequest
+
+    request = CellRequest.model_validate_json(text)
+    if page:
+        from toptraj.service.cell_plots import cell_html
+
+        return cell_html(plan_cell(request, NO_DEADLINE, "samples")).encode()
+    if request.format == "csv":
+        return csv_bytes(plan_cell(request, NO_DEADLINE, "csv"))
+    return encode_json(plan_cell(request, NO_DEADLINE))
+
+
 def plan(source: str) -> int:
-    """``toptraj plan FILE|-``: a trajectory body, or a compare body (it names ``methods``)."""
-    return _run(source, lambda text: _compare(text) if _is_compare(text) else _trajectory(text))
+    """``toptraj plan FILE|-``: a trajectory body, a compare body (it names ``methods``) or a
+    cell body (it names ``arms``)."""
+
+    def answer(text: str) -> bytes:
+        if _is_cell(text):
+            return _cell(text)
+        return _compare(text) if _is_compare(text) else _trajectory(text)
+
+    return _run(source, answer)
 
 
 def compare(source: str, methods: list[str] | None = None, as_json: bool | None = None) -> int:
@@ -176,12 +218,13 @@ def compare(source: str, methods: list[str] | None = None, as_json: bool | None 
     compared under ``methods`` (``compare_body``); a table on a terminal, JSON when piped or
     when ``as_json``."""
     as_table = sys.stdout.isatty() if as_json is None else not as_json
-    return _run(source, lambda text: _compare(compare_body(text, methods), as_table))
+    why = "toptraj compare times one arm's path under several methods"
+    return _run(source, lambda text: _compare(compare_body(_no_cell(text, why), methods), as_table))
 
 
 def plot(source: str, output: str, methods: list[str] | None = None) -> int:
     """``toptraj plot FILE|- -o OUT.html [--methods a,b]``: the page's plots of one trajectory
-    request, or of every method of a compare body drawn over each other (``--methods`` turns a
+    request or cell (``toptraj.service.cell_plots``), or of every method of a compare body drawn over each other (``--methods`` turns a
     trajectory body into one), in a self-contained HTML file (Plotly's JavaScript inlined: it
     opens offline)."""
     from toptraj.planners.execution.deadline import NO_DEADLINE
@@ -190,7 +233,10 @@ def plot(source: str, output: str, methods: list[str] | None = None) -> int:
     from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
     def page(text: str) -> bytes:
+        if _is_cell(text) and methods is None:
+            return _cell(text, page=True)
         if methods is not None or _is_compare(text):
+            text = _no_cell(text, "--methods compares timing methods of one arm's path")
             from toptraj.service.compare_plots import compare_html
 
             return compare_html(CompareRequest.model_validate_json(compare_body(text, methods)), NO_DEADLINE).encode()

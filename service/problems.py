@@ -35,6 +35,7 @@ from toptraj.robots.errors import (
 )
 from toptraj.robots.notes import Note
 from toptraj.robots.upload_options import InvalidUpload
+from toptraj.service.counts import counted
 from toptraj.service.field_hints import unknown_field_hint
 from toptraj.service.locations import where
 from toptraj.service.value_hints import collapsed, value_hint
@@ -139,8 +140,13 @@ def request_field(field: str) -> str:
 
 
 class _Words(string.Formatter):
-    """``str.format`` with ``!j`` (join a sequence with ", "), ``!e`` (excerpt) and ``!f`` (a
-    library field as the request's)."""
+    """``str.format`` with ``!j`` (join a sequence with ", "), ``!e`` (excerpt), ``!f`` (a
+    library field as the request's) and ``:~noun`` (the count and the noun, plural unless one)."""
+
+    def format_field(self, value, format_spec):
+        if format_spec.startswith("~"):
+            return counted(value, format_spec[1:])
+        return super().format_field(value, format_spec)
 
     def convert_field(self, value, conversion):
         if conversion == "j":

@@ -3,8 +3,9 @@ a class's own rule by default), in the request's vocabulary.
 
 A wording is a ``str.format`` template over the error's facts, where ``{field}`` (and each of
 ``fields``) is the request's field (``toptraj.service.problems.REQUEST_FIELD``), ``{x!j}`` joins a sequence with ", ",
-``{x!e}`` shows a value excerpted (``toptraj.robots.errors.excerpt``) and ``{x!f}`` maps a library field
-to the request's; or a function of the facts for what a template cannot say.
+``{x!e}`` shows a value excerpted (``toptraj.robots.errors.excerpt``), ``{x!f}`` maps a library field
+to the request's and ``{x:~noun}`` counts (``toptraj.service.counts.counted``); or a function of the facts
+for what a template cannot say.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from collections.abc import Callable
 
 from toptraj.robots.errors import excerpt
 from toptraj.robots.ranges import Range
+from toptraj.service.counts import counted
 from toptraj.service.field_hints import closest
 from toptraj.service.note_wordings import NOTE_WORDING
 from toptraj.service.zone_wordings import ZONE_WORDING
@@ -44,11 +46,8 @@ def _scaled_limit(facts: dict) -> str:
 
 
 def _wrong_length(facts: dict) -> str:
-    text = f"{facts['field']} has {facts['given']} values; "
-    if "robot" in facts:
-        text += f"{facts['robot']} has {facts['expected']} joints"
-    else:
-        text += f"the robot has {facts['expected']} joints"
+    text = f"{facts['field']} has {counted(facts['given'], 'value')}; "
+    text += f"{facts.get('robot', 'the robot')} has {counted(facts['expected'], 'joint')}"
     if "joint_names" in facts:
         text += f" ({', '.join(facts['joint_names'])})"
     return text
@@ -75,7 +74,7 @@ def _too_many_samples(facts: dict) -> str:
 
 
 def _needs_two_waypoints(facts: dict) -> str:
-    given = "a cartesian path" if facts["value"] is None else f"{facts['value']} waypoints"
+    given = "a cartesian path" if facts["value"] is None else counted(facts["value"], "waypoint")
     return (
         f"timing.method {facts['method']!r} plans state-to-state motions: give exactly 2 waypoints, not "
         f"{given} (the offline library has no intermediate waypoints); use phase_plane or a time "
@@ -202,7 +201,7 @@ def _arms_collide_at_start(facts: dict) -> str:
 WORDING: dict[str, Wording] = {
     "not_a_rotation": _not_a_rotation,
     "arms_collide_at_start": _arms_collide_at_start,
-    "too_many_arms": "a cell has {value} arms; from {fewest} to {most} are served (every order of the arms is tried): "
+    "too_many_arms": "a cell has {value:~arm}; from {fewest} to {most} are served (every order of the arms is tried): "
     "give between {fewest} and {most} arms, or split the cell",
     "out_of_range": _out_of_range,
     "scaled_limit_out_of_range": _scaled_limit,
@@ -212,7 +211,7 @@ WORDING: dict[str, Wording] = {
     "not_one_of": "{field} {value!r} is unknown; use one of {allowed}",
     "deviation_needs_blend": "{field} applies to interpolation 'blend', not {interpolation!r}: leave it out or use 'blend'",
     "not_joint_vectors": "{field} must be a list of joint vectors (a 2-D array)",
-    "too_few_waypoints": "{field} holds {count} waypoint(s); at least 2 are needed",
+    "too_few_waypoints": "{field} holds {count:~waypoint}; at least 2 are needed",
     "too_many_waypoints": "{field} holds {estimate} waypoints; at most {cap} are served",
     "coordinate_out_of_range": "{field} is {value:.6g}: not a finite number within +-{high:g} ({unit})",
     "outside_joint_range": "{field} = {value:.6g} is outside the limits [{low:.6g}, {high:.6g}] of joint {joint_name!r}",
@@ -345,7 +344,7 @@ WORDING: dict[str, Wording] = {
         "allows: there is no motion to search; to turn a joint a full revolution, give that goal with "
         "path.revolutions false"
     ),
-    "search_cells_length": "{field} has {given} values; give one, or one per joint ({expected})",
+    "search_cells_length": "{field} has {given:~value}; give one, or one per joint ({expected})",
     "search_cells_out_of_range": "{field} must lie in [{low}, {high}], got {value}",
     "lattice_too_large": lambda facts: (
         f"{facts['field']} gives a lattice of {facts['estimate']} grid points ({' x '.join(map(str, facts['shape']))}); "

@@ -28,7 +28,7 @@ import numpy as np
 from toptraj.planners.collision.self_collision import SelfCollision, check_self_collision
 from toptraj.planners.coordination.cell import MAX_ARMS, Cell
 from toptraj.planners.coordination.curve import SmoothCurve, resampled, shortcut, shortest_curve, widened
-from toptraj.planners.coordination.diagram import Diagram, check_ends, coordination_diagram
+from toptraj.planners.coordination.diagram import FINE_STEP, Diagram, check_ends, coordination_diagram
 from toptraj.planners.coordination.limits import within_limits
 from toptraj.planners.coordination.prioritized import pair_diagrams, prioritized
 from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
@@ -45,6 +45,11 @@ DIAGRAM_SAMPLES = 2_000
 WIDENINGS = (1, 2, 3)
 #: Spacings (in s) of the control points of the smoothed curves tried.
 SPACINGS = (0.2, 0.1, 0.05, 0.02, 0.01)
+#: Margins (m) above the clearance of the diagram's free cells, tried in turn for two arms: the
+#: schedules of the first stay clear between the diagram's samples in time; where none of
+#: them passes the strict check, the diagram without a margin, its schedules held by that
+#: check alone.
+MARGINS = (FINE_STEP, 0.0)
 
 
 @dataclass(frozen=True)
@@ -124,17 +129,18 @@ def _check_cell(cell: Cell) -> None:
     if not 2 <= len(cell.arms) <= MAX_ARMS:
         raise InvalidRequest(
             "arms", len(cell.arms), rule="too_many_arms", fewest=2, most=MAX_ARMS,
-            detail=f"a cell of {len(cell.arms)} arms; from 2 to {MAX_ARMS} are served",
+            detail=f"a cell of {len(cell.arms)} arm{'' if len(cell.arms) == 1 else 's'}; from 2 to {MAX_ARMS} are served",
         )
 
 
-def _candidates(cell: Cell, solo: list[TimeScaling], deadline: Deadline) -> tuple[dict, list[Schedule]]:
+def _candidates(cell: Cell, solo: list[TimeScaling], deadline: Deadline, margin: float) -> tuple[dict, list[Schedule]]:
     """The pairwise diagrams and the schedules to try: for two arms a late start of either and
-    the coordinated curve; for more, the prioritized schedule (``prioritized``)."""
+    the coordinated curve on the diagram of free cells ``margin`` (m) above the clearance; for
+    more, the prioritized schedule (``prioritized``)."""
     if len(cell.arms) > 2:
         diagrams = pair_diagrams(cell, deadline)
         return diagrams, [prioritized(cell, solo, diagrams, deadline)]
-    diagram = coordination_diagram(cell, deadline=deadline)
+    diagram = coordination_diagram(cell, deadline=deadline, margin=margin)
     candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), curve_schedule(cell, diagram, solo, deadline)]
     return {(0, 1): diagram}, [candidate for candidate in candidates if candidate is not None]
 
@@ -157,6 +163,16 @@ def _arms_alone(cell: Cell, deadline: Deadline) -> list[TimeScaling]:
     return solo
 
 
+def _verified(cell: Cell, candidates: list[Schedule], deadline: Deadline) -> tuple[Schedule, PairClearance] | None:
+    """The quickest of ``candidates`` (held to the limits) whose strict check keeps the
+    clearance, with that check; None when none does."""
+    for schedule in sorted((within_limits(cell, c) for c in candidates), key=lambda c: c.duration):
+        clearance = schedule_clearance(cell, schedule, deadline)
+        if clearance.bound >= cell.clearance:
+            return schedule, clearance
+    return None
+
+
 def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
     """Time the cell's arms along their paths, kept ``cell.clearance`` apart, all done as early
     as possible (module docstring; three or more arms: ``prioritized``).
@@ -172,11 +188,11 @@ def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
     _check_cell(cell)
     check_ends(cell)
     solo = _arms_alone(cell, deadline)
-    diagrams, candidates = _candidates(cell, solo, deadline)
-    found = sorted((within_limits(cell, c) for c in candidates), key=lambda c: c.duration)
-    for schedule in found:
-        clearance = schedule_clearance(cell, schedule, deadline)
-        if clearance.bound >= cell.clearance:
+    for margin in MARGINS[: 1 if len(cell.arms) > 2 else None]:
+        diagrams, candidates = _candidates(cell, solo, deadline, margin)
+        kept = _verified(cell, candidates, deadline)
+        if kept is not None:
+            schedule, clearance = kept
             t = np.linspace(0.0, schedule.duration, DIAGRAM_SAMPLES + 1)
             return Coordination(
                 schedule, tuple(motion.duration for motion in solo), diagrams, schedule.path_parameters(t), clearance

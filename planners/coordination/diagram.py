@@ -4,10 +4,15 @@ distance between the arms at every node and the region where they would come clo
 clearance marked as an obstacle.
 
 Between nodes the distance changes by at most the arms' motion over a grid step (estimated from
-the capsules' displacement, ``motion_steps``). A node is blocked when its distance is below the
-clearance plus the motion of both arms over one grid step and ``FINE_STEP``: so any (s1, s2)
-in a cell whose four corners are free is about ``clearance + FINE_STEP`` from a collision or
-farther. The schedule finally chosen is verified apart, at fine samples, with a strict bound
+the capsules' displacement, ``bounds.motion_steps``). A cell is free when the distance over it
+is proven at least the clearance plus ``FINE_STEP``: by the lower bound from its four corners
+and the steps (``bounds.cell_bounds``, the corners' mean minus half the motion), else, where
+only that margin blocks it (its corners all clear), by the bounds of its refined sub-cells
+(``bounds.refined_bounds``). A point (s1, s2) is free when its cell is, or when it lies on
+a border (an arm at rest at its start or end) along a step proven clear by the segment bound
+(``bounds.edge_bounds``); a node is blocked unless every cell around it is free (the nodes the
+quickest curve may pass). The schedule
+finally chosen is verified apart, at fine samples, with a strict bound
 (``toptraj.planners.coordination.verify``).
 """
 
@@ -18,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from toptraj.planners.coordination.bounds import cell_bounds, edge_bounds, motion_steps, refined_bounds
 from toptraj.planners.coordination.cell import Cell, CellArm, pair_distances
 from toptraj.planners.errors import InvalidRequest, OverMemory
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -26,8 +32,6 @@ from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 GRID = 100
 #: Margin (m) kept above the clearance by the blocked region, for the checks between samples.
 FINE_STEP = 0.005
-#: Factor on the capsules' displacement between grid nodes for their motion in between.
-STEP_SAFETY = 1.5
 #: Memory (bytes) the distance grid may take at once: one row of nodes, every capsule pair.
 MEMORY_CAP = 200_000_000
 
@@ -35,20 +39,42 @@ MEMORY_CAP = 200_000_000
 @dataclass(frozen=True)
 class Diagram:
     """The coordination diagram on ``s`` (M + 1,): ``distance`` (M + 1, M + 1) between the
-    arms at (s1[i], s2[j]) in m, ``blocked`` (M + 1, M + 1) where it is too close, and the arms'
-    motion bound over each grid step, ``step1`` and ``step2`` (M,), in m."""
+    arms at (s1[i], s2[j]) in m, ``blocked`` (M + 1, M + 1) the nodes not surrounded by free
+    cells, the arms' motion bound over each grid step, ``step1`` and ``step2`` (M,), in m, and
+    ``free`` (M, M) the cells proven clear (default: those with four free corners) and
+    ``edges``, the steps proven clear along the four borders, where one arm rests at its start
+    or end: s2 = 0 and s2 = 1 (each (M,) over s1), s1 = 0 and s1 = 1 (each (M,) over s2)."""
 
     s: np.ndarray
     distance: np.ndarray
     blocked: np.ndarray
     step1: np.ndarray
     step2: np.ndarray
+    free: np.ndarray | None = None
+    edges: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+
+    @property
+    def region(self) -> np.ndarray:
+        """The collision region's nodes (M + 1, M + 1): those no free cell touches (so a free
+        cell has none of them at its corners)."""
+        if self.free is None:
+            return self.blocked
+        open_ = np.pad(self.free, 1, constant_values=False)
+        return ~(open_[:-1, :-1] | open_[1:, :-1] | open_[:-1, 1:] | open_[1:, 1:])
 
     def free_at(self, s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
-        """Whether each point (s1, s2) (n,) lies in a cell with four free corners."""
+        """Whether each point (s1, s2) (n,) lies in a free cell (closed: a point on the edge
+        between cells counts in one of them) or on a border along a free step (``edges``)."""
         m = len(self.s) - 1
         i = np.clip(np.floor(np.asarray(s1) * m).astype(int), 0, m - 1)
         j = np.clip(np.floor(np.asarray(s2) * m).astype(int), 0, m - 1)
+        if self.free is not None:
+            s1, s2 = np.asarray(s1), np.asarray(s2)
+            free = self.free[i, j]
+            if self.edges is not None:
+                low, high, first, last = self.edges
+                free = free | ((s2 == 0.0) & low[i]) | ((s2 == 1.0) & high[i]) | ((s1 == 0.0) & first[j]) | ((s1 == 1.0) & last[j])
+            return free
         b = self.blocked
         return ~(b[i, j] | b[i + 1, j] | b[i, j + 1] | b[i + 1, j + 1])
 
@@ -56,16 +82,6 @@ class Diagram:
 def arm_capsules(arm: CellArm, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The arm's world capsules at path parameters ``s`` (n,): a, b (n, k, 3), radius (k,)."""
     return arm.capsules_at(arm.path.evaluate(s).q)
-
-
-def motion_steps(capsules: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
-    """How far (m) the arm's capsules move between successive samples, from their world end
-    points a, b (n, k, 3): (n - 1,). A capsule moved rigidly moves each point of its axis by a
-    convex combination of its ends' displacements, so by at most the larger; ``STEP_SAFETY``
-    covers the motion between the samples."""
-    a, b = capsules[0], capsules[1]
-    ends = np.maximum(np.linalg.norm(np.diff(a, axis=0), axis=-1), np.linalg.norm(np.diff(b, axis=0), axis=-1))
-    return STEP_SAFETY * ends.max(axis=1)
 
 
 def check_ends(cell: Cell) -> None:
@@ -83,9 +99,10 @@ def check_ends(cell: Cell) -> None:
             )
 
 
-def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE) -> Diagram:
-    """The diagram of the cell's first two arms on ``grid`` intervals per axis (memory checked
-    first: one row of (grid + 1) nodes, k1 x k2 capsule pairs, about 40 arrays of 8 bytes)."""
+def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE, margin: float = FINE_STEP) -> Diagram:
+    """The diagram of the cell's first two arms on ``grid`` intervals per axis, its free cells
+    ``margin`` (m) above the clearance (memory checked first: one row of (grid + 1) nodes, k1 x k2
+    capsule pairs, about 40 arrays of 8 bytes)."""
     first, second = cell.arms[:2]
     s = np.linspace(0.0, 1.0, grid + 1)
     one, two = arm_capsules(first, s), arm_capsules(second, s)
@@ -97,7 +114,28 @@ def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_D
         deadline.check()
         distance[i] = pair_distances((one[0][i][None], one[1][i][None], one[2]), two)[0]
     step1, step2 = motion_steps(one), motion_steps(two)
-    local1 = np.maximum(np.r_[step1, 0.0], np.r_[0.0, step1])  # the larger step beside each node
-    local2 = np.maximum(np.r_[step2, 0.0], np.r_[0.0, step2])
-    blocked = distance < cell.clearance + FINE_STEP + local1[:, None] + local2[None, :]
-    return Diagram(s=s, distance=distance, blocked=blocked, step1=step1, step2=step2)
+    free = _free_cells(cell.clearance + margin, (first, second), (distance, step1, step2), deadline)
+    closed = np.pad(~free, 1, constant_values=False)  # a node is blocked unless every cell around it is free
+    blocked = closed[:-1, :-1] | closed[1:, :-1] | closed[:-1, 1:] | closed[1:, 1:]
+    needed = cell.clearance + margin
+    edges = (
+        edge_bounds(first, (two[0][:1], two[1][:1], two[2]), distance[:, 0], step1, needed) >= needed,
+        edge_bounds(first, (two[0][-1:], two[1][-1:], two[2]), distance[:, -1], step1, needed) >= needed,
+        edge_bounds(second, (one[0][:1], one[1][:1], one[2]), distance[0, :], step2, needed) >= needed,
+        edge_bounds(second, (one[0][-1:], one[1][-1:], one[2]), distance[-1, :], step2, needed) >= needed,
+    )
+    return Diagram(s=s, distance=distance, blocked=blocked, step1=step1, step2=step2, free=free, edges=edges)
+
+
+def _free_cells(needed: float, arms: tuple[CellArm, CellArm], coarse: tuple[np.ndarray, ...], deadline: Deadline) -> np.ndarray:
+    """Which cells (M, M) are proven ``needed`` (m) apart: by the bound from their
+    corners, else, where every corner is clear, by the bound of their refined sub-cells
+    (``bounds``)."""
+    distance, step1, step2 = coarse
+    free = cell_bounds(distance, step1, step2) >= needed
+    corners = np.minimum(np.minimum(distance[:-1, :-1], distance[1:, :-1]), np.minimum(distance[:-1, 1:], distance[1:, 1:]))
+    refine = np.argwhere(~free & (corners >= needed))
+    if len(refine):
+        bounds = refined_bounds(refine, arms, len(step1), needed, deadline)
+        free[refine[:, 0], refine[:, 1]] = bounds >= needed
+    return free

@@ -168,3 +168,19 @@ def test_five_arms_are_a_422_naming_the_bound(patient_client):
 def test_a_waypoint_of_the_wrong_length_is_a_422_naming_the_arm(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a0={"waypoints": [[0.0] * 5, [0.1] * 5]}))
     assert response.status_code == 422 and "arms[0]" in response.json()["detail"]
+
+
+def test_the_example_at_a_clearance_its_timings_keep_is_a_200(patient_client):
+    # at clearance 0.028 the example is answered with the arms 0.111 m apart or more
+    response = patient_client.post("/v1/cells", json=EXAMPLE | {"clearance": 0.1})
+    assert response.status_code == 200, response.text
+    assert response.json()["min_distance"]["guaranteed"] >= 0.1
+
+
+def test_one_arm_or_one_value_is_counted_in_the_singular(patient_client):
+    one = copy.deepcopy(EXAMPLE)
+    one["arms"] = one["arms"][:1]
+    response = patient_client.post("/v1/cells", json=one)
+    assert response.status_code == 422 and "a cell has 1 arm; from 2 to 4 are served" in response.json()["detail"]
+    response = patient_client.post("/v1/cells", json=_cell(a1={"waypoints": [[0.0], [0.1]]}))
+    assert response.status_code == 422 and "arms[1].waypoints[0] has 1 value; ur5 has 6 joints" in response.json()["detail"]

@@ -139,7 +139,7 @@ def test_ur5_smoke():
         ({"kind": "free", "start": [0, 0], "goal": [1, 0], "obstacles": [{"sphere": [0, 0, 0, 1]}]}, {"method": "collocation"}, ["obstacles"]),
         ({"waypoints": [[0, 0], [1, 0]]}, {"method": "collocation"}, ["free path"]),
         ({"kind": "free", "start": [0, 0, 0], "goal": [1, 0]}, {"method": "collocation"}, ["path.start has 3 values"]),
-        ({"kind": "free", "start": [0, 0], "goal": [1, 0]}, {"method": "collocation", "boundary": {"end_velocity": [1.0]}}, ["timing.boundary.end_velocity has 1 values"]),
+        ({"kind": "free", "start": [0, 0], "goal": [1, 0]}, {"method": "collocation", "boundary": {"end_velocity": [1.0]}}, ["timing.boundary.end_velocity has 1 value; "]),
     ],
 )
 def test_free_path_errors(client, path, timing, words):

@@ -1,0 +1,43 @@
+"""The two ur5 of the shipped cell example served at every clearance some timing keeps: the
+diagram's blocked region bounded from the cells' corners and refined where only the margin
+blocks it (not the grid step's whole motion around each node), the answer checked by coal; and
+a clearance above what any timing can keep still refused."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.planners.coordination.cells import facing_cell
+from tests.planners.coordination.independent import coal_distance
+from toptraj.planners.coordination import coordinate
+from toptraj.planners.errors import InfeasiblePath
+
+
+def _coal_min(cell, schedule, samples: int) -> float:
+    t = np.linspace(0.0, schedule.duration, samples + 1)
+    (q1, _, _), (q2, _, _) = schedule.states(cell, t)
+    return min(coal_distance(cell, a, b) for a, b in zip(q1, q2))
+
+
+@pytest.mark.parametrize("clearance", [0.05, 0.1, 0.11])
+def test_a_clearance_some_timing_keeps_is_served_and_kept_by_coal(clearance):
+    # at clearance 0.028 the cell is timed with the arms 0.111 m apart or more (one arm waiting at its
+    # start while the other passes): 0.05, 0.1 and 0.11 are kept too
+    cell = facing_cell(clearance=clearance)
+    found = coordinate(cell)
+    assert found.clearance.bound >= clearance
+    assert _coal_min(cell, found.schedule, 400) >= clearance
+
+
+def test_a_clearance_no_timing_keeps_is_refused():
+    # every monotone curve from (0, 0) to (1, 1) of the diagram crosses the line s1 + s2 = 1.4, so
+    # no timing keeps the arms farther apart than the largest distance on it (coal, 401 samples;
+    # between samples each arm moves about 5 mm: 0.03 m above it is out of reach)
+    cell = facing_cell()
+    s1 = np.linspace(0.4, 1.0, 401)
+    q1, q2 = cell.arms[0].path.evaluate(s1).q, cell.arms[1].path.evaluate(1.4 - s1).q
+    reach = max(coal_distance(cell, a, b) for a, b in zip(q1, q2))
+    assert reach < 0.25
+    with pytest.raises(InfeasiblePath, match="no timing keeps the arms apart"):
+        coordinate(facing_cell(clearance=reach + 0.03))
