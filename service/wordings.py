@@ -54,8 +54,11 @@ def _wrong_length(facts: dict) -> str:
 
 
 def _kind_not_served(facts: dict) -> str:
-    hint = " (for jerk, use jerk_limited, a time law or ruckig)" if facts["value"] == "jerk" else ""
-    return f"timing.method {facts['method']!r} cannot limit {facts['value']}; it handles {facts['handles']}{hint}"
+    kind, kept = facts["value"], facts["kept"]
+    hint = " (for jerk, use jerk_limited, a time law or ruckig)" if kind == "jerk" else ""
+    drop = f"drop {kind!r} from timing.constraints" + (f" (e.g. {list(kept)})" if kept else "")
+    other = ", or use timing.method 'jerk_limited', which holds torque and jerk" if kind == "torque" else ""
+    return f"timing.method {facts['method']!r} cannot limit {kind}; it handles {facts['handles']}{hint}: {drop}{other}"
 
 
 def _too_many_samples(facts: dict) -> str:
