@@ -200,7 +200,18 @@ def _arms_collide_at_start(facts: dict) -> str:
     )
 
 
+def _duration_too_short(facts: dict) -> str:
+    return (
+        f"{facts['field']} {facts['value']:g} s is too short for the {facts.get('method', 'timing')} law under these "
+        f"limits: {'the shortest is' if facts['exact'] else 'a duration of'} {facts['stated']:g} s"
+        f"{'' if facts['exact'] else ' holds them'}; give at least that or leave {facts['field']} out (the "
+        f"{facts['limit']} limit of joint {facts['joint']!r} is exceeded by {100 * (facts['ratio'] - 1):.2f} % at "
+        f"s = {facts['s']:.4f})"
+    )
+
+
 WORDING: dict[str, Wording] = {
+    "duration_too_short": _duration_too_short,
     "not_a_rotation": _not_a_rotation,
     "arms_collide_at_start": _arms_collide_at_start,
     "too_many_arms": "a cell has {value} arms; from {fewest} to {most} are served (every order of the arms is tried): "
