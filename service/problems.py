@@ -37,7 +37,7 @@ from toptraj.robots.notes import Note
 from toptraj.robots.upload_options import InvalidUpload
 from toptraj.service.field_hints import unknown_field_hint
 from toptraj.service.locations import where
-from toptraj.service.wordings import WORDING
+from toptraj.service.wordings import WORDING, torque_remedy
 
 HTTP_TITLES = {
     400: "Bad request",
@@ -165,6 +165,8 @@ def detail(error: ToptrajError) -> str:
             f": holding still at s = {held.s:.4f} needs {held.torque:.4g} N m on joint {held.joint!r}, "
             f"above its limit of {held.limit:.4g} N m"
         )
+    if rule != "not_even_at_rest":  # that rule's wording gives the remedy itself
+        text += torque_remedy(vars(error))
     carried = getattr(error, "payload_carried", None)
     if carried is not None:
         text += (

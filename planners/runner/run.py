@@ -16,7 +16,7 @@ import time
 from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.collision.self_collision import check_self_collision
-from toptraj.planners.errors import LimitExceeded, numerical_breakdown_is_failure
+from toptraj.planners.errors import InfeasiblePath, LimitExceeded, numerical_breakdown_is_failure
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
@@ -28,6 +28,7 @@ from toptraj.planners.runner.admission import admit
 from toptraj.planners.runner.answer import answer
 from toptraj.planners.runner.duration import too_short
 from toptraj.planners.runner.given_path import timed_path
+from toptraj.planners.runner.holding import with_torque_remedy
 from toptraj.planners.timing.base import TimingMethod
 
 
@@ -47,10 +48,15 @@ def run(problem: Problem) -> PlannedTrajectory:
     """
     try:
         return _run(problem)
-    except LimitExceeded as error:
-        if problem.duration is None:
+    except InfeasiblePath as error:
+        stated = error
+        if isinstance(error, LimitExceeded) and problem.duration is not None:
+            stated = too_short(problem, error, _run)
+        if getattr(stated, "joints", None):
+            stated = with_torque_remedy(problem, stated)
+        if stated is error:
             raise
-        raise too_short(problem, error, _run) from error
+        raise stated from error
 
 
 def _run(problem: Problem) -> PlannedTrajectory:
