@@ -4,12 +4,14 @@ asked for that the method cannot hold stays a 422 that says how to fix it."""
 
 from __future__ import annotations
 
+import ast
 import re
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
+from tests.paths import ROOT
 from toptraj import robots
 
 W = {"kind": "waypoints", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [1, -1, 1.4, -0.5, 0.9, 0.3]]}
@@ -55,7 +57,13 @@ def test_torque_asked_of_ruckig_is_refused_with_the_fix(client):
 
 
 def test_the_compare_example_of_the_client_guide_answers_every_method(client):
-    body = {"robot": "ur5", "path": W, "methods": ["phase_plane", "toppra", "quintic", "ruckig"]}
+    guide = (ROOT / "docs" / "client.md").read_text()
+    waypoints = ast.literal_eval(re.search(r"^waypoints = (\[.*?\]\])$", guide, re.M | re.S).group(1))
+    call = re.search(r'toptraj\.compare\("ur5", waypoints(\[:2\])?, methods=(\[.*?\])\)', guide)
+    assert call is not None and call.group(1) == "[:2]"  # ruckig moves between two waypoints
+    methods = ast.literal_eval(call.group(2))
+    assert "ruckig" in methods
+    body = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": waypoints[:2]}, "methods": methods}
     response = client.post("/v1/trajectories/compare", json=body)
     assert response.status_code == 200, response.text
     results = response.json()["results"]
