@@ -88,8 +88,10 @@ def test_other_methods_give_the_same_figures(client, method):
         ("ur5", W, {"method": "cubic", "duration": 6.0, "limits": {"torque_scale": 0.2}}),
         ("yamamoto_2r", {"waypoints": [[0.0, 0.0], [1.5, 0.0]]}, {"constraints": ["torque"], "limits": {"torque_scale": 0.1}}),
         ("yamamoto_2r", {"waypoints": [[0.0, 0.0], [1.5, 0.0]]}, {"method": "toppra", "constraints": ["torque"], "limits": {"torque_scale": 0.1}}),
+        # Stopping at a corner: the first stretch fails, the remedy holds the second one too.
+        ("ur5", {"interpolation": "linear", "waypoints": [START, [0.5, -1.1, 1.2, -0.2, 0.7, 0.1], GOAL]}, {"limits": {"torque_scale": 0.2}}),
     ],
-    ids=["quintic", "cubic-with-duration", "yamamoto-phase-plane", "yamamoto-toppra"],
+    ids=["quintic", "cubic-with-duration", "yamamoto-phase-plane", "yamamoto-toppra", "corner"],
 )
 def test_every_refusal_that_holding_explains_gives_a_remedy_that_is_answered(client, robot, path, timing):
     body = {"robot": robot, "path": path, "timing": timing}
