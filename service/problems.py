@@ -36,8 +36,9 @@ from toptraj.robots.errors import (
 from toptraj.robots.notes import Note
 from toptraj.robots.upload_options import InvalidUpload
 from toptraj.service.field_hints import unknown_field_hint
+from toptraj.service.limit_wordings import torque_remedy
 from toptraj.service.locations import where
-from toptraj.service.wordings import WORDING, torque_remedy
+from toptraj.service.wordings import WORDING
 
 HTTP_TITLES = {
     400: "Bad request",
