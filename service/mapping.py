@@ -114,7 +114,7 @@ def limit_request(timing: TimingRequest) -> LimitRequest:
     """The limits ``timing`` asks for: kinds, overrides and scales, margin, tool limits, zones."""
     limits = timing.limits
     return LimitRequest(
-        kinds=tuple(timing.constraints),
+        kinds=None if timing.constraints is None else tuple(timing.constraints),
         overrides={kind: getattr(limits, kind) for kind in LIMIT_KINDS},
         scales={kind: getattr(limits, f"{kind}_scale") for kind in LIMIT_KINDS},
         margin=timing.limit_margin,

@@ -74,7 +74,21 @@ def _slowed_to_whole_periods(facts: dict) -> str:
     )
 
 
+def _default_kind_not_held(facts: dict) -> str:
+    kind, method = facts["kind"], facts["method"]
+    peak = (
+        f"; the {kind} peaks at {facts['peak']:.4g} times the limit of joint {facts['joint']!r} (peak_utilization.{kind})"
+        if facts["peak"] is not None else ""
+    )
+    remedy = ": to hold torque limits too, use timing.method 'jerk_limited'" if kind == "torque" else ""
+    return (
+        f"{kind} limits are not held: timing.constraints was left out, and of its default (velocity, acceleration, "
+        f"torque) timing.method {method!r} holds only {', '.join(facts['kinds'])}{peak}{remedy}"
+    )
+
+
 NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
+    "default_kind_not_held": _default_kind_not_held,
     "gap_above_target": _gap_above_target,
     "duration_given": "not estimated: timing.duration sets the duration, which is no optimum",
     "not_estimated": "not estimated for timing.method {method}",

@@ -37,6 +37,7 @@ from toptraj.robots.notes import Note
 from toptraj.robots.upload_options import InvalidUpload
 from toptraj.service.counts import counted
 from toptraj.service.field_hints import unknown_field_hint
+from toptraj.service.limit_wordings import torque_remedy
 from toptraj.service.locations import where
 from toptraj.service.value_hints import collapsed, value_hint
 from toptraj.service.wordings import WORDING
@@ -173,6 +174,8 @@ def detail(error: ToptrajError) -> str:
             f": holding still at s = {held.s:.4f} needs {held.torque:.4g} N m on joint {held.joint!r}, "
             f"above its limit of {held.limit:.4g} N m"
         )
+    if rule != "not_even_at_rest":  # that rule's wording gives the remedy itself
+        text += torque_remedy(vars(error))
     carried = getattr(error, "payload_carried", None)
     if carried is not None:
         text += (

@@ -17,6 +17,7 @@ from toptraj.robots.errors import excerpt
 from toptraj.robots.ranges import Range
 from toptraj.service.counts import counted
 from toptraj.service.field_hints import closest
+from toptraj.service.limit_wordings import LIMIT_WORDING
 from toptraj.service.note_wordings import NOTE_WORDING
 from toptraj.service.zone_wordings import ZONE_WORDING
 
@@ -54,8 +55,11 @@ def _wrong_length(facts: dict) -> str:
 
 
 def _kind_not_served(facts: dict) -> str:
-    hint = " (for jerk, use jerk_limited, a time law or ruckig)" if facts["value"] == "jerk" else ""
-    return f"timing.method {facts['method']!r} cannot limit {facts['value']}; it handles {facts['handles']}{hint}"
+    kind, kept = facts["value"], facts["kept"]
+    hint = " (for jerk, use jerk_limited, a time law or ruckig)" if kind == "jerk" else ""
+    drop = f"drop {kind!r} from timing.constraints" + (f" (e.g. {list(kept)})" if kept else "")
+    other = ", or use timing.method 'jerk_limited', which holds torque and jerk" if kind == "torque" else ""
+    return f"timing.method {facts['method']!r} cannot limit {kind}; it handles {facts['handles']}{hint}: {drop}{other}"
 
 
 def _too_many_samples(facts: dict) -> str:
@@ -392,5 +396,6 @@ WORDING: dict[str, Wording] = {
         "is to stay where it is needs no trajectory)"
     ),
     **NOTE_WORDING,
+    **LIMIT_WORDING,
     **ZONE_WORDING,
 }

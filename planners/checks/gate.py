@@ -14,6 +14,7 @@ import numpy as np
 from toptraj.planners.checks.accuracy import REFINE_ROUNDS, estimated, finer_constraints
 from toptraj.planners.checks.limit_check import Excess, LimitCheck, check_limits
 from toptraj.planners.checks.limit_kernels import utilization_pass
+from toptraj.planners.constraints.held_load import holding_facts
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.constraints.tool_speed import TOOL_KINDS, tool_speeds
 from toptraj.planners.constraints.zones import tool_speed_at, zone_factors
@@ -136,7 +137,17 @@ def _held(robot, path, method, constraints, result, boundary, duration, kinds, l
         constraints = constraints.with_points(extra)
         result, _, _ = _solved(method, constraints, boundary, duration, deadline)
     assert check.worst is not None  # each round that ends the loop found a limit exceeded
-    raise limit_exceeded(method.name, check.worst, robot, path)
+    error = limit_exceeded(method.name, check.worst, robot, path)
+    held = holding_facts(constraints) if check.worst.kind == "torque" else {}
+    if not held:
+        raise error
+    facts = {key: value for key, value in vars(error).items() if key != "detail"}
+    raise LimitExceeded(
+        f"the {method.name} timing exceeds the torque limit of joint {facts['joint']!r} by {100 * (facts['ratio'] - 1):.2f} % "
+        f"at s = {facts['s']:.4f}: holding the path still needs more torque than the limits somewhere (gravity and "
+        "friction), which no timing changes",
+        **{**facts, **held},
+    )
 
 
 def limit_exceeded(method: str, worst: Excess, robot: Robot, path: GeometricPath) -> LimitExceeded:

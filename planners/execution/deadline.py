@@ -95,6 +95,16 @@ class Deadline:
                 raise BudgetExceeded("planning was stopped by its caller", budget_s=None)
             raise BudgetExceeded(f"planning exceeded its time budget of {self.budget_s:.3g} s", budget_s=self.budget_s)
 
+    def share(self, fraction: float) -> Deadline:
+        """This deadline (the same cancellation and progress) ending once ``fraction`` of the
+        seconds now remaining have passed; without a budget, the deadline itself."""
+        remaining = self.remaining()
+        if remaining is None:
+            return self
+        part = copy.copy(self)
+        part._end = time.monotonic() + fraction * remaining
+        return part
+
     def within(self, start: float, end: float, label: str = "") -> Deadline:
         """This deadline (the same end, the same cancellation) for a part of the work spanning
         the fractions [start, end] of the whole: its ``progress(f, stage)`` reports

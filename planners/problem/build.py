@@ -31,7 +31,7 @@ from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import MotionGenerator
 from toptraj.planners.problem.problem import AT_REST, BoundaryStates, LimitRequest, MotionSpec, Problem, Sampling
 from toptraj.planners.problem.ranges import check_numbers, check_scaled_limits
-from toptraj.planners.problem.requests import WaypointPath, check_constraint_kinds
+from toptraj.planners.problem.requests import WaypointPath, check_constraint_kinds, default_kinds
 from toptraj.planners.problem.waypoints import continuous_turns, without_repeats
 from toptraj.planners.problem.zones import check_zones, check_zones_served
 from toptraj.planners.timing.base import TimingMethod
@@ -69,7 +69,12 @@ def build_problem(
     """
     if method.supporting_points is not None and boundary.moving:
         raise Conflicting("law.supporting_points", method.supporting_points, ("boundary",), rule="law_from_rest")
-    kinds = check_constraint_kinds(limits.kinds, method)
+    unheld: tuple[str, ...] = ()
+    if limits.kinds is None:
+        asked, unheld = default_kinds(method)
+        kinds = check_constraint_kinds(asked, method)
+    else:
+        kinds = check_constraint_kinds(limits.kinds, method)
     check_numbers(limits, boundary, duration, sampling.dt)
     check_obstacles(obstacles)
     if sampling.exact_period and boundary.velocities_moving:
@@ -89,6 +94,7 @@ def build_problem(
         robot=robot, motion=motion, method=method, requested=limits, grid=grid, boundary=boundary, duration=duration,
         kinds=kinds, limits=held, margin=margin, threshold=gate_threshold(margin), sampling=sampling,
         obstacles=tuple(obstacles), clearance=clearance, deadline=deadline, notes=notes, self_collision=self_collision,
+        unheld=unheld,
     )
     _check_method_serves(problem)
     return problem

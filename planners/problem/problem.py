@@ -39,7 +39,8 @@ class LimitRequest:
 
     Attributes:
         kinds: Which limits to respect, among velocity, acceleration, jerk and torque (the
-            method adds those it always applies).
+            method adds those it always applies); ``None``: ``DEFAULT_KINDS``, those of them the
+            method holds (the others are left out and told in the answer's notes).
         overrides: Per-joint replacements of the robot's limits, keys ``velocity``,
             ``acceleration``, ``jerk``, ``torque``; (n_dof,) each, SI units.
         scales: Factors on those limits, same keys.
@@ -51,7 +52,7 @@ class LimitRequest:
         zones: Limits of their own on parts of the path (``toptraj.planners.problem.zones.Zone``).
     """
 
-    kinds: tuple[str, ...] = ("velocity", "acceleration", "torque")
+    kinds: tuple[str, ...] | None = None
     overrides: dict[str, list[float] | None] = field(default_factory=dict)
     scales: dict[str, float | None] = field(default_factory=dict)
     margin: float = 0.0
@@ -129,6 +130,8 @@ class Problem:
         notes: What the build changed (waypoints dropped, turns taken), told in the answer.
         self_collision: Whether no two links may touch along the path (the search checks it
             always).
+        unheld: Kinds of ``DEFAULT_KINDS`` left out because the method cannot hold them (the
+            kinds were not asked for: ``requested.kinds`` is ``None``).
     """
 
     robot: Robot
@@ -148,3 +151,4 @@ class Problem:
     deadline: Deadline
     notes: tuple[str, ...] = ()
     self_collision: bool = False
+    unheld: tuple[str, ...] = ()

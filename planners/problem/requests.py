@@ -19,6 +19,8 @@ if TYPE_CHECKING:
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
 #: default path tolerance of MoveIt's time-optimal trajectory generation.
 DEFAULT_MAX_DEVIATION = 0.1
+#: Limit kinds respected when a caller names none (those of them the method holds).
+DEFAULT_KINDS = ("velocity", "acceleration", "torque")
 
 
 @dataclass(frozen=True)
@@ -37,6 +39,13 @@ class WaypointPath:
     continuous: str = "as_given"
 
 
+def default_kinds(method: TimingMethod | MotionGenerator) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(kinds, unheld): the ``DEFAULT_KINDS`` that ``method`` holds, and those it cannot hold
+    (left out, for the answer to tell)."""
+    held = tuple(kind for kind in DEFAULT_KINDS if kind in method.kinds)
+    return held, tuple(kind for kind in DEFAULT_KINDS if kind not in method.kinds)
+
+
 def check_constraint_kinds(kinds: Iterable[str], method: TimingMethod | MotionGenerator) -> tuple[str, ...]:
     """``kinds`` checked (each a known constraint kind that ``method`` serves), with the kinds
     ``method`` requires added, in order and without repeats."""
@@ -45,7 +54,10 @@ def check_constraint_kinds(kinds: Iterable[str], method: TimingMethod | MotionGe
         raise NotOneOf("constraints", unknown[0], CONSTRAINT_KINDS, rule="unknown_constraint")
     unsupported = [kind for kind in kinds if kind not in method.kinds]
     if unsupported:
-        raise NotServed("constraints", unsupported[0], method.name, rule="kind_not_served", handles=sorted(method.kinds))
+        raise NotServed(
+            "constraints", unsupported[0], method.name, rule="kind_not_served", handles=sorted(method.kinds),
+            kept=tuple(kind for kind in dict.fromkeys(kinds) if kind in method.kinds),
+        )
     kinds = tuple(dict.fromkeys([*kinds, *sorted(method.required_kinds)]))
     if not kinds:
         raise InvalidRequest("constraints", kinds, rule="no_constraints")

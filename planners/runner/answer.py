@@ -64,7 +64,8 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     if warning is not None:
         notes.append(warning)
     utilization = _utilization(timed.stretches, problem.margin, problem.limits)
-    notes.extend(_unasked_limits(utilization, problem.kinds, problem.method, robot.joint_names))
+    notes.extend(_unheld_defaults(problem, utilization))
+    notes.extend(_unasked_limits(utilization, (*problem.kinds, *problem.unheld), problem.method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
     notes.extend(_singularity_notes(kappa_min, kappa_max, samples.t[worst]))
     notes.extend(sampling_notes(result.duration, problem.sampling.dt, problem.sampling.exact_period, len(samples.t)))
@@ -209,6 +210,26 @@ def _utilization(stretches_: tuple[TimedStretch, ...], margin: float, limits: Jo
         if limit is not None and np.shape(limit) == np.shape(peak):
             peaks[kind] = np.where(~np.isfinite(limit) & (peak == 0.0), np.nan, peak)
     return {kind: (1.0 - margin) * peak for kind, peak in peaks.items()}
+
+
+def _unheld_defaults(problem: Problem, utilization: dict[str, np.ndarray]) -> list[Note]:
+    """A note for each default limit kind the method cannot hold (``Problem.unheld``): the
+    answer does not hold it, and its peak |value| / limit over the joints (``peak``, on
+    ``joint``) is stated where the robot has such limits (``None`` where none is finite)."""
+    notes = []
+    for kind in problem.unheld:
+        peak = np.atleast_1d(np.asarray(utilization.get(kind, ()), dtype=float))
+        finite = np.isfinite(peak)
+        worst = int(np.argmax(np.where(finite, peak, -np.inf))) if finite.any() else None
+        joint = None if worst is None else problem.robot.joint_names[worst]
+        value = None if worst is None else float(peak[worst])
+        said = "" if worst is None else f"; its peak is {value:.4g} times the limit of joint {joint!r}"
+        notes.append(Note(
+            f"the {kind} limits are not held: {problem.method.name} cannot hold them, and the limit kinds were "
+            f"not given (the default kinds that {problem.method.name} holds were used){said}",
+            "default_kind_not_held", kind=kind, method=problem.method.name, kinds=problem.kinds, peak=value, joint=joint,
+        ))
+    return notes
 
 
 def _unasked_limits(

@@ -13,10 +13,12 @@ import numpy as np
 from toptraj.planners.checks.gate import TimedStretch, gated
 from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.constraints.zones import on_stretch, with_edges
+from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.stretch import Stretch, stretches
 from toptraj.planners.problem.methods import Timed
 from toptraj.planners.problem.path_checks import check_jerk_finite, check_path_within_limits, path_boundary, timing_grid
+from toptraj.planners.runner.stretch_loads import over_every_stretch
 from toptraj.planners.timing.base import Boundary, TimingMethod
 from toptraj.planners.timing.segmented import SegmentedTiming
 
@@ -86,10 +88,14 @@ def timed_path(
     elif duration is not None:
         durations = [duration]
     shares = [deadline.within(k / len(parts), (k + 1) / len(parts)) for k in range(len(parts))]
-    timed = [
-        _time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, share, grid if part is path else None)
-        for part, n, b, T, share in zip(parts, counts, boundaries, durations, shares)
-    ]
+    timed = []
+    for part, n, b, T, share in zip(parts, counts, boundaries, durations, shares):
+        try:
+            timed.append(_time_stretch(robot, part, method, n, kinds, limits, b, T, threshold, share, grid if part is path else None))
+        except InfeasiblePath as error:
+            if not (isinstance(part, Stretch) and getattr(error, "joints", None)):
+                raise
+            raise over_every_stretch(error, part, [(other, path_grid(other, m)) for other, m in zip(parts, counts)], robot, limits, kinds, deadline) from error
     if len(timed) == 1:
         result = timed[0].timing
     else:

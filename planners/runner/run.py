@@ -16,7 +16,7 @@ import time
 from toptraj.planners.collision import check_clearance
 from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.collision.self_collision import check_self_collision
-from toptraj.planners.errors import numerical_breakdown_is_failure
+from toptraj.planners.errors import InfeasiblePath, LimitExceeded, numerical_breakdown_is_failure
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
@@ -26,7 +26,9 @@ from toptraj.planners.problem.zones import zone_limits
 from toptraj.planners.results import PlannedTrajectory
 from toptraj.planners.runner.admission import admit
 from toptraj.planners.runner.answer import answer
+from toptraj.planners.runner.duration import too_short
 from toptraj.planners.runner.given_path import timed_path
+from toptraj.planners.runner.holding import with_torque_remedy
 from toptraj.planners.timing.base import TimingMethod
 
 
@@ -44,6 +46,21 @@ def run(problem: Problem) -> PlannedTrajectory:
         TimingFailed: the method failed.
         BudgetExceeded: the problem's deadline passed.
     """
+    try:
+        return _run(problem)
+    except InfeasiblePath as error:
+        stated = error
+        if isinstance(error, LimitExceeded) and problem.duration is not None:
+            stated = too_short(problem, error, _run)
+        if getattr(stated, "joints", None):
+            stated = with_torque_remedy(problem, stated)
+        if stated is error:
+            raise
+        raise stated from error
+
+
+def _run(problem: Problem) -> PlannedTrajectory:
+    """``run`` without the search for a shorter duration's remedy."""
     started = time.perf_counter()
     admit(problem)
     method, part = problem.method, problem.deadline.within(0.0, 0.9)

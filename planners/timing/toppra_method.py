@@ -16,7 +16,7 @@ import logging
 import numpy as np
 
 from toptraj.planners.constraints.admissible import acceleration_bounds, admissible_set, friction_reference
-from toptraj.planners.constraints.held_load import static_load
+from toptraj.planners.constraints.held_load import holding_facts, not_even_at_rest, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -150,6 +150,9 @@ def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Excepti
     empty = np.flatnonzero(admissible.x_max < admissible.x_min)
     if empty.size:
         point = int(empty[0])
+        stated = not_even_at_rest(constraints, empty)
+        if stated is not None:
+            return stated
         first, second = admissible.blocking_rows[point]
         what = constraints.describe_row(first)
         if second != first:
@@ -177,6 +180,7 @@ def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Excepti
             joint=joint,
             limit=limit,
             held=held,
+            **holding_facts(constraints),
         )
     return TimingFailed("toppra failed to parameterize the path")
 
@@ -193,4 +197,5 @@ def _uncontrollable(constraints: PathConstraints, last_bad: int) -> InfeasiblePa
         joint=joint,
         limit=limit,
         held=held,
+        **holding_facts(constraints),
     )

@@ -294,10 +294,11 @@ class TimingRequest(Schema):
         "(`cubic`, `quintic`, `trapezoidal`, `cycloidal`), or on a free path `collocation` or `search` (global "
         "search among obstacles).",
     )
-    constraints: list[Literal["velocity", "acceleration", "torque", "jerk"]] = Field(
-        default=["velocity", "acceleration", "torque"],
+    constraints: list[Literal["velocity", "acceleration", "torque", "jerk"]] | None = Field(
+        default=None,
         max_length=4,
-        description="Limits to respect; jerk only with jerk_limited, the time laws and ruckig.",
+        description="Limits to respect; jerk only with jerk_limited, the time laws and ruckig. Left out: "
+        "velocity, acceleration and torque, those of them the method holds (a warning names any it cannot hold).",
     )
     limits: LimitsRequest = Field(default=LimitsRequest(), description="Limit overrides and scale factors, and tool-speed limits.")
     duration: Annotated[float, bounded(ranges.DURATION)] | None = Field(

@@ -47,7 +47,10 @@ def _post(client, body, **kwargs):
         ({"robot": "geering_2r", "path": {"waypoints": [[0, 0], [0, 1e300]]}}, 422, ["path.waypoints[1][1]", "within"]),
         ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "min_cost", "cost": {"torque_weight": 1e12}}}, 422, ["timing.cost.torque_weight"]),
         ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "trapezoidal", "trapezoid": {"tau1": 0.8, "tau2": 0.2}}}, 422, ["tau1 <= tau2"]),
-        ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "ruckig"}}, 422, ["cannot limit torque"]),
+        (
+            {"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "ruckig", "constraints": ["velocity", "torque"]}}, 422,
+            ["cannot limit torque", "drop 'torque' from timing.constraints (e.g. ['velocity'])", "use timing.method 'jerk_limited'"],
+        ),
         ({"robot": "ur5", "path": GOOD_PATH, "timing": {"method": "phase_plane", "constraints": ["jerk"]}}, 422, ["cannot limit jerk"]),
         ({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS, "interpolation": "via"}, "timing": {"method": "toppra"}}, 422, ["via points need"]),
     ],

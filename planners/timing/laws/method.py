@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from toptraj.planners.constraints.held_load import static_load
+from toptraj.planners.constraints.held_load import holding_facts, static_load
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.constraints.tool_speed import TOOL_KINDS
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotServed
@@ -199,6 +199,7 @@ class ClassicalMethod(TimingMethod):
                 joint=joint,
                 limit=exceeded,
                 held=held,
+                **holding_facts(constraints),
             )
         return LawSegment(start, end, 1.0 / y, profile=self.profile), _binding(rows, kind, index, sample)
 

@@ -47,7 +47,7 @@ import numpy as np
 
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, zero_inertia_intervals
-from toptraj.planners.constraints.held_load import static_load
+from toptraj.planners.constraints.held_load import holding_facts, not_even_at_rest, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -261,6 +261,7 @@ def _integrate(grid: Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHI
             joint=joint,
             limit=limit,
             held=held,
+            **holding_facts(constraints),
         )
     if x_start > envelope[0] * (1 + BOUNDARY_SLACK) + 1e-12:
         raise InfeasiblePath(
@@ -310,6 +311,9 @@ def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) 
     """No admissible state at interval ``i`` lets the motion reach the end: say where and why."""
     s = constraints.s
     if admissible.x_max[i] < admissible.x_min[i]:
+        stated = not_even_at_rest(constraints, np.flatnonzero(admissible.x_max < admissible.x_min))
+        if stated is not None:
+            return stated
         first, second = admissible.blocking_rows[i]
         what = constraints.describe_row(first)
         if second != first:
@@ -329,4 +333,5 @@ def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) 
         joint=joint,
         limit=limit,
         held=held,
+        **holding_facts(constraints),
     )

@@ -88,7 +88,8 @@ def test_a_payload_no_timing_can_hold_is_refused_naming_the_arm_joint_and_s():
     cell = _cell(payload(40.0, (0.0, 0.0, 0.1)))
     with pytest.raises(InfeasiblePath, match=r"arms\[0\] \(ur5\)") as refused:
         coordinate(cell)
-    assert "torque of joint 'shoulder_lift_joint'" in str(refused.value) and refused.value.s is not None
+    assert "on joint 'shoulder_lift_joint'" in str(refused.value) and refused.value.s is not None
+    assert (refused.value.joint, refused.value.limit) == ("shoulder_lift_joint", "torque")
 
 
 def test_an_arm_whose_own_path_folds_onto_itself_is_refused_naming_the_links_and_s():

@@ -1,0 +1,62 @@
+"""The service's words for the library's refusals of a path its limits cannot follow, with the
+remedy in the request's fields: a duration too short for its law (the shortest that holds the
+limits) and a path that cannot be held still within the torque limits (the torque scale or
+limits that hold it). Part of ``toptraj.service.wordings.WORDING``."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+
+def _duration_too_short(facts: dict) -> str:
+    return (
+        f"{facts['field']} {facts['value']:g} s is too short for the {facts.get('method', 'timing')} law under these "
+        f"limits: {'the shortest is' if facts['exact'] else 'a duration of'} {facts['stated']:g} s"
+        f"{'' if facts['exact'] else ' holds them'}; give at least that or leave {facts['field']} out (the "
+        f"{facts['limit']} limit of joint {facts['joint']!r} is exceeded by {100 * (facts['ratio'] - 1):.2f} % at "
+        f"s = {facts['s']:.4f})"
+    )
+
+
+def torque_remedy(facts: dict) -> str:
+    """The torque scale or limits (``torque_scale``, ``torque_limits`` among ``facts``) with
+    which every joint can hold the path still everywhere, as advice; an empty string without."""
+    remedies = []
+    if facts.get("torque_scale") is not None:
+        remedies.append(f"timing.limits.torque_scale {facts['torque_scale']:g}")
+    asked = facts.get("asked_scale", 1.0)
+    before = f" (before timing.limits.torque_scale {asked:g})" if asked != 1.0 else ""
+    needed = facts.get("torque_limits", ())
+    if needed:
+        remedies.append("timing.limits.torque of " + " and ".join(f"{value:g} N m on joint {joint!r}" for joint, value in needed) + before)
+    if not remedies:
+        return ""
+    return (
+        f"; with {', or with '.join(remedies)} (or more) every joint can hold the path still everywhere, and a slow "
+        "enough motion follows it"
+    )
+
+
+def _not_even_at_rest(facts: dict) -> str:
+    stretches = facts["stretches"]
+    shown = "; ".join(
+        f"s = {item.start:.4f} to {item.end:.4f}, where holding still needs {item.worst.torque:.4g} N m on joint "
+        f"{item.worst.joint!r} (at s = {item.worst.s:.4f}) against its limit of {item.worst.limit:.4g} N m"
+        for item in stretches[:3]
+    )
+    more = f"; and {len(stretches) - 3} more" if len(stretches) > 3 else ""
+    also = "".join(
+        f"; holding still at s = {load.s:g} needs {load.torque:.4g} N m on joint {load.joint!r} against its limit of "
+        f"{load.limit:.4g} N m too" for load in facts.get("ends", ())
+    )
+    remedy = torque_remedy(facts) or "; raise the torque limits (timing.limits.torque) or lighten the load"
+    return (
+        f"no motion along the path can meet the torque limits, not even at rest, on {len(stretches)} stretch(es): "
+        f"{shown}{more}{also}{remedy}"
+    )
+
+
+LIMIT_WORDING: dict[str, str | Callable[[dict], str]] = {
+    "duration_too_short": _duration_too_short,
+    "not_even_at_rest": _not_even_at_rest,
+}

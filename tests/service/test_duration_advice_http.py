@@ -1,0 +1,50 @@
+"""A ``timing.duration`` too short for its law under the limits: the 422 names the shortest
+duration that holds them, and that advice, followed, is answered."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+W = {"kind": "waypoints", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [1, -1, 1.4, -0.5, 0.9, 0.3]]}
+VIA = {"kind": "waypoints", "interpolation": "via", "waypoints": [*W["waypoints"], [1.5, -0.5, 0.8, -1, 1, 0.8]]}
+
+
+def test_the_quintic_too_short_is_told_its_shortest_duration(client):
+    response = client.post("/v1/trajectories", json={"robot": "ur5", "path": W, "timing": {"method": "quintic", "duration": 0.1}})
+    assert response.status_code == 422
+    detail = response.json()["detail"]
+    # 0.76 s: sqrt(10 / sqrt(3) * 1 rad / 10 rad/s^2) = 0.7598 s rounded up (tests/planners/runner/test_duration_too_short.py).
+    assert detail.startswith(
+        "timing.duration 0.1 s is too short for the quintic law under these limits: the shortest is 0.76 s; give at least "
+        "that or leave timing.duration out"
+    ), detail
+    assert "a lower limit scale or more grid points" not in detail
+
+
+@pytest.mark.parametrize(
+    ("path", "timing"),
+    [
+        (W, {"method": "quintic", "duration": 0.1}),
+        (W, {"method": "cubic", "duration": 0.5}),
+        (W, {"method": "trapezoidal", "duration": 0.5}),
+        (W, {"method": "cycloidal", "duration": 0.3, "limit_margin": 0.2}),
+        (W, {"method": "quintic", "duration": 0.3, "supporting_points": 5}),
+        (W, {"method": "quintic", "duration": 0.3, "synchronization": "none"}),
+        (VIA, {"method": "quintic", "duration": 0.3}),
+    ],
+    ids=["quintic", "cubic", "trapezoidal", "cycloidal-margin", "spline-law", "unsynchronized", "via-points"],
+)
+def test_the_duration_advised_is_answered(client, path, timing):
+    body = {"robot": "ur5", "path": path, "timing": timing}
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 422
+    detail = response.json()["detail"]
+    advised = re.search(r"(?:the shortest is|a duration of) ([0-9.]+) s(?: holds them)?; give at least that", detail)
+    assert advised is not None, detail
+    seconds = float(advised.group(1))
+    followed = client.post("/v1/trajectories", json={**body, "timing": {**timing, "duration": seconds}})
+    assert followed.status_code == 200, followed.text
+    assert followed.json()["duration"] == pytest.approx(seconds, rel=1e-9)
+    assert client.post("/v1/trajectories", json={**body, "timing": {**timing, "duration": 1.5 * seconds}}).status_code == 200
