@@ -10,7 +10,6 @@ for what a template cannot say.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
 from toptraj.robots.errors import excerpt
@@ -19,6 +18,7 @@ from toptraj.service.counts import counted
 from toptraj.service.field_hints import closest
 from toptraj.service.limit_wordings import LIMIT_WORDING
 from toptraj.service.note_wordings import NOTE_WORDING
+from toptraj.service.search_wordings import SEARCH_WORDING
 from toptraj.service.zone_wordings import ZONE_WORDING
 
 
@@ -91,57 +91,6 @@ def _where(facts: dict) -> str:
     return (
         f"{facts['field']} on the way to point {facts['index'] + 1}, {100 * facts['fraction']:.1f} % along "
         f"(at {facts['position']} m)"
-    )
-
-
-def _about(facts: dict) -> str:
-    return f"about {facts['estimate'] / 2**30:.3g} GiB, above the cap of {facts['cap'] / 2**30:.3g} GiB per search"
-
-
-def _lattice_over_memory(facts: dict) -> str:
-    cells = facts["largest"]
-    advice = f"at most {cells} cells per joint are served" if cells is not None else "no lattice fits: use timing.search.graph 'roadmap'"
-    return (
-        f"{facts['field']} gives a lattice of {facts['shape']} grid points on a {facts['dof']}-joint arm, which needs "
-        f"{_about(facts)}; {advice}"
-    )
-
-
-def _roadmap_over_memory(facts: dict) -> str:
-    points, neighbors = facts["points"], facts["neighbors"]
-    served = []
-    if facts["most_points"] is not None:
-        served.append(f"at most {facts['most_points']} roadmap points are served with {neighbors} neighbors")
-    if facts["most_neighbors"] is not None:
-        served.append(f"at most {facts['most_neighbors']} neighbors with {points} roadmap points")
-    return (
-        f"{facts['field']} {points} with neighbors {neighbors} on a {facts['dof']}-joint arm needs {_about(facts)}; "
-        + ("; ".join(served) if served else "lower timing.search.neighbors and roadmap_points")
-    )
-
-
-def _search_incomplete(facts: dict) -> str:
-    smaller = "timing.search.roadmap_points or timing.search.neighbors" if facts["graph"] == "roadmap" else "timing.search.cells"
-    return (
-        f"the search found no grid path within its share of the time budget or its max_expansions "
-        f"({facts['statistics'].expanded} partial paths expanded): give it a larger budget (a job's budget_s), fewer "
-        f"{smaller} or more timing.search.max_expansions"
-    )
-
-
-def _no_grid_path(facts: dict) -> str:
-    stats = facts["statistics"]
-    finer = (
-        "raise timing.search.roadmap_points or timing.search.neighbors (within the memory cap), try another "
-        "timing.search.seed"
-        if facts["graph"] == "roadmap"
-        else "refine timing.search.cells"
-    )
-    below = f" faster than {facts['cap']:.4g} s" if math.isfinite(facts["cap"]) else ""
-    return (
-        f"the search found no grid path from start to goal{below} that keeps the clearance and the limits "
-        f"({stats.grid_points} grid points, {stats.removed_by_obstacles} pieces of path removed by obstacles, "
-        f"{stats.points_blocked} grid points blocked): {finer}, widen timing.search.margin, or move the obstacles"
     )
 
 
@@ -355,16 +304,12 @@ WORDING: dict[str, Wording] = {
         f"at most {facts['cap']} are searched: use fewer cells, or timing.search.graph 'roadmap'"
     ),
     "unknown_graph": "{field} {value!e} is unknown; use one of {allowed}",
-    "lattice_over_memory": _lattice_over_memory,
-    "roadmap_over_memory": _roadmap_over_memory,
     "outside_the_joint_limits": "{field} is outside the joint limits",
     "end_too_close": lambda facts: (
         f"path.{facts['field']} comes within {facts['distance']:.4g} m of an obstacle (the clearance is {facts['clearance']:g} m): "
         "move it away from the obstacles or lower path.clearance"
     ),
     "max_turn_out_of_range": "{field} must lie in (0, 180) degrees, got {value}",
-    "search_incomplete": _search_incomplete,
-    "no_grid_path": _no_grid_path,
     "frame_without_speed": "{field} is given without timing.limits.tool_speed or tool_angular_speed",
     "unknown_tool_frame": _unknown_tool_frame,
     "jerk_limited_needs_jerk": "timing.method 'jerk_limited' needs the jerk constraint",
@@ -398,4 +343,5 @@ WORDING: dict[str, Wording] = {
     **NOTE_WORDING,
     **LIMIT_WORDING,
     **ZONE_WORDING,
+    **SEARCH_WORDING,
 }
