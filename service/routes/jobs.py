@@ -21,6 +21,7 @@ from toptraj.service.jobs.store import JobStore
 from toptraj.service.problem_docs import PROBLEM_JSON, problem_responses
 from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
+from toptraj.service.schemas.trajectories import TrajectoryRequest
 from toptraj.service.strict_routes import StrictJSONRoute
 
 router = APIRouter(prefix="/v1/jobs", tags=["jobs"], route_class=StrictJSONRoute)
@@ -169,7 +170,7 @@ async def create_job(body: Annotated[JobCreate, Body(openapi_examples=EXAMPLES)]
         )
     runner = request.app.state.jobs
     await run_in_threadpool(robots.load, body.request.robot)  # an unknown robot is a 404 now, not a failed job
-    request_json = body.request.model_dump_json()
+    request_json = body.request.model_dump_json(exclude_unset=True)  # what was given: its rules read again as given
     job = await run_in_threadpool(runner.store.submit, body.kind, request_json, budget_s, settings.job_queue)
     runner.wake()
     return _job_response(job, status_code=202, headers={"Location": f"/v1/jobs/{job.id}"})
@@ -244,7 +245,7 @@ def _answer(job: Job, result: bytes, request_json: str | None, accept: str | Non
     one its Accept header prefers, as ``POST /v1/trajectories`` chooses: CSV is written from
     the stored samples."""
     if job.kind == "trajectory" and request_json is not None:
-        requested = orjson.loads(request_json)["output"]["format"]
+        requested = TrajectoryRequest.model_validate_json(request_json).output.format  # the defaults of what was given
         if chosen_format(requested, accept) == "csv":
             body = orjson.loads(result)
             if "samples" in body:
