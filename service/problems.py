@@ -264,21 +264,22 @@ def validation_message(item: Mapping[str, Any]) -> str:
 
 
 #: Errors of a malformed request named in a problem's detail, and listed in its ``errors``.
-_DETAIL_ERRORS, _LISTED_ERRORS = 5, 20
+_DETAIL_ERRORS, LISTED_ERRORS = 5, 20
 
 
 def validation_errors(items: Iterable[Mapping[str, Any]], model: object = None) -> list[dict[str, str]]:
     """Each error of a request that does not fit its schema ``model`` (``errors()`` items, their
     locations relative to the body, or under ``"body"``) as ``{"field", "message"}``: the place
     as the service writes places (``timing.zones[0]``), the message in the service's words, and
-    for a field the schema does not know, where it belongs or the name it was likely meant as."""
+    for a field the schema does not know, where it belongs or the name it was likely meant as: for
+    the first ``LISTED_ERRORS`` only (the ones a problem lists), the others only counted."""
     schema = model if isinstance(model, type) and issubclass(model, BaseModel) else None
     errors = []
-    for item in collapsed(list(items)):
+    for index, item in enumerate(collapsed(list(items))):
         loc = tuple(item["loc"])
         field = where(loc)
         message = validation_message(item) + value_hint(item)
-        if item.get("type") == "extra_forbidden":
+        if item.get("type") == "extra_forbidden" and index < LISTED_ERRORS:
             message += unknown_field_hint(schema, loc[1:] if loc[:1] == ("body",) else loc, field)
         errors.append({"field": field, "message": message})
     return errors
@@ -295,7 +296,7 @@ def validation_detail(errors: list[dict[str, str]]) -> str:
 def validation_problem(error: ValidationError, model: object = None) -> dict:
     """The problem+json of a request that does not fit its schema ``model`` (as the HTTP API's 422)."""
     errors = validation_errors(error.errors(include_url=False), model)
-    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": validation_detail(errors), "errors": errors[:_LISTED_ERRORS]}
+    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": validation_detail(errors), "errors": errors[:LISTED_ERRORS]}
 
 
 class NonFiniteAnswer(ToptrajError):
