@@ -9,18 +9,42 @@ duplicate is looked for only when there is one, by a walk without recursion."""
 from __future__ import annotations
 
 import json
+import re
 from collections import Counter
 from typing import Any
+
+import numpy as np
 
 from toptraj.robots.errors import excerpt
 from toptraj.service.locations import joined
 
 #: Characters of a key shown in a place.
 MAX_KEY_CHARS = 60
+#: Deepest nesting of arrays and objects in a request (a request needs 5, a batch's body 7).
+MAX_DEPTH = 32
+#: A JSON string (its brackets are no nesting): quotes around non-quote runs and escapes.
+_STRING = re.compile(rb'"(?:[^"\\]+|\\.)*"', re.DOTALL)
+_OPEN = np.frombuffer(b"[{", dtype=np.uint8)
+_CLOSE = np.frombuffer(b"]}", dtype=np.uint8)
 
 
 #: The answer to an empty request body or file.
 EMPTY_BODY = 'the body is empty; send a JSON object (e.g. {"robot": "ur5", "path": ...})'
+
+
+def nesting_depth(data: bytes) -> int:
+    """The deepest nesting of ``[`` and ``{`` in ``data`` (outside JSON strings), counted
+    without recursion: strings removed by one regular expression, then a running sum of +1 per
+    opening and -1 per closing bracket. An unterminated string counts its brackets."""
+    codes = np.frombuffer(_STRING.sub(b"", data), dtype=np.uint8)
+    steps = np.isin(codes, _OPEN).astype(np.int64) - np.isin(codes, _CLOSE)
+    return int(np.cumsum(steps).max(initial=0))
+
+
+def too_deep(depth: int) -> str:
+    """What is wrong with a text nesting ``depth`` levels, more than a request may
+    (``MAX_DEPTH``), as the end of a sentence about it ("the body ...")."""
+    return f"is nested too deeply: it nests arrays and objects {depth} deep; a request nests at most {MAX_DEPTH} levels"
 
 
 def decode_error(error: json.JSONDecodeError) -> str:
