@@ -4,7 +4,8 @@ service words them (``toptraj.service.problems.validation_errors``):
 * a name outside its choices (``timing.method`` ``"topra"``, ``path.kind`` ``"waypoint"``): the
   allowed name it was most likely meant as (``toptraj.service.field_hints.closest``: the same
   but for case, else the closest by difflib), so that the suggestion is one that works;
-* a number sent as a string (``"dt": "0.01"``): that a string was given, and to drop the quotes;
+* a number sent as a string (``"dt": "0.01"``): that a string was given, and to drop the quotes
+  when the number is finite (JSON has no NaN or infinity, which the service refuses anyway);
 * a value that fits none of a union's members (``joint_limits: 5``): one error saying what is
   accepted, instead of one per member under pydantic's member names (``joint_limits.str``);
 * the same shape refused in every item of a list (a flat ``q`` where rows are expected): one
@@ -13,6 +14,7 @@ service words them (``toptraj.service.problems.validation_errors``):
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 from typing import Any
@@ -47,10 +49,10 @@ def value_hint(item: Mapping[str, Any]) -> str:
         return f": did you mean {close!r}?" if close else ""
     if kind in _NUMBER_TYPES:
         try:
-            float(value)
+            finite = math.isfinite(float(value))
         except ValueError:
-            return f"; got the string {value!r}"
-        return f"; got the string {value!r}; write the number without quotes"
+            finite = False
+        return f"; got the string {value!r}" + ("; write the number without quotes" if finite else "")
     return ""
 
 
