@@ -16,10 +16,12 @@ from __future__ import annotations
 
 import math
 import re
+import typing
 from collections.abc import Mapping
 from typing import Any
 
 from toptraj.service.field_hints import closest
+from toptraj.service.schemas.trajectories import PathRequest
 
 #: What a union member pydantic names in a location accepts, by the member's name.
 _KINDS = {"str": "a string", "int": "an integer", "float": "a number", "bool": "true or false", "dict": "an object", "list": "a list"}
@@ -32,6 +34,17 @@ _JSON_KIND = {str: "a string", int: "a number", float: "a number", bool: "a bool
 _SHAPE_TYPES = ("list_type", "dict_type", "model_type")
 #: Types of the errors of a number given in another form.
 _NUMBER_TYPES = ("float_type", "int_type", "float_parsing", "int_parsing")
+
+
+def _path_kinds() -> tuple[str, ...]:
+    """The ``kind`` of each path schema of ``PathRequest`` (its union's members, each with a
+    ``Literal`` kind): ``("waypoints", "cartesian", "free")``."""
+    members = typing.get_args(typing.get_args(PathRequest)[0])
+    return tuple(kind for member in members for kind in typing.get_args(typing.get_args(member)[0].model_fields["kind"].annotation))
+
+
+#: The path kinds a request may name, from the schema.
+PATH_KINDS = _path_kinds()
 
 
 def _got(value: Any) -> str:
@@ -64,7 +77,7 @@ def _path_kind(item: Mapping[str, Any]) -> Mapping[str, Any]:
     if not isinstance(kind, str):
         return item
     message = item["msg"] + (f", not {kind[:60]!r}" if len(kind) <= 60 else "")
-    close = closest(kind, ("waypoints", "cartesian", "free"))
+    close = closest(kind, PATH_KINDS)
     return {**item, "loc": (*item["loc"], "kind"), "msg": message + (f": did you mean {close!r}?" if close else ""), "input": kind}
 
 
