@@ -100,10 +100,25 @@ def check_ends(cell: Cell) -> None:
             )
 
 
-def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE, margin: float = FINE_STEP) -> Diagram:
-    """The diagram of the cell's first two arms on ``grid`` intervals per axis, its free cells
-    ``margin`` (m) above the clearance (memory checked first: one row of (grid + 1) nodes, k1 x k2
-    capsule pairs, about 40 arrays of 8 bytes)."""
+@dataclass(frozen=True)
+class Measured:
+    """What a diagram's free cells are found from, whatever the margin: the grid ``s`` (M + 1,),
+    the two arms' capsules ``one`` and ``two`` at it (a, b (M + 1, k, 3), radius (k,)), the
+    ``distance`` (M + 1, M + 1) between them in m and their motion bounds ``step1``, ``step2``
+    (M,) in m (``bounds.motion_steps``)."""
+
+    s: np.ndarray
+    one: tuple[np.ndarray, np.ndarray, np.ndarray]
+    two: tuple[np.ndarray, np.ndarray, np.ndarray]
+    distance: np.ndarray
+    step1: np.ndarray
+    step2: np.ndarray
+
+
+def measure(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE) -> Measured:
+    """The distances and steps of the cell's first two arms on ``grid`` intervals per axis
+    (memory checked first: one row of (grid + 1) nodes, k1 x k2 capsule pairs, about 40 arrays
+    of 8 bytes)."""
     first, second = cell.arms[:2]
     s = np.linspace(0.0, 1.0, grid + 1)
     one, two = arm_capsules(first, s), arm_capsules(second, s)
@@ -114,18 +129,29 @@ def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_D
     for i in range(grid + 1):
         deadline.check()
         distance[i] = pair_distances((one[0][i][None], one[1][i][None], one[2]), two)[0]
-    step1, step2 = motion_steps(one), motion_steps(two)
-    free = _free_cells(cell.clearance + margin, (first, second), (distance, step1, step2), deadline)
+    return Measured(s, one, two, distance, motion_steps(one), motion_steps(two))
+
+
+def coordination_diagram(
+    cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE, margin: float = FINE_STEP, measured: Measured | None = None
+) -> Diagram:
+    """The diagram of the cell's first two arms on ``grid`` intervals per axis, its free cells
+    ``margin`` (m) above the clearance, from ``measured`` (``measure`` of this cell and grid)
+    when given: another margin finds which cells are free again, not the distances."""
+    first, second = cell.arms[:2]
+    m = measured if measured is not None else measure(cell, grid, deadline)
+    one, two, distance, step1, step2 = m.one, m.two, m.distance, m.step1, m.step2
+    needed = cell.clearance + margin
+    free = _free_cells(needed, (first, second), (distance, step1, step2), deadline)
     closed = np.pad(~free, 1, constant_values=False)  # a node is blocked unless every cell around it is free
     blocked = closed[:-1, :-1] | closed[1:, :-1] | closed[:-1, 1:] | closed[1:, 1:]
-    needed = cell.clearance + margin
     edges = (
         edge_bounds(first, (two[0][:1], two[1][:1], two[2]), distance[:, 0], step1, needed) >= needed,
         edge_bounds(first, (two[0][-1:], two[1][-1:], two[2]), distance[:, -1], step1, needed) >= needed,
         edge_bounds(second, (one[0][:1], one[1][:1], one[2]), distance[0, :], step2, needed) >= needed,
         edge_bounds(second, (one[0][-1:], one[1][-1:], one[2]), distance[-1, :], step2, needed) >= needed,
     )
-    return Diagram(s=s, distance=distance, blocked=blocked, step1=step1, step2=step2, free=free, edges=edges)
+    return Diagram(s=m.s, distance=distance, blocked=blocked, step1=step1, step2=step2, free=free, edges=edges)
 
 
 def _free_cells(needed: float, arms: tuple[CellArm, CellArm], coarse: tuple[np.ndarray, ...], deadline: Deadline) -> np.ndarray:
