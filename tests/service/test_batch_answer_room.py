@@ -57,8 +57,9 @@ def test_the_requests_left_are_answered_when_submitted_as_the_advice_says(tmp_pa
 
 
 def test_a_request_whose_samples_exceed_the_room_gets_the_dt_that_fits(tmp_path, monkeypatch):
-    """Each request is planned with what is left as its body cap, as the synchronous endpoint
-    is with its own: more samples than that holds is this request's 422 naming output.dt."""
+    """Each request is planned with the job's answer cap as its body cap, as the synchronous
+    endpoint is with its own: more samples than that holds is this request's 422 naming
+    output.dt, and the batch goes on (what is left of the room decides only what is kept)."""
     finer = {**DENSE, "output": {"dt": 0.00005}}  # 8,000 samples: about 3.8 MB
     result, _ = _run([finer, DENSE], tmp_path, monkeypatch)
     rows = json.loads(result)["results"]
