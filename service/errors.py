@@ -27,7 +27,7 @@ from starlette.routing import Match
 
 from toptraj.robots import ToptrajError
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
-from toptraj.service.problems import HTTP_TITLES, LISTED_ERRORS, detail, status_of, title_of, validation_detail, validation_errors
+from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_detail, validation_errors
 from toptraj.service.strict_routes import BodyRefused
 
 logger = logging.getLogger("toptraj")
@@ -50,8 +50,8 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:
     body_field = getattr(request.scope.get("route"), "body_field", None)
     model = getattr(getattr(body_field, "field_info", None), "annotation", None)
-    errors = validation_errors(error.errors(), model)
-    return problem(422, "Invalid request", validation_detail(errors), errors=errors[:LISTED_ERRORS])
+    errors, count = validation_errors(error.errors(), model)
+    return problem(422, "Invalid request", validation_detail(errors, count), errors=errors)
 
 
 def _body_refused(request: Request, error: BodyRefused) -> JSONResponse:
