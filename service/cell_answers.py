@@ -87,7 +87,7 @@ def on_whole_periods(schedule: Schedule, dt: float) -> Schedule:
     return Schedule(schedule.motions, schedule.kind, schedule.stretch * periods * dt / schedule.duration)
 
 
-def _reported(peaks: dict[str, np.ndarray], limits) -> dict[str, list[float | None]]:
+def reported_utilization(peaks: dict[str, np.ndarray], limits) -> dict[str, list[float | None]]:
     """An arm's peak utilization per kind and joint, null for a joint without a finite limit of
     that kind (its peak, |value| / inf, reads 0)."""
     return {
@@ -116,7 +116,7 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_pe
         "schedule": schedule.kind,
         "t": t,
         "arms": [
-            _arm_body(arm, t, states, _reported(arm_peaks, arm.limits), format_)
+            _arm_body(arm, t, states, reported_utilization(arm_peaks, arm.limits), format_)
             for arm, states, arm_peaks in zip(cell.arms, schedule.states(cell, t), peaks)
         ],
         "min_distance": {

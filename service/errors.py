@@ -50,8 +50,8 @@ def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
 def _validation_error(request: Request, error: RequestValidationError) -> JSONResponse:
     body_field = getattr(request.scope.get("route"), "body_field", None)
     model = getattr(getattr(body_field, "field_info", None), "annotation", None)
-    errors = validation_errors(error.errors(), model)
-    return problem(422, "Invalid request", validation_detail(errors), errors=errors[:20])
+    errors, count = validation_errors(error.errors(), model)
+    return problem(422, "Invalid request", validation_detail(errors, count), errors=errors)
 
 
 def _body_refused(request: Request, error: BodyRefused) -> JSONResponse:

@@ -80,14 +80,24 @@ def _tags(model: type[BaseModel]) -> set[str]:
     return tags
 
 
+#: Places whose allowed names are kept (``names_at``), per body model.
+NAMES_KEPT = 256
+
+
 def names_at(model: type[BaseModel], loc: tuple[str | int, ...]) -> tuple[str, ...]:
     """The field names a body of ``model`` allows at ``loc`` (a pydantic location relative to
     the body, union tags included: ``("path", "cartesian")``); () where ``loc`` leaves the
-    request models (a dict's keys, a number)."""
+    request models (a dict's keys, a number). Kept per model and place (list indices aside:
+    an item of a list has its models from its field), so that many errors at one place walk
+    the schema once."""
+    return _names_at(model, tuple(part for part in loc[:MAX_DEPTH] if not isinstance(part, int)))
+
+
+@functools.lru_cache(maxsize=NAMES_KEPT)
+def _names_at(model: type[BaseModel], place: tuple[str | int, ...]) -> tuple[str, ...]:
+    """``names_at`` of ``place`` (keys only, at most ``MAX_DEPTH``)."""
     candidates = [model]
-    for part in loc[:MAX_DEPTH]:
-        if isinstance(part, int):
-            continue  # an item of a list: its models were taken when its field was
+    for part in place:
         if len(candidates) > 1 and (tagged := [current for current in candidates if part in _tags(current)]):
             candidates = tagged
             continue

@@ -264,38 +264,42 @@ def validation_message(item: Mapping[str, Any]) -> str:
 
 
 #: Errors of a malformed request named in a problem's detail, and listed in its ``errors``.
-_DETAIL_ERRORS, _LISTED_ERRORS = 5, 20
+_DETAIL_ERRORS, LISTED_ERRORS = 5, 20
 
 
-def validation_errors(items: Iterable[Mapping[str, Any]], model: object = None) -> list[dict[str, str]]:
-    """Each error of a request that does not fit its schema ``model`` (``errors()`` items, their
-    locations relative to the body, or under ``"body"``) as ``{"field", "message"}``: the place
+def validation_errors(items: Iterable[Mapping[str, Any]], model: object = None) -> tuple[list[dict[str, str]], int]:
+    """The first ``LISTED_ERRORS`` errors of a request that does not fit its schema ``model``
+    (``errors()`` items, their locations relative to the body, or under ``"body"``) as
+    ``{"field", "message"}``, and how many there are in all (the others only counted): the place
     as the service writes places (``timing.zones[0]``), the message in the service's words, and
     for a field the schema does not know, where it belongs or the name it was likely meant as."""
     schema = model if isinstance(model, type) and issubclass(model, BaseModel) else None
+    collapsed_items = collapsed(list(items))
     errors = []
-    for item in collapsed(list(items)):
+    for item in collapsed_items[:LISTED_ERRORS]:
         loc = tuple(item["loc"])
         field = where(loc)
         message = validation_message(item) + value_hint(item)
         if item.get("type") == "extra_forbidden":
             message += unknown_field_hint(schema, loc[1:] if loc[:1] == ("body",) else loc, field)
         errors.append({"field": field, "message": message})
-    return errors
+    return errors, len(collapsed_items)
 
 
-def validation_detail(errors: list[dict[str, str]]) -> str:
-    """The detail of a 422 with ``errors`` (``validation_errors``): the first few, then how many more."""
+def validation_detail(errors: list[dict[str, str]], count: int | None = None) -> str:
+    """The detail of a 422 with ``errors`` (``validation_errors``), ``count`` in all (default:
+    as many as listed): the first few, then how many more."""
+    count = len(errors) if count is None else count
     detail = "; ".join(f"{item['field']}: {item['message']}" for item in errors[:_DETAIL_ERRORS])
-    if len(errors) > _DETAIL_ERRORS:
-        detail += f"; and {len(errors) - _DETAIL_ERRORS} more"
+    if count > _DETAIL_ERRORS:
+        detail += f"; and {count - _DETAIL_ERRORS} more"
     return detail
 
 
 def validation_problem(error: ValidationError, model: object = None) -> dict:
     """The problem+json of a request that does not fit its schema ``model`` (as the HTTP API's 422)."""
-    errors = validation_errors(error.errors(include_url=False), model)
-    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": validation_detail(errors), "errors": errors[:_LISTED_ERRORS]}
+    errors, count = validation_errors(error.errors(include_url=False), model)
+    return {"type": "about:blank", "title": "Invalid request", "status": 422, "detail": validation_detail(errors, count), "errors": errors}
 
 
 class NonFiniteAnswer(ToptrajError):

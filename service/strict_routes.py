@@ -6,7 +6,8 @@ route that takes a JSON body refuses a body sent without ``Content-Type: applica
 and a body that is no JSON with a 422 that says where the text goes wrong (line, column and
 the parser's message), where FastAPI would answer that the body is no object, or name the
 character offset as if it were an array index. The body's size cap
-(``toptraj.service.body_limit``) and the parser's nesting limit (a 400) hold as before."""
+(``toptraj.service.body_limit``) and the parser's nesting limit hold as before: a body nested
+deeper than the parser reads is a 400 saying how deep it nests and how deep a request may."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ from fastapi import Request, Response, params
 from fastapi.routing import APIRoute
 from starlette.exceptions import HTTPException
 
-from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads
+from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, nesting_depth, too_deep
 
 #: The 415's advice.
 SEND_JSON = "send the header Content-Type: application/json (curl: -H 'Content-Type: application/json')"
@@ -75,6 +76,9 @@ class StrictJSONRequest(Request):
                 raise _unreadable(decode_error(error)) from None
             except UnicodeDecodeError:
                 raise _unreadable("the body is not UTF-8 text; send JSON encoded as UTF-8") from None
+            except RecursionError:  # deeper than the parser reads, as a batch's line too deep
+                detail = f"the body {too_deep(nesting_depth(await self.body()))}"
+                raise BodyRefused({"type": "about:blank", "title": "Too deeply nested", "status": 400, "detail": detail}) from None
         return self._json
 
 

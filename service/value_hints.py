@@ -4,7 +4,8 @@ service words them (``toptraj.service.problems.validation_errors``):
 * a name outside its choices (``timing.method`` ``"topra"``, ``path.kind`` ``"waypoint"``): the
   allowed name it was most likely meant as (``toptraj.service.field_hints.closest``: the same
   but for case, else the closest by difflib), so that the suggestion is one that works;
-* a number sent as a string (``"dt": "0.01"``): that a string was given, and to drop the quotes;
+* a number sent as a string (``"dt": "0.01"``): that a string was given, and to drop the quotes
+  when the number is finite (JSON has no NaN or infinity, which the service refuses anyway);
 * a value that fits none of a union's members (``joint_limits: 5``): one error saying what is
   accepted, instead of one per member under pydantic's member names (``joint_limits.str``);
 * the same shape refused in every item of a list (a flat ``q`` where rows are expected): one
@@ -13,11 +14,14 @@ service words them (``toptraj.service.problems.validation_errors``):
 
 from __future__ import annotations
 
+import math
 import re
+import typing
 from collections.abc import Mapping
 from typing import Any
 
 from toptraj.service.field_hints import closest
+from toptraj.service.schemas.trajectories import PathRequest
 
 #: What a union member pydantic names in a location accepts, by the member's name.
 _KINDS = {"str": "a string", "int": "an integer", "float": "a number", "bool": "true or false", "dict": "an object", "list": "a list"}
@@ -30,6 +34,17 @@ _JSON_KIND = {str: "a string", int: "a number", float: "a number", bool: "a bool
 _SHAPE_TYPES = ("list_type", "dict_type", "model_type")
 #: Types of the errors of a number given in another form.
 _NUMBER_TYPES = ("float_type", "int_type", "float_parsing", "int_parsing")
+
+
+def _path_kinds() -> tuple[str, ...]:
+    """The ``kind`` of each path schema of ``PathRequest`` (its union's members, each with a
+    ``Literal`` kind): ``("waypoints", "cartesian", "free")``."""
+    members = typing.get_args(typing.get_args(PathRequest)[0])
+    return tuple(kind for member in members for kind in typing.get_args(typing.get_args(member)[0].model_fields["kind"].annotation))
+
+
+#: The path kinds a request may name, from the schema.
+PATH_KINDS = _path_kinds()
 
 
 def _got(value: Any) -> str:
@@ -47,10 +62,10 @@ def value_hint(item: Mapping[str, Any]) -> str:
         return f": did you mean {close!r}?" if close else ""
     if kind in _NUMBER_TYPES:
         try:
-            float(value)
+            finite = math.isfinite(float(value))
         except ValueError:
-            return f"; got the string {value!r}"
-        return f"; got the string {value!r}; write the number without quotes"
+            finite = False
+        return f"; got the string {value!r}" + ("; write the number without quotes" if finite else "")
     return ""
 
 
@@ -62,7 +77,7 @@ def _path_kind(item: Mapping[str, Any]) -> Mapping[str, Any]:
     if not isinstance(kind, str):
         return item
     message = item["msg"] + (f", not {kind[:60]!r}" if len(kind) <= 60 else "")
-    close = closest(kind, ("waypoints", "cartesian", "free"))
+    close = closest(kind, PATH_KINDS)
     return {**item, "loc": (*item["loc"], "kind"), "msg": message + (f": did you mean {close!r}?" if close else ""), "input": kind}
 
 

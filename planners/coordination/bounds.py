@@ -2,15 +2,22 @@
 (``toptraj.planners.coordination.diagram``), from the distances at the cells' corners and the
 arms' motion over a step.
 
-Moving arm 1 by m1 and arm 2 by m2 (no point of either moving farther) changes the distance
-between them by at most m1 + m2. Along an edge of s1 between corners at distances d00 and d10
-the distance is at least max(d00 - m1 u, d10 - m1 (1 - u)) >= (d00 + d10 - m1) / 2 (the bound of
-``toptraj.planners.generators.search.local`` for a segment); between the two edges of s1, at
-least the mean of the two edges' bounds minus m2 / 2. So over the cell:
+If no point of arm 1's capsules travels a path longer than m1 over a step of s1, and none of
+arm 2's longer than m2 over a step of s2 (the length of the path each point runs, not the
+straight distance between its ends), the distance between the arms changes by at most m1 + m2
+over a cell. Along an edge of s1 between corners at distances d00 and d10 the distance is then
+at least max(d00 - m1 u, d10 - m1 (1 - u)) >= (d00 + d10 - m1) / 2 (the bound of
+``toptraj.planners.generators.search.local_objective`` for a segment); between the two edges of
+s1, at least the mean of the two edges' bounds minus m2 / 2. So over the cell:
 
     d >= max((d00 + d10 + d01 + d11) / 4 - (m1 + m2) / 2,  max(corners) - m1 - m2)
 
-(capped by the smallest corner, in case the motion was underestimated). Cells whose bound is
+(capped by the smallest corner, in case the motion was underestimated). The path lengths m1, m2
+are not known exactly: ``motion_steps`` estimates them as ``STEP_SAFETY`` times the capsules'
+largest chord between the grid's samples, which holds for paths that bend little within a step
+but is no proof. These bounds choose where the schedule may go; the schedule finally chosen is
+checked on its own at fine samples (``toptraj.planners.coordination.verify``), so an
+underestimated step cannot pass unnoticed into an answer. Cells whose bound is
 low only because the steps are long (their corners all clear) are refined: each cut into
 ``REFINE`` x ``REFINE`` sub-cells with their own corner distances and steps, its bound the
 smallest of theirs. Along the diagram's borders, where one arm rests at its start or end while
@@ -53,10 +60,11 @@ def cell_bounds(distance: np.ndarray, step1: np.ndarray, step2: np.ndarray) -> n
 
 
 def motion_steps(capsules: Capsules) -> np.ndarray:
-    """How far (m) the arm's capsules move between successive samples, from their world end
-    points a, b (n, k, 3): (n - 1,). A capsule moved rigidly moves each point of its axis by a
-    convex combination of its ends' displacements, so by at most the larger; ``STEP_SAFETY``
-    covers the motion between the samples."""
+    """An estimate of the path length (m) the arm's capsule points travel between successive
+    samples, from their world end points a, b (n, k, 3): (n - 1,). A capsule moved rigidly
+    moves each point of its axis by a convex combination of its ends' displacements, so by at
+    most the larger chord; ``STEP_SAFETY`` (1.5) times that chord stands for the path between
+    the samples, longer than the chord where the motion bends: an estimate, not a bound."""
     a, b = capsules[0], capsules[1]
     ends = np.maximum(np.linalg.norm(np.diff(a, axis=0), axis=-1), np.linalg.norm(np.diff(b, axis=0), axis=-1))
     return STEP_SAFETY * ends.max(axis=1)
@@ -131,7 +139,7 @@ def refined_bounds(
         owner, level_cells = np.broadcast_to(owner[:, None, None], again.shape)[again], sub[again]
         if not len(level_cells):
             return out
-    np.minimum.at(out, owner, -np.inf)  # still unsettled at the finest level: not proven
+    np.minimum.at(out, owner, -np.inf)  # still unsettled at the finest level: not found clear
     return out
 
 

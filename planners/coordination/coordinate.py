@@ -28,7 +28,7 @@ import numpy as np
 from toptraj.planners.collision.self_collision import SelfCollision, check_self_collision
 from toptraj.planners.coordination.cell import MAX_ARMS, Cell
 from toptraj.planners.coordination.curve import SmoothCurve, resampled, shortcut, shortest_curve, widened
-from toptraj.planners.coordination.diagram import FINE_STEP, Diagram, check_ends, coordination_diagram
+from toptraj.planners.coordination.diagram import FINE_STEP, Diagram, Measured, check_ends, coordination_diagram, measure
 from toptraj.planners.coordination.limits import within_limits
 from toptraj.planners.coordination.prioritized import pair_diagrams, prioritized
 from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
@@ -133,14 +133,17 @@ def _check_cell(cell: Cell) -> None:
         )
 
 
-def _candidates(cell: Cell, solo: list[TimeScaling], deadline: Deadline, margin: float) -> tuple[dict, list[Schedule]]:
+def _candidates(
+    cell: Cell, solo: list[TimeScaling], deadline: Deadline, margin: float, measured: Measured | None
+) -> tuple[dict, list[Schedule]]:
     """The pairwise diagrams and the schedules to try: for two arms a late start of either and
-    the coordinated curve on the diagram of free cells ``margin`` (m) above the clearance; for
-    more, the prioritized schedule (``prioritized``)."""
+    the coordinated curve on the diagram of free cells ``margin`` (m) above the clearance, from
+    the distances ``measured`` once for every margin; for more, the prioritized schedule
+    (``prioritized``)."""
     if len(cell.arms) > 2:
         diagrams = pair_diagrams(cell, deadline)
         return diagrams, [prioritized(cell, solo, diagrams, deadline)]
-    diagram = coordination_diagram(cell, deadline=deadline, margin=margin)
+    diagram = coordination_diagram(cell, deadline=deadline, margin=margin, measured=measured)
     candidates = [_delayed(diagram, solo, 1), _delayed(diagram, solo, 0), curve_schedule(cell, diagram, solo, deadline)]
     return {(0, 1): diagram}, [candidate for candidate in candidates if candidate is not None]
 
@@ -188,8 +191,9 @@ def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
     _check_cell(cell)
     check_ends(cell)
     solo = _arms_alone(cell, deadline)
+    measured = measure(cell, deadline=deadline) if len(cell.arms) == 2 else None
     for margin in MARGINS[: 1 if len(cell.arms) > 2 else None]:
-        diagrams, candidates = _candidates(cell, solo, deadline, margin)
+        diagrams, candidates = _candidates(cell, solo, deadline, margin, measured)
         kept = _verified(cell, candidates, deadline)
         if kept is not None:
             schedule, clearance = kept

@@ -3,17 +3,18 @@ their path parameters (s1, s2) in [0, 1]^2, on a grid of (M + 1) x (M + 1) nodes
 distance between the arms at every node and the region where they would come closer than the
 clearance marked as an obstacle.
 
-Between nodes the distance changes by at most the arms' motion over a grid step (estimated from
-the capsules' displacement, ``bounds.motion_steps``). A cell is free when the distance over it
-is proven at least the clearance plus ``FINE_STEP``: by the lower bound from its four corners
+Between nodes the distance changes by at most the arms' motion over a grid step, the path length
+their capsule points travel, which is estimated (``STEP_SAFETY`` times the capsules' chord
+between nodes, ``bounds.motion_steps``), not known. A cell is free when the distance over it is
+at least the clearance plus ``FINE_STEP`` by the bounds that estimate gives: from its four corners
 and the steps (``bounds.cell_bounds``, the corners' mean minus half the motion), else, where
 only that margin blocks it (its corners all clear), by the bounds of its refined sub-cells
 (``bounds.refined_bounds``). A point (s1, s2) is free when its cell is, or when it lies on
-a border (an arm at rest at its start or end) along a step proven clear by the segment bound
+a border (an arm at rest at its start or end) along a step found clear by the segment bound
 (``bounds.edge_bounds``); a node is blocked unless every cell around it is free (the nodes the
-quickest curve may pass). The schedule
+quickest curve may pass). Since the steps are estimates, "free" here is no proof: the schedule
 finally chosen is verified apart, at fine samples, with a strict bound
-(``toptraj.planners.coordination.verify``).
+(``toptraj.planners.coordination.verify``), and that check is what the answer's clearance rests on.
 """
 
 from __future__ import annotations
@@ -41,8 +42,8 @@ class Diagram:
     """The coordination diagram on ``s`` (M + 1,): ``distance`` (M + 1, M + 1) between the
     arms at (s1[i], s2[j]) in m, ``blocked`` (M + 1, M + 1) the nodes not surrounded by free
     cells, the arms' motion bound over each grid step, ``step1`` and ``step2`` (M,), in m, and
-    ``free`` (M, M) the cells proven clear (default: those with four free corners) and
-    ``edges``, the steps proven clear along the four borders, where one arm rests at its start
+    ``free`` (M, M) the cells found clear (default: those with four free corners) and
+    ``edges``, the steps found clear along the four borders, where one arm rests at its start
     or end: s2 = 0 and s2 = 1 (each (M,) over s1), s1 = 0 and s1 = 1 (each (M,) over s2)."""
 
     s: np.ndarray
@@ -99,10 +100,25 @@ def check_ends(cell: Cell) -> None:
             )
 
 
-def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE, margin: float = FINE_STEP) -> Diagram:
-    """The diagram of the cell's first two arms on ``grid`` intervals per axis, its free cells
-    ``margin`` (m) above the clearance (memory checked first: one row of (grid + 1) nodes, k1 x k2
-    capsule pairs, about 40 arrays of 8 bytes)."""
+@dataclass(frozen=True)
+class Measured:
+    """What a diagram's free cells are found from, whatever the margin: the grid ``s`` (M + 1,),
+    the two arms' capsules ``one`` and ``two`` at it (a, b (M + 1, k, 3), radius (k,)), the
+    ``distance`` (M + 1, M + 1) between them in m and their motion bounds ``step1``, ``step2``
+    (M,) in m (``bounds.motion_steps``)."""
+
+    s: np.ndarray
+    one: tuple[np.ndarray, np.ndarray, np.ndarray]
+    two: tuple[np.ndarray, np.ndarray, np.ndarray]
+    distance: np.ndarray
+    step1: np.ndarray
+    step2: np.ndarray
+
+
+def measure(cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE) -> Measured:
+    """The distances and steps of the cell's first two arms on ``grid`` intervals per axis
+    (memory checked first: one row of (grid + 1) nodes, k1 x k2 capsule pairs, about 40 arrays
+    of 8 bytes)."""
     first, second = cell.arms[:2]
     s = np.linspace(0.0, 1.0, grid + 1)
     one, two = arm_capsules(first, s), arm_capsules(second, s)
@@ -113,22 +129,33 @@ def coordination_diagram(cell: Cell, grid: int = GRID, deadline: Deadline = NO_D
     for i in range(grid + 1):
         deadline.check()
         distance[i] = pair_distances((one[0][i][None], one[1][i][None], one[2]), two)[0]
-    step1, step2 = motion_steps(one), motion_steps(two)
-    free = _free_cells(cell.clearance + margin, (first, second), (distance, step1, step2), deadline)
+    return Measured(s, one, two, distance, motion_steps(one), motion_steps(two))
+
+
+def coordination_diagram(
+    cell: Cell, grid: int = GRID, deadline: Deadline = NO_DEADLINE, margin: float = FINE_STEP, measured: Measured | None = None
+) -> Diagram:
+    """The diagram of the cell's first two arms on ``grid`` intervals per axis, its free cells
+    ``margin`` (m) above the clearance, from ``measured`` (``measure`` of this cell and grid)
+    when given: another margin finds which cells are free again, not the distances."""
+    first, second = cell.arms[:2]
+    m = measured if measured is not None else measure(cell, grid, deadline)
+    one, two, distance, step1, step2 = m.one, m.two, m.distance, m.step1, m.step2
+    needed = cell.clearance + margin
+    free = _free_cells(needed, (first, second), (distance, step1, step2), deadline)
     closed = np.pad(~free, 1, constant_values=False)  # a node is blocked unless every cell around it is free
     blocked = closed[:-1, :-1] | closed[1:, :-1] | closed[:-1, 1:] | closed[1:, 1:]
-    needed = cell.clearance + margin
     edges = (
         edge_bounds(first, (two[0][:1], two[1][:1], two[2]), distance[:, 0], step1, needed) >= needed,
         edge_bounds(first, (two[0][-1:], two[1][-1:], two[2]), distance[:, -1], step1, needed) >= needed,
         edge_bounds(second, (one[0][:1], one[1][:1], one[2]), distance[0, :], step2, needed) >= needed,
         edge_bounds(second, (one[0][-1:], one[1][-1:], one[2]), distance[-1, :], step2, needed) >= needed,
     )
-    return Diagram(s=s, distance=distance, blocked=blocked, step1=step1, step2=step2, free=free, edges=edges)
+    return Diagram(s=m.s, distance=distance, blocked=blocked, step1=step1, step2=step2, free=free, edges=edges)
 
 
 def _free_cells(needed: float, arms: tuple[CellArm, CellArm], coarse: tuple[np.ndarray, ...], deadline: Deadline) -> np.ndarray:
-    """Which cells (M, M) are proven ``needed`` (m) apart: by the bound from their
+    """Which cells (M, M) are found ``needed`` (m) apart: by the bound from their
     corners, else, where every corner is clear, by the bound of their refined sub-cells
     (``bounds``)."""
     distance, step1, step2 = coarse

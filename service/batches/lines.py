@@ -24,27 +24,19 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import orjson
 
 from toptraj.robots.errors import excerpt
-from toptraj.service.strict_json import DuplicateKey, decode_error, loads
+from toptraj.service.strict_json import MAX_DEPTH, DuplicateKey, decode_error, loads, nesting_depth, too_deep
 
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000
-#: Deepest nesting of arrays and objects in a request line (a request needs 5).
-MAX_DEPTH = 32
 #: Characters of a parser's message kept in a problem's detail.
 _MAX_DETAIL = 200
-#: A JSON string (its brackets are no nesting): quotes around non-quote runs and escapes.
-_STRING = re.compile(rb'"(?:[^"\\]+|\\.)*"', re.DOTALL)
-_OPEN = np.frombuffer(b"[{", dtype=np.uint8)
-_CLOSE = np.frombuffer(b"]}", dtype=np.uint8)
 
 
 @dataclass(frozen=True)
@@ -65,15 +57,6 @@ def problem_body(status: int, title: str, detail: str) -> bytes:
     return orjson.dumps({"type": "about:blank", "title": title, "status": status, "detail": detail})
 
 
-def nesting_depth(data: bytes) -> int:
-    """The deepest nesting of ``[`` and ``{`` in ``data`` (outside JSON strings), counted
-    without recursion: strings removed by one regular expression, then a running sum of +1 per
-    opening and -1 per closing bracket. An unterminated string counts its brackets."""
-    codes = np.frombuffer(_STRING.sub(b"", data), dtype=np.uint8)
-    steps = np.isin(codes, _OPEN).astype(np.int64) - np.isin(codes, _CLOSE)
-    return int(np.cumsum(steps).max(initial=0))
-
-
 def _digest(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
@@ -89,7 +72,7 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
         return refused(400, "Empty line", "the line is blank; put one request (a JSON object) on each line, or remove the line")
     depth = nesting_depth(data)
     if depth > MAX_DEPTH:
-        return refused(400, "Too deeply nested", f"the line nests arrays and objects {depth} deep; a request nests at most {MAX_DEPTH}")
+        return refused(400, "Too deeply nested", f"the line {too_deep(depth)}")
     try:
         body = loads(data, finite=True)
     except DuplicateKey as error:

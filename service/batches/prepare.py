@@ -13,7 +13,8 @@ What a worker does once:
 * the server's warm-up steps (``toptraj.service.warmup``: catalog robots, kernels loaded from
   numba's cache, the typical request), then the solver stacks every method imports on its first
   run (cvxpy, casadi, toppra, ruckig, scipy's optimizers): 3 to 5 s a worker, instead of up to
-  5 s on the first line of each method.
+  5 s on the first line of each method; not the search's warm-up (a search of its own, paid by
+  the first line that searches, not by every worker of every batch).
 
 A step that fails is logged and skipped: its line then pays for it, or answers its own error.
 """
@@ -28,9 +29,20 @@ from toptraj.planners.execution.threads import single_blas_thread
 
 logger = logging.getLogger("toptraj.batches")
 
-#: Modules a worker imports once: the fork server's (``isolated.PRELOAD``) and the stacks of
-#: the methods that import theirs on their first run.
-STACKS = [*PRELOAD, "toptraj.planners.timing.toppra_method", "toppra.algorithm", "toppra.constraint", "ruckig"]
+#: Modules of ``isolated.PRELOAD`` that compute when imported (a warm-up, not a stack): the
+#: search's (``search.warm``, a small search and local optimization, about 0.9 s) is left to a
+#: worker's first line that searches, which loads the same kernels as it runs (a batch worker's
+#: calls run inline: it has no fork server to warm).
+WARM_UPS = ("toptraj.planners.generators.search.warm",)
+#: Modules a worker imports once: the fork server's (``isolated.PRELOAD``) but its warm-ups
+#: (``WARM_UPS``), and the stacks of the methods that import theirs on their first run.
+STACKS = [
+    *(name for name in PRELOAD if name not in WARM_UPS),
+    "toptraj.planners.timing.toppra_method",
+    "toppra.algorithm",
+    "toppra.constraint",
+    "ruckig",
+]
 #: The hook, as Ray's ``runtime_env`` names it.
 SETUP_HOOK = "toptraj.service.batches.prepare.prepare_worker"
 

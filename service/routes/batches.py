@@ -16,7 +16,7 @@ from pydantic import BaseModel, ValidationError
 
 from toptraj.service.field_hints import unknown_field_hint
 from toptraj.service.locations import where
-from toptraj.service.problems import RequestRefused
+from toptraj.service.problems import LISTED_ERRORS, RequestRefused
 from toptraj.service.routes.jobs import _job_response, _problem
 from toptraj.service.schemas.jobs import BatchCreate, JobPublic
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
@@ -27,20 +27,21 @@ router = APIRouter(prefix="/v1/batches", tags=["jobs"], route_class=StrictJSONRo
 
 def _checked(requests: list[dict]) -> None:
     """Each request against its schema (strictly, as the endpoints take them): a 422 naming
-    the first bad one and its field."""
+    the first bad one and its field; hints only for the errors a problem lists (``LISTED_ERRORS``)."""
     for index, item in enumerate(requests):
         schema = CompareRequest if "methods" in item else TrajectoryRequest
         try:
             schema.model_validate(item, strict=True)
         except ValidationError as error:
-            raise RequestValidationError([_within(e, index, schema) for e in error.errors(include_url=False, include_context=False)]) from None
+            errors = error.errors(include_url=False, include_context=False)
+            raise RequestValidationError([_within(e, index, schema, rank < LISTED_ERRORS) for rank, e in enumerate(errors)]) from None
 
 
-def _within(item: Mapping[str, Any], index: int, schema: type[BaseModel]) -> dict:
+def _within(item: Mapping[str, Any], index: int, schema: type[BaseModel], hinted: bool = True) -> dict:
     """Error ``item`` of request ``index`` as an error of the batch's body; an unknown field's
-    message with its hint from the request's own schema (the batch's holds the requests as
-    objects of any shape)."""
-    if item["type"] == "extra_forbidden":
+    message with its hint from the request's own schema when ``hinted`` (the batch's holds the
+    requests as objects of any shape)."""
+    if item["type"] == "extra_forbidden" and hinted:
         item = {**item, "msg": item["msg"] + unknown_field_hint(schema, item["loc"], where(item["loc"]))}
     return {**item, "loc": ("body", "requests", index, *item["loc"])}
 

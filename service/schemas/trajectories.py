@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
+from toptraj.planners.checks.gate import PROMISED_TOLERANCE
 from toptraj.planners.collision.self_collision import PADDING
 from toptraj.planners.problem import ranges
 from toptraj.planners.timing import METHODS
@@ -330,7 +331,8 @@ class TimingRequest(Schema):
         default=0.0,
         description="Fraction of every velocity, acceleration, jerk and torque limit kept in reserve: "
         "the motion is planned under the limits times (1 - margin). With a positive margin no returned "
-        "sample exceeds any limit; with 0, no limit is exceeded by more than 0.3 % on a dense resampling.",
+        f"sample exceeds any limit; with 0, no limit is exceeded by more than {(PROMISED_TOLERANCE - 1.0) * 100:g} % "
+        "on a dense resampling.",
     )
     zones: list[ZoneRequest] = ZONES
 

@@ -11,7 +11,7 @@ import orjson
 
 import toptraj.service.batches.work as batch_work
 from toptraj.planners import Deadline
-from toptraj.service.jobs.work import WorkerSetup, _batch
+from toptraj.service.jobs.work import KINDS, WorkerSetup
 
 #: A ur5 motion of 0.4 s sampled every 0.5 ms: an answer of about 380 kB.
 DENSE = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.4, 0.3, -0.2, 0.1, 0.2, 0.3]]}, "output": {"dt": 0.0005}}
@@ -27,7 +27,7 @@ def _run(requests: list[dict], tmp_path, monkeypatch) -> tuple[bytes, int]:
     planned = []
     original = batch_work.answer
     monkeypatch.setattr(batch_work, "answer", lambda *args: planned.append(1) or original(*args))
-    result = _batch(orjson.dumps({"requests": requests}).decode(), Deadline(120.0), _setup(tmp_path))
+    result = KINDS["batch"](orjson.dumps({"requests": requests}).decode(), Deadline(120.0), _setup(tmp_path))
     return result, len(planned)
 
 
@@ -57,8 +57,9 @@ def test_the_requests_left_are_answered_when_submitted_as_the_advice_says(tmp_pa
 
 
 def test_a_request_whose_samples_exceed_the_room_gets_the_dt_that_fits(tmp_path, monkeypatch):
-    """Each request is planned with what is left as its body cap, as the synchronous endpoint
-    is with its own: more samples than that holds is this request's 422 naming output.dt."""
+    """Each request is planned with the job's answer cap as its body cap, as the synchronous
+    endpoint is with its own: more samples than that holds is this request's 422 naming
+    output.dt, and the batch goes on (what is left of the room decides only what is kept)."""
     finer = {**DENSE, "output": {"dt": 0.00005}}  # 8,000 samples: about 3.8 MB
     result, _ = _run([finer, DENSE], tmp_path, monkeypatch)
     rows = json.loads(result)["results"]

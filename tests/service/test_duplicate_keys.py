@@ -11,7 +11,7 @@ import pytest
 from tests.conftest import UR5_WAYPOINTS
 from toptraj.service.batches.lines import parse_line
 from toptraj.service.cli import main
-from toptraj.service.strict_json import DuplicateKey, loads
+from toptraj.service.strict_json import MAX_DEPTH, DuplicateKey, loads
 
 PATH = json.dumps({"waypoints": UR5_WAYPOINTS[:2]})
 URDF = '<robot name="r"><link name="a"/></robot>'
@@ -56,9 +56,30 @@ def test_the_place_is_found_inside_lists_and_the_count_given():
     assert (refused.value.where, refused.value.key, refused.value.count) == ("[1].x[1].k", "k", 3)
 
 
+def test_a_repeated_object_replaced_by_a_later_one_is_not_the_place_named():
+    """The object holding ``method`` twice was replaced by the second ``timing``: the repeated
+    ``timing`` is named, at the top, not a ``method`` the parsed body no longer holds."""
+    with pytest.raises(DuplicateKey) as refused:
+        loads('{"timing": {"method": 1, "method": 2}, "timing": {}}')
+    assert (refused.value.where, refused.value.key, refused.value.count) == ("timing", "timing", 2)
+
+
+def test_a_repeated_key_inside_a_kept_object_is_named_at_its_place():
+    with pytest.raises(DuplicateKey) as refused:
+        loads('{"a": {"b": {"c": 1, "c": 2}}, "a2": {"x": 1, "x": 2}}')
+    assert (refused.value.where, refused.value.key) == ("a.b.c", "c")
+
+
 def test_a_body_too_deep_is_still_refused_with_a_400(client):
+    """A 400 saying how deep the body nests and how deep a request may, as a batch's line."""
     answer = client.post("/v1/trajectories", content=b"[" * 100_000, headers={"content-type": "application/json"})
     assert answer.status_code == 400
+    assert answer.headers["content-type"] == "application/problem+json"
+    problem = answer.json()
+    assert problem["title"] == "Too deeply nested"
+    assert problem["detail"] == f"the body is nested too deeply: it nests arrays and objects 100000 deep; a request nests at most {MAX_DEPTH} levels"
+    line = json.loads(parse_line(1, b"[" * 100_000).problem[1])
+    assert line["detail"].endswith(f"nested too deeply: it nests arrays and objects 100000 deep; a request nests at most {MAX_DEPTH} levels")
 
 
 def test_a_batch_line_giving_a_key_twice_is_its_own_422():

@@ -95,3 +95,56 @@ def test_a_batch_request_and_the_cli_get_the_name_meant_too(client, tmp_path, ca
     request.write_text(json.dumps(body))
     assert main(["plan", str(request)]) == 1
     assert json.loads(capsys.readouterr().err)["detail"] == "timing.methd: Extra inputs are not permitted: did you mean 'method'?"
+
+
+#: Unknown keys under ``timing`` in a body meant to be refused quickly.
+MANY_UNKNOWN = 3000
+
+
+def _counted(monkeypatch, module) -> list:
+    """``module.unknown_field_hint`` replaced by itself with a count of its calls (the list's length)."""
+    calls: list = []
+    original = module.unknown_field_hint
+
+    def counting(*args):
+        calls.append(args)
+        return original(*args)
+
+    monkeypatch.setattr(module, "unknown_field_hint", counting)
+    return calls
+
+
+def test_hints_are_worked_out_only_for_the_errors_a_problem_lists(client, monkeypatch):
+    """Thousands of unknown keys: each is counted in the detail, only the listed ones get a hint."""
+    from toptraj.service import problems
+
+    calls = _counted(monkeypatch, problems)
+    body = {**WAYPOINTS, "timing": {f"bogus{k}": 1 for k in range(MANY_UNKNOWN)}}
+    answer = client.post("/v1/trajectories", json=body)
+    assert answer.status_code == 422
+    assert answer.json()["detail"].endswith(f"and {MANY_UNKNOWN - 5} more")
+    assert len(answer.json()["errors"]) == problems.LISTED_ERRORS
+    assert len(calls) == problems.LISTED_ERRORS
+
+
+def test_a_batch_hints_only_the_errors_a_problem_lists(client, monkeypatch):
+    from toptraj.service.problems import LISTED_ERRORS
+    from toptraj.service.routes import batches
+
+    calls = _counted(monkeypatch, batches)
+    request = {**WAYPOINTS, "timing": {f"bogus{k}": 1 for k in range(MANY_UNKNOWN)}}
+    answer = client.post("/v1/batches", json={"requests": [request]})
+    assert answer.status_code == 422
+    assert answer.json()["detail"].endswith(f"and {MANY_UNKNOWN - 5} more")
+    assert len(calls) == LISTED_ERRORS
+
+
+def test_the_names_at_a_place_are_walked_once(monkeypatch):
+    """Many unknown keys at one place (list items apart) walk the schema for that place once."""
+    from toptraj.service import field_hints
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
+
+    field_hints._names_at.cache_clear()
+    for k in range(50):
+        field_hints.nearest(TrajectoryRequest, ("timing", "zones", k, f"velocity_scal{k}"))
+    assert field_hints._names_at.cache_info().misses == 1

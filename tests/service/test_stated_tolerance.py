@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from tests.paths import ROOT
@@ -31,3 +33,20 @@ def test_the_docs_state_the_promise(document):
 
 def test_the_clients_utilization_states_the_promise():
     assert "within 0.5 %" in (Utilization.__doc__ or "")
+
+
+def _descriptions(value) -> list[str]:
+    """Every ``description`` in an OpenAPI document (nested dicts and lists)."""
+    if isinstance(value, dict):
+        return [*([value["description"]] if isinstance(value.get("description"), str) else []), *(text for item in value.values() for text in _descriptions(item))]
+    if isinstance(value, list):
+        return [text for item in value for text in _descriptions(item)]
+    return []
+
+
+def test_the_openapi_descriptions_state_the_promise(client):
+    """Each figure stated before "on a dense resampling" is the promise (``limit_margin`` states one)."""
+    descriptions = _descriptions(client.get("/openapi.json").json())
+    stated = [figure for text in descriptions for figure in re.findall(r"([\d.]+) % on a dense resampling", text)]
+    assert stated and set(stated) == {"0.5"}
+    assert not any("0.3 %" in text for text in descriptions)

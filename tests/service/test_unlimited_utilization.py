@@ -48,8 +48,8 @@ def test_the_csv_metadata_writes_null(client):
 def test_a_cell_arms_unlimited_joint_reads_null():
     from types import SimpleNamespace
 
-    from toptraj.service.cell_answers import _reported
+    from toptraj.service.cell_answers import reported_utilization
 
     limits = SimpleNamespace(velocity=np.array([np.inf, 2.0]), torque=np.array([5.0, 5.0]))
-    reported = _reported({"velocity": np.array([0.0, 0.75]), "torque": np.array([1.0, 0.5])}, limits)
+    reported = reported_utilization({"velocity": np.array([0.0, 0.75]), "torque": np.array([1.0, 0.5])}, limits)
     assert reported == {"velocity": [None, 0.75], "torque": [1.0, 0.5]}

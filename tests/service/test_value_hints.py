@@ -63,6 +63,19 @@ def test_a_number_sent_as_a_string_says_so(client):
     ]
 
 
+@pytest.mark.parametrize("text", ["nan", "1e999", "-inf"])
+def test_a_non_finite_number_as_a_string_is_not_told_to_drop_the_quotes(client, text):
+    """NaN and infinity are refused without quotes too: the advice would not work."""
+    errors = client.post("/v1/trajectories", json=_with({"output.dt": text})).json()["errors"]
+    assert errors == [{"field": "output.dt", "message": f"Input should be a valid number; got the string {text!r}"}]
+
+
+def test_the_path_kinds_suggested_are_the_schemas():
+    from toptraj.service.value_hints import PATH_KINDS
+
+    assert PATH_KINDS == ("waypoints", "cartesian", "free")
+
+
 def test_a_value_fitting_no_member_of_a_union_is_one_sentence(client):
     errors = client.post("/v1/robots", json={"urdf": "<robot name='a'/>", "joint_limits": 5}).json()["errors"]
     assert errors == [{"field": "joint_limits", "message": "should be a string or an object; got a number"}]

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tests.planners.generators.test_search_objective import CASES, _objective, _random_points
+from tests.planners.generators.test_search_objective import CASES, random_points, search_objective
 from toptraj.planners.generators.search.objective_kernels import objective_value
 from toptraj.service.warmup import install_steps, run_steps
 
@@ -19,6 +19,6 @@ def test_the_install_compiles_the_signature_every_search_evaluates():
     assert len(compiled) == 1
     rng = np.random.default_rng(1)
     for arm in CASES:  # two, six and seven joints; one obstacle or two; friction or none
-        objective = _objective(arm)
-        objective.value(_random_points(objective, 4, 0.1, rng))
+        objective = search_objective(arm)
+        objective.value(random_points(objective, 4, 0.1, rng))
     assert list(objective_value.signatures) == compiled  # nothing compiled anew

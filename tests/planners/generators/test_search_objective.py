@@ -38,14 +38,16 @@ CASES = {
 }
 
 
-def _objective(arm: str, torque_scale: float = 1.0) -> Objective:
+def search_objective(arm: str, torque_scale: float = 1.0) -> Objective:
+    """The local optimization's objective of case ``arm`` (``CASES``), its torque limits
+    scaled by ``torque_scale``, with the default settings and no deadline."""
     start, goal, kinds, obstacles, clearance = CASES[arm]
     robot = robots.load(arm)
     limits = dataclasses.replace(robot.limits, torque=robot.limits.torque * torque_scale)
     return Objective(robot, limits, kinds, np.array(start), np.array(goal), obstacles, clearance, LocalSettings(), NO_DEADLINE)
 
 
-def _random_points(objective: Objective, count: int, spread: float, rng: np.random.Generator) -> np.ndarray:
+def random_points(objective: Objective, count: int, spread: float, rng: np.random.Generator) -> np.ndarray:
     """Interior control points (count - 2 of them, flattened) scattered by ``spread`` (rad)
     about the straight joint line."""
     line = np.linspace(objective.start, objective.goal, count)[1:-1]
@@ -54,14 +56,14 @@ def _random_points(objective: Objective, count: int, spread: float, rng: np.rand
 
 @pytest.mark.parametrize("arm", list(CASES))
 def test_the_compiled_objective_equals_the_reference_path(arm):
-    objective = _objective(arm)
+    objective = search_objective(arm)
     assert objective.fused
     rng = np.random.default_rng(7)
     penalized = 0
     for count in (4, 5, 9, 13):
         objective.interior = np.sort(dyadic_knots(count - 4))
         for spread in (0.05, 0.3, 1.0):
-            x = _random_points(objective, count, spread, rng)
+            x = random_points(objective, count, spread, rng)
             reference = objective.reference(x)
             assert objective.value(x) == pytest.approx(reference, rel=1e-12, abs=0.0)
             penalized += objective.penalty(objective.path(x)) > 0.0
@@ -72,11 +74,11 @@ def test_the_compiled_objective_equals_the_reference_path(arm):
 def test_a_path_no_timing_can_follow_gets_the_same_objective():
     """ur5 with a twentieth of its torques cannot hold its own weight: every path is
     infeasible, its objective ``INFEASIBLE`` plus the same penalties."""
-    objective = _objective("ur5", torque_scale=0.05)
+    objective = search_objective("ur5", torque_scale=0.05)
     rng = np.random.default_rng(3)
     objective.interior = np.sort(dyadic_knots(3))
     for spread in (0.05, 0.5):
-        x = _random_points(objective, 7, spread, rng)
+        x = random_points(objective, 7, spread, rng)
         reference = objective.reference(x)
         assert reference >= INFEASIBLE
         assert objective.value(x) == pytest.approx(reference, rel=1e-12, abs=0.0)
@@ -85,8 +87,8 @@ def test_a_path_no_timing_can_follow_gets_the_same_objective():
 def test_the_knots_of_a_new_round_give_new_basis_weights():
     """The weights follow the interior knots: the same control points on other knots give the
     reference's other value."""
-    objective = _objective("geering_2r")
-    x = _random_points(objective, 7, 0.2, np.random.default_rng(5))
+    objective = search_objective("geering_2r")
+    x = random_points(objective, 7, 0.2, np.random.default_rng(5))
     values = []
     for interior in (np.array([0.25, 0.5, 0.75]), np.array([0.125, 0.5, 0.875])):
         objective.interior = interior
@@ -102,5 +104,5 @@ def test_limits_the_kernel_does_not_compute_take_the_reference_path():
     robot = robots.load("geering_2r")
     objective = Objective(robot, robot.limits, ("torque", "jerk"), np.array(start), np.array(goal), obstacles, clearance, LocalSettings(), NO_DEADLINE)
     assert not objective.fused
-    x = _random_points(objective, 4, 0.1, np.random.default_rng(2))
+    x = random_points(objective, 4, 0.1, np.random.default_rng(2))
     assert objective.value(x) == objective.reference(x)

@@ -9,7 +9,7 @@ import importlib
 
 import numpy as np
 
-from tests.planners.generators.test_search_objective import CASES, _objective, _random_points
+from tests.planners.generators.test_search_objective import CASES, random_points, search_objective
 from toptraj.planners.execution.isolated import PRELOAD
 from toptraj.planners.generators.search.objective_kernels import objective_value
 
@@ -21,6 +21,6 @@ def test_the_fork_server_preloads_the_search_and_its_objective():
     assert len(loaded) == 1
     rng = np.random.default_rng(4)
     for arm in CASES:
-        objective = _objective(arm)
-        objective.value(_random_points(objective, 5, 0.1, rng))
+        objective = search_objective(arm)
+        objective.value(random_points(objective, 5, 0.1, rng))
     assert list(objective_value.signatures) == loaded
