@@ -127,6 +127,10 @@ def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | 
     return encode_json(body), "application/json"
 
 
+#: The rules of the notes on how samples render a motion (``planners.runner.sampling_notes``).
+SAMPLING_RULES = ("too_few_samples", "slowed_to_whole_periods")
+
+
 def method_request(request: CompareRequest, method: str, dt: float = 1.0) -> TrajectoryRequest:
     """The trajectory request of one method of a comparison, sampled every ``dt`` seconds."""
     return TrajectoryRequest(
@@ -162,7 +166,9 @@ def compare_results(request: CompareRequest, deadline: Deadline, dt: float = 1.0
             results.append(({"method": method, "error": {"status": status_of(error), "title": title_of(error), "detail": detail(error)}}, None))
             continue
         body = trajectory_body(result)
-        entry = {key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy", "warnings")}
+        entry = {key: body[key] for key in ("method", "duration", "peak_utilization", "binding", "solve_ms", "accuracy")}
+        # a comparison returns no samples: what its coarse sampling renders is no news to its reader
+        entry["warnings"] = [note_text(note) for note in result.warnings if getattr(note, "rule", None) not in SAMPLING_RULES]
         results.append((entry, result))
     return results
 

@@ -55,3 +55,15 @@ def test_a_slowing_within_one_percent_is_not_warned_of(client):
     answer = _answer(client, dt=0.01, format="joint_trajectory")
     assert answer["sampled_duration"] / answer["duration"] - 1 < 0.01
     assert not _about(answer["warnings"], "slows the motion") and not _about(answer["warnings"], "output.dt =")
+
+
+def test_a_comparison_which_returns_no_samples_warns_of_none(client):
+    """A comparison samples coarsely for its figures and returns no samples, and its body takes
+    no ``output``: a sampling warning would advise what it cannot take."""
+    short = {"kind": "waypoints", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [1, -1, 1.4, -0.5, 0.9, 0.3]]}
+    body = {"robot": "ur5", "path": short, "methods": ["phase_plane", "toppra"]}
+    response = client.post("/v1/trajectories/compare", json=body)
+    assert response.status_code == 200, response.text
+    for entry in response.json()["results"]:
+        assert entry["duration"] < 1.0  # shorter than the comparison's own period
+        assert not _about(entry["warnings"], "output.dt") and not _about(entry["warnings"], "slows the motion"), entry
