@@ -245,7 +245,8 @@ WORDING: dict[str, Wording] = {
     ),
     "ruckig_needs_a_limit": (
         "{field} 'ruckig' needs a finite velocity, acceleration or jerk limit on the joints that "
-        "move, and this robot has none among timing.constraints: set one in timing.limits"
+        "move, and this robot has none among timing.constraints: set velocity and acceleration limits in "
+        "timing.limits (a velocity limit alone lets the velocity jump, with unbounded accelerations and torques)"
     ),
     "unsynchronized_joint_unlimited": (
         "{field} 'none': joint {joint_name!r} has no finite velocity, "

@@ -21,7 +21,7 @@ def test_ruckig_without_any_finite_limit_is_refused_with_advice():
     with pytest.raises(InvalidRequest) as refused:
         plan(build_problem(robots.load("yamamoto_2r"), MOVE, METHODS["ruckig"], limits=LimitRequest(kinds=KINDS)))
     assert (refused.value.field, refused.value.rule) == ("method", "ruckig_needs_a_limit")
-    assert "set one in timing.limits" in detail(refused.value)
+    assert "set velocity and acceleration limits in timing.limits" in detail(refused.value)
 
 
 def test_the_advice_plans_a_motion_within_the_limit_set():
