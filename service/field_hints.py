@@ -135,6 +135,11 @@ def closest(given: str, allowed: typing.Iterable[str]) -> str | None:
     return close[0] if close else None
 
 
+#: Where a cell body (``arms``, each with its own path) goes.
+CELL_ELSEWHERE = (
+    ": a cell (several arms, each along its own path) is planned by POST /v1/cells or `toptraj plan FILE`, "
+    "not by this route; its other fields (clearance, dt) belong to that body"
+)
 #: What to do with a field that belongs to another route or to no body at all, by the body's
 #: schema and the field's place ("*": any unknown field at the top of that schema).
 ELSEWHERE = {
@@ -143,6 +148,10 @@ ELSEWHERE = {
     ("CompareRequest", "output"): ": a comparison answers each method's duration, peak utilization and solve time, "
     "without samples, so it takes no `output`; POST /v1/trajectories (one method, timing.method) returns the samples",
     ("CompareRequest", "method"): ": a comparison runs the list `methods` (e.g. [\"phase_plane\", \"quintic\"])",
+    ("TrajectoryRequest", "arms"): CELL_ELSEWHERE,
+    ("CompareRequest", "arms"): CELL_ELSEWHERE,
+    ("JobCreate", "cell"): CELL_ELSEWHERE,
+    ("JobCreate", "arms"): CELL_ELSEWHERE,
     ("JobCreate", "*"): ": put the request under `trajectory` (a POST /v1/trajectories body) or `compare` "
     "(a POST /v1/trajectories/compare body), e.g. {\"trajectory\": {\"robot\": \"ur5\", \"path\": ...}}",
 }

@@ -7,6 +7,7 @@ import json
 
 import pytest
 
+from tests.paths import ROOT
 from toptraj.service.field_hints import field_places
 
 WAYPOINTS = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.1] * 6]}}
@@ -148,3 +149,13 @@ def test_the_names_at_a_place_are_walked_once(monkeypatch):
     for k in range(50):
         field_hints.nearest(TrajectoryRequest, ("timing", "zones", k, f"velocity_scal{k}"))
     assert field_hints._names_at.cache_info().misses == 1
+
+
+@pytest.mark.parametrize(("route", "wrap"), [("/v1/trajectories", None), ("/v1/trajectories/compare", None), ("/v1/jobs", "cell")])
+def test_a_cell_body_sent_elsewhere_is_pointed_to_the_cells_route(client, route, wrap):
+    cell = json.loads((ROOT / "examples" / "cell_two_ur5.json").read_text())
+    response = client.post(route, json={wrap: cell} if wrap else cell)
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"]
+    assert "is planned by POST /v1/cells or `toptraj plan FILE`" in detail, detail
+    assert client.post("/v1/cells", json=cell).status_code == 200  # the advice, followed
