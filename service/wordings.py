@@ -265,8 +265,11 @@ WORDING: dict[str, Wording] = {
         f"the search needed more memory than its estimate of {facts['estimate'] / 2**30:.3g} GiB allowed ({facts['cause']}): "
         "lower timing.search.roadmap_points or neighbors (cells on a lattice)"
     ),
-    "free_path_needs_collocation": (
-        "a free path (start and goal only) needs timing.method 'collocation' or 'search', and collocation a free path"
+    "free_path_needs_collocation": lambda facts: (
+        "timing.method 'collocation' finds the path itself: give a free path (path.kind 'free', start and goal)"
+        if facts.get("value") == "collocation"
+        else f"a free path (start and goal only) needs timing.method 'collocation' or 'search', not {facts.get('value')!r}; "
+        f"for {facts.get('value')!r} give the path itself (path.kind 'waypoints' or 'cartesian')"
     ),
     "collocation_intervals": "{field} sets the collocation intervals, {low} to {high}; got {value}",
     "positions_or_poses": "a cartesian path needs exactly one of path.positions and path.poses",

@@ -145,3 +145,18 @@ def test_the_service_picks_the_status_not_the_library(client, monkeypatch):
     status, detail, _ = _post(client, {"robot": "nope", "path": GOOD_PATH})
     assert (status, "no robot named 'nope'" in detail) == (404, True)
     assert status_of(BudgetExceeded("spent")) == 504
+
+
+@pytest.mark.parametrize(
+    ("path", "method", "words"),
+    [
+        ({"kind": "waypoints", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [1, -1, 1.4, -0.5, 0.9, 0.3]]}, "collocation",
+         "timing.method 'collocation' finds the path itself: give a free path (path.kind 'free', start and goal)"),
+        ({"kind": "free", "start": [0, -1.2, 1, 0, 0.5, 0], "goal": [1, -1, 1.4, -0.5, 0.9, 0.3]}, "toppra",
+         "needs timing.method 'collocation' or 'search', not 'toppra'; for 'toppra' give the path itself"),
+    ],
+)
+def test_a_method_and_a_path_kind_that_do_not_pair_say_which_fits(client, path, method, words):
+    response = client.post("/v1/trajectories", json={"robot": "ur5", "path": path, "timing": {"method": method}})
+    assert response.status_code == 422, response.text
+    assert words in response.json()["detail"], response.json()["detail"]
