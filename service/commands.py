@@ -26,6 +26,11 @@ class _Unreadable(Exception):
     """The request cannot be read: exit status 2."""
 
 
+def _plain(value: object) -> object:
+    """A numpy scalar among an error's facts as the Python number JSON writes."""
+    return value.item() if hasattr(value, "item") else str(value)
+
+
 def _problem(title: str, status: int, detail: str) -> dict:
     return {"type": "about:blank", "title": title, "status": status, "detail": detail}
 
@@ -118,7 +123,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
     """Read the request at ``source``, compute ``answer(text)`` and write it to ``out``
     (standard output); errors to standard error as problem+json."""
     from toptraj.robots import ToptrajError
-    from toptraj.service.problems import detail, status_of, title_of, validation_problem
+    from toptraj.service.problems import detail, problem_facts, status_of, title_of, validation_problem
     from toptraj.service.strict_json import DuplicateKey
 
     try:
@@ -133,7 +138,7 @@ def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
         print(json.dumps(validation_problem(error, _schema_named(error.title))), file=sys.stderr)
         return 1
     except ToptrajError as error:
-        print(json.dumps(_problem(title_of(error), status_of(error), detail(error))), file=sys.stderr)
+        print(json.dumps({**_problem(title_of(error), status_of(error), detail(error)), **problem_facts(error)}, default=_plain), file=sys.stderr)
         return 1
     return _write(content, out)
 

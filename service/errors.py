@@ -27,7 +27,7 @@ from starlette.routing import Match
 
 from toptraj.robots import ToptrajError
 from toptraj.service.problem_docs import PROBLEM_JSON, declare_problems
-from toptraj.service.problems import HTTP_TITLES, detail, status_of, title_of, validation_detail, validation_errors
+from toptraj.service.problems import HTTP_TITLES, detail, problem_facts, status_of, title_of, validation_detail, validation_errors
 from toptraj.service.strict_routes import BodyRefused
 
 logger = logging.getLogger("toptraj")
@@ -41,7 +41,7 @@ def problem(status: int, title: str, detail: str, headers: dict[str, str] | None
 
 
 def _toptraj_error(request: Request, error: ToptrajError) -> JSONResponse:
-    extra = {key: getattr(error, key) for key in ("s", "joint", "limit", "link", "obstacle", "link_a", "link_b") if hasattr(error, key)}
+    extra = problem_facts(error)
     retry_after = getattr(error, "retry_after", None)
     headers = None if retry_after is None else {"Retry-After": str(retry_after)}
     return problem(status_of(error), title_of(error), detail(error), headers, **extra)

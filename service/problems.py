@@ -213,6 +213,16 @@ def _cut(text: str) -> str:
     return text
 
 
+#: The facts of an error a problem body carries beside its detail, where the error has them.
+PROBLEM_FACTS = ("s", "joint", "limit", "link", "obstacle", "link_a", "link_b")
+
+
+def problem_facts(error: ToptrajError) -> dict[str, Any]:
+    """The facts (``PROBLEM_FACTS``) of ``error`` that a problem body carries: where along the
+    path (``s``), which joint, limit, link or obstacle; those that are ``None`` left out."""
+    return {key: getattr(error, key) for key in PROBLEM_FACTS if getattr(error, key, None) is not None}
+
+
 def title_of(error: ToptrajError) -> str:
     """The title of ``error``'s answer: ``TITLE`` of its class or nearest base there; an error
     class of the service itself states its own."""

@@ -41,6 +41,19 @@ def test_plan_reports_bad_input_on_stderr(tmp_path, capsys):
     assert json.loads(capsys.readouterr().err)["status"] == 422
 
 
+def test_plan_reports_where_and_which_limit_as_the_http_problem_does(tmp_path, capsys, client):
+    body = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [1, -1, 1.4, -0.5, 0.9, 0.3]]},
+            "timing": {"limits": {"torque_scale": 0.2}}}
+    request = tmp_path / "request.json"
+    request.write_text(json.dumps(body))
+    assert main(["plan", str(request)]) == 1
+    printed = json.loads(capsys.readouterr().err)
+    served = client.post("/v1/trajectories", json=body).json()
+    assert printed["status"] == served["status"] == 422
+    facts = {key: served[key] for key in ("s", "joint", "limit") if key in served}
+    assert facts and {key: printed.get(key) for key in facts} == facts
+
+
 def test_plan_reads_stdin(monkeypatch, capsys):
     monkeypatch.setattr("sys.stdin", io.StringIO(json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}})))
     assert main(["plan", "-"]) == 0
