@@ -114,10 +114,13 @@ def _path_in_collision(facts: dict) -> str:
     )
 
 
-def _unknown_tool_frame(facts: dict) -> str:
+def _unknown_frame(facts: dict) -> str:
+    """A frame the robot lacks: the nearest of its frames if one is close, and all of them."""
     frames = facts["allowed"]
     shown = ", ".join(repr(item) for item in frames[:60]) + (", ..." if len(frames) > 60 else "")
-    return f"{facts['field']} {facts['value'][:100]!r} is not a frame of {facts['robot']}; its frames are {shown}"
+    meant = closest(str(facts["value"]), frames)
+    nearest = f" (did you mean {meant!r}?)" if meant else ""
+    return f"{facts['field']} {facts['value'][:100]!r} is not a frame of {facts['robot']}{nearest}; its frames are {shown}"
 
 
 Wording = str | Callable[[dict], str]
@@ -279,7 +282,7 @@ WORDING: dict[str, Wording] = {
     "not_finite_number": "{field} is not a finite number",
     "quaternion_not_unit": "{field} has a quaternion of norm {norm:.6g}, not 1",
     "only_the_start_pose": "{field} holds only the start pose: give at least one more point",
-    "unknown_frame": "{field} {value!r} is not a frame of {robot}",
+    "unknown_frame": _unknown_frame,
     "not_finite_joint_values": "{field} must hold {expected} finite joint values",
     "outside_joint_limits": "{field} = {value:.6g} is outside the limits of joint {joint_name!r}",
     "line_too_long": "the line to {field} is {length:.4g} m long: it leaves the workspace of {robot}",
@@ -315,7 +318,7 @@ WORDING: dict[str, Wording] = {
     ),
     "max_turn_out_of_range": "{field} must lie in (0, 180) degrees, got {value}",
     "frame_without_speed": "{field} is given without timing.limits.tool_speed or tool_angular_speed",
-    "unknown_tool_frame": _unknown_tool_frame,
+    "unknown_tool_frame": _unknown_frame,
     "jerk_limited_needs_jerk": "timing.method 'jerk_limited' needs the jerk constraint",
     "jerk_limited_from_zero_acceleration": "timing.method 'jerk_limited' starts and ends with zero acceleration",
     "law_acceleration_steps": _law_acceleration_steps,

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from toptraj.planners.errors import Conflicting, InvalidRequest
+from toptraj.planners.errors import Conflicting, InvalidRequest, NotOneOf
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.kinematics.ik import frame_pose, solve_ik
 from toptraj.planners.paths.base import GeometricPath
@@ -91,7 +91,8 @@ def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DE
     """
     frame = line.frame or robot.end_effector
     if not robot.model.existFrame(frame):
-        raise InvalidRequest("frame", frame, rule="unknown_frame", robot=robot.name)
+        frames = tuple(item.name for item in robot.model.frames if item.name != "universe")
+        raise NotOneOf("frame", frame, frames, rule="unknown_frame", robot=robot.name)
     frame_id = robot.frame_id(frame)
     start = np.asarray(line.start, dtype=float)
     if start.shape != (robot.dof,) or not np.all(np.isfinite(start)):

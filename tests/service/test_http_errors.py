@@ -160,3 +160,13 @@ def test_a_method_and_a_path_kind_that_do_not_pair_say_which_fits(client, path, 
     response = client.post("/v1/trajectories", json={"robot": "ur5", "path": path, "timing": {"method": method}})
     assert response.status_code == 422, response.text
     assert words in response.json()["detail"], response.json()["detail"]
+
+
+def test_a_cartesian_line_of_a_frame_the_robot_lacks_names_the_nearest_and_all(client):
+    path = {"kind": "cartesian", "frame": "tool1", "start": [0.0, -1.2, 1.0, 0.0, 0.5, 0.0],
+            "positions": [[0.4, 0.1, 0.4], [0.4, 0.2, 0.4]]}
+    response = client.post("/v1/trajectories", json={"robot": "ur5", "path": path})
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"]
+    assert "path.frame 'tool1' is not a frame of ur5 (did you mean 'tool0'?); its frames are" in detail, detail
+    assert "'ee_link'" in detail
