@@ -101,12 +101,18 @@ def collapsed(items: list[Mapping[str, Any]]) -> list[dict[str, Any]]:
             and loc and isinstance(loc[-1], int)
             and tuple(last["loc"])[:-1] == loc[:-1]
             and last.get("type") == item.get("type") in _SHAPE_TYPES
-            and type(last.get("input")) is type(item.get("input"))
+            and _kind(last.get("input")) == _kind(item.get("input"))
         ):
             last["items"].append(loc[-1])
             continue
         out.append({**item, "items": [loc[-1]] if loc and isinstance(loc[-1], int) else []})
     return [_worded(item) for item in out]
+
+
+def _kind(value: object) -> str:
+    """What a value is for merging the same error of a list's items: a number (int or float
+    alike: a flat list of waypoints mixes them), else its type's name."""
+    return "number" if isinstance(value, int | float) and not isinstance(value, bool) else type(value).__name__
 
 
 def _worded(item: dict) -> dict:

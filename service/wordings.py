@@ -173,7 +173,10 @@ WORDING: dict[str, Wording] = {
     "outside_joint_range": "{field} = {value:.6g} is outside the limits [{low:.6g}, {high:.6g}] of joint {joint_name!r}",
     "unknown_constraint": "{field} holds {value!r}; use any of {allowed}",
     "kind_not_served": _kind_not_served,
-    "no_constraints": "{field} is empty: without limits the time-optimal motion is instantaneous",
+    "no_constraints": (
+        "{field} is empty: without limits the time-optimal motion is instantaneous; list the limits to hold, "
+        "e.g. [\"velocity\", \"acceleration\", \"torque\"], or leave it out for the kinds the method holds"
+    ),
     "trapezoid_order": "{field} needs 0 < tau1 <= tau2 < 1, got {value[0]}, {value[1]}",
     "count_out_of_range": "{field} = {value!r} is outside [{low}, {high}]",
     "law_spline_failed": "{field}: {reason}",

@@ -170,3 +170,12 @@ def test_a_cartesian_line_of_a_frame_the_robot_lacks_names_the_nearest_and_all(c
     detail = response.json()["detail"]
     assert "path.frame 'tool1' is not a frame of ur5 (did you mean 'tool0'?); its frames are" in detail, detail
     assert "'ee_link'" in detail
+
+
+def test_empty_constraints_say_what_to_list_and_the_advice_plans(client):
+    path = {"kind": "waypoints", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [1, -1, 1.4, -0.5, 0.9, 0.3]]}
+    refused = client.post("/v1/trajectories", json={"robot": "ur5", "path": path, "timing": {"constraints": []}})
+    assert refused.status_code == 422
+    assert 'e.g. ["velocity", "acceleration", "torque"], or leave it out' in refused.json()["detail"]
+    for timing in ({"constraints": ["velocity", "acceleration", "torque"]}, {}):
+        assert client.post("/v1/trajectories", json={"robot": "ur5", "path": path, "timing": timing}).status_code == 200

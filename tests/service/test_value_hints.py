@@ -81,7 +81,8 @@ def test_a_value_fitting_no_member_of_a_union_is_one_sentence(client):
     assert errors == [{"field": "joint_limits", "message": "should be a string or an object; got a number"}]
 
 
-def test_a_flat_list_where_rows_are_expected_is_one_sentence_with_the_shape(client):
-    errors = client.post("/v1/robots/ur5/skeleton", json={"q": [0, 0, 0, 0, 0, 0]}).json()["errors"]
-    assert len(errors) == 1 and errors[0]["field"] == "q"
+@pytest.mark.parametrize("flat", [[0, 0, 0, 0, 0, 0], [0, -1.2, 1, 0, 0.5, 0], [0, -1.2]])  # ints and floats mixed too
+def test_a_flat_list_where_rows_are_expected_is_one_sentence_with_the_shape(client, flat):
+    errors = client.post("/v1/robots/ur5/skeleton", json={"q": flat}).json()["errors"]
+    assert len(errors) == 1 and errors[0]["field"] == "q", errors
     assert errors[0]["message"].startswith("should be a list of lists (one list of values per item, e.g. [[0, 0], [1, 1]]); got a flat list")
