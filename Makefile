@@ -10,7 +10,7 @@ STAMP := $(VENV)/.installed
 .PHONY: serve test install guide browser lock clean
 
 GUIDE := service/web/guide
-GUIDE_SOURCES := mkdocs.yml $(shell find docs robots planners client -name '*.md' -o -name '*.py' -o -name '*.png' 2>/dev/null)
+GUIDE_SOURCES := mkdocs.yml $(shell find docs compiled robots planners client -name '*.md' -o -name '*.py' -o -name '*.png' 2>/dev/null)
 
 # Exact versions with their hashes from requirements.lock (the runtime dependencies and the
 # test extra, resolved from the ranges in pyproject.toml), then the project itself on top;

@@ -98,7 +98,7 @@ def _bytecode(root: Path) -> None:
     """The bytecode of the tree at ``root`` written, as an install writes it (pip; ``make
     install``'s warm-up), even where ``PYTHONDONTWRITEBYTECODE`` keeps Python from writing it on
     import: otherwise each new interpreter would compile the project's sources again."""
-    folders = [str(root / part) for part in ("toptraj", "robots", "planners", "service", "client")]
+    folders = [str(root / part) for part in ("toptraj", "robots", "planners", "service", "client", "compiled")]
     subprocess.run([sys.executable, "-m", "compileall", "-q", *folders], check=True, stdout=subprocess.DEVNULL)
 
 

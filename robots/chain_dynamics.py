@@ -27,8 +27,8 @@ Shapes: q (n, n_dof) in rad or m; qd, qdd, tau (n_sets, n, n_dof) in rad/s, rad/
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.robots.chain import Chain, axis_rotation
 
 

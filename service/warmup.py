@@ -46,7 +46,9 @@ TYPICAL = {
 }
 
 Report = Callable[[str], None]
-Step = tuple[str, Callable[[], None]]
+#: A label and its work; the work may return what its done-line says instead of the count of
+#: numba's compilations.
+Step = tuple[str, Callable[[], "str | None"]]
 
 _imported = threading.Event()
 
@@ -92,7 +94,7 @@ def _phase_plane() -> None:
 
 
 def _conditioning() -> None:
-    """Conditioning's singular-value kernel, on a singular Jacobian."""
+    """Conditioning's kernel (its Gram matrices), on a singular Jacobian, which the singular values then decide."""
     import numpy as np
 
     from toptraj.planners.kinematics.conditioning import frobenius_condition_number
@@ -125,6 +127,19 @@ def _search_objective() -> None:
     sphere = SphereObstacle(np.array([0.52, 0.28, 0.0]), 0.05)
     objective = Objective(arm, arm.limits, ("torque",), np.zeros(2), np.array([0.76, 0.0]), (sphere,), 0.01, LocalSettings(), NO_DEADLINE)
     objective.value(np.array([0.25, 0.0, 0.5, 0.0]))
+
+
+def _ahead_of_time() -> str | None:
+    """The typical request's kernels compiled ahead of time into one library
+    (``toptraj.compiled.build``): ``toptraj plan`` of such a request then runs without importing
+    numba. A machine without a C compiler keeps numba's cache alone, and says so."""
+    from toptraj.compiled.build import BuildFailed, build
+
+    try:
+        exported = build(_typical)
+    except BuildFailed as failure:
+        return f"not built, the kernels run from numba's cache: {failure}"
+    return f"compiled {exported} functions into the library"
 
 
 def server_steps() -> list[Step]:
@@ -162,6 +177,7 @@ def install_steps() -> list[Step]:
         ("writing the bytecode of toptraj's modules", write_bytecode),
         *server_steps(),
         ("compiling the typical request's kernels (ur5, spline, velocity, acceleration, torque)", _typical),
+        ("compiling them ahead of time into one library (toptraj plan then starts without numba)", _ahead_of_time),
         ("compiling the search's local-optimization objective", _search_objective),
     ]
 
@@ -209,10 +225,11 @@ def run_steps(steps: list[Step], report: Report) -> int:
         report(f"{label} ...")
         started = time.monotonic()
         with _compilations() as events, _heartbeat(label, events, report):
-            step()
+            note = step()
         count = _compiled(events)
         compiled += count
         source = f"compiled {count} functions" if count else "nothing to compile"
+        source = note or source
         report(f"{label}: done in {time.monotonic() - started:.1f} s ({source})")
     return compiled
 

@@ -1,5 +1,5 @@
 """Habits CI keeps: mypy checks the bodies of every function, every public function of the
-library (``planners/``, ``robots/``) is annotated, and the runtime image carries no browser (the
+library (``planners/``, ``robots/``, ``compiled/``) is annotated, and the runtime image carries no browser (the
 ``test`` stage of the Dockerfile adds it, and CI runs the suite there)."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import pytest
 
 from tests.paths import ROOT
 
-LIBRARY = ("planners", "robots")
+LIBRARY = ("planners", "robots", "compiled")
 
 
 def _public_functions(tree: ast.Module):
@@ -71,8 +71,8 @@ def test_mypy_checks_untyped_bodies_and_ruff_asks_for_annotations_and_docstrings
     assert settings["tool"]["mypy"]["check_untyped_defs"] is True
     lint = settings["tool"]["ruff"]["lint"]
     assert {"ANN201", "ANN204", "D"} <= set(lint["select"])
-    # on the library only: outside planners/ and robots/ both families are ignored
-    assert set(lint["extend-per-file-ignores"]["!{planners,robots}/**"]) == {"ANN", "D"}
+    # on the library only: outside planners/, robots/ and compiled/ both families are ignored
+    assert set(lint["extend-per-file-ignores"]["!{planners,robots,compiled}/**"]) == {"ANN", "D"}
 
 
 def _stages(dockerfile: str) -> list[tuple[str, str | None, str]]:

@@ -17,7 +17,7 @@ from toptraj import robots
 arm = robots.load("ur5")
 from toptraj.robots.catalog import catalog_names
 assert arm.dof == 6 and len(catalog_names()) >= 3 and robots.load("geering_2r").dof == 2
-for old in ("planners", "robots", "service", "client"):
+for old in ("planners", "robots", "service", "client", "compiled"):
     assert importlib.util.find_spec(old) is None, old
 print("ok", toptraj.__version__)
 """
@@ -34,7 +34,7 @@ def test_the_installed_package_works_from_anywhere_and_the_old_names_are_gone(tm
 def test_the_wheel_holds_toptraj_alone(tmp_path):
     source = tmp_path / "source"  # a copy: the build writes beside its sources
     skip = shutil.ignore_patterns("__pycache__", "*.pyc")
-    for part in ("toptraj", "robots", "planners", "service", "client"):
+    for part in ("toptraj", "robots", "planners", "service", "client", "compiled"):
         shutil.copytree(ROOT / part, source / part, symlinks=True, ignore=skip)
     for name in ("pyproject.toml", "README.md"):
         shutil.copy(ROOT / name, source / name)

@@ -7,7 +7,7 @@ import ast
 
 from tests.paths import ROOT
 
-PACKAGES = ("robots", "planners", "service", "client")
+PACKAGES = ("robots", "planners", "service", "client", "compiled")
 MAX_MODULE_LINES = 400
 MAX_FUNCTION_LINES = 60
 #: Functions still over the limit: each leaves this list when it is split (none today).

@@ -13,9 +13,9 @@ import collections
 import pathlib
 import sys
 
-ROOTS = ("robots", "planners", "service", "client")
+ROOTS = ("compiled", "robots", "planners", "service", "client")
 #: Layer of each top-level package: an import may point down or sideways, never up.
-PACKAGE_LAYER = {"robots": 0, "planners": 1, "service": 2, "client": 2}
+PACKAGE_LAYER = {"compiled": -1, "robots": 0, "planners": 1, "service": 2, "client": 2}
 #: Today's planners module (or folder) -> its room in the target tree.
 ROOM = {
     "toptraj.planners.runner": "runner",

@@ -15,7 +15,7 @@ from toptraj.planners.execution.deadline import Deadline
 from toptraj.service.planning import plan_request
 from toptraj.service.schemas.trajectories import TrajectoryRequest
 
-ROOTS = ("robots", "planners", "service", "client")
+ROOTS = ("compiled", "robots", "planners", "service", "client")
 
 
 def _module(frame) -> str | None:

@@ -4,7 +4,7 @@ state, the states beyond a threshold). No knowledge of paths or robots (``nogil`
 
 from __future__ import annotations
 
-from numba import njit
+from toptraj.compiled import njit
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

@@ -12,7 +12,8 @@ of a row share their slope q = -b / a).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from toptraj.compiled import njit
 
 _INF = np.inf
 #: |a| below this fraction of the row's scale |a| + |b| counts as zero (a zero-inertia point).

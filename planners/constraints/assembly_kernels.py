@@ -7,7 +7,8 @@ module only writes them (``nogil``, cached on disk, no knowledge of paths or rob
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from toptraj.compiled import njit
 
 
 @njit(cache=True, nogil=True)

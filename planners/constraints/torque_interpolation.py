@@ -32,7 +32,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
+
+from toptraj.compiled import njit
 
 if TYPE_CHECKING:
     from toptraj.planners.constraints.path_constraints import PathConstraints

@@ -5,7 +5,8 @@ values must decide instead. No knowledge of robots (``nogil``, cached on disk)."
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from toptraj.compiled import njit
 
 
 @njit(cache=True, nogil=True)
@@ -64,22 +65,3 @@ def gram_condition_numbers(stack, kappa):  # pragma: no cover - compiled
                 squares += inverse[row, column] ** 2
         kappa[index] = np.sqrt(trace * squares) / k
 
-
-@njit(cache=True, nogil=True)
-def singular_value_condition_numbers(stack, kappa):  # pragma: no cover - compiled
-    """kappa_F = sqrt(sum sigma_i^2 sum sigma_i^-2) / k of every matrix of ``stack`` (s, m, n)
-    into ``kappa`` (s,), over its k = min(m, n) singular values (LAPACK's SVD); inf where it is
-    rank-deficient to rounding (sigma_min <= 1e-12 sigma_max)."""
-    for index in range(stack.shape[0]):
-        values = np.linalg.svd(np.ascontiguousarray(stack[index]))[1]
-        largest = values.max()
-        smallest = values.min()
-        if smallest <= 1e-12 * max(largest, 1e-300):
-            kappa[index] = np.inf
-            continue
-        squares = 0.0
-        inverse_squares = 0.0
-        for value in values:
-            squares += value * value
-            inverse_squares += 1.0 / (value * value)
-        kappa[index] = np.sqrt(squares * inverse_squares) / values.shape[0]

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from toptraj.planners.kinematics.condition_kernels import gram_condition_numbers, singular_value_condition_numbers
+from toptraj.planners.kinematics.condition_kernels import gram_condition_numbers
 from toptraj.planners.kinematics.frame_jacobians import frame_jacobians
 from toptraj.robots import Robot
 
@@ -48,13 +48,22 @@ def frobenius_condition_number(jacobian: np.ndarray) -> float | np.ndarray:
     trusted = kappa <= GRAM_KAPPA  # False where not a number, too
     if not trusted.all():
         exact = ~trusted
-        chosen = np.ascontiguousarray(stack[exact])
-        values = np.empty(len(chosen))
-        singular_value_condition_numbers(chosen, values)
-        kappa[exact] = values
+        kappa[exact] = singular_value_condition_numbers(stack[exact])
     if jacobian.ndim == 2:
         return float(kappa[0])
     return kappa.reshape(jacobian.shape[:-2])
+
+
+def singular_value_condition_numbers(stack: np.ndarray) -> np.ndarray:
+    """kappa_F = sqrt(sum sigma_i^2 sum sigma_i^-2) / k of every matrix of ``stack`` (s, m, n)
+    over its k = min(m, n) singular values (numpy's LAPACK SVD, values only); inf where one is
+    rank-deficient to rounding (sigma_min <= 1e-12 sigma_max). Shape (s,)."""
+    values = np.linalg.svd(stack, compute_uv=False)  # (s, k), descending
+    largest, smallest = values[:, 0], values[:, -1]
+    with np.errstate(divide="ignore", invalid="ignore"):  # a zero matrix: inf, then set below
+        kappa = np.sqrt(np.sum(values * values, axis=1) * np.sum(1.0 / (values * values), axis=1)) / values.shape[1]
+    kappa[smallest <= 1e-12 * np.maximum(largest, 1e-300)] = np.inf
+    return kappa
 
 
 def characteristic_length(robot: Robot) -> float:

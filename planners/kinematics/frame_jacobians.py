@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.robots import Robot
 from toptraj.robots.chain import axis_rotation
 

@@ -11,8 +11,8 @@ motion start or end at a velocity tangent to the path. Continuous joints are int
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.paths.base import RANGE_SLACK, GeometricPath, PathPoints
 

@@ -5,7 +5,8 @@ robots (``nogil``, cached)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from toptraj.compiled import njit
 
 
 @njit(cache=True, nogil=True)

@@ -85,7 +85,7 @@ def test_a_value_of_another_json_type_is_refused_as_the_schema_says(client, timi
 # --- descriptions speak to the user ----------------------------------------------------------
 
 #: The project's packages: a dotted name starting with one of them names a module.
-PACKAGES = ("service", "planners", "robots", "client")
+PACKAGES = ("service", "planners", "robots", "client", "compiled")
 #: Their one import name.
 IMPORT_NAME = "toptraj"
 #: The server's inner workings, which a description has no need to name.

@@ -29,8 +29,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, interval_bounds, point_bounds
 from toptraj.planners.constraints.path_constraints import build_path_constraints, grid_rows, speed_bound
 from toptraj.planners.generators.search.curve import GridSplinePath

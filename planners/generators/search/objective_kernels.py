@@ -24,8 +24,8 @@ Shapes: control points (k, n_dof); grid N + 1 points; obstacle samples S + 1 poi
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.planners.constraints.admissible_kernels import interval_bounds, point_bounds
 from toptraj.planners.constraints.assembly_kernels import assemble_rows, velocity_bound
 from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, pair_minimum

@@ -22,8 +22,8 @@ length, instead of carrying a set of visited points per subset.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.planners.generators.search.bounds import forward_time, path_time
 
 # node columns

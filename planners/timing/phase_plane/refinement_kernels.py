@@ -10,8 +10,8 @@ scheme; these loops hold no knowledge of paths or robots (``nogil``, cached on d
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.planners.timing.phase_plane.split_kernels import _pieces
 
 _INF = np.inf

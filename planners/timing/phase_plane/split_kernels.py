@@ -7,7 +7,8 @@ per interval that bring a summed error to a target with the fewest in all (``_pi
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from toptraj.compiled import njit
 
 
 @njit(cache=True, nogil=True, inline="always")

@@ -11,8 +11,8 @@ such bound.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.planners.constraints.admissible_kernels import interval_bounds
 from toptraj.planners.timing.phase_plane.refinement_kernels import switch_excess
 

@@ -1,0 +1,27 @@
+"""Compiled kernels: numba's ``njit`` with its options, made where a kernel is first called.
+
+A kernel is a Python function over numpy arrays and scalars (``@njit(cache=True, nogil=True)``
+on its definition, as with numba). It runs, in this order of preference:
+
+* from the library compiled ahead of time at the install (``toptraj.compiled.build``, loaded by
+  ``toptraj.compiled.library``): the typical request's kernels, for the argument types they were
+  built for. Loading it takes about a millisecond and needs neither numba nor LLVM, so
+  ``toptraj plan`` of the typical request never imports numba (its import and first cache load
+  cost most of a second);
+* else numba's just-in-time compilation, loaded from numba's cache (``cache=True``), imported
+  only then.
+
+Both compile the same source with the same options through the same LLVM, so they give the same
+numbers to the bit (``tests/compiled/``).
+
+    from toptraj.compiled import njit
+
+    @njit(cache=True, nogil=True)
+    def kernel(values: np.ndarray) -> float: ...
+"""
+
+from __future__ import annotations
+
+from toptraj.compiled.kernel import Kernel, njit
+
+__all__ = ["Kernel", "njit"]

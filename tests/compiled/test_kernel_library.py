@@ -1,0 +1,113 @@
+"""The library compiled ahead of time (``toptraj.compiled``): ``toptraj plan`` of the typical
+request runs from it without importing numba, and answers exactly as numba's kernels do; a
+library built from other sources is not used; arguments of other types than it was built for
+go to numba, with numba's answer."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+
+import numpy as np
+import pytest
+
+from tests.paths import ROOT
+from toptraj.compiled import arguments, kernel, library
+from toptraj.compiled.build import build
+from toptraj.service.warmup import TYPICAL, _typical
+
+pytestmark = pytest.mark.skipif(
+    shutil.which((sysconfig.get_config_var("CC") or "cc").split()[0]) is None, reason="no C compiler to build the library with"
+)
+
+#: Plans the typical request as ``toptraj plan`` does, then says whether numba was imported.
+PLAN = """
+import sys
+from toptraj.service import commands
+commands.plan(sys.argv[1])
+sys.stdout.flush()
+print("numba imported" if "numba" in sys.modules else "numba not imported", file=sys.stderr)
+"""
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """A library of the typical request's kernels in a folder of its own."""
+    folder = tmp_path_factory.mktemp("kernels")
+    saved = os.environ.get("TOPTRAJ_KERNEL_LIBRARY")
+    os.environ["TOPTRAJ_KERNEL_LIBRARY"] = str(folder)
+    try:
+        build(_typical)
+        yield folder
+    finally:
+        if saved is None:
+            os.environ.pop("TOPTRAJ_KERNEL_LIBRARY", None)
+        else:
+            os.environ["TOPTRAJ_KERNEL_LIBRARY"] = saved
+        kernel.forget_library()
+
+
+def _plan(request_file, **env):
+    done = subprocess.run(
+        [sys.executable, "-c", PLAN, str(request_file)],
+        cwd=ROOT, env={**os.environ, **env}, capture_output=True, text=True, timeout=600,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    answer = json.loads(done.stdout)
+    answer.pop("solve_ms", None)
+    return answer, done.stderr.strip().splitlines()[-1]
+
+
+def test_the_typical_request_runs_from_the_library_without_numba_and_answers_as_numba(built, tmp_path):
+    request = tmp_path / "typical.json"
+    request.write_text(json.dumps(TYPICAL))
+    ahead, ahead_numba = _plan(request, TOPTRAJ_KERNEL_LIBRARY=str(built))
+    jit, jit_numba = _plan(request, TOPTRAJ_KERNEL_LIBRARY=str(built), TOPTRAJ_KERNELS="jit")
+    assert (ahead_numba, jit_numba) == ("numba not imported", "numba imported")
+    assert ahead == jit  # every number, to the bit (JSON keeps a float's shortest round trip)
+    assert len(ahead["samples"]["t"]) > 50
+
+
+def test_a_library_built_from_other_sources_is_not_used(built, monkeypatch):
+    manifest = json.loads((built / f"{library.MODULE}.json").read_text())
+    assert library.current(manifest)
+    source = next(iter(manifest["sources"]))
+    manifest["sources"][source] = "0" * 64
+    assert not library.current(manifest)
+    stale = built.parent / "stale"
+    stale.mkdir(exist_ok=True)
+    shutil.copy(built / manifest["library"], stale / manifest["library"])
+    (stale / f"{library.MODULE}.json").write_text(json.dumps(manifest))
+    monkeypatch.setenv("TOPTRAJ_KERNEL_LIBRARY", str(stale))
+    kernel.forget_library()
+    try:
+        assert library.functions_of("toptraj.planners.checks.limit_kernels", "utilization_pass") == {}
+    finally:
+        kernel.forget_library()
+
+
+def test_arguments_of_other_types_go_to_numba(built, monkeypatch):
+    from toptraj.planners.checks.limit_kernels import utilization_pass
+
+    monkeypatch.setenv("TOPTRAJ_KERNEL_LIBRARY", str(built))
+    kernel.forget_library()
+    try:
+        compiled = library.functions_of("toptraj.planners.checks.limit_kernels", "utilization_pass")
+        assert compiled, "the typical request checks its limits through this kernel"
+        rng = np.random.default_rng(3)
+        values, limits = rng.normal(size=(40, 6)), np.full(6, 1.5)
+        for dtype, in_library in ((np.float64, True), (np.float32, False)):  # float32: numba's own
+            args = (values.astype(dtype), limits.astype(dtype), 1.0, np.zeros(6), np.zeros(40, dtype=bool))
+            expected = (*args[:3], np.zeros(6), np.zeros(40, dtype=bool))
+            assert (arguments.key(args) in compiled) == in_library
+            result = utilization_pass(*args)
+            reference = utilization_pass.py_func(*expected)
+            np.testing.assert_array_equal(args[3], expected[3])
+            np.testing.assert_array_equal(args[4], expected[4])
+            assert result == reference
+    finally:
+        kernel.forget_library()
