@@ -6,7 +6,8 @@ The install runs it on the typical request (``toptraj.service.warmup``), after n
 holds the kernels: about ten seconds on two cores. Each exported function is a one-line Python
 wrapper around the kernel's numba dispatcher, so the kernel itself is compiled with its own
 options (``error_model="numpy"`` included) and its callees as numba compiles them; the
-library's functions and numba's give the same numbers to the bit (``tests/compiled/``).
+library's functions and numba's give the same numbers to the bit (``tests/compiled/``), and
+release the interpreter lock while they run, as ``nogil=True`` kernels do.
 
 It needs a C compiler (pycc links the module with the platform's): without one, ``BuildFailed``
 says so and every kernel keeps running from numba.
@@ -22,7 +23,7 @@ import sys
 import sysconfig
 import tempfile
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from toptraj.compiled import arguments, library
@@ -99,7 +100,7 @@ def _compile(exports: dict[str, tuple[Kernel, tuple, object]], scratch: Path) ->
         module.export(symbol, signature)(_wrapper(kernel))
     output = io.StringIO()
     try:
-        with contextlib.redirect_stdout(output), contextlib.redirect_stderr(output), warnings.catch_warnings():
+        with contextlib.redirect_stdout(output), contextlib.redirect_stderr(output), warnings.catch_warnings(), _releasing_the_lock():
             warnings.simplefilter("ignore")
             module.compile()
     except Exception as error:  # noqa: BLE001 - a compiler's failure, of whatever kind, is a failed build
@@ -108,6 +109,28 @@ def _compile(exports: dict[str, tuple[Kernel, tuple, object]], scratch: Path) ->
     if not built.is_file():
         raise BuildFailed(f"pycc wrote no {built.name}")
     return built
+
+
+@contextlib.contextmanager
+def _releasing_the_lock() -> Iterator[None]:
+    """pycc compiles its exports with numba's default flags, whose CPython wrappers hold the
+    interpreter lock through the call; within the block they release it, as ``nogil=True``
+    does for numba's own (every kernel is ``nogil``): a long kernel never stalls the server's
+    other threads."""
+    from numba.pycc import compiler
+
+    original = compiler.Flags
+
+    class Releasing(original):  # type: ignore[misc, valid-type]
+        def __init__(self, *args: object, **keywords: object) -> None:
+            super().__init__(*args, **keywords)
+            self.release_gil = True
+
+    setattr(compiler, "Flags", Releasing)  # noqa: B010 - a module's class, swapped for the block
+    try:
+        yield
+    finally:
+        setattr(compiler, "Flags", original)  # noqa: B010
 
 
 def _wrapper(kernel: Kernel) -> Callable:

@@ -64,6 +64,12 @@ class Kernel:
                 return function(*args)
         return self.dispatcher(*args)
 
+    def loaded(self) -> int:
+        """How many argument types this kernel runs for now without compiling or loading
+        anything: those of the library it has looked up, and those numba's dispatcher holds."""
+        held = len(self._ahead or {})
+        return held + (len(self._dispatcher.signatures) if self._dispatcher is not None else 0)
+
     def __getattr__(self, name: str) -> Any:
         # numba's own attributes (signatures, targetoptions, overloads, ...), from the dispatcher.
         if name.startswith("__") or name in ("_dispatcher", "_ahead", "py_func", "options"):

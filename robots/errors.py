@@ -139,6 +139,10 @@ class UploadStoreUnavailable(ToptrajError):
     is full, the database is damaged): a condition of the server, not of the request."""
 
 
+class InvalidUpload(ToptrajError):
+    """The options of an upload do not fit its URDF or are malformed."""
+
+
 class InvalidLimits(InvalidInput):
     """A limit override of the wrong length or value."""
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 from toptraj.robots.catalog import catalog_names, is_catalog_robot, load_catalog_robot
 from toptraj.robots.errors import UnknownRobot
 from toptraj.robots.robot import Robot
-from toptraj.robots.uploads import load_upload
 
 
 def load(name: str) -> Robot:
@@ -17,6 +16,8 @@ def load(name: str) -> Robot:
     """
     if is_catalog_robot(name):
         return load_catalog_robot(name)
+    from toptraj.robots.uploads import load_upload  # the store and its SQLite: uploads only
+
     robot = load_upload(name)
     if robot is None:
         raise UnknownRobot(name, catalog_names())

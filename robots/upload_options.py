@@ -45,7 +45,7 @@ import yaml
 
 from toptraj.robots import bounded_yaml
 from toptraj.robots.equipment import Payload
-from toptraj.robots.errors import ToptrajError, excerpt
+from toptraj.robots.errors import InvalidUpload, excerpt
 from toptraj.robots.ranges import limit_problem
 from toptraj.robots.srdf import allowed_pairs
 
@@ -58,10 +58,6 @@ _KNOWN_KEYS = set(_MAXIMA) | set(_FLAGS.values()) | _POSITION_KEYS
 _SCALING_KEYS = {"default_velocity_scaling_factor", "default_acceleration_scaling_factor"}
 #: Largest joint_limits text accepted, in characters.
 MAX_LIMITS_CHARS = bounded_yaml.MAX_CHARS
-
-
-class InvalidUpload(ToptrajError):
-    """The options of an upload do not fit its URDF or are malformed."""
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,7 @@ from toptraj.robots.errors import (
     CatalogRobotReadOnly,
     InvalidLimits,
     InvalidRobotName,
+    InvalidUpload,
     InvalidURDF,
     RobotConflict,
     UnknownRobot,
@@ -34,7 +35,6 @@ from toptraj.robots.errors import (
     excerpt,
 )
 from toptraj.robots.notes import Note
-from toptraj.robots.upload_options import InvalidUpload
 from toptraj.service.counts import counted
 from toptraj.service.field_hints import unknown_field_hint
 from toptraj.service.limit_wordings import torque_remedy

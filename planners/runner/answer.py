@@ -5,6 +5,7 @@ times, the phase plane, and the notes that tell what the numbers alone do not.""
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -14,9 +15,6 @@ from toptraj.planners.collision.clearance import Clearance
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.zones import BINDING_SHARE
 from toptraj.planners.errors import TimingFailed
-from toptraj.planners.generators.collocation.bang_bang import collocation_switches, switching_times
-from toptraj.planners.generators.collocation.report import CollocationReport
-from toptraj.planners.generators.search.report import SearchReport
 from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
 from toptraj.planners.paths.grid import spread_indices
@@ -32,6 +30,10 @@ from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.trajectory import Samples, sample_trajectory
 from toptraj.robots import JointLimits
 from toptraj.robots.notes import Note
+
+if TYPE_CHECKING:  # the generators' reports, imported where a generator ran
+    from toptraj.planners.generators.collocation.report import CollocationReport
+    from toptraj.planners.generators.search.report import SearchReport
 
 #: Seconds the sampling takes per sample and joint, with the checks, the conditioning and the
 #: encoding of the answer that follow it (measured about 0.3 us on ur5 at 236 to 23,409
@@ -71,13 +73,14 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     notes.extend(sampling_notes(result.duration, problem.sampling.dt, problem.sampling.exact_period, len(samples.t)))
     switching = timed.switching_times
     if switching is None and timed.method == "collocation" and getattr(problem.method, "torque_weight", None) == 0.0:
+        from toptraj.planners.generators.collocation.bang_bang import collocation_switches, switching_times
+
         read = collocation_switches(samples.t, samples.tau, problem.limits.torque, level=SATURATION_READ)
         switching = switching_times(read, robot.joint_names)
     s, sd, mvc = _phase_plane(timed.stretches)
     require_finite(timed.method, path_speed=sd, cost=timed.cost)
-    solver, search = timed.solver, timed.search
-    assert solver is None or isinstance(solver, CollocationReport)
-    assert search is None or isinstance(search, SearchReport)
+    solver = cast("CollocationReport | None", timed.solver)
+    search = cast("SearchReport | None", timed.search)
     return PlannedTrajectory(
         robot=robot.name, method=timed.method, joint_names=robot.joint_names, duration=result.duration, samples=samples,
         phase_plane=PhasePlane(s, sd, mvc, result.switch_points), peak_utilization=utilization,

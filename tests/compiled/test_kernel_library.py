@@ -111,3 +111,10 @@ def test_arguments_of_other_types_go_to_numba(built, monkeypatch):
             assert result == reference
     finally:
         kernel.forget_library()
+
+
+def test_the_library_releases_the_interpreter_lock_as_nogil_kernels_do(built):
+    """Its functions' CPython wrappers save the thread state (``PyEval_SaveThread``) around the
+    call, as numba's ``nogil=True`` wrappers do; pycc's own would hold the lock throughout."""
+    manifest = json.loads((built / f"{library.MODULE}.json").read_text())
+    assert b"PyEval_SaveThread" in (built / manifest["library"]).read_bytes()
