@@ -13,7 +13,6 @@ ships one (``shipped_pairs``).
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ElementTree
 from collections.abc import Iterable
 
 from toptraj.robots.errors import ToptrajError, excerpt
@@ -58,6 +57,8 @@ def srdf_pairs(text: str) -> frozenset[tuple[str, str]]:
         raise InvalidCollisionList(f"the SRDF must be a text of at most {MAX_SRDF_CHARS} characters, got {size}")
     if "<!DOCTYPE" in text.upper() or "<!ENTITY" in text.upper():
         raise InvalidCollisionList("the SRDF must not hold a <!DOCTYPE> or <!ENTITY>: remove it (SRDFs need none)")
+    import xml.etree.ElementTree as ElementTree  # here: most plans read no SRDF
+
     try:
         root = ElementTree.fromstring(text)
     except ElementTree.ParseError as error:

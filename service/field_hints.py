@@ -6,7 +6,6 @@ can say where to move it (``format`` at the top of a trajectory request belongs 
 
 from __future__ import annotations
 
-import difflib
 import functools
 import re
 import typing
@@ -131,6 +130,8 @@ def closest(given: str, allowed: typing.Iterable[str]) -> str | None:
     same = [name for name in allowed if name.casefold() == given.casefold()]
     if same:
         return same[0]
+    import difflib  # here: only a refused name needs it
+
     close = difflib.get_close_matches(given, allowed, n=1, cutoff=CLOSE)
     return close[0] if close else None
 
