@@ -66,6 +66,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     if warning is not None:
         notes.append(warning)
     utilization = _utilization(timed.stretches, problem.margin, problem.limits)
+    notes.extend(_jumping_jerk(problem.method, utilization))
     notes.extend(_unheld_defaults(problem, utilization))
     notes.extend(_unasked_limits(utilization, (*problem.kinds, *problem.unheld), problem.method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
@@ -213,6 +214,24 @@ def _utilization(stretches_: tuple[TimedStretch, ...], margin: float, limits: Jo
         if limit is not None and np.shape(limit) == np.shape(peak):
             peaks[kind] = np.where(~np.isfinite(limit) & (peak == 0.0), np.nan, peak)
     return {kind: (1.0 - margin) * peak for kind, peak in peaks.items()}
+
+
+def _jumping_jerk(method: TimingMethod | MotionGenerator, utilization: dict[str, np.ndarray]) -> list[str]:
+    """A time law whose acceleration jumps (cubic, trapezoidal: ``continuous_acceleration``
+    false) has an infinite jerk at each jump, whatever its duration; the finite peak between
+    the jumps would read as the motion's, so ``utilization`` loses its jerk and a note says why."""
+    if "jerk" not in utilization or method.continuous_acceleration:
+        return []
+    del utilization["jerk"]
+    law = getattr(method, "law", method)
+    profile = getattr(law, "profile", None)
+    steps = profile.acceleration_steps() if profile is not None else ()
+    where = f" at tau = {', '.join(f'{tau:.4g}' for tau in steps)} (as a fraction of each stretch's duration)" if len(steps) else ""
+    name = profile.description if profile is not None else f"{method.name} law"
+    return [
+        f"the {name}'s acceleration jumps{where}, so its jerk is infinite there: peak_utilization leaves the jerk out "
+        "(quintic, cycloidal, trapezoidal with a cycloidal blend, ruckig and jerk_limited keep the jerk finite)"
+    ]
 
 
 def _unheld_defaults(problem: Problem, utilization: dict[str, np.ndarray]) -> list[Note]:
