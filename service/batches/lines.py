@@ -69,7 +69,7 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
         return RequestLine(number, _digest(data), problem=(status, problem_body(status, title, f"line {number}: {detail}")))
 
     if not data:
-        return refused(400, "Empty line", "the line is blank; put one request (a JSON object) on each line, or remove the line")
+        return refused(422, "Invalid request", "the line is blank; put one request (a JSON object) on each line, or remove the line")
     depth = nesting_depth(data)
     if depth > MAX_DEPTH:
         return refused(400, "Too deeply nested", f"the line {too_deep(depth)}")
@@ -79,9 +79,9 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
         return refused(422, "Invalid request", str(error))
     except json.JSONDecodeError as error:
         # a line is one line of JSON text: its column is the place
-        return refused(400, "Malformed JSON", decode_error(error).replace("line 1, column", "column", 1)[:_MAX_DETAIL])
+        return refused(422, "Invalid request", decode_error(error).replace("line 1, column", "column", 1)[:_MAX_DETAIL])
     except ValueError as error:  # no JSON, or no UTF-8
-        return refused(400, "Malformed JSON", f"the line is not JSON (UTF-8): {str(error)[:_MAX_DETAIL]}")
+        return refused(422, "Invalid request", f"the line is not JSON (UTF-8): {str(error)[:_MAX_DETAIL]}")
     if not isinstance(body, dict):
         return refused(
             422, "Invalid request", f"the line is a JSON {type(body).__name__}; a request is a JSON object (a POST /v1/trajectories body)"

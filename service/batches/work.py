@@ -49,7 +49,7 @@ def answer(text: str, budget_s: float, max_body_bytes: int | None = None) -> tup
     try:
         body = orjson.loads(text)
     except orjson.JSONDecodeError as error:
-        return 400, problem_body(400, "Malformed JSON", f"the line is not JSON: {str(error)[:200]}")
+        return 422, problem_body(422, "Invalid request", f"the line is not JSON: {str(error)[:200]}")
     schema = CompareRequest if isinstance(body, dict) and "methods" in body else TrajectoryRequest
     try:
         if schema is CompareRequest:

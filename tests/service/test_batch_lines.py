@@ -97,23 +97,23 @@ def _hostile_file(path: Path, monkeypatch) -> dict[int, int]:
     deep = "[" * 1300 + "]" * 1300  # 2.6 KB: RecursionError in a recursive parser
     lines: list[tuple[bytes, int]] = [
         (b"\xef\xbb\xbf" + json.dumps(GOOD).encode(), 200),  # a byte order mark before the first line
-        (b"not json", 400),
+        (b"not json", 422),  # as POST /v1/trajectories answers a body that is no JSON
         (deep.encode(), 400),
         (b'{"robot": "ur5", "path": ' + b"[" * 60 + b"]" * 60 + b"}", 400),
-        (b"", 400),
-        (b"   \t ", 400),
+        (b"", 422),
+        (b"   \t ", 422),
         (b"42", 422),
         (b"[1, 2]", 422),
         (b'"a string"', 422),
         (b"null", 422),
         (json.dumps(GOOD, indent=None, separators=(", ", ": ")).encode(), 200),  # the same request again
-        (b'{"robot": "\xff\xfe"}', 400),  # not UTF-8
+        (b'{"robot": "\xff\xfe"}', 422),  # not UTF-8
         (b'{"robot": "ur5", "path": {"waypoints": "no"}}', 422),
         (json.dumps({**GOOD, "robot": "nope"}).encode(), 404),
         (b'{"robot": "' + b"x" * 30_000 + b'"}', 413),
         (json.dumps(OTHER).encode(), 200),
         (json.dumps(GOOD).encode(), 200),  # and again
-        (b'{"robot": "ur5", "path": {"waypoints": [[0,0,0,0,0,0]]}', 400),  # cut short
+        (b'{"robot": "ur5", "path": {"waypoints": [[0,0,0,0,0,0]]}', 422),  # cut short
         (b"{" + b'"a": {' * 40 + b"}" * 40 + b"}", 400),
         (b'{"robot": "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[", "path": 1}', 422),  # brackets in a string are no nesting
     ]

@@ -76,7 +76,7 @@ def test_errors_are_lines_too(tmp_path):
     )
     run_batch(requests, tmp_path / "results.jsonl")
     results = _results(tmp_path / "results.jsonl")
-    assert {n: r["status"] for n, r in results.items()} == {1: 400, 2: 404, 3: 400, 4: 422, 5: 422}
+    assert {n: r["status"] for n, r in results.items()} == {1: 422, 2: 404, 3: 422, 4: 422, 5: 422}
     assert "outside the limits" in results[5]["body"]["detail"] and results[2]["body"]["title"] == "Unknown robot"
 
 

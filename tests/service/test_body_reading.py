@@ -82,5 +82,5 @@ def test_a_batch_line_that_is_no_json_says_its_line_and_column():
     line = parse_line(7, b"{'robot': 'ur5'}")
     assert line.problem is not None
     status, problem = line.problem
-    assert status == 400
+    assert status == 422  # as POST /v1/trajectories answers a body that is no JSON
     assert json.loads(problem)["detail"].startswith("line 7: column 2: Expecting property name enclosed in double quotes (JSON needs double quotes")

@@ -91,7 +91,7 @@ def test_a_batch_line_giving_a_key_twice_is_its_own_422():
 
 def test_a_batch_line_with_nan_is_still_no_json():
     status, _ = parse_line(1, b'{"robot": "ur5", "path": {"waypoints": [[NaN]]}}').problem
-    assert status == 400
+    assert status == 422
 
 
 def test_the_cli_refuses_a_key_given_twice(tmp_path, capsys):

@@ -51,13 +51,13 @@ def test_serve_on_a_busy_port_says_so_and_which_option_to_pass(capsys):
 
 def test_a_resumed_batch_with_nothing_left_says_so(tmp_path):
     requests, output = tmp_path / "requests.jsonl", tmp_path / "results.jsonl"
-    requests.write_text("{'robot': 'ur5'}\n")  # answered without planning: a 400 line
+    requests.write_text("{'robot': 'ur5'}\n")  # answered without planning: a 422 line
     run_batch(requests, output, pool=lambda: None)
     stream = io.StringIO()
     report = run_batch(requests, output, pool=lambda: None, progress=progress_bar(stream))
     assert report.skipped == 1
     assert stream.getvalue() == "nothing left to do: every request already has its result in the output\n"
-    assert json.loads(output.read_text())["status"] == 400
+    assert json.loads(output.read_text())["status"] == 422
 
 
 def test_the_progress_line_leaves_out_the_time_left_until_there_is_a_rate():
