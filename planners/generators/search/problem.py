@@ -207,8 +207,10 @@ CHECK_EVERY = 4_096
 
 
 def _states(graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: PieceBounds, usable, deadline: Deadline = NO_DEADLINE):
-    """The search's states and moves (``SearchProblem``), the cost-to-go h2 of each state and
-    the point where its fixed curve ends; ``deadline`` checked every ``CHECK_EVERY`` spans."""
+    """The search's states and moves (``SearchProblem``), the cost-to-go h2 of each state toward
+    ``graph.goals`` (``inf`` where none of them is reachable: the subsets there are discarded by
+    t1 at once) and the point where its fixed curve ends; ``deadline`` checked every
+    ``CHECK_EVERY`` spans."""
     n_turns = len(turn_in)
     starts = np.flatnonzero(graph.edge_from == graph.start)
     goal = np.zeros(len(graph.points), dtype=bool)
@@ -234,7 +236,8 @@ def _states(graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: Piece
         source.append(before)
         target.append(after)
         weight.append(bounds.t2[k])
-    for turn in np.flatnonzero(last >= 0):
+    # the last spans into this variant's goal only: the others' end where no grid path to it goes
+    for turn in np.flatnonzero((last >= 0) & goal[graph.edge_to[turn_out]]):
         source.append(int(turn))
         target.append(-1)
         weight.append(bounds.t2[last[turn]])
