@@ -84,11 +84,19 @@ def start(sim, fsim, counters, best, best_x, maxfev, begin, end, fixed):  # prag
 
 @njit(cache=True, nogil=True)
 def _converged(sim, fsim, xatol, fatol):  # pragma: no cover - compiled
+    """SciPy's test: every vertex within ``xatol`` of the best and every objective within
+    ``fatol`` of its (a nan anywhere, as ``np.max`` propagates it, is no convergence)."""
     worst_x, worst_f = 0.0, 0.0
     for k in range(1, sim.shape[0]):
         for j in range(sim.shape[1]):
-            worst_x = max(worst_x, abs(sim[k, j] - sim[0, j]))
-        worst_f = max(worst_f, abs(fsim[0] - fsim[k]))
+            step = abs(sim[k, j] - sim[0, j])
+            if np.isnan(step):
+                return False
+            worst_x = max(worst_x, step)
+        gap = abs(fsim[0] - fsim[k])
+        if np.isnan(gap):
+            return False
+        worst_f = max(worst_f, gap)
     return worst_x <= xatol and worst_f <= fatol
 
 
