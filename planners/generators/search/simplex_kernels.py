@@ -1,9 +1,10 @@
 """Nelder-Mead over the compiled objective of the local optimization
 (``toptraj.planners.generators.search.local``, ``objective_kernels.objective_value``) in one
-compiled loop: SciPy's ``_minimize_neldermead`` (Nelder & Mead 1965; with ``adaptive``, the
-coefficients of Gao & Han 2012, eqs. 4.1 to 4.4) step for step, the same arithmetic in the same
-order, so that it walks the same simplices and spends the same evaluations, without a Python
-call per evaluation (a tenth of an evaluation's time on the two-joint arm).
+compiled loop: SciPy's ``_minimize_neldermead`` (Nelder & Mead 1965; with ``adaptive``, Gao &
+Han 2012's coefficients for n variables: reflection 1, expansion 1 + 2/n, contraction
+3/4 - 1/(2n), shrink 1 - 1/n) step for step, the same arithmetic in the same order, so that
+it walks the same simplices and spends the same evaluations, without a Python call per
+evaluation (a tenth of an evaluation's time on the two-joint arm).
 
 What SciPy does, and so this loop: the vertices (N + 1, N) sorted by objective (``fsim``,
 (N + 1,)); each iteration stops first when the simplex has converged (every vertex within
