@@ -111,10 +111,11 @@ def _typical() -> None:
 
 
 def _search_objective() -> None:
-    """The search's local-optimization objective (``toptraj.planners.generators.search.objective_kernels``):
-    one evaluation on the Geering arm around a sphere, in the signature every search's takes
-    (compiling it takes half a minute on a busy two-core machine, which a first search would
-    otherwise spend of its budget)."""
+    """The search's local-optimization objective (``toptraj.planners.generators.search.objective_kernels``)
+    and its compiled Nelder-Mead (``simplex_kernels``): one evaluation and a few steps on the
+    Geering arm around a sphere, in the signature every search's takes (compiling them takes
+    about a minute on a busy two-core machine, which a first search would otherwise spend of its
+    budget)."""
     import numpy as np
 
     from toptraj import robots
@@ -122,11 +123,14 @@ def _search_objective() -> None:
     from toptraj.planners.execution.deadline import NO_DEADLINE
     from toptraj.planners.generators.search.local_objective import Objective
     from toptraj.planners.generators.search.local_outcome import LocalSettings
+    from toptraj.planners.generators.search.simplex import compiled_nelder_mead
 
     arm = robots.load("geering_2r")
     sphere = SphereObstacle(np.array([0.52, 0.28, 0.0]), 0.05)
     objective = Objective(arm, arm.limits, ("torque",), np.zeros(2), np.array([0.76, 0.0]), (sphere,), 0.01, LocalSettings(), NO_DEADLINE)
-    objective.value(np.array([0.25, 0.0, 0.5, 0.0]))
+    x = np.array([0.25, 0.0, 0.5, 0.0])
+    objective.value(x)
+    compiled_nelder_mead(objective, np.vstack([x, x + 0.02 * np.eye(4)]), 12, 1e-4, 1e-6, False)
 
 
 def _ahead_of_time() -> str | None:

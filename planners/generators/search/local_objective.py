@@ -126,13 +126,19 @@ class Objective:
         """J at x: the fused path where it applies, else the reference path."""
         if self._fixed is None:
             return self.reference(x)
+        return float(objective_value(np.ascontiguousarray(x, dtype=float), *self.fused_arguments()))
+
+    def fused_arguments(self) -> tuple:
+        """The arguments of ``objective_value`` after the interior control points, for the
+        current knots (the fused path only)."""
+        assert self._fixed is not None
         if self._weights is None:
             self._weights = basis_weights(self._interior)
         chain, limits, velocity_limited, distances, settings = self._fixed
-        return float(objective_value(
-            np.ascontiguousarray(x, dtype=float), self.start, self.goal, self._weights, self.grid, self.samples, chain, limits,
-            velocity_limited, distances, settings, INFEASIBLE, SLACK, BOUNDARY_SLACK, NOTHING_KEPT, NOTHING_BEFORE,
-        ))
+        return (
+            self.start, self.goal, self._weights, self.grid, self.samples, chain, limits, velocity_limited, distances, settings,
+            INFEASIBLE, SLACK, BOUNDARY_SLACK, NOTHING_KEPT, NOTHING_BEFORE,
+        )
 
     def __call__(self, x: np.ndarray) -> float:
         self.deadline.check()

@@ -68,7 +68,9 @@ def global_search(
     paths faster than ``VARIANT_CAP`` times the best found before it (the cap prunes its
     subsets from the start). With a budget, the variants' searches share ``SEARCH_SHARE`` of
     the time left, each stopping at its part with the grid paths it found: that is what ends
-    a variant no grid path reaches, which would otherwise run until ``max_expansions``.
+    a variant that no grid path reaches though the graph does (the cost to go allows loops), which
+    would otherwise run until ``max_expansions``. A variant the graph does not reach is
+    discarded at once: its cost to go is infinite from every start.
 
     The search's memory is admitted before it by the runner (``Search.estimate``, against
     ``options.memory_bytes``: ``toptraj.planners.runner.admission``).

@@ -25,7 +25,8 @@ from toptraj.planners.generators.search.graph import (
     lattice_graph,
     roadmap_graph,
 )
-from toptraj.planners.generators.search.pieces import DIRECT, FIRST, LAST, MIDDLE, Pieces, build_pieces
+from toptraj.planners.generators.search.pieces import Pieces, build_pieces
+from toptraj.planners.generators.search.states import search_states
 from toptraj.robots import JointLimits, Robot
 
 GRAPH_KINDS = ("auto", "lattice", "roadmap")
@@ -106,22 +107,6 @@ def _check_apart(robot: Robot, name: str, q: np.ndarray) -> None:
         )
 
 
-def _cost_to_go(n_states: int, source: np.ndarray, target: np.ndarray, weight: np.ndarray) -> np.ndarray:
-    """Least cost from each state to a goal over arcs (source, target, weight), target -1 the
-    goal: Dijkstra from the goal over the reversed arcs."""
-    if not len(source):
-        return np.full(n_states, np.inf)
-    from scipy.sparse import csr_matrix  # here: scipy.sparse is imported by the searches only
-    from scipy.sparse.csgraph import dijkstra
-
-    target = np.where(target < 0, n_states, target)
-    finite = np.isfinite(weight)
-    reversed_arcs = csr_matrix(
-        (weight[finite] + 1e-300, (target[finite], source[finite])), shape=(n_states + 1, n_states + 1)
-    )  # 1e-300: sparse matrices drop zero weights
-    return dijkstra(reversed_arcs, directed=True, indices=n_states)[:n_states]
-
-
 def build_problem(
     robot: Robot,
     limits: JointLimits,
@@ -191,7 +176,7 @@ def toward_goal(problem: SearchProblem, goal: int, deadline: Deadline = NO_DEADL
 def _with_states(problem: SearchProblem, graph: SearchGraph, deadline: Deadline = NO_DEADLINE) -> SearchProblem:
     """``problem`` with the states, moves and costs to go toward ``graph.goals``."""
     bounds = problem.bounds
-    successors, start_moves, state_point, h2, cut = _states(
+    successors, start_moves, state_point, h2, cut = search_states(
         graph, problem.turn_in, problem.turn_out, problem.pieces, bounds, problem.usable, deadline
     )
     goal_points = graph.points[graph.goals]
@@ -200,52 +185,3 @@ def _with_states(problem: SearchProblem, graph: SearchGraph, deadline: Deadline 
     return dataclasses.replace(
         problem, graph=graph, start_moves=start_moves, successors=successors, state_point=state_point, h1=h1, h2=h2
     )
-
-
-#: Spans handled between two deadline checks while the states are built.
-CHECK_EVERY = 4_096
-
-
-def _states(graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: PieceBounds, usable, deadline: Deadline = NO_DEADLINE):
-    """The search's states and moves (``SearchProblem``), the cost-to-go h2 of each state and
-    the point where its fixed curve ends; ``deadline`` checked every ``CHECK_EVERY`` spans."""
-    n_turns = len(turn_in)
-    starts = np.flatnonzero(graph.edge_from == graph.start)
-    goal = np.zeros(len(graph.points), dtype=bool)
-    goal[graph.goals] = True
-    start_state = {int(e): n_turns + k for k, e in enumerate(starts)}
-    n_states = n_turns + len(starts)
-    state_point = np.concatenate([graph.edge_to[turn_out], graph.edge_to[starts]])
-    last = np.full(n_turns, -1)
-    keep = usable & (pieces.kind == LAST)
-    last[pieces.turn_in[keep]] = np.flatnonzero(keep)
-    direct = {int(pieces.edge[k]): int(k) for k in np.flatnonzero(usable & (pieces.kind == DIRECT))}
-    successors: list[list[tuple[int, int, int]]] = [[] for _ in range(n_states)]
-    source, target, weight = [], [], []
-    for counted, k in enumerate(np.flatnonzero(usable & ((pieces.kind == FIRST) | (pieces.kind == MIDDLE)))):
-        if counted % CHECK_EVERY == 0:
-            deadline.check()
-        after = int(pieces.turn_out[k])
-        before = int(pieces.turn_in[k]) if pieces.kind[k] == MIDDLE else start_state[int(turn_in[after])]
-        ending = int(last[after]) if goal[graph.edge_to[turn_out[after]]] else -1
-        if goal[graph.edge_to[turn_out[after]]] and ending < 0:
-            continue  # the last span into the goal is not usable
-        successors[before].append((after, int(k), ending))
-        source.append(before)
-        target.append(after)
-        weight.append(bounds.t2[k])
-    for turn in np.flatnonzero(last >= 0):
-        source.append(int(turn))
-        target.append(-1)
-        weight.append(bounds.t2[last[turn]])
-    h2 = _cost_to_go(n_states, np.array(source, dtype=int), np.array(target, dtype=int), np.array(weight, dtype=float))
-    start_moves = []
-    for e in starts:
-        into_goal = bool(goal[graph.edge_to[e]])
-        start_moves.append((int(e), -1 if into_goal else start_state[int(e)], direct.get(int(e), -1)))
-    P = graph.points
-    cut = np.concatenate([
-        (P[graph.edge_from[turn_in]] + 4.0 * P[graph.edge_to[turn_in]] + P[graph.edge_to[turn_out]]) / 6.0,
-        P[np.full(len(starts), graph.start)],
-    ])
-    return successors, start_moves, state_point, h2, cut

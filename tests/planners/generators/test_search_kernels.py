@@ -56,8 +56,9 @@ def test_the_compiled_search_expands_and_finds_what_the_python_loop_did(cells, o
 
 
 def test_the_node_table_stops_growing_at_its_most_bytes(monkeypatch):
-    """A variant no grid path reaches, searched without a cap, fills the node table: at
-    ``MAX_NODE_BYTES`` the search stops, incomplete, before ``max_expansions``."""
+    """The variant one revolution up, reached only the long way round (some 21,000 subsets
+    expanded), fills a node table of a mebibyte first: at ``MAX_NODE_BYTES`` the search stops,
+    incomplete, before ``max_expansions``."""
     import toptraj.planners.generators.search.node_table as node_table
 
     monkeypatch.setattr(node_table, "MAX_NODE_BYTES", 2**20)
