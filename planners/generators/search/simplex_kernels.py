@@ -26,8 +26,8 @@ iterations); ``best`` and ``best_x`` the least objective evaluated and its point
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from toptraj.compiled import njit
 from toptraj.planners.generators.search.objective_kernels import objective_value
 
 # counters
