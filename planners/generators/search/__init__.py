@@ -26,32 +26,11 @@ the search's kernels preloaded in the workers' fork server (``warm``), its reque
 about 950 times one bare TOPP-RA solve.
 """
 
-from __future__ import annotations
-
-import importlib
-from typing import TYPE_CHECKING, Any
-
-if TYPE_CHECKING:
-    from toptraj.planners.generators.search.branch_and_bound import branch_and_bound, enumerate_grid_paths
-    from toptraj.planners.generators.search.curve import GridSplinePath
-    from toptraj.planners.generators.search.graph import SearchOptions
-    from toptraj.planners.generators.search.outcome import GridPath, SearchResult, SearchStatistics
-    from toptraj.planners.generators.search.problem import SearchProblem, build_problem
-
-#: The package's names and their modules, imported when a name is first asked for: a module of
-#: the search read alone (its options' defaults, its report) does not import the search.
-_MODULES = {
-    "branch_and_bound": "branch_and_bound", "enumerate_grid_paths": "branch_and_bound", "GridSplinePath": "curve",
-    "SearchOptions": "graph", "GridPath": "outcome", "SearchResult": "outcome", "SearchStatistics": "outcome",
-    "SearchProblem": "problem", "build_problem": "problem",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _MODULES:
-        return getattr(importlib.import_module(f"{__name__}.{_MODULES[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
+from toptraj.planners.generators.search.branch_and_bound import branch_and_bound, enumerate_grid_paths
+from toptraj.planners.generators.search.curve import GridSplinePath
+from toptraj.planners.generators.search.graph import SearchOptions
+from toptraj.planners.generators.search.outcome import GridPath, SearchResult, SearchStatistics
+from toptraj.planners.generators.search.problem import SearchProblem, build_problem
 
 __all__ = [
     "GridPath",
