@@ -10,8 +10,8 @@ import pytest
 
 from toptraj import robots
 from toptraj.planners import LimitRequest, WaypointPath, build_problem, plan
-from toptraj.planners.problem.time_law import TimeLaw
 from toptraj.planners.problem.problem import Sampling
+from toptraj.planners.problem.time_law import TimeLaw
 
 WAYPOINTS = np.array([[0.0, -1.2, 1.0, 0.0, 0.3, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3]])
 
