@@ -217,19 +217,21 @@ def _utilization(stretches_: tuple[TimedStretch, ...], margin: float, limits: Jo
 
 
 def _jumping_jerk(method: TimingMethod | MotionGenerator, utilization: dict[str, np.ndarray]) -> list[str]:
-    """A time law whose acceleration jumps (cubic, trapezoidal: ``continuous_acceleration``
-    false) has an infinite jerk at each jump, whatever its duration; the finite peak between
-    the jumps would read as the motion's, so ``utilization`` loses its jerk and a note says why."""
+    """A motion whose acceleration jumps (``continuous_acceleration`` false: the cubic and
+    trapezoidal laws, a collocation's bang-bang answer) has an infinite jerk at each jump,
+    whatever its duration; the finite peak between the jumps would read as the motion's, so
+    ``utilization`` loses its jerk and a note says why."""
     if "jerk" not in utilization or method.continuous_acceleration:
         return []
     del utilization["jerk"]
-    law = getattr(method, "law", method)
-    profile = getattr(law, "profile", None)
-    steps = profile.acceleration_steps() if profile is not None else ()
-    where = f" at tau = {', '.join(f'{tau:.4g}' for tau in steps)} (as a fraction of each stretch's duration)" if len(steps) else ""
-    name = profile.description if profile is not None else f"{method.name} law"
+    profile = getattr(getattr(method, "law", method), "profile", None)
+    if profile is not None:
+        where = ", ".join(f"{tau:.4g}" for tau in profile.acceleration_steps())
+        jumps = f"the {profile.description}'s acceleration jumps at tau = {where} (as a fraction of each stretch's duration)"
+    else:
+        jumps = f"{method.name}'s acceleration jumps where the limit it rides on switches"
     return [
-        f"the {name}'s acceleration jumps{where}, so its jerk is infinite there: peak_utilization leaves the jerk out "
+        f"{jumps}, so its jerk is infinite there: peak_utilization leaves the jerk out "
         "(quintic, cycloidal, trapezoidal with a cycloidal blend, ruckig and jerk_limited keep the jerk finite)"
     ]
 

@@ -34,9 +34,9 @@ class PhasePlanePublic(BaseModel):
 class UtilizationPublic(BaseModel):
     """Peak |value| / limit per joint over a dense resampling (1.0: the limit binds), against
     the limit in force at each state (a zone's inside it); jerk for timings with a finite jerk
-    (jerk_limited, ruckig, the time laws whose acceleration is continuous: not cubic or
-    trapezoidal, whose jerk is infinite where their acceleration jumps); null where a joint has no
-    finite limit of that kind."""
+    (jerk_limited, ruckig, the time laws whose acceleration is continuous: not cubic, trapezoidal
+    or a collocation's bang-bang motion, whose jerk is infinite where their acceleration jumps);
+    null where a joint has no finite limit of that kind."""
 
     velocity: list[float | None] = Field(description="Peak |qd| / velocity limit per joint; null for a joint without a finite velocity limit.")
     acceleration: list[float | None] = Field(description="Peak |qdd| / acceleration limit per joint; null for a joint without a finite acceleration limit.")
