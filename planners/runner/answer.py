@@ -217,22 +217,21 @@ def _utilization(stretches_: tuple[TimedStretch, ...], margin: float, limits: Jo
 
 
 def _jumping_jerk(method: TimingMethod | MotionGenerator, utilization: dict[str, np.ndarray]) -> list[str]:
-    """A motion whose acceleration jumps (``continuous_acceleration`` false: the cubic and
-    trapezoidal laws, a collocation's bang-bang answer) has an infinite jerk at each jump,
-    whatever its duration; the finite peak between the jumps would read as the motion's, so
-    ``utilization`` loses its jerk and a note says why."""
+    """A motion whose acceleration jumps (``continuous_acceleration`` false) has an infinite
+    jerk at each jump, whatever its duration; the finite peak between the jumps would read as
+    the motion's, so ``utilization`` loses its jerk, as a phase-plane answer has none. A time
+    law's answer (cubic, trapezoidal), whose law was chosen, says why in a note."""
     if "jerk" not in utilization or method.continuous_acceleration:
         return []
     del utilization["jerk"]
     profile = getattr(getattr(method, "law", method), "profile", None)
-    if profile is not None:
-        where = ", ".join(f"{tau:.4g}" for tau in profile.acceleration_steps())
-        jumps = f"the {profile.description}'s acceleration jumps at tau = {where} (as a fraction of each stretch's duration)"
-    else:
-        jumps = f"{method.name}'s acceleration jumps where the limit it rides on switches"
+    if profile is None:  # a collocation's bang-bang motion: no jerk, as phase_plane's
+        return []
+    where = ", ".join(f"{tau:.4g}" for tau in profile.acceleration_steps())
     return [
-        f"{jumps}, so its jerk is infinite there: peak_utilization leaves the jerk out "
-        "(quintic, cycloidal, trapezoidal with a cycloidal blend, ruckig and jerk_limited keep the jerk finite)"
+        f"the {profile.description}'s acceleration jumps at tau = {where} (as a fraction of each stretch's duration), "
+        "so its jerk is infinite there: peak_utilization leaves the jerk out (quintic, cycloidal, trapezoidal with a "
+        "cycloidal blend, ruckig and jerk_limited keep the jerk finite)"
     ]
 
 

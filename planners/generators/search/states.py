@@ -82,7 +82,8 @@ def _grouped(n_states: int, before: np.ndarray, after: np.ndarray, span: np.ndar
 
 
 def search_states(
-    graph: SearchGraph, turn_in, turn_out, pieces: Pieces, bounds: PieceBounds, usable, deadline: Deadline = NO_DEADLINE
+    graph: SearchGraph, turn_in: np.ndarray, turn_out: np.ndarray, pieces: Pieces, bounds: PieceBounds, usable: np.ndarray,
+    deadline: Deadline = NO_DEADLINE,
 ) -> States:
     """The search's states and moves toward ``graph.goals`` (module docstring), ``deadline``
     checked before and after."""
