@@ -13,8 +13,7 @@ from toptraj import robots
 from toptraj.planners import Deadline, PlannedTrajectory, plan
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE
-from toptraj.planners.execution.memory import MAX_SAMPLES
-from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY, MAX_SAMPLES
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
 from toptraj.service.equipping import equipment_body, equipped_robot, payload_named

@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import TYPE_CHECKING
 
-from toptraj.planners.generators.collocation.report import CollocationReport
-from toptraj.planners.generators.search.report import LocalReport, SearchReport
 from toptraj.planners.trajectory import SwitchingTimes
+
+if TYPE_CHECKING:  # the generators' reports: a typical request imports neither generator
+    from toptraj.planners.generators.collocation.report import CollocationReport
+    from toptraj.planners.generators.search.report import LocalReport, SearchReport
 
 
 def solver_body(report: CollocationReport | None) -> dict | None:

@@ -8,7 +8,7 @@ from pathlib import Path
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY
 from toptraj.robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
 from toptraj.robots.uploads import DEFAULT_CACHE_SIZE
 from toptraj.service.web import GUIDE

@@ -17,6 +17,10 @@ within the same figure (``largest_grid``).
 
 from __future__ import annotations
 
+#: Default memory cap of one search, in bytes (``toptraj.planners.generators.search.memory``; the service's
+#: ``search_memory_bytes``): 2 GiB, which serves every arm's default search (the three-joint
+#: lattice's, estimated at 1.6 GiB, peaks at 1.45 GB).
+DEFAULT_SEARCH_MEMORY = 2**31
 #: The most bytes one planning may take by its estimate: 140,000 grid intervals times joints at
 #: toppra's 2,300 bytes each.
 MEMORY_CAP_BYTES = 140_000 * 2_300

@@ -19,7 +19,7 @@ import orjson
 from toptraj import robots
 from toptraj.planners import Deadline
 from toptraj.planners.execution.deadline import Progress
-from toptraj.planners.generators.search.graph import DEFAULT_SEARCH_MEMORY
+from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY
 from toptraj.service.jobs.answer_room import AnswerRoom, kept_results
 from toptraj.service.planning import compare_request, encode_json, plan_request, render
 from toptraj.service.problems import RequestRefused

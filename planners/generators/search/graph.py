@@ -29,6 +29,7 @@ import numpy as np
 
 from toptraj.planners.errors import InvalidRequest, OutOfRange, TooLarge, WrongLength
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY
 from toptraj.robots import Robot
 
 #: Grid intervals per joint across the search region when a request names none, by joint count.
@@ -43,10 +44,6 @@ DEFAULT_MAX_TURN = {"lattice": 45.0, "roadmap": 90.0}
 CHECK_EVERY = 1_024
 #: Joints beyond which ``graph = "auto"`` takes a roadmap.
 LATTICE_MAX_JOINTS = 3
-#: Default memory cap of one search, in bytes (``toptraj.planners.generators.search.memory``; the service's
-#: ``search_memory_bytes``): 2 GiB, which serves every arm's default search (the three-joint
-#: lattice's, estimated at 1.6 GiB, peaks at 1.45 GB).
-DEFAULT_SEARCH_MEMORY = 2**31
 
 
 @dataclass(frozen=True)
