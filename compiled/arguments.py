@@ -33,7 +33,7 @@ def _item(value: Any) -> Any:
     if isinstance(value, np.ndarray):
         flags = value.flags
         layout = "C" if flags.c_contiguous else "F" if flags.f_contiguous else "A"
-        if not value.dtype.isnative or value.dtype.hasobject:
+        if not value.dtype.isnative or value.dtype.hasobject or value.dtype.fields is not None:
             return None
         return ("array", value.dtype.str, value.ndim, layout, not flags.writeable)
     if isinstance(value, tuple):

@@ -45,27 +45,52 @@ def build(run: Callable[[], object]) -> int:
     if not exports:
         raise BuildFailed("the run called no kernel from Python")
     target = library.folder()
-    target.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=target) as scratch:
-        built = _compile(exports, Path(scratch))
-        name = f"{library.MODULE}-{library.digest(built)[:16]}{sysconfig.get_config_var('EXT_SUFFIX')}"
-        os.replace(built, target / name)
-    manifest = {
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=target) as scratch:
+            built = _compile(exports, Path(scratch))
+            digest = library.digest(built)
+            name = f"{library.MODULE}-{digest[:16]}{sysconfig.get_config_var('EXT_SUFFIX')}"
+            with _locked(target):  # another build's replace, manifest and clean-up wait
+                os.replace(built, target / name)
+                _write_atomically(library.manifest_path(), json.dumps(_manifest(exports, name, digest), indent=1))
+                for old in target.glob(f"{library.MODULE}-*"):
+                    if old.name != name:
+                        old.unlink(missing_ok=True)
+    except OSError as error:  # a folder that cannot be written
+        raise BuildFailed(f"cannot write the library into {target}: {error}") from error
+    forget_library()
+    return len(exports)
+
+
+def _manifest(exports: dict[str, tuple[Kernel, tuple, object]], name: str, digest: str) -> dict:
+    """What ``library.current`` checks (sources, versions, the library file's SHA-256) and the
+    exports by kernel and argument key."""
+    return {
         "format": library.FORMAT,
         "versions": library.versions(),
         "sources": _sources(),
         "library": name,
+        "sha256": digest,
         "exports": [
             {"module": kernel.__module__, "name": kernel.__name__, "symbol": symbol, "arguments": key}
             for symbol, (kernel, key, _) in exports.items()
         ],
     }
-    _write_atomically(library.manifest_path(), json.dumps(manifest, indent=1))
-    for old in target.glob(f"{library.MODULE}-*"):
-        if old.name != name:
-            old.unlink(missing_ok=True)
-    forget_library()
-    return len(exports)
+
+
+@contextlib.contextmanager
+def _locked(folder: Path) -> Iterator[None]:
+    """An exclusive lock on ``folder``'s lock file for the block (two installs at once each
+    write a whole library and its manifest, the later one winning)."""
+    import fcntl
+
+    with open(folder / f"{library.MODULE}.lock", "w") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def _exports(calls: list[tuple[Kernel, tuple]]) -> dict[str, tuple[Kernel, tuple, object]]:
@@ -76,7 +101,7 @@ def _exports(calls: list[tuple[Kernel, tuple]]) -> dict[str, tuple[Kernel, tuple
     exports: dict[str, tuple[Kernel, tuple, object]] = {}
     for kernel, args in calls:
         key = arguments.key(args)
-        if key is None or (id(kernel), key) in seen or not _under_package(kernel):
+        if key is None or (id(kernel), key) in seen or not _under_package(kernel) or "<locals>" in kernel.__qualname__:
             continue
         seen.add((id(kernel), key))
         types = tuple(numba.typeof(value) for value in args)
@@ -89,17 +114,17 @@ def _exports(calls: list[tuple[Kernel, tuple]]) -> dict[str, tuple[Kernel, tuple
 
 def _compile(exports: dict[str, tuple[Kernel, tuple, object]], scratch: Path) -> Path:
     """The extension module of ``exports``, compiled in ``scratch``; its file."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # pycc's pending deprecation
-        from numba.pycc import CC
-
-    module = CC(library.MODULE)
-    module.output_dir = str(scratch)
-    module.verbose = False
-    for symbol, (kernel, _, signature) in exports.items():
-        module.export(symbol, signature)(_wrapper(kernel))
     output = io.StringIO()
     try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # pycc's pending deprecation
+            from numba.pycc import CC
+
+            module = CC(library.MODULE)  # raises without a C compiler
+        module.output_dir = str(scratch)
+        module.verbose = False
+        for symbol, (kernel, _, signature) in exports.items():
+            module.export(symbol, signature)(_wrapper(kernel, len(signature.args)))  # type: ignore[attr-defined]
         with contextlib.redirect_stdout(output), contextlib.redirect_stderr(output), warnings.catch_warnings(), _releasing_the_lock():
             warnings.simplefilter("ignore")
             module.compile()
@@ -133,10 +158,10 @@ def _releasing_the_lock() -> Iterator[None]:
         setattr(compiler, "Flags", original)  # noqa: B010
 
 
-def _wrapper(kernel: Kernel) -> Callable:
-    """``def call(a0, ..., an): return kernel(a0, ..., an)`` with the kernel's dispatcher: pycc
-    compiles this with its own flags, the kernel keeps its options."""
-    count = kernel.py_func.__code__.co_argcount
+def _wrapper(kernel: Kernel, count: int) -> Callable:
+    """``def call(a0, ..., an): return kernel(a0, ..., an)`` (``count`` arguments, as the kernel
+    was called) with the kernel's dispatcher: pycc compiles this with its own flags, the kernel
+    keeps its options."""
     names = ", ".join(f"a{index}" for index in range(count))
     namespace: dict = {"kernel": kernel.dispatcher}
     exec(f"def call({names}):\n    return kernel({names})\n", namespace)  # noqa: S102 - a fixed template

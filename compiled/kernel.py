@@ -53,8 +53,9 @@ class Kernel:
     def __call__(self, *args: Any, **keywords: Any) -> Any:
         if keywords:
             return self.dispatcher(*args, **keywords)
-        if _recorder is not None:
+        if _recorder is not None:  # a build records what numba compiles, never the library's
             _recorder.append((self, args))
+            return self.dispatcher(*args)
         ahead = self._ahead
         if ahead is None:
             ahead = self._ahead = library.functions_of(self.__module__, self.__name__)
@@ -68,13 +69,17 @@ class Kernel:
         """How many argument types this kernel runs for now without compiling or loading
         anything: those of the library it has looked up, and those numba's dispatcher holds."""
         held = len(self._ahead or {})
-        return held + (len(self._dispatcher.signatures) if self._dispatcher is not None else 0)
+        return held + len(getattr(self._dispatcher, "signatures", ()))  # NUMBA_DISABLE_JIT: a function
 
     def __getattr__(self, name: str) -> Any:
         # numba's own attributes (signatures, targetoptions, overloads, ...), from the dispatcher.
         if name.startswith("__") or name in ("_dispatcher", "_ahead", "py_func", "options"):
             raise AttributeError(name)
         return getattr(self.dispatcher, name)
+
+    def __reduce__(self) -> str:
+        # pickled by reference, as a module-level function (its module's attribute)
+        return self.__qualname__
 
     def __repr__(self) -> str:
         return f"<kernel {self.__module__}.{self.__qualname__}>"

@@ -7,10 +7,11 @@ name) and the argument key it was built for (``toptraj.compiled.arguments``). It
 the library was compiled from: the SHA-256 of every module that defines a kernel, numba's and
 numpy's versions, Python's. The library is used only while all of them still hold, so an edited
 kernel, or another numba, runs from numba again until the next build; a missing, partial or
-unreadable library is the same as none (``functions_of`` gives ``{}``).
+unreadable library is the same as none (``functions_of`` gives ``{}``): the library file's own
+SHA-256 is checked before it is loaded, since loading maps it.
 
-Loaded once per process, at the first call of any kernel (about a millisecond: the manifest, the
-hashes of some twenty modules, one ``dlopen``).
+Loaded once per process, at the first call of any kernel (a few milliseconds: the manifest, the
+hashes of some twenty modules and of the library file, one ``dlopen``).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from typing import Any
 from toptraj.compiled.arguments import as_key
 
 #: The manifest's format; a manifest of another is ignored.
-FORMAT = 1
+FORMAT = 2
 #: The extension module's name (its ``PyInit_`` symbol); its file is named by its own hash.
 MODULE = "toptraj_kernels"
 
@@ -38,13 +39,17 @@ _table: dict[tuple[str, str], dict] | None = None
 
 def folder() -> Path:
     """Where the library and its manifest live: ``$TOPTRAJ_KERNEL_LIBRARY`` when set, else
-    ``$NUMBA_CACHE_DIR/toptraj`` when numba's cache is elsewhere than beside the sources, else
-    this package's ``__pycache__``."""
+    under ``$NUMBA_CACHE_DIR`` when numba's cache is elsewhere than beside the sources (a folder
+    per installed package, as numba keys its cache by source path: two checkouts sharing the
+    cache keep a library each), else this package's ``__pycache__``."""
     chosen = os.environ.get("TOPTRAJ_KERNEL_LIBRARY")
     if chosen:
         return Path(chosen)
     cache = os.environ.get("NUMBA_CACHE_DIR")
-    return Path(cache) / "toptraj" if cache else Path(__file__).resolve().parent / "__pycache__"
+    if not cache:
+        return Path(__file__).resolve().parent / "__pycache__"
+    root = hashlib.sha256(str(package_root().resolve()).encode()).hexdigest()[:16]
+    return Path(cache) / f"toptraj-{root}"
 
 
 def manifest_path() -> Path:
@@ -116,6 +121,8 @@ def _load(path: Path) -> dict[tuple[str, str], dict]:
         if not current(manifest):
             return {}
         location = path.parent / manifest["library"]
+        if digest(location) != manifest["sha256"]:  # a truncated or altered file is never mapped
+            return {}
         loader = importlib.machinery.ExtensionFileLoader(MODULE, str(location))
         spec = importlib.util.spec_from_file_location(MODULE, location, loader=loader)
         if spec is None:

@@ -17,11 +17,8 @@ ONE_SHOT = frozenset({"plan", "compare", "plot"})
 
 
 def _commands():  # noqa: ANN202 - the module
-    """``toptraj.service.commands``, imported when a command runs. A one-shot command first
-    turns pydantic's plugins off (``PYDANTIC_DISABLE_PLUGINS``, unless set): finding them scans
-    every installed package's entry points, about 30 ms of ``toptraj plan``'s start."""
-    if sys.argv[1:2] and sys.argv[1] in ONE_SHOT:
-        os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
+    """``toptraj.service.commands``, imported when a command runs (``main`` first turns
+    pydantic's plugins off for a one-shot command)."""
     from toptraj.service import commands
 
     return commands
@@ -193,6 +190,10 @@ def main(argv: list[str] | None = None) -> int:
         run=lambda args: _commands().batch(args.requests, args.output, args.workers, args.ray_address, args.budget, args.retry_failed)
     )
     args = parser.parse_args(argv)
+    if args.command in ONE_SHOT:
+        # pydantic's plugins (unless asked for): finding them scans every installed package's
+        # entry points, about 30 ms of toptraj plan's start; the service's models are made after this
+        os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
     return args.run(args)
 
 

@@ -118,3 +118,68 @@ def test_the_library_releases_the_interpreter_lock_as_nogil_kernels_do(built):
     call, as numba's ``nogil=True`` wrappers do; pycc's own would hold the lock throughout."""
     manifest = json.loads((built / f"{library.MODULE}.json").read_text())
     assert b"PyEval_SaveThread" in (built / manifest["library"]).read_bytes()
+
+
+def test_a_truncated_library_file_is_not_loaded(built, tmp_path):
+    """Loading maps the file: a cut-off copy would kill the process at its first call (SIGBUS).
+    Its SHA-256 differs from the manifest's, so the kernels run from numba instead."""
+    manifest = json.loads((built / f"{library.MODULE}.json").read_text())
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    whole = (built / manifest["library"]).read_bytes()
+    (cut / manifest["library"]).write_bytes(whole[: len(whole) // 10])
+    (cut / f"{library.MODULE}.json").write_text(json.dumps(manifest))
+    probe = (
+        "from toptraj.compiled import library\n"
+        "print(len(library.functions_of('toptraj.planners.checks.limit_kernels', 'utilization_pass')))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", probe], cwd=ROOT, env={**os.environ, "TOPTRAJ_KERNEL_LIBRARY": str(cut)},
+        capture_output=True, text=True, timeout=300,
+    )
+    assert (done.returncode, done.stdout.strip()) == (0, "0"), done.stderr[-1000:]
+
+
+def test_without_a_c_compiler_the_install_step_says_so_and_goes_on(monkeypatch, tmp_path):
+    from toptraj.service.warmup import _ahead_of_time
+
+    monkeypatch.setenv("TOPTRAJ_KERNEL_LIBRARY", str(tmp_path / "library"))
+    monkeypatch.setenv("PATH", str(tmp_path))  # no cc, gcc or ld on it
+    try:
+        note = _ahead_of_time()
+    finally:
+        kernel.forget_library()
+    assert note is not None and note.startswith("not built, the kernels run from numba's cache: ")
+    assert not (tmp_path / "library" / f"{library.MODULE}.json").exists()
+
+
+def test_a_build_records_what_numba_compiles_never_the_librarys_functions():
+    """While a build records, every call goes to numba (whose overloads it exports), even for a
+    kernel that already holds library functions for those arguments."""
+    from toptraj.compiled.kernel import recording
+    from toptraj.planners.checks.limit_kernels import utilization_pass
+
+    args = (np.ones((3, 2)), np.full(2, 2.0), 1.0, np.zeros(2), np.zeros(3, dtype=bool))
+    used = []
+    with recording() as calls:
+        utilization_pass._ahead = {arguments.key(args): lambda *given: used.append(given)}
+        result = utilization_pass(*args)
+    kernel.forget_library()
+    assert used == [] and result == (0.5, 0, 0) and calls[-1][0] is utilization_pass
+    assert numba_types(args) in utilization_pass.dispatcher.overloads
+
+
+def test_checkouts_sharing_numba_s_cache_keep_a_library_each(monkeypatch, tmp_path):
+    monkeypatch.delenv("TOPTRAJ_KERNEL_LIBRARY", raising=False)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    folders = set()
+    for root in (tmp_path / "one" / "toptraj", tmp_path / "two" / "toptraj"):
+        monkeypatch.setattr(library, "package_root", lambda root=root: root)
+        folders.add(library.folder())
+    assert len(folders) == 2 and all(folder.parent == tmp_path for folder in folders)
+
+
+def numba_types(args):
+    import numba
+
+    return tuple(numba.typeof(value) for value in args)
