@@ -73,7 +73,7 @@ def _manifest(exports: dict[str, tuple[Kernel, tuple, object]], name: str, diges
         "library": name,
         "sha256": digest,
         "exports": [
-            {"module": kernel.__module__, "name": kernel.__name__, "symbol": symbol, "arguments": key}
+            {"module": kernel.__module__, "name": kernel.__name__, "symbol": symbol, "arguments": arguments.as_json(key)}
             for symbol, (kernel, key, _) in exports.items()
         ],
     }
@@ -104,7 +104,10 @@ def _exports(calls: list[tuple[Kernel, tuple]]) -> dict[str, tuple[Kernel, tuple
         if key is None or (id(kernel), key) in seen or not _under_package(kernel) or "<locals>" in kernel.__qualname__:
             continue
         seen.add((id(kernel), key))
-        types = tuple(numba.typeof(value) for value in args)
+        try:
+            types = tuple(numba.typeof(value) for value in args)
+        except ValueError:  # a value numba cannot type (it ran as Python): nothing to export
+            continue
         overload = kernel.dispatcher.overloads.get(types)
         if overload is None:
             continue
