@@ -1,18 +1,28 @@
 """The install compiles the search's local-optimization objective (``service.warmup``'s
-``_search_objective`` step) in the one signature that the searches of every arm then use, so
-that no first search spends its budget compiling it."""
+``_search_objective`` step) and its graph kernels (``_search_graph``) in the one signature
+each that the searches of every arm then use, so that no first search spends its budget
+compiling them."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from tests.planners.generators.test_search_objective import CASES, random_points, search_objective
+from toptraj import robots
+from toptraj.planners.collision import BoxObstacle, SphereObstacle
+from toptraj.planners.constraints.admissible_kernels import interval_bounds, point_bounds
+from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, pair_minimum
+from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.objective_kernels import objective_value
+from toptraj.planners.generators.search.problem import build_problem
+from toptraj.planners.generators.search.span_kernels import span_points
 from toptraj.service.warmup import install_steps, run_steps
+
+GRAPH_KERNELS = (capsule_ends, lower_distances, pair_minimum, span_points, interval_bounds, point_bounds)
 
 
 def test_the_install_compiles_the_signature_every_search_evaluates():
-    steps = [step for step in install_steps() if "search" in step[0]]
+    steps = [step for step in install_steps() if "objective" in step[0]]
     assert len(steps) == 1
     run_steps(steps, lambda line: None)
     compiled = list(objective_value.signatures)
@@ -22,3 +32,24 @@ def test_the_install_compiles_the_signature_every_search_evaluates():
         objective = search_objective(arm)
         objective.value(random_points(objective, 4, 0.1, rng))
     assert list(objective_value.signatures) == compiled  # nothing compiled anew
+
+
+def test_the_install_compiles_the_search_graphs_kernels_every_roadmap_calls():
+    """After the graph step, roadmaps of panda around a box and of ur5 around a sphere (pieces
+    refined near each) call every kernel of the build in a signature it holds."""
+    steps = [step for step in install_steps() if "graph kernels" in step[0]]
+    assert len(steps) == 1
+    run_steps(steps, lambda line: None)
+    compiled = [list(kernel.signatures) for kernel in GRAPH_KERNELS]
+    assert all(len(signatures) == 1 for signatures in compiled)
+    kinds = ("velocity", "acceleration", "torque")
+    panda = robots.load("panda")
+    start, goal = np.array([-0.8, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8]), np.array([0.8, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8])
+    box = BoxObstacle(np.array([0.4854, 0.0, 0.491]), np.array([0.1, 0.1, 0.1]))
+    problem = build_problem(panda, panda.limits, kinds, start, goal, SearchOptions(roadmap_points=10, neighbors=4), True, (box,), 0.01)
+    ur5 = robots.load("ur5")
+    start, goal = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]), np.array([1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    sphere = SphereObstacle(np.array([0.626, 0.109, 0.29]), 0.08)
+    other = build_problem(ur5, ur5.limits, kinds, start, goal, SearchOptions(roadmap_points=10, neighbors=4), True, (sphere,), 0.02)
+    assert problem.removed > 0 and other.removed > 0  # pieces near the obstacles were refined
+    assert [list(kernel.signatures) for kernel in GRAPH_KERNELS] == compiled  # nothing compiled anew
