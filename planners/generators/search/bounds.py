@@ -20,7 +20,9 @@ a lower bound on the discrete t4 of that grid, which ``grid_path_time`` computes
 phase-plane method itself. Viscous friction, which the phase-plane method linearizes, is relaxed
 to the widest bounds it can take below the first-order speed bound. t1 and t2 add up over the
 pieces of a grid path; t3 over a partial path uses the forward curve only (the speed at its cut
-is not known), the complete path's both.
+is not known), the complete path's both. The rows are computed once at each of a piece's
+INTERVALS + 1 samples (an interval's end is the next one's start), the samples of a chunk of
+pieces laid out as one grid for the phase-plane kernels.
 """
 
 from __future__ import annotations

@@ -6,8 +6,11 @@ The distance of the arm from an obstacle changes by at most sum_j R_j |dq_j| bet
 configurations dq apart (R_j bounds the distance from joint j to any point of the arm beyond
 it); pieces are checked where this bound cannot prove them clear, at samples refined where the
 bound between them comes within the clearance (``clear_pieces``). A piece is kept only when the
-bound proves it clear. Distances are computed for all configurations at once (the joint frames
-of a batch of configurations in numpy, ``joint_placements``).
+bound proves it clear. Distances are computed for all configurations at once by the compiled
+``distance_kernels`` (the link capsules' ends, then a box's golden section or a pair of links'
+segment distance only where a cheaper bound says it may lower a configuration's least), at
+samples along the spans given by the compiled ``span_kernels``; ``joint_placements`` is the
+same kinematics in numpy, for the arms the kernels do not serve.
 """
 
 from __future__ import annotations
