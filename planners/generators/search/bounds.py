@@ -97,15 +97,9 @@ def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
 
 def _samples(pieces: Pieces, rows: slice) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """q, dq, ddq (c (INTERVALS + 1), n_dof) at the INTERVALS + 1 samples of the pieces
-    ``rows``, piece after piece: each interval's start, then the last interval's end (the end
-    of an interval is the next one's start)."""
-    n = pieces.q0.shape[1]
-
-    def joined(starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        starts, ends = starts.reshape(-1, INTERVALS, n)[rows], ends.reshape(-1, INTERVALS, n)[rows, -1:]
-        return np.concatenate([starts, ends], axis=1).reshape(-1, n)
-
-    return joined(pieces.q0, pieces.q1), joined(pieces.dq0, pieces.dq1), joined(pieces.ddq0, pieces.ddq1)
+    ``rows``, piece after piece (views of ``Pieces.q``, ``dq``, ``ddq``)."""
+    n = pieces.q.shape[2]
+    return pieces.q[rows].reshape(-1, n), pieces.dq[rows].reshape(-1, n), pieces.ddq[rows].reshape(-1, n)
 
 
 def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds: tuple[str, ...], deadline: Deadline) -> PieceBounds:
@@ -136,8 +130,8 @@ def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds: tuple
     feasible = np.bincount(owner, weights=bad, minlength=len(pieces)) == 0
     t2 = np.bincount(owner, weights=np.where(bad, 0.0, interval_t2), minlength=len(pieces))
     t2 = np.where(feasible, t2, _INF)
-    speed0 = np.linalg.norm(pieces.dq0, axis=1)
-    speed1 = np.linalg.norm(pieces.dq1, axis=1)
+    speeds = np.linalg.norm(pieces.dq, axis=2)  # (K, INTERVALS + 1)
+    speed0, speed1 = speeds[:, :-1].ravel(), speeds[:, 1:].ravel()
     fast = np.concatenate([speed0 * np.sqrt(np.maximum(cap_start, 0.0)), speed1 * np.sqrt(np.maximum(cap_end, 0.0))])
     v_max = float(fast.max()) if fast.size else _INF
     if not np.isfinite(v_max) or v_max >= 1e6:

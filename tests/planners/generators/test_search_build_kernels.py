@@ -3,9 +3,10 @@ inputs: the box and self-collision distances computed only where a bound says th
 the least (``distance_kernels.lower_distances``, ``pair_minimum``) against every distance
 computed (the same least to the bit, and the numpy distances of
 ``toptraj.planners.collision.distance`` to rounding); the samples along the spans
-(``span_kernels.span_points``) against ``curve.span_values``; and the pieces' bounds, their
-rows computed once per sample (``bounds.piece_bounds``), against the rows computed at both
-ends of every interval as before."""
+(``span_kernels.span_points``) against ``curve.span_values``; the pieces' samples held once
+per piece; and the pieces' bounds, their rows computed once per sample
+(``bounds.piece_bounds``), against the rows computed at both ends of every interval as
+before."""
 
 from __future__ import annotations
 
@@ -177,3 +178,20 @@ def test_piece_bounds_compute_each_sample_once_and_equal_both_ends_computed(arm,
     for mine, before in zip((ours.p, ours.q, ours.r, ours.cap_start, ours.cap_end), theirs):
         assert np.array_equal(mine, before)  # to the bit
     assert np.isfinite(ours.t2).any()
+
+
+def test_pieces_hold_each_sample_once():
+    """A piece's INTERVALS + 1 samples are held once (K, INTERVALS + 1, n_dof): the intervals'
+    starts and ends read from them are those of ``curve.span_values`` on the pieces' control
+    points, an interval's end the next one's start."""
+    robot = robots.load("panda")
+    start, goal = PANDA
+    pieces = build_problem(robot, robot.limits, ("velocity",), start, goal, SearchOptions(roadmap_points=10, neighbors=4), True).pieces
+    n = robot.dof
+    assert pieces.q.shape == pieces.dq.shape == pieces.ddq.shape == (len(pieces), INTERVALS + 1, n)
+    q, dq, ddq = span_values(pieces.control, np.linspace(0.0, 1.0, INTERVALS + 1))
+    for held, computed in ((pieces.q, q), (pieces.dq, dq), (pieces.ddq, ddq)):
+        assert np.array_equal(held, computed)
+    starts, ends = pieces.q0.reshape(len(pieces), INTERVALS, n), pieces.q1.reshape(len(pieces), INTERVALS, n)
+    assert np.array_equal(ends[:, :-1], starts[:, 1:])
+    assert np.array_equal(pieces.dq1.reshape(len(pieces), INTERVALS, n)[:, -1], dq[:, -1])
