@@ -146,6 +146,26 @@ def _ahead_of_time() -> str | None:
     return f"compiled {exported} functions into the library"
 
 
+def _search_graph() -> None:
+    """The search's graph kernels (``toptraj.planners.generators.search``: the arm's capsules,
+    the box and self-collision distances, the samples along the spans, the pieces' bounds):
+    a small roadmap of ur5 around a box where the tool passes halfway, whose pieces near the box
+    are refined (compiling them takes tens of seconds on a busy two-core machine, which a first
+    search of a six- or seven-joint arm would otherwise spend of its budget)."""
+    import numpy as np
+
+    from toptraj import robots
+    from toptraj.planners.collision import BoxObstacle
+    from toptraj.planners.generators.search.graph import SearchOptions
+    from toptraj.planners.generators.search.problem import build_problem
+
+    arm = robots.load("ur5")
+    start, goal = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]), np.array([1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    box = BoxObstacle(np.array([0.626, 0.109, 0.29]), np.array([0.15, 0.15, 0.15]))
+    options = SearchOptions(graph="roadmap", roadmap_points=8, neighbors=3)
+    build_problem(arm, arm.limits, ("velocity", "acceleration", "torque"), start, goal, options, True, (box,), 0.02)
+
+
 def server_steps() -> list[Step]:
     """What each server process does before it answers (kernels loaded from the cache)."""
     return [
@@ -175,14 +195,15 @@ def write_bytecode() -> None:
 
 def install_steps() -> list[Step]:
     """What the install does: toptraj's bytecode written, the server's steps, then the kernels
-    of the typical request (velocity and acceleration rows, sampling, dense checks) and the
-    search's objective, compiled into the cache."""
+    of the typical request (velocity and acceleration rows, sampling, dense checks), the
+    search's objective and its graph kernels, compiled into the cache."""
     return [
         ("writing the bytecode of toptraj's modules", write_bytecode),
         *server_steps(),
         ("compiling the typical request's kernels (ur5, spline, velocity, acceleration, torque)", _typical),
         ("compiling them ahead of time into one library (toptraj plan then starts without numba)", _ahead_of_time),
         ("compiling the search's local-optimization objective", _search_objective),
+        ("compiling the search's graph kernels (ur5 around a box: distances, span samples, bounds)", _search_graph),
     ]
 
 

@@ -20,7 +20,9 @@ a lower bound on the discrete t4 of that grid, which ``grid_path_time`` computes
 phase-plane method itself. Viscous friction, which the phase-plane method linearizes, is relaxed
 to the widest bounds it can take below the first-order speed bound. t1 and t2 add up over the
 pieces of a grid path; t3 over a partial path uses the forward curve only (the speed at its cut
-is not known), the complete path's both.
+is not known), the complete path's both. The rows are computed once at each of a piece's
+INTERVALS + 1 samples (an interval's end is the next one's start), the samples of a chunk of
+pieces laid out as one grid for the phase-plane kernels.
 """
 
 from __future__ import annotations
@@ -93,17 +95,26 @@ def _rows(robot: Robot, limits: JointLimits, kinds, q, dq, ddq):
     return np.ascontiguousarray(a), np.ascontiguousarray(b), np.ascontiguousarray(c), d, lower, upper, x_bound
 
 
+def _samples(pieces: Pieces, rows: slice) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """q, dq, ddq (c (INTERVALS + 1), n_dof) at the INTERVALS + 1 samples of the pieces
+    ``rows``, piece after piece (views of ``Pieces.q``, ``dq``, ``ddq``)."""
+    n = pieces.q.shape[2]
+    return pieces.q[rows].reshape(-1, n), pieces.dq[rows].reshape(-1, n), pieces.ddq[rows].reshape(-1, n)
+
+
 def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds: tuple[str, ...], deadline: Deadline) -> PieceBounds:
-    """The bounds of every piece (t1, t2 and the arrays t3 runs on)."""
+    """The bounds of every piece (t1, t2 and the arrays t3 runs on). The limits' rows are
+    computed once per sample of a piece (``_samples``), a chunk of ``CHUNK`` intervals at a
+    time."""
     count = len(pieces.ds)
     p = q = r = np.empty((count, 0))
     cap_start, cap_end = np.empty(count), np.empty(count)
-    for begin in range(0, count, CHUNK):
+    per_chunk = max(1, CHUNK // INTERVALS)
+    for begin in range(0, len(pieces), per_chunk):
         deadline.check()
-        rows = slice(begin, begin + CHUNK)
-        start = _rows(robot, limits, kinds, pieces.q0[rows], pieces.dq0[rows], pieces.ddq0[rows])
-        end = _rows(robot, limits, kinds, pieces.q1[rows], pieces.dq1[rows], pieces.ddq1[rows])
-        part = _interval_arrays(pieces.ds[rows], start, end)
+        chunk = slice(begin, min(begin + per_chunk, len(pieces)))
+        rows = slice(chunk.start * INTERVALS, chunk.stop * INTERVALS)
+        part = _interval_arrays(pieces.ds[rows], _rows(robot, limits, kinds, *_samples(pieces, chunk)))
         if begin == 0:  # the rows' count is known now: the arrays filled in place, chunk by chunk
             p, q, r = (np.empty((count, part[0].shape[1])) for _ in range(3))
         p[rows], q[rows], r[rows], cap_start[rows], cap_end[rows] = part
@@ -119,8 +130,8 @@ def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds: tuple
     feasible = np.bincount(owner, weights=bad, minlength=len(pieces)) == 0
     t2 = np.bincount(owner, weights=np.where(bad, 0.0, interval_t2), minlength=len(pieces))
     t2 = np.where(feasible, t2, _INF)
-    speed0 = np.linalg.norm(pieces.dq0, axis=1)
-    speed1 = np.linalg.norm(pieces.dq1, axis=1)
+    speeds = np.linalg.norm(pieces.dq, axis=2)  # (K, INTERVALS + 1)
+    speed0, speed1 = speeds[:, :-1].ravel(), speeds[:, 1:].ravel()
     fast = np.concatenate([speed0 * np.sqrt(np.maximum(cap_start, 0.0)), speed1 * np.sqrt(np.maximum(cap_end, 0.0))])
     v_max = float(fast.max()) if fast.size else _INF
     if not np.isfinite(v_max) or v_max >= 1e6:
@@ -132,35 +143,29 @@ def piece_bounds(pieces: Pieces, robot: Robot, limits: JointLimits, kinds: tuple
     return PieceBounds(pieces.ds, p, q, r, cap_start, cap_end, np.where(feasible, t1, _INF), t2, v_max, feasible)
 
 
-def _interval_arrays(ds, start, end):
-    """p, q, r (k, 2m), cap_start, cap_end (k,) of intervals with rows ``start`` at their
-    starts and ``end`` at their ends (``_rows``), through the phase-plane kernels: both ends
-    of interval i are laid out as points 2i and 2i + 1 of one grid."""
-    a0, b0, c0, d0, lo0, up0, xb0 = start
-    a1, b1, c1, d1, lo1, up1, xb1 = end
-    k, m = a0.shape
-
-    def interleave(x0, x1):
-        out = np.empty((2 * k, *x0.shape[1:]))
-        out[0::2], out[1::2] = x0, x1
-        return np.ascontiguousarray(out)
-
-    a, b, c = interleave(a0, a1), interleave(b0, b1), interleave(c0, c1)
-    zero = np.zeros_like(a)
-    lower, upper = interleave(lo0, lo1), interleave(up0, up1)
-    x_bound = interleave(xb0, xb1)
-    s = np.zeros(2 * k)
-    s[1::2] = ds
-    s = np.ascontiguousarray(s)
+def _interval_arrays(ds, sampled):
+    """p, q, r (k, 2m), cap_start, cap_end (k,) of the k intervals of k / INTERVALS pieces
+    (lengths ``ds`` (k,)) from the rows ``sampled`` (``_rows``) at the pieces' samples
+    (``_samples``), through the phase-plane kernels: the samples laid out as one grid, a piece's
+    INTERVALS intervals followed by a gap of length 1 to the next piece's first sample, whose
+    bounds are dropped."""
+    a, b, c, _, lower, upper, x_bound = sampled
+    k, m = len(ds), a.shape[1]
+    pieces = k // INTERVALS
+    width = INTERVALS + 1
+    starts = (np.arange(pieces * width).reshape(pieces, width)[:, :-1]).ravel()  # each interval's first sample
+    ends = starts + 1
     if m == 0:
         empty = np.zeros((k, 0))
-        return empty, empty, empty, np.where(np.isfinite(xb0), xb0, _INF), np.where(np.isfinite(xb1), xb1, _INF)
+        return empty, empty, empty, np.where(np.isfinite(x_bound[starts]), x_bound[starts], _INF), np.where(np.isfinite(x_bound[ends]), x_bound[ends], _INF)
+    # s: a piece's samples at s_0 + j ds, the next piece's first one step of 1 beyond its last
+    steps = np.ones(pieces * width - 1)
+    steps[starts[starts < len(steps)]] = ds
+    s = np.concatenate([[0.0], np.cumsum(steps)])
+    zero = np.zeros_like(a)
     p, q, r, _, x_high, _ = interval_bounds(s, a, b, c, zero, a, b, c, zero, lower, upper, x_bound, x_bound, False, False, NOTHING_KEPT, NOTHING_BEFORE)
-    cap_end = point_bounds(
-        np.ascontiguousarray(a1), np.ascontiguousarray(b1), np.ascontiguousarray(c1),
-        np.ascontiguousarray(lo1), np.ascontiguousarray(up1), np.ascontiguousarray(xb1),
-    )[4]
-    return p[0::2], q[0::2], r[0::2], x_high[0::2], cap_end
+    cap = point_bounds(a, b, c, lower, upper, x_bound)[4]
+    return p[starts], q[starts], r[starts], x_high[starts], cap[ends]
 
 
 @njit(cache=True, nogil=True)

@@ -108,10 +108,43 @@ def _point_segment(p, a, b):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _box_at(la, lb, half, t):  # pragma: no cover - compiled
+def _box_at(la0, la1, la2, lb0, lb1, lb2, h0, h1, h2, t):  # pragma: no cover - compiled
+    """The box's signed distance at a + t (b - a), ends and half sizes in the box's frame."""
     outside, inside = 0.0, -np.inf
-    for i in range(3):
-        excess = abs(la[i] + t * (lb[i] - la[i])) - half[i]
+    excess = abs(la0 + t * (lb0 - la0)) - h0
+    if excess > 0.0:
+        outside += excess * excess
+    inside = max(inside, excess)
+    excess = abs(la1 + t * (lb1 - la1)) - h1
+    if excess > 0.0:
+        outside += excess * excess
+    inside = max(inside, excess)
+    excess = abs(la2 + t * (lb2 - la2)) - h2
+    if excess > 0.0:
+        outside += excess * excess
+    inside = max(inside, excess)
+    return math.sqrt(outside) + min(inside, 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _in_box_frame(a, b, i, c, row, local):  # pragma: no cover - compiled
+    """The ends a[i, c], b[i, c] in the box's frame (``obstacle_row``) into ``local`` (6,)."""
+    for m in range(3):
+        local[m] = (a[i, c, 0] - row[0]) * row[10 + m] + (a[i, c, 1] - row[1]) * row[13 + m] + (a[i, c, 2] - row[2]) * row[16 + m]
+        local[3 + m] = (b[i, c, 0] - row[0]) * row[10 + m] + (b[i, c, 1] - row[1]) * row[13 + m] + (b[i, c, 2] - row[2]) * row[16 + m]
+
+
+@njit(cache=True, nogil=True)
+def box_bound(local, row):  # pragma: no cover - compiled
+    """A lower bound on the box's signed distance along the segment with ends ``local`` (6,:
+    a then b, in the box's frame): along each axis of the box, the least |coordinate| over the
+    segment (0 where it crosses the plane through the center) less the half size bounds that
+    axis's excess at every point, and the signed distance grows with each excess."""
+    outside, inside = 0.0, -np.inf
+    for m in range(3):
+        a, b = local[m], local[3 + m]
+        least = 0.0 if a * b <= 0.0 else min(abs(a), abs(b))
+        excess = least - row[7 + m]
         if excess > 0.0:
             outside += excess * excess
         inside = max(inside, excess)
@@ -119,20 +152,28 @@ def _box_at(la, lb, half, t):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _segment_box(a, b, row):  # pragma: no cover - compiled
-    la, lb = np.empty(3), np.empty(3)
-    for i in range(3):
-        la[i] = (a[0] - row[0]) * row[10 + i] + (a[1] - row[1]) * row[13 + i] + (a[2] - row[2]) * row[16 + i]
-        lb[i] = (b[0] - row[0]) * row[10 + i] + (b[1] - row[1]) * row[13 + i] + (b[2] - row[2]) * row[16 + i]
-    half = row[7:10]
+def segment_box(local, row):  # pragma: no cover - compiled
+    """The box's signed distance along the segment with ends ``local`` (6,, the box's frame):
+    golden section on [0, 1] of the convex signed distance, with both ends."""
+    la0, la1, la2, lb0, lb1, lb2 = local[0], local[1], local[2], local[3], local[4], local[5]
+    h0, h1, h2 = row[7], row[8], row[9]
     lo, hi = 0.0, 1.0
     for _ in range(GOLDEN_STEPS):
         c, d = hi - _RATIO * (hi - lo), lo + _RATIO * (hi - lo)
-        if _box_at(la, lb, half, c) < _box_at(la, lb, half, d):
+        if _box_at(la0, la1, la2, lb0, lb1, lb2, h0, h1, h2, c) < _box_at(la0, la1, la2, lb0, lb1, lb2, h0, h1, h2, d):
             hi = d
         else:
             lo = c
-    return min(_box_at(la, lb, half, (lo + hi) / 2.0), _box_at(la, lb, half, 0.0), _box_at(la, lb, half, 1.0))
+    return min(
+        _box_at(la0, la1, la2, lb0, lb1, lb2, h0, h1, h2, (lo + hi) / 2.0),
+        _box_at(la0, la1, la2, lb0, lb1, lb2, h0, h1, h2, 0.0),
+        _box_at(la0, la1, la2, lb0, lb1, lb2, h0, h1, h2, 1.0),
+    )
+
+
+#: Below this (m), a bound is not trusted to prove an exact distance larger than a smaller one
+#: (their roundings differ by far less).
+BOUND_SLACK = 1e-9
 
 
 @njit(cache=True, nogil=True)
@@ -140,7 +181,12 @@ def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: n
     """``nearest`` (k,) lowered to each configuration's least signed distance of its capsules
     (a, b (k, C, 3), ``radius`` (C,)) to the obstacle (``obstacle_row``). For a box, the
     distance is exact where its ball bound is below ``exact_below`` or below the least
-    distance to its center over all the configurations given, a lower bound elsewhere."""
+    distance to its center over all the configurations given, a lower bound elsewhere.
+
+    A box's exact distance (``segment_box``, a golden section) is computed only for the
+    capsules whose lower bound (the larger of the ball bound and ``box_bound``) may still lower
+    the configuration's least: the least first, the others against it. The least is the
+    same as with every exact distance computed, to the last bit."""
     k, n_caps = a.shape[0], a.shape[1]
     center = row[0:3]
     if kind == SPHERE:
@@ -160,12 +206,27 @@ def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: n
             to_center[i, c] = _point_segment(center, a[i, c], b[i, c]) - radius[c]
             least = min(least, to_center[i, c])
     threshold = max(exact_below, least)
+    local = np.empty((n_caps, 6))
+    bound = np.empty(n_caps)
     for i in range(k):
+        best = nearest[i]
+        first = -1
         for c in range(n_caps):
             lower = to_center[i, c] - row[6]
-            if lower < threshold:
-                lower = _segment_box(a[i, c], b[i, c], row) - radius[c]
-            nearest[i] = min(nearest[i], lower)
+            bound[c] = np.inf
+            if lower >= threshold:
+                best = min(best, lower)
+                continue
+            _in_box_frame(a, b, i, c, row, local[c])
+            bound[c] = max(lower, box_bound(local[c], row) - radius[c])
+            if first < 0 or bound[c] < bound[first]:
+                first = c
+        if first >= 0 and bound[first] - BOUND_SLACK < best:
+            best = min(best, segment_box(local[first], row) - radius[first])
+        for c in range(n_caps):
+            if c != first and bound[c] - BOUND_SLACK < best:
+                best = min(best, segment_box(local[c], row) - radius[c])
+        nearest[i] = best
 
 
 @njit(cache=True, nogil=True)
@@ -194,14 +255,65 @@ def _segments(p1, q1, p2, q2):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _capsules_apart(a, b, i, f, g):  # pragma: no cover - compiled
+    """``_segments`` of the capsules f and g at configuration i of the ends a, b (k, C, 3): the
+    same arithmetic, read from the arrays without views."""
+    d1x, d1y, d1z = b[i, f, 0] - a[i, f, 0], b[i, f, 1] - a[i, f, 1], b[i, f, 2] - a[i, f, 2]
+    d2x, d2y, d2z = b[i, g, 0] - a[i, g, 0], b[i, g, 1] - a[i, g, 1], b[i, g, 2] - a[i, g, 2]
+    rx, ry, rz = a[i, f, 0] - a[i, g, 0], a[i, f, 1] - a[i, g, 1], a[i, f, 2] - a[i, g, 2]
+    a_ = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f_ = d2x * rx + d2y * ry + d2z * rz
+    c = d1x * rx + d1y * ry + d1z * rz
+    b_ = d1x * d2x + d1y * d2y + d1z * d2z
+    denom = a_ * e - b_ * b_
+    s = min(max((b_ * f_ - c * e) / denom, 0.0), 1.0) if denom > _TINY else 0.0
+    t = (b_ * s + f_) / e if e > _TINY else 0.0
+    if t < 0.0:
+        s = min(max(-c / a_, 0.0), 1.0) if a_ > _TINY else 0.0
+    elif t > 1.0:
+        s = min(max((b_ - c) / a_, 0.0), 1.0) if a_ > _TINY else 0.0
+    t = min(max(t, 0.0), 1.0)
+    x, y, z = rx + s * d1x - t * d2x, ry + s * d1y - t * d2y, rz + s * d1z - t * d2z
+    return math.sqrt(x * x + y * y + z * z)
+
+
+@njit(cache=True, nogil=True)
 def pair_minimum(a, b, first, second, radius, out):  # pragma: no cover - compiled
     """Smallest signed distance (m) between the capsules ``first[p]`` and ``second[p]`` (m,),
     of radius sum ``radius[p]``, over the pairs, at each configuration of the capsule ends a, b
-    (k, C, 3): into ``out`` (k,) (inf without pairs)."""
-    for i in range(a.shape[0]):
-        best = np.inf
-        for p in range(first.shape[0]):
-            d = _segments(a[i, first[p]], b[i, first[p]], a[i, second[p]], b[i, second[p]]) - radius[p]
+    (k, C, 3): into ``out`` (k,) (inf without pairs).
+
+    A pair's segment distance is computed only where the bound by the balls around the two
+    segments (center at the midpoint, radius half the length) may still lower the least: first
+    the pair nearest at the configuration before, then the others against it. The least is
+    the same as with every pair computed, to the last bit."""
+    k, n_caps, n_pairs = a.shape[0], a.shape[1], first.shape[0]
+    middle = np.empty((n_caps, 3))
+    half = np.empty(n_caps)
+    nearest_pair = 0
+    for i in range(k):
+        if n_pairs == 0:
+            out[i] = np.inf
+            continue
+        for c in range(n_caps):
+            length = 0.0
+            for m in range(3):
+                middle[c, m] = 0.5 * (a[i, c, m] + b[i, c, m])
+                length += (b[i, c, m] - a[i, c, m]) ** 2
+            half[c] = 0.5 * math.sqrt(length)
+        best = _capsules_apart(a, b, i, first[nearest_pair], second[nearest_pair]) - radius[nearest_pair]
+        for p in range(n_pairs):
+            if p == nearest_pair:
+                continue
+            f, g = first[p], second[p]
+            reach = best + half[f] + half[g] + radius[p] + BOUND_SLACK
+            if reach <= 0.0:
+                continue
+            x, y, z = middle[f, 0] - middle[g, 0], middle[f, 1] - middle[g, 1], middle[f, 2] - middle[g, 2]
+            if x * x + y * y + z * z >= reach * reach:
+                continue
+            d = _capsules_apart(a, b, i, f, g) - radius[p]
             if d < best:
-                best = d
+                best, nearest_pair = d, p
         out[i] = best

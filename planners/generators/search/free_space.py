@@ -6,8 +6,11 @@ The distance of the arm from an obstacle changes by at most sum_j R_j |dq_j| bet
 configurations dq apart (R_j bounds the distance from joint j to any point of the arm beyond
 it); pieces are checked where this bound cannot prove them clear, at samples refined where the
 bound between them comes within the clearance (``clear_pieces``). A piece is kept only when the
-bound proves it clear. Distances are computed for all configurations at once (the joint frames
-of a batch of configurations in numpy, ``joint_placements``).
+bound proves it clear. Distances are computed for all configurations at once by the compiled
+``distance_kernels`` (the link capsules' ends, then a box's golden section or a pair of links'
+segment distance only where a cheaper bound says it may lower a configuration's least), at
+samples along the spans given by the compiled ``span_kernels``; ``joint_placements`` is the
+same kinematics in numpy, for the arms the kernels do not serve.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.curve import BASIS
 from toptraj.planners.generators.search.distance_kernels import capsule_ends, lower_distances, obstacle_row, pair_minimum
 from toptraj.planners.generators.search.pieces import Pieces
+from toptraj.planners.generators.search.span_kernels import span_points
 from toptraj.robots import Robot
 from toptraj.robots.collision import robot_capsules
 
@@ -194,12 +198,6 @@ def joint_reaches(robot: Robot) -> np.ndarray:
     return out
 
 
-def _span_points(control: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """q at one local parameter per span: control (k, 4, n), t (k,) -> (k, n)."""
-    powers = np.stack([np.ones_like(t), t, t**2, t**3], axis=1)  # (k, 4)
-    return np.einsum("kp,pj,kjn->kn", powers, BASIS, control)
-
-
 def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: list[Obstacle], clearance: float,
                  deadline: Deadline) -> tuple[np.ndarray, np.ndarray]:
     """Which pieces keep ``clearance`` (m) from ``obstacles`` and the links apart along all of
@@ -244,7 +242,7 @@ def _refine(spans: np.ndarray, count: int, control: np.ndarray, speed: np.ndarra
     4 ``REFINED`` intervals per level of splitting."""
     t = np.linspace(0.0, 1.0, count + 1)
     owner = np.repeat(spans, count + 1)
-    q = _span_points(control[owner], np.tile(t, len(spans)))
+    q = span_points(control, owner, np.tile(t, len(spans)), BASIS)
     d = free_distances(robot, q, obstacles, clearance, clearance + COARSE_STEP, deadline)
     blocked[owner[d < clearance]] = True
     d_rows = d.reshape(len(spans), count + 1)
@@ -265,7 +263,7 @@ def _refine(spans: np.ndarray, count: int, control: np.ndarray, speed: np.ndarra
             continue
         width = width / 4.0
         inner = t_a[:, None] + width[:, None] * np.arange(1, 4)[None, :]  # (m, 3)
-        q = _span_points(control[np.repeat(piece, 3)], inner.ravel())
+        q = span_points(control, np.repeat(piece, 3), inner.ravel(), BASIS)
         new = free_distances(robot, q, obstacles, clearance, clearance + COARSE_STEP, deadline).reshape(-1, 3)
         blocked[piece[(new < clearance).any(axis=1)]] = True
         ends = np.column_stack([d_a, new, d_b])  # (m, 5)

@@ -15,7 +15,9 @@ the phase-plane kernels as ``midpoint_duration`` sweeps them (the interpolation 
 viscous friction, then the midpoint pass; without friction, of the interpolation pass only
 the backward sweep, which decides whether it fails; never the switching excesses, which only
 an exact timing's refinement reads), and the distance lower bound of the penalty comes
-from ``distance_kernels`` as in ``free_space.point_distances``. The answers equal the reference
+from ``distance_kernels`` as in ``free_space.point_distances`` (a box's or a pair's exact
+distance computed only where a bound says it may lower the least, the same least to the
+bit). The answers equal the reference
 path's to rounding: the same inputs reach the same kernels (tests/planners/generators/test_search_objective.py).
 
 Shapes: control points (k, n_dof); grid N + 1 points; obstacle samples S + 1 points; m rows.

@@ -40,8 +40,10 @@ class Pieces:
         control: The four control points of each span, shape (K, 4, n_dof).
         first: Index of each piece's first interval, shape (K + 1,).
         ds: Parameter length of every interval (1 / INTERVALS), shape (I,).
-        q0, dq0, ddq0: Configuration and its first and second u-derivatives at each interval's
-            start, shape (I, n_dof); q1, dq1, ddq1 at its end.
+        q, dq, ddq: Configuration and its first and second u-derivatives at each piece's
+            INTERVALS + 1 samples (its intervals' ends), shape (K, INTERVALS + 1, n_dof): held
+            once, an interval's end being the next one's start (``q0`` ... ``ddq1`` give them
+            per interval).
         reach_l1: A bound on the L1 joint distance from the corner point to any point of the
             span (the span lies in the convex hull of its control points), shape (K,).
     """
@@ -54,16 +56,51 @@ class Pieces:
     control: np.ndarray
     first: np.ndarray
     ds: np.ndarray
-    q0: np.ndarray
-    dq0: np.ndarray
-    ddq0: np.ndarray
-    q1: np.ndarray
-    dq1: np.ndarray
-    ddq1: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
     reach_l1: np.ndarray
 
     def __len__(self) -> int:
         return len(self.kind)
+
+    @staticmethod
+    def _starts(x: np.ndarray) -> np.ndarray:
+        return x[:, :-1].reshape(-1, x.shape[2])
+
+    @staticmethod
+    def _ends(x: np.ndarray) -> np.ndarray:
+        return x[:, 1:].reshape(-1, x.shape[2])
+
+    @property
+    def q0(self) -> np.ndarray:
+        """q at each interval's start, shape (I, n_dof) (a copy)."""
+        return self._starts(self.q)
+
+    @property
+    def dq0(self) -> np.ndarray:
+        """dq/du at each interval's start, shape (I, n_dof) (a copy)."""
+        return self._starts(self.dq)
+
+    @property
+    def ddq0(self) -> np.ndarray:
+        """d2q/du2 at each interval's start, shape (I, n_dof) (a copy)."""
+        return self._starts(self.ddq)
+
+    @property
+    def q1(self) -> np.ndarray:
+        """q at each interval's end, shape (I, n_dof) (a copy)."""
+        return self._ends(self.q)
+
+    @property
+    def dq1(self) -> np.ndarray:
+        """dq/du at each interval's end, shape (I, n_dof) (a copy)."""
+        return self._ends(self.dq)
+
+    @property
+    def ddq1(self) -> np.ndarray:
+        """d2q/du2 at each interval's end, shape (I, n_dof) (a copy)."""
+        return self._ends(self.ddq)
 
     def sample(self, piece_ids: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
         """Configurations along the given spans at most ``spacing`` (joint-space norm) apart,
@@ -142,16 +179,9 @@ def build_pieces(
     corner[m] = edge_from[edge[m]]
     t = np.linspace(0.0, 1.0, INTERVALS + 1)
     q, dq, ddq = span_values(control, t)  # (K, INTERVALS + 1, n)
-
-    def starts(x):
-        return x[:, :-1].reshape(-1, n)
-
-    def ends(x):
-        return x[:, 1:].reshape(-1, n)
-
     reach_l1 = np.abs(control - control[:, 1:2]).sum(axis=2).max(axis=1)
     return Pieces(
         kind=kind, turn_in=t_in, turn_out=t_out, edge=edge, corner=corner, control=control,
         first=np.arange(len(kind) + 1) * INTERVALS, ds=np.full(len(kind) * INTERVALS, 1.0 / INTERVALS),
-        q0=starts(q), dq0=starts(dq), ddq0=starts(ddq), q1=ends(q), dq1=ends(dq), ddq1=ends(ddq), reach_l1=reach_l1,
+        q=np.ascontiguousarray(q), dq=np.ascontiguousarray(dq), ddq=np.ascontiguousarray(ddq), reach_l1=reach_l1,
     )
