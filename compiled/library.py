@@ -64,10 +64,15 @@ def package_root() -> Path:
     return Path(toptraj.__file__).parent
 
 
-def jit_only() -> bool:
-    """Whether every kernel runs from numba: ``TOPTRAJ_KERNELS=jit``, or ``NUMBA_DISABLE_JIT=1``
-    (numba runs them as Python)."""
-    return os.environ.get("TOPTRAJ_KERNELS", "").lower() == "jit" or os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0")
+def in_use() -> bool:
+    """Whether kernels may run from the library: ``TOPTRAJ_KERNELS=library``, which the one-shot
+    commands (``toptraj plan``, ``compare``, ``plot``) set unless it is set, and not
+    ``NUMBA_DISABLE_JIT=1`` (numba then runs every kernel as Python). A long-lived process (a
+    server) keeps numba's dispatchers: it gains nothing from sparing numba's start once, and a
+    call through the library costs about 3 us more (its argument check, about 0.15 ms of the
+    typical request's 60 calls)."""
+    chosen = os.environ.get("TOPTRAJ_KERNELS", "").lower() == "library"
+    return chosen and os.environ.get("NUMBA_DISABLE_JIT", "0") in ("", "0")
 
 
 def digest(path: Path) -> str:
@@ -88,12 +93,12 @@ def versions() -> dict[str, str]:
 
 def functions_of(module: str, name: str) -> dict:
     """The library's functions of the kernel ``module.name``, by argument key; ``{}`` when the
-    library lacks it, is stale or absent, or ``jit_only()``."""
+    library lacks it, is stale or absent, or is not ``in_use()``."""
     global _table
     if _table is None:
         with _lock:
             if _table is None:
-                _table = {} if jit_only() else _load(manifest_path())
+                _table = _load(manifest_path()) if in_use() else {}
     return _table.get((module, name), {})
 
 

@@ -194,6 +194,8 @@ def main(argv: list[str] | None = None) -> int:
         # pydantic's plugins (unless asked for): finding them scans every installed package's
         # entry points, about 30 ms of toptraj plan's start; the service's models are made after this
         os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
+        # the kernels the install compiled ahead of time, without numba's start (toptraj.compiled)
+        os.environ.setdefault("TOPTRAJ_KERNELS", "library")
     return args.run(args)
 
 

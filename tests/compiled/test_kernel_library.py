@@ -65,7 +65,7 @@ def _plan(request_file, **env):
 def test_the_typical_request_runs_from_the_library_without_numba_and_answers_as_numba(built, tmp_path):
     request = tmp_path / "typical.json"
     request.write_text(json.dumps(TYPICAL))
-    ahead, ahead_numba = _plan(request, TOPTRAJ_KERNEL_LIBRARY=str(built))
+    ahead, ahead_numba = _plan(request, TOPTRAJ_KERNEL_LIBRARY=str(built), TOPTRAJ_KERNELS="library")
     jit, jit_numba = _plan(request, TOPTRAJ_KERNEL_LIBRARY=str(built), TOPTRAJ_KERNELS="jit")
     assert (ahead_numba, jit_numba) == ("numba not imported", "numba imported")
     assert ahead == jit  # every number, to the bit (JSON keeps a float's shortest round trip)
@@ -83,6 +83,7 @@ def test_a_library_built_from_other_sources_is_not_used(built, monkeypatch):
     shutil.copy(built / manifest["library"], stale / manifest["library"])
     (stale / f"{library.MODULE}.json").write_text(json.dumps(manifest))
     monkeypatch.setenv("TOPTRAJ_KERNEL_LIBRARY", str(stale))
+    monkeypatch.setenv("TOPTRAJ_KERNELS", "library")
     kernel.forget_library()
     try:
         assert library.functions_of("toptraj.planners.checks.limit_kernels", "utilization_pass") == {}
@@ -94,6 +95,7 @@ def test_arguments_of_other_types_go_to_numba(built, monkeypatch):
     from toptraj.planners.checks.limit_kernels import utilization_pass
 
     monkeypatch.setenv("TOPTRAJ_KERNEL_LIBRARY", str(built))
+    monkeypatch.setenv("TOPTRAJ_KERNELS", "library")
     kernel.forget_library()
     try:
         compiled = library.functions_of("toptraj.planners.checks.limit_kernels", "utilization_pass")
@@ -134,7 +136,7 @@ def test_a_truncated_library_file_is_not_loaded(built, tmp_path):
         "print(len(library.functions_of('toptraj.planners.checks.limit_kernels', 'utilization_pass')))\n"
     )
     done = subprocess.run(
-        [sys.executable, "-c", probe], cwd=ROOT, env={**os.environ, "TOPTRAJ_KERNEL_LIBRARY": str(cut)},
+        [sys.executable, "-c", probe], cwd=ROOT, env={**os.environ, "TOPTRAJ_KERNEL_LIBRARY": str(cut), "TOPTRAJ_KERNELS": "library"},
         capture_output=True, text=True, timeout=300,
     )
     assert (done.returncode, done.stdout.strip()) == (0, "0"), done.stderr[-1000:]
@@ -183,3 +185,25 @@ def numba_types(args):
     import numba
 
     return tuple(numba.typeof(value) for value in args)
+
+
+def test_only_one_shot_commands_use_the_library(built, tmp_path):
+    """``toptraj plan`` (which sets ``TOPTRAJ_KERNELS=library``) runs from it; the library call a
+    server makes does not (its dispatchers are cheaper per call, and its start is paid once)."""
+    request = tmp_path / "typical.json"
+    request.write_text(json.dumps(TYPICAL))
+    env = {key: value for key, value in os.environ.items() if key != "TOPTRAJ_KERNELS"}
+    probe = (
+        "import sys\nfrom toptraj.service.cli import main\nstatus = main(['plan', sys.argv[1]])\nsys.stdout.flush()\n"
+        "print('numba imported' if 'numba' in sys.modules else 'numba not imported', file=sys.stderr)\n"
+    )
+    server_like = "import sys\nfrom toptraj.service import commands\ncommands.plan(sys.argv[1])\nprint('numba' in sys.modules, file=sys.stderr)\n"
+    outcomes = []
+    for code in (probe, server_like):
+        done = subprocess.run(
+            [sys.executable, "-c", code, str(request)], cwd=ROOT, env={**env, "TOPTRAJ_KERNEL_LIBRARY": str(built)},
+            capture_output=True, text=True, timeout=600,
+        )
+        assert done.returncode == 0, done.stderr[-2000:]
+        outcomes.append(done.stderr.strip().splitlines()[-1])
+    assert outcomes == ["numba not imported", "True"]
