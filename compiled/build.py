@@ -132,7 +132,8 @@ def _compile(exports: dict[str, tuple[Kernel, tuple, object]], scratch: Path) ->
             warnings.simplefilter("ignore")
             module.compile()
     except Exception as error:  # noqa: BLE001 - a compiler's failure, of whatever kind, is a failed build
-        raise BuildFailed(f"{type(error).__name__}: {error} {output.getvalue()[-400:]}".strip()) from error
+        said = " ".join(f"{error} {output.getvalue()[-400:]}".split())  # one line, however the compiler wrote it
+        raise BuildFailed(f"{type(error).__name__}: {said[:300]}") from error
     built = scratch / f"{library.MODULE}{sysconfig.get_config_var('EXT_SUFFIX')}"
     if not built.is_file():
         raise BuildFailed(f"pycc wrote no {built.name}")
