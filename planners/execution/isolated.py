@@ -87,10 +87,20 @@ _lock = threading.Lock()
 _in_worker = False
 
 
+#: numpy's transparent huge pages in the workers (``NUMPY_MADVISE_HUGEPAGE``), unless set: off. A
+#: worker lives for one computation and touches its large arrays once, where faulting in 2 MB
+#: pages costs more than their fewer TLB misses save: a search's build in a fresh worker took
+#: 2.9 and 3.8 s with them against 1.5 and 2.0 s without (ur5 and panda around a box,
+#: ``benchmarks/search_speed.py``, alternating), the answers unchanged.
+WORKER_HUGEPAGES = "0"
+
+
 def _get_context():
     global _context
     with _lock:
         if _context is None:
+            # read by numpy as the fork server imports it; the server's own numpy is unchanged
+            os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", WORKER_HUGEPAGES)
             if "forkserver" in multiprocessing.get_all_start_methods():
                 forkserver = multiprocessing.get_context("forkserver")
                 forkserver.set_forkserver_preload(PRELOAD)

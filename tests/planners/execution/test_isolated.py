@@ -184,3 +184,15 @@ def _nested(megabytes: int) -> tuple[int, int]:
 def test_a_call_inside_a_worker_process_keeps_its_memory_allowance_for_the_call():
     assert run_isolated(_nested, 512, deadline=Deadline(60)) == (-1, 512 * 2**17)
     assert run_isolated(_nested, 64, deadline=Deadline(60)) == (64 * 2**17, 64 * 2**17)
+
+
+def _huge_pages() -> bool:
+    return bool(np._core.multiarray._get_madvise_hugepage())
+
+
+def test_workers_allocate_without_huge_pages_unless_asked():
+    """A worker touches its large arrays once (``WORKER_HUGEPAGES``): numpy's huge pages are off
+    there, whatever the calling process's numpy does."""
+    if os.environ.get("NUMPY_MADVISE_HUGEPAGE", "0") != "0":
+        pytest.skip("this environment asks for huge pages")
+    assert run_isolated(_huge_pages, deadline=Deadline(60)) is False
