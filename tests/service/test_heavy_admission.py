@@ -56,7 +56,7 @@ def test_which_plannings_are_heavy(method, kind, grid_points, expected):
 def test_a_search_does_not_take_the_threads_of_the_short_requests():
     """One planning thread and no queue for the short requests, one heavy worker and no heavy
     queue: while a search runs, a short request is served, and a second heavy one is refused at
-    once with 503 and Retry-After."""
+    once with 503 and Retry-After; the search itself answers within its budget or is refused at it."""
     app = create_app(Settings(preload_robots=False, plan_workers=1, plan_queue=0, plan_heavy_workers=1, plan_heavy_queue=0, plan_budget_s=3.0))
 
     async def scenario():
@@ -75,7 +75,11 @@ def test_a_search_does_not_take_the_threads_of_the_short_requests():
     short, second, search = asyncio.run(run())
     assert short.status_code == 200, short.text[:300]
     assert second.status_code == 503 and "heavy planning" in second.json()["detail"] and second.headers["retry-after"]
-    assert search.status_code == 504, search.text[:300]
+    # the search answers within its budget (its local optimization stopped at its share) or is
+    # refused at it, depending on the machine's speed; never a better duration than the optimum's
+    assert search.status_code in (200, 504), search.text[:300]
+    if search.status_code == 200:
+        assert search.json()["duration"] >= 0.95028 * (1 - 1e-6)
 
 
 def _tree_rss(server: LiveServer) -> int:
