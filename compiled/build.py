@@ -198,10 +198,3 @@ def _write_atomically(path: Path, text: str) -> None:
     scratch.write_text(text)
     os.replace(scratch, path)
 
-
-def remove() -> None:
-    """Delete the library and its manifest (every kernel then runs from numba)."""
-    library.manifest_path().unlink(missing_ok=True)
-    for old in library.folder().glob(f"{library.MODULE}-*"):
-        old.unlink(missing_ok=True)
-    forget_library()

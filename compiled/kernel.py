@@ -9,8 +9,9 @@ Inside other kernels a ``Kernel`` is its numba dispatcher: numba types a ``Kerne
 
 from __future__ import annotations
 
+import contextlib
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from toptraj.compiled import arguments, library
@@ -98,24 +99,17 @@ def njit(function: Callable | None = None, **options: Any) -> Any:
     return make(function) if function is not None else make
 
 
-class recording:  # noqa: N801 - used as a context manager, like a function
+@contextlib.contextmanager
+def recording() -> Iterator[list[tuple[Kernel, tuple]]]:
     """Within the block, every kernel runs from numba and each call from Python is recorded
     (``calls``: ``(kernel, args)``), for the ahead-of-time build."""
-
-    def __enter__(self) -> list[tuple[Kernel, tuple]]:
-        global _recorder
-        self.calls: list[tuple[Kernel, tuple]] = []
-        self._saved = [(kernel, kernel._ahead) for kernel in KERNELS]
-        for kernel in KERNELS:
-            kernel._ahead = {}
-        _recorder = self.calls
-        return self.calls
-
-    def __exit__(self, *exc: object) -> None:
-        global _recorder
+    global _recorder
+    calls: list[tuple[Kernel, tuple]] = []
+    _recorder = calls
+    try:
+        yield calls
+    finally:
         _recorder = None
-        for kernel, ahead in self._saved:
-            kernel._ahead = ahead
 
 
 def forget_library() -> None:

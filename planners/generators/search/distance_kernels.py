@@ -229,14 +229,11 @@ def lower_distances(a, b, radius, kind, row, exact_below, nearest):  # pragma: n
         nearest[i] = best
 
 
-@njit(cache=True, nogil=True)
-def _segments(p1, q1, p2, q2):  # pragma: no cover - compiled
-    """The distance between segments [p1, q1] and [p2, q2] (end points (3,) each), the closest
-    parameters clamped to the segments (Ericson, Real-Time Collision Detection, 5.1.9), on
-    scalars without temporaries."""
-    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
-    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
-    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
+@njit(cache=True, nogil=True, inline="always")
+def _closest(d1x, d1y, d1z, d2x, d2y, d2z, rx, ry, rz):  # pragma: no cover - compiled
+    """The distance between segments p1 + s d1 and p2 + t d2 (s, t in [0, 1]) given their
+    directions d1, d2 and r = p1 - p2 as scalars, the closest parameters clamped to the
+    segments (Ericson, Real-Time Collision Detection, 5.1.9), without temporaries."""
     a = d1x * d1x + d1y * d1y + d1z * d1z
     e = d2x * d2x + d2y * d2y + d2z * d2z
     f = d2x * rx + d2y * ry + d2z * rz
@@ -255,27 +252,21 @@ def _segments(p1, q1, p2, q2):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _segments(p1, q1, p2, q2):  # pragma: no cover - compiled
+    """The distance between segments [p1, q1] and [p2, q2] (end points (3,) each), the closest
+    parameters clamped to the segments (``_closest``)."""
+    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
+    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
+    return _closest(d1x, d1y, d1z, d2x, d2y, d2z, p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2])
+
+
+@njit(cache=True, nogil=True)
 def _capsules_apart(a, b, i, f, g):  # pragma: no cover - compiled
-    """``_segments`` of the capsules f and g at configuration i of the ends a, b (k, C, 3): the
-    same arithmetic, read from the arrays without views."""
+    """``_segments`` of the capsules f and g at configuration i of the ends a, b (k, C, 3), read
+    from the arrays without views (``_closest``)."""
     d1x, d1y, d1z = b[i, f, 0] - a[i, f, 0], b[i, f, 1] - a[i, f, 1], b[i, f, 2] - a[i, f, 2]
     d2x, d2y, d2z = b[i, g, 0] - a[i, g, 0], b[i, g, 1] - a[i, g, 1], b[i, g, 2] - a[i, g, 2]
-    rx, ry, rz = a[i, f, 0] - a[i, g, 0], a[i, f, 1] - a[i, g, 1], a[i, f, 2] - a[i, g, 2]
-    a_ = d1x * d1x + d1y * d1y + d1z * d1z
-    e = d2x * d2x + d2y * d2y + d2z * d2z
-    f_ = d2x * rx + d2y * ry + d2z * rz
-    c = d1x * rx + d1y * ry + d1z * rz
-    b_ = d1x * d2x + d1y * d2y + d1z * d2z
-    denom = a_ * e - b_ * b_
-    s = min(max((b_ * f_ - c * e) / denom, 0.0), 1.0) if denom > _TINY else 0.0
-    t = (b_ * s + f_) / e if e > _TINY else 0.0
-    if t < 0.0:
-        s = min(max(-c / a_, 0.0), 1.0) if a_ > _TINY else 0.0
-    elif t > 1.0:
-        s = min(max((b_ - c) / a_, 0.0), 1.0) if a_ > _TINY else 0.0
-    t = min(max(t, 0.0), 1.0)
-    x, y, z = rx + s * d1x - t * d2x, ry + s * d1y - t * d2y, rz + s * d1z - t * d2z
-    return math.sqrt(x * x + y * y + z * z)
+    return _closest(d1x, d1y, d1z, d2x, d2y, d2z, a[i, f, 0] - a[i, g, 0], a[i, f, 1] - a[i, g, 1], a[i, f, 2] - a[i, g, 2])
 
 
 @njit(cache=True, nogil=True)
