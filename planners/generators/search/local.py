@@ -46,6 +46,15 @@ one phase-plane integration; it dominates everything else, so:
   optimum exactly (Boehm's knot insertion leaves the curve unchanged). The optimization grid
   holds every dyadic knot, so it is the same grid in every round, and the objective of the
   best point of each round is never above that of the round before.
+* Rounds end when the exact duration has improved by less than ``improvement`` in ``patience``
+  successive rounds, or at once after a round whose exact duration is no better than the best
+  before it: its objective gain on the optimization grid was below what the exact timing
+  resolves, and more control points, started from that optimum, have not done better in the
+  cases measured (ur5 and panda around a box: the rounds of 5 and 7 control points both end
+  above the 4-point round's 0.950284 s and 0.880976 s; skipping the 7-point round saves 3,000
+  and 3,500 of 6,000 and 6,234 evaluations, the answers unchanged). A round that gains
+  anything, however little, is followed by another (the Geering arm's round of 11 control
+  points gains 0.07 %, the next 0.37 %).
 
 Penalties. The distance penalty acts on a lower bound of the distance between the optimization
 samples of the obstacle check (``obstacle_samples`` configurations): from the distances d_i,
@@ -281,14 +290,16 @@ def _rounds(
         clear, found = _clear(path, objective.robot, objective.limits, objective.obstacles, objective.clearance, deadline)
         duration = np.inf if timing is None else timing.duration
         rounds.append(LocalRound(count, float(value), float(duration), clear, objective.evaluations - before))
+        worse = False
         if timing is not None and clear:
             stalls = stalls + 1 if best is not None and duration > best[0] * (1.0 - settings.improvement) else 0
+            worse = best is not None and duration >= best[0]
             if best is None or duration < best[0]:
                 best = (duration, path, timing, found)
         if spent:
             stopped = "allowance spent"
             break
-        if stalls >= settings.patience:
+        if stalls >= settings.patience or worse:
             stopped = "converged"
             break
     return rounds, best, stopped
