@@ -74,7 +74,8 @@ class Kernel:
 
     def __getattr__(self, name: str) -> Any:
         # numba's own attributes (signatures, targetoptions, overloads, ...), from the dispatcher.
-        if name.startswith("__") or name in ("_dispatcher", "_ahead", "py_func", "options"):
+        # (``dispatcher`` too: an AttributeError raised while making it is not looked up again)
+        if name.startswith("__") or name in ("_dispatcher", "_ahead", "py_func", "options", "dispatcher"):
             raise AttributeError(name)
         return getattr(self.dispatcher, name)
 
@@ -121,12 +122,17 @@ def forget_library() -> None:
 
 
 def _teach_numba() -> None:
-    """numba types a ``Kernel`` global in a kernel as its dispatcher (once, on numba's import)."""
+    """numba types a ``Kernel`` global in a kernel as its dispatcher, and keeps the kernels'
+    disk cache fresh across modules (``toptraj.compiled.cache``); once, on numba's import."""
     global _numba_taught
     if _numba_taught:
         return
     from numba.core import types
     from numba.core.typing.typeof import typeof_impl
+
+    from toptraj.compiled.cache import keep_fresh
+
+    keep_fresh()
 
     @typeof_impl.register(Kernel)
     def _typeof_kernel(value: Kernel, context: Any) -> Any:
