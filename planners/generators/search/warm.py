@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from toptraj import robots
-from toptraj.planners.collision import SphereObstacle
+from toptraj.planners.collision import BoxObstacle, SphereObstacle
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.local import optimize_locally
 from toptraj.planners.generators.search.local_outcome import LocalSettings
@@ -24,12 +24,31 @@ from toptraj.planners.generators.search.method import global_search
 
 
 def warm() -> None:
-    """A small search and two rounds' worth of local optimization, computed and dropped."""
+    """A small search and two rounds' worth of local optimization, computed and dropped, on the
+    lattice of the two-link arm, then on a roadmap of ur5 (its velocity, acceleration and torque
+    limits, its links kept apart), and the phase-plane timing of a ur5 path through the limit
+    gate, as the search's answer is timed."""
     robot = robots.load("geering_2r")
     sphere = (SphereObstacle(np.array([0.52, 0.28, 0.0]), 0.05),)
     found = global_search(robot, robot.limits, ("torque",), np.zeros(2), np.array([0.76, 0.0]), SearchOptions(cells=(8,), tubes=1), True, sphere, 0.01)
     settings = LocalSettings(max_control_points=5, evaluations_per_variable=2)
     optimize_locally(robot, found.result.tubes[0].points, robot.limits, ("torque",), sphere, 0.01, settings=settings)
+    _roadmap_and_timing()
+
+
+def _roadmap_and_timing() -> None:
+    from toptraj.planners.plan import plan
+    from toptraj.planners.problem.build import build_problem
+    from toptraj.planners.problem.problem import LimitRequest
+    from toptraj.planners.problem.requests import WaypointPath
+    from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+
+    robot, kinds = robots.load("ur5"), ("velocity", "acceleration", "torque")
+    start, goal = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]), np.array([1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    box = (BoxObstacle(np.array([2.0, 2.0, 2.0]), np.array([0.15, 0.15, 0.15])),)  # out of reach: a grid path always
+    global_search(robot, robot.limits, kinds, start, goal, SearchOptions(roadmap_points=4, neighbors=2, tubes=1), True, box, 0.02)
+    path = WaypointPath(np.array([start, (start + goal) / 2 + 0.1, goal]))
+    plan(build_problem(robot, path, PhasePlaneMethod(), limits=LimitRequest(kinds=kinds)))
 
 
 warm()
