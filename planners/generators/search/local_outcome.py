@@ -23,8 +23,8 @@ class LocalSettings:
         max_control_points: No round goes beyond this many control points.
         improvement: Rounds stop when the exact duration has improved by less than this
             fraction in ``patience`` successive rounds (a spline of few control points may be
-            unable to follow the better path that more of them reach), and at once after a
-            round that did not improve it at all.
+            unable to follow the better path that more of them reach), and at once when a
+            round does not improve it right after a round that did.
         patience: Successive rounds without improvement before the rounds stop.
         grid_intervals: Intervals of the uniform optimization grid; a power of two, so that it
             holds the dyadic knots (at least 8 intervals per knot interval are kept).
