@@ -147,10 +147,13 @@ def _not_a_rotation(facts: dict) -> str:
 
 def _arms_collide_at_start(facts: dict) -> str:
     (a, b), (link_a, link_b), (robot_a, robot_b) = (facts["first"], facts["second"]), facts["links"], facts["robots"]
+    distance, clearance = facts["distance"], facts["clearance"]
+    lower = f", or lower clearance to {distance:.4g} m or less" if distance > 0.0 else ""
     return (
-        f"the arms collide at their start: link {link_a!r} of arms[{a}] ({robot_a}) is {facts['distance']:.4g} m "
-        f"from link {link_b!r} of arms[{b}] ({robot_b}) at s = 0 (the clearance is {facts['clearance']:g} m): "
-        "move a base apart, change the first waypoints or lower clearance"
+        f"the arms collide at their start: link {link_a!r} of arms[{a}] ({robot_a}) is {distance:.4g} m "
+        f"from link {link_b!r} of arms[{b}] ({robot_b}) at s = 0 (the clearance is {clearance:g} m): "
+        f"move arms[{b}].base at least {clearance - distance:.4g} m farther from arms[{a}]'s (those two links "
+        f"{'overlap' if distance < 0.0 else 'are too close'}), change either arm's first waypoint{lower}"
     )
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import json
+import re
 
 import numpy as np
 import pytest
@@ -138,7 +139,12 @@ def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_cli
     detail = response.json()["detail"]
     assert detail.startswith("the arms collide at their start") and "link '" in detail
     assert "_0' of arms" not in detail  # the URDF's link names, not the capsules' names
-    assert detail.endswith("move a base apart, change the first waypoints or lower clearance")
+    # the advice names how far to move and what clearance would do, from the distance found
+    match = re.search(r"is (-?[\d.e-]+) m from link .*the clearance is ([\d.e-]+) m\): move arms\[1\]\.base at least ([\d.e-]+) m farther", detail)
+    assert match, detail
+    distance, clearance, move = (float(group) for group in match.groups())
+    assert move == pytest.approx(clearance - distance, rel=1e-3, abs=1e-4)
+    assert ("lower clearance to" in detail) == (distance > 0.0)
 
 
 def test_three_arms_are_answered_on_one_clock_with_every_pairs_diagram(patient_client):
