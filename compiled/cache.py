@@ -11,7 +11,12 @@ with the old answer until the cache was cleared).
 stamp that also holds the SHA-256 of every kernel module of the package (``kernel_sources``:
 the modules that import this package's ``njit``), so that an edit to any of them makes every
 kernel compile again at its next use, as the install's warm-up does. It serves the kernel
-modules only; every other function numba caches is located as before.
+modules only; every other function numba caches is located as before (and
+``NUMBA_CACHE_LOCATOR_CLASSES``, when set, replaces numba's locators, this one with them).
+
+A process whose kernel modules changed on disk after it imported them (code updated under a
+running server, or edited during a test run) compiles its kernels without caching them
+(``current``), so that no code older than the files is saved under their stamp.
 """
 
 from __future__ import annotations
@@ -19,11 +24,15 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import re
 from pathlib import Path
 from typing import Any
 
-#: What marks a module that defines kernels.
-KERNEL_IMPORT = b"from toptraj.compiled import njit"
+#: What marks a module that defines kernels: it imports this package's ``njit`` (alone or with
+#: other names, in parentheses or not, from ``toptraj.compiled`` or ``toptraj.compiled.kernel``).
+KERNEL_IMPORT = re.compile(rb"^[ \t]*from[ \t]+toptraj\.compiled(?:\.kernel)?[ \t]+import[ \t]+(?:\([^)]*\bnjit\b|[^\n#]*\bnjit\b)", re.M)
+#: (st_mtime_ns, st_size) of each module that defined a kernel in this process, when it did.
+_imported: dict[str, tuple[int, int]] = {}
 #: The subpackages that may define kernels (the layers above ``compiled``).
 KERNEL_PACKAGES = ("robots", "planners")
 
@@ -44,7 +53,7 @@ def kernel_sources() -> list[Path]:
             folders[:] = sorted(name for name in folders if name != "__pycache__")
             for name in sorted(files):
                 path = Path(folder) / name
-                if name.endswith(".py") and KERNEL_IMPORT in path.read_bytes():
+                if name.endswith(".py") and KERNEL_IMPORT.search(path.read_bytes()):
                     found.append(path)
     return found
 
@@ -52,7 +61,7 @@ def kernel_sources() -> list[Path]:
 @functools.cache
 def _sources() -> tuple[str, frozenset[Path]]:
     """SHA-256 (hex) of the kernel modules' paths (relative to the package) and bytes, and
-    their files (symbolic links resolved); read once per process (about 3 ms)."""
+    their files (symbolic links resolved); read once per process (a few milliseconds)."""
     root, digest = package_root(), hashlib.sha256()
     paths = kernel_sources()
     for path in paths:
@@ -64,6 +73,32 @@ def _sources() -> tuple[str, frozenset[Path]]:
 def sources_digest() -> str:
     """SHA-256 (hex) of every kernel module's path and bytes."""
     return _sources()[0]
+
+
+def defined_in(py_file: str) -> None:
+    """Note that a kernel was defined from ``py_file`` now (its module is being imported): the
+    file's state then is that of the code this process runs (``current``)."""
+    if py_file not in _imported:
+        try:
+            stat = os.stat(py_file)
+        except OSError:
+            return
+        _imported[py_file] = (stat.st_mtime_ns, stat.st_size)
+
+
+def current() -> bool:
+    """Whether every module that defined a kernel in this process is still, on disk, the file it
+    imported. Else its kernels must not be cached: this process would save the code it imported
+    under the stamp of the files now on disk (``sources_digest``), and every later process would
+    load that old code as fresh."""
+    for py_file, state in list(_imported.items()):
+        try:
+            stat = os.stat(py_file)
+        except OSError:
+            return False
+        if (stat.st_mtime_ns, stat.st_size) != state:
+            return False
+    return True
 
 
 def is_kernel_module(py_file: str) -> bool:

@@ -14,7 +14,7 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from toptraj.compiled import arguments, library
+from toptraj.compiled import arguments, cache, library
 
 #: Every kernel made so far, in the order their modules defined them.
 KERNELS: list[Kernel] = []
@@ -45,10 +45,16 @@ class Kernel:
         if self._dispatcher is None:
             with _numba_lock:
                 if self._dispatcher is None:
-                    _teach_numba()
-                    import numba
+                    try:
+                        _teach_numba()
+                        import numba
 
-                    self._dispatcher = numba.njit(**self.options)(self.py_func)
+                        options = self.options
+                        if options.get("cache") and not cache.current():  # code older than its files: not saved
+                            options = {**options, "cache": False}
+                        self._dispatcher = numba.njit(**options)(self.py_func)
+                    except Exception as error:  # not an AttributeError, which __getattr__ would hide
+                        raise RuntimeError(f"numba's dispatcher of {self!r} could not be made: {error!r}") from error
         return self._dispatcher
 
     def __call__(self, *args: Any, **keywords: Any) -> Any:
@@ -93,6 +99,7 @@ def njit(function: Callable | None = None, **options: Any) -> Any:
     Python, as numba's own do."""
 
     def make(function: Callable) -> Kernel:
+        cache.defined_in(function.__code__.co_filename)
         kernel = Kernel(function, options)
         KERNELS.append(kernel)
         return kernel
@@ -130,9 +137,7 @@ def _teach_numba() -> None:
     from numba.core import types
     from numba.core.typing.typeof import typeof_impl
 
-    from toptraj.compiled.cache import keep_fresh
-
-    keep_fresh()
+    cache.keep_fresh()
 
     @typeof_impl.register(Kernel)
     def _typeof_kernel(value: Kernel, context: Any) -> Any:

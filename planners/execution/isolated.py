@@ -63,7 +63,8 @@ LOW_PRIORITY = 5
 #: search: scipy's sparse graphs, optimizers and B-splines), and the compiled kernels the
 #: collocation's first guess calls (``collocation.warm``: each worker would otherwise load them
 #: from numba's disk cache itself, 0.36 s a ur5 free motion) and those of a small search and its
-#: local optimization (``search.warm``: 0.3 to 0.9 s a search). The server process imports none.
+#: local optimization (``search.warm``: 0.3 to 0.9 s a search), and those of a path timed through
+#: the runner, as every search's answer is (``runner.warm``). The server process imports none.
 PRELOAD = [
     "numpy",
     "threadpoolctl",
@@ -79,6 +80,7 @@ PRELOAD = [
     "toptraj.planners.generators.search.generator",
     "toptraj.planners.generators.collocation.warm",
     "toptraj.planners.generators.search.warm",
+    "toptraj.planners.runner.warm",
 ]
 
 _context: multiprocessing.context.BaseContext | None = None

@@ -57,7 +57,8 @@ one phase-plane integration; it dominates everything else, so:
   its sphere gains 0.07 %, the next 0.37 %), and so is a round that follows one that gained
   nothing: with no obstacle, the Geering arm's first round ends above its fitted seed (1.0228
   against 1.0152 s, its objective on the optimization grid lower), and the rounds after it reach
-  0.9773 s.
+  0.9773 s. A round whose path fails the dense checks or cannot be timed decides nothing: the
+  rounds go on as after the round before it.
 
 Penalties. The distance penalty acts on a lower bound of the distance between the optimization
 samples of the obstacle check (``obstacle_samples`` configurations): from the distances d_i,
@@ -277,7 +278,7 @@ def _rounds(
     settings, deadline = objective.settings, objective.deadline
     rounds: list[LocalRound] = []
     stopped, stalls = "most control points", 0
-    gained = False  # whether the round before set a new best path
+    gained = False  # whether the last round that was timed and clear set a new best path
     for number, count in enumerate(counts):
         deadline.progress(number / len(counts), f"local optimization: {count} control points")
         while len(control) < count:
@@ -294,15 +295,17 @@ def _rounds(
         clear, found = _clear(path, objective.robot, objective.limits, objective.obstacles, objective.clearance, deadline)
         duration = np.inf if timing is None else timing.duration
         rounds.append(LocalRound(count, float(value), float(duration), clear, objective.evaluations - before))
-        gained_before, gained = gained, False
+        fruitless = False  # a timed, clear round no faster than the best, right after one that gained
         if timing is not None and clear:
             stalls = stalls + 1 if best is not None and duration > best[0] * (1.0 - settings.improvement) else 0
-            if best is None or duration < best[0]:
-                best, gained = (duration, path, timing, found), True
+            fruitless = gained and not (best is None or duration < best[0])
+            gained = best is None or duration < best[0]
+            if gained:
+                best = (duration, path, timing, found)
         if spent:
             stopped = "allowance spent"
             break
-        if stalls >= settings.patience or (gained_before and not gained):
+        if stalls >= settings.patience or fruitless:
             stopped = "converged"
             break
     return rounds, best, stopped
