@@ -30,10 +30,10 @@ from toptraj.planners.execution.threads import single_blas_thread
 logger = logging.getLogger("toptraj.batches")
 
 #: Modules of ``isolated.PRELOAD`` that compute when imported (a warm-up, not a stack): the
-#: search's (``search.warm``, a small search and local optimization, about 0.9 s) is left to a
-#: worker's first line that searches, which loads the same kernels as it runs (a batch worker's
-#: calls run inline: it has no fork server to warm).
-WARM_UPS = ("toptraj.planners.generators.search.warm",)
+#: search's (``search.warm``, two small searches and a local optimization, about 1.5 s) and the
+#: runner's (``runner.warm``, a ur5 path timed) are left to a worker's first line, which loads
+#: the same kernels as it runs (a batch worker's calls run inline: it has no fork server to warm).
+WARM_UPS = ("toptraj.planners.generators.search.warm", "toptraj.planners.runner.warm")
 #: Modules a worker imports once: the fork server's (``isolated.PRELOAD``) but its warm-ups
 #: (``WARM_UPS``), and the stacks of the methods that import theirs on their first run.
 STACKS = [
