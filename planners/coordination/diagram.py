@@ -166,3 +166,25 @@ def _free_cells(needed: float, arms: tuple[CellArm, CellArm], coarse: tuple[np.n
         bounds = refined_bounds(refine, arms, len(step1), needed, deadline)
         free[refine[:, 0], refine[:, 1]] = bounds >= needed
     return free
+
+
+def widest_coordination(diagram: Diagram) -> tuple[float, int, int]:
+    """The largest distance (m) any monotone coordination of the two arms keeps on the diagram's
+    grid, from (0, 0) to (M, M) by steps of (1, 0), (0, 1) or (1, 1), and the node (i, j) where
+    the coordination that keeps it comes closest: a maximin (bottleneck) path, by dynamic
+    programming over the nodes, O(M^2)."""
+    distance = diagram.distance
+    n = distance.shape[0]
+    widest = np.full((n, n), -np.inf)  # the largest least distance over the paths to each node
+    closest = np.zeros((n, n, 2), dtype=np.int64)  # where that path comes closest
+    for i in range(n):
+        for j in range(n):
+            came, at = (-np.inf, (i, j)) if i or j else (np.inf, (0, 0))
+            for di, dj in ((1, 0), (0, 1), (1, 1)):
+                if i >= di and j >= dj and widest[i - di, j - dj] > came:
+                    came, at = widest[i - di, j - dj], tuple(closest[i - di, j - dj])
+            if distance[i, j] <= came:
+                came, at = distance[i, j], (i, j)
+            widest[i, j], closest[i, j] = came, at
+    i, j = closest[-1, -1]
+    return float(widest[-1, -1]), int(i), int(j)

@@ -5,12 +5,15 @@ a clearance above what any timing can keep still refused."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
 from tests.planners.coordination.cells import facing_cell
 from tests.planners.coordination.independent import coal_distance
 from toptraj.planners.coordination import coordinate
+from toptraj.planners.coordination.diagram import Diagram, widest_coordination
 from toptraj.planners.errors import InfeasiblePath
 
 
@@ -39,5 +42,39 @@ def test_a_clearance_no_timing_keeps_is_refused():
     q1, q2 = cell.arms[0].path.evaluate(s1).q, cell.arms[1].path.evaluate(1.4 - s1).q
     reach = max(coal_distance(cell, a, b) for a, b in zip(q1, q2))
     assert reach < 0.25
-    with pytest.raises(InfeasiblePath, match="no timing keeps the arms apart"):
+    with pytest.raises(InfeasiblePath, match="no timing keeps the arms apart") as refused:
         coordinate(facing_cell(clearance=reach + 0.03))
+    # it names the closest approach of the coordination that keeps the arms farthest apart (on
+    # the diagram's grid; no more than the largest distance on that line) and the clearance to
+    # ask for instead; asked for, it is served and kept (coal, 401 samples)
+    error = refused.value
+    assert 0.0 < error.distance <= reach and error.clearance == reach + 0.03
+    assert error.arms == (0, 1) and all(link in error.detail for link in error.links)
+    room = float(re.search(r"lower clearance to ([\d.e-]+) m or less", error.detail).group(1))
+    assert error.distance - 0.006 < room <= error.distance - 0.005
+    found = coordinate(facing_cell(clearance=room))
+    assert found.clearance.bound >= room
+    assert _coal_min(facing_cell(clearance=room), found.schedule, 400) >= room
+
+
+def _all_monotone_least(distance: np.ndarray) -> float:
+    """The largest least distance over every monotone path of the grid, by enumeration."""
+    n = distance.shape[0]
+
+    def walk(i, j, least):
+        least = min(least, distance[i, j])
+        if (i, j) == (n - 1, n - 1):
+            return least
+        steps = [(i + di, j + dj) for di, dj in ((1, 0), (0, 1), (1, 1)) if i + di < n and j + dj < n]
+        return max(walk(a, b, least) for a, b in steps)
+
+    return walk(0, 0, np.inf)
+
+
+def test_the_widest_coordination_is_the_best_of_every_monotone_path():
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        distance = rng.uniform(0.0, 1.0, (6, 6))
+        diagram = Diagram(np.linspace(0.0, 1.0, 6), distance, np.zeros((6, 6), dtype=bool), np.zeros(5), np.zeros(5))
+        widest, i, j = widest_coordination(diagram)
+        assert widest == _all_monotone_least(distance) and distance[i, j] == widest
