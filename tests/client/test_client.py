@@ -191,9 +191,12 @@ def test_problems_are_raised_with_their_facts(toptraj):
 
 
 def test_timeouts_are_the_clients_and_each_calls(server):
+    # a request the server takes tens of milliseconds on (jerk limits), against a 2 ms timeout for
+    # that call: the quick request (a few milliseconds) was answered within a 1 ms timeout once
+    jerk = json.loads((ROOT / "examples" / "ur5_jerk_limited.json").read_text())
     with Client(f"http://127.0.0.1:{server.port}", timeout=30) as quick:
         with pytest.raises(httpx.TimeoutException):
-            quick.plan(QUICK, timeout=0.001)
+            quick.plan(jerk, timeout=0.002)
         assert quick.health() == "ok"
 
 
