@@ -28,6 +28,8 @@ import re
 from pathlib import Path
 from typing import Any
 
+from toptraj.compiled.library import package_root
+
 #: What marks a module that defines kernels: it imports this package's ``njit`` (alone or with
 #: other names, in parentheses or not, from ``toptraj.compiled`` or ``toptraj.compiled.kernel``).
 KERNEL_IMPORT = re.compile(rb"^[ \t]*from[ \t]+toptraj\.compiled(?:\.kernel)?[ \t]+import[ \t]+(?:\([^)]*\bnjit\b|[^\n#]*\bnjit\b)", re.M)
@@ -35,13 +37,6 @@ KERNEL_IMPORT = re.compile(rb"^[ \t]*from[ \t]+toptraj\.compiled(?:\.kernel)?[ \
 _imported: dict[str, tuple[int, int]] = {}
 #: The subpackages that may define kernels (the layers above ``compiled``).
 KERNEL_PACKAGES = ("robots", "planners")
-
-
-def package_root() -> Path:
-    """The ``toptraj`` package's folder."""
-    import toptraj
-
-    return Path(toptraj.__file__).parent
 
 
 def kernel_sources() -> list[Path]:

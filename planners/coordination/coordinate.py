@@ -221,27 +221,17 @@ def coordinate(cell: Cell, deadline: Deadline = NO_DEADLINE) -> Coordination:
 
 def _widest_refusal(cell: Cell, diagram: Diagram, text: str) -> InfeasiblePath:
     """The refusal naming where the coordination that keeps the two arms farthest apart comes
-    closest, and the clearance below which the diagram has room for it (its margin
+    closest, and ``room``: the clearance below which the diagram has room for it (its margin
     ``FINE_STEP`` below that distance)."""
     widest, i, j = widest_coordination(diagram)
     s1, s2 = float(diagram.s[i]), float(diagram.s[j])
     first, second = cell.arms
     _, k1, k2 = pair_distances(arm_capsules(first, np.array([s1])), arm_capsules(second, np.array([s2])))
     link_a, link_b = first.link_names()[int(k1[0])], second.link_names()[int(k2[0])]
-    room = _down(widest - FINE_STEP)
-    lower = f", or lower clearance to {room:g} m or less" if room > 0.0 else ""
     return InfeasiblePath(
         f"{text}: every coordination of the two motions comes within {widest:.3g} m (the clearance is {cell.clearance:g} m); "
-        f"the one that keeps them farthest apart brings link {link_a!r} of arms[0] at s = {s1:.3g} that close to link "
-        f"{link_b!r} of arms[1] at s = {s2:.3g}: move a base apart, change a path{lower}",
-        s=s1, arms=(0, 1), links=(link_a, link_b), distance=widest, clearance=cell.clearance,
+        f"the one that keeps them farthest apart brings link {link_a!r} of arm 0 at s = {s1:.3g} that close to link "
+        f"{link_b!r} of arm 1 at s = {s2:.3g}",
+        s=s1, rule="arms_never_apart", arms=(0, 1), links=(link_a, link_b), s_pair=(s1, s2), distance=widest,
+        clearance=cell.clearance, room=widest - FINE_STEP,
     )
-
-
-def _down(value: float, digits: int = 3) -> float:
-    """``value`` rounded down to ``digits`` significant digits (advice that, followed as
-    printed, stays within the bound it comes from)."""
-    if value <= 0.0 or not np.isfinite(value):
-        return value
-    scale = 10.0 ** (digits - 1 - int(np.floor(np.log10(value))))
-    return float(np.floor(value * scale) / scale)

@@ -31,6 +31,13 @@ def rounded_up(seconds: float, digits: int = STATED_DIGITS) -> float:
     return round(math.ceil(seconds / step - 1e-9) * step, 12)
 
 
+def rounded_down(value: float, digits: int = STATED_DIGITS) -> float:
+    """``value`` (> 0) rounded down to ``digits`` significant digits (advice that, followed as
+    printed, stays within the bound it comes from)."""
+    step = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return round(math.floor(value / step + 1e-9) * step, 12)
+
+
 def too_short(problem: Problem, error: LimitExceeded, run: Callable[[Problem], PlannedTrajectory]) -> LimitExceeded:
     """``error`` (a limit exceeded by the timing of ``problem``, whose duration was given) with
     the shortest duration that holds the limits when the duration is what breaks them: the same

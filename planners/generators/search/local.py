@@ -298,9 +298,9 @@ def _rounds(
         fruitless = False  # a timed, clear round no faster than the best, right after one that gained
         if timing is not None and clear:
             stalls = stalls + 1 if best is not None and duration > best[0] * (1.0 - settings.improvement) else 0
-            fruitless = gained and not (best is None or duration < best[0])
-            gained = best is None or duration < best[0]
-            if gained:
+            improved = best is None or duration < best[0]
+            fruitless, gained = gained and not improved, improved
+            if improved:
                 best = (duration, path, timing, found)
         if spent:
             stopped = "allowance spent"

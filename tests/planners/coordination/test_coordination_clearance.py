@@ -15,6 +15,7 @@ from tests.planners.coordination.independent import coal_distance
 from toptraj.planners.coordination import coordinate
 from toptraj.planners.coordination.diagram import Diagram, widest_coordination
 from toptraj.planners.errors import InfeasiblePath
+from toptraj.service.problems import detail
 
 
 def _coal_min(cell, schedule, samples: int) -> float:
@@ -49,8 +50,9 @@ def test_a_clearance_no_timing_keeps_is_refused():
     # ask for instead; asked for, it is served and kept (coal, 401 samples)
     error = refused.value
     assert 0.0 < error.distance <= reach and error.clearance == reach + 0.03
-    assert error.arms == (0, 1) and all(link in error.detail for link in error.links)
-    room = float(re.search(r"lower clearance to ([\d.e-]+) m or less", error.detail).group(1))
+    worded = detail(error)  # as the service words it
+    assert error.arms == (0, 1) and all(link in worded for link in error.links) and "arms[1] at s = " in worded
+    room = float(re.search(r"lower clearance to ([\d.e-]+) m or less", worded).group(1))
     assert error.distance - 0.006 < room <= error.distance - 0.005
     found = coordinate(facing_cell(clearance=room))
     assert found.clearance.bound >= room
