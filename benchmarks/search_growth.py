@@ -9,7 +9,9 @@ augmented graph, pieces of curve bounded), the time to build the problem (pieces
 configuration-space obstacle check and their bounds) and the branch and bound's time, nodes
 expanded and pruning. Local optimization is not included (its cost is that of the timings
 along the candidates, see the README). Lattices: geering_2r (2 joints) and lecture_3r (3);
-roadmaps: ur5 (6) and panda (7), each with one box on the straight joint line.
+roadmaps: ur5 (6) and panda (7), each with one box on the straight joint line, every span
+checked before the branch and bound (``SearchOptions.lazy`` false; the search checks a
+roadmap's spans lazily by default, see ``benchmarks/search_speed.py``).
 """
 
 from __future__ import annotations
@@ -101,7 +103,7 @@ def main() -> int:
     study = STUDY_MEMORY
     cases = [("geering_2r", SearchOptions(cells=(c,), memory_bytes=study)) for c in (8, 16, 24, 32)]
     cases += [("lecture_3r", SearchOptions(cells=(c,), memory_bytes=study)) for c in (6, 8, 10)]
-    cases += [(arm, SearchOptions(roadmap_points=p, memory_bytes=study)) for arm in ("ur5", "panda") for p in (50, 100, 150)]
+    cases += [(arm, SearchOptions(roadmap_points=p, memory_bytes=study, lazy=False)) for arm in ("ur5", "panda") for p in (50, 100, 150)]
     cases = [case for case in cases if case[0] in args.arms]
     if args.quick:
         cases = [case for case in cases if (case[1].cells or (0,))[0] <= 16 and case[1].roadmap_points <= 100]

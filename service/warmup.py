@@ -162,7 +162,7 @@ def _search_graph() -> None:
     arm = robots.load("ur5")
     start, goal = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]), np.array([1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
     box = BoxObstacle(np.array([0.626, 0.109, 0.29]), np.array([0.15, 0.15, 0.15]))
-    options = SearchOptions(graph="roadmap", roadmap_points=8, neighbors=3)
+    options = SearchOptions(graph="roadmap", roadmap_points=8, neighbors=3, lazy=False)  # every span checked, refinement too
     build_problem(arm, arm.limits, ("velocity", "acceleration", "torque"), start, goal, options, True, (box,), 0.02)
 
 

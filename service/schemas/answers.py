@@ -112,6 +112,12 @@ class SearchPublic(BaseModel):
     turns: int = Field(description="Edges of the direction-augmented graph: pairs of consecutive moves without a sharp turn (count).")
     removed_by_obstacles: int = Field(description="Pieces of curve (B-spline spans) removed as configuration-space obstacles (count).")
     points_blocked: int = Field(description="Grid points closer to an obstacle than path.clearance (count).")
+    spans_checked: int = Field(
+        default=0,
+        description="Pieces of curve whose clearance was checked (count): all of a lattice's; on a roadmap only those of "
+        "the grid paths the search timed (lazy checks, as in Lazy PRM).",
+    )
+    searches: int = Field(default=1, description="Branch and bounds run: one more after each whose grid paths met a piece of curve found blocked.")
     v_max: float | None = Field(description="V_max of the maximum speed test t1 (joint units/s); null where no limit bounds the speed.")
     expanded: int = Field(description="Partial paths branched (count).")
     generated: int = Field(description="Subsets of grid paths created (count).")

@@ -53,10 +53,10 @@ def test_the_install_compiles_the_search_graphs_kernels_every_roadmap_calls():
     panda = robots.load("panda")
     start, goal = np.array([-0.8, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8]), np.array([0.8, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8])
     box = BoxObstacle(np.array([0.4854, 0.0, 0.491]), np.array([0.1, 0.1, 0.1]))
-    problem = build_problem(panda, panda.limits, kinds, start, goal, SearchOptions(roadmap_points=10, neighbors=4), True, (box,), 0.01)
+    problem = build_problem(panda, panda.limits, kinds, start, goal, SearchOptions(roadmap_points=10, neighbors=4, lazy=False), True, (box,), 0.01)
     ur5 = robots.load("ur5")
     start, goal = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0]), np.array([1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
     sphere = SphereObstacle(np.array([0.626, 0.109, 0.29]), 0.08)
-    other = build_problem(ur5, ur5.limits, kinds, start, goal, SearchOptions(roadmap_points=10, neighbors=4), True, (sphere,), 0.02)
+    other = build_problem(ur5, ur5.limits, kinds, start, goal, SearchOptions(roadmap_points=10, neighbors=4, lazy=False), True, (sphere,), 0.02)
     assert problem.removed > 0 and other.removed > 0  # pieces near the obstacles were refined
     assert [list(kernel.signatures) for kernel in GRAPH_KERNELS] == compiled  # nothing compiled anew

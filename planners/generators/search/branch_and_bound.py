@@ -75,6 +75,7 @@ class _Search:
         self.t_u = cap
         self.stop_at = stop_at
         self.found: list[GridPath] = []
+        self.timed: list[int] = []  # the spans of every grid path timed (a lazy problem checks them)
         self.stats = SearchStatistics(
             graph=graph.kind,
             grid_points=len(graph.points),
@@ -140,6 +141,7 @@ class _Search:
             node = _Node(state, edge, 0.0, 0.0, 0.0, 0.0, node.visited | 1 << int(problem.graph.edge_to[edge]), node, piece)
             if ending >= 0:
                 node = _Node(state, -1, 0.0, 0.0, 0.0, 0.0, node.visited, node, ending, complete=True)
+                self.timed += node.pieces()
                 self._lower_t_u(self.t4_of(self.points(node)))
                 return
             options = [
@@ -160,6 +162,7 @@ class _Search:
                     self.stats.complete = False  # the node table is at its most bytes
                     break
             elif status == kernels.NEED_T4:
+                self.timed += tables.pieces(index)
                 tables.settle(index, self.t4_of(self.points_of(tables.edges(index))), self.options.upper_margin)
             elif status == kernels.FOUND:
                 g1, g2, _, _, t3, t4 = tables.floats[index]
@@ -230,25 +233,26 @@ def branch_and_bound(
     stop_at = np.inf if allowance_s is None else time.monotonic() + allowance_s
     search = _Search(problem, options, deadline, cap, stop_at)
     search.run()
+    timed = np.unique(np.asarray(search.timed, dtype=int))
     if not search.found:
         stats = search.stats
         if not stats.complete:
             raise NoGridPath(
                 f"the search found no grid path within its share of the time budget or its max_expansions "
                 f"({stats.expanded} partial paths expanded)",
-                stats, rule="search_incomplete", graph=problem.graph.kind,
+                stats, timed, rule="search_incomplete", graph=problem.graph.kind,
             )
         below = f" faster than {cap:.4g} s" if np.isfinite(cap) else ""
         raise NoGridPath(
             f"the search found no grid path from start to goal{below} that keeps the clearance and the limits "
             f"({stats.grid_points} grid points, {stats.removed_by_obstacles} pieces of path removed by obstacles, "
             f"{stats.points_blocked} grid points blocked)",
-            stats, rule="no_grid_path", graph=problem.graph.kind, cap=cap,
+            stats, timed, rule="no_grid_path", graph=problem.graph.kind, cap=cap,
         )
     scale = problem.graph.scale
     radius = options.tube_radius if options.tube_radius is not None else 3.0 * float(np.linalg.norm(scale))
     tubes = select_tubes(search.found, radius, max(1, options.tubes))
-    return SearchResult(tuple(tubes), tuple(search.found), search.stats, radius)
+    return SearchResult(tuple(tubes), tuple(search.found), search.stats, radius, timed)
 
 
 def enumerate_grid_paths(problem: SearchProblem, deadline: Deadline = NO_DEADLINE, limit: int = 100_000) -> list[GridPath]:

@@ -201,7 +201,17 @@ def joint_reaches(robot: Robot) -> np.ndarray:
 def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: list[Obstacle], clearance: float,
                  deadline: Deadline) -> tuple[np.ndarray, np.ndarray]:
     """Which pieces keep ``clearance`` (m) from ``obstacles`` and the links apart along all of
-    them, shape (K,), and the distance of every grid point (``free_distances``), shape (P,).
+    them, shape (K,), and the distance of every grid point (``free_distances``), shape (P,):
+    ``clear_spans`` of every piece."""
+    distance = free_distances(robot, points, obstacles, clearance, deadline=deadline)
+    return clear_spans(pieces, np.arange(len(pieces)), distance, robot, obstacles, clearance, deadline), distance
+
+
+def clear_spans(pieces: Pieces, spans: np.ndarray, distance: np.ndarray, robot: Robot, obstacles: list[Obstacle],
+                clearance: float, deadline: Deadline) -> np.ndarray:
+    """Which of the pieces ``spans`` (indices, shape (m,)) keep ``clearance`` (m) from
+    ``obstacles`` and the links apart along all of them, shape (m,); ``distance`` (P,) is
+    ``free_distances`` at every grid point.
 
     The arm's points move at most sum_j R_j |dq_j| (``joint_reaches``); along a span, |dq_j/dt|
     is at most the largest difference of its control points in joint j, so over a parameter
@@ -213,15 +223,16 @@ def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: li
     one: a sample closer than the clearance, or an interval still undecided then, removes the
     span.
     """
-    distance = free_distances(robot, points, obstacles, clearance, deadline=deadline)
+    spans = np.asarray(spans, dtype=int)
     weights = joint_reaches(robot)
     control = pieces.control
-    hull = (np.abs(control - control[:, 1:2]) * weights).sum(axis=2).max(axis=1)
-    keep = distance[pieces.corner] - hull >= clearance
-    undecided = np.flatnonzero(~keep)
+    hull = (np.abs(control[spans] - control[spans, 1:2]) * weights).sum(axis=2).max(axis=1)
+    keep = distance[pieces.corner[spans]] - hull >= clearance
+    undecided = spans[~keep]
     if not undecided.size:
-        return keep, distance
-    speed = (np.abs(np.diff(control, axis=1)).max(axis=1) * weights).sum(axis=1)  # S per span
+        return keep
+    speed = np.zeros(len(pieces))
+    speed[undecided] = (np.abs(np.diff(control[undecided], axis=1)).max(axis=1) * weights).sum(axis=1)  # S per span
     blocked = np.zeros(len(pieces), dtype=bool)
     count = pieces.first[1] - pieces.first[0]
     # the undecided spans a group at a time, each group refined to the end before the next:
@@ -229,8 +240,8 @@ def clear_pieces(pieces: Pieces, points: np.ndarray, robot: Robot, obstacles: li
     group = max(1, REFINED // (count + 1))
     for begin in range(0, len(undecided), group):
         _refine(undecided[begin : begin + group], count, control, speed, blocked, robot, obstacles, clearance, deadline)
-    keep[undecided] = ~blocked[undecided]
-    return keep, distance
+    keep[~keep] = ~blocked[undecided]
+    return keep
 
 
 def _refine(spans: np.ndarray, count: int, control: np.ndarray, speed: np.ndarray, blocked: np.ndarray, robot: Robot,

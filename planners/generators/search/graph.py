@@ -70,6 +70,8 @@ class SearchOptions:
         max_expansions: Most partial paths the branch and bound expands.
         memory_bytes: Most bytes the search may take by its estimate
             (``toptraj.planners.generators.search.memory``); set by the service, not by a request.
+        lazy: Whether the spans' clearance is checked only where the search times a grid path
+            (``toptraj.planners.generators.search.problem.build_problem``); ``None``: on a roadmap.
     """
 
     cells: tuple[int, ...] | None = None
@@ -84,6 +86,7 @@ class SearchOptions:
     seed: int = 0
     max_expansions: int = 200_000
     memory_bytes: int = DEFAULT_SEARCH_MEMORY
+    lazy: bool | None = None
 
 
 DEFAULT_OPTIONS = SearchOptions()

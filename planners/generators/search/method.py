@@ -14,7 +14,7 @@ from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.branch_and_bound import branch_and_bound
 from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
 from toptraj.planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
-from toptraj.planners.generators.search.problem import build_problem, toward_goal
+from toptraj.planners.generators.search.problem import SearchProblem, build_problem, toward_goal, with_spans_checked
 from toptraj.planners.generators.search.report import LocalReport, SearchReport
 from toptraj.planners.generators.search.shadows import obstacle_shadows
 from toptraj.robots import JointLimits, Robot
@@ -26,6 +26,12 @@ VARIANT_CAP = 2.0
 #: Share of the time left that the branch and bound of the goal variants may take together;
 #: the rest is the local optimization's and the final timing's.
 SEARCH_SHARE = 0.25
+#: Searches of a lazy problem (``build_problem``) whose grid paths may meet obstacles unseen
+#: before every span is checked at once: each search after one that timed a blocked span
+#: starts over without it (Lazy PRM's loop), and where the obstacles block that many best
+#: paths in turn, checking all spans costs less than more searches (ur5 and panda around a
+#: box: 2 and 4 searches; the Geering arm's lattice, checked at once, would take 10).
+LAZY_ATTEMPTS = 6
 
 
 @dataclass(frozen=True)
@@ -72,6 +78,14 @@ def global_search(
     would otherwise run until ``max_expansions``. A variant the graph does not reach is
     discarded at once: its cost to go is infinite from every start.
 
+    On a lazy problem (a roadmap's, by default: ``build_problem``) the spans of every grid path
+    the searches timed are then checked (``with_spans_checked``); where one is blocked, the
+    searches run again without it (Bohlin & Kavraki's Lazy PRM loop), and after
+    ``LAZY_ATTEMPTS`` searches every span left is checked before the last. The answer is that
+    of a search whose timed grid paths all keep the clearance, on a graph that holds every
+    span that does: the best grid path of the fully checked graph (the costs to go over the
+    unchecked spans are lower bounds of it).
+
     The search's memory is admitted before it by the runner (``Search.estimate``, against
     ``options.memory_bytes``: ``toptraj.planners.runner.admission``).
 
@@ -84,6 +98,37 @@ def global_search(
     problem = build_problem(
         robot, limits, kinds, start, goal, options, revolutions, obstacles, clearance, deadline.within(0.0, 0.4)
     )
+    problem, result = _lazily_searched(problem, options, deadline)
+    points = problem.graph.points
+    low, high = points.min(axis=0), points.max(axis=0)
+    shadows = obstacle_shadows(robot, list(obstacles), clearance, low, high) if obstacles else None
+    return GlobalSearch(result, low, high, shadows)
+
+
+def _lazily_searched(problem: SearchProblem, options: SearchOptions, deadline: Deadline) -> tuple[SearchProblem, SearchResult]:
+    """The searches of ``global_search``, run again while their timed grid paths meet spans
+    found blocked when checked (its docstring): the problem with the spans checked, and the
+    merged result of the last searches."""
+    for attempt in range(LAZY_ATTEMPTS + 1):
+        if attempt == LAZY_ATTEMPTS:  # the grid paths keep meeting obstacles: every span checked at once
+            problem, _ = with_spans_checked(problem, np.flatnonzero(~problem.checked), deadline)
+        results, failures = _searched(problem, options, deadline)
+        timed = np.concatenate([r.timed for r in results] + [np.asarray(f.timed, dtype=int) for f in failures])
+        problem, blocked = with_spans_checked(problem, timed, deadline)
+        if not blocked:  # every grid path timed keeps the clearance: the answer of the checked graph
+            break
+    checked = int(problem.checked.sum())
+    if not results:
+        failures[0].statistics.spans_checked, failures[0].statistics.searches = checked, attempt + 1
+        raise failures[0]
+    result = _merged(results, [f.statistics for f in failures], problem.prepare_s, options.tubes)
+    result.statistics.spans_checked, result.statistics.searches = checked, attempt + 1
+    return problem, result
+
+
+def _searched(problem: SearchProblem, options: SearchOptions, deadline: Deadline) -> tuple[list[SearchResult], list[NoGridPath]]:
+    """``branch_and_bound`` toward each goal variant of ``problem`` (``global_search``): the
+    results, and the failures of the variants without a grid path."""
     # the variants by their least time to go (h2 from the start), the likeliest best first, so
     # that its t~ caps the searches of the others
     toward = [toward_goal(problem, index, deadline) for index in range(len(problem.graph.goals))]
@@ -99,13 +144,7 @@ def global_search(
             results.append(branch_and_bound(variant, options, part, cap, allowance))
         except NoGridPath as error:
             failures.append(error)
-    if not results:
-        raise failures[0]
-    result = _merged(results, [f.statistics for f in failures], problem.prepare_s, options.tubes)
-    points = problem.graph.points
-    low, high = points.min(axis=0), points.max(axis=0)
-    shadows = obstacle_shadows(robot, list(obstacles), clearance, low, high) if obstacles else None
-    return GlobalSearch(result, low, high, shadows)
+    return results, failures
 
 
 def _merged(results: list[SearchResult], failed: list[SearchStatistics], prepare_s: float, count: int) -> SearchResult:

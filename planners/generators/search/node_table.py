@@ -112,6 +112,15 @@ class NodeTable:
             index = int(self.ints[index, kernels.PARENT])
         return out[::-1]
 
+    def pieces(self, index: int) -> list[int]:
+        """The spans of the path ending at node ``index``, from the start."""
+        out = []
+        while index >= 0:
+            if self.ints[index, kernels.PIECE] >= 0:
+                out.append(int(self.ints[index, kernels.PIECE]))
+            index = int(self.ints[index, kernels.PARENT])
+        return out[::-1]
+
     def count_into(self, stats: SearchStatistics) -> None:
         """The counters added to ``stats``."""
         c = self.counters

@@ -36,6 +36,10 @@ class SearchStatistics:
             joint (empty for a roadmap).
         turns: Edges of the direction-augmented graph (moves after a move).
         removed_by_obstacles: Pieces of curve removed as configuration-space obstacles.
+        spans_checked: Pieces of curve whose clearance was checked: all of a lattice's, those of
+            the grid paths timed on a roadmap (checked lazily: ``build_problem``).
+        searches: Branch and bounds over the graph: one more after each that timed a grid path
+            through a span found blocked when checked.
         points_blocked: Grid points closer to an obstacle than the clearance.
         v_max: V_max of t1 (joint units / s; ``inf`` where no limit bounds the speed).
         expanded: Partial paths branched.
@@ -71,6 +75,8 @@ class SearchStatistics:
     prepare_s: float = 0.0
     search_s: float = 0.0
     goal_variants: int = 1
+    spans_checked: int = 0
+    searches: int = 1
 
 
 @dataclass(frozen=True)
@@ -84,19 +90,24 @@ class SearchResult:
         candidates: Every grid path found within t_u, best first.
         statistics: What the search did.
         tube_radius: D_max (joint units).
+        timed: The spans (indices into the problem's pieces) of every grid path the search
+            timed, shape (m,).
     """
 
     tubes: tuple[GridPath, ...]
     candidates: tuple[GridPath, ...]
     statistics: SearchStatistics
     tube_radius: float
+    timed: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
 
 
 class NoGridPath(InfeasiblePath):
     """No grid path was found: with its search's ``statistics`` (and ``rule``: why none, and
-    the ``graph`` kind searched)."""
+    the ``graph`` kind searched) and the spans of the grid paths it timed (``timed``, a tuple of
+    ``SearchResult.timed``'s indices)."""
 
     statistics: SearchStatistics
 
-    def __init__(self, detail: str, statistics: SearchStatistics, **facts: Any):
+    def __init__(self, detail: str, statistics: SearchStatistics, timed: np.ndarray | None = None, **facts: Any):
         super().__init__(detail, statistics=statistics, **facts)
+        self.timed = () if timed is None else tuple(int(span) for span in timed)

@@ -15,7 +15,7 @@ from toptraj.planners.collision.self_collision import SelfCollision, self_distan
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotOneOf, OutOfRange
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.bounds import PieceBounds, piece_bounds
-from toptraj.planners.generators.search.free_space import clear_pieces, free_distances, point_distances
+from toptraj.planners.generators.search.free_space import clear_pieces, clear_spans, free_distances, point_distances
 from toptraj.planners.generators.search.graph import (
     DEFAULT_MAX_TURN,
     DEFAULT_OPTIONS,
@@ -58,6 +58,10 @@ class SearchProblem:
         removed: Spans removed by the obstacles; ``points_blocked``: grid points closer than
             the clearance.
         prepare_s: Seconds spent building the problem.
+        checked: Per span, whether its clearance has been checked (all of them unless the
+            problem is lazy: ``build_problem``); an unchecked span counts as usable.
+        point_distance: ``free_distances`` at every grid point, shape (P,).
+        obstacles, clearance: What the spans keep their clearance (m) from.
     """
 
     graph: SearchGraph
@@ -77,6 +81,10 @@ class SearchProblem:
     removed: int
     points_blocked: int
     prepare_s: float
+    checked: np.ndarray
+    point_distance: np.ndarray
+    obstacles: tuple[Obstacle, ...]
+    clearance: float
 
 
 def _graph(robot, start, goal, options: SearchOptions, revolutions, obstacles, clearance, deadline: Deadline) -> SearchGraph:
@@ -107,6 +115,21 @@ def _check_apart(robot: Robot, name: str, q: np.ndarray) -> None:
         )
 
 
+def _check_end(robot: Robot, name: str, q: np.ndarray, obstacles: list[Obstacle], clearance: float) -> None:
+    """Raise where the start or goal ``q`` lies outside the joint limits, within the clearance
+    of an obstacle, or with two links touching."""
+    if robot.outside_position_limits(q) is not None:
+        raise InvalidRequest(name, q, rule="outside_the_joint_limits")
+    if obstacles:
+        nearest = float(point_distances(robot, q[None, :], obstacles)[0])
+        if nearest < clearance:
+            raise InfeasiblePath(
+                f"the {name} comes within {nearest:.4g} m of an obstacle (the clearance is {clearance:g} m)",
+                rule="end_too_close", field=name, distance=nearest, clearance=clearance,
+            )
+    _check_apart(robot, name, q)
+
+
 def build_problem(
     robot: Robot,
     limits: JointLimits,
@@ -122,6 +145,14 @@ def build_problem(
     """The graph between ``start`` and ``goal`` (n_dof,), its pieces kept clear of
     ``obstacles`` by ``clearance`` (m), their bounds and the costs to go.
 
+    A lazy problem (``options.lazy``; by default, on a roadmap) leaves the spans' clearance
+    unchecked, as in Lazy PRM (Bohlin & Kavraki, "Path planning using lazy PRM", ICRA 2000):
+    every span counts as usable
+    until ``with_spans_checked`` checks it, which the search does for the spans of the grid
+    paths it times (``toptraj.planners.generators.search.method``). The costs to go over more
+    spans are still lower bounds, so the branch and bound's best grid path, once its spans are
+    checked and clear, is the best of the checked graph too.
+
     Raises:
         InvalidRequest: start or goal outside the joint limits, an unknown graph kind, a grid
             too large.
@@ -131,16 +162,7 @@ def build_problem(
     options = options or DEFAULT_OPTIONS
     obstacle_list = list(obstacles)
     for name, q in (("start", start), ("goal", goal)):
-        if robot.outside_position_limits(q) is not None:
-            raise InvalidRequest(name, q, rule="outside_the_joint_limits")
-        if obstacle_list:
-            nearest = float(point_distances(robot, q[None, :], obstacle_list)[0])
-            if nearest < clearance:
-                raise InfeasiblePath(
-                    f"the {name} comes within {nearest:.4g} m of an obstacle (the clearance is {clearance:g} m)",
-                    rule="end_too_close", field=name, distance=nearest, clearance=clearance,
-                )
-        _check_apart(robot, name, q)
+        _check_end(robot, name, q, obstacle_list, clearance)
     deadline.progress(0.0, "search: graph")
     graph = _graph(robot, start, goal, options, revolutions, obstacle_list, clearance, deadline)
     max_turn = options.max_turn if options.max_turn is not None else DEFAULT_MAX_TURN[graph.kind]
@@ -150,7 +172,12 @@ def build_problem(
     pieces = build_pieces(graph.points, graph.edge_from, graph.edge_to, graph.start, graph.goals, turn_in, turn_out)
     deadline.check()
     deadline.progress(0.1, "search: obstacles and self-collision")
-    usable, distance = clear_pieces(pieces, graph.points, robot, obstacle_list, clearance, deadline)
+    if options.lazy if options.lazy is not None else graph.kind == "roadmap":
+        distance = free_distances(robot, graph.points, obstacle_list, clearance, deadline=deadline)
+        usable, checked = np.ones(len(pieces), dtype=bool), np.zeros(len(pieces), dtype=bool)
+    else:
+        usable, distance = clear_pieces(pieces, graph.points, robot, obstacle_list, clearance, deadline)
+        checked = np.ones(len(pieces), dtype=bool)
     points_blocked = int((distance < clearance).sum())
     removed = int((~usable).sum())
     deadline.progress(0.2, "search: bounds")
@@ -160,9 +187,28 @@ def build_problem(
         graph=graph, turn_in=turn_in, turn_out=turn_out, pieces=pieces, bounds=bounds, usable=usable,
         start_moves=[], successors=[], state_point=np.empty(0, dtype=int), h1=np.empty(0), h2=np.empty(0),
         robot=robot, limits=limits, kinds=tuple(kinds), removed=removed, points_blocked=points_blocked,
-        prepare_s=0.0,
+        prepare_s=0.0, checked=checked, point_distance=distance, obstacles=tuple(obstacle_list), clearance=clearance,
     )
     return dataclasses.replace(_with_states(problem, graph, deadline), prepare_s=time.perf_counter() - began)
+
+
+def with_spans_checked(problem: SearchProblem, spans: np.ndarray, deadline: Deadline = NO_DEADLINE) -> tuple[SearchProblem, int]:
+    """``problem`` with the clearance of the unchecked ones among ``spans`` (indices) checked
+    (``clear_spans``), the blocked ones no longer usable and the states and costs to go redone
+    where any is: the problem and how many were found blocked."""
+    spans = np.unique(np.asarray(spans, dtype=int))
+    spans = spans[~problem.checked[spans]]
+    if not spans.size:
+        return problem, 0
+    clear = clear_spans(
+        problem.pieces, spans, problem.point_distance, problem.robot, list(problem.obstacles), problem.clearance, deadline
+    )
+    checked, usable = problem.checked.copy(), problem.usable.copy()
+    checked[spans] = True
+    usable[spans[~clear]] = False
+    blocked = int((~clear).sum())
+    problem = dataclasses.replace(problem, checked=checked, usable=usable, removed=problem.removed + blocked)
+    return (_with_states(problem, problem.graph, deadline) if blocked else problem), blocked
 
 
 def toward_goal(problem: SearchProblem, goal: int, deadline: Deadline = NO_DEADLINE) -> SearchProblem:
