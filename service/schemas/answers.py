@@ -110,7 +110,7 @@ class SearchPublic(BaseModel):
     grid_edges: int = Field(description="Moves between grid points (count).")
     grid_shape: list[int] = Field(description="Grid points per joint of a lattice; empty for a roadmap.")
     turns: int = Field(description="Edges of the direction-augmented graph: pairs of consecutive moves without a sharp turn (count).")
-    removed_by_obstacles: int = Field(description="Pieces of curve (B-spline spans) removed as configuration-space obstacles (count).")
+    removed_by_obstacles: int = Field(description="Pieces of curve (B-spline spans) removed as configuration-space obstacles, among those checked (count; see spans_checked).")
     points_blocked: int = Field(description="Grid points closer to an obstacle than path.clearance (count).")
     spans_checked: int = Field(
         default=0,

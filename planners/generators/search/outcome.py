@@ -35,7 +35,8 @@ class SearchStatistics:
         grid_points, grid_edges: Size of the graph; ``grid_shape`` the lattice's points per
             joint (empty for a roadmap).
         turns: Edges of the direction-augmented graph (moves after a move).
-        removed_by_obstacles: Pieces of curve removed as configuration-space obstacles.
+        removed_by_obstacles: Pieces of curve removed as configuration-space obstacles, among
+            those checked.
         spans_checked: Pieces of curve whose clearance was checked: all of a lattice's, those of
             the grid paths timed on a roadmap (checked lazily: ``build_problem``).
         searches: Branch and bounds over the graph: one more after each that timed a grid path
