@@ -71,7 +71,8 @@ class SearchOptions:
         memory_bytes: Most bytes the search may take by its estimate
             (``toptraj.planners.generators.search.memory``); set by the service, not by a request.
         lazy: Whether the spans' clearance is checked only where the search times a grid path
-            (``toptraj.planners.generators.search.problem.build_problem``); ``None``: on a roadmap.
+            (``toptraj.planners.generators.search.problem.build_problem``); ``None``: on a
+            roadmap in ``global_search``, never in ``build_problem`` alone.
     """
 
     cells: tuple[int, ...] | None = None

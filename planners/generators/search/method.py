@@ -5,6 +5,7 @@ obstacle shadows."""
 from __future__ import annotations
 
 import dataclasses
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -12,7 +13,7 @@ import numpy as np
 from toptraj.planners.collision import Obstacle
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.branch_and_bound import branch_and_bound
-from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, SearchOptions
+from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, LATTICE_MAX_JOINTS, SearchOptions
 from toptraj.planners.generators.search.outcome import NoGridPath, SearchResult, SearchStatistics
 from toptraj.planners.generators.search.problem import SearchProblem, build_problem, toward_goal, with_spans_checked
 from toptraj.planners.generators.search.report import LocalReport, SearchReport
@@ -95,6 +96,9 @@ def global_search(
         BudgetExceeded: ``deadline`` passed.
     """
     options = options or DEFAULT_OPTIONS
+    if options.lazy is None:  # lazily on a roadmap
+        roadmap = options.graph == "roadmap" or (options.graph == "auto" and robot.dof > LATTICE_MAX_JOINTS)
+        options = dataclasses.replace(options, lazy=roadmap)
     problem = build_problem(
         robot, limits, kinds, start, goal, options, revolutions, obstacles, clearance, deadline.within(0.0, 0.4)
     )
@@ -108,38 +112,46 @@ def global_search(
 def _lazily_searched(problem: SearchProblem, options: SearchOptions, deadline: Deadline) -> tuple[SearchProblem, SearchResult]:
     """The searches of ``global_search``, run again while their timed grid paths meet spans
     found blocked when checked (its docstring): the problem with the spans checked, and the
-    merged result of the last searches."""
+    merged result of the last searches, its counts and seconds those of all of them. Together
+    they take ``SEARCH_SHARE`` of the time left."""
+    remaining = deadline.remaining()
+    share_ends = None if remaining is None else time.monotonic() + SEARCH_SHARE * remaining
+    earlier: list[SearchStatistics] = []
     for attempt in range(LAZY_ATTEMPTS + 1):
         if attempt == LAZY_ATTEMPTS:  # the grid paths keep meeting obstacles: every span checked at once
             problem, _ = with_spans_checked(problem, np.flatnonzero(~problem.checked), deadline)
-        results, failures = _searched(problem, options, deadline)
+        results, failures = _searched(problem, options, deadline, share_ends)
         timed = np.concatenate([r.timed for r in results] + [np.asarray(f.timed, dtype=int) for f in failures])
         problem, blocked = with_spans_checked(problem, timed, deadline)
         if not blocked:  # every grid path timed keeps the clearance: the answer of the checked graph
             break
+        earlier += [r.statistics for r in results] + [f.statistics for f in failures]
     checked = int(problem.checked.sum())
     if not results:
         failures[0].statistics.spans_checked, failures[0].statistics.searches = checked, attempt + 1
         raise failures[0]
-    result = _merged(results, [f.statistics for f in failures], problem.prepare_s, options.tubes)
+    result = _merged(results, [f.statistics for f in failures], problem.prepare_s, options.tubes, earlier)
     result.statistics.spans_checked, result.statistics.searches = checked, attempt + 1
     return problem, result
 
 
-def _searched(problem: SearchProblem, options: SearchOptions, deadline: Deadline) -> tuple[list[SearchResult], list[NoGridPath]]:
-    """``branch_and_bound`` toward each goal variant of ``problem`` (``global_search``): the
-    results, and the failures of the variants without a grid path."""
+def _searched(
+    problem: SearchProblem, options: SearchOptions, deadline: Deadline, share_ends: float | None,
+) -> tuple[list[SearchResult], list[NoGridPath]]:
+    """``branch_and_bound`` toward each goal variant of ``problem`` (``global_search``), the
+    variants sharing the time until ``share_ends`` (``time.monotonic()``; ``None``: no limit):
+    the results, and the failures of the variants without a grid path."""
     # the variants by their least time to go (h2 from the start), the likeliest best first, so
     # that its t~ caps the searches of the others
     toward = [toward_goal(problem, index, deadline) for index in range(len(problem.graph.goals))]
     toward.sort(key=lambda one: float(np.min(one.h2[[state for _, state, _ in one.start_moves if state >= 0]], initial=np.inf)))
     results: list[SearchResult] = []
     failures: list[NoGridPath] = []
-    remaining = deadline.remaining()
+    left = None if share_ends is None else max(share_ends - time.monotonic(), 0.0)
     for index, variant in enumerate(toward):
         part = deadline.within(0.4 + 0.6 * index / len(toward), 0.4 + 0.6 * (index + 1) / len(toward))
         cap = VARIANT_CAP * min((r.tubes[0].time for r in results), default=np.inf)
-        allowance = None if remaining is None else SEARCH_SHARE * remaining / len(toward)
+        allowance = None if left is None else left / len(toward)
         try:
             results.append(branch_and_bound(variant, options, part, cap, allowance))
         except NoGridPath as error:
@@ -147,16 +159,21 @@ def _searched(problem: SearchProblem, options: SearchOptions, deadline: Deadline
     return results, failures
 
 
-def _merged(results: list[SearchResult], failed: list[SearchStatistics], prepare_s: float, count: int) -> SearchResult:
+def _merged(
+    results: list[SearchResult], failed: list[SearchStatistics], prepare_s: float, count: int,
+    earlier: list[SearchStatistics] | None = None,
+) -> SearchResult:
     """One result of the searches toward each goal variant (and the statistics of those that
     found no grid path): statistics summed (the upper bound is that of the best variant's
-    search), tubes as ``global_search`` says."""
+    search), tubes as ``global_search`` says; the counts and seconds of the ``earlier``
+    searches of a lazy problem added."""
     firsts = sorted((r.tubes[0] for r in results), key=lambda tube: tube.time)
     rest = sorted((tube for r in results for tube in r.tubes[1:]), key=lambda tube: tube.time)
     tubes = tuple(sorted([*firsts, *rest][: max(1, count)], key=lambda tube: tube.time))
     candidates = tuple(sorted((c for r in results for c in r.candidates), key=lambda c: c.time))
     best = min(results, key=lambda r: r.tubes[0].time)
-    every = [r.statistics for r in results] + failed
+    last = [r.statistics for r in results] + failed
+    every = last + (earlier or [])
     statistics = dataclasses.replace(
         best.statistics,
         expanded=sum(s.expanded for s in every),
@@ -165,9 +182,9 @@ def _merged(results: list[SearchResult], failed: list[SearchStatistics], prepare
         t4_evaluations=sum(s.t4_evaluations for s in every),
         candidates=len(candidates),
         best_grid_time=tubes[0].time,
-        complete=all(s.complete for s in every),
+        complete=all(s.complete for s in last),
         prepare_s=prepare_s,
         search_s=sum(s.search_s for s in every),
-        goal_variants=len(every),
+        goal_variants=len(last),
     )
     return SearchResult(tubes, candidates, statistics, best.tube_radius)

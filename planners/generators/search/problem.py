@@ -145,13 +145,8 @@ def build_problem(
     """The graph between ``start`` and ``goal`` (n_dof,), its pieces kept clear of
     ``obstacles`` by ``clearance`` (m), their bounds and the costs to go.
 
-    A lazy problem (``options.lazy``; by default, on a roadmap) leaves the spans' clearance
-    unchecked, as in Lazy PRM (Bohlin & Kavraki, "Path planning using lazy PRM", ICRA 2000):
-    every span counts as usable
-    until ``with_spans_checked`` checks it, which the search does for the spans of the grid
-    paths it times (``toptraj.planners.generators.search.method``). The costs to go over more
-    spans are still lower bounds, so the branch and bound's best grid path, once its spans are
-    checked and clear, is the best of the checked graph too.
+    A lazy problem (``options.lazy``; ``global_search``'s default on a roadmap) leaves the
+    spans unchecked, as in Lazy PRM (Bohlin & Kavraki, ICRA 2000), until ``with_spans_checked``.
 
     Raises:
         InvalidRequest: start or goal outside the joint limits, an unknown graph kind, a grid
@@ -172,7 +167,7 @@ def build_problem(
     pieces = build_pieces(graph.points, graph.edge_from, graph.edge_to, graph.start, graph.goals, turn_in, turn_out)
     deadline.check()
     deadline.progress(0.1, "search: obstacles and self-collision")
-    if options.lazy if options.lazy is not None else graph.kind == "roadmap":
+    if options.lazy:
         distance = free_distances(robot, graph.points, obstacle_list, clearance, deadline=deadline)
         usable, checked = np.ones(len(pieces), dtype=bool), np.zeros(len(pieces), dtype=bool)
     else:

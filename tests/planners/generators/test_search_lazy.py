@@ -14,7 +14,7 @@ from toptraj.planners.collision import BoxObstacle
 from toptraj.planners.generators.search import method
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.method import global_search
-from toptraj.planners.generators.search.problem import build_problem
+from toptraj.planners.generators.search.problem import build_problem, with_spans_checked
 
 UR5_START = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
 UR5_GOAL = np.array([1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
@@ -62,19 +62,23 @@ def test_the_lazy_search_finds_the_grid_paths_of_the_full_check(name):
     problem = build_problem(robot, robot.limits, KINDS, CASES[name][1], CASES[name][2], SearchOptions(roadmap_points=points, lazy=False), True, (box,), clearance)
     assert spans == len(problem.pieces) and eager.statistics.searches == 1
     assert lazy.statistics.spans_checked <= spans / 10
-    assert lazy.statistics.removed_by_obstacles <= eager.statistics.removed_by_obstacles
 
 
 def test_a_box_on_the_straight_line_makes_the_lazy_search_start_again():
     """ur5's straight joint line meets the box: the first search's best path is the direct
     span, found blocked when checked, so a second search runs without it and ends on a clear
-    path; every span of the tubes returned keeps the clearance by the full check."""
+    path. A lazy problem starts with no span checked; checking them all gives the eager
+    problem's usable spans, removed count and costs to go."""
     robot, box, clearance, points, found = _searches("ur5")
     lazy = found[True].result
     assert lazy.statistics.searches >= 2 and lazy.statistics.removed_by_obstacles >= 1
-    eager_problem = build_problem(robot, robot.limits, KINDS, UR5_START, UR5_GOAL, SearchOptions(roadmap_points=points, lazy=False), True, (box,), clearance)
-    lazy_problem = build_problem(robot, robot.limits, KINDS, UR5_START, UR5_GOAL, SearchOptions(roadmap_points=points), True, (box,), clearance)
-    assert not lazy_problem.checked.any() and lazy_problem.usable.sum() > eager_problem.usable.sum()
+    eager_problem = build_problem(robot, robot.limits, KINDS, UR5_START, UR5_GOAL, SearchOptions(roadmap_points=points), True, (box,), clearance)
+    lazy_problem = build_problem(robot, robot.limits, KINDS, UR5_START, UR5_GOAL, SearchOptions(roadmap_points=points, lazy=True), True, (box,), clearance)
+    assert eager_problem.checked.all() and not lazy_problem.checked.any()
+    assert lazy_problem.usable.sum() > eager_problem.usable.sum()
+    checked, blocked = with_spans_checked(lazy_problem, np.arange(len(lazy_problem.pieces))[::-1])
+    assert blocked == eager_problem.removed > 0 and checked.removed == eager_problem.removed
+    assert np.array_equal(checked.usable, eager_problem.usable) and np.array_equal(checked.h2, eager_problem.h2)
 
 
 def test_after_its_attempts_the_lazy_search_checks_every_span(monkeypatch):
@@ -85,6 +89,7 @@ def test_after_its_attempts_the_lazy_search_checks_every_span(monkeypatch):
     for attempts in (0, 1):
         monkeypatch.setattr(method, "LAZY_ATTEMPTS", attempts)
         forced = global_search(robot, robot.limits, KINDS, UR5_START, UR5_GOAL, SearchOptions(roadmap_points=points, tubes=1), True, (box,), clearance).result
+        assert forced.statistics.searches == attempts + 1
         assert forced.statistics.spans_checked == eager.statistics.spans_checked
         assert forced.statistics.removed_by_obstacles == eager.statistics.removed_by_obstacles
         assert forced.tubes[0].time == pytest.approx(eager.tubes[0].time, rel=1e-12)
