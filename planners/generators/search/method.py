@@ -119,10 +119,10 @@ def _lazily_searched(problem: SearchProblem, options: SearchOptions, deadline: D
     earlier: list[SearchStatistics] = []
     for attempt in range(LAZY_ATTEMPTS + 1):
         if attempt == LAZY_ATTEMPTS:  # the grid paths keep meeting obstacles: every span checked at once
-            problem, _ = with_spans_checked(problem, np.flatnonzero(~problem.checked), deadline)
+            problem, _ = with_spans_checked(problem, np.flatnonzero(~problem.checked), deadline, states=False)
         results, failures = _searched(problem, options, deadline, share_ends)
         timed = np.concatenate([r.timed for r in results] + [np.asarray(f.timed, dtype=int) for f in failures])
-        problem, blocked = with_spans_checked(problem, timed, deadline)
+        problem, blocked = with_spans_checked(problem, timed, deadline, states=False)  # toward_goal redoes them
         if not blocked:  # every grid path timed keeps the clearance: the answer of the checked graph
             break
         earlier += [r.statistics for r in results] + [f.statistics for f in failures]

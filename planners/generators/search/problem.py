@@ -187,10 +187,13 @@ def build_problem(
     return dataclasses.replace(_with_states(problem, graph, deadline), prepare_s=time.perf_counter() - began)
 
 
-def with_spans_checked(problem: SearchProblem, spans: np.ndarray, deadline: Deadline = NO_DEADLINE) -> tuple[SearchProblem, int]:
+def with_spans_checked(
+    problem: SearchProblem, spans: np.ndarray, deadline: Deadline = NO_DEADLINE, states: bool = True,
+) -> tuple[SearchProblem, int]:
     """``problem`` with the clearance of the unchecked ones among ``spans`` (indices) checked
-    (``clear_spans``), the blocked ones no longer usable and the states and costs to go redone
-    where any is: the problem and how many were found blocked."""
+    (``clear_spans``), the blocked ones no longer usable and, with ``states``, the states and
+    costs to go redone where any is (without, they are left as they were: ``toward_goal``
+    redoes them for each goal): the problem and how many were found blocked."""
     spans = np.unique(np.asarray(spans, dtype=int))
     spans = spans[~problem.checked[spans]]
     if not spans.size:
@@ -203,7 +206,7 @@ def with_spans_checked(problem: SearchProblem, spans: np.ndarray, deadline: Dead
     usable[spans[~clear]] = False
     blocked = int((~clear).sum())
     problem = dataclasses.replace(problem, checked=checked, usable=usable, removed=problem.removed + blocked)
-    return (_with_states(problem, problem.graph, deadline) if blocked else problem), blocked
+    return (_with_states(problem, problem.graph, deadline) if blocked and states else problem), blocked
 
 
 def toward_goal(problem: SearchProblem, goal: int, deadline: Deadline = NO_DEADLINE) -> SearchProblem:

@@ -5,15 +5,20 @@ its paths keep the clearance by the full check."""
 
 from __future__ import annotations
 
+import dataclasses
+import time
+
 import numpy as np
 import pinocchio as pin
 import pytest
 
 from toptraj import robots
 from toptraj.planners.collision import BoxObstacle
+from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.generators.search import method
 from toptraj.planners.generators.search.graph import SearchOptions
 from toptraj.planners.generators.search.method import global_search
+from toptraj.planners.generators.search.outcome import NoGridPath, SearchStatistics
 from toptraj.planners.generators.search.problem import build_problem, with_spans_checked
 
 UR5_START = np.array([-1.0, -1.2, 1.5, -1.9, -1.57, 0.0])
@@ -94,3 +99,33 @@ def test_after_its_attempts_the_lazy_search_checks_every_span(monkeypatch):
         assert forced.statistics.removed_by_obstacles == eager.statistics.removed_by_obstacles
         assert forced.tubes[0].time == pytest.approx(eager.tubes[0].time, rel=1e-12)
         assert np.array_equal(forced.tubes[0].points, eager.tubes[0].points)
+
+
+def test_the_lazy_searches_share_one_quarter_of_the_time_left(monkeypatch):
+    """However many searches the lazy loop runs, their branch and bounds take together
+    ``SEARCH_SHARE`` of the time left when the first began, not that share each: here every
+    search spends its whole allowance and times a span found blocked, until the last."""
+    robot, box, clearance, points, _ = _searches("ur5", tubes=1)
+    spent: list[float] = []
+
+    def stubborn(problem, options, deadline, cap, allowance_s):
+        began = time.monotonic()
+        time.sleep(allowance_s)
+        spent.append(time.monotonic() - began)
+        unchecked = np.flatnonzero(~problem.checked & problem.usable)
+        raise NoGridPath("no grid path within the allowance", SearchStatistics("roadmap", 0, 0, [], 0, 0, 0, 1.0), unchecked[:1])
+
+    def all_blocked(problem, spans, deadline=None, states=True):
+        spans = np.unique(np.asarray(spans, dtype=int))
+        spans = spans[~problem.checked[spans]]
+        checked, usable = problem.checked.copy(), problem.usable.copy()
+        checked[spans], usable[spans] = True, False
+        return dataclasses.replace(problem, checked=checked, usable=usable), len(spans)
+
+    monkeypatch.setattr(method, "branch_and_bound", stubborn)
+    monkeypatch.setattr(method, "with_spans_checked", all_blocked)
+    budget = Deadline(4.0)
+    with pytest.raises(NoGridPath):
+        global_search(robot, robot.limits, KINDS, UR5_START, UR5_GOAL, SearchOptions(roadmap_points=points, tubes=1), True, (box,), clearance, budget)
+    assert len(spent) == method.LAZY_ATTEMPTS + 1
+    assert sum(spent) <= method.SEARCH_SHARE * 4.0 + 0.1
