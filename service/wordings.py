@@ -170,8 +170,34 @@ def _arms_never_apart(facts: dict) -> str:
     )
 
 
+def _no_order_of_arms(facts: dict) -> str:
+    turns = facts["turns"]
+    pairs = sorted({tuple(sorted((turn.moving, turn.resting))) for turn in turns})
+
+    def near(turn) -> str:
+        return f"overlaps by {-turn.distance:.3g} m" if turn.distance < 0.0 else f"comes within {turn.distance:.3g} m of"
+
+    where = "; ".join(
+        f"arms[{turn.moving}]'s link {turn.moving_link!r} at s = {turn.s:.3g} {near(turn)} link {turn.resting_link!r} of "
+        f"arms[{turn.resting}] resting at its {turn.rests_at}"
+        for turn in turns
+    )
+    named = ", ".join(f"arms[{a}] with arms[{b}]" for a, b in pairs)
+    told = (
+        f": {named} can take turns in neither order ({where}; the clearance is {facts['clearance']:g} m): move the bases "
+        "of such a pair apart or change a path so that each arm's path keeps clear of the other arm at rest"
+        if turns else
+        ": move a base apart, change a path or lower clearance"
+    )
+    return (
+        "no order of the arms lets each pass the others by waiting at its start (an arm's path crosses where another arm "
+        f"rests at its start or end){told}"
+    )
+
+
 WORDING: dict[str, Wording] = {
     "not_a_rotation": _not_a_rotation,
+    "no_order_of_arms": _no_order_of_arms,
     "arms_collide_at_start": _arms_collide_at_start,
     "arms_never_apart": _arms_never_apart,
     "too_many_arms": "a cell has {value:~arm}; from {fewest} to {most} are served (every order of the arms is tried): "

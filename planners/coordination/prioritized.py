@@ -16,11 +16,12 @@ after the other is free, never slower than that. Two arms are coordinated in ful
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.coordination.cell import Cell
-from toptraj.planners.coordination.diagram import Diagram, coordination_diagram
+from toptraj.planners.coordination.cell import Cell, pair_distances
+from toptraj.planners.coordination.diagram import Diagram, arm_capsules, coordination_diagram
 from toptraj.planners.coordination.timing import Schedule, SoloMotion
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import Deadline
@@ -83,8 +84,64 @@ def prioritized(cell: Cell, solo: list[TimeScaling], diagrams: dict[tuple[int, i
     found = [_in_order(diagrams, solo, order, deadline) for order in itertools.permutations(range(len(cell.arms)))]
     best = min((schedule for schedule in found if schedule is not None), key=lambda schedule: schedule.duration, default=None)
     if best is None:
+        turns = [turn for pair in itertools.combinations(range(len(cell.arms)), 2) for turn in _blocked_turns(cell, diagrams, *pair)]
+        where = "; ".join(_said(turn) for turn in turns)
         raise InfeasiblePath(
             "no order of the arms lets each pass the others by waiting at its start (an arm's path crosses where "
-            "another arm rests at its start or end): move a base apart, change a path or lower clearance"
+            f"another arm rests at its start or end){': ' + where if where else ''}: move a base apart, change a path "
+            "or lower clearance",
+            rule="no_order_of_arms", turns=tuple(turns), clearance=cell.clearance,
         )
     return best
+
+
+@dataclass(frozen=True)
+class BlockedTurn:
+    """Where one arm, moving, comes closest to another resting at its start or end (``rests_at``):
+    the arms (indices), the moving arm's path parameter ``s``, the two links and the distance
+    (m) between them, below the clearance."""
+
+    moving: int
+    resting: int
+    rests_at: str
+    s: float
+    moving_link: str
+    resting_link: str
+    distance: float
+
+
+def _blocked_turns(cell: Cell, diagrams: dict[tuple[int, int], Diagram], a: int, b: int) -> list[BlockedTurn]:
+    """For arms ``a`` < ``b`` that can take turns in neither order (each waiting for the other
+    to end first comes closer than the clearance somewhere on the borders of their diagram), the
+    closest approach of each order: [] when either order keeps the clearance on the borders.
+
+    Arm a first: a moves while b rests at its start (column s_b = 0), then b while a rests at
+    its end (row s_a = 1); b first: the row s_a = 0 and the column s_b = 1."""
+    diagram = diagrams[(a, b)]
+    d, s = diagram.distance, diagram.s
+    borders = {  # order: ((distances, moving, resting, rests at), ...) along the moving arm's s
+        a: ((d[:, 0], a, b, "start"), (d[-1, :], b, a, "end")),
+        b: ((d[0, :], b, a, "start"), (d[:, -1], a, b, "end")),
+    }
+    closest = [min(((float(line.min()), int(line.argmin()), moving, resting, at) for line, moving, resting, at in order))
+               for order in borders.values()]
+    if any(distance >= cell.clearance for distance, *_ in closest):
+        return []
+    turns = []
+    for distance, index, moving, resting, at in closest:
+        rest = np.array([0.0 if at == "start" else 1.0])
+        _, k_moving, k_resting = pair_distances(arm_capsules(cell.arms[moving], s[index : index + 1]), arm_capsules(cell.arms[resting], rest))
+        turns.append(BlockedTurn(
+            moving, resting, at, float(s[index]), cell.arms[moving].link_names()[int(k_moving[0])],
+            cell.arms[resting].link_names()[int(k_resting[0])], distance,
+        ))
+    return turns
+
+
+def _said(turn: BlockedTurn) -> str:
+    """One blocked turn in the library's words."""
+    near = f"overlaps by {-turn.distance:.3g} m" if turn.distance < 0.0 else f"comes within {turn.distance:.3g} m of"
+    return (
+        f"arm {turn.moving}'s link {turn.moving_link!r} at s = {turn.s:.3g} {near} link {turn.resting_link!r} of arm "
+        f"{turn.resting} resting at its {turn.rests_at}"
+    )

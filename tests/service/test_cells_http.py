@@ -161,6 +161,24 @@ def test_three_arms_are_answered_on_one_clock_with_every_pairs_diagram(patient_c
     assert answer["min_distance"]["guaranteed"] >= body["clearance"] and answer["schedule"].startswith("prioritized")
 
 
+def test_three_arms_that_can_take_turns_in_no_order_are_a_422_naming_the_pairs_and_links(patient_client):
+    """A third arm resting at its start and end where the facing pair passes: the 422 names both
+    pairs, the links and where, in the request's words (``arms[i]``); its base moved back as
+    advised, the cell is answered."""
+    body = copy.deepcopy(EXAMPLE)
+    quarter = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    reaching = [[0.0, -0.6, 0.6, 0.0, 0.3, 0.0], [0.0, -0.6, 0.6, 0.0, 1.0, 0.0], [0.0, -0.6, 0.6, 0.0, 1.7, 0.0]]
+    body["arms"].append(copy.deepcopy(body["arms"][0]) | {"waypoints": reaching, "base": {"position": [0.6, 1.1, 0.0], "rotation": quarter}})
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 422, response.text[:300]
+    detail = response.json()["detail"]
+    assert "arms[0] with arms[2], arms[1] with arms[2] can take turns in neither order" in detail
+    assert re.search(r"arms\[0\]'s link 'forearm_link' at s = [\d.]+ overlaps by [\d.]+ m link 'forearm_link' of arms\[2\] resting at its start", detail)
+    assert "move the bases of such a pair apart" in detail
+    body["arms"][2]["base"]["position"] = [0.6, 1.8, 0.0]
+    assert patient_client.post("/v1/cells", json=body).status_code == 200
+
+
 def test_five_arms_are_a_422_naming_the_bound(patient_client):
     body = copy.deepcopy(EXAMPLE)
     body["arms"] += [copy.deepcopy(body["arms"][0]) | {"base": {"position": [0.0, 3.0 * k, 0.0]}} for k in range(1, 4)]

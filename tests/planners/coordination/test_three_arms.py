@@ -16,6 +16,7 @@ from tests.planners.coordination.cells import FIRST, facing_cell, ur5_arm
 from tests.planners.coordination.independent import coal_distance
 from toptraj.planners.coordination import Cell, coordinate
 from toptraj.planners.coordination.timing import Schedule, SoloMotion, solo_timing
+from toptraj.planners.errors import InfeasiblePath
 
 #: A quarter turn about z: the third base faces -y, towards the middle of the table.
 QUARTER = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
@@ -60,3 +61,31 @@ def test_every_arms_limits_hold_on_a_dense_resampling(three):
         assert (np.abs(qdd) <= arm.limits.acceleration * 1.005).all()
         assert np.abs(q[0] - arm.path.evaluate(np.zeros(1)).q[0]).max() < 1e-12
         assert np.abs(q[-1] - arm.path.evaluate(np.ones(1)).q[0]).max() < 1e-12
+
+
+#: The third arm reaching into the table's middle at its start and its end (only its wrist turns):
+#: the facing pair sweeps through where it rests.
+REACHING = [[0.0, -0.6, 0.6, 0.0, 0.3, 0.0], [0.0, -0.6, 0.6, 0.0, 1.0, 0.0], [0.0, -0.6, 0.6, 0.0, 1.7, 0.0]]
+
+
+def test_an_arm_resting_where_the_others_pass_is_refused_naming_the_pairs_the_links_and_where():
+    """No order lets the facing pair pass the third arm, which rests in their way at its start and
+    its end: the refusal names, for each of the two pairs, the closest approach of either order,
+    which coal confirms closer than the clearance; moved 0.7 m back, the third arm lets them pass."""
+    pair = facing_cell()
+    cell = Cell(pair.arms + (ur5_arm(REACHING, [0.6, 1.1, 0.0], QUARTER),), pair.clearance)
+    with pytest.raises(InfeasiblePath, match="no order of the arms") as refused:
+        coordinate(cell)
+    turns = refused.value.turns
+    assert refused.value.rule == "no_order_of_arms"
+    assert {(t.moving, t.resting, t.rests_at) for t in turns} == {(0, 2, "start"), (0, 2, "end"), (1, 2, "start"), (1, 2, "end")}
+    assert "arm 0's link 'forearm_link' at s = " in refused.value.detail and "of arm 2 resting at its start" in refused.value.detail
+    for turn in turns:
+        assert turn.distance < cell.clearance and 0.0 < turn.s < 1.0
+        assert turn.moving_link in cell.arms[turn.moving].link_names() and turn.resting_link in cell.arms[turn.resting].link_names()
+        moving, resting = cell.arms[turn.moving], cell.arms[turn.resting]
+        q_moving = moving.path.evaluate(np.array([turn.s])).q[0]
+        q_resting = resting.path.evaluate(np.array([0.0 if turn.rests_at == "start" else 1.0])).q[0]
+        assert coal_distance(Cell((moving, resting), cell.clearance), q_moving, q_resting) < cell.clearance
+    moved = Cell(pair.arms + (ur5_arm(REACHING, [0.6, 1.8, 0.0], QUARTER),), pair.clearance)
+    assert coordinate(moved).clearance.bound >= cell.clearance
