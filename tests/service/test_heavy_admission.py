@@ -5,6 +5,7 @@ server is idle again and holds the memory it held before."""
 from __future__ import annotations
 
 import asyncio
+import json
 import threading
 import time
 
@@ -35,10 +36,12 @@ SEARCH = {
     "timing": {"method": "search"},
 }
 #: The same on 300 roadmap points: its build alone takes about 2.4 s (1.7 GiB by its estimate),
-#: so that two at once beside a stream of short requests on two cores pass a 3 s budget while
-#: they build (the default search's build, 0.85 s, leaves its branch and bound to run out of
-#: its share of the budget instead, which is a 422).
+#: so that two at once beside a stream of short requests on two cores run out of a 3 s budget.
 OVER_BUDGET_SEARCH = {**SEARCH, "timing": {"method": "search", "search": {"roadmap_points": 300}}}
+#: How a search that runs out of its budget ends: a 504 where the budget passes (in its build or
+#: its local optimization), a 422 where its branch and bound spends its share of the budget (a
+#: quarter of the time left after the build) without a grid path.
+OUT_OF_BUDGET = (504, "the search found no grid path within its share of the time budget")
 
 
 @pytest.mark.parametrize(
@@ -82,7 +85,7 @@ def test_a_search_does_not_take_the_threads_of_the_short_requests():
     assert second.status_code == 503 and "heavy planning" in second.json()["detail"] and second.headers["retry-after"]
     # the search answers within its budget (its local optimization stopped at its share) or is
     # refused at it, depending on the machine's speed; never a better duration than the optimum's
-    assert search.status_code in (200, 504), search.text[:300]
+    assert search.status_code in (200, 504) or search.json()["detail"].startswith(OUT_OF_BUDGET[1]), search.text[:300]
     if search.status_code == 200:
         assert search.json()["duration"] >= 0.95028 * (1 - 1e-6)
 
@@ -113,7 +116,8 @@ def test_two_searches_over_budget_leave_the_typical_request_served_and_the_serve
         done = threading.Event()
 
         def search() -> None:
-            statuses.append(server.request("POST", "/v1/trajectories", OVER_BUDGET_SEARCH)[0])
+            status, _, body = server.request("POST", "/v1/trajectories", OVER_BUDGET_SEARCH)
+            statuses.append(status if status != 422 else json.loads(body)["detail"][: len(OUT_OF_BUDGET[1])])
             ended.append(time.monotonic())
 
         def stream() -> None:
@@ -132,23 +136,23 @@ def test_two_searches_over_budget_leave_the_typical_request_served_and_the_serve
         done.set()
         for thread in streams:
             thread.join()
-        assert statuses == [504, 504]
+        assert len(statuses) == 2 and set(statuses) <= set(OUT_OF_BUDGET), statuses
         # Typical requests are answered while both searches run (events, not a latency figure:
         # benchmarks/heavy_latency.py measures the p99 beside the idle one): a server that held
-        # them behind the searches would answer none before the first 504.
-        before_504 = sum(instant < min(ended) for instant in answered)
-        assert before_504 >= 10, f"{before_504} typical requests answered while the searches ran"
-        # the work stops with the 504s: under 0.5 CPU-s over the tree in the 2 s after both
+        # them behind the searches would answer none before the first search ends.
+        before_end = sum(instant < min(ended) for instant in answered)
+        assert before_end >= 10, f"{before_end} typical requests answered while the searches ran"
+        # the work stops with the searches: under 0.5 CPU-s over the tree in the 2 s after both
         before = server.cpu_seconds()
         time.sleep(max(0.0, ended[-1] + 2.0 - time.monotonic()))
         used = server.cpu_seconds() - before
-        assert used < 0.5, f"{used:.2f} CPU-s in the 2 s after the 504s"
+        assert used < 0.5, f"{used:.2f} CPU-s in the 2 s after the searches ended"
         # and the memory goes back: within 200 MB of the warm figure (waited for with a hang
         # guard: how soon a busy machine reaps the workers is not what is tested)
         give_up = max(ended) + 60.0
         while (held := _tree_rss(server)) - warm > 200e6 and time.monotonic() < give_up:
             time.sleep(0.1)
-        assert held - warm < 200e6, f"{(held - warm) / 1e6:.0f} MB above the warm figure a minute after the 504s"
+        assert held - warm < 200e6, f"{(held - warm) / 1e6:.0f} MB above the warm figure a minute after the searches ended"
 
 
 def test_a_comparison_is_heavy_when_one_of_its_methods_is():
