@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from toptraj.planners.runner.duration import rounded_down, rounded_up
 from toptraj.robots.errors import excerpt
 from toptraj.robots.ranges import Range
+from toptraj.service.cell_wordings import CELL_WORDING
 from toptraj.service.counts import counted
 from toptraj.service.field_hints import closest
 from toptraj.service.limit_wordings import LIMIT_WORDING
@@ -146,60 +146,8 @@ def _not_a_rotation(facts: dict) -> str:
     )
 
 
-def _arms_collide_at_start(facts: dict) -> str:
-    (a, b), (link_a, link_b), (robot_a, robot_b) = (facts["first"], facts["second"]), facts["links"], facts["robots"]
-    distance, clearance = facts["distance"], facts["clearance"]
-    lower = f", or lower clearance to {rounded_down(distance, 4):g} m or less" if distance > 0.0 else ""
-    return (
-        f"the arms collide at their start: link {link_a!r} of arms[{a}] ({robot_a}) is {distance:.4g} m "
-        f"from link {link_b!r} of arms[{b}] ({robot_b}) at s = 0 (the clearance is {clearance:g} m): "
-        f"move arms[{b}].base at least {rounded_up(clearance - distance, 4):g} m farther from arms[{a}]'s (those two "
-        f"links {'overlap' if distance < 0.0 else 'are too close'}), change either arm's first waypoint{lower}"
-    )
-
-
-def _arms_never_apart(facts: dict) -> str:
-    (link_a, link_b), (s1, s2), room = facts["links"], facts["s_pair"], facts["room"]
-    lower = f", or lower clearance to {rounded_down(room):g} m or less" if room > 0.0 else ""
-    return (
-        "no timing keeps the arms apart along these paths (neither waiting nor a coordinated curve through the "
-        f"coordination diagram is free): every coordination of the two motions comes within {facts['distance']:.3g} m "
-        f"(the clearance is {facts['clearance']:g} m); the one that keeps them farthest apart brings link {link_a!r} "
-        f"of arms[0] at s = {s1:.3g} that close to link {link_b!r} of arms[1] at s = {s2:.3g}: move a base apart, "
-        f"change a path{lower}"
-    )
-
-
-def _no_order_of_arms(facts: dict) -> str:
-    turns = facts["turns"]
-    pairs = sorted({tuple(sorted((turn.moving, turn.resting))) for turn in turns})
-
-    def near(turn) -> str:
-        return f"overlaps by {-turn.distance:.3g} m" if turn.distance < 0.0 else f"comes within {turn.distance:.3g} m of"
-
-    where = "; ".join(
-        f"arms[{turn.moving}]'s link {turn.moving_link!r} at s = {turn.s:.3g} {near(turn)} link {turn.resting_link!r} of "
-        f"arms[{turn.resting}] resting at its {turn.rests_at}"
-        for turn in turns
-    )
-    named = ", ".join(f"arms[{a}] with arms[{b}]" for a, b in pairs)
-    told = (
-        f": {named} can take turns in neither order ({where}; the clearance is {facts['clearance']:g} m): move the bases "
-        "of such a pair apart or change a path so that each arm's path keeps clear of the other arm at rest"
-        if turns else
-        ": move a base apart, change a path or lower clearance"
-    )
-    return (
-        "no order of the arms lets each pass the others by waiting at its start (an arm's path crosses where another arm "
-        f"rests at its start or end){told}"
-    )
-
-
 WORDING: dict[str, Wording] = {
     "not_a_rotation": _not_a_rotation,
-    "no_order_of_arms": _no_order_of_arms,
-    "arms_collide_at_start": _arms_collide_at_start,
-    "arms_never_apart": _arms_never_apart,
     "too_many_arms": "a cell has {value:~arm}; from {fewest} to {most} are served (every order of the arms is tried): "
     "give between {fewest} and {most} arms, or split the cell",
     "out_of_range": _out_of_range,
@@ -397,4 +345,5 @@ WORDING: dict[str, Wording] = {
     **LIMIT_WORDING,
     **ZONE_WORDING,
     **SEARCH_WORDING,
+    **CELL_WORDING,
 }

@@ -85,7 +85,7 @@ def prioritized(cell: Cell, solo: list[TimeScaling], diagrams: dict[tuple[int, i
     best = min((schedule for schedule in found if schedule is not None), key=lambda schedule: schedule.duration, default=None)
     if best is None:
         turns = [turn for pair in itertools.combinations(range(len(cell.arms)), 2) for turn in _blocked_turns(cell, diagrams, *pair)]
-        where = "; ".join(_said(turn) for turn in turns)
+        where = "; ".join(turn.said() for turn in turns)
         raise InfeasiblePath(
             "no order of the arms lets each pass the others by waiting at its start (an arm's path crosses where "
             f"another arm rests at its start or end){': ' + where if where else ''}: move a base apart, change a path "
@@ -97,10 +97,11 @@ def prioritized(cell: Cell, solo: list[TimeScaling], diagrams: dict[tuple[int, i
 
 @dataclass(frozen=True)
 class BlockedTurn:
-    """Where one arm, moving, comes closest to another resting at its start or end (``rests_at``):
-    the arms (indices), the moving arm's path parameter ``s``, the two links and the distance
-    (m) between them, below the clearance."""
+    """Where, with arm ``first`` going first, one arm, moving, comes closest to another resting
+    at its start or end (``rests_at``): the arms (indices), the moving arm's path parameter
+    ``s``, the two links and the distance (m, negative where they overlap) between them."""
 
+    first: int
     moving: int
     resting: int
     rests_at: str
@@ -109,39 +110,42 @@ class BlockedTurn:
     resting_link: str
     distance: float
 
+    def said(self) -> str:
+        """The turn in the library's words."""
+        near = (f"overlaps link {self.resting_link!r} of arm {self.resting} resting at its {self.rests_at} by {-self.distance:.3g} m"
+                if self.distance < 0.0 else
+                f"comes within {self.distance:.3g} m of link {self.resting_link!r} of arm {self.resting} resting at its {self.rests_at}")
+        return f"with arm {self.first} first, arm {self.moving}'s link {self.moving_link!r} at s = {self.s:.3g} {near}"
+
 
 def _blocked_turns(cell: Cell, diagrams: dict[tuple[int, int], Diagram], a: int, b: int) -> list[BlockedTurn]:
-    """For arms ``a`` < ``b`` that can take turns in neither order (each waiting for the other
-    to end first comes closer than the clearance somewhere on the borders of their diagram), the
-    closest approach of each order: [] when either order keeps the clearance on the borders.
+    """For arms ``a`` < ``b`` that can take turns in neither order (in each, the arm that waits
+    for the other to end first leaves the free part of their diagram on its borders, as
+    ``prioritized`` checks it), the closest approach on the borders of each order: [] when
+    either order is free there.
 
     Arm a first: a moves while b rests at its start (column s_b = 0), then b while a rests at
     its end (row s_a = 1); b first: the row s_a = 0 and the column s_b = 1."""
     diagram = diagrams[(a, b)]
     d, s = diagram.distance, diagram.s
+    zeros, ones = np.zeros_like(s), np.ones_like(s)
+    free = {
+        a: diagram.free_at(s, zeros).all() and diagram.free_at(ones, s).all(),
+        b: diagram.free_at(zeros, s).all() and diagram.free_at(s, ones).all(),
+    }
+    if free[a] or free[b]:
+        return []
     borders = {  # order: ((distances, moving, resting, rests at), ...) along the moving arm's s
         a: ((d[:, 0], a, b, "start"), (d[-1, :], b, a, "end")),
         b: ((d[0, :], b, a, "start"), (d[:, -1], a, b, "end")),
     }
-    closest = [min(((float(line.min()), int(line.argmin()), moving, resting, at) for line, moving, resting, at in order))
-               for order in borders.values()]
-    if any(distance >= cell.clearance for distance, *_ in closest):
-        return []
     turns = []
-    for distance, index, moving, resting, at in closest:
+    for first, order in borders.items():
+        distance, index, moving, resting, at = min((float(line.min()), int(line.argmin()), moving, resting, at) for line, moving, resting, at in order)
         rest = np.array([0.0 if at == "start" else 1.0])
         _, k_moving, k_resting = pair_distances(arm_capsules(cell.arms[moving], s[index : index + 1]), arm_capsules(cell.arms[resting], rest))
         turns.append(BlockedTurn(
-            moving, resting, at, float(s[index]), cell.arms[moving].link_names()[int(k_moving[0])],
+            first, moving, resting, at, float(s[index]), cell.arms[moving].link_names()[int(k_moving[0])],
             cell.arms[resting].link_names()[int(k_resting[0])], distance,
         ))
     return turns
-
-
-def _said(turn: BlockedTurn) -> str:
-    """One blocked turn in the library's words."""
-    near = f"overlaps by {-turn.distance:.3g} m" if turn.distance < 0.0 else f"comes within {turn.distance:.3g} m of"
-    return (
-        f"arm {turn.moving}'s link {turn.moving_link!r} at s = {turn.s:.3g} {near} link {turn.resting_link!r} of arm "
-        f"{turn.resting} resting at its {turn.rests_at}"
-    )

@@ -172,9 +172,13 @@ def test_three_arms_that_can_take_turns_in_no_order_are_a_422_naming_the_pairs_a
     response = patient_client.post("/v1/cells", json=body)
     assert response.status_code == 422, response.text[:300]
     detail = response.json()["detail"]
-    assert "arms[0] with arms[2], arms[1] with arms[2] can take turns in neither order" in detail
-    assert re.search(r"arms\[0\]'s link 'forearm_link' at s = [\d.]+ overlaps by [\d.]+ m link 'forearm_link' of arms\[2\] resting at its start", detail)
-    assert "move the bases of such a pair apart" in detail
+    assert "arms[0] and arms[2], and arms[1] and arms[2], can each take turns in neither order" in detail
+    assert re.search(
+        r"with arms\[0\] first, arms\[0\]'s link 'forearm_link' at s = [\d.]+ overlaps link 'forearm_link' of arms\[2\] "
+        r"resting at its start by [\d.]+ m", detail,
+    )
+    assert "with arms[2] first, arms[1]'s link 'forearm_link'" in detail and "resting at its end by" in detail
+    assert "move the bases of each such pair apart" in detail and "lower clearance" not in detail
     body["arms"][2]["base"]["position"] = [0.6, 1.8, 0.0]
     assert patient_client.post("/v1/cells", json=body).status_code == 200
 

@@ -79,13 +79,15 @@ def test_an_arm_resting_where_the_others_pass_is_refused_naming_the_pairs_the_li
     turns = refused.value.turns
     assert refused.value.rule == "no_order_of_arms"
     assert {(t.moving, t.resting, t.rests_at) for t in turns} == {(0, 2, "start"), (0, 2, "end"), (1, 2, "start"), (1, 2, "end")}
-    assert "arm 0's link 'forearm_link' at s = " in refused.value.detail and "of arm 2 resting at its start" in refused.value.detail
+    assert {(t.first, t.moving, t.rests_at) for t in turns} == {(0, 0, "start"), (2, 0, "end"), (1, 1, "start"), (2, 1, "end")}
+    assert "with arm 0 first, arm 0's link 'forearm_link' at s = " in refused.value.detail
+    assert "overlaps link 'forearm_link' of arm 2 resting at its start by " in refused.value.detail
     for turn in turns:
         assert turn.distance < cell.clearance and 0.0 < turn.s < 1.0
         assert turn.moving_link in cell.arms[turn.moving].link_names() and turn.resting_link in cell.arms[turn.resting].link_names()
         moving, resting = cell.arms[turn.moving], cell.arms[turn.resting]
         q_moving = moving.path.evaluate(np.array([turn.s])).q[0]
         q_resting = resting.path.evaluate(np.array([0.0 if turn.rests_at == "start" else 1.0])).q[0]
-        assert coal_distance(Cell((moving, resting), cell.clearance), q_moving, q_resting) < cell.clearance
+        assert coal_distance(Cell((moving, resting), cell.clearance), q_moving, q_resting) == pytest.approx(turn.distance, abs=1e-6)
     moved = Cell(pair.arms + (ur5_arm(REACHING, [0.6, 1.8, 0.0], QUARTER),), pair.clearance)
     assert coordinate(moved).clearance.bound >= cell.clearance
