@@ -105,19 +105,18 @@ class NodeTable:
 
     def edges(self, index: int) -> list[int]:
         """The moves of the path ending at node ``index``, from the start."""
-        out = []
-        while index >= 0:
-            if self.ints[index, kernels.EDGE] >= 0:
-                out.append(int(self.ints[index, kernels.EDGE]))
-            index = int(self.ints[index, kernels.PARENT])
-        return out[::-1]
+        return self._along(index, kernels.EDGE)
 
     def pieces(self, index: int) -> list[int]:
         """The spans of the path ending at node ``index``, from the start."""
+        return self._along(index, kernels.PIECE)
+
+    def _along(self, index: int, column: int) -> list[int]:
+        """The values >= 0 of ``column`` on the chain of parents of node ``index``, from the start."""
         out = []
         while index >= 0:
-            if self.ints[index, kernels.PIECE] >= 0:
-                out.append(int(self.ints[index, kernels.PIECE]))
+            if self.ints[index, column] >= 0:
+                out.append(int(self.ints[index, column]))
             index = int(self.ints[index, kernels.PARENT])
         return out[::-1]
 
