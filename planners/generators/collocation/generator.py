@@ -94,9 +94,11 @@ class Collocation(MotionGenerator):
                 problem, collocation, (path, result, stretch), notes, deadline
             )
             how = "refined" if switching is not None else "read off the samples"
+        cost = getattr(result, "cost", None) if self.torque_weight else result.duration
+        if source is collocation:  # the answer's own objective against the collocation's optimum
+            source = collocation.gap_of(result.duration if cost is None else cost)
         solver = CollocationReport.of(winner, how, source)
         notes = (*notes, *self._gap_note(source, collocation))
-        cost = getattr(result, "cost", None) if self.torque_weight else result.duration
         return Timed(
             path, result, (stretch,), "collocation", notes, cost, solver, switching_times=switching,
             motion_gap=(source.optimality_gap, source.gap_basis),

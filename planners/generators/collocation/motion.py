@@ -6,7 +6,7 @@ got there.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -21,7 +21,7 @@ class CollocationResult:
     the fine-grid solutions to the other goals (the elbow a revolution either way) whose coarse
     cost came close, costlier on the fine grid, for a comparison on exact terms (the bang-bang
     refinement); the same goal's cost on the coarse grid (``coarse_intervals``), for the estimate
-    of the fine grid's error."""
+    of the fine grid's error (``extrapolated_cost``)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -37,22 +37,43 @@ class CollocationResult:
     coarse_cost: float | None = None
     coarse_intervals: int = 0
 
-    @property
-    def optimality_gap(self) -> float | None:
-        """Estimated relative distance of the cost from the optimum of the collocation's problem
-        (its goal): the difference from the same goal's solution on the coarse grid, which
-        bounds the fine grid's error from above where the error shrinks with the interval.
-        ``None`` when unknown."""
-        if self.coarse_cost is None:
-            return None
-        return max(0.0, (self.coarse_cost - self.cost) / self.cost)
+    def extrapolated_cost(self) -> float | None:
+        """The optimum J* of the collocation's problem (s), estimated from the cost J_c on the
+        coarse grid (K_c intervals) and J_K on this grid (K intervals) by Richardson's
+        extrapolation at first order,
 
-    @property
-    def gap_basis(self) -> str:
-        """How ``optimality_gap`` was obtained."""
-        if self.coarse_cost is None:
-            return "none"
-        return f"second grid: the cost on {self.coarse_intervals} intervals against {len(self.t) - 1}"
+            J* ~ J_K - |J_c - J_K| K_c / (K - K_c),
+
+        an error that shrinks at least in proportion to the interval: the torques are
+        collocated at the instants, and a bang-bang optimum's switches fall between them (the
+        Geering arm's cost converges at order 0.9 to 1.7 between 20 and 100 intervals; ur5's
+        and Yamamoto's at order 2, whose errors this overstates). ``None`` when there is no
+        coarse cost or this grid is no finer."""
+        intervals = len(self.t) - 1
+        if self.coarse_cost is None or intervals <= self.coarse_intervals:
+            return None
+        return self.cost - abs(self.coarse_cost - self.cost) * self.coarse_intervals / (intervals - self.coarse_intervals)
+
+    def gap_of(self, value: float) -> StatedGap:
+        """The estimated relative distance of ``value``, the returned motion's objective (its
+        re-timed duration, or cost with a torque weight; s), from the optimum of the
+        collocation's problem: (value - J*) / J*, J* from ``extrapolated_cost`` (at least 0)."""
+        optimum = self.extrapolated_cost()
+        if optimum is None or not optimum > 0.0:
+            return StatedGap(None, "none: no coarser collocation grid to compare with")
+        basis = (
+            f"second grid: the collocation's cost on {self.coarse_intervals} and {len(self.t) - 1} intervals, "
+            f"extrapolated at first order to an optimum of {optimum:.6g} s"
+        )
+        return StatedGap(max(0.0, (value - optimum) / optimum), basis)
+
+
+class StatedGap(NamedTuple):
+    """An answer's estimated relative distance from its method's optimum (``None``: not
+    estimated) and how it was estimated."""
+
+    optimality_gap: float | None
+    gap_basis: str
 
 
 def collocation_path(result: CollocationResult) -> tuple[ViaPath, ConstantSpeedTiming]:

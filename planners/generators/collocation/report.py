@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 from toptraj.planners.problem.methods import Report
 
 if TYPE_CHECKING:
-    from toptraj.planners.generators.collocation.motion import CollocationResult
+    from toptraj.planners.generators.collocation.motion import CollocationResult, StatedGap
     from toptraj.planners.timing.base import PathTiming
 
 
@@ -44,10 +44,11 @@ class CollocationReport(Report):
     gap_basis: str
 
     @classmethod
-    def of(cls, collocation: CollocationResult, switching: str | None, gap: CollocationResult | PathTiming) -> CollocationReport:
+    def of(cls, collocation: CollocationResult, switching: str | None, gap: StatedGap | PathTiming) -> CollocationReport:
         """The report of ``collocation`` (a ``CollocationResult``) whose motion is returned,
-        with the gap of ``gap`` (the collocation itself, or the refined motion that replaced it:
-        anything with ``optimality_gap`` and ``gap_basis``)."""
+        with the gap of ``gap`` (the returned motion's against the collocation's extrapolated
+        optimum, or that of the refined motion that replaced it: anything with
+        ``optimality_gap`` and ``gap_basis``)."""
         return cls(
             cost=collocation.cost, duration=float(collocation.t[-1]), status=collocation.status,
             iterations=collocation.iterations, initial_guess=collocation.initial_guess, solve_s=collocation.solve_s,
