@@ -20,7 +20,7 @@ from fastapi import Request, Response, params
 from fastapi.routing import APIRoute
 from starlette.exceptions import HTTPException
 
-from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, nesting_depth, too_deep
+from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, refused_depth, too_deep
 
 #: The 415's advice.
 SEND_JSON = "send the header Content-Type: application/json (curl: -H 'Content-Type: application/json')"
@@ -62,23 +62,29 @@ def _is_json(content_type: str | None) -> bool:
     return message.get_content_maintype() == "application" and (subtype == "json" or subtype.endswith("+json"))
 
 
+def _too_deep(depth: int) -> BodyRefused:
+    """The 400 of a body nesting ``depth`` levels, more than a request may."""
+    return BodyRefused({"type": "about:blank", "title": "Too deeply nested", "status": 400, "detail": f"the body {too_deep(depth)}"})
+
+
 class StrictJSONRequest(Request):
     """A request whose ``json()`` refuses a key given twice and says where a text that is no
     JSON goes wrong."""
 
     async def json(self) -> Any:
         if not hasattr(self, "_json"):
+            body = await self.body()
+            depth = refused_depth(body)
+            if depth is not None:
+                raise _too_deep(depth)
             try:
-                self._json = loads(await self.body())
+                self._json = loads(body)
             except DuplicateKey as duplicate:
                 raise DuplicateKeyRefused(duplicate) from None
             except json.JSONDecodeError as error:
                 raise _unreadable(decode_error(error)) from None
             except UnicodeDecodeError:
                 raise _unreadable("the body is not UTF-8 text; send JSON encoded as UTF-8") from None
-            except RecursionError:  # deeper than the parser reads, as a batch's line too deep
-                detail = f"the body {too_deep(nesting_depth(await self.body()))}"
-                raise BodyRefused({"type": "about:blank", "title": "Too deeply nested", "status": 400, "detail": detail}) from None
         return self._json
 
 

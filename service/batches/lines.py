@@ -31,7 +31,7 @@ from pathlib import Path
 import orjson
 
 from toptraj.robots.errors import excerpt
-from toptraj.service.strict_json import MAX_DEPTH, DuplicateKey, decode_error, loads, nesting_depth, too_deep
+from toptraj.service.strict_json import DuplicateKey, decode_error, loads, refused_depth, too_deep
 
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000
@@ -70,8 +70,8 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
 
     if not data:
         return refused(422, "Invalid request", "the line is blank; put one request (a JSON object) on each line, or remove the line")
-    depth = nesting_depth(data)
-    if depth > MAX_DEPTH:
+    depth = refused_depth(data)
+    if depth is not None:
         return refused(400, "Too deeply nested", f"the line {too_deep(depth)}")
     try:
         body = loads(data, finite=True)

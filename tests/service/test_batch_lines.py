@@ -26,10 +26,11 @@ from tests.paths import ROOT
 from toptraj.planners import Deadline
 from toptraj.service.batches import lines as lines_
 from toptraj.service.batches import run_batch, runner
-from toptraj.service.batches.lines import MAX_DEPTH, nesting_depth, request_key
+from toptraj.service.batches.lines import request_key
 from toptraj.service.batches.work import answer, answer_chunk
 from toptraj.service.cli import main
 from toptraj.service.jobs.work import WorkerSetup, _batch
+from toptraj.service.strict_json import MAX_DEPTH, nesting_depth
 
 GOOD = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [0.4, 0.3, -0.2, 0.1, 0.2, 0.3]]}}
 OTHER = {"robot": "ur5", "path": {"waypoints": [[0.0] * 6, [-0.3, 0.2, 0.2, -0.1, 0.1, 0.2]]}}

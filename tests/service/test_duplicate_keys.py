@@ -82,6 +82,30 @@ def test_a_body_too_deep_is_still_refused_with_a_400(client):
     assert line["detail"].endswith(f"nested too deeply: it nests arrays and objects 100000 deep; a request nests at most {MAX_DEPTH} levels")
 
 
+@pytest.mark.parametrize("depth", [MAX_DEPTH + 1, 1000])
+def test_a_body_deeper_than_a_request_nests_is_refused_before_it_is_parsed(client, monkeypatch, depth):
+    """Valid JSON nesting more than ``MAX_DEPTH`` levels, as a body or as a batch's line, is the
+    same 400, before the parser builds anything from it; ``MAX_DEPTH`` levels are read (and
+    then refused by the schema, with the place)."""
+    from toptraj.service import strict_routes
+
+    parsed = []
+    monkeypatch.setattr(strict_routes, "loads", lambda data: parsed.append(data) or loads(data))
+    waypoints = "[" * (depth - 2) + "0" + "]" * (depth - 2)
+    body = f'{{"robot": "ur5", "path": {{"waypoints": {waypoints}}}}}'.encode()
+    answer = client.post("/v1/trajectories", content=body, headers={"content-type": "application/json"})
+    assert answer.status_code == 400, answer.text
+    expected = f"nested too deeply: it nests arrays and objects {depth} deep; a request nests at most {MAX_DEPTH} levels"
+    assert answer.json() == {"type": "about:blank", "title": "Too deeply nested", "status": 400, "detail": f"the body is {expected}"}
+    assert parsed == []
+    line = json.loads(parse_line(2, body).problem[1])
+    assert line["title"] == "Too deeply nested" and line["detail"] == f"line 2: the line is {expected}"
+    allowed = "[" * (MAX_DEPTH - 2) + "0" + "]" * (MAX_DEPTH - 2)
+    read = client.post("/v1/trajectories", content=f'{{"robot": "ur5", "path": {{"waypoints": {allowed}}}}}', headers={"content-type": "application/json"})
+    assert read.status_code == 422 and read.json()["detail"].startswith("path.waypoints[0][0]: ")
+    assert len(parsed) == 1
+
+
 def test_a_batch_line_giving_a_key_twice_is_its_own_422():
     line = parse_line(3, b'{"robot": "ur5", "path": {"waypoints": [[0,0,0,0,0,0]], "waypoints": []}}')
     status, body = line.problem
