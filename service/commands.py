@@ -53,13 +53,16 @@ def _json(text: str):
 
 
 def _unique_keys(source: str, text: str) -> str:
-    """``text``, once it is JSON (``_Unreadable`` saying where it goes wrong otherwise) and no
-    object of it gives a key twice (``DuplicateKey`` otherwise); a text nested too deep is
-    left to the schema's reading."""
-    from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads
+    """``text``, once it nests no deeper than a request may and is JSON (``_Unreadable`` saying
+    how deep, or where it goes wrong, otherwise) and no object of it gives a key twice
+    (``DuplicateKey`` otherwise)."""
+    from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, refused_depth, too_deep
 
     if not text.strip():
         raise _Unreadable(f"{source}: {EMPTY_BODY}".replace("the body is", "the request is"))
+    depth = refused_depth(text.encode())
+    if depth is not None:
+        raise _Unreadable(f"{source}: the request {too_deep(depth)}")
     try:
         loads(text)
     except DuplicateKey:

@@ -20,7 +20,7 @@ from fastapi import Request, Response, params
 from fastapi.routing import APIRoute
 from starlette.exceptions import HTTPException
 
-from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, refused_depth, too_deep
+from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, nesting_depth, refused_depth, too_deep
 
 #: The 415's advice.
 SEND_JSON = "send the header Content-Type: application/json (curl: -H 'Content-Type: application/json')"
@@ -74,17 +74,21 @@ class StrictJSONRequest(Request):
     async def json(self) -> Any:
         if not hasattr(self, "_json"):
             body = await self.body()
+            try:
+                text = body.decode("utf-8-sig")  # JSON between systems is UTF-8 (RFC 8259, section 8.1); a BOM is ignored
+            except UnicodeDecodeError:
+                raise _unreadable("the body is not UTF-8 text; send JSON encoded as UTF-8") from None
             depth = refused_depth(body)
             if depth is not None:
                 raise _too_deep(depth)
             try:
-                self._json = loads(body)
+                self._json = loads(text)
             except DuplicateKey as duplicate:
                 raise DuplicateKeyRefused(duplicate) from None
             except json.JSONDecodeError as error:
                 raise _unreadable(decode_error(error)) from None
-            except UnicodeDecodeError:
-                raise _unreadable("the body is not UTF-8 text; send JSON encoded as UTF-8") from None
+            except RecursionError:  # never with the depth counted above; kept as the same answer
+                raise _too_deep(nesting_depth(body)) from None
         return self._json
 
 

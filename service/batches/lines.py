@@ -70,23 +70,27 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
 
     if not data:
         return refused(422, "Invalid request", "the line is blank; put one request (a JSON object) on each line, or remove the line")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        return refused(422, "Invalid request", f"the line is not UTF-8 text ({error.reason} at byte {error.start}); write the file in UTF-8")
     depth = refused_depth(data)
     if depth is not None:
         return refused(400, "Too deeply nested", f"the line {too_deep(depth)}")
     try:
-        body = loads(data, finite=True)
+        body = loads(text, finite=True)
     except DuplicateKey as error:
         return refused(422, "Invalid request", str(error))
     except json.JSONDecodeError as error:
         # a line is one line of JSON text: its column is the place
         return refused(422, "Invalid request", decode_error(error).replace("line 1, column", "column", 1)[:_MAX_DETAIL])
-    except ValueError as error:  # no JSON, or no UTF-8
-        return refused(422, "Invalid request", f"the line is not JSON (UTF-8): {str(error)[:_MAX_DETAIL]}")
+    except ValueError as error:  # NaN or Infinity
+        return refused(422, "Invalid request", f"the line is not JSON: {str(error)[:_MAX_DETAIL]}")
     if not isinstance(body, dict):
         return refused(
             422, "Invalid request", f"the line is a JSON {type(body).__name__}; a request is a JSON object (a POST /v1/trajectories body)"
         )
-    return RequestLine(number, _digest(orjson.dumps(body, option=orjson.OPT_SORT_KEYS)), text=data.decode())
+    return RequestLine(number, _digest(orjson.dumps(body, option=orjson.OPT_SORT_KEYS)), text=text)
 
 
 def request_key(text: str | bytes) -> str:

@@ -107,8 +107,6 @@ def _nested(depth: int) -> list:
 HOSTILE_JSON = {
     "integer of 401 digits": ({"elbow_joint": {"has_velocity_limits": True, "max_velocity": 10**400}},
                               "max_velocity must be a finite number, got an integer of about 401 digits"),
-    "nesting 200 deep": ({"elbow_joint": {"has_velocity_limits": True, "max_velocity": _nested(200)}},
-                         f"more than {MAX_DEPTH} levels deep"),
     "many values": ({"elbow_joint": {"has_velocity_limits": True, "max_velocity": [0.5] * (MAX_NODES + 1)}},
                     f"more than {MAX_NODES} values"),
     "boolean for a number": ({"elbow_joint": {"has_jerk_limits": True, "max_jerk": False}}, "got False"),
@@ -121,6 +119,17 @@ def test_hostile_json_limits_are_a_422(client, limits, fragment):
     response, seconds = _post(client, {"joint_limits": limits})
     assert response.status_code == 422, response.text
     assert fragment in response.json()["detail"] and seconds < 2.0
+
+
+def test_json_limits_nested_deeper_than_a_request_are_refused_before_they_are_read(client):
+    """Limits given as JSON in the body nest the body itself: more than a request may is the
+    body's 400, before the body is parsed (the YAML text's own bound is tested above)."""
+    from toptraj.service.strict_json import MAX_DEPTH as BODY_DEPTH
+
+    response, seconds = _post(client, {"elbow_joint": {"has_velocity_limits": True, "max_velocity": _nested(200)}})
+    assert response.status_code == 400, response.text
+    assert response.json()["detail"] == f"the body is nested too deeply: it nests arrays and objects 204 deep; a request nests at most {BODY_DEPTH} levels"
+    assert seconds < 2.0
 
 
 @pytest.mark.parametrize("kind", LIMITS)

@@ -84,3 +84,48 @@ def test_a_batch_line_that_is_no_json_says_its_line_and_column():
     status, problem = line.problem
     assert status == 422  # as POST /v1/trajectories answers a body that is no JSON
     assert json.loads(problem)["detail"].startswith("line 7: column 2: Expecting property name enclosed in double quotes (JSON needs double quotes")
+
+
+def test_a_string_never_closed_is_read_in_linear_time():
+    """The depth count skips strings with a pattern that cannot backtrack: a body of 40
+    waypoints with a quote never closed (a typo) took seconds per added character before.
+    Run in a child process, so that a relapse fails the test instead of hanging the suite."""
+    import subprocess
+    import sys
+
+    script = (
+        "from toptraj.service.strict_json import nesting_depth\n"
+        "waypoints = ', '.join(['[0, 0, 0, 0, 0, 0]'] * 40)\n"
+        "body = ('{\"robot\": \"ur5\", \"note\": \"abc, \"path\": {\"waypoints\": [' + waypoints + ']}}' + ' x' * 50_000).encode()\n"
+        "print(nesting_depth(body))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60, cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().isdigit()
+
+
+def test_a_body_in_another_encoding_than_utf8_is_a_422_naming_utf8(client):
+    """A UTF-16 body (where a quote byte can be half of another character, so that brackets
+    hide from the depth count) is refused as JSON between systems must be UTF-8 (RFC 8259);
+    a UTF-8 byte order mark is ignored."""
+    body = json.loads(SPLINE)
+    for encoding in ("utf-16", "utf-32"):
+        answer = client.post("/v1/trajectories", content=json.dumps(body).encode(encoding), headers=JSON)
+        assert answer.status_code == 422, answer.text
+        assert answer.json()["detail"] == "body: the body is not UTF-8 text; send JSON encoded as UTF-8"
+        line = parse_line(2, json.dumps(body).encode(encoding))
+        assert line.problem is not None and line.problem[0] == 422
+        assert json.loads(line.problem[1])["detail"].startswith("line 2: the line is not UTF-8 text (")
+    answer = client.post("/v1/trajectories", content=b"\xef\xbb\xbf" + SPLINE, headers=JSON)
+    assert answer.status_code == 200, answer.text
+    assert parse_line(3, b"\xef\xbb\xbf" + SPLINE).problem is None
+
+
+def test_the_cli_refuses_a_file_nested_too_deep_before_reading_it(tmp_path, capsys):
+    from toptraj.service.strict_json import MAX_DEPTH
+
+    deep = tmp_path / "deep.json"
+    deep.write_text('{"robot": "ur5", "path": {"waypoints": ' + "[" * 5000 + "]" * 5000 + "}}")
+    assert main(["plan", str(deep)]) == 2
+    problem = json.loads(capsys.readouterr().err)
+    assert problem["detail"] == f"{deep}: the request is nested too deeply: it nests arrays and objects 5002 deep; a request nests at most {MAX_DEPTH} levels"
