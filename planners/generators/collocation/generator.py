@@ -95,8 +95,10 @@ class Collocation(MotionGenerator):
             )
             how = "refined" if switching is not None else "read off the samples"
         cost = getattr(result, "cost", None) if self.torque_weight else result.duration
+        if cost is None:  # the collocation's own timing, returned: its cost is the collocation's
+            cost = collocation.cost
         if source is collocation:  # the answer's own objective against the collocation's optimum
-            source = collocation.gap_of(result.duration if cost is None else cost)
+            source = collocation.gap_of(cost)
         solver = CollocationReport.of(winner, how, source)
         notes = (*notes, *self._gap_note(source, collocation))
         return Timed(
