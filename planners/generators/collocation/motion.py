@@ -68,7 +68,7 @@ class CollocationResult:
         if not optimum > 0.0:
             return StatedGap(None, (
                 f"none: the collocation's costs on {self.coarse_intervals} and {intervals} intervals differ too much to "
-                "extrapolate; more timing.grid_points give an estimate"
+                "extrapolate; more collocation intervals give an estimate"
             ))
         basis = (
             f"second grid: the collocation's cost on {self.coarse_intervals} and {intervals} intervals, "
