@@ -78,6 +78,20 @@ def _too_many_samples(facts: dict) -> str:
     )
 
 
+def _curvature_jump(facts: dict) -> str:
+    """A blended path under a jerk limit; jerk_limited always limits jerk, so its remedy is
+    another method, not leaving 'jerk' out of the constraints."""
+    remedy = (
+        "use interpolation 'spline', or time the blended path with a method without a jerk limit (phase_plane, toppra)"
+        if facts.get("method") == "jerk_limited"
+        else "use interpolation 'spline' with a jerk limit, or leave 'jerk' out of timing.constraints"
+    )
+    return (
+        f"the path's curvature d2q/ds2 jumps at s = {facts['s']:.4f} (where a straight segment meets a blend), "
+        f"so the joint accelerations jump there and no motion that passes it has a finite jerk: {remedy}"
+    )
+
+
 def _needs_two_waypoints(facts: dict) -> str:
     given = "a cartesian path" if facts["value"] is None else counted(facts["value"], "waypoint")
     return (
@@ -206,11 +220,7 @@ WORDING: dict[str, Wording] = {
         "collocation does not see obstacles"
     ),
     "too_many_samples": _too_many_samples,
-    "curvature_jump": (
-        "the path's curvature d2q/ds2 jumps at s = {s:.4f} (where a straight segment meets a blend), "
-        "so the joint accelerations jump there and no motion that passes it has a finite jerk: use "
-        "interpolation 'spline' with a jerk limit, or leave 'jerk' out of timing.constraints"
-    ),
+    "curvature_jump": _curvature_jump,
     "boundary_accelerations_not_used": "{field} accelerations are not used by timing.method {method!r}; use quintic",
     "duration_not_used": (
         "{field} is not used by timing.method {method!r}, which finds the shortest "

@@ -36,10 +36,11 @@ def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -
         )
 
 
-def check_jerk_finite(path: GeometricPath, kinds: tuple[str, ...]) -> None:
+def check_jerk_finite(path: GeometricPath, kinds: tuple[str, ...], method: str = "") -> None:
     """A jerk limit needs a path whose d2q/ds2 is continuous where the motion goes on: at a
     break (a straight segment meeting a circular blend) the joint acceleration q'' sd^2 jumps
-    unless the motion stops there, an infinite jerk."""
+    unless the motion stops there, an infinite jerk. ``method``: the timing method's name, a
+    fact of the refusal (a method that always limits jerk is no remedy)."""
     if "jerk" not in kinds or not len(path.breaks):
         return
     s = float(path.breaks[0])
@@ -49,6 +50,7 @@ def check_jerk_finite(path: GeometricPath, kinds: tuple[str, ...]) -> None:
         s=s,
         limit="jerk",
         rule="curvature_jump",
+        method=method,
     )
 
 

@@ -69,7 +69,7 @@ def timed_path(
     rest-to-rest problem, and every one through the limit gate."""
     grid = path_grid(path, grid_points)
     check_path_within_limits(robot, path, grid)
-    check_jerk_finite(path, kinds)
+    check_jerk_finite(path, kinds, method.name)
     boundary = path_boundary(path, states, duration, method)
     parts = stretches(path)
     widths = [getattr(part, "width", 1.0) for part in parts]
