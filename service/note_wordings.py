@@ -40,6 +40,24 @@ def _collocation_gap(facts: dict) -> str:
     return f"the duration may lie up to {100 * facts['gap']:.2g} % above the optimum ({facts['basis']}){advice}"
 
 
+def _limit_far_above_own(facts: dict) -> str:
+    """A limit asked far above the robot's own, with the slips that give one: degrees for
+    radians, percent for a factor."""
+    kind, unit = facts["kind"], facts["unit"]
+    if facts["field"].endswith("_scale"):
+        slip = f"a scale is a factor ({facts['field']} = 0.8 for 80 %)"
+    elif kind == "torque":
+        slip = f"limits are in SI units ({unit}), one per joint in the robot's joint order"
+    else:
+        slip = f"limits are in SI units ({unit}; radians, not degrees: 180 deg/s is 3.14 rad/s)"
+    return (
+        f"{facts['field']} = {facts['given']:g} puts the {kind} limit of joint {facts['joint_name'][:64]!r} at "
+        f"{facts['value']:.4g} {unit}, {facts['ratio']:.3g} times its own limit of {facts['own']:.4g} {unit}: the "
+        f"motion is planned under it, and peak_utilization is measured against it. If that is not meant, {slip}; "
+        "leave the field out to plan under the robot's own limits"
+    )
+
+
 def _missed_region(facts: dict) -> str:
     zone, distance = f"timing.zones[{facts['index']}]", facts["distance"]
     grow = (
@@ -108,6 +126,7 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
         "stops there"
     ),
     "collocation_gap": _collocation_gap,
+    "limit_far_above_own": _limit_far_above_own,
     "missed_region": _missed_region,
     "too_few_samples": _too_few_samples,
     "slowed_to_whole_periods": _slowed_to_whole_periods,

@@ -30,6 +30,7 @@ from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import MotionGenerator
 from toptraj.planners.problem.problem import AT_REST, BoundaryStates, LimitRequest, MotionSpec, Problem, Sampling
+from toptraj.planners.problem.raised_limits import raised_limits
 from toptraj.planners.problem.ranges import check_numbers, check_scaled_limits
 from toptraj.planners.problem.requests import WaypointPath, check_constraint_kinds, default_kinds
 from toptraj.planners.problem.waypoints import continuous_turns, without_repeats
@@ -85,11 +86,11 @@ def build_problem(
         raise OutOfRange("limits.margin", margin, 0.0, MAX_LIMIT_MARGIN, rule="margin_out_of_range")
     held = _limits(robot, motion, method, limits)
     held = held.tightened(margin) if margin else held
-    notes: tuple[str, ...] = ()
+    notes: tuple[str, ...] = raised_limits(robot, limits, kinds)
     if isinstance(motion, WaypointPath):
         motion, turns = continuous_turns(robot, motion)
         motion, dropped = without_repeats(motion)
-        notes = (*turns, *dropped)
+        notes = (*notes, *turns, *dropped)
     problem = Problem(
         robot=robot, motion=motion, method=method, requested=limits, grid=grid, boundary=boundary, duration=duration,
         kinds=kinds, limits=held, margin=margin, threshold=gate_threshold(margin), sampling=sampling,

@@ -1,0 +1,49 @@
+"""Limits asked far above the robot's own: a note in the answer, for a value given in degrees
+(57 times the radians), a scale given in percent (100 times the factor) or a torque override
+for the wrong joint would otherwise be planned under without a word, and the answer's
+utilizations, measured against the limits asked, would not show it."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from toptraj.robots.notes import Note
+from toptraj.robots.ranges import LIMITS
+
+if TYPE_CHECKING:
+    from toptraj.planners.problem.problem import LimitRequest
+    from toptraj.robots import Robot
+
+#: A limit asked above this many times the robot's own is noted (the robot's limits are the
+#: rated ones of its URDF or catalog entry; 3 leaves room for conservative ratings).
+RAISED_FACTOR = 3.0
+
+
+def raised_limits(robot: Robot, asked: LimitRequest, kinds: tuple[str, ...]) -> tuple[Note, ...]:
+    """A note per limit kind held (``kinds``) whose overrides or scale in ``asked`` put some
+    joint's limit above ``RAISED_FACTOR`` times the robot's own finite one: the joint that is
+    raised most, its limit asked and its own (SI units), and the field that raised it."""
+    notes = []
+    for kind in LIMITS:
+        override, scale = asked.overrides.get(kind), asked.scales.get(kind)
+        if kind not in kinds or (override is None and scale is None):
+            continue
+        own = np.asarray(getattr(robot.limits, kind), dtype=float)
+        held = (own if override is None else np.asarray(override, dtype=float)) * (1.0 if scale is None else scale)
+        rated = np.isfinite(own) & (own > 0.0)
+        ratio = np.where(rated, held / np.where(rated, own, 1.0), 0.0)
+        joint = int(np.argmax(ratio))
+        if not ratio[joint] > RAISED_FACTOR:
+            continue
+        field = f"limits.{kind}[{joint}]" if override is not None else f"limits.{kind}_scale"
+        given = float(override[joint]) if override is not None else float(scale or 1.0)
+        notes.append(Note(
+            f"{field} = {given:g} puts the {kind} limit of joint {robot.joint_names[joint]!r} at {held[joint]:.4g} "
+            f"{LIMITS[kind].unit}, {ratio[joint]:.3g} times its own ({own[joint]:.4g}): the motion is planned under it",
+            "limit_far_above_own", field=field, kind=kind, given=given,
+            joint_name=robot.joint_names[joint], value=float(held[joint]), own=float(own[joint]), ratio=float(ratio[joint]),
+            unit=LIMITS[kind].unit,
+        ))
+    return tuple(notes)
