@@ -315,10 +315,12 @@ WORDING: dict[str, Wording] = {
         f"at most {facts['cap']} are searched: use fewer cells, or timing.search.graph 'roadmap'"
     ),
     "unknown_graph": "{field} {value!e} is unknown; use one of {allowed}",
-    "outside_the_joint_limits": "{field} is outside the joint limits",
     "end_too_close": lambda facts: (
-        f"path.{facts['field']} comes within {facts['distance']:.4g} m of an obstacle (the clearance is {facts['clearance']:g} m): "
-        "move it away from the obstacles or lower path.clearance"
+        f"at {facts['field']}, link {facts['link']!r} "
+        + (f"is inside path.obstacles[{facts['obstacle']}] (by {-facts['distance']:.4g} m)" if facts["distance"] < 0
+           else f"comes within {facts['distance']:.4g} m of path.obstacles[{facts['obstacle']}]")
+        + f" (the clearance is {facts['clearance']:g} m): move {facts['field']} away from the obstacle"
+        + (" or lower path.clearance" if facts["distance"] >= 0 else "")
     ),
     "max_turn_out_of_range": "{field} must lie in (0, 180) degrees, got {value}",
     "frame_without_speed": "{field} is given without timing.limits.tool_speed or tool_angular_speed",

@@ -7,13 +7,25 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from toptraj.planners.errors import InfeasiblePath, NotServed, OutsideJointRange
+from toptraj.planners.errors import InfeasiblePath, NotServed, OutOfRange, OutsideJointRange
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.boundary import path_acceleration, path_speed
 from toptraj.planners.problem.problem import BoundaryStates
 from toptraj.planners.timing.base import Boundary, TimingMethod
 from toptraj.robots import Robot
+
+
+def check_within_joint_limits(robot: Robot, field: str, q: ArrayLike) -> None:
+    """OutOfRange naming the joint, its value and its range where the configuration ``q``
+    (n_dof,), given as ``field`` (a free path's start or goal), lies outside the joint limits."""
+    q = np.asarray(q, dtype=float)
+    outside = robot.outside_position_limits(q)
+    if outside is not None:
+        joint = outside[1]
+        lower, upper = robot.limits.position_lower, robot.limits.position_upper
+        raise OutOfRange(f"{field}[{joint}]", float(q[joint]), float(lower[joint]), float(upper[joint]),
+                         rule="outside_joint_range", joint_name=robot.joint_names[joint])
 
 
 def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:

@@ -33,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from toptraj.planners.constraints.path_constraints import build_path_constraints
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline, Progress
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.generators.collocation.guesses import bend_guesses, goal_guesses
@@ -41,6 +41,7 @@ from toptraj.planners.generators.collocation.motion import CollocationResult
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.waypoints import SplinePath
 from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.planners.problem.path_checks import check_within_joint_limits
 from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 from toptraj.robots import JointLimits, Robot
 
@@ -288,10 +289,8 @@ def _optimize_motion(
     """``optimize_motion``'s work, in the calling process: every initial guess on the coarse
     grid, then the best of each goal within ``RIVAL_MARGIN`` of the best refined on
     ``motion.intervals``; the cheapest refined motion, the others as its ``rivals``."""
-    if robot.outside_position_limits(motion.start) is not None:
-        raise InvalidRequest("start", motion.start, rule="outside_the_joint_limits")
-    if robot.outside_position_limits(motion.goal) is not None:
-        raise InvalidRequest("goal", motion.goal, rule="outside_the_joint_limits")
+    check_within_joint_limits(robot, "start", motion.start)
+    check_within_joint_limits(robot, "goal", motion.goal)
     started = time.perf_counter()
     coarse = _coarse_solutions(robot, limits, motion, torque_weight, max_iterations, progress)
     finished: list[CollocationResult] = []

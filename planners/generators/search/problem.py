@@ -11,8 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.collision import Obstacle
+from toptraj.planners.collision.clearance import clearance_along
 from toptraj.planners.collision.self_collision import SelfCollision, self_distances, self_pairs
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, NotOneOf, OutOfRange
+from toptraj.planners.errors import InfeasiblePath, NotOneOf, OutOfRange
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.bounds import PieceBounds, piece_bounds
 from toptraj.planners.generators.search.free_space import clear_pieces, clear_spans, free_distances, point_distances
@@ -27,7 +28,9 @@ from toptraj.planners.generators.search.graph import (
 )
 from toptraj.planners.generators.search.pieces import Pieces, build_pieces
 from toptraj.planners.generators.search.states import search_states
+from toptraj.planners.problem.path_checks import check_within_joint_limits
 from toptraj.robots import JointLimits, Robot
+from toptraj.robots.collision import robot_capsules
 
 GRAPH_KINDS = ("auto", "lattice", "roadmap")
 
@@ -118,14 +121,18 @@ def _check_apart(robot: Robot, name: str, q: np.ndarray) -> None:
 def _check_end(robot: Robot, name: str, q: np.ndarray, obstacles: list[Obstacle], clearance: float) -> None:
     """Raise where the start or goal ``q`` lies outside the joint limits, within the clearance
     of an obstacle, or with two links touching."""
-    if robot.outside_position_limits(q) is not None:
-        raise InvalidRequest(name, q, rule="outside_the_joint_limits")
+    check_within_joint_limits(robot, name, q)
     if obstacles:
         nearest = float(point_distances(robot, q[None, :], obstacles)[0])
         if nearest < clearance:
+            _, capsule, obstacle = clearance_along(robot, q[None, :], obstacles)
+            link = robot_capsules(robot)[int(capsule[0])].name
+            how = f"is inside obstacle {int(obstacle[0])} (by {-nearest:.4g} m)" if nearest < 0 else (
+                f"comes within {nearest:.4g} m of obstacle {int(obstacle[0])}"
+            )
             raise InfeasiblePath(
-                f"the {name} comes within {nearest:.4g} m of an obstacle (the clearance is {clearance:g} m)",
-                rule="end_too_close", field=name, distance=nearest, clearance=clearance,
+                f"at the {name}, link {link!r} {how} (the clearance is {clearance:g} m)",
+                rule="end_too_close", field=name, distance=nearest, clearance=clearance, link=link, obstacle=int(obstacle[0]),
             )
     _check_apart(robot, name, q)
 
