@@ -16,7 +16,11 @@ def _path(path: dict | None, waypoints: Any) -> dict:
         raise ValueError("give either waypoints (joint configurations, one row each) or path (a request's path object)")
     if path is not None:
         return dict(path)
-    return {"kind": "waypoints", "waypoints": np.asarray(waypoints, dtype=float).tolist()}
+    try:
+        rows = np.asarray(waypoints, dtype=float).tolist()
+    except ValueError:  # rows of different lengths: sent row by row, for the service to name the row
+        rows = [np.asarray(row, dtype=float).tolist() for row in waypoints]
+    return {"kind": "waypoints", "waypoints": rows}
 
 
 def _timing(timing: dict | None, fields: dict[str, Any]) -> dict:

@@ -179,6 +179,9 @@ def test_problems_are_raised_with_their_facts(toptraj):
     with pytest.raises(ProblemError) as caught:
         toptraj.plan("ur5", [[0.0] * 6])
     assert caught.value.status == 422 and caught.value.errors[0]["field"] == "path.waypoints"
+    with pytest.raises(ProblemError) as caught:  # rows of different lengths: the service names the row
+        toptraj.plan("ur5", [[0.0, -1.2, 1.0, 0.0, 0.5], [1.0, -1.0, 1.2, 0.0, 0.6, 0.0]])
+    assert caught.value.status == 422 and caught.value.detail.startswith("path.waypoints[0] has 5 values; ur5 has 6 joints")
     with pytest.raises(ProblemError) as caught:
         toptraj.plan("nope", [[0.0], [1.0]])
     assert caught.value.status == 404 and caught.value.type == "about:blank"
