@@ -18,6 +18,7 @@ from toptraj.planners.errors import TimingFailed
 from toptraj.planners.kinematics.conditioning import NEAR_SINGULAR_KAPPA, conditioning_along
 from toptraj.planners.paths.blended import MIN_BLEND, BlendedPath
 from toptraj.planners.paths.grid import spread_indices
+from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import MotionGenerator, Timed
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.results import Accuracy, Conditioning, PhasePlane, PlannedTrajectory, ZoneReport, require_finite
@@ -70,7 +71,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     notes.extend(_unheld_defaults(problem, utilization))
     notes.extend(_unasked_limits(utilization, (*problem.kinds, *problem.unheld), problem.method, robot.joint_names))
     kappa_min, kappa_max, length, worst = conditioning_along(robot, samples.q, spread_indices(len(samples.q), CONDITIONING_POINTS))
-    notes.extend(_singularity_notes(kappa_min, kappa_max, samples.t[worst]))
+    notes.extend(_singularity_notes(kappa_min, kappa_max, samples.t[worst], isinstance(problem.motion, FreeMotion)))
     notes.extend(sampling_notes(result.duration, problem.sampling.dt, problem.sampling.exact_period, len(samples.t)))
     switching = timed.switching_times
     if switching is None and timed.method == "collocation" and getattr(problem.method, "torque_weight", None) == 0.0:
@@ -164,11 +165,15 @@ def _accuracy(problem: Problem, timed: Timed) -> tuple[Accuracy, str | None]:
     )
 
 
-def _singularity_notes(kappa_min: float, kappa_max: float, at: float) -> list[str]:
+def _singularity_notes(kappa_min: float, kappa_max: float, at: float, free: bool = False) -> list[str]:
     """A note when the arm passes through or near a singularity (at ``at``, s), or stays in one
-    all along (``kappa_min`` infinite: no single instant to name), each with what to do."""
+    all along (``kappa_min`` infinite: no single instant to name), each with what to do; a free
+    path (``free``) has no waypoints to move, only its start and goal."""
     unaffected = "the timing is unaffected, but the tool's motion is poorly controlled near that pose"
-    remedy = f"to avoid it, move the path's waypoints near t = {at:.4g} s off that pose (a Cartesian path: give it in joint space there)"
+    remedy = (
+        "to avoid it at an end of the motion, move its start or goal off that pose (between them, the path is the planner's)"
+        if free else f"to avoid it, move the path's waypoints near t = {at:.4g} s off that pose (a Cartesian path: give it in joint space there)"
+    )
     if not np.isfinite(kappa_min):
         return [
             "the arm is at a singularity all along the motion: its end effector's Jacobian lacks full rank at every "

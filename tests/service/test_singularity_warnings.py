@@ -32,3 +32,18 @@ def test_an_arm_singular_all_along_names_no_instant(client):
     assert conditioning["kappa_min"] is None and conditioning["kappa_max"] is None
     (note,) = [w for w in warnings if "singularity" in w]
     assert "at t =" not in note and "all along the motion" in note and "needs no change" in note
+
+
+def test_a_free_path_is_told_to_move_its_start_or_goal_not_waypoints(client):
+    """The Geering arm starts stretched out (a singular pose): its free motion has no waypoints."""
+    body = {
+        "robot": "geering_2r",
+        "path": {"kind": "free", "start": [0.0, 0.0], "goal": [0.76, 0.0], "revolutions": True},
+        "timing": {"method": "collocation", "constraints": ["torque"]},
+        "output": {"dt": 0.01},
+    }
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 200, response.text
+    (note,) = [w for w in response.json()["warnings"] if "singularity" in w]
+    assert note.startswith("the arm passes through a singularity at t = 0 s")
+    assert note.endswith("to avoid it at an end of the motion, move its start or goal off that pose (between them, the path is the planner's)")
