@@ -327,6 +327,13 @@ def check_urdf(urdf: str) -> pin.Model:
     try:
         root = ElementTree.fromstring(urdf)
     except ElementTree.ParseError as error:
+        text = urdf.strip()
+        if not text.startswith("<") and "\n" not in text and len(text) < 4096:  # a file's name, not its text
+            raise InvalidURDF(
+                f"the URDF is the text {excerpt(text, 80)}, not XML: give the file's contents, not its name "
+                "(jq -n --rawfile urdf FILE '{name: \"my_arm\", urdf: $urdf}' writes a body holding them, as the "
+                "guide's Uploads page shows)"
+            ) from None
         raise InvalidURDF(f"malformed XML: {excerpt(str(error), 200)}") from None
     if root.tag != "robot":
         tag = root.tag if len(root.tag) <= 40 else f"{root.tag[:40]}..."
