@@ -20,6 +20,7 @@ GUIDE_SOURCES := mkdocs.yml $(shell find docs compiled robots planners client -n
 $(STAMP): pyproject.toml requirements.lock
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
+	@echo "toptraj install: the locked dependencies into $(VENV) (about 2.6 GB; a minute or more) ..."
 	$(BIN)/python -m pip install --quiet --require-hashes -r requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
 	$(BIN)/python -m pip check
