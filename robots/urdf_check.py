@@ -328,7 +328,10 @@ def check_urdf(urdf: str) -> pin.Model:
         root = ElementTree.fromstring(urdf)
     except ElementTree.ParseError as error:
         text = urdf.strip()
-        if not text.startswith("<") and "\n" not in text and len(text) < 4096:  # a file's name, not its text
+        if not text:
+            raise InvalidURDF("the URDF is empty: give the text of a URDF file (<robot name=...> ... </robot>)") from None
+        looks_like_a_path = "/" in text or "\\" in text or text.lower().endswith((".urdf", ".xacro", ".xml"))
+        if looks_like_a_path and not text.startswith("<") and "\n" not in text and len(text) < 4096:
             raise InvalidURDF(
                 f"the URDF is the text {excerpt(text, 80)}, not XML: give the file's contents, not its name "
                 "(jq -n --rawfile urdf FILE '{name: \"my_arm\", urdf: $urdf}' writes a body holding them, as the "

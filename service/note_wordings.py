@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from toptraj.planners.problem.raised_limits import RAISED_FACTOR
 from toptraj.planners.runner.sampling_notes import percent
 
 
@@ -42,19 +43,25 @@ def _collocation_gap(facts: dict) -> str:
 
 def _limit_far_above_own(facts: dict) -> str:
     """A limit asked far above the robot's own, with the slips that give one: degrees for
-    radians, percent for a factor."""
-    kind, unit = facts["kind"], facts["unit"]
-    if facts["field"].endswith("_scale"):
-        slip = f"a scale is a factor ({facts['field']} = 0.8 for 80 %)"
-    elif kind == "torque":
+    radians, percent for a factor (the one of override and scale that alone goes beyond)."""
+    kind, unit, override, scale = facts["kind"], facts["unit"], facts["override"], facts["scale"]
+    scale_field = f"timing.limits.{kind}_scale"
+    given = " and ".join(
+        ([f"timing.limits.{kind}[{facts['index']}] = {override:g}"] if override is not None else [])
+        + ([f"{scale_field} = {scale:g}"] if scale is not None else [])
+    )
+    if scale is not None and (override is None or scale > RAISED_FACTOR):
+        slip = f"a scale is a factor ({scale_field} = 0.8 for 80 %)"
+    elif kind == "torque" or facts["prismatic"]:
         slip = f"limits are in SI units ({unit}), one per joint in the robot's joint order"
     else:
         slip = f"limits are in SI units ({unit}; radians, not degrees: 180 deg/s is 3.14 rad/s)"
+    planned = "the motion is planned under it, and " if facts["held"] else ""
     return (
-        f"{facts['field']} = {facts['given']:g} puts the {kind} limit of joint {facts['joint_name'][:64]!r} at "
-        f"{facts['value']:.4g} {unit}, {facts['ratio']:.3g} times its own limit of {facts['own']:.4g} {unit}: the "
-        f"motion is planned under it, and peak_utilization is measured against it. If that is not meant, {slip}; "
-        "leave the field out to plan under the robot's own limits"
+        f"{given} put{'s' if ' and ' not in given else ''} the {kind} limit of joint {facts['joint_name'][:64]!r} at "
+        f"{facts['value']:.4g} {unit}, {facts['ratio']:.3g} times its own limit of {facts['own']:.4g} {unit}: "
+        f"{planned}peak_utilization is measured against it. If that is not meant, {slip}; leave the field out to use "
+        "the robot's own limits"
     )
 
 

@@ -14,8 +14,9 @@ from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
 WAYPOINTS = [[0.0, -1.2, 1.0, 0.0, 0.5, 0.0], [1.0, -1.0, 1.2, 0.0, 0.6, 0.0]]
 
 
-def _warnings(client, limits: dict) -> list[str]:
-    answer = client.post("/v1/trajectories", json={"robot": "ur5", "path": {"waypoints": WAYPOINTS}, "timing": {"limits": limits}})
+def _warnings(client, limits: dict, **timing) -> list[str]:
+    body = {"robot": "ur5", "path": {"waypoints": WAYPOINTS}, "timing": {"limits": limits, **timing}}
+    answer = client.post("/v1/trajectories", json=body)
     assert answer.status_code == 200, answer.text
     return [warning for warning in answer.json()["warnings"] if "times its own limit" in warning]
 
@@ -49,3 +50,43 @@ def test_the_note_starts_above_the_factor_and_names_the_joint_raised_most(factor
     assert bool(notes) == noted
     if noted:
         assert notes[0].facts["joint_name"] == "wrist_1_joint" and notes[0].facts["ratio"] == pytest.approx(factor)
+
+
+def test_an_override_and_a_scale_are_named_together_with_the_slip_of_the_one_beyond(client):
+    (warning,) = _warnings(client, {"velocity": [3.0] * 6, "velocity_scale": 80})
+    assert warning.startswith("timing.limits.velocity[0] = 3 and timing.limits.velocity_scale = 80 put the velocity limit")
+    assert "a scale is a factor (timing.limits.velocity_scale = 0.8 for 80 %)" in warning
+
+
+def test_a_limit_not_held_is_noted_for_its_utilization(client):
+    """Torque left out of the constraints is still reported in peak_utilization, against the
+    limit asked."""
+    (warning,) = _warnings(client, {"torque_scale": 100}, constraints=["velocity", "acceleration"])
+    assert ": peak_utilization is measured against it. If that is not meant, a scale is a factor" in warning
+    assert "planned under it" not in warning
+
+
+def test_a_limit_of_the_services_default_rule_is_no_rating(client):
+    """ur5's jerk limit (200 rad/s^3) comes from the default rule, not a datasheet: a jerk
+    limit of 1,000 is no slip."""
+    arm = robots.load("ur5")
+    assert arm.limit_sources["jerk"][0].startswith("default")
+    assert _warnings(client, {"jerk": [1000.0] * 6}, method="jerk_limited") == []
+
+
+def test_a_prismatic_joint_is_spoken_of_in_metres(client):
+    from tests.paths import DATA
+
+    created = client.post("/v1/robots", json={"name": "lift_raised", "urdf": (DATA / "lift_rp.urdf").read_text()})
+    assert created.status_code == 201, created.text
+    lift = created.json()
+    joint = lift["joint_names"].index("lift")
+    velocity = [lift["limits"]["velocity"][j] * (20.0 if j == joint else 1.0) for j in range(len(lift["joint_names"]))]
+    answer = client.post("/v1/trajectories", json={
+        "robot": "lift_raised", "path": {"waypoints": [[0.0] * len(velocity), [0.1] * len(velocity)]},
+        "timing": {"limits": {"velocity": velocity}},
+    })
+    assert answer.status_code == 200, answer.text
+    (warning,) = [w for w in answer.json()["warnings"] if "times its own limit" in w]
+    assert "m/s, 20 times its own limit of" in warning and "one per joint in the robot's joint order" in warning
+    assert "degrees" not in warning

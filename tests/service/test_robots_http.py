@@ -80,6 +80,8 @@ def test_upload_under_a_name(client):
         ("<robot><link name='a'>", ["malformed XML"]),
         # a file's name where its text belongs
         ("/tmp/two_link.urdf", ["the URDF is the text '/tmp/two_link.urdf', not XML: give the file's contents, not its name", "--rawfile urdf FILE"]),
+        ("robot", ["malformed XML"]),  # no file's name
+        ("  \n ", ["the URDF is empty"]),
         ("<nothing/>", ["root element is <nothing>"]),
         (MINIMAL.format(effort=5, inertial=""), ["joint 'j'", "link 'arm' has no <inertial>"]),
         (MINIMAL.format(effort=0, inertial=INERTIAL), ["joint 'j'", "effort limit must be positive"]),
