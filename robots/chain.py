@@ -56,6 +56,16 @@ class Chain:
     gravity: np.ndarray
 
 
+def sliding_joints(model: pin.Model) -> np.ndarray:
+    """Whether each velocity coordinate (model.nv,) belongs to a prismatic joint (``_PRISMATIC``),
+    whose limits are in m/s, m/s^2, m/s^3 and N rather than rad/s ... and N m."""
+    sliding = np.zeros(model.nv, dtype=bool)
+    for joint in list(model.joints)[1:]:
+        if joint.nv == 1 and joint.shortname() in _PRISMATIC:
+            sliding[joint.idx_v] = True
+    return sliding
+
+
 def chain_of(model: pin.Model) -> Chain | None:
     """The ``Chain`` of ``model``, or ``None`` when it has a joint other than a revolute or a
     prismatic one. Each axis is read from the joint's motion subspace (its angular part for a

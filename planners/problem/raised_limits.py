@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from toptraj.robots.chain import sliding_joints
 from toptraj.robots.notes import Note
 from toptraj.robots.ranges import LIMITS
 
@@ -22,15 +23,6 @@ if TYPE_CHECKING:
 RAISED_FACTOR = 3.0
 #: The units of a prismatic joint's limits (a revolute joint's: ``LIMITS[kind].unit``).
 PRISMATIC_UNITS = {"velocity": "m/s", "acceleration": "m/s^2", "jerk": "m/s^3", "torque": "N"}
-
-
-def prismatic_joints(robot: Robot) -> np.ndarray:
-    """Whether each joint (n_dof,) slides rather than turns (Pinocchio's joint model names)."""
-    prismatic = np.zeros(robot.dof, dtype=bool)
-    for joint in list(robot.model.joints)[1:]:
-        if joint.nv == 1 and ("JointModelP" in joint.shortname() or "Prismatic" in joint.shortname()):
-            prismatic[joint.idx_v] = True
-    return prismatic
 
 
 def raised_limits(robot: Robot, asked: LimitRequest, kinds: tuple[str, ...]) -> tuple[Note, ...]:
@@ -52,7 +44,8 @@ def raised_limits(robot: Robot, asked: LimitRequest, kinds: tuple[str, ...]) -> 
         joint = int(np.argmax(ratio))
         if not ratio[joint] > RAISED_FACTOR:
             continue
-        unit = PRISMATIC_UNITS[kind] if prismatic_joints(robot)[joint] else LIMITS[kind].unit
+        prismatic = bool(sliding_joints(robot.model)[joint])
+        unit = PRISMATIC_UNITS[kind] if prismatic else LIMITS[kind].unit
         given = None if override is None else float(override[joint])
         field = f"limits.{kind}[{joint}]" if override is not None else f"limits.{kind}_scale"
         notes.append(Note(
@@ -60,6 +53,6 @@ def raised_limits(robot: Robot, asked: LimitRequest, kinds: tuple[str, ...]) -> 
             f"{ratio[joint]:.3g} times its own ({own[joint]:.4g})",
             "limit_far_above_own", field=field, kind=kind, override=given, scale=scale, held=kind in kinds,
             index=joint, joint_name=robot.joint_names[joint], value=float(held[joint]), own=float(own[joint]), ratio=float(ratio[joint]),
-            unit=unit, prismatic=bool(prismatic_joints(robot)[joint]),
+            unit=unit, prismatic=prismatic,
         ))
     return tuple(notes)
