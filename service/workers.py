@@ -26,6 +26,7 @@ from toptraj.planners import Deadline
 from toptraj.planners.errors import BudgetExceeded
 from toptraj.planners.execution.deadline import Leash, LeashSlipped
 from toptraj.robots.errors import ToptrajError
+from toptraj.service.budget_advice import advised
 
 
 class ServiceBusy(ToptrajError):
@@ -91,9 +92,10 @@ class PlanningWorkers:
         self._admitted = 0
         self._waiting: deque[_Waiter] = deque()  # first come, first served
 
-    async def run(self, function, budget_s: float, leashed: bool = False):
+    async def run(self, function, budget_s: float, leashed: bool = False, advice: str = ""):
         """``function(deadline)`` in a worker thread; past ``budget_s`` seconds from now (waiting
-        for a worker included), cancel its deadline and raise ``BudgetExceeded``.
+        for a worker included), cancel its deadline and raise ``BudgetExceeded``, its message
+        ending with ``advice`` (what the caller can do instead, ``toptraj.service.budget_advice``).
 
         With ``leashed``, when no other planning runs or waits (``_alone``), ``function`` is
         first tried on the event loop itself under a ``Leash`` of ``leash_s`` (shorter than the
@@ -108,6 +110,13 @@ class PlanningWorkers:
             ServiceBusy: ``workers`` plannings run and ``queue`` more wait already.
             BudgetExceeded: the budget was spent, waiting or planning.
         """
+        try:
+            return await self._run(function, budget_s, leashed)
+        except BudgetExceeded as error:
+            raise advised(error, advice) from None
+
+    async def _run(self, function, budget_s: float, leashed: bool):
+        """``run`` without the advice."""
         with self._lock:
             if self._admitted >= self.workers + self.queue:
                 raise ServiceBusy(

@@ -35,6 +35,7 @@ import orjson
 from toptraj import robots
 from toptraj.robots.catalog import is_catalog_robot
 from toptraj.service.batches.lines import ForeignOutput, problem_body, read_requests, result_line, resume_output
+from toptraj.service.budget_advice import advised_line, for_batch_line
 
 #: Requests per Ray task.
 CHUNK = 4
@@ -216,7 +217,9 @@ def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, out,
     if not overdue:
         return 0
     runner.cancel(overdue)
-    detail = f"the planning did not end within its budget of {budget_s:g} s and was stopped; run the batch again with --retry-failed, or a larger --budget"
+    detail = (
+        f"the planning did not end within its budget of {budget_s:g} s and was stopped; {for_batch_line(budget_s, MAX_BUDGET_S)}"
+    )
     written = 0
     for handle in overdue:
         del started_at[handle]
@@ -324,6 +327,7 @@ def _plan_lines(
     texts.clear()
     del keys
     window = 2 * runner.cpus + 1
+    advice = for_batch_line(budget_s, MAX_BUDGET_S)
     running: dict[Any, list[tuple[str, str]]] = {}  # in the order submitted
     started_at: dict[Any, float] = {}
     next_chunk, written = 0, 0
@@ -342,6 +346,7 @@ def _plan_lines(
                 if stop.is_set():
                     continue  # cancelled by the stop: resumed later
                 answers = _failed(chunk, error)
+            answers = [(key, status, advised_line(status, body, advice)) for key, status, body in answers]
             written += _write(out, numbers, answers)
         overdue = _kill_overdue(runner, running, started_at, budget_s, out, numbers)
         written += overdue

@@ -27,5 +27,7 @@ def job_runner(settings) -> JobRunner:
         max_response_bytes=settings.max_response_bytes,
         ray_address=settings.ray_address,
         search_memory_bytes=settings.search_memory_bytes,
+        job_budget_s=settings.job_budget_s,
+        job_max_budget_s=settings.job_max_budget_s,
     )
     return JobRunner(store, settings.job_workers, setup)

@@ -30,6 +30,7 @@ from toptraj.planners import Deadline
 from toptraj.planners.errors import BudgetExceeded
 from toptraj.planners.execution.isolated import run_isolated
 from toptraj.robots.errors import ToptrajError
+from toptraj.service.budget_advice import larger_job_budget
 from toptraj.service.jobs import work
 from toptraj.service.jobs.records import ClaimedJob, Job, JobStoreUnavailable, owner_name
 from toptraj.service.jobs.store import JobStore
@@ -312,9 +313,8 @@ class JobRunner:
         except BudgetExceeded:
             if entry.stopped:
                 return None
-            return "failed", None, problem_of(
-                BudgetExceeded(f"the job exceeded its time budget of {job.budget_s:g} s; submit it with a larger budget_s")
-            )
+            advice = larger_job_budget(job.budget_s, self.setup.job_max_budget_s)
+            return "failed", None, problem_of(BudgetExceeded(f"the job exceeded its time budget of {job.budget_s:g} s; {advice}"))
         except Exception as error:
             if entry.stopped:  # its process killed, or its fork server gone: not its failure
                 return None

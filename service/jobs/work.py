@@ -20,6 +20,7 @@ from toptraj import robots
 from toptraj.planners import Deadline
 from toptraj.planners.execution.deadline import Progress
 from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY
+from toptraj.service.budget_advice import advised_line, as_job, job_kind
 from toptraj.service.jobs.answer_room import AnswerRoom, kept_results
 from toptraj.service.planning import compare_request, encode_json, plan_request, render
 from toptraj.service.problems import RequestRefused
@@ -29,7 +30,8 @@ from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryReque
 @dataclass(frozen=True)
 class WorkerSetup:
     """The server's settings a worker process needs: where uploads live (and their caps), the
-    largest answer body served and the memory cap of a search, in bytes."""
+    largest answer body served and the memory cap of a search, in bytes; a job's default and
+    largest budgets, in s (for the advice of a batch line past its budget)."""
 
     data_dir: str
     max_uploads: int
@@ -38,6 +40,8 @@ class WorkerSetup:
     max_response_bytes: int
     ray_address: str | None = None
     search_memory_bytes: int = DEFAULT_SEARCH_MEMORY
+    job_budget_s: float = 300.0
+    job_max_budget_s: float = 3_600.0
 
 
 def _trajectory(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
@@ -65,8 +69,16 @@ def _batch(request: str, deadline: Deadline, setup: WorkerSetup) -> bytes:
     items = orjson.loads(request)["requests"]
     texts = [orjson.dumps(item).decode() for item in items]
     room = AnswerRoom(setup.max_response_bytes, len(texts))
-    answers = _on_ray(texts, setup, deadline, room) if setup.ray_address else _here(texts, deadline, room)
+    answers = _on_ray(texts, setup, deadline, room) if setup.ray_address else _here(texts, deadline, room, setup)
     return kept_results(answers)
+
+
+def _line_advised(status: int, body: bytes, text: str, setup: WorkerSetup) -> bytes:
+    """A line's answer past its budget (504) ending with how to plan it alone, as a job."""
+    if status != 504:
+        return body
+    advice = as_job(job_kind(text), BATCH_REQUEST_BUDGET_S, setup.job_budget_s, setup.job_max_budget_s)
+    return advised_line(status, body, advice.replace("<this request>", "<this line's request>"))
 
 
 def _not_reached(budget_s: float | None) -> tuple[int, bytes]:
@@ -82,7 +94,7 @@ def _line_budget(deadline: Deadline) -> float:
     return BATCH_REQUEST_BUDGET_S if remaining is None else min(BATCH_REQUEST_BUDGET_S, remaining)
 
 
-def _here(texts: list[str], deadline: Deadline, room: AnswerRoom) -> list[tuple[int, bytes]]:
+def _here(texts: list[str], deadline: Deadline, room: AnswerRoom, setup: WorkerSetup) -> list[tuple[int, bytes]]:
     from toptraj.service.batches.work import answer
 
     answers = []
@@ -92,7 +104,8 @@ def _here(texts: list[str], deadline: Deadline, room: AnswerRoom) -> list[tuple[
         if room.full():
             answers.append(room.not_kept(k))
         elif budget > MIN_LINE_BUDGET_S:
-            answers.append(room.keep(k, *answer(text, budget, room.cap_bytes)))
+            status, body = answer(text, budget, room.cap_bytes)
+            answers.append(room.keep(k, status, _line_advised(status, body, text, setup)))
         else:
             answers.append(_not_reached(deadline.budget_s))
     return answers
@@ -117,7 +130,7 @@ def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline, room: Answ
             k = pending.pop(ref)
             try:
                 _, [(_, status, body)] = ray.get(ref)
-                answers[k] = room.keep(k, status, body)
+                answers[k] = room.keep(k, status, _line_advised(status, body, texts[k], setup))
             except Exception as error:  # the task as a whole: its worker died
                 answers[k] = (500, _worker_failed(error))
         done = len(texts) - len(pending)

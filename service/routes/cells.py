@@ -7,6 +7,7 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
+from toptraj.service.budget_advice import for_cell
 from toptraj.service.cell_answers import csv_bytes
 from toptraj.service.cells import plan_cell
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format
@@ -46,10 +47,12 @@ async def create_cell(body: Annotated[CellRequest, Body(openapi_examples=cell_ex
     format_ = chosen_format(body.format, request.headers.get("accept"))
     if format_ == "csv":
         content = await request.app.state.heavy_planning.run(
-            lambda deadline: csv_bytes(plan_cell(body, deadline, "csv")), settings.plan_budget_s
+            lambda deadline: csv_bytes(plan_cell(body, deadline, "csv")),
+            settings.plan_budget_s,
+            advice=for_cell(),
         )
         return Response(content, media_type=CSV_MEDIA_TYPE)
     content = await request.app.state.heavy_planning.run(
-        lambda deadline: encode_json(plan_cell(body, deadline)), settings.plan_budget_s
+        lambda deadline: encode_json(plan_cell(body, deadline)), settings.plan_budget_s, advice=for_cell()
     )
     return Response(content, media_type="application/json")

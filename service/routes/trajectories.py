@@ -7,6 +7,7 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
+from toptraj.service.budget_advice import as_job
 from toptraj.service.planning import compare_request, encode_json, heavy_request, plan_request, render, worth_a_leash
 from toptraj.service.problem_docs import problem_responses
 from toptraj.service.schemas.answers import CompareResponse, TrajectoryResponse
@@ -49,10 +50,13 @@ async def create_trajectory(
     def planned(deadline) -> tuple[bytes, str]:
         return render(plan_request(body, deadline, settings.max_response_bytes, accept, settings.search_memory_bytes), body, accept)
 
+    advice = as_job("trajectory", settings.plan_budget_s, settings.job_budget_s, settings.job_max_budget_s)
     if heavy_request(body):  # admitted apart, so that it never holds up the short requests
-        content, media_type = await request.app.state.heavy_planning.run(planned, settings.plan_budget_s)
+        content, media_type = await request.app.state.heavy_planning.run(planned, settings.plan_budget_s, advice=advice)
     else:
-        content, media_type = await request.app.state.planning.run(planned, settings.plan_budget_s, leashed=worth_a_leash(body))
+        content, media_type = await request.app.state.planning.run(
+            planned, settings.plan_budget_s, leashed=worth_a_leash(body), advice=advice
+        )
     return Response(content, media_type=media_type)
 
 
@@ -64,5 +68,6 @@ async def compare_trajectories(
     each one's duration, peak utilization and solve time: what time-optimality buys."""
     settings = request.app.state.settings
     lane = request.app.state.heavy_planning if heavy_request(body) else request.app.state.planning
-    content = await lane.run(lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s)
+    advice = as_job("compare", settings.plan_budget_s, settings.job_budget_s, settings.job_max_budget_s)
+    content = await lane.run(lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s, advice=advice)
     return Response(content, media_type="application/json")
