@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from toptraj.client.bodies import compare_request, trajectory_request
+from toptraj.client.bodies import compare_request, rows_of, trajectory_request
 from toptraj.client.jobs import JobCalls
 from toptraj.client.resources import Robot, RobotSummary, Skeleton
 from toptraj.client.results import Comparison, CsvTrajectory, Trajectory, comparisons
@@ -144,7 +144,8 @@ class Client(JobCalls):
         """``POST /v1/robots/{name}/skeleton``: the arm as a stick figure in configurations
         ``q`` (rad, m; shape (n_configurations, n_dof), at most 1,000 rows); with ``mounting``
         (``{"position": [x, y, z], "orientation": [qx, qy, qz, qw]}``), its base placed in the world."""
-        rows = np.atleast_2d(np.asarray(q, dtype=float)).tolist()
+        rows = rows_of(q)
+        rows = [rows] if rows and not isinstance(rows[0], list) else rows  # one configuration
         request: dict[str, Any] = {"q": rows} if mounting is None else {"q": rows, "mounting": dict(mounting)}
         body = self._call("POST", f"/v1/robots/{name}/skeleton", request)
         return Skeleton(list(body["points"]), np.asarray(body["positions"], dtype=float).reshape(len(rows), -1, 3))

@@ -16,11 +16,16 @@ def _path(path: dict | None, waypoints: Any) -> dict:
         raise ValueError("give either waypoints (joint configurations, one row each) or path (a request's path object)")
     if path is not None:
         return dict(path)
+    return {"kind": "waypoints", "waypoints": rows_of(waypoints)}
+
+
+def rows_of(values: Any) -> list:
+    """Rows of joint values as JSON lists; rows of different lengths are sent row by row, for
+    the service to name the row."""
     try:
-        rows = np.asarray(waypoints, dtype=float).tolist()
-    except ValueError:  # rows of different lengths: sent row by row, for the service to name the row
-        rows = [np.asarray(row, dtype=float).tolist() for row in waypoints]
-    return {"kind": "waypoints", "waypoints": rows}
+        return np.asarray(values, dtype=float).tolist()
+    except ValueError:
+        return [np.asarray(row, dtype=float).tolist() for row in values]
 
 
 def _timing(timing: dict | None, fields: dict[str, Any]) -> dict:

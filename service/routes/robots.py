@@ -140,9 +140,13 @@ def robot_skeleton(name: str, body: SkeletonRequest) -> SkeletonPublic:
     robot = robots.load(name)
     if body.mounting is not None:
         robot = robots.equip(robot, mounting=body.mounting.mounting())
-    q = np.array(body.q, dtype=float) if len({len(row) for row in body.q}) == 1 else None
-    if q is None or q.shape[1] != robot.dof:
-        raise RequestRefused(f"each row of q must hold {robot.dof} values, one per joint of {name} ({', '.join(robot.joint_names)})")
+    wrong = next((k for k, row in enumerate(body.q) if len(row) != robot.dof), None)
+    if wrong is not None:
+        raise RequestRefused(
+            f"q[{wrong}] holds {len(body.q[wrong])} values; each row of q must hold {robot.dof}, one per joint of {name} "
+            f"({', '.join(robot.joint_names)})"
+        )
+    q = np.array(body.q, dtype=float)
     if not np.all(np.isfinite(q)):
         row, joint = np.argwhere(~np.isfinite(q))[0]
         raise RequestRefused(f"q[{row}][{joint}] is not a finite number")

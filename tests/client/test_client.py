@@ -147,6 +147,11 @@ def test_robots_list_describe_and_draw(toptraj):
     assert not np.allclose(figure.positions[1, -1], figure.positions[0, -1])
     hanging = toptraj.skeleton("ur5", [[0.0] * 6], mounting={"position": [0.0, 0.0, 2.0], "orientation": [1.0, 0.0, 0.0, 0.0]})
     np.testing.assert_allclose(hanging.positions[0], figure.positions[0] * [1.0, -1.0, -1.0] + [0.0, 0.0, 2.0], atol=1e-12)
+    single = toptraj.skeleton("ur5", [0.0] * 6)  # one configuration
+    np.testing.assert_allclose(single.positions, figure.positions[:1], atol=1e-12)
+    with pytest.raises(ProblemError) as caught:  # rows of different lengths: the service names the row
+        toptraj.skeleton("ur5", [[0.0] * 6, [0.0] * 5])
+    assert caught.value.status == 422 and caught.value.detail.startswith("q[1] holds 5 values; each row of q must hold 6")
 
 
 def test_upload_with_its_options_then_delete(toptraj):
