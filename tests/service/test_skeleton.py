@@ -23,5 +23,5 @@ def test_the_planar_arm_is_where_its_geometry_puts_it(client, q):
 
 def test_rows_of_the_wrong_length_are_a_422(client):
     response = client.post("/v1/robots/ur5/skeleton", json={"q": [[0.0] * 6, [0.0] * 5]})
-    assert response.status_code == 422 and "6 values" in response.json()["detail"]
+    assert response.status_code == 422 and response.json()["detail"].startswith("q[1] holds 5 values; each row of q must hold 6, one per joint")
     assert client.post("/v1/robots/nope/skeleton", json={"q": [[0.0]]}).status_code == 404
