@@ -21,11 +21,12 @@ import os
 import sqlite3
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 from toptraj.robots.errors import RobotConflict, UploadStoreFull, UploadStoreUnavailable, excerpt
+from toptraj.robots.sqlite_file import connected
 
 DEFAULT_MAX_UPLOADS = 1_000
 DEFAULT_MAX_BYTES = 200_000_000
@@ -108,34 +109,13 @@ class UploadStore:
             assert connection is not None
             yield connection
 
-    @contextmanager
-    def _connect(self, write: bool) -> Iterator[sqlite3.Connection | None]:
+    def _connect(self, write: bool) -> AbstractContextManager[sqlite3.Connection | None]:
         """A connection in autocommit mode (``None`` when reading a store that does not exist).
 
         Raises:
             UploadStoreUnavailable: SQLite or the file system failed, here or in the block.
         """
-        if not write and not self.path.exists():
-            yield None
-            return
-        try:
-            if write:
-                self.data_dir.mkdir(parents=True, exist_ok=True)
-            connection = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
-            try:
-                if write:
-                    connection.execute("PRAGMA auto_vacuum = INCREMENTAL")  # takes effect on a new database
-                    connection.execute("PRAGMA journal_mode = WAL")
-                    connection.executescript(_SCHEMA)
-                _migrate(connection)
-                yield connection
-            finally:
-                connection.close()
-        except (sqlite3.Error, OSError) as error:
-            raise UploadStoreUnavailable(
-                f"the upload store cannot be used ({type(error).__name__}: {excerpt(str(error), 120)}); "
-                "its data directory (setting data_dir, TOPTRAJ_DATA_DIR) must be a writable directory"
-            ) from error
+        return connected(self.path, _SCHEMA, write, UploadStoreUnavailable, "the upload store", _migrate)
 
     def digest(self, name: str) -> str | None:
         """SHA-256 of the text stored under ``name``, ``None`` when there is none."""

@@ -25,10 +25,10 @@ import sqlite3
 import time
 import uuid
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 
-from toptraj.robots.errors import excerpt
+from toptraj.robots.sqlite_file import connected
 from toptraj.service.jobs.records import ClaimedJob, Job, JobEnded, JobQueueFull, JobStoreUnavailable, owner_is_gone
 
 DATABASE = "jobs.sqlite3"
@@ -88,33 +88,13 @@ class JobStore:
             assert connection is not None
             yield connection
 
-    @contextmanager
-    def _connect(self, write: bool) -> Iterator[sqlite3.Connection | None]:
+    def _connect(self, write: bool) -> AbstractContextManager[sqlite3.Connection | None]:
         """A connection in autocommit mode (``None`` when reading a store that does not exist).
 
         Raises:
             JobStoreUnavailable: SQLite or the file system failed, here or in the block.
         """
-        if not write and not self.path.exists():
-            yield None
-            return
-        try:
-            if write:
-                self.data_dir.mkdir(parents=True, exist_ok=True)
-            connection = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
-            try:
-                if write:
-                    connection.execute("PRAGMA auto_vacuum = INCREMENTAL")  # takes effect on a new database
-                    connection.execute("PRAGMA journal_mode = WAL")
-                    connection.executescript(_SCHEMA)
-                yield connection
-            finally:
-                connection.close()
-        except (sqlite3.Error, OSError) as error:
-            raise JobStoreUnavailable(
-                f"the job store cannot be used ({type(error).__name__}: {excerpt(str(error), 120)}); "
-                "its data directory (setting data_dir, TOPTRAJ_DATA_DIR) must be a writable directory"
-            ) from error
+        return connected(self.path, _SCHEMA, write, JobStoreUnavailable, "the job store")
 
     @contextmanager
     def _transaction(self) -> Iterator[sqlite3.Connection]:
