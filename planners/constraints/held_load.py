@@ -154,3 +154,23 @@ def _ends_beyond(constraints: PathConstraints, stretches: tuple[RestExcess, ...]
         for point in (0, last)
         if ratios[point].max() > 1.0 and not any(item.start <= constraints.s[point] <= item.end for item in stretches)
     )
+
+
+def blocked_even_at_rest(constraints: PathConstraints, blocking_rows, empty: np.ndarray, point: int, where: str) -> InfeasiblePath:
+    """The error of a path whose grid ``empty`` (indices of intervals or points where a timing
+    method finds no admissible state, not even rest) is not empty: ``not_even_at_rest``'s when
+    holding still breaks the torque limits, else the limit rows that block at ``point``
+    (``blocking_rows[point]``: the pair of row indices of ``admissible_set``), ``where`` naming
+    the place in the method's words ("at s = 0.4000")."""
+    stated = not_even_at_rest(constraints, empty)
+    if stated is not None:
+        return stated
+    first, second = blocking_rows[point]
+    what = constraints.describe_row(first)
+    if second != first:
+        what += f" and {constraints.describe_row(second)}"
+    kind, joint = constraints.rows[first % len(constraints.rows)]
+    return InfeasiblePath(
+        f"no motion along the path can meet the {what} {where}, not even at rest",
+        s=float(constraints.s[point]), joint=constraints.joint_names[joint], limit=kind,
+    )

@@ -16,7 +16,7 @@ import logging
 import numpy as np
 
 from toptraj.planners.constraints.admissible import acceleration_bounds, admissible_set, friction_reference
-from toptraj.planners.constraints.held_load import holding_facts, not_even_at_rest, static_load
+from toptraj.planners.constraints.held_load import blocked_even_at_rest, holding_facts, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -150,20 +150,8 @@ def _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end) -> Excepti
     empty = np.flatnonzero(admissible.x_max < admissible.x_min)
     if empty.size:
         point = int(empty[0])
-        stated = not_even_at_rest(constraints, empty)
-        if stated is not None:
-            return stated
-        first, second = admissible.blocking_rows[point]
-        what = constraints.describe_row(first)
-        if second != first:
-            what += f" and {constraints.describe_row(second)}"
-        return InfeasiblePath(
-            f"no motion along the path can meet the {what} at s = {constraints.s[point]:.4f} "
-            f"(grid point {point} of {len(constraints.s) - 1}), not even at rest",
-            s=float(constraints.s[point]),
-            joint=constraints.joint_names[constraints.rows[first % len(constraints.rows)][1]],
-            limit=constraints.rows[first % len(constraints.rows)][0],
-        )
+        where = f"at s = {constraints.s[point]:.4f} (grid point {point} of {len(constraints.s) - 1})"
+        return blocked_even_at_rest(constraints, admissible.blocking_rows, empty, point, where)
     if sd_start**2 > admissible.x_max[0] or sd_end**2 > admissible.x_max[-1]:
         return InfeasiblePath(
             f"the boundary path speeds ({sd_start}, {sd_end}) 1/s exceed the maximum velocity curve "

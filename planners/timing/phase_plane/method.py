@@ -47,7 +47,7 @@ import numpy as np
 
 from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, zero_inertia_intervals
-from toptraj.planners.constraints.held_load import holding_facts, not_even_at_rest, static_load
+from toptraj.planners.constraints.held_load import blocked_even_at_rest, holding_facts, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
@@ -311,20 +311,8 @@ def _stuck(constraints: PathConstraints, admissible, stage: LinearRows, i: int) 
     """No admissible state at interval ``i`` lets the motion reach the end: say where and why."""
     s = constraints.s
     if admissible.x_max[i] < admissible.x_min[i]:
-        stated = not_even_at_rest(constraints, np.flatnonzero(admissible.x_max < admissible.x_min))
-        if stated is not None:
-            return stated
-        first, second = admissible.blocking_rows[i]
-        what = constraints.describe_row(first)
-        if second != first:
-            what += f" and {constraints.describe_row(second)}"
-        return InfeasiblePath(
-            f"no motion along the path can meet the {what} between s = {s[i]:.4f} and "
-            f"s = {s[i + 1]:.4f}, not even at rest",
-            s=float(s[i]),
-            joint=constraints.joint_names[constraints.rows[first % len(constraints.rows)][1]],
-            limit=constraints.rows[first % len(constraints.rows)][0],
-        )
+        empty = np.flatnonzero(admissible.x_max < admissible.x_min)
+        return blocked_even_at_rest(constraints, admissible.blocking_rows, empty, i, f"between s = {s[i]:.4f} and s = {s[i + 1]:.4f}")
     held, joint, limit = static_load(constraints, i + 1)
     return InfeasiblePath(
         f"no motion can follow the path from s = {s[i]:.4f} to its end: the limits cannot bring "
