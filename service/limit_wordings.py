@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from toptraj.robots.ranges import LIMITS
+
 
 def _duration_too_short(facts: dict) -> str:
     return (
@@ -56,7 +58,55 @@ def _not_even_at_rest(facts: dict) -> str:
     )
 
 
+def _either(words) -> str:
+    """"a", "a or b", "a, b or c"."""
+    words = list(words)
+    return " or ".join(words) if len(words) < 3 else f"{', '.join(words[:-1])} or {words[-1]}"
+
+
+def _bounding_remedies(facts: dict, example_kind: str) -> str:
+    """How to bound a motion that nothing bounds: the kinds the robot has finite limits of, to
+    add to the constraints held; limits of the kinds held, given in the request (a trajectory)
+    or in an upload of the robot (a cell, whose arms take scales only)."""
+    cell = str(facts["field"]).startswith("arms[")
+    constraints = "constraints" if cell else "timing.constraints"
+    extra = [kind for kind in facts["available"] if kind not in facts["kinds"]]
+    remedies = []
+    if extra:
+        remedies.append(f"add {_either(repr(kind) for kind in extra)} to {constraints} ({facts['robot']} has finite limits of {'those kinds' if len(extra) > 1 else 'that kind'})")
+    unit = LIMITS[example_kind].unit if example_kind in LIMITS else ""
+    if cell and not extra:  # a cell's arms take scales only
+        remedies.append("upload the robot with its limits (POST /v1/robots with joint_limits) and plan the cell with it")
+    elif not cell:
+        remedies.append(f'give the limits in timing.limits, e.g. "{example_kind}": one value per joint in {unit}')
+    return "; or ".join(remedies)
+
+
+def _no_limit_bounds_speed(facts: dict) -> str:
+    kinds = facts["kinds"]
+    where = f"{facts['field']}: " if str(facts["field"]).startswith("arms[") else ""
+    first = next((kind for kind in kinds if kind != "torque"), "velocity")
+    return (
+        f"{where}nothing bounds the motion of {facts['robot']}: it has no finite {_either(kinds) or 'requested'} limit, "
+        f"so the shortest time would be zero; {_bounding_remedies(facts, first)}"
+    )
+
+
+def _segment_unbounded(facts: dict) -> str:
+    kinds = facts["kinds"]
+    where = f"{facts['field']}: " if str(facts["field"]).startswith("arms[") else ""
+    first = next((kind for kind in kinds if kind != "torque"), "velocity")
+    joints = facts["joints"]
+    return (
+        f"{where}from waypoint {facts['segment']} to {facts['segment'] + 1} only {', '.join(repr(j) for j in joints)} "
+        f"{'moves' if len(joints) == 1 else 'move'}, and {'it has' if len(joints) == 1 else 'they have'} no finite "
+        f"{_either(kinds)} limit: nothing bounds the speed there; {_bounding_remedies(facts, first)}"
+    )
+
+
 LIMIT_WORDING: dict[str, str | Callable[[dict], str]] = {
     "duration_too_short": _duration_too_short,
+    "no_limit_bounds_speed": _no_limit_bounds_speed,
+    "segment_unbounded": _segment_unbounded,
     "not_even_at_rest": _not_even_at_rest,
 }

@@ -156,7 +156,9 @@ def _ends_beyond(constraints: PathConstraints, stretches: tuple[RestExcess, ...]
     )
 
 
-def blocked_even_at_rest(constraints: PathConstraints, blocking_rows, empty: np.ndarray, point: int, where: str) -> InfeasiblePath:
+def blocked_even_at_rest(
+    constraints: PathConstraints, blocking_rows: np.ndarray, empty: np.ndarray, point: int, where: str
+) -> InfeasiblePath:
     """The error of a path whose grid ``empty`` (indices of intervals or points where a timing
     method finds no admissible state, not even rest) is not empty: ``not_even_at_rest``'s when
     holding still breaks the torque limits, else the limit rows that block at ``point``

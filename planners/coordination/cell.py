@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike
 from toptraj.planners.collision.distance import segment_distance
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.paths.base import GeometricPath
+from toptraj.planners.problem.bounded import check_speed_bounded
 from toptraj.robots import JointLimits, Robot
 from toptraj.robots.collision import robot_capsules, world_capsules
 from toptraj.robots.equipment import ROTATION_TOLERANCE
@@ -99,6 +100,16 @@ class Cell:
     arms: tuple[CellArm, ...]
     clearance: float
     kinds: tuple[str, ...] = ("velocity", "acceleration")
+
+    def __post_init__(self) -> None:
+        """Every arm's motion is bounded by the limits of ``kinds`` it has
+        (``toptraj.planners.problem.bounded``: an arm with none would be timed at zero).
+
+        Raises:
+            InvalidRequest: field ``arms[i]``, rules "no_limit_bounds_speed" or "segment_unbounded".
+        """
+        for index, arm in enumerate(self.arms):
+            check_speed_bounded(arm.robot, arm.limits, self.kinds, getattr(arm.path, "waypoints", None), field=f"arms[{index}]")
 
 
 def pair_distances(first: tuple[np.ndarray, np.ndarray, np.ndarray], second: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -27,6 +27,7 @@ from toptraj.planners.constraints.tool_speed import tool_speed_limit
 from toptraj.planners.errors import Conflicting, NotServed, OutOfRange
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.grid import MAX_POINTS
+from toptraj.planners.problem.bounded import check_speed_bounded
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import MotionGenerator
 from toptraj.planners.problem.problem import AT_REST, BoundaryStates, LimitRequest, MotionSpec, Problem, Sampling
@@ -91,6 +92,7 @@ def build_problem(
         motion, turns = continuous_turns(robot, motion)
         motion, dropped = without_repeats(motion)
         notes = (*notes, *turns, *dropped)
+    check_speed_bounded(robot, held, kinds, motion.waypoints if isinstance(motion, WaypointPath) else None)
     problem = Problem(
         robot=robot, motion=motion, method=method, requested=limits, grid=grid, boundary=boundary, duration=duration,
         kinds=kinds, limits=held, margin=margin, threshold=gate_threshold(margin), sampling=sampling,
