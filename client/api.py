@@ -41,6 +41,21 @@ def _text(value: str | os.PathLike[str]) -> str:
     return Path(value).read_text() if isinstance(value, os.PathLike) else value
 
 
+def _json_body(value: dict | str | os.PathLike[str]) -> dict:
+    """A request body from a dict, JSON text, or the path of a file holding it (a string that
+    is not JSON text is taken for a path).
+
+    Raises:
+        ValueError: the text, or the file's, is not JSON (``json.JSONDecodeError``).
+        OSError: a path that cannot be read.
+    """
+    if isinstance(value, dict):
+        return value
+    if isinstance(value, str) and not value.lstrip().startswith(("{", "[")):
+        value = Path(value)
+    return json.loads(_text(value).removeprefix("\ufeff"))
+
+
 def _alone(body: dict, **arguments: Any) -> None:
     """Refuse the arguments that would be lost beside a whole request ``body``."""
     given = [name for name, value in arguments.items() if value is not None]
@@ -255,5 +270,4 @@ class Client(JobCalls):
             ``min_distance``, the coordination ``diagram`` of arms 0 and 1 and ``diagrams``
             of every pair.
         """
-        request = body if isinstance(body, dict) else json.loads(_text(body))
-        return self._call("POST", "/v1/cells", request, timeout=timeout)
+        return self._call("POST", "/v1/cells", _json_body(body), timeout=timeout)

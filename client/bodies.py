@@ -11,6 +11,27 @@ import numpy as np
 OUTPUT_FORMATS = ("samples", "joint_trajectory", "csv")
 
 
+def plain(value: Any, where: str = "the body") -> Any:
+    """``value`` with numpy arrays and scalars (and tuples) as JSON's lists and numbers, so that
+    a request may hold what the client's own results give (``Robot.limits.velocity * 0.5``).
+
+    Raises:
+        ValueError: a NaN or infinite number, named by its place (``limits.velocity[2]``):
+            JSON has neither.
+    """
+    if isinstance(value, dict):
+        return {key: plain(item, f"{key}" if where == "the body" else f"{where}.{key}") for key, item in value.items()}
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    elif isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, (list, tuple)):
+        return [plain(item, f"{where}[{k}]") for k, item in enumerate(value)]
+    if isinstance(value, float) and not np.isfinite(value):
+        raise ValueError(f"{where} is {value}: JSON has no NaN or infinity; give a finite number")
+    return value
+
+
 def _path(path: dict | None, waypoints: Any) -> dict:
     if (path is None) == (waypoints is None):
         raise ValueError("give either waypoints (joint configurations, one row each) or path (a request's path object)")

@@ -7,6 +7,7 @@ from typing import Any, Self
 
 import httpx
 
+from toptraj.client.bodies import plain
 from toptraj.client.errors import ProblemError
 from toptraj.client.results import CsvTrajectory
 
@@ -55,11 +56,15 @@ class Transport:
         timeout: float | None = None,
     ) -> httpx.Response:
         """One request as it is, for what the typed methods do not cover: the response, raw.
+        ``json`` may hold numpy arrays and scalars (sent as lists and numbers).
 
         Raises:
             ProblemError: The service answered with a status of 400 or more.
+            ValueError: ``json`` holds a NaN or infinite number (JSON has neither).
         """
         extra: dict[str, Any] = {} if timeout is None else {"timeout": timeout}
+        if json is not None:
+            json = plain(json)
         response = self._http.request(method, path, json=json, headers=headers, params=params, **extra)
         if response.status_code >= 400:
             raise ProblemError.from_response(response)

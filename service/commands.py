@@ -38,8 +38,8 @@ def _problem(title: str, status: int, detail: str) -> dict:
 def _read(source: str) -> str:
     try:
         if source == "-":
-            return sys.stdin.read()
-        with open(source, encoding="utf-8") as handle:
+            return sys.stdin.read().removeprefix("\ufeff")
+        with open(source, encoding="utf-8-sig") as handle:  # a byte order mark is ignored, as over HTTP
             return handle.read()
     except (OSError, UnicodeDecodeError) as error:
         raise _Unreadable(f"cannot read the request {source!r}: {error}") from None

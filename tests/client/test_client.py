@@ -177,6 +177,19 @@ def test_upload_with_its_options_then_delete(toptraj):
     assert caught.value.status == 409 and caught.value.title
 
 
+def test_numpy_values_anywhere_in_a_request_are_sent_as_numbers(toptraj, server):
+    half = toptraj.robot("ur5").limits.velocity * 0.5  # an ndarray, as the client gives it
+    planned = toptraj.plan("ur5", np.array(UR5_WAYPOINTS), limits={"velocity": half}, dt=np.float32(0.01),
+                           constraints=list(np.array(["velocity"])))
+    served = _served(server, "/v1/trajectories", {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS},
+                     "timing": {"constraints": ["velocity"], "limits": {"velocity": half.tolist()}}, "output": {"dt": 0.01}})
+    assert planned.duration == served["duration"]
+    with pytest.raises(ValueError, match=r"^path\.waypoints\[1\]\[5\] is nan: JSON has no NaN or infinity"):
+        toptraj.plan("ur5", [UR5_WAYPOINTS[0], [*UR5_WAYPOINTS[1][:5], float("nan")]])
+    with pytest.raises(ValueError, match=r"^timing\.limits\.velocity\[0\] is inf"):
+        toptraj.plan("ur5", UR5_WAYPOINTS, limits={"velocity": np.full(6, np.inf)})
+
+
 def test_problems_are_raised_with_their_facts(toptraj):
     with pytest.raises(ProblemError) as caught:
         toptraj.plan("ur5", OUTSIDE)
@@ -321,4 +334,7 @@ def test_csv_comments_and_columns_are_read():
 def test_a_cell_through_the_client(toptraj):
     answer = toptraj.cell(ROOT / "examples" / "cell_two_ur5.json", timeout=120.0)
     assert max(answer["solo_durations"]) < answer["duration"] <= answer["sequential_duration"]
+    # A file's path as a string, and its text, are the same request.
+    assert toptraj.cell(str(ROOT / "examples" / "cell_two_ur5.json"), timeout=120.0)["duration"] == answer["duration"]
+    assert toptraj.cell((ROOT / "examples" / "cell_two_ur5.json").read_text(), timeout=120.0)["duration"] == answer["duration"]
     assert [arm["robot"] for arm in answer["arms"]] == ["ur5", "ur5"]

@@ -60,6 +60,17 @@ def test_plan_reads_stdin(monkeypatch, capsys):
     assert json.loads(capsys.readouterr().out)["robot"] == "ur5"
 
 
+def test_a_byte_order_mark_is_ignored_as_over_http(tmp_path, monkeypatch, capsys):
+    """Editors on Windows save UTF-8 with a byte order mark; the service ignores it, so does the CLI."""
+    body = json.dumps({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}})
+    request = tmp_path / "bom.json"
+    request.write_bytes(b"\xef\xbb\xbf" + body.encode())
+    assert main(["plan", str(request)]) == 0
+    monkeypatch.setattr("sys.stdin", io.StringIO("\ufeff" + body))
+    assert main(["plan", "-"]) == 0
+    assert [json.loads(line)["robot"] for line in capsys.readouterr().out.splitlines() if line.startswith("{")] == ["ur5", "ur5"]
+
+
 @pytest.mark.parametrize("command", ["plan", "compare"])
 def test_the_compare_example_runs(command, capsys):
     assert main([command, str(ROOT / "examples" / "compare_methods.json")]) == 0
