@@ -101,11 +101,13 @@ DEFAULT_METHODS = ("phase_plane", "toppra", "quintic")
 FREE_METHODS = ("collocation", "search")
 
 
-def compare_body(text: str, methods: list[str] | None = None) -> str:
+def compare_body(text: str, methods: list[str] | None = None, left_out: list[str] | None = None) -> str:
     """The compare body (JSON) of ``text``: a compare body, its ``methods`` replaced by
     ``methods`` when given; or a trajectory body's robot, path and timing (its ``output`` left
-    out) under ``methods``, by default its own method then ``DEFAULT_METHODS`` (``FREE_METHODS``
-    on a free path); its ``timing.method`` is taken out, the methods saying what runs."""
+    out) under ``methods``, by default its own method then those of ``DEFAULT_METHODS``
+    (``FREE_METHODS`` on a free path) that serve its timing as it is (a jerk limit, a cost: each
+    one left out is added to ``left_out`` with why); its ``timing.method`` is taken out, the
+    methods saying what runs."""
     body = _json(text)
     if not isinstance(body, dict):
         return text  # refused by the schema, which says what it expects
@@ -119,7 +121,34 @@ def compare_body(text: str, methods: list[str] | None = None) -> str:
     shared = {key: value for key, value in body.items() if key != "output"}
     if isinstance(timing, dict):
         shared["timing"] = {key: value for key, value in timing.items() if key != "method"}
+    if methods is None and isinstance(own, str):
+        chosen = [name for name in chosen if name == own or _serves(shared, name, left_out)]
     return json.dumps({**shared, "methods": chosen})
+
+
+def _serves(body: dict, method: str, left_out: list[str] | None) -> bool:
+    """Whether ``method`` serves the trajectory ``body``'s timing as it is (a problem of it can
+    be built; anything but a setting the method does not serve counts as served, for the
+    comparison to report); when not, why, added to ``left_out``."""
+    from toptraj.planners.errors import NotServed
+    from toptraj.planners.execution.deadline import NO_DEADLINE
+    from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY, MAX_SAMPLES
+    from toptraj.service.equipping import equipped_robot
+    from toptraj.service.mapping import problem_of
+    from toptraj.service.problems import request_field
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
+
+    try:
+        request = TrajectoryRequest.model_validate({**body, "timing": {**body.get("timing", {}), "method": method}})
+        problem_of(request, equipped_robot(request), NO_DEADLINE, MAX_SAMPLES, False, DEFAULT_SEARCH_MEMORY)
+    except NotServed as error:
+        if left_out is not None:
+            value = f" {error.value!r}" if isinstance(error.value, str) else ""
+            left_out.append(f"{method} (it does not serve {request_field(error.field)}{value})")
+        return False
+    except Exception:  # noqa: BLE001 - any other failure is the comparison's to report
+        return True
+    return True
 
 
 def _run(source: str, answer: Callable[[str], bytes], out=None) -> int:
@@ -227,7 +256,15 @@ def compare(source: str, methods: list[str] | None = None, as_json: bool | None 
     when ``as_json``."""
     as_table = sys.stdout.isatty() if as_json is None else not as_json
     why = "toptraj compare times one arm's path under several methods"
-    return _run(source, lambda text: _compare(compare_body(_no_cell(text, why), methods), as_table))
+    left_out: list[str] = []
+
+    def answer(text: str) -> bytes:
+        body = compare_body(_no_cell(text, why), methods, left_out)
+        if left_out:
+            print(f"toptraj compare: left out {'; '.join(left_out)}; --methods names the methods to run", file=sys.stderr)
+        return _compare(body, as_table)
+
+    return _run(source, answer)
 
 
 def plot(source: str, output: str, methods: list[str] | None = None) -> int:

@@ -258,3 +258,20 @@ def test_help_is_plain_text(command, capsys):
     assert text.startswith("usage: toptraj")
     assert "`" not in text and ":class:" not in text and ":func:" not in text
     assert re.search(r"\b(service|planners|robots|client)\.[a-z_]", text) is None, text
+
+
+def test_compare_of_a_body_leaves_out_the_default_methods_that_do_not_serve_its_timing(capsys):
+    """A jerk-limited body is compared with the defaults that hold a jerk limit, a weighted one
+    alone: each method left out is named with the setting it does not serve, instead of rows
+    that all fail."""
+    assert main(["compare", str(ROOT / "examples" / "ur5_jerk_limited.json"), "--json"]) == 0
+    captured = capsys.readouterr()
+    results = json.loads(captured.out)["results"]
+    assert [row["method"] for row in results] == ["jerk_limited", "quintic"] and all("error" not in row for row in results)
+    assert captured.err == (
+        "toptraj compare: left out phase_plane (it does not serve timing.constraints 'jerk'); toppra (it does not serve "
+        "timing.constraints 'jerk'); --methods names the methods to run\n"
+    )
+    assert main(["compare", str(ROOT / "examples" / "ur5_jerk_limited.json"), "--json", "--methods", "phase_plane"]) == 0
+    named = capsys.readouterr()
+    assert "error" in json.loads(named.out)["results"][0] and named.err == ""  # what is named runs, and says why it fails
