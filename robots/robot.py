@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from toptraj.robots.chain import Chain, chain_of
+from toptraj.robots.chain import Chain, chain_of, sliding_joints
 from toptraj.robots.chain_dynamics import chain_rnea
 from toptraj.robots.limits import JointLimits
 
@@ -165,6 +165,12 @@ class Robot:
         data = self.model.createData()
         pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
         return float(np.linalg.norm(data.oMf[self.frame_id(self.end_effector)].translation - data.oMi[1].translation))
+
+    @cached_property
+    def force_units(self) -> tuple[str, ...]:
+        """The unit of each joint's torque (n_dof,): "N m", or "N" for a prismatic joint
+        (computed once)."""
+        return tuple("N" if sliding else "N m" for sliding in sliding_joints(self.model))
 
     @cached_property
     def has_friction(self) -> bool:

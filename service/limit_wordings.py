@@ -30,7 +30,7 @@ def torque_remedy(facts: dict) -> str:
     before = f" (before timing.limits.torque_scale {asked:g})" if asked != 1.0 else ""
     needed = facts.get("torque_limits", ())
     if needed:
-        remedies.append("timing.limits.torque of " + " and ".join(f"{value:g} N m on joint {joint!r}" for joint, value in needed) + before)
+        remedies.append("timing.limits.torque of " + " and ".join(f"{value:g} {unit} on joint {joint!r}" for joint, value, unit in needed) + before)
     if not remedies:
         return ""
     return (
@@ -42,14 +42,14 @@ def torque_remedy(facts: dict) -> str:
 def _not_even_at_rest(facts: dict) -> str:
     stretches = facts["stretches"]
     shown = "; ".join(
-        f"s = {item.start:.4f} to {item.end:.4f}, where holding still needs {item.worst.torque:.4g} N m on joint "
-        f"{item.worst.joint!r} (at s = {item.worst.s:.4f}) against its limit of {item.worst.limit:.4g} N m"
+        f"s = {item.start:.4f} to {item.end:.4f}, where holding still needs {item.worst.torque:.4g} {item.worst.unit} on joint "
+        f"{item.worst.joint!r} (at s = {item.worst.s:.4f}) against its limit of {item.worst.limit:.4g} {item.worst.unit}"
         for item in stretches[:3]
     )
     more = f"; and {len(stretches) - 3} more" if len(stretches) > 3 else ""
     also = "".join(
-        f"; holding still at s = {load.s:g} needs {load.torque:.4g} N m on joint {load.joint!r} against its limit of "
-        f"{load.limit:.4g} N m too" for load in facts.get("ends", ())
+        f"; holding still at s = {load.s:g} needs {load.torque:.4g} {load.unit} on joint {load.joint!r} against its limit of "
+        f"{load.limit:.4g} {load.unit} too" for load in facts.get("ends", ())
     )
     remedy = torque_remedy(facts) or "; raise the torque limits (timing.limits.torque) or lighten the load"
     return (

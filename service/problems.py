@@ -171,8 +171,8 @@ def detail(error: ToptrajError) -> str:
     held = getattr(error, "held", None)
     if held is not None:
         text += (
-            f": holding still at s = {held.s:.4f} needs {held.torque:.4g} N m on joint {held.joint!r}, "
-            f"above its limit of {held.limit:.4g} N m"
+            f": holding still at s = {held.s:.4f} needs {held.torque:.4g} {held.unit} on joint {held.joint!r}, "
+            f"above its limit of {held.limit:.4g} {held.unit}"
         )
     if rule != "not_even_at_rest":  # that rule's wording gives the remedy itself
         text += torque_remedy(vars(error))

@@ -12,13 +12,14 @@ from toptraj.planners.errors import InfeasiblePath
 
 
 class HeldLoad(NamedTuple):
-    """At path parameter ``s``, holding still needs ``torque`` (N m, N for a prismatic joint)
-    on ``joint``, above its ``limit``."""
+    """At path parameter ``s``, holding still needs ``torque`` (in ``unit``: N m, N for a
+    prismatic joint) on ``joint``, above its ``limit``."""
 
     s: float
     torque: float
     joint: str
     limit: float
+    unit: str = "N m"
 
 
 def static_load(constraints: PathConstraints, point: int) -> tuple[HeldLoad | None, str | None, str | None]:
@@ -33,7 +34,10 @@ def static_load(constraints: PathConstraints, point: int) -> tuple[HeldLoad | No
     joint = constraints.joint_names[constraints.rows[worst][1]]
     if load.max() <= 1.0:
         return None, joint, "torque"
-    held = HeldLoad(float(constraints.s[point]), float(abs(constraints.c[point, worst])), joint, float(constraints.upper[point, worst]))
+    held = HeldLoad(
+        float(constraints.s[point]), float(abs(constraints.c[point, worst])), joint, float(constraints.upper[point, worst]),
+        constraints.force_unit(constraints.rows[worst][1]),
+    )
     return held, joint, "torque"
 
 
@@ -97,7 +101,7 @@ def _load(constraints: PathConstraints, ratios: np.ndarray, joints: list[int], f
     row = constraints.rows.index(("torque", joints[k]))
     torque = max(abs(constraints.c[point, row]), abs(constraints.c_left[point, row]))
     limit = constraints.upper[point, row] if constraints.c[point, row] >= 0.0 else -constraints.lower[point, row]
-    return HeldLoad(float(constraints.s[point]), float(torque), constraints.joint_names[joints[k]], float(limit))
+    return HeldLoad(float(constraints.s[point]), float(torque), constraints.joint_names[joints[k]], float(limit), constraints.force_unit(joints[k]))
 
 
 def holding_facts(constraints: PathConstraints) -> dict:
@@ -128,14 +132,14 @@ def not_even_at_rest(constraints: PathConstraints, intervals: np.ndarray) -> Inf
     ends = _ends_beyond(constraints, stretches)
     first = stretches[0]
     shown = "; ".join(
-        f"s = {item.start:.4f} to {item.end:.4f}, where holding still needs {item.worst.torque:.4g} N m on joint "
-        f"{item.worst.joint!r} (at s = {item.worst.s:.4f}) against its limit of {item.worst.limit:.4g} N m"
+        f"s = {item.start:.4f} to {item.end:.4f}, where holding still needs {item.worst.torque:.4g} {item.worst.unit} on joint "
+        f"{item.worst.joint!r} (at s = {item.worst.s:.4f}) against its limit of {item.worst.limit:.4g} {item.worst.unit}"
         for item in stretches[:NAMED_STRETCHES]
     )
     more = f"; and {len(stretches) - NAMED_STRETCHES} more" if len(stretches) > NAMED_STRETCHES else ""
     also = "".join(
-        f"; holding still at s = {load.s:g} needs {load.torque:.4g} N m on joint {load.joint!r} against its limit of "
-        f"{load.limit:.4g} N m too" for load in ends
+        f"; holding still at s = {load.s:g} needs {load.torque:.4g} {load.unit} on joint {load.joint!r} against its limit of "
+        f"{load.limit:.4g} {load.unit} too" for load in ends
     )
     return InfeasiblePath(
         f"no motion along the path can meet the torque limits, not even at rest, on {len(stretches)} stretch(es): {shown}{more}{also}",

@@ -70,6 +70,8 @@ class PathConstraints:
             not smooth across them even where they are continuous); ``None`` when unknown.
         q: The path's points at the grid, (N + 1, n_dof); ``None`` when unknown.
         evaluate: Builds the same constraints at other values of s (for methods that refine).
+        force_units: The unit of each joint's torque, "N m" or "N" (a prismatic joint), for
+            messages; empty when unknown ("N m").
     """
 
     s: np.ndarray
@@ -93,6 +95,11 @@ class PathConstraints:
     knots: np.ndarray | None = None
     q: np.ndarray | None = None
     evaluate: Callable[..., PathConstraints] | None = field(default=None, repr=False, compare=False)
+    force_units: tuple[str, ...] = ()
+
+    def force_unit(self, joint: int) -> str:
+        """The unit of joint ``joint``'s torque: "N m", or "N" for a prismatic joint."""
+        return self.force_units[joint] if joint < len(self.force_units) else "N m"
 
     @property
     def can_refine(self) -> bool:
@@ -368,4 +375,5 @@ def build_path_constraints(
         knots=np.asarray(path.knots, dtype=float),
         q=points.q,
         evaluate=lambda extra_s: build_path_constraints(path, robot, limits, kinds, extra_s, deadline),
+        force_units=robot.force_units,
     )

@@ -38,7 +38,7 @@ from toptraj.planners.coordination.diagram import (
     measure,
     widest_coordination,
 )
-from toptraj.planners.coordination.limits import within_limits
+from toptraj.planners.coordination.limits import cannot_hold_still, within_limits
 from toptraj.planners.coordination.prioritized import pair_diagrams, prioritized
 from toptraj.planners.coordination.timing import CurveMotion, Schedule, SoloMotion, pair_timing, solo_timing
 from toptraj.planners.coordination.verify import PairClearance, schedule_clearance
@@ -170,6 +170,10 @@ def _arms_alone(cell: Cell, deadline: Deadline) -> list[TimeScaling]:
             s = float(getattr(error, "s", 0.0))
             raise SelfCollision(f"{where}: {error.detail}", s, error.link_a, error.link_b, error.distance) from error
         except InfeasiblePath as error:
+            held = getattr(error, "held", None)  # a load that no timing holds: what holds it instead
+            if held is not None:
+                joint = arm.robot.joint_names.index(held.joint)
+                raise cannot_hold_still(index, arm, held.s, held.torque, joint) from error
             facts = {key: getattr(error, key, None) for key in ("s", "joint", "limit")}
             raise InfeasiblePath(f"{where} cannot follow its own path alone: {error.detail}", **facts) from error
     return solo

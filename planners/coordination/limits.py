@@ -46,6 +46,25 @@ class ArmLoad:
     quadratic: np.ndarray
 
 
+def cannot_hold_still(index: int, arm: CellArm, s: float, torque: float, joint: int) -> InfeasiblePath:
+    """The error of arm ``index``, whose path at ``s`` needs ``torque`` (N m, N on a prismatic
+    joint) at rest on joint index ``joint``, above its torque limit: what holds it instead (a
+    torque scale up to 1, a lighter payload, waypoints elsewhere)."""
+    name, unit, limit = arm.robot.joint_names[joint], arm.robot.force_units[joint], float(arm.limits.torque[joint])
+    remedies = []
+    if limit < arm.robot.limits.torque[joint]:
+        remedies.append(f"raise arms[{index}].torque_scale (at most 1)")
+    if arm.robot.payload is not None:
+        remedies.append(f"lighten arms[{index}].payload")
+    remedies.append("move the path's waypoints there to where the arm holds itself with less torque")
+    return InfeasiblePath(
+        f"arms[{index}] ({arm.robot.name}): holding its path still at s = {s:.4f} needs {torque:.4g} {unit} on joint "
+        f"{name!r}, above its torque limit of {limit:.4g} {unit} (gravity{' and payload' if arm.robot.payload is not None else ''}): "
+        f"no timing holds it; {', or '.join(remedies)}",
+        s=s, joint=name, limit="torque",
+    )
+
+
 def arm_load(arm: CellArm, s: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> ArmLoad:
     """The arm's samples (each (n, n_dof)) split as ``ArmLoad`` (module docstring)."""
     robot = arm.robot
@@ -97,15 +116,7 @@ def _static_failure(cell: Cell, loads: list[ArmLoad]) -> InfeasiblePath | None:
         u = np.abs(load.static) / arm.limits.torque
         if u.max() > 1.0:
             k, j = np.unravel_index(int(np.argmax(u)), u.shape)
-            joint = arm.robot.joint_names[j]
-            return InfeasiblePath(
-                f"arms[{index}] ({arm.robot.name}): holding its path still at s = {load.s[k]:.4f} needs "
-                f"{abs(load.static[k, j]):.4g} N m on joint {joint!r}, above its torque limit of {arm.limits.torque[j]:.4g} N m "
-                "(gravity and payload): no timing holds it; lighten the payload, change the path there or raise the limit",
-                s=float(load.s[k]),
-                joint=joint,
-                limit="torque",
-            )
+            return cannot_hold_still(index, arm, float(load.s[k]), abs(float(load.static[k, j])), int(j))
     return None
 
 

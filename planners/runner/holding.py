@@ -31,8 +31,8 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
     limits, as ``problem`` asks for them, that hold the path still everywhere: facts
     ``asked_scale`` (the torque scale asked, 1 without one), ``torque_scale`` (it times the
     largest ratio, rounded up; ``None`` outside the accepted ranges) and ``torque_limits``
-    ((joint, N m) for each joint beyond its limit: its limit as asked, before the scale, times
-    its ratio, rounded up, where that lies in the accepted range)."""
+    ((joint, value, unit: N m or N) for each joint beyond its limit: its limit as asked, before
+    the scale, times its ratio, rounded up, where that lies in the accepted range)."""
     facts = {key: value for key, value in vars(error).items() if key != "detail"}
     asked = problem.requested
     scale = asked.scales.get("torque") or 1.0
@@ -44,7 +44,7 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
             continue
         value = rounded_up(float(limits[names.index(load.joint)]) * ratio * (1.0 + ROOM), ADVISED_DIGITS)
         if np.isfinite(value) and TORQUE.low <= value * scale <= TORQUE.high and value <= TORQUE.high:
-            needed.append((load.joint, value))
+            needed.append((load.joint, value, load.unit))
     advised = rounded_up(scale * facts["ratio"] * (1.0 + ROOM), ADVISED_DIGITS) if np.isfinite(facts["ratio"]) else None
     finite = limits[np.isfinite(limits)]
     if not (advised is not None and SCALE.low <= advised <= SCALE.high and (finite * advised <= TORQUE.high).all()):

@@ -1,0 +1,50 @@
+"""A prismatic joint's effort is a force: the errors about holding a path still speak of it in N,
+as its limit is given, and a revolute joint's in N m (a lift carrying 22 kg needs 22 x 9.81 =
+215.8 N against its URDF effort of 100 N)."""
+
+from __future__ import annotations
+
+import pytest
+from fastapi.testclient import TestClient
+
+from toptraj.service.app import create_app
+from toptraj.service.settings import Settings
+
+LIFT = """<robot name="slider">
+  <link name="base"/>
+  <link name="carriage"><inertial><mass value="20"/><origin xyz="0 0 0"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><mass value="2"/><origin xyz="0.3 0 0"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="lift" type="prismatic"><parent link="base"/><child link="carriage"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="1" effort="100" velocity="1"/></joint>
+  <joint name="turn" type="revolute"><parent link="carriage"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="50" velocity="2"/></joint>
+</robot>"""
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory):
+    with TestClient(create_app(Settings(preload_robots=False, data_dir=tmp_path_factory.mktemp("units")))) as test_client:
+        assert test_client.post("/v1/robots", json={"name": "slider", "urdf": LIFT}).status_code == 201
+        yield test_client
+
+
+def test_holding_a_prismatic_joint_still_is_worded_in_newtons(client):
+    response = client.post("/v1/trajectories", json={"robot": "slider", "path": {"waypoints": [[0.0, 0.0], [0.5, 1.0]]},
+                                                     "timing": {"constraints": ["torque"]}})
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"]
+    weight = 22.0 * 9.81
+    assert f"holding still at s = 0.0000 needs {weight:.4g} N on joint 'lift', above its limit of 100 N;" in detail, detail
+    assert "timing.limits.torque of 217 N on joint 'lift'" in detail and "N m" not in detail
+
+
+def test_a_cell_arm_that_cannot_hold_its_path_names_the_unit_and_a_remedy_it_can_follow(client):
+    arm = {"robot": "slider", "waypoints": [[0.0, 0.0], [0.5, 1.0]], "torque_scale": 1.0}
+    cell = {"arms": [arm, {**arm, "base": {"position": [2.0, 0.0, 0.0]}}], "constraints": ["velocity", "torque"]}
+    response = client.post("/v1/cells", json=cell)
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"]
+    assert f"needs {22.0 * 9.81:.4g} N on joint 'lift', above its torque limit of 100 N (gravity)" in detail, detail
+    assert "raise the limit" not in detail and "move the path's waypoints there" in detail
