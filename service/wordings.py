@@ -10,6 +10,7 @@ for what a template cannot say.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from toptraj.robots.errors import excerpt
@@ -123,10 +124,14 @@ def _path_in_collision(facts: dict) -> str:
     index, distance = facts["obstacle"], facts["distance"]
     how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of path.obstacles[{index}]"
     closest = "" if facts["closest"] is None else f"; the closest approach is {facts['closest'][0]:.4g} m at s = {facts['closest'][1]:.4g}"
-    return (
-        f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): "
-        "move the waypoints away from the obstacle or lower path.clearance"
-    )
+    if facts.get("fixed"):
+        advice = f"no joint moves that link: move path.obstacles[{index}] away from it, or the robot by its mounting"
+    else:
+        advice = "move the waypoints away from the obstacle"
+        least = math.floor(1e4 * facts.get("least", -1.0)) / 1e4  # a lower bound on the path's distance, 0.1 mm down
+        if least > 0.0:
+            advice += f" or lower path.clearance to {least:g} m"
+    return f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): {advice}"
 
 
 def _unknown_frame(facts: dict) -> str:

@@ -38,8 +38,9 @@ COARSE = 200
 
 
 class PathInCollision(InfeasiblePath):
-    """The path comes closer to an obstacle than the clearance: ``link``, ``obstacle`` (its
-    index in ``path.obstacles``) and ``s`` say where."""
+    """The path comes closer to an obstacle than the clearance: ``link`` (the URDF's link),
+    ``obstacle`` (its index in ``path.obstacles``) and ``s`` say where; ``fixed``, when given,
+    whether that link is fixed to the base (no joint moves it)."""
 
     def __init__(self, detail: str, s: float, link: str, obstacle: int, **facts: Any):
         super().__init__(detail, s=s, link=link, obstacle=obstacle, rule="path_in_collision", **facts)
@@ -96,7 +97,8 @@ def _too_close(s, distances, capsule, obstacle, capsules, clearance: float, foun
     if not closer.size:
         return
     first = int(closer[0])
-    link, index, distance = capsules[capsule[first]].name, int(obstacle[first]), float(distances[first])
+    touching = capsules[capsule[first]]
+    link, index, distance = touching.link, int(obstacle[first]), float(distances[first])
     how = f"is inside obstacle {index} (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of obstacle {index}"
     closest = "" if found is None else f"; the closest approach is {found.distance:.4g} m at s = {found.s:.4g}"
     raise PathInCollision(
@@ -107,19 +109,63 @@ def _too_close(s, distances, capsule, obstacle, capsules, clearance: float, foun
         distance=distance,
         clearance=clearance,
         closest=None if found is None else (found.distance, found.s),
+        fixed=touching.joint == 0,
     )
 
 
 def check_clearance(
-    path: GeometricPath, robot: Robot, obstacles: list[Obstacle], clearance: float, deadline: Deadline = NO_DEADLINE
+    path: GeometricPath, robot: Robot, obstacles: list[Obstacle], clearance: float, deadline: Deadline = NO_DEADLINE,
+    explain: bool = True,
 ) -> Clearance:
     """The clearance of ``path`` (a ``GeometricPath``) from ``obstacles``, checked where it
     matters: configurations at most ``COARSE_STEP`` of arm motion apart, and those intervals
     whose ends are within their motion of the clearance split to ``RESOLUTION``.
 
     Raises:
-        PathInCollision: a link comes closer than ``clearance`` (m) to an obstacle.
+        PathInCollision: a link comes closer than ``clearance`` (m) to an obstacle; its
+            ``least`` a lower bound on the path's distance from them (``closest_approach``, a
+            second pass over the whole path: the first stops where it first comes too close),
+            unless ``explain`` is false (a caller that only needs to know).
     """
+    try:
+        return _checked(path, robot, obstacles, clearance, deadline)
+    except PathInCollision as error:
+        if not explain:
+            raise
+        least, at = closest_approach(path, robot, obstacles, deadline)
+        facts = {key: value for key, value in vars(error).items() if key not in ("detail", "rule")}
+        raise PathInCollision(
+            f"{error.detail}; the path comes no closer than {least:.4g} m, near s = {at:.4g}", **facts, least=least
+        ) from None
+
+
+def closest_approach(path: GeometricPath, robot: Robot, obstacles: list[Obstacle], deadline: Deadline = NO_DEADLINE) -> tuple[float, float]:
+    """A lower bound (m) on the distance between the arm and ``obstacles`` along the whole of
+    ``path`` (negative inside one), within about ``RESOLUTION`` / 2 of it, and the s where the
+    sampled distance is least: exact distances at configurations ``COARSE_STEP`` of arm motion
+    apart, the intervals that may hold the least split to ``RESOLUTION``; between two samples
+    the distance is at least the smaller end's less half the interval's motion, so that a
+    clearance no larger than the bound lets the path through any check."""
+    reach = _reach(robot)
+    coarse_q = path.evaluate(np.linspace(0.0, 1.0, COARSE + 1)).q
+    motion = reach * np.abs(np.diff(coarse_q, axis=0)).sum()
+    s = np.linspace(0.0, 1.0, min(MAX_CONFIGURATIONS, max(COARSE, math.ceil(motion / COARSE_STEP))) + 1)
+    for attempt in range(2):  # the samples, then the intervals that may hold the least, split
+        deadline.check()
+        q = path.evaluate(s).q
+        distances, _, _ = clearance_along(robot, q, obstacles)
+        step = reach * np.abs(np.diff(q, axis=0)).sum(axis=1)
+        lower = np.minimum(distances[:-1], distances[1:]) - step / 2.0
+        near = lower < distances.min()
+        if attempt == 1 or not near.any() or step[near].max() <= RESOLUTION:
+            break
+        pieces = int(min(100, max(2, math.ceil(step[near].max() / RESOLUTION))))
+        s = _refined(s, near, max(2, min(pieces, MAX_CONFIGURATIONS // int(near.sum()))))
+    return float(min(lower.min(), distances.min())), float(s[int(np.argmin(distances))])
+
+
+def _checked(path: GeometricPath, robot: Robot, obstacles: list[Obstacle], clearance: float, deadline: Deadline) -> Clearance:
+    """``check_clearance`` without the second pass."""
     reach = _reach(robot)
     capsules = robot_capsules(robot)
     coarse_s = np.linspace(0.0, 1.0, COARSE + 1)
@@ -143,6 +189,6 @@ def check_clearance(
         q = path.evaluate(s).q
         distances, capsule, obstacle = clearance_along(robot, q, obstacles, exact_below)
     worst = int(np.argmin(distances))
-    found = Clearance(float(distances[worst]), capsules[capsule[worst]].name, int(obstacle[worst]), float(s[worst]), len(s))
+    found = Clearance(float(distances[worst]), capsules[capsule[worst]].link, int(obstacle[worst]), float(s[worst]), len(s))
     _too_close(s, distances, capsule, obstacle, capsules, clearance, found)
     return found

@@ -172,7 +172,7 @@ def _search(work: _Work, deadline: Deadline) -> Timed:
     for path, index, optimum in candidates:
         try:
             if work.obstacles:
-                check_clearance(path, robot, list(work.obstacles), work.clearance, deadline)
+                check_clearance(path, robot, list(work.obstacles), work.clearance, deadline, explain=False)
             check_self_collision(path, robot, deadline=deadline)
             timed = work.time_path(robot, path, PhasePlaneMethod(), work.grid, plain, None, work.kinds, work.limits, deadline.within(0.9, 1.0), work.threshold)
         except InfeasiblePath as error:

@@ -163,7 +163,7 @@ def _clear(path, robot, limits, obstacles, clearance, deadline) -> tuple[bool, C
     if not obstacles:
         return True, None
     try:
-        return True, check_clearance(path, robot, list(obstacles), clearance, deadline)
+        return True, check_clearance(path, robot, list(obstacles), clearance, deadline, explain=False)
     except PathInCollision:
         return False, None
 

@@ -4,6 +4,8 @@ closest approach of a clear path)."""
 
 from __future__ import annotations
 
+import re
+
 import coal
 import numpy as np
 import pinocchio as pin
@@ -103,7 +105,7 @@ def test_a_path_through_an_obstacle_is_a_422_naming_link_obstacle_and_s(client):
     response = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [far, sphere]}})
     assert response.status_code == 422, response.text
     problem = response.json()
-    assert problem["obstacle"] == 1 and problem["link"] in {c.name for c in robot_capsules(robots.load("ur5"))}
+    assert problem["obstacle"] == 1 and problem["link"] in {c.link for c in robot_capsules(robots.load("ur5"))}  # the URDF's names
     assert 0.0 < problem["s"] < 1.0 and "path.obstacles[1]" in problem["detail"]
 
 
@@ -147,6 +149,30 @@ def test_a_lower_clearance_lets_a_close_path_through(client):
     assert found["obstacle"] == 0 and 0.0 < found["distance"] < 0.01
     nearest = _coal_nearest(np.array(response.json()["samples"]["q"]), SphereObstacle(np.array(sphere["center"]), sphere["radius"]))
     assert found["distance"] - 1e-6 <= nearest <= found["distance"] + 0.01
+
+
+def test_the_advice_of_a_close_path_is_the_clearance_that_lets_it_through(client):
+    sphere = {"kind": "sphere", "center": [0.5, 0.5, 0.5], "radius": 0.1}
+    refused = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [sphere]}})
+    detail = refused.json()["detail"]
+    advised = re.search(r"move the waypoints away from the obstacle or lower path\.clearance to (\S+) m$", detail)
+    assert advised, detail
+    followed = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [sphere], "clearance": float(advised.group(1))}})
+    assert followed.status_code == 200, followed.text[:300]
+    # Inside the ball, no clearance lets it through: only moving the waypoints is advised.
+    inside = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [{**sphere, "radius": 0.3}], "clearance": 0.0}})
+    assert inside.status_code == 422 and inside.json()["detail"].endswith("move the waypoints away from the obstacle")
+
+
+def test_an_obstacle_on_a_link_no_joint_moves_advises_moving_it_or_the_robot(client):
+    floor = {"kind": "box", "center": [0.0, 0.0, -0.05], "size": [2.0, 2.0, 0.2]}
+    refused = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [floor]}})
+    assert refused.status_code == 422 and refused.json()["link"] == "base_link", refused.text[:300]
+    assert refused.json()["detail"].endswith(
+        "no joint moves that link: move path.obstacles[0] away from it, or the robot by its mounting"
+    ), refused.json()["detail"]
+    lowered = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [{**floor, "center": [0.0, 0.0, -0.5]}]}})
+    assert lowered.status_code == 200, lowered.text[:300]
 
 
 def test_the_planar_paper_arm_uses_link_capsules(client):
