@@ -39,8 +39,9 @@ LINK_RADIUS = 0.03
 @dataclass(frozen=True)
 class LinkCapsule:
     """A capsule of a link: ``name``, the Pinocchio ``joint`` moving it (0: the fixed base), end
-    points ``a``, ``b`` (3,) in that joint's frame (m), its ``radius`` (m) and the ``link`` (URDF
-    link name) it belongs to ("": not known)."""
+    points ``a``, ``b`` (3,) in that joint's frame (m), its ``radius`` (m), the ``link`` (URDF
+    link name) it belongs to ("": not known) and whether it wraps a collision mesh (``mesh``;
+    else a capsule along the link, of ``LINK_RADIUS``, or a payload's sphere)."""
 
     name: str
     joint: int
@@ -48,6 +49,7 @@ class LinkCapsule:
     b: np.ndarray
     radius: float
     link: str = ""
+    mesh: bool = False
 
 
 def fit_capsule(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -104,7 +106,7 @@ def capsules_from_geometry(model: pin.Model, geometry_model: pin.GeometryModel) 
         placed = points @ item.placement.rotation.T + item.placement.translation
         a, b, radius = fit_capsule(placed)
         link = model.frames[item.parentFrame].name if item.parentFrame < len(model.frames) else item.name
-        capsules.append(LinkCapsule(item.name, int(item.parentJoint), a, b, radius, link))
+        capsules.append(LinkCapsule(item.name, int(item.parentJoint), a, b, radius, link, mesh=True))
     return capsules
 
 

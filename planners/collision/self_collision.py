@@ -182,22 +182,30 @@ def self_distances(robot: Robot, q: np.ndarray, pairs: SelfPairs | None = None) 
     return nearest, which
 
 
-def _refuse(s: float, pairs: SelfPairs, which: int, distance: float, certain: bool) -> SelfCollision:
+def _refuse(s: float, pairs: SelfPairs, which: int, distance: float, certain: bool, upload: bool) -> SelfCollision:
+    """The refusal of the pair ``which`` at ``s`` (``distance``: the capsules' signed distance,
+    m; ``certain``: they touch there, else the check could not tell), with what may be done: the
+    capsules' padding where they wrap meshes, allowing the pair in an upload (``upload``)."""
     link_a, link_b = pairs.links[which]
-    if certain:
-        how = (
-            f"touch at s = {s:.4g} (their capsules overlap by {-distance:.4g} m; the capsules contain the links' "
-            f"collision meshes with a padding of up to about {PADDING:g} m, so the meshes may still be that far apart)"
+    meshes = pairs.capsules[pairs.first[which]].mesh and pairs.capsules[pairs.second[which]].mesh
+    if certain and meshes:
+        shape = (
+            f"the capsules contain the links' collision meshes with a padding of up to about {PADDING:g} m "
+            "on the catalog arms, so the meshes may still be apart"
         )
+    elif certain:
+        radius = max(pairs.capsules[pairs.first[which]].radius, pairs.capsules[pairs.second[which]].radius)
+        shape = f"without collision meshes, links are capsules of radius {radius:g} m along them, so their real shapes may differ"
+    if certain:
+        how = f"touch at s = {s:.4g} (their capsules overlap by {-distance:.4g} m; {shape})"
     else:
         how = f"may touch after s = {s:.4g} (the check could not tell within {MAX_CONFIGURATIONS} configurations)"
     if "payload" in (link_a, link_b):  # the payload's sphere (``toptraj.robots.collision``) is no link to allow
         advice = "move the waypoints there so that the payload stays clear of the arm, or give the payload a smaller collision radius"
     else:
-        advice = (
-            "move the waypoints there so that the arm does not fold onto itself, "
-            "or allow the pair in the robot's allowed collisions if the links may touch"
-        )
+        advice = "move the waypoints there so that the arm does not fold onto itself"
+        if upload:
+            advice += ", or list the pair in the upload's allowed_collisions if the links may touch"
     return SelfCollision(
         f"links {link_a!r} and {link_b!r} {how}: {advice}",
         s=s, link_a=link_a, link_b=link_b, distance=distance,
@@ -223,6 +231,7 @@ def check_self_collision(
             cannot be certified within ``MAX_CONFIGURATIONS`` configurations.
     """
     pairs = self_pairs(robot, allowed)
+    upload = robot.source == "upload"
     reach = _reach(robot)
     coarse = path.evaluate(np.linspace(0.0, 1.0, COARSE + 1)).q
     motion = reach * float(np.abs(np.diff(coarse, axis=0)).sum())
@@ -239,7 +248,7 @@ def check_self_collision(
             break
         if len(s) + 3 * int(unsure.sum()) > MAX_CONFIGURATIONS:
             first = int(np.flatnonzero(unsure)[0])
-            raise _refuse(float(s[first]), pairs, int(which[first]), float((d[first] + d[first + 1] - step[first]) / 2.0), False)
+            raise _refuse(float(s[first]), pairs, int(which[first]), float((d[first] + d[first + 1] - step[first]) / 2.0), False, upload)
         new_s = _split(s, unsure)
         new_q = path.evaluate(new_s).q
         new_d, new_which = self_distances(robot, new_q, pairs)
@@ -248,7 +257,7 @@ def check_self_collision(
         d, which = np.concatenate([d, new_d])[order], np.concatenate([which, new_which])[order]
     if contact.size:
         first = int(contact[0])
-        raise _refuse(float(s[first]), pairs, int(which[first]), float(d[first]), True)
+        raise _refuse(float(s[first]), pairs, int(which[first]), float(d[first]), True, upload)
     worst = int(np.argmin(d))
     link_a, link_b = pairs.links[int(which[worst])] if len(pairs.links) else ("", "")
     return SelfClearance(float(d[worst]), link_a, link_b, float(s[worst]), len(s))

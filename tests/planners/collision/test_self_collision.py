@@ -5,6 +5,8 @@ start whose links touch and keeps its pieces' links apart."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import coal
 import numpy as np
 import pinocchio as pin
@@ -185,3 +187,19 @@ def test_a_payload_with_a_radius_is_kept_from_the_arms_own_links():
         return coal.distance(capsule[0], capsule[1], sphere[0], sphere[1], coal.DistanceRequest(), coal.DistanceResult())
 
     assert -1e-3 <= apart(refused.value.s) <= 1e-9 and apart(refused.value.s - 0.01) > 0.0
+
+
+def test_a_refusal_says_what_the_capsules_are_and_offers_allowing_a_pair_only_where_it_can_be():
+    """An arm without collision meshes (lecture_3r) is drawn as capsules of 0.03 m along its
+    links: the refusal says so, not the catalog meshes' padding; allowing the pair is offered only
+    for an upload (a catalog robot's allowed pairs cannot be changed)."""
+    robot = robots.load("lecture_3r")
+    folded = SplinePath(np.array([[0.0, 0.0, 0.0], [0.0, 2.9, 2.9]]))
+    with pytest.raises(SelfCollision) as refused:
+        check_self_collision(folded, robot)
+    assert "without collision meshes, links are capsules of radius 0.03 m along them" in refused.value.detail
+    assert "padding" not in refused.value.detail and refused.value.detail.endswith("so that the arm does not fold onto itself")
+    uploaded = dataclasses.replace(robot, source="upload")
+    with pytest.raises(SelfCollision) as refused:
+        check_self_collision(folded, uploaded)
+    assert refused.value.detail.endswith("or list the pair in the upload's allowed_collisions if the links may touch")
