@@ -24,6 +24,8 @@ def torque_remedy(facts: dict) -> str:
     """The torque scale or limits (``torque_scale``, ``torque_limits`` among ``facts``) with
     which every joint can hold the path still everywhere, as advice; an empty string without."""
     remedies = []
+    for index, value in facts.get("zone_scales", ()):
+        remedies.append(f"timing.zones[{index}].torque_scale {value:g}")
     if facts.get("torque_scale") is not None:
         remedies.append(f"timing.limits.torque_scale {facts['torque_scale']:g}")
     asked = facts.get("asked_scale", 1.0)

@@ -7,16 +7,24 @@ its scale and ``1 - margin``), a torque scale ``ratio`` times the one asked, or 
 everywhere, with room to spare, a slow enough motion follows the path: its inertial and
 velocity terms vanish with the path speed (Bobrow, Dubowsky & Gibson 1985, the phase plane at
 sd -> 0).
+
+Inside a zone that scales the torque limits down (``timing.zones``), holding still may exceed
+only the zone's limits: where every joint's worst load would be held by the limits outside the
+zones (its ratio times the zone's factor at most 1), the remedy is the zones' own torque scales
+(the factor times the ratio), not the limits of the whole path, which would raise them outside
+the zones as well.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from toptraj.planners.constraints.zones import inside, zone_factors
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.problem.ranges import SCALE
 from toptraj.planners.runner.duration import rounded_up
+from toptraj.robots import LimitZone
 from toptraj.robots.ranges import TORQUE
 
 #: Significant digits of the torque scale and limits advised (rounded up: room to spare).
@@ -34,6 +42,10 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
     ((joint, value, unit: N m or N) for each joint beyond its limit: its limit as asked, before
     the scale, times its ratio, rounded up, where that lies in the accepted range)."""
     facts = {key: value for key, value in vars(error).items() if key != "detail"}
+    zoned = _zone_remedy(facts.pop("zones", problem.limits.zones), facts["joints"])
+    if zoned:
+        facts.update(asked_scale=problem.requested.scales.get("torque") or 1.0, torque_scale=None, torque_limits=(), zone_scales=zoned)
+        return type(error)(error.detail, **facts)
     asked = problem.requested
     scale = asked.scales.get("torque") or 1.0
     limits = np.asarray(problem.robot.limits.with_request(asked.overrides).torque, dtype=float)
@@ -51,3 +63,22 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
         advised = None
     facts.update(asked_scale=scale, torque_scale=advised, torque_limits=tuple(needed))
     return type(error)(error.detail, **facts)
+
+
+def _zone_remedy(located: tuple[LimitZone, ...], joints: tuple) -> tuple[tuple[int, float], ...]:
+    """(zone index, torque scale) for each of the zones ``located`` on the path that alone keeps
+    a joint from holding it still (module docstring), when the zones alone do; empty otherwise."""
+    zones = tuple(zone for zone in located if zone.torque < 1.0)
+    if not zones or not joints:
+        return ()
+    needed: dict[int, float] = {}
+    for ratio, load in joints:
+        at = np.array([load.s])
+        factor = float(zone_factors(zones, at).torque[0])
+        if not np.isfinite(ratio) or ratio * factor > 1.0:
+            return ()  # the limits outside the zones do not hold it either
+        for zone in zones:
+            if factor < 1.0 and zone.torque == factor and inside(zone, at)[0]:
+                value = min(1.0, rounded_up(ratio * factor * (1.0 + ROOM), ADVISED_DIGITS))
+                needed[zone.index] = max(needed.get(zone.index, 0.0), value)
+    return tuple(sorted(needed.items()))

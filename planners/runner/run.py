@@ -104,10 +104,15 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
         part.progress(0.07, "self-collision")
         check_self_collision(path, problem.robot, deadline=problem.deadline)
     assert isinstance(problem.method, TimingMethod)  # run gives the generators' problems to them
-    timed = timed_path(
-        problem.robot, path, problem.method, problem.grid, problem.boundary, problem.duration, problem.kinds, problem.limits,
-        part.within(0.1, 1.0), problem.threshold,
-    )
+    try:
+        timed = timed_path(
+            problem.robot, path, problem.method, problem.grid, problem.boundary, problem.duration, problem.kinds, problem.limits,
+            part.within(0.1, 1.0), problem.threshold,
+        )
+    except InfeasiblePath as error:
+        if problem.limits.zones and getattr(error, "joints", None):  # the zones located, for the torque remedy
+            error.__dict__["zones"] = problem.limits.zones
+        raise
     return timed, checked, problem
 
 

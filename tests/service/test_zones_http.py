@@ -80,3 +80,25 @@ def test_a_box_turned_by_no_unit_quaternion_is_422_naming_its_orientation(client
         "timing.zones[1].box.orientation has norm 0.5: it is no rotation; give a unit quaternion [qx, qy, qz, qw] "
         "(norm 1 within 0.001), e.g. [0, 0, 0, 1] for a box along the world's axes"
     )
+
+
+README_PATH = {"kind": "waypoints", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [0.8, -1, 1.4, -0.5, 0.9, 0.3], [2, -1.3, 1.2, 0.2, 0.6, 1.2]]}
+
+
+@pytest.mark.parametrize("scale", [0.01, 0.2])
+def test_a_zone_too_weak_to_hold_the_arm_still_is_told_its_own_torque_scale(client, scale):
+    """Holding the ur5 still inside a zone of a hundredth (or a fifth) of its torque needs 37.96 N m on
+    shoulder_lift_joint, 25.3 % of its 150 N m: the advice is the zone's torque_scale 0.254 (the
+    share, with room, rounded up), which plans the path, not the whole path's torque_scale, which
+    would raise the limits outside the zone as well."""
+    zone = {"s_range": [0.2, 0.5], "torque_scale": scale}
+    body = {"robot": "ur5", "path": README_PATH, "timing": {"zones": [zone]}}
+    refused = client.post("/v1/trajectories", json=body)
+    assert refused.status_code == 422, refused.text[:300]
+    detail = refused.json()["detail"]
+    assert "holding still needs 37.96 N m on joint 'shoulder_lift_joint'" in detail
+    assert f"against its limit of {150 * scale:g} N m; with timing.zones[0].torque_scale 0.254 (or more) every joint" in detail, detail
+    assert "timing.limits.torque" not in detail
+    followed = client.post("/v1/trajectories", json={**body, "timing": {"zones": [{**zone, "torque_scale": 0.254}]}})
+    assert followed.status_code == 200, followed.text[:300]
+    assert max(followed.json()["peak_utilization"]["torque"]) <= 1.005
