@@ -45,8 +45,8 @@ def test_the_refusal_carries_every_load_at_rest_and_the_remedy():
     assert [load.joint for _, load in error.joints] == ["shoulder_lift_joint"]
     assert error.asked_scale == 0.2
     assert 0.2 * error.ratio < error.torque_scale <= 0.2 * error.ratio * 1.001 + 1e-3
-    [(joint, limit)] = error.torque_limits
-    assert joint == "shoulder_lift_joint" and 150.0 * error.ratio < limit <= 150.0 * error.ratio * 1.001 + 1.0
+    [(joint, limit, unit)] = error.torque_limits
+    assert (joint, unit) == ("shoulder_lift_joint", "N m") and 150.0 * error.ratio < limit <= 150.0 * error.ratio * 1.001 + 1.0
 
 
 def test_a_joint_holding_no_gravity_is_never_blamed():
