@@ -83,6 +83,7 @@ class MinCostMethod(TimingMethod):
             sd_start=boundary.sd_start,
             sd_end=boundary.sd_end,
             torque_weight=self.torque_weight,
+            torque_unit=_torque_units(constraints, torque),
         )
         deadline.check()
         # cvxpy's canonicalization and Clarabel cannot check a deadline: they run in a child
@@ -104,6 +105,9 @@ class MinCostProgram:
             column per torque row.
         sd_start, sd_end: Path speed at the ends, in 1/s.
         torque_weight: beta, in 1/(N m)^2.
+        torque_unit: A typical torque of each torque row (k,), N m (its limit): the torques
+            enter the cone constraints in this unit, so that they are of order one (Clarabel's
+            tolerances are absolute; in N m, tau^2 of thousands failed it on fine grids).
     """
 
     ds: np.ndarray
@@ -116,6 +120,15 @@ class MinCostProgram:
     sd_start: float
     sd_end: float
     torque_weight: float
+    torque_unit: np.ndarray | None = None
+
+
+def _torque_units(constraints: PathConstraints, torque: list[int]) -> np.ndarray:
+    """(k,) the largest finite torque limit of each torque row along the path (N m), 1 where
+    none is finite."""
+    bound = np.maximum(np.abs(constraints.upper[:, torque]), np.abs(constraints.lower[:, torque]))
+    bound = np.where(np.isfinite(bound), bound, 0.0).max(axis=0, initial=0.0)
+    return np.where(bound > 0.0, bound, 1.0)
 
 
 def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
@@ -156,11 +169,15 @@ def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
     cost = cp.sum(cp.multiply(2 * ds, cp.inv_pos(z)))
     if program.torque_weight > 0:
         middle = 0.5 * (b[:-1] + b[1:])
-        for column in range(program.torque_a.shape[1]):
-            tau = cp.multiply(program.torque_a[:, column], a) + cp.multiply(program.torque_b[:, column], middle) + program.torque_c[:, column]
+        units = np.ones(program.torque_a.shape[1]) if program.torque_unit is None else program.torque_unit
+        for column, unit in enumerate(units):
+            tau = (
+                cp.multiply(program.torque_a[:, column] / unit, a) + cp.multiply(program.torque_b[:, column] / unit, middle)
+                + program.torque_c[:, column] / unit
+            )  # in units of ``unit``: w is then (tau / unit)^2 / z
             w = cp.Variable(n, nonneg=True)
             limits.append(cp.SOC(w + z, cp.vstack([2 * tau, w - z]), axis=0))
-            cost = cost + program.torque_weight * cp.sum(cp.multiply(2 * ds, w))
+            cost = cost + program.torque_weight * unit**2 * cp.sum(cp.multiply(2 * ds, w))
     problem = cp.Problem(cp.Minimize(cost), limits)
     try:
         with warnings.catch_warnings():
