@@ -267,7 +267,8 @@ class Client(JobCalls):
             s, shared by every arm), ``arms`` (per arm: ``robot``, ``joint_names``, ``samples``
             ``{t, q, qd, qdd, tau}``, or with ``format`` ``joint_trajectory`` a
             ``joint_trajectory``, ``peak_utilization``, ``payload`` and ``base``),
-            ``min_distance``, the coordination ``diagram`` of arms 0 and 1 and ``diagrams``
-            of every pair.
+            ``min_distance``, the coordination ``diagram`` of arms 0 and 1, ``diagrams``
+            of every pair, and the ``warnings`` (a limit not held that the motion exceeds,
+            a sampling that does not follow it).
         """
         return self._call("POST", "/v1/cells", _json_body(body), timeout=timeout)

@@ -14,7 +14,8 @@ by default (``exact_period``, ``toptraj.service.formats.exact_period_for``).
 Beside the samples: the durations (the cell's, each arm's own optimum, one after the other, the
 time lost to coordination), each arm's peak utilization per limit on a dense resampling, the
 arms' smallest distance (the closest pair), and the coordination diagram of arms 0 and 1
-(``diagram``) and of every pair (``diagrams``).
+(``diagram``) and of every pair (``diagrams``), and the ``warnings``
+(``toptraj.service.cell_warnings``).
 """
 
 from __future__ import annotations
@@ -25,9 +26,10 @@ import math
 import numpy as np
 
 from toptraj.planners.coordination import Cell, Coordination
-from toptraj.planners.coordination.limits import dense_loads, peak_utilization
+from toptraj.planners.coordination.limits import KINDS, dense_loads, peak_utilization
 from toptraj.planners.coordination.timing import Schedule
 from toptraj.planners.errors import InvalidRequest
+from toptraj.service.cell_warnings import cell_warnings
 from toptraj.service.equipping import mounting_body, payload_body
 from toptraj.service.formats import time_from_start
 
@@ -104,7 +106,9 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_pe
     samples' motion."""
     schedule = on_whole_periods(found.schedule, dt) if exact_period else found.schedule
     t = sample_times(schedule.duration, dt)
-    peaks = peak_utilization(cell, dense_loads(cell, schedule))
+    loads = dense_loads(cell, schedule)
+    peaks = peak_utilization(cell, loads)
+    unheld = peak_utilization(cell, loads, kinds=tuple(kind for kind in KINDS if kind not in cell.kinds))
     pick = np.linspace(0, len(found.curve) - 1, CURVE_POINTS).round().astype(int)
     clearance = found.clearance
     return {
@@ -128,6 +132,7 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_pe
         },
         "diagram": _diagram(found, (0, 1), pick),
         "diagrams": [_diagram(found, pair, pick) for pair in found.diagrams],
+        "warnings": cell_warnings(cell, unheld, found.schedule.duration, schedule.duration, dt, len(t)),
     }
 
 
@@ -158,6 +163,8 @@ def _metadata(body: dict) -> list[str]:
     for index, arm in enumerate(arms):
         for kind, values in arm["peak_utilization"].items():
             lines.append(f"peak_utilization.arms[{index}].{kind}: " + ",".join("null" if v is None else repr(float(v)) for v in values))
+    lines.append(f"warnings: {len(body['warnings'])}")
+    lines += [f"warning: {text}" for text in body["warnings"]]
     return ["# " + " ".join(line.split()) for line in lines]
 
 

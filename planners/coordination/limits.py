@@ -88,11 +88,14 @@ def _utilization(arm: CellArm, load: ArmLoad, kinds: tuple[str, ...], y: float) 
     return out
 
 
-def peak_utilization(cell: Cell, loads: list[ArmLoad], y: float = 1.0) -> list[dict[str, np.ndarray]]:
-    """Per arm, the peak |quantity| / limit of each kind of the cell per joint (n_dof,) over the
-    dense samples, at the slowing y."""
+def peak_utilization(
+    cell: Cell, loads: list[ArmLoad], y: float = 1.0, kinds: tuple[str, ...] | None = None
+) -> list[dict[str, np.ndarray]]:
+    """Per arm, the peak |quantity| / limit of each kind of the cell (or of ``kinds``, those not
+    held too) per joint (n_dof,) over the dense samples, at the slowing y."""
+    kinds = cell.kinds if kinds is None else kinds
     return [
-        {kind: u.max(axis=0) for kind, u in _utilization(arm, load, cell.kinds, y).items()} for arm, load in zip(cell.arms, loads)
+        {kind: u.max(axis=0) for kind, u in _utilization(arm, load, kinds, y).items()} for arm, load in zip(cell.arms, loads)
     ]
 
 

@@ -212,3 +212,21 @@ def test_one_arm_or_one_value_is_counted_in_the_singular(patient_client):
     assert response.status_code == 422 and "a cell has 1 arm; from 2 to 4 are served" in response.json()["detail"]
     response = patient_client.post("/v1/cells", json=_cell(a1={"waypoints": [[0.0], [0.1]]}))
     assert response.status_code == 422 and "arms[1].waypoints[0] has 1 value; ur5 has 6 joints" in response.json()["detail"]
+
+
+def test_a_cell_warns_of_limits_it_was_not_asked_to_hold_and_of_its_sampling(patient_client):
+    """As a trajectory's answer: with velocity limits only, the arms' accelerations and torques
+    run far past their limits (66 and 17 times), each named with how to hold it; samples a second
+    apart on whole periods slow the 1.88 s motion to 2 s (6.3 %), which is said; the example as it
+    is warns of nothing."""
+    velocity_only = patient_client.post("/v1/cells", json=EXAMPLE | {"constraints": ["velocity"]}).json()
+    found = {re.match(r"arms\[(\d)\]: the (\w+) of", text).groups() for text in velocity_only["warnings"]}
+    assert found == {("0", "acceleration"), ("0", "torque"), ("1", "acceleration"), ("1", "torque")}, velocity_only["warnings"]
+    arm0 = velocity_only["arms"][0]["samples"]
+    tau = np.abs(np.asarray(arm0["tau"])).max()  # the answer's own samples exceed the torque limit (150 N m)
+    assert tau > 150.0 and all(text.endswith("to constraints to hold it") for text in velocity_only["warnings"])
+    coarse = patient_client.post("/v1/cells", json=EXAMPLE | {"dt": 1.0, "format": "joint_trajectory"}).json()
+    [slowed] = coarse["warnings"]
+    scale = coarse["sampled_duration"] / coarse["duration"]
+    assert coarse["sampled_duration"] == 2.0 and slowed.startswith(f"exact_period slows the motion by {100 * (scale - 1):.3g} %")
+    assert patient_client.post("/v1/cells", json=EXAMPLE).json()["warnings"] == []
