@@ -98,12 +98,12 @@ def reported_utilization(peaks: dict[str, np.ndarray], limits) -> dict[str, list
     }
 
 
-def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_period: bool) -> dict:
+def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_period: bool, notes: list[str] | None = None) -> dict:
     """The answer (module docstring); ``format_`` ``csv`` gives the ``samples`` body that
     ``csv_bytes`` writes. With ``exact_period`` the samples lie on whole periods ``dt``, the
     final state included (``on_whole_periods``); ``duration`` stays the planned one and
     ``sampled_duration`` is the last sample's time. The peak utilization is that of the
-    samples' motion."""
+    samples' motion. ``notes``: warnings from building the arms, first among the answer's."""
     schedule = on_whole_periods(found.schedule, dt) if exact_period else found.schedule
     t = sample_times(schedule.duration, dt)
     loads = dense_loads(cell, schedule)
@@ -132,7 +132,7 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_pe
         },
         "diagram": _diagram(found, (0, 1), pick),
         "diagrams": [_diagram(found, pair, pick) for pair in found.diagrams],
-        "warnings": cell_warnings(cell, unheld, found.schedule.duration, schedule.duration, dt, len(t)),
+        "warnings": [*(notes or []), *cell_warnings(cell, unheld, found.schedule.duration, schedule.duration, dt, len(t))],
     }
 
 

@@ -12,12 +12,12 @@ from toptraj.planners.coordination import Cell, CellArm, checked_rotation, coord
 from toptraj.planners.errors import InvalidRequest, WrongLength
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.problem.requests import WaypointPath
-from toptraj.planners.problem.waypoints import make_path
+from toptraj.planners.problem.waypoints import make_path, without_repeats
 from toptraj.robots.equipment import InvalidEquipment, equip, mounting
 from toptraj.robots.errors import UnknownRobot
 from toptraj.service.cell_answers import cell_body
 from toptraj.service.formats import exact_period_for
-from toptraj.service.problems import detail
+from toptraj.service.problems import detail, note_text
 from toptraj.service.schemas.cells import CellArmRequest, CellRequest
 
 
@@ -46,14 +46,31 @@ def _in_arm(index: int, error: InvalidRequest) -> InvalidRequest:
     return InvalidRequest(f"arms[{index}].waypoints", detail=text)
 
 
-def _arm(index: int, request: CellArmRequest, gravity, deadline: Deadline) -> CellArm:
+def _arm(index: int, request: CellArmRequest, gravity, deadline: Deadline, warnings: list[str]) -> CellArm:
+    """Arm ``index`` of the cell, its waypoints that repeat the one before them dropped (a
+    warning added to ``warnings``, as a trajectory's answer says it)."""
     robot = _robot(index, request, gravity)
     try:
         for row, waypoint in enumerate(request.waypoints):  # rows of other lengths make no array
             if len(waypoint) != robot.dof:
                 raise WrongLength(f"waypoints[{row}]", waypoint, len(waypoint), robot.dof, robot=robot.name, joint_names=robot.joint_names)
-        path = make_path(robot, WaypointPath(np.asarray(request.waypoints, dtype=float)), deadline)
+        try:
+            motion, dropped = without_repeats(WaypointPath(np.asarray(request.waypoints, dtype=float)))
+        except InvalidRequest as error:
+            if getattr(error, "rule", None) != "all_waypoints_coincide":
+                raise
+            raise InvalidRequest(
+                f"arms[{index}].waypoints", detail=(
+                    f"arms[{index}] does not move: its {len(request.waypoints)} waypoints coincide. A cell times arms that "
+                    f"move and keeps them apart from each other, not from an arm standing still: leave arms[{index}] out, "
+                    "or give it a waypoint that differs from the first"
+                ),
+            ) from error
+        warnings += [note_text(note).replace("path.waypoints", f"arms[{index}].waypoints") for note in dropped]
+        path = make_path(robot, motion, deadline)
     except InvalidRequest as error:
+        if error.field.startswith(f"arms[{index}]"):
+            raise
         raise _in_arm(index, error) from error
     scales: dict[str, float | None] = {
         "velocity": request.velocity_scale,
@@ -66,8 +83,9 @@ def _arm(index: int, request: CellArmRequest, gravity, deadline: Deadline) -> Ce
 def plan_cell(body: CellRequest, deadline: Deadline, format_: str | None = None) -> dict:
     """The answer to a cell request in ``format_`` (default the request's; ``csv``: the
     ``samples`` body that ``cell_answers.csv_bytes`` writes)."""
-    arms = tuple(_arm(index, arm, body.gravity, deadline) for index, arm in enumerate(body.arms))
+    warnings: list[str] = []
+    arms = tuple(_arm(index, arm, body.gravity, deadline, warnings) for index, arm in enumerate(body.arms))
     cell = Cell(arms, body.clearance, tuple(body.constraints))
     format_ = format_ or body.format
     exact = exact_period_for(format_, body.exact_period)
-    return cell_body(cell, coordinate(cell, deadline), body.dt, format_, exact)
+    return cell_body(cell, coordinate(cell, deadline), body.dt, format_, exact, warnings)

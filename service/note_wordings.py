@@ -30,7 +30,9 @@ def _gap_above_target(facts: dict) -> str:
 def _waypoints_dropped(facts: dict) -> str:
     repeats = facts["indices"]
     shown = ", ".join(map(str, repeats[:10])) + (", ..." if len(repeats) > 10 else "")
-    return f"{facts['field']} [{shown}] repeat the waypoint before them and were dropped ({len(repeats)} in all)"
+    if len(repeats) == 1:
+        return f"{facts['field']}[{repeats[0]}] repeats the waypoint before it and was dropped"
+    return f"{facts['field']} [{shown}] repeat the waypoint before each of them and were dropped ({len(repeats)} in all)"
 
 
 def _collocation_gap(facts: dict) -> str:

@@ -107,9 +107,8 @@ def test_a_path_of_another_kind_is_a_422_saying_what_is_served(patient_client, o
         ),
         (
             [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0]] * 2,
-            "arms[1].waypoints[0] and arms[1].waypoints[1] coincide (no joint differs by more than 1e-12 rad or m), so "
-            "the path has no direction between them: remove arms[1].waypoints[1], or change one of its joint values by "
-            "more than 1e-12",
+            "arms[1] does not move: its 2 waypoints coincide. A cell times arms that move and keeps them apart from each "
+            "other, not from an arm standing still: leave arms[1] out, or give it a waypoint that differs from the first",
         ),
         (
             [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0], [99.0, -0.5, 0.5, 0.0, 0.0, 0.0]],
@@ -230,3 +229,18 @@ def test_a_cell_warns_of_limits_it_was_not_asked_to_hold_and_of_its_sampling(pat
     scale = coarse["sampled_duration"] / coarse["duration"]
     assert coarse["sampled_duration"] == 2.0 and slowed.startswith(f"exact_period slows the motion by {100 * (scale - 1):.3g} %")
     assert patient_client.post("/v1/cells", json=EXAMPLE).json()["warnings"] == []
+
+
+def test_an_arm_repeating_a_waypoint_drops_it_and_an_arm_standing_still_is_told_what_a_cell_does(patient_client):
+    arms = copy.deepcopy(EXAMPLE["arms"])
+    arms[1]["waypoints"] = [arms[1]["waypoints"][0], *arms[1]["waypoints"]]  # a recorded path that waits at its start
+    repeated = patient_client.post("/v1/cells", json=EXAMPLE | {"arms": arms})
+    assert repeated.status_code == 200, repeated.text[:300]
+    assert repeated.json()["warnings"] == ["arms[1].waypoints[1] repeats the waypoint before it and was dropped"]
+    assert repeated.json()["duration"] == pytest.approx(patient_client.post("/v1/cells", json=EXAMPLE).json()["duration"], rel=1e-9)
+    arms[1]["waypoints"] = [arms[1]["waypoints"][0]] * 2
+    still = patient_client.post("/v1/cells", json=EXAMPLE | {"arms": arms})
+    assert still.status_code == 422 and still.json()["detail"].startswith(
+        "arms[1] does not move: its 2 waypoints coincide. A cell times arms that move"
+    ), still.text[:300]
+    assert "remove" not in still.json()["detail"]

@@ -297,4 +297,4 @@ def test_a_note_crosses_processes_with_its_facts():
     note = Note("waypoints [2] repeat the waypoint before them", "waypoints_dropped", field="waypoints", indices=(2,))
     copy = pickle.loads(pickle.dumps(note))
     assert (str(copy), copy.rule, copy.facts) == (str(note), "waypoints_dropped", {"field": "waypoints", "indices": (2,)})
-    assert note_text(copy) == "path.waypoints [2] repeat the waypoint before them and were dropped (1 in all)"
+    assert note_text(copy) == "path.waypoints[2] repeats the waypoint before it and was dropped"
