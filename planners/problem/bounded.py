@@ -31,21 +31,25 @@ def bounded_joints(limits: JointLimits, kinds: tuple[str, ...]) -> np.ndarray:
 
 
 def check_speed_bounded(
-    robot: Robot, limits: JointLimits, kinds: tuple[str, ...], waypoints: np.ndarray | None = None, field: str = "constraints"
+    robot: Robot, limits: JointLimits, kinds: tuple[str, ...], waypoints: np.ndarray | None = None, field: str = "constraints",
+    served: frozenset[str] | tuple[str, ...] | None = None,
 ) -> None:
     """Refuse a motion that the held ``limits`` of ``kinds`` leave unbounded (module docstring);
     ``waypoints`` (n_waypoints, n_dof), when the path is one through them, are checked segment
-    by segment. ``field`` names the input in the error (a cell's arm).
+    by segment. ``field`` names the input in the error (a cell's arm); ``served``, the kinds the
+    method can hold (``None``: all), those the error offers to add.
 
     Raises:
         InvalidRequest: rule "no_limit_bounds_speed" (no joint bounded; facts: the robot, the
-            kinds held and those the robot has finite limits of) or "segment_unbounded" (the
+            kinds held and those the robot has finite limits of, among ``served``) or "segment_unbounded" (the
             first segment moving only unbounded joints: its waypoints and those joints).
     """
     if limits.tool is not None:
         return
     bounded = bounded_joints(limits, kinds)
-    available = tuple(kind for kind in BOUNDING_KINDS if np.any(np.isfinite(getattr(limits, kind))))
+    available = tuple(
+        kind for kind in BOUNDING_KINDS if np.any(np.isfinite(getattr(limits, kind))) and (served is None or kind in served)
+    )
     if not bounded.any():
         raise InvalidRequest(
             field, list(kinds), rule="no_limit_bounds_speed", robot=robot.name, kinds=tuple(kinds), available=available,

@@ -70,7 +70,8 @@ def test_a_synchronous_504_names_the_job_that_plans_it_and_that_job_does(tight, 
 
 
 def test_a_cell_past_its_budget_names_the_setting_that_gives_it_more_time(tight):
-    cell = {"arms": [{"robot": "ur5", "waypoints": UR5_WAYPOINTS[:2]}]}
+    arm = {"robot": "ur5", "waypoints": UR5_WAYPOINTS[:2]}
+    cell = {"arms": [arm, {**arm, "base": {"position": [2.0, 0.0, 0.0]}}]}
     response = tight.post("/v1/cells", json=cell)
     assert response.status_code == 504, response.text
     assert response.json()["detail"] == (

@@ -88,7 +88,8 @@ def test_via_points_take_their_generator():
     with pytest.raises(NotServed) as refused:
         build_problem(ARM, via, METHODS["cubic"])
     assert (refused.value.field, refused.value.rule) == ("interpolation", "via_points_need_their_generator")
-    problem = build_problem(ARM, via, ViaPoints(METHODS["cubic"]), limits=LimitRequest(kinds=("velocity", "acceleration")))
+    asked = LimitRequest(kinds=("velocity", "acceleration"), overrides={"velocity": [1.0, 1.0], "acceleration": [2.0, 2.0]})
+    problem = build_problem(ARM, via, ViaPoints(METHODS["cubic"]), limits=asked)
     assert problem.method.family == "generator"
 
 

@@ -10,6 +10,8 @@ laboratory arm of the Cartesian example), with three joints and 2 rad/s limits: 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -136,12 +138,17 @@ def test_non_normalized_refusals(path, method, options, rule, fragment):
 
 
 def test_unlimited_joint_is_named():
-    """geering_2r has no velocity limit of its own: the error names the joint that lacks one."""
+    """geering_2r with a velocity limit on psi only: phi, moving on its own, has none, and the
+    error names it (without any, the problem is refused before: nothing bounds the motion)."""
     limits = LimitRequest(kinds=("velocity",))
+    arm = dataclasses.replace(ARM, limits=dataclasses.replace(ARM.limits, velocity=np.array([np.inf, 2.0])))
     with pytest.raises(InvalidRequest) as refused:
-        plan(build_problem(ARM, WaypointPath(np.array([A, B])), Unsynchronized(METHODS["trapezoidal"]), limits=limits))
+        plan(build_problem(arm, WaypointPath(np.array([A, B])), Unsynchronized(METHODS["trapezoidal"]), limits=limits))
     assert (refused.value.rule, refused.value.joint_name) == ("unsynchronized_joint_unlimited", "phi")
     assert "'phi'" in detail(refused.value)
+    with pytest.raises(InvalidRequest) as refused:
+        build_problem(ARM, WaypointPath(np.array([A, B])), Unsynchronized(METHODS["trapezoidal"]), limits=limits)
+    assert refused.value.rule == "no_limit_bounds_speed"
 
 
 def test_lecture_over_http(client):

@@ -20,8 +20,9 @@ KINDS = ("velocity", "acceleration", "jerk")
 def test_ruckig_without_any_finite_limit_is_refused_with_advice():
     with pytest.raises(InvalidRequest) as refused:
         plan(build_problem(robots.load("yamamoto_2r"), MOVE, METHODS["ruckig"], limits=LimitRequest(kinds=KINDS)))
-    assert (refused.value.field, refused.value.rule) == ("method", "ruckig_needs_a_limit")
-    assert "set velocity and acceleration limits in timing.limits" in detail(refused.value)
+    assert (refused.value.field, refused.value.rule) == ("constraints", "no_limit_bounds_speed")
+    assert "give the limits in timing.limits" in detail(refused.value)
+    assert "add 'torque'" not in detail(refused.value)  # ruckig holds no torque limit
 
 
 def test_the_advice_plans_a_motion_within_the_limit_set():
