@@ -120,6 +120,18 @@ def _law_acceleration_steps(facts: dict) -> str:
     )
 
 
+def _outside_joint_range(facts: dict) -> str:
+    """A joint value outside its range, with the value it would be in radians (metres) where
+    it looks given in degrees (millimetres) and that lies within the range."""
+    value, low, high = facts["value"], facts["low"], facts["high"]
+    text = f"{facts['field']} = {value:.6g} is outside the limits [{low:.6g}, {high:.6g}] of joint {facts['joint_name']!r}"
+    if abs(value) >= 10.0:
+        unit, factor, given = ("m", 1e-3, "millimetres") if facts.get("prismatic") else ("rad", math.pi / 180.0, "degrees")
+        if low <= value * factor <= high:
+            text += f"; joint values are in {unit}: if it is in {given}, give {value * factor:.6g} {unit}"
+    return text
+
+
 def _path_in_collision(facts: dict) -> str:
     index, distance = facts["obstacle"], facts["distance"]
     how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of path.obstacles[{index}]"
@@ -180,7 +192,7 @@ WORDING: dict[str, Wording] = {
     "too_few_waypoints": "{field} holds {count:~waypoint}; at least 2 are needed",
     "too_many_waypoints": "{field} holds {estimate} waypoints; at most {cap} are served",
     "coordinate_out_of_range": "{field} is {value:.6g}: not a finite number within +-{high:g} ({unit})",
-    "outside_joint_range": "{field} = {value:.6g} is outside the limits [{low:.6g}, {high:.6g}] of joint {joint_name!r}",
+    "outside_joint_range": _outside_joint_range,
     "unknown_constraint": "{field} holds {value!r}; use any of {allowed}",
     "kind_not_served": _kind_not_served,
     "no_constraints": (

@@ -25,7 +25,7 @@ def check_within_joint_limits(robot: Robot, field: str, q: ArrayLike) -> None:
         joint = outside[1]
         lower, upper = robot.limits.position_lower, robot.limits.position_upper
         raise OutOfRange(f"{field}[{joint}]", float(q[joint]), float(lower[joint]), float(upper[joint]),
-                         rule="outside_joint_range", joint_name=robot.joint_names[joint])
+                         rule="outside_joint_range", joint_name=robot.joint_names[joint], prismatic=robot.force_units[joint] == "N")
 
 
 def check_path_within_limits(robot: Robot, path: GeometricPath, s: np.ndarray) -> None:

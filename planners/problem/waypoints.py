@@ -51,7 +51,7 @@ def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
     if outside is not None:
         index, joint = outside
         raise OutOfRange(f"waypoints[{index}][{joint}]", waypoints[index, joint], lower[joint], upper[joint],
-                         rule="outside_joint_range", joint_name=robot.joint_names[joint])
+                         rule="outside_joint_range", joint_name=robot.joint_names[joint], prismatic=robot.force_units[joint] == "N")
     return waypoints
 
 

@@ -112,7 +112,8 @@ def test_a_path_of_another_kind_is_a_422_saying_what_is_served(patient_client, o
         ),
         (
             [[1.5, -0.5, 0.5, 0.0, 0.0, 0.0], [99.0, -0.5, 0.5, 0.0, 0.0, 0.0]],
-            "arms[1].waypoints[1][0] = 99 is outside the limits [-6.28319, 6.28319] of joint 'shoulder_pan_joint'",
+            "arms[1].waypoints[1][0] = 99 is outside the limits [-6.28319, 6.28319] of joint 'shoulder_pan_joint'; joint "
+            "values are in rad: if it is in degrees, give 1.72788 rad",
         ),
     ],
 )

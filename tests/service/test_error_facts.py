@@ -97,6 +97,19 @@ def test_a_waypoint_outside_its_joint_range_names_the_entry_and_the_joint():
     assert detail(error).startswith("path.waypoints[1][2] = 10 is outside the limits [-3.14159, 3.14159] of joint 'elbow_joint'")
 
 
+def test_a_waypoint_that_looks_given_in_degrees_is_told_its_value_in_radians(client):
+    """ur5's elbow at 90 (degrees, meant): the 422 gives 1.5708 rad, which plans; 4 rad, just outside
+    [-pi, pi], gets no such hint (it is no angle in degrees within the range that is likely meant)."""
+    waypoints = [[0.0, -1.2, 1.0, 0.0, 0.5, 0.0], [0.5, -1.0, 90.0, -0.5, 0.9, 0.3]]
+    refused = client.post("/v1/trajectories", json={"robot": "ur5", "path": {"waypoints": waypoints}})
+    detail_ = refused.json()["detail"]
+    assert detail_.endswith("; joint values are in rad: if it is in degrees, give 1.5708 rad"), detail_
+    waypoints[1][2] = 1.5708
+    assert client.post("/v1/trajectories", json={"robot": "ur5", "path": {"waypoints": waypoints}}).status_code == 200
+    waypoints[1][2] = 4.0
+    assert "degrees" not in client.post("/v1/trajectories", json={"robot": "ur5", "path": {"waypoints": waypoints}}).json()["detail"]
+
+
 def test_a_waypoint_of_the_wrong_length_says_given_and_expected():
     error = _refused(WaypointPath(np.array([[0.0, 0.1, 0.2, 0.3], [0.5, 0.1, 0.2, 0.3]])), dict(method=METHODS["phase_plane"]))
     assert isinstance(error, WrongLength)
