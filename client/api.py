@@ -206,8 +206,11 @@ class Client(JobCalls):
         Raises:
             ProblemError: 404 unknown robot; 422 malformed or impossible (``s``, ``joint`` and
                 ``limit`` say where a limit cannot be met); 503 busy; 504 over the budget.
+            ValueError: a whole body with arguments beside it, or a comparison's body.
         """
         if isinstance(robot, dict):
+            if "methods" in robot:
+                raise ValueError("this body names methods: it is a comparison; send it with compare(body)")
             _alone(robot, waypoints=waypoints, path=path, method=method, constraints=constraints, limits=limits,
                    duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period)
             body = robot

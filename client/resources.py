@@ -192,7 +192,7 @@ class Job:
     started_at: datetime | None
     finished_at: datetime | None
     error: ProblemError | None
-    result: Trajectory | list[Comparison] | list[BatchItem] | None = None
+    result: Trajectory | list[Comparison] | list[BatchItem] | None = field(default=None, repr=False)
     body: dict[str, Any] = field(default_factory=dict, repr=False)
 
     @property

@@ -230,6 +230,14 @@ class Trajectory:
     joint_trajectory: dict | None = field(default=None, repr=False)
     body: dict = field(default_factory=dict, repr=False)
 
+    def __repr__(self) -> str:
+        """One line: what was planned, how long it lasts, how many samples and warnings (the
+        arrays are the attributes)."""
+        return (
+            f"Trajectory(robot={self.robot!r}, method={self.method!r}, duration={self.duration!r}, samples={len(self.t)}, "
+            f"joints={len(self.joint_names)}, warnings={len(self.warnings)})"
+        )
+
     @classmethod
     def from_body(cls, body: dict) -> Trajectory:
         """From a ``TrajectoryResponse`` body, in either JSON format."""
@@ -278,7 +286,8 @@ class CsvTrajectory:
         qdd: Joint accelerations (rad/s^2, m/s^2), shape (n, n_dof).
         tau: Joint torques (N m) or forces (N), shape (n, n_dof).
         comments: The text of the lines starting with ``#`` (without the ``#``), in order.
-        metadata: The comment lines of the form ``name: value`` (or ``name = value``), by name.
+        metadata: The comment lines of the form ``name: value`` (or ``name = value``), by name
+            (a name given twice, as ``warning``, keeps its last value: ``warnings`` has them all).
         headers: The response's HTTP headers (lower-case names).
         text: The CSV as the service sent it.
     """
@@ -293,6 +302,23 @@ class CsvTrajectory:
     metadata: dict[str, str]
     headers: dict[str, str] = field(repr=False)
     text: str = field(repr=False)
+
+    def __repr__(self) -> str:
+        return f"CsvTrajectory(duration={self.duration!r}, samples={len(self.t)}, joints={len(self.joint_names)}, warnings={len(self.warnings)})"
+
+    @property
+    def duration(self) -> float | None:
+        """The planned duration (s) of the ``# duration:`` line, None without one."""
+        value = self.metadata.get("duration", "").removesuffix(" s").strip()
+        try:
+            return float(value)
+        except ValueError:
+            return None
+
+    @property
+    def warnings(self) -> list[str]:
+        """Every ``# warning:`` line's text, in order."""
+        return [comment.partition(":")[2].strip() for comment in self.comments if comment.startswith("warning:")]
 
     @classmethod
     def from_text(cls, text: str, headers: dict[str, str] | None = None) -> CsvTrajectory:

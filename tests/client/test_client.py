@@ -317,6 +317,8 @@ def test_arguments_beside_a_whole_request_are_refused():
             offline.compare({**QUICK, "methods": ["quintic"]}, methods=["cubic"])
         with pytest.raises(ValueError, match="waypoints"):
             offline.plan("ur5")
+        with pytest.raises(ValueError, match=r"it is a comparison; send it with compare\(body\)"):
+            offline.plan({**QUICK, "methods": ["quintic"]})
 
 
 def test_csv_comments_and_columns_are_read():
@@ -329,6 +331,20 @@ def test_csv_comments_and_columns_are_read():
     np.testing.assert_array_equal(table.t, [0.0, 1.0, 2.0])
     np.testing.assert_array_equal(table.tau[:, 1], [0.8, 1.8, 2.8])
     assert table.q.shape == table.qd.shape == table.qdd.shape == (3, 2)
+    assert table.duration == 0.5 and table.warnings == []
+    warned = CsvTrajectory.from_text("# duration: 1.25 s\n# warning: first\n# warning: second\n" + text.replace("# duration = 0.5\n", ""))
+    assert (warned.duration, warned.warnings) == (1.25, ["first", "second"])
+    assert repr(warned) == "CsvTrajectory(duration=1.25, samples=3, joints=2, warnings=2)"
+
+
+def test_a_trajectory_and_a_job_print_in_a_line(toptraj):
+    planned = toptraj.plan("ur5", UR5_WAYPOINTS)
+    assert repr(planned) == (
+        f"Trajectory(robot='ur5', method='phase_plane', duration={planned.duration!r}, samples={len(planned.t)}, joints=6, "
+        f"warnings={len(planned.warnings)})"
+    )
+    job = toptraj.wait(toptraj.submit({"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}}).id)
+    assert "\n" not in repr(job) and len(repr(job)) < 600 and job.result is not None
 
 
 def test_a_cell_through_the_client(toptraj):
