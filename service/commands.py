@@ -206,12 +206,16 @@ def _trajectory(text: str) -> bytes:
     return render(plan_request(request), request)[0]
 
 
-def _compare(text: str, as_table: bool = False) -> bytes:
+def _compare(text: str, as_table: bool = False, outcome: dict | None = None) -> bytes:
+    """The comparison of the compare body ``text``, as a table or JSON; ``outcome["failed"]``
+    set to whether every method failed."""
     from toptraj.planners.execution.deadline import NO_DEADLINE
     from toptraj.service.planning import compare_request, encode_json
     from toptraj.service.schemas.trajectories import CompareRequest
 
     answer = compare_request(CompareRequest.model_validate_json(text), NO_DEADLINE)
+    if outcome is not None:
+        outcome["failed"] = all("error" in result for result in answer["results"])
     if as_table:
         from toptraj.service.compare_table import compare_table
 
@@ -253,18 +257,23 @@ def plan(source: str) -> int:
 def compare(source: str, methods: list[str] | None = None, as_json: bool | None = None) -> int:
     """``toptraj compare FILE|- [--methods a,b] [--json]``: a compare body, or a trajectory body
     compared under ``methods`` (``compare_body``); a table on a terminal, JSON when piped or
-    when ``as_json``."""
+    when ``as_json``. Exit status 1 when every method failed (their errors are in the answer)."""
     as_table = sys.stdout.isatty() if as_json is None else not as_json
     why = "toptraj compare times one arm's path under several methods"
     left_out: list[str] = []
+    outcome: dict = {}
 
     def answer(text: str) -> bytes:
         body = compare_body(_no_cell(text, why), methods, left_out)
         if left_out:
             print(f"toptraj compare: left out {'; '.join(left_out)}; --methods names the methods to run", file=sys.stderr)
-        return _compare(body, as_table)
+        return _compare(body, as_table, outcome)
 
-    return _run(source, answer)
+    status = _run(source, answer)
+    if status == 0 and outcome.get("failed"):
+        print("toptraj compare: every method failed (each one's error is in the comparison)", file=sys.stderr)
+        return 1
+    return status
 
 
 def plot(source: str, output: str, methods: list[str] | None = None) -> int:

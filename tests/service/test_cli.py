@@ -272,6 +272,7 @@ def test_compare_of_a_body_leaves_out_the_default_methods_that_do_not_serve_its_
         "toptraj compare: left out phase_plane (it does not serve timing.constraints 'jerk'); toppra (it does not serve "
         "timing.constraints 'jerk'); --methods names the methods to run\n"
     )
-    assert main(["compare", str(ROOT / "examples" / "ur5_jerk_limited.json"), "--json", "--methods", "phase_plane"]) == 0
+    assert main(["compare", str(ROOT / "examples" / "ur5_jerk_limited.json"), "--json", "--methods", "phase_plane"]) == 1
     named = capsys.readouterr()
-    assert "error" in json.loads(named.out)["results"][0] and named.err == ""  # what is named runs, and says why it fails
+    assert "error" in json.loads(named.out)["results"][0]  # what is named runs, and says why it fails
+    assert named.err == "toptraj compare: every method failed (each one's error is in the comparison)\n"
