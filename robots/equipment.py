@@ -36,8 +36,9 @@ from toptraj.robots.robot import Robot
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-#: Largest |R^T R - I| (entrywise) of a rotation matrix accepted; it is then made exactly orthonormal.
-ROTATION_TOLERANCE = 1e-6
+#: Largest |R^T R - I| (entrywise) of a rotation matrix accepted; it is then made exactly
+#: orthonormal (entries written with four digits, 0.7071 for cos 45 degrees, are off by 2e-5).
+ROTATION_TOLERANCE = 1e-3
 #: Largest |1 - |q|| of an orientation quaternion accepted; it is then normalized.
 QUATERNION_TOLERANCE = 1e-3
 #: Equipped robots kept per process.

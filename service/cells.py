@@ -28,10 +28,11 @@ def _robot(index: int, request: CellArmRequest, gravity) -> robots.Robot:
     except UnknownRobot as error:  # the same error, with the field that names the robot
         vars(error)["field"] = f"arms[{index}].robot"
         raise
-    rotation = checked_rotation(request.base.rotation, f"arms[{index}].base.rotation")
+    base = request.base
+    rotation = None if base.rotation is None else checked_rotation(base.rotation, f"arms[{index}].base.rotation")
     try:
         payload = None if request.payload is None else request.payload.payload()
-        return equip(robot, payload, mounting(request.base.position, rotation, gravity=gravity))
+        return equip(robot, payload, mounting(base.position, rotation, base.orientation, gravity=gravity))
     except InvalidEquipment as error:
         where = "payload" if error.field in ("mass", "center_of_mass", "inertia", "frame") else "base"
         raise InvalidRequest(f"arms[{index}].{where}", detail=f"arms[{index}].{where}: {error.detail}") from error

@@ -32,7 +32,8 @@ MAX_ARMS = 4
 
 
 def checked_rotation(rotation: ArrayLike, where: str) -> np.ndarray:
-    """``rotation`` as a (3, 3) rotation matrix, or InvalidRequest naming ``where`` and why."""
+    """``rotation`` as a (3, 3) rotation matrix, made exactly orthonormal (the polar factor, by
+    SVD) when within ``ROTATION_TOLERANCE`` of one, or InvalidRequest naming ``where`` and why."""
     matrix = np.asarray(rotation, dtype=float)
     if matrix.shape != (3, 3) or not np.isfinite(matrix).all():
         raise InvalidRequest(
@@ -46,7 +47,8 @@ def checked_rotation(rotation: ArrayLike, where: str) -> np.ndarray:
             where, rotation, rule="not_a_rotation", deviation=error, determinant=determinant,
             detail=f"{where} is not a rotation: R R^T differs from the identity by {error:.3g} and det R = {determinant:.4g}",
         )
-    return matrix
+    u, _, vt = np.linalg.svd(matrix)
+    return u @ vt
 
 
 @dataclass(frozen=True)

@@ -18,21 +18,33 @@ MAX_CELL_ARMS = 8
 #: Waypoints per arm.
 MAX_CELL_WAYPOINTS = 100
 RotationRow = Annotated[list[Annotated[float, Field(ge=-2.0, le=2.0)]], Field(min_length=3, max_length=3)]
-IDENTITY = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
 #: Fields of other kinds of path (the trajectory endpoint's ``path``), refused with advice.
 _PATH_FIELDS = ("interpolation", "max_deviation", "continuous", "revolutions")
 OTHER_PATH_KEYS = ("path", "kind", "points", "positions", "poses", "line", "start", "goal", "frame", *_PATH_FIELDS)
 
 
 class BasePose(Schema):
-    """Where an arm's base stands in the world: p_world = rotation p_base + position."""
+    """Where an arm's base stands in the world: p_world = rotation p_base + position (the
+    rotation given as a matrix or, as a trajectory's ``mounting``, a unit quaternion)."""
 
     position: Point = Field(default=[0.0, 0.0, 0.0], description="The base's origin [x, y, z] (m), world frame.")
-    rotation: Annotated[list[RotationRow], Field(min_length=3, max_length=3)] = Field(
-        default=IDENTITY,
-        description="Rotation matrix (rows) from the base's axes to the world's: orthonormal, determinant +1 "
-        "(entries within 1e-6). [[-1,0,0],[0,-1,0],[0,0,1]] turns the base half a turn about z.",
+    rotation: Annotated[list[RotationRow], Field(min_length=3, max_length=3)] | None = Field(
+        default=None,
+        description="Rotation matrix (rows) from the base's axes to the world's: orthonormal within 1e-3 (then made "
+        "exact), determinant +1; default the identity. [[-1,0,0],[0,-1,0],[0,0,1]] turns the base half a turn about z. "
+        "Give this or orientation.",
     )
+    orientation: Annotated[list[Annotated[float, Field(ge=-2.0, le=2.0)]], Field(min_length=4, max_length=4)] | None = Field(
+        default=None,
+        description="The base's orientation as a unit quaternion [qx, qy, qz, qw] (norm 1 within 1e-3); [0, 0, 1, 0] "
+        "turns it half a turn about z. Give this or rotation.",
+    )
+
+    @model_validator(mode="after")
+    def _one_rotation(self):
+        if self.orientation is not None and self.rotation is not None:
+            raise ValueError("give base.orientation or base.rotation, not both")
+        return self
 
 
 class CellArmRequest(Schema):

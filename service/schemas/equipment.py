@@ -98,7 +98,7 @@ class MountingRequest(Schema):
     rotation: Annotated[list[_Row], Field(min_length=3, max_length=3)] | None = Field(
         default=None,
         description="The base frame's orientation as a 3x3 rotation matrix, base axes to world axes (orthonormal "
-        "within 1e-6, determinant +1). Give this or orientation.",
+        "within 1e-3, then made exact; determinant +1). Give this or orientation.",
     )
     gravity: Annotated[list[Annotated[float, signed(GRAVITY)]], Field(min_length=3, max_length=3)] | None = Field(
         default=None, description="Gravity in the world (m/s^2); default the robot's own, [0, 0, -9.81] for the catalog arms."

@@ -245,3 +245,31 @@ def test_an_arm_repeating_a_waypoint_drops_it_and_an_arm_standing_still_is_told_
         "arms[1] does not move: its 2 waypoints coincide. A cell times arms that move"
     ), still.text[:300]
     assert "remove" not in still.json()["detail"]
+
+
+def test_a_base_turned_by_a_quaternion_or_by_a_four_digit_matrix_is_the_same_base(patient_client):
+    """The second arm of the example stands turned half a turn about z: as the matrix
+    [[-1,0,0],[0,-1,0],[0,0,1]], as the quaternion [0, 0, 1, 0] (a trajectory's mounting takes both)
+    give the same cell; turned by 135 degrees, the matrix written with four digits (0.7071,
+    orthonormal within 1e-3 only, refused before within 1e-6) gives the cell of the exact quaternion
+    to the digits the matrix was given with."""
+    planned = patient_client.post("/v1/cells", json=EXAMPLE).json()
+    turned = copy.deepcopy(EXAMPLE)
+    assert turned["arms"][1]["base"]["rotation"] == [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]
+    del turned["arms"][1]["base"]["rotation"]
+    turned["arms"][1]["base"]["orientation"] = [0.0, 0.0, 1.0, 0.0]
+    quaternion = patient_client.post("/v1/cells", json=turned).json()
+    assert quaternion["duration"] == pytest.approx(planned["duration"], rel=1e-9)
+    np.testing.assert_allclose(quaternion["arms"][1]["base"]["rotation"], planned["arms"][1]["base"]["rotation"], atol=1e-12)
+    turned["arms"][1]["base"]["orientation"] = [0.0, 0.0, float(np.sin(np.radians(67.5))), float(np.cos(np.radians(67.5)))]
+    exact = patient_client.post("/v1/cells", json=turned)
+    assert exact.status_code == 200, exact.text[:300]
+    del turned["arms"][1]["base"]["orientation"]
+    turned["arms"][1]["base"]["rotation"] = [[-0.7071, -0.7071, 0.0], [0.7071, -0.7071, 0.0], [0.0, 0.0, 1.0]]
+    rounded = patient_client.post("/v1/cells", json=turned)
+    assert rounded.status_code == 200, rounded.text[:300]
+    assert rounded.json()["duration"] == pytest.approx(exact.json()["duration"], rel=1e-3)
+    np.testing.assert_allclose(rounded.json()["arms"][1]["base"]["rotation"], exact.json()["arms"][1]["base"]["rotation"], atol=1e-4)
+    turned["arms"][1]["base"]["orientation"] = [0.0, 0.0, 1.0, 0.0]
+    both = patient_client.post("/v1/cells", json=turned)
+    assert both.status_code == 422 and "give base.orientation or base.rotation, not both" in both.text

@@ -56,7 +56,7 @@ async function drawCellArms(answer, body) {
   const indices = [...Array(count).keys()].map((k) => Math.round((k * (t.length - 1)) / Math.max(1, count - 1)));
   const traces = [];
   for (const [index, arm] of answer.arms.entries()) {
-    const base = body.arms[index].base || {};
+    const base = arm.base || body.arms[index].base || {};  // the pose planned with (a quaternion given, a matrix echoed)
     const mounting = {position: base.position || [0, 0, 0], rotation: base.rotation || [[1, 0, 0], [0, 1, 0], [0, 0, 1]]};
     const figure = await postJSON(`/v1/robots/${encodeURIComponent(arm.robot)}/skeleton`, {q: indices.map((i) => arm.samples.q[i]), mounting});
     const [r, g, b] = CELL_COLORS[index % CELL_COLORS.length];
