@@ -153,6 +153,8 @@ ELSEWHERE = {
     ("CompareRequest", "arms"): CELL_ELSEWHERE,
     ("JobCreate", "cell"): CELL_ELSEWHERE,
     ("JobCreate", "arms"): CELL_ELSEWHERE,
+    ("CellArmRequest", "mounting"): ": a cell arm's pose in the world is its `base` ({\"position\": [x, y, z], "
+    "\"orientation\": [qx, qy, qz, qw]} or a 3x3 \"rotation\"), and the world's gravity is the cell's `gravity`",
     ("JobCreate", "*"): ": put the request under `trajectory` (a POST /v1/trajectories body) or `compare` "
     "(a POST /v1/trajectories/compare body), e.g. {\"trajectory\": {\"robot\": \"ur5\", \"path\": ...}}",
 }
@@ -174,4 +176,6 @@ def unknown_field_hint(model: type[BaseModel] | None, loc: tuple[str | int, ...]
     (``hint``), else the nearest allowed name there (``nearest``), else the top of a job's
     body's advice."""
     specific = ELSEWHERE.get((model.__name__, location), "") if model is not None else ""
+    if model is not None and model.__name__ == "CellRequest" and len(loc) == 3 and loc[0] == "arms":
+        specific = specific or ELSEWHERE.get(("CellArmRequest", str(loc[2])), "")
     return specific or hint(model, location) or nearest(model, loc) or elsewhere(model, location)

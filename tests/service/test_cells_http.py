@@ -273,3 +273,13 @@ def test_a_base_turned_by_a_quaternion_or_by_a_four_digit_matrix_is_the_same_bas
     turned["arms"][1]["base"]["orientation"] = [0.0, 0.0, 1.0, 0.0]
     both = patient_client.post("/v1/cells", json=turned)
     assert both.status_code == 422 and "give base.orientation or base.rotation, not both" in both.text
+
+
+def test_a_trajectorys_mounting_on_a_cell_arm_says_where_the_pose_goes(patient_client):
+    arms = copy.deepcopy(EXAMPLE["arms"])
+    arms[1]["mounting"] = {"position": [1.2, 0.0, 0.0], "orientation": [0.0, 0.0, 1.0, 0.0]}
+    refused = patient_client.post("/v1/cells", json=EXAMPLE | {"arms": arms}).json()
+    assert refused["detail"].startswith("arms[1].mounting: Extra inputs are not permitted: a cell arm's pose in the world is its `base`")
+    arms[1]["orientation"] = arms[1].pop("mounting")["orientation"]
+    refused = patient_client.post("/v1/cells", json=EXAMPLE | {"arms": arms}).json()
+    assert refused["detail"].endswith("'orientation' belongs in arms[i].base.orientation"), refused["detail"]
