@@ -46,4 +46,12 @@ def test_the_cell_preset_shows_both_arms_and_the_coordination_diagram(browser_pa
     assert np.allclose(line["x"], curve[:, 0]) and np.allclose(line["y"], curve[:, 1])
     # the trajectory's tables and joint plots are not shown for a cell
     assert not page.is_visible("#joints") and not page.is_visible("#downloads")
+    assert page.locator("#warnings li").count() == len(answer["warnings"]) == 0
+    # under velocity limits only, the answer's warnings (accelerations and torques past their limits) are listed
+    cell = json.loads(page.input_value("#path"))
+    page.fill("#path", json.dumps(cell | {"constraints": ["velocity"]}))
+    page.click("#plan")
+    page.wait_for_function("() => document.querySelectorAll('#warnings li').length > 0", timeout=120_000)
+    warned = json.loads(server.request("POST", "/v1/cells", request | {"constraints": ["velocity"]})[2])
+    assert page.locator("#warnings li").all_inner_texts() == warned["warnings"]
     assert outside == []

@@ -29,7 +29,7 @@ async function planCell(request, dt) {
   $("duration").dataset.duration = String(answer.duration);
   $("binding").textContent = `(${answer.schedule}; each arm alone ${answer.solo_durations.map((d) => d.toFixed(4)).join(", ")} s, `
     + `lost to coordination ${answer.time_lost.toFixed(4)} s; closest ${(1000 * answer.min_distance.distance).toFixed(1)} mm)`;
-  $("warnings").replaceChildren();
+  $("warnings").replaceChildren(...(answer.warnings || []).map((text) => Object.assign(document.createElement("li"), {textContent: text})));
   drawDiagram(answer.diagram);
   await drawCellArms(answer, body);
   return answer;
