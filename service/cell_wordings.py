@@ -45,6 +45,14 @@ def _no_order_of_arms(facts: dict) -> str:
         "no order of the arms lets each pass the others by waiting at its start (an arm's path crosses where another arm "
         "rests at its start or end)"
     )
+    cycle = facts.get("cycle") or ()
+    if not turns and cycle:
+        chain = " before ".join(f"arms[{k}]" for k in cycle)
+        return (
+            f"{text}: each pair of arms can take turns, but only in orders that go round in a circle: {chain} (each of "
+            "these can pass the next only by moving first, while the next rests at its start); move the base of one of "
+            "them apart, or change its path so that it can also wait for the next one"
+        )
     if not turns:
         return f"{text}: move a base apart, change a path or lower clearance"
 

@@ -85,14 +85,48 @@ def prioritized(cell: Cell, solo: list[TimeScaling], diagrams: dict[tuple[int, i
     best = min((schedule for schedule in found if schedule is not None), key=lambda schedule: schedule.duration, default=None)
     if best is None:
         turns = [turn for pair in itertools.combinations(range(len(cell.arms)), 2) for turn in _blocked_turns(cell, diagrams, *pair)]
-        where = "; ".join(turn.said() for turn in turns)
+        cycle = () if turns else _precedence_cycle(diagrams, len(cell.arms))
+        where = "; ".join(turn.said() for turn in turns) or " before ".join(f"arm {k}" for k in cycle)
         raise InfeasiblePath(
             "no order of the arms lets each pass the others by waiting at its start (an arm's path crosses where "
             f"another arm rests at its start or end){': ' + where if where else ''}: move a base apart, change a path "
             "or lower clearance",
-            rule="no_order_of_arms", turns=tuple(turns), clearance=cell.clearance,
+            rule="no_order_of_arms", turns=tuple(turns), clearance=cell.clearance, cycle=cycle,
         )
     return best
+
+
+def _orders(diagram: Diagram) -> tuple[bool, bool]:
+    """Whether the first arm of a pair may go first (moving while the second rests at its
+    start, then resting at its end while the second moves), and whether the second may."""
+    s = diagram.s
+    zeros, ones = np.zeros_like(s), np.ones_like(s)
+    first = bool(diagram.free_at(s, zeros).all() and diagram.free_at(ones, s).all())
+    second = bool(diagram.free_at(zeros, s).all() and diagram.free_at(s, ones).all())
+    return first, second
+
+
+def _precedence_cycle(diagrams: dict[tuple[int, int], Diagram], count: int) -> tuple[int, ...]:
+    """Arms (indices) each of which can pass the next only by going first, the last the first
+    again: why no order serves when every pair can take turns in some order. Empty when the
+    pairs' orders leave no cycle."""
+    before: dict[int, list[int]] = {k: [] for k in range(count)}
+    for (a, b), diagram in diagrams.items():
+        a_first, b_first = _orders(diagram)
+        if a_first and not b_first:
+            before[a].append(b)
+        elif b_first and not a_first:
+            before[b].append(a)
+    for start in range(count):  # a depth-first walk back to the start
+        stack: list[tuple[int, tuple[int, ...]]] = [(start, (start,))]
+        while stack:
+            arm, walked = stack.pop()
+            for after in before[arm]:
+                if after == start:
+                    return (*walked, start)
+                if after not in walked:
+                    stack.append((after, (*walked, after)))
+    return ()
 
 
 @dataclass(frozen=True)
@@ -128,12 +162,7 @@ def _blocked_turns(cell: Cell, diagrams: dict[tuple[int, int], Diagram], a: int,
     its end (row s_a = 1); b first: the row s_a = 0 and the column s_b = 1."""
     diagram = diagrams[(a, b)]
     d, s = diagram.distance, diagram.s
-    zeros, ones = np.zeros_like(s), np.ones_like(s)
-    free = {
-        a: diagram.free_at(s, zeros).all() and diagram.free_at(ones, s).all(),
-        b: diagram.free_at(zeros, s).all() and diagram.free_at(s, ones).all(),
-    }
-    if free[a] or free[b]:
+    if any(_orders(diagram)):
         return []
     borders = {  # order: ((distances, moving, resting, rests at), ...) along the moving arm's s
         a: ((d[:, 0], a, b, "start"), (d[-1, :], b, a, "end")),

@@ -91,3 +91,39 @@ def test_an_arm_resting_where_the_others_pass_is_refused_naming_the_pairs_the_li
         assert coal_distance(Cell((moving, resting), cell.clearance), q_moving, q_resting) == pytest.approx(turn.distance, abs=1e-6)
     moved = Cell(pair.arms + (ur5_arm(REACHING, [0.6, 1.8, 0.0], QUARTER),), pair.clearance)
     assert coordinate(moved).clearance.bound >= cell.clearance
+
+
+class _Turns:
+    """A pair's diagram reduced to which arm may go first (``_orders`` reads its borders)."""
+
+    def __init__(self, first_may: bool, second_may: bool):
+        self.s = np.linspace(0.0, 1.0, 5)
+        self.first_may, self.second_may = first_may, second_may
+
+    def free_at(self, s_a, s_b):
+        s_a, s_b = np.broadcast_arrays(np.asarray(s_a, dtype=float), np.asarray(s_b, dtype=float))
+        # first arm first: its column s_b = 0 and then the row s_a = 1; second first: row s_a = 0, column s_b = 1
+        if np.all(s_b == 0.0) or (np.all(s_a == 1.0) and not np.all(s_b == 1.0)):
+            return np.full(s_a.shape, self.first_may)
+        return np.full(s_a.shape, self.second_may)
+
+
+def test_pairs_that_take_turns_only_in_circular_orders_are_named_as_that_circle():
+    """Four arms in a ring: each pair can take turns, but arm 0 only before arm 1, 1 before 2, 2
+    before 0 (and arm 3 either way): no order serves, and the refusal names the circle instead of
+    nothing."""
+    from toptraj.planners.coordination.prioritized import _orders, _precedence_cycle
+    from toptraj.service.problems import detail
+
+    assert _orders(_Turns(True, False)) == (True, False) and _orders(_Turns(False, True)) == (False, True)
+    diagrams = {(0, 1): _Turns(True, False), (1, 2): _Turns(True, False), (0, 2): _Turns(False, True),
+                (0, 3): _Turns(True, True), (1, 3): _Turns(True, True), (2, 3): _Turns(True, True)}
+    assert _precedence_cycle(diagrams, 4) == (0, 1, 2, 0)
+    diagrams[(0, 2)] = _Turns(True, False)  # 0 before 2 as well: 0, 1, 2, 3 serves
+    assert _precedence_cycle(diagrams, 4) == ()
+    refused = InfeasiblePath("no order", rule="no_order_of_arms", turns=(), clearance=0.02, cycle=(0, 1, 2, 0))
+    assert detail(refused).endswith(
+        "each pair of arms can take turns, but only in orders that go round in a circle: arms[0] before arms[1] before "
+        "arms[2] before arms[0] (each of these can pass the next only by moving first, while the next rests at its start); "
+        "move the base of one of them apart, or change its path so that it can also wait for the next one"
+    )
