@@ -285,6 +285,9 @@ def validation_errors(items: Iterable[Mapping[str, Any]], model: object = None) 
     for a field the schema does not know, where it belongs or the name it was likely meant as."""
     schema = model if isinstance(model, type) and issubclass(model, BaseModel) else None
     collapsed_items = collapsed(list(items))
+    cell = [item for item in collapsed_items if item.get("type") == "extra_forbidden" and _relative(item["loc"]) == ("arms",)]
+    if cell:  # a cell's body sent to another route: where it goes is the one thing to say
+        collapsed_items = cell
     errors = []
     for item in collapsed_items[:LISTED_ERRORS]:
         loc = tuple(item["loc"])
@@ -294,6 +297,12 @@ def validation_errors(items: Iterable[Mapping[str, Any]], model: object = None) 
             message += unknown_field_hint(schema, loc[1:] if loc[:1] == ("body",) else loc, field)
         errors.append({"field": field, "message": message})
     return errors, len(collapsed_items)
+
+
+def _relative(loc) -> tuple:
+    """An error's location relative to the body."""
+    loc = tuple(loc)
+    return loc[1:] if loc[:1] == ("body",) else loc
 
 
 def validation_detail(errors: list[dict[str, str]], count: int | None = None) -> str:

@@ -158,4 +158,6 @@ def test_a_cell_body_sent_elsewhere_is_pointed_to_the_cells_route(client, route,
     assert response.status_code == 422, response.text
     detail = response.json()["detail"]
     assert "is planned by POST /v1/cells or `toptraj plan FILE`" in detail, detail
+    if wrap is None:  # the one thing said: not where each of the cell's own fields would go in this body
+        assert [error["field"] for error in response.json()["errors"]] == ["arms"] and "path.clearance" not in detail
     assert client.post("/v1/cells", json=cell).status_code == 200  # the advice, followed
