@@ -33,6 +33,13 @@ def torque_remedy(facts: dict) -> str:
     needed = facts.get("torque_limits", ())
     if needed:
         remedies.append("timing.limits.torque of " + " and ".join(f"{value:g} {unit} on joint {joint!r}" for joint, value, unit in needed) + before)
+    beyond = facts.get("beyond_range", ())
+    if beyond:
+        needs = " and ".join(f"{value:.4g} {unit} on joint {joint!r}" for joint, value, unit in beyond)
+        return (
+            f"; holding it still would need {needs}, beyond any torque limit accepted ({facts['most']:g} {beyond[0][2]}): "
+            "a lighter payload, or a path where the arm holds itself with less torque, is needed"
+        )
     if not remedies:
         return ""
     return (

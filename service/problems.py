@@ -178,9 +178,10 @@ def detail(error: ToptrajError) -> str:
         text += torque_remedy(vars(error))
     carried = getattr(error, "payload_carried", None)
     if carried is not None:
+        higher = "" if getattr(error, "beyond_range", ()) else " or higher torque limits (timing.limits.torque)"
         text += (
             f"; the torques include the payload of {carried[0]:g} kg at {carried[1]}: a lighter payload "
-            "(payload.mass) or higher torque limits (timing.limits.torque) may make the path feasible"
+            f"(payload.mass){higher} may make the path feasible"
         )
     return _cut(text)
 

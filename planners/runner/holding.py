@@ -40,7 +40,10 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
     ``asked_scale`` (the torque scale asked, 1 without one), ``torque_scale`` (it times the
     largest ratio, rounded up; ``None`` outside the accepted ranges) and ``torque_limits``
     ((joint, value, unit: N m or N) for each joint beyond its limit: its limit as asked, before
-    the scale, times its ratio, rounded up, where that lies in the accepted range)."""
+    the scale, times its ratio, rounded up, where that lies in the accepted range). Where a
+    joint would need a limit beyond the accepted range, no limit advice holds the path:
+    ``beyond_range`` ((joint, value, unit) for each such joint) and ``most`` (the range's top)
+    instead."""
     facts = {key: value for key, value in vars(error).items() if key != "detail"}
     zoned = _zone_remedy(facts.pop("zones", problem.limits.zones), facts["joints"])
     if zoned:
@@ -50,13 +53,18 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
     scale = asked.scales.get("torque") or 1.0
     limits = np.asarray(problem.robot.limits.with_request(asked.overrides).torque, dtype=float)
     names = problem.robot.joint_names
-    needed = []
+    needed, beyond = [], []
     for ratio, load in facts["joints"]:
         if not (np.isfinite(ratio) and np.isfinite(limits[names.index(load.joint)])):
             continue
         value = rounded_up(float(limits[names.index(load.joint)]) * ratio * (1.0 + ROOM), ADVISED_DIGITS)
         if np.isfinite(value) and TORQUE.low <= value * scale <= TORQUE.high and value <= TORQUE.high:
             needed.append((load.joint, value, load.unit))
+        else:
+            beyond.append((load.joint, value * scale, load.unit))
+    if beyond:  # no limit accepted holds that joint: advice for the others would not plan the path
+        facts.update(asked_scale=scale, torque_scale=None, torque_limits=(), beyond_range=tuple(beyond), most=TORQUE.high)
+        return type(error)(error.detail, **facts)
     advised = rounded_up(scale * facts["ratio"] * (1.0 + ROOM), ADVISED_DIGITS) if np.isfinite(facts["ratio"]) else None
     finite = limits[np.isfinite(limits)]
     if not (advised is not None and SCALE.low <= advised <= SCALE.high and (finite * advised <= TORQUE.high).all()):

@@ -103,3 +103,14 @@ def test_every_refusal_that_holding_explains_gives_a_remedy_that_is_answered(cli
     assert scale is not None, detail
     followed = client.post("/v1/trajectories", json={**body, "timing": {**timing, "limits": {"torque_scale": float(scale.group(1))}}})
     assert followed.status_code == 200, followed.text
+
+
+def test_a_load_no_accepted_limit_holds_is_told_so_without_advice_that_cannot_work(client):
+    """1000 kg held 17 m from ur5's tool: holding it still needs about 1.1e5 N m on the wrist,
+    beyond the largest torque limit a request may give (1e5 N m): no torque scale or limit is
+    advised (one for the other joints alone would not plan the path), only a lighter payload."""
+    waypoints = [[0, -1.2, 1, 0, 0.5, 0], [0.8, -1, 1.4, -0.5, 0.9, 0.3]]
+    body = {"robot": "ur5", "path": {"waypoints": waypoints}, "payload": {"mass": 1000.0, "center_of_mass": [10.0, 10.0, 10.0]}}
+    detail = client.post("/v1/trajectories", json=body).json()["detail"]
+    assert "beyond any torque limit accepted (100000 N m): a lighter payload, or a path where the arm holds itself" in detail
+    assert "every joint can hold the path still" not in detail and "timing.limits.torque" not in detail, detail
