@@ -11,6 +11,7 @@ import numpy as np
 
 from toptraj import robots
 from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.problem.gravity_notes import gravity_notes
 from toptraj.robots.equipment import Mounting, Payload, equip
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 
@@ -31,15 +32,19 @@ def equipped_robot(request: TrajectoryRequest | CompareRequest) -> robots.Robot:
 @contextmanager
 def payload_named(robot: robots.Robot) -> Iterator[None]:
     """A torque limit a path cannot meet says that its torques include the robot's payload,
-    and what to change."""
+    and an unusual gravity of its mounting (``gravity_notes``), and what to change."""
     try:
         yield
     except InfeasiblePath as error:
-        payload = robot.payload
-        if payload is None or getattr(error, "limit", None) != "torque":
+        if getattr(error, "limit", None) != "torque":
             raise
-        # a fact of the error, worded with it (``toptraj.service.problems.detail``)
-        vars(error)["payload_carried"] = (payload.mass, payload.frame or robot.end_effector)
+        # facts of the error, worded with it (``toptraj.service.problems.detail``)
+        payload = robot.payload
+        if payload is not None:
+            vars(error)["payload_carried"] = (payload.mass, payload.frame or robot.end_effector)
+        unusual = gravity_notes(robot)
+        if unusual:
+            vars(error)["gravity_unusual"] = unusual[0]
         raise
 
 

@@ -101,6 +101,20 @@ def _slowed_to_whole_periods(facts: dict) -> str:
     )
 
 
+def _gravity_unusual(facts: dict) -> str:
+    gravity = ", ".join(f"{value:g}" for value in facts["gravity"])
+    if facts["up"]:
+        return (
+            f"mounting.gravity [{gravity}] points up (+z in the world), and the torques follow it; the Earth's is "
+            "[0, 0, -9.81] in a world whose z is up, and a ceiling-mounted arm is given by mounting.orientation "
+            "([1, 0, 0, 0]) with that gravity"
+        )
+    return (
+        f"mounting.gravity [{gravity}] has a magnitude of {facts['magnitude']:.4g} m/s^2, and the torques follow it; "
+        "the Earth's is 9.81 m/s^2 (gravity is in m/s^2, not in g)"
+    )
+
+
 def _default_kind_not_held(facts: dict) -> str:
     kind, method = facts["kind"], facts["method"]
     peak = (
@@ -138,6 +152,7 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     "limit_far_above_own": _limit_far_above_own,
     "missed_region": _missed_region,
     "too_few_samples": _too_few_samples,
+    "gravity_unusual": _gravity_unusual,
     "slowed_to_whole_periods": _slowed_to_whole_periods,
     "urdf_limit_out_of_range": (
         "{where}: {kind} limit {value:g} {unit} in the URDF is outside the accepted range "

@@ -183,6 +183,9 @@ def detail(error: ToptrajError) -> str:
             f"; the torques include the payload of {carried[0]:g} kg at {carried[1]}: a lighter payload "
             f"(payload.mass){higher} may make the path feasible"
         )
+    unusual = getattr(error, "gravity_unusual", None)
+    if unusual is not None:
+        text += f"; {note_text(unusual)}"
     return _cut(text)
 
 

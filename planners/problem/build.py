@@ -29,6 +29,7 @@ from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.planners.problem.bounded import check_speed_bounded
 from toptraj.planners.problem.free_motion import FreeMotion
+from toptraj.planners.problem.gravity_notes import gravity_notes
 from toptraj.planners.problem.methods import MotionGenerator
 from toptraj.planners.problem.problem import AT_REST, BoundaryStates, LimitRequest, MotionSpec, Problem, Sampling
 from toptraj.planners.problem.raised_limits import raised_limits
@@ -87,7 +88,7 @@ def build_problem(
         raise OutOfRange("limits.margin", margin, 0.0, MAX_LIMIT_MARGIN, rule="margin_out_of_range")
     held = _limits(robot, motion, method, limits)
     held = held.tightened(margin) if margin else held
-    notes: tuple[str, ...] = raised_limits(robot, limits, kinds)
+    notes: tuple[str, ...] = (*raised_limits(robot, limits, kinds), *gravity_notes(robot))
     if isinstance(motion, WaypointPath):
         motion, turns = continuous_turns(robot, motion)
         motion, dropped = without_repeats(motion)
