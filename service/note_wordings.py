@@ -101,6 +101,14 @@ def _slowed_to_whole_periods(facts: dict) -> str:
     )
 
 
+def _obstacles_far(facts: dict) -> str:
+    return (
+        f"the obstacles of path.obstacles stay at least {facts['distance']:.4g} m from the arm, {facts['distance'] / facts['reach']:.0f} "
+        f"times its reach ({facts['reach']:.3g} m): they constrain nothing. Obstacles are in metres, in the world frame "
+        "(the robot's base frame without a mounting); a position in millimetres is a thousand times too far"
+    )
+
+
 def _gravity_unusual(facts: dict) -> str:
     gravity = ", ".join(f"{value:g}" for value in facts["gravity"])
     if facts["up"]:
@@ -153,6 +161,7 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     "missed_region": _missed_region,
     "too_few_samples": _too_few_samples,
     "gravity_unusual": _gravity_unusual,
+    "obstacles_far": _obstacles_far,
     "slowed_to_whole_periods": _slowed_to_whole_periods,
     "urdf_limit_out_of_range": (
         "{where}: {kind} limit {value:g} {unit} in the URDF is outside the accepted range "

@@ -29,7 +29,7 @@ from toptraj.planners.timing.base import TimingMethod
 from toptraj.planners.timing.laws.law_timing import LawTiming
 from toptraj.planners.timing.laws.method import ClassicalMethod
 from toptraj.planners.trajectory import Samples, sample_trajectory
-from toptraj.robots import JointLimits
+from toptraj.robots import JointLimits, Robot
 from toptraj.robots.notes import Note
 
 if TYPE_CHECKING:  # the generators' reports, imported where a generator ran
@@ -61,6 +61,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     if problem.obstacles:
         # a given path was checked before its timing; a path shaped with its timing (via points) now
         found_clearance = checked_first or check_clearance(timed.path, robot, list(problem.obstacles), problem.clearance, deadline)
+        notes.extend(_far_obstacles(found_clearance, robot))
     deadline.progress(0.9, "sampling")
     samples = _samples(problem, timed)
     accuracy, warning = _accuracy(problem, timed)
@@ -276,3 +277,19 @@ def _unasked_limits(
         remedy = f"add {kind!r} to the constraints to hold it" if kind in method.kinds else f"{method.name} cannot hold {kind} limits"
         notes.append(f"the {kind} of joint {name!r} reaches {peak[joint]:.4g} times its limit, which was not asked for: {remedy}")
     return notes
+
+
+#: Obstacles farther from the arm than this many times its reach, all of them, are noted: a
+#: position given in millimetres, or in another frame, would otherwise check nothing unnoticed.
+FAR_REACHES = 10.0
+
+
+def _far_obstacles(found: Clearance, robot: Robot) -> list[Note]:
+    """A note when even the nearest obstacle stays ``FAR_REACHES`` times the arm's reach away."""
+    reach = robot.neutral_reach
+    if not (reach > 0.0 and found.distance > FAR_REACHES * reach):
+        return []
+    return [Note(
+        f"the obstacles stay at least {found.distance:.4g} m from the arm, {found.distance / reach:.0f} times its reach",
+        "obstacles_far", field="obstacles", distance=found.distance, reach=reach,
+    )]

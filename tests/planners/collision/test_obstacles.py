@@ -244,3 +244,17 @@ def test_a_box_orientation_that_is_no_unit_quaternion_is_named(client, orientati
     response = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [sphere, box]}})
     assert response.status_code == 422, response.text
     assert response.json()["detail"].startswith(f"path.obstacles[1].orientation has norm {norm}; a box's orientation is a unit quaternion")
+
+
+def test_obstacles_far_beyond_the_arms_reach_are_noted(client):
+    """A sphere given in millimetres (500, 200, 300 for 0.5, 0.2, 0.3 m) is 565 m from ur5, whose
+    reach is under a metre: the answer says the obstacles constrain nothing and are in metres; one
+    within reach is not noted."""
+    far = {"kind": "sphere", "center": [500.0, 200.0, 300.0], "radius": 50.0}
+    answer = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [far]}}).json()
+    [noted] = [warning for warning in answer["warnings"] if "path.obstacles" in warning]
+    assert noted.startswith(f"the obstacles of path.obstacles stay at least {answer['min_clearance']['distance']:.4g} m from the arm")
+    assert "a position in millimetres is a thousand times too far" in noted
+    near = {"kind": "sphere", "center": [0.5, 0.5, 0.9], "radius": 0.05}
+    answer = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [near]}}).json()
+    assert not any("path.obstacles" in warning for warning in answer["warnings"]), answer
