@@ -101,21 +101,19 @@ def _no_limit_bounds_speed(facts: dict) -> str:
     )
 
 
-def _segment_unbounded(facts: dict) -> str:
-    kinds = facts["kinds"]
-    where = f"{facts['field']}: " if str(facts["field"]).startswith("arms[") else ""
-    first = next((kind for kind in kinds if kind != "torque"), "velocity")
+def _stretch_unbounded(facts: dict) -> str:
     joints = facts["joints"]
+    moving = f"{'joint ' if len(joints) == 1 else 'joints '}{', '.join(repr(j) for j in joints)}" if joints else "no joint"
     return (
-        f"{where}from waypoint {facts['segment']} to {facts['segment'] + 1} only {', '.join(repr(j) for j in joints)} "
-        f"{'moves' if len(joints) == 1 else 'move'}, and {'it has' if len(joints) == 1 else 'they have'} no finite "
-        f"{_either(kinds)} limit: nothing bounds the speed there; {_bounding_remedies(facts, first)}"
+        f"from s = {facts['s_from']:.4f} to {facts['s_to']:.4f} nothing bounds the motion: {moving} "
+        f"{'moves' if len(joints) == 1 else 'move'} there without a finite {_either(facts['kinds'])} limit (or a "
+        f"tool-speed limit that holds there), so the shortest time would be zero; {_bounding_remedies(facts, next((k for k in facts['kinds'] if k != 'torque'), 'velocity'))}"
     )
 
 
 LIMIT_WORDING: dict[str, str | Callable[[dict], str]] = {
     "duration_too_short": _duration_too_short,
     "no_limit_bounds_speed": _no_limit_bounds_speed,
-    "segment_unbounded": _segment_unbounded,
+    "stretch_unbounded": _stretch_unbounded,
     "not_even_at_rest": _not_even_at_rest,
 }

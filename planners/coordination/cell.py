@@ -108,10 +108,10 @@ class Cell:
         (``toptraj.planners.problem.bounded``: an arm with none would be timed at zero).
 
         Raises:
-            InvalidRequest: field ``arms[i]``, rules "no_limit_bounds_speed" or "segment_unbounded".
+            InvalidRequest: field ``arms[i]``, rule "no_limit_bounds_speed".
         """
         for index, arm in enumerate(self.arms):
-            check_speed_bounded(arm.robot, arm.limits, self.kinds, getattr(arm.path, "waypoints", None), field=f"arms[{index}]")
+            check_speed_bounded(arm.robot, arm.limits, self.kinds, field=f"arms[{index}]")
 
 
 def pair_distances(first: tuple[np.ndarray, np.ndarray, np.ndarray], second: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -93,7 +93,7 @@ def build_problem(
         motion, turns = continuous_turns(robot, motion)
         motion, dropped = without_repeats(motion)
         notes = (*notes, *turns, *dropped)
-    check_speed_bounded(robot, held, kinds, motion.waypoints if isinstance(motion, WaypointPath) else None, served=method.kinds)
+    check_speed_bounded(robot, held, kinds, served=method.kinds)
     problem = Problem(
         robot=robot, motion=motion, method=method, requested=limits, grid=grid, boundary=boundary, duration=duration,
         kinds=kinds, limits=held, margin=margin, threshold=gate_threshold(margin), sampling=sampling,

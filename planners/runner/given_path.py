@@ -16,6 +16,7 @@ from toptraj.planners.constraints.zones import on_stretch, with_edges
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.paths.stretch import Stretch, stretches
+from toptraj.planners.problem.bounded import check_stretches_bounded
 from toptraj.planners.problem.methods import Timed
 from toptraj.planners.problem.path_checks import check_jerk_finite, check_path_within_limits, path_boundary, timing_grid
 from toptraj.planners.runner.stretch_loads import over_every_stretch
@@ -51,6 +52,8 @@ def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, 
         s = with_edges(s, limits.zones, stretch.knots)
     deadline.progress(0.0, "constraints")
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
+    start, width = (stretch.start, stretch.width) if isinstance(stretch, Stretch) else (0.0, 1.0)
+    check_stretches_bounded(constraints, stretch, robot, limits, kinds, lambda sigma: start + width * sigma, method.kinds)
     deadline.check()
     timing, constraints, check = gated(
         robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline.within(0.3, 1.0),

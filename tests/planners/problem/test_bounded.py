@@ -12,9 +12,10 @@ import pytest
 from fastapi.testclient import TestClient
 
 from toptraj import robots
+from toptraj.planners import METHODS, LimitRequest, WaypointPath, build_problem, plan
 from toptraj.planners.errors import InvalidRequest
-from toptraj.planners.problem.bounded import check_speed_bounded
 from toptraj.service.app import create_app
+from toptraj.service.problems import detail
 from toptraj.service.settings import Settings
 
 
@@ -42,7 +43,8 @@ def test_limits_the_robot_does_not_have_are_refused_naming_what_bounds_it(client
 
 def test_either_remedy_plans_the_motion(client):
     with_torque = client.post("/v1/trajectories", json=_trajectory(["velocity", "torque"]))
-    assert with_torque.status_code == 200 and with_torque.json()["duration"] == pytest.approx(1.2654, abs=1e-3)
+    torque_only = client.post("/v1/trajectories", json=_trajectory(["torque"]))  # no velocity limit to hold: the same motion
+    assert with_torque.status_code == 200 and with_torque.json()["duration"] == torque_only.json()["duration"]
     given = client.post("/v1/trajectories", json=_trajectory(["velocity"], velocity=[2.0, 2.0]))
     assert given.status_code == 200, given.text
     # 1 rad at 2 rad/s: 0.5 s, and on the grid of 100 intervals the first and last take twice
@@ -66,11 +68,36 @@ def test_a_cell_of_arms_without_the_limits_asked_is_refused_and_with_torque_is_p
     assert max(planned.json()["arms"][0]["peak_utilization"]["torque"]) == pytest.approx(1.0, abs=5e-3)
 
 
-def test_a_segment_that_moves_only_joints_without_a_limit_is_refused_naming_it():
+def _planned(limits: dict, kinds: tuple[str, ...], waypoints, interpolation: str = "spline"):
     robot = robots.load("geering_2r")
-    limits = dataclasses.replace(robot.limits, velocity=np.array([2.0, np.inf]))
-    check_speed_bounded(robot, limits, ("velocity",), np.array([[0.0, 0.0], [1.0, 1.0]]))  # phi moves throughout
-    with pytest.raises(InvalidRequest) as raised:
-        check_speed_bounded(robot, limits, ("velocity",), np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
-    assert (raised.value.rule, raised.value.segment, raised.value.joints) == ("segment_unbounded", 1, ("psi",))
-    check_speed_bounded(robot, limits, ("velocity", "torque"), np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
+    robot = dataclasses.replace(robot, limits=dataclasses.replace(robot.limits, **{k: np.array(v) for k, v in limits.items()}))
+    path = WaypointPath(np.array(waypoints, dtype=float), interpolation)
+    return plan(build_problem(robot, path, METHODS["phase_plane"], limits=LimitRequest(kinds=kinds)))
+
+
+def test_a_stretch_that_moves_only_joints_without_a_limit_is_refused_naming_it():
+    """phi limited, psi not: the straight segment on which psi alone moves has nothing to bound
+    it; a spline through the same waypoints turns phi there too (it overshoots) and plans, and a
+    torque limit on phi alone bounds psi through the inertia that couples them."""
+    with pytest.raises(InvalidRequest) as refused:
+        _planned({"velocity": [2.0, np.inf]}, ("velocity",), [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], "linear")
+    assert (refused.value.rule, refused.value.joints) == ("stretch_unbounded", ("psi",))
+    assert refused.value.s_from >= 0.5 and refused.value.s_to == pytest.approx(1.0, abs=0.02)
+    assert detail(refused.value).startswith(f"from s = {refused.value.s_from:.4f} to {refused.value.s_to:.4f} nothing bounds the motion: joint 'psi' moves")
+    assert _planned({"velocity": [2.0, np.inf]}, ("velocity",), [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]).duration > 0.5
+    assert _planned({"torque": [25.0, np.inf]}, ("torque",), [[0.0, 0.0], [0.0, 1.0]]).duration > 0.1
+
+
+def test_a_tool_speed_that_holds_only_where_it_can_is_no_bound_elsewhere(client):
+    """A zone's tool speed bounds its zone only, and an angular speed limit nothing where the
+    tool does not turn: both were divisions by zero in the timing."""
+    zone = _trajectory(["velocity"]) | {}
+    zone["timing"] = zone["timing"] | {"zones": [{"s_range": [0.4, 0.6], "tool_speed": 0.5}]}
+    refused = client.post("/v1/trajectories", json=zone)
+    assert refused.status_code == 422 and refused.json()["detail"].startswith("nothing bounds the motion of geering_2r"), refused.text
+    turning = _trajectory(["velocity"])
+    turning["path"]["waypoints"] = [[0.0, 0.0], [1.0, -1.0]]  # the hand's orientation phi + psi never changes
+    turning["timing"]["limits"] = {"tool_angular_speed": 1.0}
+    refused = client.post("/v1/trajectories", json=turning)
+    assert refused.status_code == 422, refused.text
+    assert refused.json()["detail"].startswith("from s = 0.0000 to 1.0000 nothing bounds the motion: joints 'phi', 'psi' move"), refused.text
