@@ -24,12 +24,15 @@ def torque_remedy(facts: dict) -> str:
     """The torque scale or limits (``torque_scale``, ``torque_limits`` among ``facts``) with
     which every joint can hold the path still everywhere, as advice; an empty string without."""
     remedies = []
-    for index, value in facts.get("zone_scales", ()):
-        remedies.append(f"timing.zones[{index}].torque_scale {value:g}")
+    zones = facts.get("zone_scales", ())
+    if zones:  # every zone listed is raised together
+        remedies.append(" and ".join(f"timing.zones[{index}].torque_scale {value:g}" for index, value in zones))
     if facts.get("torque_scale") is not None:
         remedies.append(f"timing.limits.torque_scale {facts['torque_scale']:g}")
     asked = facts.get("asked_scale", 1.0)
     before = f" (before timing.limits.torque_scale {asked:g})" if asked != 1.0 else ""
+    if facts.get("without_scale"):
+        before = " (without timing.limits.torque_scale)"
     needed = facts.get("torque_limits", ())
     if needed:
         remedies.append("timing.limits.torque of " + " and ".join(f"{value:g} {unit} on joint {joint!r}" for joint, value, unit in needed) + before)

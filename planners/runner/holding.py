@@ -19,12 +19,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from toptraj.planners.constraints.held_load import rest_loads
+from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.constraints.zones import inside, zone_factors
 from toptraj.planners.errors import InfeasiblePath
+from toptraj.planners.paths.base import GeometricPath
+from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.problem.ranges import SCALE
 from toptraj.planners.runner.duration import rounded_up
-from toptraj.robots import LimitZone
 from toptraj.robots.ranges import TORQUE
 
 #: Significant digits of the torque scale and limits advised (rounded up: room to spare).
@@ -45,7 +48,7 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
     ``beyond_range`` ((joint, value, unit) for each such joint) and ``most`` (the range's top)
     instead."""
     facts = {key: value for key, value in vars(error).items() if key != "detail"}
-    zoned = _zone_remedy(facts.pop("zones", problem.limits.zones), facts["joints"])
+    zoned = facts.pop("zone_scales", ())
     if zoned:
         facts.update(asked_scale=problem.requested.scales.get("torque") or 1.0, torque_scale=None, torque_limits=(), zone_scales=zoned)
         return type(error)(error.detail, **facts)
@@ -58,35 +61,47 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
         if not (np.isfinite(ratio) and np.isfinite(limits[names.index(load.joint)])):
             continue
         value = rounded_up(float(limits[names.index(load.joint)]) * ratio * (1.0 + ROOM), ADVISED_DIGITS)
-        if np.isfinite(value) and TORQUE.low <= value * scale <= TORQUE.high and value <= TORQUE.high:
-            needed.append((load.joint, value, load.unit))
-        else:
-            beyond.append((load.joint, value * scale, load.unit))
+        in_force = rounded_up(float(limits[names.index(load.joint)]) * scale * ratio * (1.0 + ROOM), ADVISED_DIGITS)
+        if not (np.isfinite(in_force) and in_force <= TORQUE.high):
+            beyond.append((load.joint, in_force, load.unit))
+        needed.append((load.joint, value, in_force, load.unit))
     if beyond:  # no limit accepted holds that joint: advice for the others would not plan the path
         facts.update(asked_scale=scale, torque_scale=None, torque_limits=(), beyond_range=tuple(beyond), most=TORQUE.high)
         return type(error)(error.detail, **facts)
+    if all(TORQUE.low <= value <= TORQUE.high for _, value, _, _ in needed):  # overrides under the scale asked
+        limits_advised = tuple((joint, value, unit) for joint, value, _, unit in needed)
+        unscaled = False
+    else:  # an override beyond the range under the scale: the limits in force, without the scale
+        limits_advised = tuple((joint, in_force, unit) for joint, _, in_force, unit in needed)
+        unscaled = True
     advised = rounded_up(scale * facts["ratio"] * (1.0 + ROOM), ADVISED_DIGITS) if np.isfinite(facts["ratio"]) else None
     finite = limits[np.isfinite(limits)]
     if not (advised is not None and SCALE.low <= advised <= SCALE.high and (finite * advised <= TORQUE.high).all()):
         advised = None
-    facts.update(asked_scale=scale, torque_scale=advised, torque_limits=tuple(needed))
+    facts.update(asked_scale=scale, torque_scale=advised, torque_limits=limits_advised, without_scale=unscaled)
     return type(error)(error.detail, **facts)
 
 
-def _zone_remedy(located: tuple[LimitZone, ...], joints: tuple) -> tuple[tuple[int, float], ...]:
-    """(zone index, torque scale) for each of the zones ``located`` on the path that alone keeps
-    a joint from holding it still (module docstring), when the zones alone do; empty otherwise."""
-    zones = tuple(zone for zone in located if zone.torque < 1.0)
-    if not zones or not joints:
+def zone_remedy(problem: Problem, path: GeometricPath) -> tuple[tuple[int, float], ...]:
+    """(zone index, torque scale) for the zones of ``problem`` (located on ``path``) whose torque
+    scales alone keep the path from being held still, when raising them holds it everywhere
+    (module docstring); empty otherwise. Holding still is measured on the path's default grid
+    (``rest_loads``: each point's largest share of a joint's limit in force there), and a zone
+    is raised to the largest share its own points need without the zones' factors."""
+    zones = tuple(zone for zone in problem.limits.zones if zone.torque < 1.0)
+    if not zones:
         return ()
-    needed: dict[int, float] = {}
-    for ratio, load in joints:
-        at = np.array([load.s])
-        factor = float(zone_factors(zones, at).torque[0])
-        if not np.isfinite(ratio) or ratio * factor > 1.0:
-            return ()  # the limits outside the zones do not hold it either
-        for zone in zones:
-            if factor < 1.0 and zone.torque == factor and inside(zone, at)[0]:
-                value = min(1.0, rounded_up(ratio * factor * (1.0 + ROOM), ADVISED_DIGITS))
-                needed[zone.index] = max(needed.get(zone.index, 0.0), value)
+    constraints = build_path_constraints(path, problem.robot, problem.limits, ("torque",), path_grid(path), problem.deadline)
+    ratios, _ = rest_loads(constraints)
+    if not ratios.size:
+        return ()
+    factor = zone_factors(zones, constraints.s).torque
+    unzoned = ratios.max(axis=1) * factor  # each point's share of the limits outside the zones
+    if not (np.isfinite(unzoned).all() and unzoned.max() <= 1.0):
+        return ()  # the limits outside the zones do not hold it either
+    needed = {}
+    for zone in zones:
+        within = inside(zone, constraints.s)
+        if within.any() and unzoned[within].max() > zone.torque:
+            needed[zone.index] = min(1.0, rounded_up(float(unzoned[within].max()) * (1.0 + ROOM), ADVISED_DIGITS))
     return tuple(sorted(needed.items()))

@@ -28,7 +28,7 @@ from toptraj.planners.runner.admission import admit
 from toptraj.planners.runner.answer import answer
 from toptraj.planners.runner.duration import too_short
 from toptraj.planners.runner.given_path import timed_path
-from toptraj.planners.runner.holding import with_torque_remedy
+from toptraj.planners.runner.holding import with_torque_remedy, zone_remedy
 from toptraj.planners.timing.base import TimingMethod
 
 
@@ -110,8 +110,8 @@ def _given_path(problem: Problem, part: Deadline) -> tuple[Timed, Clearance | No
             part.within(0.1, 1.0), problem.threshold,
         )
     except InfeasiblePath as error:
-        if problem.limits.zones and getattr(error, "joints", None):  # the zones located, for the torque remedy
-            error.__dict__["zones"] = problem.limits.zones
+        if problem.limits.zones and getattr(error, "joints", None):  # the zones' own remedy, on the located zones
+            error.__dict__["zone_scales"] = zone_remedy(problem, path)
         raise
     return timed, checked, problem
 

@@ -114,3 +114,21 @@ def test_a_load_no_accepted_limit_holds_is_told_so_without_advice_that_cannot_wo
     detail = client.post("/v1/trajectories", json=body).json()["detail"]
     assert "beyond any torque limit accepted (100000 N m): a lighter payload, or a path where the arm holds itself" in detail
     assert "every joint can hold the path still" not in detail and "timing.limits.torque" not in detail, detail
+
+
+def test_limits_beyond_the_range_under_a_scale_are_advised_without_the_scale(client):
+    """550 kg at 17 m from ur5's tool under torque_scale 0.5: the overrides that would hold it
+    under the scale (up to 124,800 N m) lie beyond the accepted 100,000; the limits in force that
+    hold it do not, and are advised without the scale: following that plans the path."""
+    waypoints = [[0, -1.2, 1, 0, 0.5, 0], [0.8, -1, 1.4, -0.5, 0.9, 0.3]]
+    payload = {"mass": 550.0, "center_of_mass": [10.0, 10.0, 10.0]}
+    body = {"robot": "ur5", "path": {"waypoints": waypoints}, "payload": payload, "timing": {"limits": {"torque_scale": 0.5}}}
+    detail = client.post("/v1/trajectories", json=body).json()["detail"]
+    assert "(without timing.limits.torque_scale) (or more) every joint can hold the path still" in detail, detail
+    advised = dict((joint, float(value)) for value, joint in re.findall(r"(\d+) N m on joint '(\w+)'", detail.split("; with ")[1]))
+    assert max(advised.values()) <= 100_000
+    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
+    own = [150.0, 150.0, 150.0, 28.0, 28.0, 28.0]
+    torque = [advised.get(name, limit) for name, limit in zip(names, own, strict=True)]
+    followed = client.post("/v1/trajectories", json=body | {"timing": {"limits": {"torque": torque}}})
+    assert followed.status_code == 200, followed.text[:300]

@@ -4,6 +4,8 @@ zones a 422 saying which do."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from tests.conftest import UR5_WAYPOINTS
@@ -102,3 +104,21 @@ def test_a_zone_too_weak_to_hold_the_arm_still_is_told_its_own_torque_scale(clie
     followed = client.post("/v1/trajectories", json={**body, "timing": {"zones": [{**zone, "torque_scale": 0.254}]}})
     assert followed.status_code == 200, followed.text[:300]
     assert max(followed.json()["peak_utilization"]["torque"]) <= 1.005
+
+
+def test_the_zone_remedy_holds_the_whole_path_or_is_not_given(client):
+    """ur5 lifting its upper arm to the horizontal: holding it there needs 59.17 N m on
+    shoulder_lift_joint (39 % of 150). Two overlapping zones at the end, of 5 % and 10 %: both
+    are raised, together, and following the advice plans the path. With a torque scale of 0.3 the
+    path's end, outside any zone, cannot hold it either: no zone is advised, only limits of the
+    whole path."""
+    lift = {"kind": "waypoints", "waypoints": [[0.0, -1.57, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]]}
+    zones = [{"s_range": [0.9, 1.0], "torque_scale": 0.05}, {"s_range": [0.85, 1.0], "torque_scale": 0.1}]
+    detail = client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": {"zones": zones}}).json()["detail"]
+    advised = re.findall(r"timing\.zones\[(\d)\]\.torque_scale ([\d.]+)", detail)
+    assert [index for index, _ in advised] == ["0", "1"] and "timing.zones[0].torque_scale 0.395 and timing.zones[1]" in detail
+    followed = [{**zone, "torque_scale": float(value)} for zone, (_, value) in zip(zones, advised, strict=True)]
+    assert client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": {"zones": followed}}).status_code == 200
+    scaled = {"limits": {"torque_scale": 0.3}, "zones": [{"s_range": [0.0, 0.3], "torque_scale": 0.05}]}
+    detail = client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": scaled}).json()["detail"]
+    assert "timing.zones" not in detail and "timing.limits.torque_scale 3.61" in detail, detail
