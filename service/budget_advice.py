@@ -14,15 +14,17 @@ from toptraj.planners.errors import BudgetExceeded
 
 def as_job(kind: str, plan_budget_s: float, job_budget_s: float, job_max_budget_s: float) -> str:
     """Advice for a synchronous ``kind`` request ("trajectory" or "compare") past the planning
-    budget of ``plan_budget_s`` s: to run it as a job, when a job may run longer."""
+    budget of ``plan_budget_s`` s: to run it as a job, when a job may run longer, with a budget
+    of the job's default (``job_budget_s``) or five times the planning budget if more, within
+    ``job_max_budget_s``."""
     if job_max_budget_s <= plan_budget_s:
         return (
             f"this server allows no planning longer than {plan_budget_s:g} s; its operator can raise "
             "TOPTRAJ_PLAN_BUDGET_S and TOPTRAJ_JOB_MAX_BUDGET_S"
         )
-    default = min(job_budget_s, job_max_budget_s)
+    suggested = min(job_max_budget_s, max(job_budget_s, 5.0 * plan_budget_s))  # always more time than it had
     return (
-        f'run it as a job, in the background: POST /v1/jobs with {{"{kind}": <this request>, "budget_s": {default:g}}} '
+        f'run it as a job, in the background: POST /v1/jobs with {{"{kind}": <this request>, "budget_s": {suggested:g}}} '
         f"(at most {job_max_budget_s:g} s), then GET the job's Location until it is done"
     )
 

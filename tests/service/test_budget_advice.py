@@ -115,3 +115,11 @@ def test_a_line_of_a_batch_job_past_its_budget_names_the_job_that_plans_it(tmp_p
         assert "(at most 900 s)" in detail, detail
         route, job = _job_body(detail, line)
         assert route == "/v1/jobs" and job == {kind: line, "budget_s": 120}
+
+
+def test_the_advised_job_budget_is_always_more_than_the_request_had():
+    """A server whose planning budget exceeds a job's default (600 s against 300): the job advised
+    gets five times the planning budget, within the job maximum."""
+    assert '"budget_s": 3000}' in budget_advice.as_job("trajectory", 600.0, 300.0, 3600.0)
+    assert '"budget_s": 3600}' in budget_advice.as_job("trajectory", 1000.0, 300.0, 3600.0)
+    assert '"budget_s": 300}' in budget_advice.as_job("trajectory", 20.0, 300.0, 3600.0)
