@@ -51,9 +51,9 @@ def _json_body(value: dict | str | os.PathLike[str]) -> dict:
     """
     if isinstance(value, dict):
         return value
-    if isinstance(value, str) and not value.lstrip().startswith(("{", "[")):
+    if isinstance(value, str) and not value.lstrip("\ufeff \t\r\n").startswith(("{", "[")):
         value = Path(value)
-    return json.loads(_text(value).removeprefix("\ufeff"))
+    return json.loads(_text(value).lstrip("\ufeff"))
 
 
 def _alone(body: dict, **arguments: Any) -> None:

@@ -74,7 +74,21 @@ def _no_order_of_arms(facts: dict) -> str:
     )
 
 
+def _arm_not_held(facts: dict) -> str:
+    index, unit = facts["index"], facts["unit"]
+    remedies = [f"raise arms[{index}].torque_scale (at most 1)"] if facts["scaled"] else []
+    if facts["carrying"]:
+        remedies.append(f"lighten arms[{index}].payload")
+    remedies.append(f"move arms[{index}].waypoints there to where the arm holds itself with less torque")
+    return (
+        f"arms[{index}] ({facts['robot']}): holding its path still at s = {facts['s']:.4f} needs {facts['torque']:.4g} {unit} "
+        f"on joint {facts['joint']!r}, above its torque limit of {facts['torque_limit']:.4g} {unit} "
+        f"(gravity{' and payload' if facts['carrying'] else ''}): no timing holds it; {', or '.join(remedies)}"
+    )
+
+
 CELL_WORDING: dict[str, str | Callable[[dict], str]] = {
+    "arm_not_held": _arm_not_held,
     "arms_collide_at_start": _arms_collide_at_start,
     "arms_never_apart": _arms_never_apart,
     "no_order_of_arms": _no_order_of_arms,

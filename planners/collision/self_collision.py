@@ -187,15 +187,16 @@ def _refuse(s: float, pairs: SelfPairs, which: int, distance: float, certain: bo
     m; ``certain``: they touch there, else the check could not tell), with what may be done: the
     capsules' padding where they wrap meshes, allowing the pair in an upload (``upload``)."""
     link_a, link_b = pairs.links[which]
-    meshes = pairs.capsules[pairs.first[which]].mesh and pairs.capsules[pairs.second[which]].mesh
-    if certain and meshes:
+    capsules = [pairs.capsules[pairs.first[which]], pairs.capsules[pairs.second[which]]]
+    links = [capsule for capsule in capsules if capsule.link != "payload"]  # the payload's sphere is its own collision shape
+    if certain and all(capsule.mesh for capsule in links):
         shape = (
             f"the capsules contain the links' collision meshes with a padding of up to about {PADDING:g} m "
             "on the catalog arms, so the meshes may still be apart"
         )
     elif certain:
-        radius = max(pairs.capsules[pairs.first[which]].radius, pairs.capsules[pairs.second[which]].radius)
-        shape = f"without collision meshes, links are capsules of radius {radius:g} m along them, so their real shapes may differ"
+        radius = max(capsule.radius for capsule in links if not capsule.mesh)
+        shape = f"a link without a collision mesh is a capsule of radius {radius:g} m along it, so its real shape may differ"
     if certain:
         how = f"touch at s = {s:.4g} (their capsules overlap by {-distance:.4g} m; {shape})"
     else:
@@ -205,7 +206,7 @@ def _refuse(s: float, pairs: SelfPairs, which: int, distance: float, certain: bo
     else:
         advice = "move the waypoints there so that the arm does not fold onto itself"
         if upload:
-            advice += ", or list the pair in the upload's allowed_collisions if the links may touch"
+            advice += ", or, if the links may touch, allow the pair among the robot's allowed collisions when uploading it"
     return SelfCollision(
         f"links {link_a!r} and {link_b!r} {how}: {advice}",
         s=s, link_a=link_a, link_b=link_b, distance=distance,

@@ -48,20 +48,16 @@ class ArmLoad:
 
 def cannot_hold_still(index: int, arm: CellArm, s: float, torque: float, joint: int) -> InfeasiblePath:
     """The error of arm ``index``, whose path at ``s`` needs ``torque`` (N m, N on a prismatic
-    joint) at rest on joint index ``joint``, above its torque limit: what holds it instead (a
-    torque scale up to 1, a lighter payload, waypoints elsewhere)."""
+    joint) at rest on joint index ``joint``, above its torque limit, with the facts of what may
+    hold it instead: whether its limits are scaled down (``scaled``), whether it carries a
+    payload (``carrying``)."""
     name, unit, limit = arm.robot.joint_names[joint], arm.robot.force_units[joint], float(arm.limits.torque[joint])
-    remedies = []
-    if limit < arm.robot.limits.torque[joint]:
-        remedies.append(f"raise arms[{index}].torque_scale (at most 1)")
-    if arm.robot.payload is not None:
-        remedies.append(f"lighten arms[{index}].payload")
-    remedies.append("move the path's waypoints there to where the arm holds itself with less torque")
+    carrying = arm.robot.payload is not None
     return InfeasiblePath(
-        f"arms[{index}] ({arm.robot.name}): holding its path still at s = {s:.4f} needs {torque:.4g} {unit} on joint "
-        f"{name!r}, above its torque limit of {limit:.4g} {unit} (gravity{' and payload' if arm.robot.payload is not None else ''}): "
-        f"no timing holds it; {', or '.join(remedies)}",
-        s=s, joint=name, limit="torque",
+        f"arm {index} ({arm.robot.name}): holding its path still at s = {s:.4f} needs {torque:.4g} {unit} on joint {name!r}, "
+        f"above its torque limit of {limit:.4g} {unit} (gravity{' and payload' if carrying else ''}): no timing holds it",
+        s=s, joint=name, limit="torque", rule="arm_not_held", index=index, robot=arm.robot.name, torque=torque, unit=unit,
+        torque_limit=limit, scaled=bool(limit < arm.robot.limits.torque[joint]), carrying=carrying,
     )
 
 

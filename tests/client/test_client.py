@@ -353,4 +353,6 @@ def test_a_cell_through_the_client(toptraj):
     # A file's path as a string, and its text, are the same request.
     assert toptraj.cell(str(ROOT / "examples" / "cell_two_ur5.json"), timeout=120.0)["duration"] == answer["duration"]
     assert toptraj.cell((ROOT / "examples" / "cell_two_ur5.json").read_text(), timeout=120.0)["duration"] == answer["duration"]
+    marked = "\ufeff" + (ROOT / "examples" / "cell_two_ur5.json").read_text()  # a text read with its byte order mark
+    assert toptraj.cell(marked, timeout=120.0)["duration"] == answer["duration"]
     assert [arm["robot"] for arm in answer["arms"]] == ["ur5", "ur5"]

@@ -47,4 +47,4 @@ def test_a_cell_arm_that_cannot_hold_its_path_names_the_unit_and_a_remedy_it_can
     assert response.status_code == 422, response.text
     detail = response.json()["detail"]
     assert f"needs {22.0 * 9.81:.4g} N on joint 'lift', above its torque limit of 100 N (gravity)" in detail, detail
-    assert "raise the limit" not in detail and "move the path's waypoints there" in detail
+    assert "raise the limit" not in detail and detail.endswith("no timing holds it; move arms[0].waypoints there to where the arm holds itself with less torque")

@@ -171,6 +171,7 @@ def test_a_payload_with_a_radius_is_kept_from_the_arms_own_links():
         check_self_collision(path, carrying)
     assert {refused.value.link_a, refused.value.link_b} == {"upper_arm_link", "payload"}
     assert refused.value.detail.endswith("or give the payload a smaller collision radius")
+    assert "collision meshes with a padding" in refused.value.detail  # ur5's upper arm is a mesh; the payload, its sphere
     # independently: coal between a sphere at tool0's placement of the centre of mass (Pinocchio) and
     # the upper arm's capsule; they first touch at the s reported
     data = robot.model.createData()
@@ -197,9 +198,9 @@ def test_a_refusal_says_what_the_capsules_are_and_offers_allowing_a_pair_only_wh
     folded = SplinePath(np.array([[0.0, 0.0, 0.0], [0.0, 2.9, 2.9]]))
     with pytest.raises(SelfCollision) as refused:
         check_self_collision(folded, robot)
-    assert "without collision meshes, links are capsules of radius 0.03 m along them" in refused.value.detail
+    assert "a link without a collision mesh is a capsule of radius 0.03 m along it" in refused.value.detail
     assert "padding" not in refused.value.detail and refused.value.detail.endswith("so that the arm does not fold onto itself")
     uploaded = dataclasses.replace(robot, source="upload")
     with pytest.raises(SelfCollision) as refused:
         check_self_collision(folded, uploaded)
-    assert refused.value.detail.endswith("or list the pair in the upload's allowed_collisions if the links may touch")
+    assert refused.value.detail.endswith("or, if the links may touch, allow the pair among the robot's allowed collisions when uploading it")
