@@ -76,13 +76,16 @@ def clearance_along(
 
 
 def _reach(robot: Robot) -> float:
-    """A bound (m), whatever the configuration, on the distance from any joint to any point of
-    the arm: the lengths between successive joints, plus the farthest capsule point from its
-    own joint."""
+    """A bound R (m), whatever the configuration, on the distance from any joint to any point of
+    the arm (the lengths between successive joints, plus the farthest capsule point from its
+    own joint), so that a joint motion dq moves no point by more than R sum |dq_j|: a revolute
+    joint turning by |dq| moves a point at most R |dq|, a prismatic one sliding by |dq| exactly
+    |dq|, so R is at least 1 on an arm with a prismatic joint."""
     model = robot.model
     chain = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(2, model.njoints))
     capsule = max(max(np.linalg.norm(c.a), np.linalg.norm(c.b)) + c.radius for c in robot_capsules(robot))
-    return chain + float(capsule)
+    reach = chain + float(capsule)
+    return max(reach, 1.0) if "N" in robot.force_units else reach
 
 
 def _refined(s: np.ndarray, flagged: np.ndarray, pieces: int) -> np.ndarray:

@@ -91,7 +91,8 @@ class CellArm:
         chain = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(2, model.njoints))
         moving = [c for c in robot_capsules(self.robot) if c.joint != 0]  # the base's capsules never move
         tip = max(max(np.linalg.norm(c.a), np.linalg.norm(c.b)) + c.radius for c in moving)
-        return chain + float(tip)
+        reach = chain + float(tip)
+        return max(reach, 1.0) if "N" in self.robot.force_units else reach  # a slide of |dq| moves points by |dq|
 
 
 @dataclass(frozen=True)

@@ -48,3 +48,21 @@ def test_a_cell_arm_that_cannot_hold_its_path_names_the_unit_and_a_remedy_it_can
     detail = response.json()["detail"]
     assert f"needs {22.0 * 9.81:.4g} N on joint 'lift', above its torque limit of 100 N (gravity)" in detail, detail
     assert "raise the limit" not in detail and detail.endswith("no timing holds it; move arms[0].waypoints there to where the arm holds itself with less torque")
+
+
+def test_the_clearance_of_a_sliding_arm_is_checked_at_its_slide(client):
+    """The slider's reach bound is 0.03 m, yet its lift moves every point of the arm by the whole
+    slide: a sphere 1 mm from the carriage's path at mid-lift, radius 0.5 mm, under a clearance of
+    1 mm is 0.99 mm from the arm there by an independent computation (the carriage's capsule axis is
+    the lift's axis, of radius 0.03 m), so the path is refused, not served with a clearance of 1.09
+    mm found between too sparse samples."""
+    from toptraj import robots
+    from toptraj.robots.collision import robot_capsules
+
+    carriage = next(c for c in robot_capsules(robots.load("slider")) if c.link == "carriage")
+    center = [carriage.radius + 0.0015 - 0.00001, 0.0, 0.5025]
+    sphere = {"kind": "sphere", "center": center, "radius": 0.0005}
+    body = {"robot": "slider", "path": {"waypoints": [[0.0, 0.0], [1.0, 0.0]], "obstacles": [sphere], "clearance": 0.001},
+            "timing": {"constraints": ["velocity", "acceleration"]}}
+    response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 422 and response.json()["link"] == "carriage", response.text[:300]
