@@ -66,7 +66,7 @@ def check_speed_bounded(
     tool = limits.tool
     if tool is not None and (np.isfinite(tool.speed) or np.isfinite(tool.angular_speed)):
         return  # where it bounds nothing (a tool turning without moving), ``unbounded_stretch`` says so
-    if bounded_joints(limits, kinds).any():
+    if "velocity" in kinds and np.isfinite(limits.velocity).any() or bounded_joints(limits, kinds).any():
         return
     raise InvalidRequest(
         field, list(kinds), rule="no_limit_bounds_speed", robot=robot.name, kinds=tuple(kinds), available=_available(limits, served),
@@ -79,6 +79,8 @@ def unbounded_stretch(constraints: PathConstraints) -> tuple[int, int] | None:
     the path speed (module docstring); ``None`` when there is none (a single such point, where a
     limited joint turns back, is bounded by its neighbours)."""
     bounded = np.isfinite(constraints.sd_max)
+    if bounded.all():  # the usual case: the speed is bounded everywhere
+        return None
     if constraints.a.size:
         finite = np.isfinite(constraints.lower) | np.isfinite(constraints.upper)
         bounded |= ((constraints.a != 0.0) & finite).any(axis=1) | ((constraints.a_left != 0.0) & finite).any(axis=1)
