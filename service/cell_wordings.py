@@ -76,7 +76,10 @@ def _no_order_of_arms(facts: dict) -> str:
 
 def _arm_not_held(facts: dict) -> str:
     index, unit = facts["index"], facts["unit"]
-    remedies = [f"raise arms[{index}].torque_scale (at most 1)"] if facts["scaled"] else []
+    remedies = []
+    if facts["scaled"] and facts["torque"] <= facts["own_limit"]:  # the robot's own limit holds it
+        needed = rounded_up(facts["torque"] / facts["own_limit"] * 1.001, 3)
+        remedies.append(f"raise arms[{index}].torque_scale to {needed:g} or more (at most 1)")
     if facts["carrying"]:
         remedies.append(f"lighten arms[{index}].payload")
     remedies.append(f"move arms[{index}].waypoints there to where the arm holds itself with less torque")

@@ -84,8 +84,24 @@ def _reach(robot: Robot) -> float:
     model = robot.model
     chain = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(2, model.njoints))
     capsule = max(max(np.linalg.norm(c.a), np.linalg.norm(c.b)) + c.radius for c in robot_capsules(robot))
-    reach = chain + float(capsule)
+    reach = chain + sliding_travel(robot) + float(capsule)
     return max(reach, 1.0) if "N" in robot.force_units else reach
+
+
+#: Largest travel (m) counted for a prismatic joint: a joint coordinate of a request lies within
+#: 1e4 (``toptraj.planners.problem.waypoints.MAX_COORDINATE``), so a slide without limits too.
+MAX_TRAVEL = 1e4
+
+
+def sliding_travel(robot: Robot) -> float:
+    """How far (m) the prismatic joints can carry the links beyond them from where the zero
+    configuration puts them: the sum of each one's largest |position limit|, at most
+    ``MAX_TRAVEL`` (the joint lengths of ``_reach`` are those at zero)."""
+    sliding = np.array([unit == "N" for unit in robot.force_units])
+    if not sliding.any():
+        return 0.0
+    lower, upper = robot.limits.position_lower[sliding], robot.limits.position_upper[sliding]
+    return float(np.minimum(np.maximum(np.abs(lower), np.abs(upper)), MAX_TRAVEL).sum())
 
 
 def _refined(s: np.ndarray, flagged: np.ndarray, pieces: int) -> np.ndarray:

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from toptraj.planners.collision.clearance import sliding_travel
 from toptraj.planners.collision.distance import segment_distance
 from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.paths.base import GeometricPath
@@ -91,7 +92,7 @@ class CellArm:
         chain = sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(2, model.njoints))
         moving = [c for c in robot_capsules(self.robot) if c.joint != 0]  # the base's capsules never move
         tip = max(max(np.linalg.norm(c.a), np.linalg.norm(c.b)) + c.radius for c in moving)
-        reach = chain + float(tip)
+        reach = chain + sliding_travel(self.robot) + float(tip)
         return max(reach, 1.0) if "N" in self.robot.force_units else reach  # a slide of |dq| moves points by |dq|
 
 

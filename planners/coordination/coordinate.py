@@ -171,6 +171,9 @@ def _arms_alone(cell: Cell, deadline: Deadline) -> list[TimeScaling]:
             raise SelfCollision(f"{where}: {error.detail}", s, error.link_a, error.link_b, error.distance) from error
         except InfeasiblePath as error:
             held = getattr(error, "held", None)  # a load that no timing holds: what holds it instead
+            loads = getattr(error, "joints", None)  # or the worst of the loads held still beyond a limit
+            if held is None and loads:
+                held = max(loads, key=lambda item: item[0])[1]
             if held is not None:
                 joint = arm.robot.joint_names.index(held.joint)
                 raise cannot_hold_still(index, arm, held.s, held.torque, joint) from error

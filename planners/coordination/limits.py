@@ -54,10 +54,11 @@ def cannot_hold_still(index: int, arm: CellArm, s: float, torque: float, joint: 
     name, unit, limit = arm.robot.joint_names[joint], arm.robot.force_units[joint], float(arm.limits.torque[joint])
     carrying = arm.robot.payload is not None
     return InfeasiblePath(
-        f"arm {index} ({arm.robot.name}): holding its path still at s = {s:.4f} needs {torque:.4g} {unit} on joint {name!r}, "
+        f"arms[{index}] ({arm.robot.name}): holding its path still at s = {s:.4f} needs {torque:.4g} {unit} on joint {name!r}, "
         f"above its torque limit of {limit:.4g} {unit} (gravity{' and payload' if carrying else ''}): no timing holds it",
         s=s, joint=name, limit="torque", rule="arm_not_held", index=index, robot=arm.robot.name, torque=torque, unit=unit,
-        torque_limit=limit, scaled=bool(limit < arm.robot.limits.torque[joint]), carrying=carrying,
+        torque_limit=limit, own_limit=float(arm.robot.limits.torque[joint]), scaled=bool(limit < arm.robot.limits.torque[joint]),
+        carrying=carrying,
     )
 
 

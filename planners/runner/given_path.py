@@ -52,8 +52,9 @@ def _time_stretch(robot, stretch, method, grid_points, kinds, limits, boundary, 
         s = with_edges(s, limits.zones, stretch.knots)
     deadline.progress(0.0, "constraints")
     constraints = build_path_constraints(stretch, robot, limits, kinds, s, deadline)
-    start, width = (stretch.start, stretch.width) if isinstance(stretch, Stretch) else (0.0, 1.0)
-    check_stretches_bounded(constraints, stretch, robot, limits, kinds, lambda sigma: start + width * sigma, method.kinds)
+    if method.pointwise:
+        start, width = (stretch.start, stretch.width) if isinstance(stretch, Stretch) else (0.0, 1.0)
+        check_stretches_bounded(constraints, stretch, robot, limits, kinds, lambda sigma: start + width * sigma, method.kinds)
     deadline.check()
     timing, constraints, check = gated(
         robot, stretch, method, constraints, boundary, duration, kinds, limits, threshold, deadline.within(0.3, 1.0),

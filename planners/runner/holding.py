@@ -21,7 +21,7 @@ import numpy as np
 
 from toptraj.planners.constraints.held_load import rest_loads
 from toptraj.planners.constraints.path_constraints import build_path_constraints
-from toptraj.planners.constraints.zones import inside, zone_factors
+from toptraj.planners.constraints.zones import inside, with_edges, zone_factors
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.planners.paths.grid import path_grid
@@ -87,11 +87,13 @@ def zone_remedy(problem: Problem, path: GeometricPath) -> tuple[tuple[int, float
     scales alone keep the path from being held still, when raising them holds it everywhere
     (module docstring); empty otherwise. Holding still is measured on the path's default grid
     (``rest_loads``: each point's largest share of a joint's limit in force there), and a zone
-    is raised to the largest share its own points need without the zones' factors."""
+    is raised to the largest share its own points need without the zones' factors (the grid holds
+    each zone's edges, so that a zone narrower than a grid interval has points of its own)."""
     zones = tuple(zone for zone in problem.limits.zones if zone.torque < 1.0)
     if not zones:
         return ()
-    constraints = build_path_constraints(path, problem.robot, problem.limits, ("torque",), path_grid(path), problem.deadline)
+    grid = with_edges(path_grid(path), problem.limits.zones, np.asarray(path.knots, dtype=float))  # each zone's edges on it
+    constraints = build_path_constraints(path, problem.robot, problem.limits, ("torque",), grid, problem.deadline)
     ratios, _ = rest_loads(constraints)
     if not ratios.size:
         return ()

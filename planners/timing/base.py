@@ -230,6 +230,10 @@ class TimingMethod(abc.ABC):
         supporting_points: For a time law replaced by its spline through this many points
             (``toptraj.planners.timing.laws.splines.SplineProfile``): the spline leaves and
             reaches rest, so the method takes no moving boundary. ``None`` otherwise.
+        pointwise: Whether the method's speed at each grid point is bounded by the limits at and
+            near that point (the phase plane and its kin), so that a stretch which no limit
+            bounds has no answer (``toptraj.planners.problem.bounded``); a time law fits one
+            duration to a whole stretch, which a limit anywhere on it bounds.
     """
 
     family: ClassVar[Literal["timing"]] = "timing"
@@ -244,6 +248,7 @@ class TimingMethod(abc.ABC):
     bytes_per_interval_joint: int = 2_300
     interruptible: bool = True
     supporting_points: int | None = None
+    pointwise: bool = True
 
     def max_grid_intervals(self, n_dof: int) -> int:
         """The most grid intervals the method serves on a robot with ``n_dof`` joints: its

@@ -83,6 +83,7 @@ class RuckigMethod(TimingMethod):
     takes_acceleration_boundary = True
     two_waypoints_only = True
     continuous_acceleration = True
+    pointwise = False  # one profile along the line, bounded by its tightest limit anywhere
 
     def solve(
         self,

@@ -4,6 +4,8 @@ as its limit is given, and a revolute joint's in N m (a lift carrying 22 kg need
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from fastapi.testclient import TestClient
 
@@ -66,3 +68,47 @@ def test_the_clearance_of_a_sliding_arm_is_checked_at_its_slide(client):
             "timing": {"constraints": ["velocity", "acceleration"]}}
     response = client.post("/v1/trajectories", json=body)
     assert response.status_code == 422 and response.json()["link"] == "carriage", response.text[:300]
+
+
+TURN_SLIDE = """<robot name="turn_slide">
+  <link name="base"/>
+  <link name="boom"><inertial><mass value="5"/><origin xyz="0 0 0"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tip"><inertial><mass value="1"/><origin xyz="0 0 0"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="turn" type="revolute"><parent link="base"/><child link="boom"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="50" velocity="1"/></joint>
+  <joint name="slide" type="prismatic"><parent link="boom"/><child link="tip"/><origin xyz="0.1 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="3" effort="100" velocity="1"/></joint>
+</robot>"""
+
+
+def test_the_motion_bound_counts_what_a_slide_can_carry_out(client):
+    """A turn before a 3 m slide: at full slide the tip is 3.1 m from the turn's axis, and the
+    bound on how far a turn moves any point (per radian) must be at least that, not the 0.1 m of
+    the joints' placement at zero."""
+    from toptraj import robots
+    from toptraj.planners.collision.clearance import _reach, sliding_travel
+
+    assert client.post("/v1/robots", json={"name": "turn_slide", "urdf": TURN_SLIDE}).status_code == 201
+    robot = robots.load("turn_slide")
+    assert sliding_travel(robot) == 3.0 and _reach(robot) >= 3.1
+
+
+def test_a_cell_arm_is_told_to_raise_its_torque_scale_only_where_that_holds_it(client):
+    """The slider's lift needs 215.8 N, above its own 100 N: under a torque scale of 0.5, raising
+    the scale cannot hold it and is not advised, only the waypoints. A ur5 holding its upper arm
+    out needs 59.2 N m of its 150: under a scale of 0.1 the scale that holds it is advised, and
+    following the advice plans the cell."""
+    arm = {"robot": "slider", "waypoints": [[0.0, 0.0], [0.5, 1.0]], "torque_scale": 0.5}
+    cell = {"arms": [arm, {**arm, "base": {"position": [2.0, 0.0, 0.0]}}], "constraints": ["velocity", "torque"]}
+    detail = client.post("/v1/cells", json=cell).json()["detail"]
+    assert "torque_scale" not in detail and detail.endswith("move arms[0].waypoints there to where the arm holds itself with less torque")
+    lift = [[0.0, -1.57, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]]
+    ur5 = {"robot": "ur5", "waypoints": lift, "torque_scale": 0.1}
+    cell = {"arms": [ur5, {**ur5, "base": {"position": [3.0, 0.0, 0.0]}}], "constraints": ["velocity", "acceleration", "torque"]}
+    detail = client.post("/v1/cells", json=cell).json()["detail"]
+    advised = re.search(r"raise arms\[0\]\.torque_scale to ([\d.]+) or more \(at most 1\)", detail)
+    assert advised and 59.17 / 150 < float(advised.group(1)) <= 0.4, detail
+    followed = [{**arm, "torque_scale": float(advised.group(1))} for arm in cell["arms"]]
+    assert client.post("/v1/cells", json=cell | {"arms": followed}).status_code == 200

@@ -119,6 +119,12 @@ def test_the_zone_remedy_holds_the_whole_path_or_is_not_given(client):
     assert [index for index, _ in advised] == ["0", "1"] and "timing.zones[0].torque_scale 0.395 and timing.zones[1]" in detail
     followed = [{**zone, "torque_scale": float(value)} for zone, (_, value) in zip(zones, advised, strict=True)]
     assert client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": {"zones": followed}}).status_code == 200
+    narrow = [{"s_range": [0.9051, 0.9079], "torque_scale": 0.05}, zones[1]]  # narrower than a grid interval
+    detail = client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": {"zones": narrow}}).json()["detail"]
+    advised = re.findall(r"timing\.zones\[(\d)\]\.torque_scale ([\d.]+)", detail)
+    assert [index for index, _ in advised] == ["0", "1"], detail
+    followed = [{**zone, "torque_scale": float(value)} for zone, (_, value) in zip(narrow, advised, strict=True)]
+    assert client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": {"zones": followed}}).status_code == 200
     scaled = {"limits": {"torque_scale": 0.3}, "zones": [{"s_range": [0.0, 0.3], "torque_scale": 0.05}]}
     detail = client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": scaled}).json()["detail"]
     assert "timing.zones" not in detail and "timing.limits.torque_scale 3.61" in detail, detail

@@ -96,6 +96,7 @@ class ClassicalMethod(TimingMethod):
 
     kinds = frozenset({"velocity", "acceleration", "torque", "jerk"})
     takes_duration = True
+    pointwise = False  # one duration for the whole stretch: a limit anywhere on it bounds it (``law_unbounded`` else)
 
     def __init__(self, profile: NormalizedProfile, boundary_law: str | None = None):
         self.profile = profile

@@ -88,6 +88,20 @@ def test_a_stretch_that_moves_only_joints_without_a_limit_is_refused_naming_it()
     assert _planned({"torque": [25.0, np.inf]}, ("torque",), [[0.0, 0.0], [0.0, 1.0]]).duration > 0.1
 
 
+def test_a_time_law_fits_a_stretch_that_a_limit_anywhere_on_it_bounds():
+    """A time law takes one duration for the whole stretch between corners: where psi alone moves
+    on a blend path, phi's limit elsewhere on the stretch still bounds it (the phase plane, point
+    by point, is refused there)."""
+    limits, waypoints = {"velocity": [2.0, np.inf]}, [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]
+    robot = robots.load("geering_2r")
+    robot = dataclasses.replace(robot, limits=dataclasses.replace(robot.limits, velocity=np.array(limits["velocity"])))
+    path = WaypointPath(np.array(waypoints), "blend")
+    for law in ("quintic", "cycloidal"):
+        assert plan(build_problem(robot, path, METHODS[law], limits=LimitRequest(kinds=("velocity",)))).duration > 1.0
+    with pytest.raises(InvalidRequest, match="nothing bounds the motion|no limit held"):
+        plan(build_problem(robot, path, METHODS["phase_plane"], limits=LimitRequest(kinds=("velocity",))))
+
+
 def test_a_tool_speed_that_holds_only_where_it_can_is_no_bound_elsewhere(client):
     """A zone's tool speed bounds its zone only, and an angular speed limit nothing where the
     tool does not turn: both were divisions by zero in the timing."""
