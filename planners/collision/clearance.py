@@ -104,6 +104,21 @@ def sliding_travel(robot: Robot) -> float:
     return float(np.minimum(np.maximum(np.abs(lower), np.abs(upper)), MAX_TRAVEL).sum())
 
 
+def _dense_grid(reach: float, coarse_q: np.ndarray) -> np.ndarray:
+    """The uniform grid of s whose configurations lie at most ``COARSE_STEP`` of arm motion
+    apart, judged on the coarse pass's configurations ``coarse_q`` (within ``COARSE`` and
+    ``MAX_CONFIGURATIONS`` points)."""
+    motion = reach * np.abs(np.diff(coarse_q, axis=0)).sum()
+    return np.linspace(0.0, 1.0, min(MAX_CONFIGURATIONS, max(COARSE, math.ceil(motion / COARSE_STEP))) + 1)
+
+
+def _split_near(s: np.ndarray, near: np.ndarray, step: np.ndarray) -> np.ndarray:
+    """``s`` with the ``near`` intervals (their arm motion ``step``, m) split to ``RESOLUTION``
+    of motion, within ``MAX_CONFIGURATIONS`` new points in all."""
+    pieces = int(min(100, max(2, math.ceil(step[near].max() / RESOLUTION))))
+    return _refined(s, near, max(2, min(pieces, MAX_CONFIGURATIONS // int(near.sum()))))
+
+
 def _refined(s: np.ndarray, flagged: np.ndarray, pieces: int) -> np.ndarray:
     """``s`` with each flagged interval (s[i], s[i + 1]) split into ``pieces``."""
     inside = [np.linspace(s[i], s[i + 1], pieces + 1)[1:-1] for i in np.flatnonzero(flagged)]
@@ -166,9 +181,7 @@ def closest_approach(path: GeometricPath, robot: Robot, obstacles: list[Obstacle
     the distance is at least the smaller end's less half the interval's motion, so that a
     clearance no larger than the bound lets the path through any check."""
     reach = _reach(robot)
-    coarse_q = path.evaluate(np.linspace(0.0, 1.0, COARSE + 1)).q
-    motion = reach * np.abs(np.diff(coarse_q, axis=0)).sum()
-    s = np.linspace(0.0, 1.0, min(MAX_CONFIGURATIONS, max(COARSE, math.ceil(motion / COARSE_STEP))) + 1)
+    s = _dense_grid(reach, path.evaluate(np.linspace(0.0, 1.0, COARSE + 1)).q)
     for attempt in range(2):  # the samples, then the intervals that may hold the least, split
         deadline.check()
         q = path.evaluate(s).q
@@ -178,8 +191,7 @@ def closest_approach(path: GeometricPath, robot: Robot, obstacles: list[Obstacle
         near = lower < distances.min()
         if attempt == 1 or not near.any() or step[near].max() <= RESOLUTION:
             break
-        pieces = int(min(100, max(2, math.ceil(step[near].max() / RESOLUTION))))
-        s = _refined(s, near, max(2, min(pieces, MAX_CONFIGURATIONS // int(near.sum()))))
+        s = _split_near(s, near, step)
     return float(min(lower.min(), distances.min())), float(s[int(np.argmin(distances))])
 
 
@@ -191,9 +203,7 @@ def _checked(path: GeometricPath, robot: Robot, obstacles: list[Obstacle], clear
     coarse_q = path.evaluate(coarse_s).q
     # a first look: a path through an obstacle is refused without the dense pass
     _too_close(coarse_s, *clearance_along(robot, coarse_q, obstacles, clearance), capsules, clearance, None)
-    motion = reach * np.abs(np.diff(coarse_q, axis=0)).sum()
-    count = min(MAX_CONFIGURATIONS, max(COARSE, math.ceil(motion / COARSE_STEP))) + 1
-    s = np.linspace(0.0, 1.0, count)
+    s = _dense_grid(reach, coarse_q)
     q = path.evaluate(s).q
     exact_below = clearance + COARSE_STEP
     distances, capsule, obstacle = clearance_along(robot, q, obstacles, exact_below)
@@ -202,9 +212,7 @@ def _checked(path: GeometricPath, robot: Robot, obstacles: list[Obstacle], clear
     step = reach * np.abs(np.diff(q, axis=0)).sum(axis=1)
     near = np.minimum(distances[:-1], distances[1:]) - step / 2.0 < clearance
     if near.any():
-        pieces = int(min(100, max(2, math.ceil(step[near].max() / RESOLUTION))))
-        pieces = max(2, min(pieces, MAX_CONFIGURATIONS // int(near.sum())))
-        s = _refined(s, near, pieces)
+        s = _split_near(s, near, step)
         q = path.evaluate(s).q
         distances, capsule, obstacle = clearance_along(robot, q, obstacles, exact_below)
     worst = int(np.argmin(distances))

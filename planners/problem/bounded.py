@@ -30,16 +30,6 @@ from toptraj.robots import JointLimits, Robot
 BOUNDING_KINDS = ("velocity", "acceleration", "jerk", "torque")
 
 
-def bounded_joints(limits: JointLimits, kinds: tuple[str, ...]) -> np.ndarray:
-    """Which joints (n_dof,) have a finite, positive limit of one of ``kinds``."""
-    bounded = np.zeros(len(limits.velocity), dtype=bool)
-    for kind in BOUNDING_KINDS:
-        if kind in kinds:
-            values = np.asarray(getattr(limits, kind), dtype=float)
-            bounded |= np.isfinite(values) & (values > 0.0)
-    return bounded
-
-
 def _available(limits: JointLimits, served: frozenset[str] | tuple[str, ...] | None, joints: np.ndarray | None = None) -> tuple[str, ...]:
     """The kinds (among ``served``; ``None``: all) of which the robot has a finite limit on one
     of ``joints`` (``None``: any joint)."""
@@ -66,7 +56,7 @@ def check_speed_bounded(
     tool = limits.tool
     if tool is not None and (np.isfinite(tool.speed) or np.isfinite(tool.angular_speed)):
         return  # where it bounds nothing (a tool turning without moving), ``unbounded_stretch`` says so
-    if "velocity" in kinds and np.isfinite(limits.velocity).any() or bounded_joints(limits, kinds).any():
+    if _available(limits, kinds):  # a joint has a finite limit of a kind held
         return
     raise InvalidRequest(
         field, list(kinds), rule="no_limit_bounds_speed", robot=robot.name, kinds=tuple(kinds), available=_available(limits, served),

@@ -9,10 +9,10 @@ velocity terms vanish with the path speed (Bobrow, Dubowsky & Gibson 1985, the p
 sd -> 0).
 
 Inside a zone that scales the torque limits down (``timing.zones``), holding still may exceed
-only the zone's limits: where every joint's worst load would be held by the limits outside the
-zones (its ratio times the zone's factor at most 1), the remedy is the zones' own torque scales
-(the factor times the ratio), not the limits of the whole path, which would raise them outside
-the zones as well.
+only the zone's limits: where the limits outside the zones would hold the path still at every
+point (each point's share of its limits in force times the zone factor there at most 1), the
+remedy is the zones' own torque scales (``zone_remedy``), not the limits of the whole path,
+which would raise them outside the zones as well.
 """
 
 from __future__ import annotations
@@ -48,12 +48,12 @@ def with_torque_remedy(problem: Problem, error: InfeasiblePath) -> InfeasiblePat
     ``beyond_range`` ((joint, value, unit) for each such joint) and ``most`` (the range's top)
     instead."""
     facts = {key: value for key, value in vars(error).items() if key != "detail"}
-    zoned = facts.pop("zone_scales", ())
-    if zoned:
-        facts.update(asked_scale=problem.requested.scales.get("torque") or 1.0, torque_scale=None, torque_limits=(), zone_scales=zoned)
-        return type(error)(error.detail, **facts)
     asked = problem.requested
     scale = asked.scales.get("torque") or 1.0
+    zoned = facts.pop("zone_scales", ())
+    if zoned:
+        facts.update(asked_scale=scale, torque_scale=None, torque_limits=(), zone_scales=zoned)
+        return type(error)(error.detail, **facts)
     limits = np.asarray(problem.robot.limits.with_request(asked.overrides).torque, dtype=float)
     names = problem.robot.joint_names
     needed, beyond = [], []
