@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.results import PlannedTrajectory
+from toptraj.planners.runner.admission import admit
 from toptraj.planners.runner.run import run
 
 
@@ -38,3 +39,15 @@ def plan(problem: Problem) -> PlannedTrajectory:
         BudgetExceeded: the problem's deadline passed.
     """
     return run(problem)
+
+
+def check(problem: Problem) -> None:
+    """Refuse ``problem`` as ``plan`` would before any work, without planning it: its memory
+    estimate against the cap (``toptraj.planners.runner.admission.admit``); ``build_problem``
+    has validated the rest. For a caller that queues the problem to plan it later.
+
+    Raises:
+        TooLarge: the grid asked for does not fit (the largest that does is named).
+        OverMemory: a search's graph does not fit its allowance.
+    """
+    admit(problem)

@@ -14,6 +14,7 @@ from toptraj.planners import Deadline, PlannedTrajectory, plan
 from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY, MAX_SAMPLES
+from toptraj.planners.plan import check
 from toptraj.robots import InvalidLimits, UnknownRobot
 from toptraj.robots.catalog import catalog_robot_built
 from toptraj.service.equipping import equipment_body, equipped_robot, payload_named
@@ -107,11 +108,29 @@ def plan_request(
     on whole periods. A search is refused beyond ``search_memory_bytes`` by its estimate
     (``toptraj.planners.generators.search.memory``)."""
     robot = equipped_robot(request)
+    with payload_named(robot):
+        return plan(_problem(request, robot, deadline or NO_DEADLINE, max_body_bytes, accept, search_memory_bytes))
+
+
+def check_request(request: TrajectoryRequest, max_body_bytes: int | None = None, search_memory_bytes: int = DEFAULT_SEARCH_MEMORY) -> None:
+    """Refuse ``request`` as ``plan_request`` would before any work, without planning: its
+    problem built and validated (fields, limits, a free path's start and goal) and its memory
+    estimate (``toptraj.planners.plan.check``). A job is checked so before it is queued.
+
+    Raises:
+        InvalidRequest, InfeasiblePath, InvalidLimits, UnknownRobot: as ``plan_request`` would.
+    """
+    robot = equipped_robot(request)
+    with payload_named(robot):
+        check(_problem(request, robot, NO_DEADLINE, max_body_bytes, None, search_memory_bytes))
+
+
+def _problem(request: TrajectoryRequest, robot: robots.Robot, deadline: Deadline, max_body_bytes: int | None, accept: str | None, search_memory_bytes: int):
+    """The validated problem of ``request`` for ``robot``, its samples within ``max_body_bytes``."""
     format_ = chosen_format(request.output.format, accept)
     max_samples = MAX_SAMPLES if max_body_bytes is None else min(MAX_SAMPLES, samples_within(max_body_bytes, robot.dof, format_))
     exact_period = exact_period_for(format_, request.output.exact_period)
-    with payload_named(robot):
-        return plan(problem_of(request, robot, deadline or NO_DEADLINE, max_samples, exact_period, search_memory_bytes))
+    return problem_of(request, robot, deadline, max_samples, exact_period, search_memory_bytes)
 
 
 def render(result: PlannedTrajectory, request: TrajectoryRequest, accept: str | None = None) -> tuple[bytes, str]:

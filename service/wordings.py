@@ -146,6 +146,21 @@ def _path_in_collision(facts: dict) -> str:
     return f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): {advice}"
 
 
+def _end_too_close(facts: dict) -> str:
+    """A free path's start or goal within the clearance of an obstacle; a link no joint moves is
+    advised to move the obstacle or the robot, since no start or goal moves it."""
+    field, index, distance = facts["field"], facts["obstacle"], facts["distance"]
+    how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {distance:.4g} m of path.obstacles[{index}]"
+    if facts.get("fixed"):
+        advice = f"no joint moves that link: move path.obstacles[{index}] away from it, or the robot by its mounting"
+    else:
+        advice = f"move {field} away from the obstacle"
+        below = math.floor(1e4 * distance) / 1e4  # the end's distance, 0.1 mm down
+        if below > 0.0:
+            advice += f" or lower path.clearance to {below:g} m"
+    return f"at {field}, link {facts['link']!r} {how} (the clearance is {facts['clearance']:g} m): {advice}"
+
+
 def _unknown_frame(facts: dict) -> str:
     """A frame the robot lacks: the nearest of its frames if one is close, and all of them."""
     frames = facts["allowed"]
@@ -332,13 +347,7 @@ WORDING: dict[str, Wording] = {
         f"at most {facts['cap']} are searched: use fewer cells, or timing.search.graph 'roadmap'"
     ),
     "unknown_graph": "{field} {value!e} is unknown; use one of {allowed}",
-    "end_too_close": lambda facts: (
-        f"at {facts['field']}, link {facts['link']!r} "
-        + (f"is inside path.obstacles[{facts['obstacle']}] (by {-facts['distance']:.4g} m)" if facts["distance"] < 0
-           else f"comes within {facts['distance']:.4g} m of path.obstacles[{facts['obstacle']}]")
-        + f" (the clearance is {facts['clearance']:g} m): move {facts['field']} away from the obstacle"
-        + (" or lower path.clearance" if facts["distance"] >= 0 else "")
-    ),
+    "end_too_close": _end_too_close,
     "max_turn_out_of_range": "{field} must lie in (0, 180) degrees, got {value}",
     "frame_without_speed": "{field} is given without timing.limits.tool_speed or tool_angular_speed",
     "unknown_tool_frame": _unknown_frame,

@@ -18,6 +18,7 @@ from toptraj.robots.errors import ToptrajError, excerpt
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes
 from toptraj.service.jobs.records import Job, JobEnded
 from toptraj.service.jobs.store import JobStore
+from toptraj.service.planning import check_request
 from toptraj.service.problem_docs import PROBLEM_JSON, problem_responses
 from toptraj.service.problems import RequestRefused
 from toptraj.service.schemas.jobs import JobCreate, JobList, JobPublic, JobStatus
@@ -151,7 +152,7 @@ async def _strictly(request: Request) -> None:
             "headers": {"Location": {"description": "`/v1/jobs/{id}`", "schema": {"type": "string"}}},
         },
         404: _problem(404, "No robot has that name."),
-        422: _problem(422, "Malformed request, or a budget_s over the server's maximum."),
+        422: _problem(422, "Malformed request, a budget_s over the server's maximum, or a trajectory the planner refuses before any work."),
         503: _problem(503, "The job queue is full (`Retry-After`), or the job store cannot be written."),
     },
 )
@@ -169,7 +170,10 @@ async def create_job(body: Annotated[JobCreate, Body(openapi_examples=EXAMPLES)]
             f"{settings.job_max_budget_s:g} (setting TOPTRAJ_JOB_MAX_BUDGET_S)"
         )
     runner = request.app.state.jobs
-    await run_in_threadpool(robots.load, body.request.robot)  # an unknown robot is a 404 now, not a failed job
+    if body.trajectory is not None:  # refused now as the synchronous endpoint would before any work, not minutes later
+        await run_in_threadpool(check_request, body.trajectory, settings.max_response_bytes, settings.search_memory_bytes)
+    else:  # a comparison answers each method's refusal in its entry, as its endpoint does
+        await run_in_threadpool(robots.load, body.request.robot)  # an unknown robot is a 404 now, not a failed job
     request_json = body.request.model_dump_json(exclude_unset=True)  # what was given: its rules read again as given
     job = await run_in_threadpool(runner.store.submit, body.kind, request_json, budget_s, settings.job_queue)
     runner.wake()

@@ -161,6 +161,32 @@ def test_a_bad_submission_is_refused_at_once(client, body, status, words):
     assert words in response.json()["detail"]
 
 
+GEERING_FREE = {"robot": "geering_2r", "path": {"kind": "free", "start": [0.0, 0.0], "goal": [0.76, 0.0]}, "timing": {"method": "search"}}
+
+
+@pytest.mark.parametrize(
+    "body, words",
+    [
+        ({**QUICK, "path": {"waypoints": [[0.0, 0.0], [1.0, 1.0]]}}, "path.waypoints[0] has 2 values; ur5 has 6 joints"),
+        ({**GEERING_FREE, "path": {**GEERING_FREE["path"], "goal": [9.0, 0.0]}}, "path.goal[0] = 9 is outside the limits"),
+        ({**GEERING_FREE, "timing": {"method": "collocation"}, "path": {**GEERING_FREE["path"], "start": [-9.0, 0.0]}},
+         "path.start[0] = -9 is outside the limits"),
+        ({**GEERING_FREE, "path": {**GEERING_FREE["path"], "obstacles": [{"kind": "sphere", "center": [0.5, 0.0, 0.0], "radius": 0.3}]}},
+         "at path.start, link "),
+        ({**QUICK, "timing": {"method": "min_cost", "grid_points": 20_000}}, "use timing.grid_points <= "),
+    ],
+)
+def test_a_job_the_planner_would_refuse_before_any_work_is_refused_at_submission(client, body, words):
+    """What the synchronous endpoint refuses before planning (the problem's own checks, a free
+    path's ends, the memory estimate) is refused when the job is submitted, with the same
+    problem, rather than queued to fail later."""
+    synchronous = client.post("/v1/trajectories", json=body)
+    assert synchronous.status_code == 422 and words in synchronous.json()["detail"], synchronous.text[:300]
+    submitted = client.post("/v1/jobs", json={"trajectory": body})
+    assert submitted.status_code == 422, submitted.text[:300]
+    assert submitted.json() == synchronous.json()
+
+
 def test_an_unknown_job_is_a_404(client):
     for method, path in [("GET", "/v1/jobs/0123"), ("GET", "/v1/jobs/0123/result"), ("DELETE", "/v1/jobs/0123")]:
         response = client.request(method, path)

@@ -20,7 +20,7 @@ from toptraj.planners.generators.collocation.switching import refine_collocation
 from toptraj.planners.paths.grid import path_grid
 from toptraj.planners.problem.free_motion import FreeMotion
 from toptraj.planners.problem.methods import Execution, MotionGenerator, Timed
-from toptraj.planners.problem.path_checks import moving_velocity, path_boundary, timing_grid
+from toptraj.planners.problem.path_checks import check_within_joint_limits, moving_velocity, path_boundary, timing_grid
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.timing.base import GAP_TARGET, TimingMethod
 from toptraj.planners.timing.min_cost import MinCostMethod
@@ -59,6 +59,8 @@ class Collocation(MotionGenerator):
             raise NotServed("method", self.name, self.name, rule="free_path_needs_collocation", alternatives=("collocation", "search"))
         if problem.grid is not None and not 4 <= problem.grid <= MAX_INTERVALS:
             raise OutOfRange("grid.intervals", problem.grid, 4, MAX_INTERVALS, rule="collocation_intervals")
+        check_within_joint_limits(problem.robot, "start", problem.motion.start)
+        check_within_joint_limits(problem.robot, "goal", problem.motion.goal)
 
     def generate(self, problem: Problem, execution: Execution) -> Timed:
         """The collocation's path, re-timed exactly along itself, its switching times refined."""

@@ -27,6 +27,7 @@ from toptraj.planners.generators.search.local import optimize_locally
 from toptraj.planners.generators.search.local_outcome import LocalOptimum
 from toptraj.planners.generators.search.memory import over_memory, search_bytes
 from toptraj.planners.generators.search.method import global_search
+from toptraj.planners.generators.search.problem import check_end
 from toptraj.planners.generators.search.report import LocalReport
 from toptraj.planners.paths import GeometricPath
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -67,6 +68,8 @@ class Search(MotionGenerator):
         moving = moving_velocity(motion.start_velocity) is not None or moving_velocity(motion.end_velocity) is not None
         if moving or problem.duration is not None:
             raise Conflicting("method", "search", ("boundary", "duration"), rule="search_from_rest")
+        for name, q in (("start", motion.start), ("goal", motion.goal)):
+            check_end(problem.robot, name, q, list(problem.obstacles), problem.clearance)
 
     def estimate(self, problem: Problem) -> int:
         """The bytes of the search's graph (``toptraj.planners.generators.search.memory``); 0 for

@@ -118,21 +118,24 @@ def _check_apart(robot: Robot, name: str, q: np.ndarray) -> None:
         )
 
 
-def _check_end(robot: Robot, name: str, q: np.ndarray, obstacles: list[Obstacle], clearance: float) -> None:
+def check_end(robot: Robot, name: str, q: np.ndarray, obstacles: list[Obstacle], clearance: float) -> None:
     """Raise where the start or goal ``q`` lies outside the joint limits, within the clearance
-    of an obstacle, or with two links touching."""
+    of an obstacle, or with two links touching (what the search's generator checks before any
+    work, and ``build_problem`` again for a caller of the search alone)."""
     check_within_joint_limits(robot, name, q)
     if obstacles:
         nearest = float(point_distances(robot, q[None, :], obstacles)[0])
         if nearest < clearance:
             _, capsule, obstacle = clearance_along(robot, q[None, :], obstacles)
-            link = robot_capsules(robot)[int(capsule[0])].name
+            touching = robot_capsules(robot)[int(capsule[0])]
+            link = touching.link
             how = f"is inside obstacle {int(obstacle[0])} (by {-nearest:.4g} m)" if nearest < 0 else (
                 f"comes within {nearest:.4g} m of obstacle {int(obstacle[0])}"
             )
             raise InfeasiblePath(
                 f"at the {name}, link {link!r} {how} (the clearance is {clearance:g} m)",
                 rule="end_too_close", field=name, distance=nearest, clearance=clearance, link=link, obstacle=int(obstacle[0]),
+                fixed=touching.joint == 0,
             )
     _check_apart(robot, name, q)
 
@@ -164,7 +167,7 @@ def build_problem(
     options = options or DEFAULT_OPTIONS
     obstacle_list = list(obstacles)
     for name, q in (("start", start), ("goal", goal)):
-        _check_end(robot, name, q, obstacle_list, clearance)
+        check_end(robot, name, q, obstacle_list, clearance)
     deadline.progress(0.0, "search: graph")
     graph = _graph(robot, start, goal, options, revolutions, obstacle_list, clearance, deadline)
     max_turn = options.max_turn if options.max_turn is not None else DEFAULT_MAX_TURN[graph.kind]
