@@ -202,7 +202,8 @@ def rotation_matrix(rotation: ArrayLike | None = None, orientation: ArrayLike | 
         )
         raise InvalidEquipment(
             f"rotation is not a rotation matrix: {why}; give an orthonormal matrix with determinant +1 "
-            f"(R^T R = I within {ROTATION_TOLERANCE:g}), or a unit quaternion", "rotation"
+            f"(R^T R = I within {ROTATION_TOLERANCE:g}; [[-1,0,0],[0,-1,0],[0,0,1]] turns the base half a turn about z), "
+            "or a unit quaternion", "rotation"
         )
     u, _, vt = np.linalg.svd(matrix)
     return u @ vt

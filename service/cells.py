@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from toptraj import robots
-from toptraj.planners.coordination import Cell, CellArm, checked_rotation, coordinate
+from toptraj.planners.coordination import Cell, CellArm, coordinate
 from toptraj.planners.errors import InvalidRequest, WrongLength
 from toptraj.planners.execution.deadline import Deadline
 from toptraj.planners.problem.requests import WaypointPath
@@ -29,10 +29,9 @@ def _robot(index: int, request: CellArmRequest, gravity) -> robots.Robot:
         vars(error)["field"] = f"arms[{index}].robot"
         raise
     base = request.base
-    rotation = None if base.rotation is None else checked_rotation(base.rotation, f"arms[{index}].base.rotation")
     try:
         payload = None if request.payload is None else request.payload.payload()
-        return equip(robot, payload, mounting(base.position, rotation, base.orientation, gravity=gravity))
+        return equip(robot, payload, mounting(base.position, base.rotation, base.orientation, gravity=gravity))
     except InvalidEquipment as error:
         where = "payload" if error.field in ("mass", "center_of_mass", "inertia", "frame") else "base"
         raise InvalidRequest(f"arms[{index}].{where}", detail=f"arms[{index}].{where}: {error.detail}") from error

@@ -182,18 +182,7 @@ def _unknown_robot(facts: dict) -> str:
     )
 
 
-def _not_a_rotation(facts: dict) -> str:
-    if facts["determinant"] is None:
-        return f"{facts['field']} must be a 3x3 matrix of finite numbers (the base's axes as columns, in the world)"
-    return (
-        f"{facts['field']} is not a rotation: R R^T differs from the identity by {facts['deviation']:.3g} and "
-        f"det R = {facts['determinant']:.4g}; give an orthonormal matrix with determinant +1 (e.g. [[1,0,0],[0,1,0],[0,0,1]], "
-        "or [[-1,0,0],[0,-1,0],[0,0,1]] for a base turned half a turn about z)"
-    )
-
-
 WORDING: dict[str, Wording] = {
-    "not_a_rotation": _not_a_rotation,
     "too_many_arms": "a cell has {value:~arm}; from {fewest} to {most} are served (every order of the arms is tried): "
     "give between {fewest} and {most} arms, or split the cell",
     "out_of_range": _out_of_range,

@@ -5,7 +5,7 @@ coordination diagram of O'Donnell & Lozano-Pérez 1989): ``cell`` (the arms and 
 ``timing`` (each arm's optimum and the pair along a curve), ``verify`` (fine checks) and
 ``coordinate`` (the whole)."""
 
-from toptraj.planners.coordination.cell import Cell, CellArm, checked_rotation
+from toptraj.planners.coordination.cell import Cell, CellArm
 from toptraj.planners.coordination.coordinate import Coordination, coordinate
 
-__all__ = ["Cell", "CellArm", "Coordination", "checked_rotation", "coordinate"]
+__all__ = ["Cell", "CellArm", "Coordination", "coordinate"]

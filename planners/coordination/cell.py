@@ -15,41 +15,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from toptraj.planners.collision.clearance import sliding_travel
 from toptraj.planners.collision.distance import segment_distance
-from toptraj.planners.errors import InvalidRequest
 from toptraj.planners.paths.base import GeometricPath
 from toptraj.planners.problem.bounded import check_speed_bounded
 from toptraj.robots import JointLimits, Robot
 from toptraj.robots.collision import robot_capsules, world_capsules
-from toptraj.robots.equipment import ROTATION_TOLERANCE
 
 #: Arms a cell holds: two coordinated in full (the square of their path parameters), more by
 #: prioritized planning over every order of the arms (``prioritized``: 4! = 24 orders, 6 pairwise
 #: diagrams).
 MAX_ARMS = 4
-
-
-def checked_rotation(rotation: ArrayLike, where: str) -> np.ndarray:
-    """``rotation`` as a (3, 3) rotation matrix, made exactly orthonormal (the polar factor, by
-    SVD) when within ``ROTATION_TOLERANCE`` of one, or InvalidRequest naming ``where`` and why."""
-    matrix = np.asarray(rotation, dtype=float)
-    if matrix.shape != (3, 3) or not np.isfinite(matrix).all():
-        raise InvalidRequest(
-            where, rotation, rule="not_a_rotation", deviation=None, determinant=None,
-            detail=f"{where} is not a 3x3 matrix of finite numbers",
-        )
-    error = float(np.abs(matrix @ matrix.T - np.eye(3)).max())
-    determinant = float(np.linalg.det(matrix))
-    if error > ROTATION_TOLERANCE or determinant <= 0.0:
-        raise InvalidRequest(
-            where, rotation, rule="not_a_rotation", deviation=error, determinant=determinant,
-            detail=f"{where} is not a rotation: R R^T differs from the identity by {error:.3g} and det R = {determinant:.4g}",
-        )
-    u, _, vt = np.linalg.svd(matrix)
-    return u @ vt
 
 
 @dataclass(frozen=True)

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from toptraj.robots.ranges import GRAVITY
 from toptraj.service.schemas.common import Schema, signed
-from toptraj.service.schemas.equipment import PayloadRequest
+from toptraj.service.schemas.equipment import PayloadRequest, checked_orientation, checked_rotation
 from toptraj.service.schemas.trajectories import JointVector, Name, Point
 
 #: Arms a request may list (the planner serves up to ``coordination.cell.MAX_ARMS``; more are
@@ -39,6 +39,9 @@ class BasePose(Schema):
         description="The base's orientation as a unit quaternion [qx, qy, qz, qw] (norm 1 within 1e-3); [0, 0, 1, 0] "
         "turns it half a turn about z. Give this or rotation.",
     )
+
+    check_orientation = field_validator("orientation")(checked_orientation)
+    check_rotation = field_validator("rotation")(checked_rotation)
 
     @model_validator(mode="after")
     def _one_rotation(self):

@@ -26,6 +26,20 @@ def _checked(check, *args, **kwargs):
         raise ValueError(error.detail) from None
 
 
+def checked_orientation(cls, value):
+    """A base's ``orientation`` field: a unit quaternion (``equipment.rotation_matrix``'s rule)."""
+    if value is not None:
+        _checked(equipment.rotation_matrix, orientation=value)
+    return value
+
+
+def checked_rotation(cls, value):
+    """A base's ``rotation`` field: a rotation matrix (``equipment.rotation_matrix``'s rule)."""
+    if value is not None:
+        _checked(equipment.rotation_matrix, rotation=value)
+    return value
+
+
 def _inertia_shape(value: object) -> str | None:
     """Which form of an inertia ``value`` is: ``"values"`` (a list of 6), ``"matrix"`` (a list of
     3) or ``None`` (neither: a 422 saying both forms)."""
@@ -104,19 +118,8 @@ class MountingRequest(Schema):
         default=None, description="Gravity in the world (m/s^2); default the robot's own, [0, 0, -9.81] for the catalog arms."
     )
 
-    @field_validator("orientation")
-    @classmethod
-    def _unit(cls, value):
-        if value is not None:
-            _checked(equipment.rotation_matrix, orientation=value)
-        return value
-
-    @field_validator("rotation")
-    @classmethod
-    def _rotation(cls, value):
-        if value is not None:
-            _checked(equipment.rotation_matrix, rotation=value)
-        return value
+    check_orientation = field_validator("orientation")(checked_orientation)
+    check_rotation = field_validator("rotation")(checked_rotation)
 
     @model_validator(mode="after")
     def _one_rotation(self):

@@ -128,8 +128,8 @@ def test_a_base_that_is_not_a_rotation_is_a_422_saying_where(patient_client):
     response = patient_client.post("/v1/cells", json=_cell(a1={"base": mirrored}))
     assert response.status_code == 422
     detail = response.json()["detail"]
-    assert detail.startswith("arms[1].base.rotation is not a rotation") and "det R = -1" in detail
-    assert "breaks the rule" not in detail and detail.endswith("for a base turned half a turn about z)")
+    assert detail.startswith("arms[1].base.rotation: rotation is not a rotation matrix: its determinant is -1 (a reflection)")
+    assert "[[-1,0,0],[0,-1,0],[0,0,1]] turns the base half a turn about z" in detail, detail
     assert response.headers["content-type"].startswith("application/problem+json")
 
 
