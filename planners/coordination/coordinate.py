@@ -165,7 +165,7 @@ def _arms_alone(cell: Cell, deadline: Deadline) -> list[TimeScaling]:
         where = f"arms[{index}] ({arm.robot.name})"
         try:
             check_self_collision(arm.path, arm.robot, deadline=deadline)
-            solo.append(solo_timing(arm, cell.kinds, deadline=deadline))
+            solo.append(solo_timing(arm, cell.kinds, deadline=deadline, field=f"arms[{index}]"))
         except SelfCollision as error:
             s = float(getattr(error, "s", 0.0))
             raise SelfCollision(f"{where}: {error.detail}", s, error.link_a, error.link_b, error.distance) from error

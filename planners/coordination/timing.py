@@ -22,6 +22,7 @@ from toptraj.planners.constraints.path_constraints import PathConstraints, build
 from toptraj.planners.coordination.cell import Cell, CellArm
 from toptraj.planners.coordination.curve import SmoothCurve
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.problem.bounded import check_stretches_bounded
 from toptraj.planners.timing.base import AT_REST, TimeScaling
 from toptraj.planners.timing.scaled import solve_well_scaled
 from toptraj.planners.timing.toppra_method import ToppraMethod
@@ -36,10 +37,16 @@ def _timing_grid(arm: CellArm, intervals: int) -> np.ndarray:
 
 
 def solo_timing(
-    arm: CellArm, kinds: tuple[str, ...], intervals: int = TIMING_GRID, deadline: Deadline = NO_DEADLINE
+    arm: CellArm, kinds: tuple[str, ...], intervals: int = TIMING_GRID, deadline: Deadline = NO_DEADLINE, field: str = "arm",
 ) -> TimeScaling:
-    """The arm's own time-optimal motion along its path, alone in the world (TOPP-RA)."""
+    """The arm's own time-optimal motion along its path, alone in the world (TOPP-RA).
+
+    Raises:
+        InvalidRequest: a stretch of the path that no limit of ``kinds`` bounds (rule
+            "stretch_unbounded", ``toptraj.planners.problem.bounded``; ``field`` names the arm).
+    """
     constraints = build_path_constraints(arm.path, arm.robot, arm.limits, kinds, _timing_grid(arm, intervals), deadline)
+    check_stretches_bounded(constraints, arm.path, arm.robot, arm.limits, kinds, field=field)
     return solve_well_scaled(ToppraMethod(), constraints, AT_REST, None, deadline)  # type: ignore[return-value]
 
 

@@ -90,11 +90,12 @@ def unbounded_stretch(constraints: PathConstraints) -> tuple[int, int] | None:
 
 def check_stretches_bounded(
     constraints: PathConstraints, path: GeometricPath, robot: Robot, limits: JointLimits, kinds: tuple[str, ...],
-    s_of: Callable[[float], float] = float, served: frozenset[str] | tuple[str, ...] | None = None,
+    s_of: Callable[[float], float] = float, served: frozenset[str] | tuple[str, ...] | None = None, field: str = "constraints",
 ) -> None:
     """Refuse ``path`` (timed on ``constraints``) where a stretch of it has nothing that bounds
     it (``unbounded_stretch``), naming it by ``s_of`` (the whole path's parameter of the
-    stretch's own) and the joints moving there.
+    stretch's own) and the joints moving there; ``field`` names whose path it is (a cell's
+    ``arms[i]``).
 
     Raises:
         InvalidRequest: rule "stretch_unbounded" (facts: ``s_from``, ``s_to``, the moving
@@ -110,7 +111,7 @@ def check_stretches_bounded(
     joints = tuple(robot.joint_names[j] for j in moving)
     s_from, s_to = float(s_of(constraints.s[first])), float(s_of(constraints.s[last]))
     raise InvalidRequest(
-        "constraints", list(kinds), rule="stretch_unbounded", robot=robot.name, kinds=tuple(kinds), s=s_from, s_from=s_from, s_to=s_to,
+        field, list(kinds), rule="stretch_unbounded", robot=robot.name, kinds=tuple(kinds), s=s_from, s_from=s_from, s_to=s_to,
         joints=joints, available=_available(limits, served, moving),
         detail=f"from s = {s_from:.4f} to {s_to:.4f} no limit held bounds the motion of {', '.join(joints) or 'the tool'}",
     )

@@ -115,3 +115,30 @@ def test_a_tool_speed_that_holds_only_where_it_can_is_no_bound_elsewhere(client)
     refused = client.post("/v1/trajectories", json=turning)
     assert refused.status_code == 422, refused.text
     assert refused.json()["detail"].startswith("from s = 0.0000 to 1.0000 nothing bounds the motion: joints 'phi', 'psi' move"), refused.text
+
+
+def test_a_cell_arm_moving_only_a_joint_without_a_limit_is_refused_naming_the_arm():
+    """A library caller's cell: geering_2r with a velocity limit on phi only, its first arm
+    moving psi alone under the velocity limits. It was timed alone in 0.2 ms (nothing bounds
+    psi) and the cell answered; it is refused naming the arm, the stretch and the joint."""
+    from toptraj.planners.coordination import Cell, CellArm, coordinate
+    from toptraj.planners.problem.waypoints import make_path
+    from toptraj.robots.equipment import equip, mounting
+
+    bare = robots.load("geering_2r")
+    limited = dataclasses.replace(bare, limits=dataclasses.replace(bare.limits, velocity=np.array([2.0, np.inf])))
+
+    def arm(waypoints, x):
+        robot = equip(limited, None, mounting([x, 0.0, 0.0]))
+        return CellArm(robot, make_path(robot, WaypointPath(np.array(waypoints, dtype=float))), robot.limits)
+
+    moving_psi = Cell((arm([[0.0, 0.0], [0.0, 1.0]], 0.0), arm([[0.0, 0.0], [1.0, 0.0]], 5.0)), 0.01, ("velocity",))
+    with pytest.raises(InvalidRequest) as refused:
+        coordinate(moving_psi)
+    assert refused.value.field == "arms[0]" and refused.value.rule == "stretch_unbounded"
+    assert detail(refused.value).startswith(
+        "arms[0]: from s = 0.0000 to 1.0000 nothing bounds the motion: joint 'psi' moves there without a finite velocity limit"
+    ), detail(refused.value)
+    # both arms turning phi, which has its limit: planned, the slower arm at 1 rad / 2 rad/s
+    planned = coordinate(Cell((arm([[0.0, 0.0], [1.0, 0.0]], 0.0), arm([[0.0, 0.0], [0.5, 0.0]], 5.0)), 0.01, ("velocity",)))
+    assert planned.solo[0] == pytest.approx(0.5, rel=0.02)
