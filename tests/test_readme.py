@@ -100,3 +100,13 @@ def test_the_readme_says_where_uploads_and_jobs_live_and_how_to_move_them(monkey
     assert default_data_dir() == Path.home() / ".local" / "share" / "toptraj"
     monkeypatch.setenv("TOPTRAJ_DATA_DIR", str(tmp_path))
     assert default_data_dir() == tmp_path
+
+
+def test_every_file_the_guide_and_the_readme_name_exists():
+    """Paths to the project's files in the guide's pages and the README (a test named as the
+    proof of a figure) lead to a file; ``design.md`` records the tree as it was before its
+    reshaping and is left out."""
+    pattern = re.compile(r"(?<![\w/.])(?:planners|service|robots|client|compiled|benchmarks|tests|examples)/[\w./-]*\.(?:py|json|js|jsonl|urdf|yaml)")
+    pages = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "design.md")]
+    missing = [f"{page.name}: {path}" for page in pages for path in sorted(set(pattern.findall(page.read_text()))) if not (ROOT / path).exists()]
+    assert not missing, missing
