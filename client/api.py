@@ -114,6 +114,7 @@ class Client(JobCalls):
         locked_joints: dict[str, float] | None = None,
         joint_limits: str | os.PathLike[str] | dict | None = None,
         payload: dict | None = None,
+        allowed_collisions: str | os.PathLike[str] | list | None = None,
         timeout: float | None = None,
     ) -> Robot:
         """``POST /v1/robots``: check, build and store a fixed-base arm's URDF.
@@ -128,6 +129,9 @@ class Client(JobCalls):
                 limits are taken as given, velocity and effort limits only tighten the URDF's.
             payload: What the robot carries unless a request gives its own: ``{"mass": kg,
                 "center_of_mass": [x, y, z], "inertia": [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]}`` (m, kg m^2).
+            allowed_collisions: Pairs of links allowed to touch, not checked for
+                self-collision: an SRDF's text, a ``pathlib.Path`` to one (its
+                ``disable_collisions`` are read), or a list of ``[link, link]`` pairs.
             timeout: Seconds to wait for this answer instead of the client's.
 
         Returns:
@@ -145,6 +149,8 @@ class Client(JobCalls):
             body["joint_limits"] = joint_limits if isinstance(joint_limits, dict) else _text(joint_limits)
         if payload is not None:
             body["payload"] = dict(payload)
+        if allowed_collisions is not None:
+            body["allowed_collisions"] = [list(pair) for pair in allowed_collisions] if isinstance(allowed_collisions, list) else _text(allowed_collisions)
         return Robot.from_body(self._call("POST", "/v1/robots", body, timeout=timeout))
 
     def delete_robot(self, name: str) -> None:
@@ -181,6 +187,8 @@ class Client(JobCalls):
         dt: float | None = None,
         format: str | None = None,
         exact_period: bool | None = None,
+        payload: dict | None = None,
+        mounting: dict | None = None,
         timeout: float | None = None,
     ) -> Trajectory | CsvTrajectory:
         """``POST /v1/trajectories``: time a path.
@@ -198,6 +206,8 @@ class Client(JobCalls):
             dt: ``output.dt``, the sample period (s).
             format: ``output.format``: ``samples`` (default), ``joint_trajectory`` or ``csv``.
             exact_period: ``output.exact_period``: samples on whole periods of ``dt``.
+            payload: ``payload``, what the robot carries (``{"mass": kg, ...}``).
+            mounting: ``mounting``, the base pose and gravity (``{"position": [x, y, z], ...}``).
             timeout: Seconds to wait for this answer instead of the client's.
 
         Returns:
@@ -212,12 +222,14 @@ class Client(JobCalls):
             if "methods" in robot:
                 raise ValueError("this body names methods: it is a comparison; send it with compare(body)")
             _alone(robot, waypoints=waypoints, path=path, method=method, constraints=constraints, limits=limits,
-                   duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period)
+                   duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period, payload=payload,
+                   mounting=mounting)
             body = robot
         else:
             body = trajectory_request(
                 robot, waypoints, path=path, method=method, constraints=constraints, limits=limits,
-                duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period,
+                duration=duration, timing=timing, dt=dt, format=format, exact_period=exact_period, payload=payload,
+                mounting=mounting,
             )
         answer = self._answer(self.request("POST", "/v1/trajectories", body, timeout=timeout))
         return answer if isinstance(answer, CsvTrajectory) else Trajectory.from_body(answer)
@@ -232,6 +244,8 @@ class Client(JobCalls):
         constraints: list[str] | None = None,
         limits: dict | None = None,
         timing: dict | None = None,
+        payload: dict | None = None,
+        mounting: dict | None = None,
         timeout: float | None = None,
     ) -> list[Comparison]:
         """``POST /v1/trajectories/compare``: the same path under each of ``methods``.
@@ -244,6 +258,8 @@ class Client(JobCalls):
             constraints: ``timing.constraints`` shared by every method.
             limits: ``timing.limits`` shared by every method.
             timing: Other ``timing`` fields.
+            payload: ``payload``, what the robot carries, for every method.
+            mounting: ``mounting``, the base pose and gravity, for every method.
             timeout: Seconds to wait for this answer instead of the client's.
 
         Returns:
@@ -251,12 +267,16 @@ class Client(JobCalls):
             its ``error`` (not raised).
         """
         if isinstance(robot, dict):
-            _alone(robot, waypoints=waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing)
+            _alone(robot, waypoints=waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing,
+                   payload=payload, mounting=mounting)
             body = robot
         else:
             if not methods:
                 raise ValueError("give methods, e.g. ['phase_plane', 'quintic']")
-            body = compare_request(robot, waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing)
+            body = compare_request(
+                robot, waypoints, methods=methods, path=path, constraints=constraints, limits=limits, timing=timing,
+                payload=payload, mounting=mounting,
+            )
         return comparisons(self._call("POST", "/v1/trajectories/compare", body, timeout=timeout))
 
     def cell(self, body: dict | str | os.PathLike[str], *, timeout: float | None = None) -> dict:

@@ -74,6 +74,8 @@ def trajectory_request(
     dt: float | None = None,
     format: str | None = None,
     exact_period: bool | None = None,
+    payload: dict | None = None,
+    mounting: dict | None = None,
 ) -> dict:
     """The body of ``POST /v1/trajectories``.
 
@@ -92,6 +94,10 @@ def trajectory_request(
         dt: ``output.dt``, the sample period (s); 0.01 on the service.
         format: ``output.format``: ``samples``, ``joint_trajectory`` or ``csv``.
         exact_period: ``output.exact_period``: samples on whole periods of ``dt``.
+        payload: What the robot carries at its tool: ``{"mass": kg, "center_of_mass": [x, y,
+            z], "inertia": [...], "frame": ..., "radius": m}`` (the request's ``payload``).
+        mounting: The base pose and the world's gravity: ``{"position": [x, y, z],
+            "orientation": [qx, qy, qz, qw] or "rotation": 3x3, "gravity": [gx, gy, gz]}``.
 
     Returns:
         The request as a JSON-ready dict.
@@ -110,7 +116,12 @@ def trajectory_request(
     output = {key: value for key, value in {"dt": dt, "format": format, "exact_period": exact_period}.items() if value is not None}
     if output:
         body["output"] = output
-    return body
+    return body | _equipment(payload, mounting)
+
+
+def _equipment(payload: dict | None, mounting: dict | None) -> dict:
+    """The request's ``payload`` and ``mounting`` fields that are given."""
+    return {key: dict(value) for key, value in (("payload", payload), ("mounting", mounting)) if value is not None}
 
 
 def compare_request(
@@ -122,6 +133,8 @@ def compare_request(
     constraints: list[str] | None = None,
     limits: dict | None = None,
     timing: dict | None = None,
+    payload: dict | None = None,
+    mounting: dict | None = None,
 ) -> dict:
     """The body of ``POST /v1/trajectories/compare``: one path under each of ``methods`` (e.g.
     ``["phase_plane", "quintic"]``), with the constraints and limits every method shares; the
@@ -134,4 +147,4 @@ def compare_request(
         "path": _path(path, waypoints),
         "methods": list(methods),
         "timing": _timing(timing, {"constraints": constraints, "limits": limits}),
-    }
+    } | _equipment(payload, mounting)

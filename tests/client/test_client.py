@@ -356,3 +356,36 @@ def test_a_cell_through_the_client(toptraj):
     marked = "\ufeff" + (ROOT / "examples" / "cell_two_ur5.json").read_text()  # a text read with its byte order mark
     assert toptraj.cell(marked, timeout=120.0)["duration"] == answer["duration"]
     assert [arm["robot"] for arm in answer["arms"]] == ["ur5", "ur5"]
+
+
+def test_upload_with_allowed_collisions_as_a_list_or_an_srdf_file(toptraj, tmp_path):
+    """The folding lecture_3r path is refused for self-collision on a plain upload and served on
+    one whose allowed pairs, given as a list or as an SRDF file, hold the pair that touches."""
+    urdf = ROOT / "robots" / "urdf" / "lecture_3r.urdf"
+    folding = {"kind": "waypoints", "waypoints": [[0.0, 2.8, 0.0], [0.0, 2.8, 2.0]], "self_collision": True}
+    toptraj.upload(urdf, "client_plain_3r")
+    with pytest.raises(ProblemError) as caught:
+        toptraj.plan("client_plain_3r", path=folding)
+    assert caught.value.status == 422 and {caught.value.problem["link_a"], caught.value.problem["link_b"]} == {"turret", "forearm"}
+    srdf = tmp_path / "lecture_3r.srdf"
+    srdf.write_text('<?xml version="1.0"?>\n<robot name="lecture_3r"><disable_collisions link1="turret" link2="forearm"/></robot>\n')
+    for name, allowed in (("client_listed_3r", [("forearm", "turret")]), ("client_srdf_3r", srdf)):
+        toptraj.upload(urdf, name, allowed_collisions=allowed)
+        assert toptraj.plan(name, path=folding).duration > 0.0
+
+
+def test_payload_and_mounting_are_request_fields(toptraj, server):
+    """plan() and compare() send payload and mounting as the request's fields: the answer is
+    the service's to the body holding them, and a ceiling mount with a payload changes the torques."""
+    payload, mounting = {"mass": 3.0, "center_of_mass": [0.0, 0.0, 0.05]}, {"orientation": [1.0, 0.0, 0.0, 0.0]}
+    planned = toptraj.plan("ur5", UR5_WAYPOINTS, constraints=["velocity", "acceleration", "torque"], payload=payload, mounting=mounting)
+    body = trajectory_request("ur5", UR5_WAYPOINTS, constraints=["velocity", "acceleration", "torque"]) | {"payload": payload, "mounting": mounting}
+    served = _served(server, "/v1/trajectories", body)
+    assert planned.duration == served["duration"]
+    np.testing.assert_array_equal(planned.tau, np.array(served["samples"]["tau"]))
+    bare = toptraj.plan("ur5", UR5_WAYPOINTS, constraints=["velocity", "acceleration", "torque"])
+    assert np.abs(planned.tau[0] - bare.tau[0]).max() > 1.0  # N m: the payload's weight, pulling the other way
+    compared = toptraj.compare("ur5", UR5_WAYPOINTS, methods=["phase_plane"], payload=payload, mounting=mounting)
+    assert compared[0].duration == served["duration"]
+    with pytest.raises(ValueError, match="payload"):
+        toptraj.plan(body, payload=payload)

@@ -55,3 +55,35 @@ def test_the_cell_preset_shows_both_arms_and_the_coordination_diagram(browser_pa
     warned = json.loads(server.request("POST", "/v1/cells", request | {"constraints": ["velocity"]})[2])
     assert page.locator("#warnings li").all_inner_texts() == warned["warnings"]
     assert outside == []
+
+
+def test_a_cell_is_kept_in_the_link_and_hides_the_single_arm_controls(browser_page):
+    """The single-arm controls (robot, methods, constraints), which a cell ignores, are hidden
+    while the path holds a cell; the link after planning one reopens and plans that cell."""
+    page, base, server, outside = browser_page
+    page.goto(base + "/")
+    page.wait_for_selector("body[data-ready=true]", timeout=30_000)
+    assert page.is_visible("#robot") and page.is_visible("#constraints") and not page.is_visible("#cell-note")
+    page.select_option("#preset", PRESET)
+    assert not page.is_visible("#robot") and not page.is_visible("#methods") and not page.is_visible("#constraints")
+    assert page.is_visible("#cell-note")
+    cell = json.loads(page.input_value("#path"))
+    page.fill("#path", json.dumps(cell | {"clearance": 0.03}))
+    page.click("#plan")
+    page.wait_for_selector("body[data-planned=true], #error:not([hidden])", timeout=120_000)
+    assert not page.is_visible("#error"), page.inner_text("#error")
+    planned = float(page.get_attribute("#duration", "data-duration"))
+    link = page.url
+    assert "#r=" in link
+    page.goto("about:blank")
+    page.goto(link)
+    page.wait_for_selector("body[data-planned=true], #error:not([hidden])", timeout=120_000)
+    assert not page.is_visible("#error"), page.inner_text("#error")
+    assert json.loads(page.input_value("#path"))["clearance"] == 0.03
+    assert float(page.get_attribute("#duration", "data-duration")) == planned
+    assert page.inner_text("#duration").startswith("cell of 2 arms")
+    # a single arm's path again: its controls are back
+    page.fill("#path", json.dumps({"kind": "waypoints", "waypoints": [[0.0, 0.0], [1.0, 1.0]]}))
+    page.dispatch_event("#path", "input")
+    assert page.is_visible("#robot") and page.is_visible("#constraints") and not page.is_visible("#cell-note")
+    assert outside == []

@@ -79,7 +79,24 @@ function checked(container) {
   return [...container.querySelectorAll("input:checked")].map((box) => box.value);
 }
 
+function showFormFor(text) {
+  // a cell's request (with arms) takes its robots, limits and constraints from its body: the
+  // single-arm controls are hidden while the path field holds one
+  let cell = false;
+  try {
+    cell = isCell(JSON.parse(text));
+  } catch (error) {
+    cell = document.body.dataset.form === "cell" && /"arms"/.test(text);  // mid-edit: as it was
+  }
+  document.body.dataset.form = cell ? "cell" : "trajectory";
+}
+
 function applyPreset(name) {
+  applyPresetFields(name);
+  showFormFor($("path").value);
+}
+
+function applyPresetFields(name) {
   if (name === CELL_PRESET_NAME) {
     // one line per arm
     const lines = Object.entries(CELL_PRESET).map(([key, value]) => (Array.isArray(value)
@@ -119,6 +136,7 @@ async function init() {
   checkboxes($("methods"), methods, []);
   for (const name of [...Object.keys(PRESETS), CELL_PRESET_NAME]) $("preset").append(new Option(name, name));
   $("preset").addEventListener("change", () => applyPreset($("preset").value));
+  $("path").addEventListener("input", () => showFormFor($("path").value));
   applyPreset(Object.keys(PRESETS)[0]);
   $("plan").addEventListener("click", plan);
   $("cancel").addEventListener("click", cancel);
@@ -148,6 +166,7 @@ function applyForm(form) {
   checkboxes($("methods"), [...methods, ...form.methods.filter((name) => !methods.includes(name))], form.methods);
   checkboxes($("constraints"), CONSTRAINTS, form.constraints);
   $("dt").value = String(form.dt);
+  showFormFor($("path").value);
 }
 
 function showError(message) {
@@ -251,7 +270,11 @@ async function planAsCell(request) {
   $("plan").disabled = true;
   $("status").textContent = "planning the cell…";
   try {
-    const answer = await planCell(request, Number($("dt").value));
+    const dt = Number($("dt").value);
+    const answer = await planCell(request, dt);
+    // the cell in the URL as a trajectory's request is (robot, methods and constraints are the
+    // form's: a cell takes its own from its body)
+    $("link-note").textContent = await keepInURL({robot: $("robot").value, path: request, methods: checked($("methods")), constraints: checked($("constraints")), dt});
     $("status").textContent = `planned: ${answer.arms.length} arms on one clock`;
     document.body.dataset.planned = "true";
   } catch (error) {

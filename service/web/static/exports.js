@@ -10,7 +10,8 @@ const TOLERANCE = 0.005;
 function showUtilization(answer, constraints) {
   // one row per joint, a column per limit kind the answer reports (a kind left out of the
   // constraints only where some joint uses its limit; a joint without a finite limit reads null,
-  // shown as "no limit"); in each row the largest utilization (the limit that binds that joint) is marked
+  // shown as "no limit"); a limit held that the joint reaches (within the tolerance of 0.5 %) is
+  // marked: those bind the motion
   const used = (kind) => constraints.includes(kind) || answer.peak_utilization[kind].some((value) => value > 0);
   const kinds = KINDS.filter((kind) => answer.peak_utilization[kind] && used(kind));
   const head = $("utilization").querySelector("thead tr");
@@ -25,7 +26,6 @@ function showUtilization(answer, constraints) {
     const row = body.insertRow();
     row.insertCell().textContent = name;
     const values = kinds.map((kind) => answer.peak_utilization[kind][joint]);
-    const top = Math.max(...values.filter((value) => value !== null));
     kinds.forEach((kind, k) => {
       const cell = row.insertCell();
       cell.dataset.kind = kind;
@@ -36,9 +36,9 @@ function showUtilization(answer, constraints) {
         return;
       }
       cell.textContent = values[k].toFixed(4);
-      if (values[k] === top) {
+      if (constraints.includes(kind) && values[k] >= 1 - TOLERANCE) {
         cell.classList.add("binding");
-        cell.title = "the binding limit of this joint";
+        cell.title = "this joint reaches this limit: it binds the motion";
         cell.textContent += " ◀";
       }
       if (constraints.includes(kind) && values[k] > 1 + TOLERANCE) cell.classList.add("over");
@@ -47,7 +47,8 @@ function showUtilization(answer, constraints) {
 }
 
 function csvText(answer) {
-  // the samples as the service's CSV (service/formats.py): a header, then a row per sample
+  // the samples as shown, laid out as the service's CSV (service/formats.py): its header, then a
+  // row per sample (without the service's "#" lines of metadata, which the JSON download holds)
   const names = answer.joint_names;
   const header = ["t", ...["q", "qd", "qdd", "tau"].flatMap((quantity) => names.map((name) => `${quantity}.${name}`))];
   const s = answer.samples;
