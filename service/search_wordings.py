@@ -24,8 +24,12 @@ def _lattice_over_memory(facts: dict) -> str:
 def _roadmap_over_memory(facts: dict) -> str:
     points, neighbors = facts["points"], facts["neighbors"]
     served = []
-    if facts["most_points"] is not None:
-        served.append(f"at most {facts['most_points']} roadmap points are served with {neighbors} neighbors")
+    most_points = facts["most_points"]
+    if most_points is not None and most_points < neighbors:  # a point has fewer others than neighbors asks
+        served.append(f"at most {most_points} roadmap points are served (fewer than the {neighbors} neighbors asked, "
+                      "which beyond the number of points join nothing more)")
+    elif most_points is not None:
+        served.append(f"at most {most_points} roadmap points are served with {neighbors} neighbors")
     if facts["most_neighbors"] is not None:
         served.append(f"at most {facts['most_neighbors']} neighbors with {points} roadmap points")
     return (

@@ -24,7 +24,7 @@ CSV_EXAMPLE = "t,arms[0].q.shoulder_pan_joint,…\n# robots: ur5, ur5\n# duratio
 @router.post(
     "",
     summary="Time arms sharing a workspace",
-    responses=problem_responses(404, 413, 422, 504)
+    responses=problem_responses(404, 413, 422, 503, 504)
     | {200: {"content": {"text/csv": {"schema": {"type": "string"}, "example": CSV_EXAMPLE}}}},
 )
 async def create_cell(body: Annotated[CellRequest, Body(openapi_examples=cell_examples())], request: Request) -> Response:
@@ -40,7 +40,8 @@ async def create_cell(body: Annotated[CellRequest, Body(openapi_examples=cell_ex
     and the time lost to coordination. Errors: an unknown robot (404), a base rotation that is
     not one, a payload that is not physical, more than four arms, arms that collide at their
     start, an arm's path whose links touch (naming them and s), a torque no timing holds,
-    paths that cannot pass each other (422).
+    paths that cannot pass each other (422); the heavy plannings' queue full (503, with
+    `Retry-After`); past the budget (504).
     \f
     Runs in the heavy lane under the planning budget."""
     settings = request.app.state.settings

@@ -65,3 +65,18 @@ def test_pandas_read_csv_with_comment(answers):
     frame = pandas.read_csv(io.StringIO(text), comment="#")
     assert list(frame.columns)[0] == "t" and all(dtype.kind == "f" for dtype in frame.dtypes)
     np.testing.assert_array_equal(frame.to_numpy(), _table(answer))
+
+
+def test_the_documented_metadata_reader_keeps_every_warning(client):
+    """docs/http-api.md's reader of the ``#`` lines: one value per key, and every
+    ``# warning:`` line, in order (a dict of all the lines kept only the last warning)."""
+    waypoints = [[0.0, -1.2, 1.0, 0.0, 0.0, 0.0], [0.8, -1.0, 1.4, -0.5, 0.6, 0.3]]  # the wrist at its singularity first
+    body = {"robot": "ur5", "path": {"kind": "waypoints", "waypoints": waypoints}, "output": {"dt": 5.0, "exact_period": True}}
+    answer = client.post("/v1/trajectories", json=body).json()
+    text = client.post("/v1/trajectories", json=body | {"output": {"dt": 5.0, "exact_period": True, "format": "csv"}}).text
+    assert len(answer["warnings"]) >= 2, answer["warnings"]
+    pairs = [line[2:].rstrip("\n").split(": ", 1) for line in io.StringIO(text) if line.startswith("# ")]
+    metadata = {key: value for key, value in pairs if key != "warning"}
+    warnings = [value for key, value in pairs if key == "warning"]
+    assert warnings == answer["warnings"]
+    assert metadata["warnings"] == str(len(answer["warnings"])) and metadata["robot"] == "ur5"

@@ -116,7 +116,7 @@ def test_a_search_beyond_the_memory_cap_gets_422_naming_the_largest_setting_serv
     assert response.status_code == 422, response.text[:300]
     detail = response.json()["detail"]
     assert "roadmap_points 2000 with neighbors 50" in detail and "GiB" in detail
-    most = int(re.search(r"at most (\d+) roadmap points are served with 50 neighbors", detail).group(1))
+    most = int(re.search(r"at most (\d+) roadmap points are served \(fewer than the 50 neighbors asked, which beyond the number of points join nothing more\)", detail).group(1))
     fewest = int(re.search(r"at most (\d+) neighbors with 2000 roadmap points", detail).group(1))
     robot = robots.load("ur5")
     start, goal = np.array(UR5_START), np.array(UR5_GOAL)
@@ -175,3 +175,21 @@ def test_an_estimate_too_low_is_a_clear_error_not_the_system_killing_a_process(m
     assert response.status_code == 422, response.text[:300]
     assert response.json()["title"] == "Computation over its memory cap"
     assert "memory allowance" in response.json()["detail"] and "timing.search.roadmap_points" in response.json()["detail"]
+
+
+def test_fewer_roadmap_points_than_neighbors_are_advised_as_such():
+    """Under a small cap the largest roadmap served has fewer points than the neighbors asked:
+    the advice says that neighbors beyond the points join nothing more (the roadmap caps them),
+    not a count of neighbors that no point could have."""
+    from toptraj.planners.generators.search.memory import over_memory
+    from toptraj.service.problems import detail
+
+    robot = robots.load("ur5")
+    start, goal = np.array(UR5_START), np.array(UR5_GOAL)
+    options = SearchOptions(roadmap_points=2000, neighbors=50)
+    cap = search_bytes(robot, start, goal, SearchOptions(roadmap_points=30, neighbors=50), True)
+    refusal = over_memory(robot, start, goal, options, True, cap)
+    assert refusal.most_points is not None and refusal.most_points < 50
+    text = detail(refusal)
+    assert f"at most {refusal.most_points} roadmap points are served (fewer than the 50 neighbors asked, which beyond the number of points join nothing more)" in text, text
+    assert "with 50 neighbors" not in text.split(";", 1)[1]
