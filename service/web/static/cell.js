@@ -44,7 +44,7 @@ function drawDiagram(diagram) {
     {x: diagram.curve.map((p) => p[0]), y: diagram.curve.map((p) => p[1]), mode: "lines", name: "the arms' coordination",
      line: {color: "#1f5fbf", width: 3}},
   ];
-  const layout = {...LAYOUT, title: {text: "Coordination diagram (red: arms too close)"},
+  const layout = {...LAYOUT, title: plotTitle("Coordination diagram (red: arms too close)"),
     xaxis: {title: {text: "s of arms[0]", standoff: 4}, range: [0, 1], automargin: true},
     yaxis: {title: {text: "s of arms[1]"}, range: [0, 1], scaleanchor: "x"}};
   Plotly.newPlot("phase-plane", traces, layout, {responsive: true});
@@ -68,7 +68,7 @@ async function drawCellArms(answer, body) {
     });
   }
   const shown = traces.filter((trace) => trace.showlegend).length;
-  const layout = {...LAYOUT, title: {text: "The arms, stroboscopically (light: start, dark: end)"},
+  const layout = {...LAYOUT, title: plotTitle("The arms, stroboscopically (light: start, dark: end)"),
     margin: {...LAYOUT.margin, b: legendMargin(shown, $("arm").clientWidth)},
     scene: {aspectmode: "data", camera: {eye: {x: 0.4, y: -2.0, z: 1.2}}, xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}}, zaxis: {title: {text: "z (m)"}}}};
   Plotly.newPlot("arm", traces, layout, {responsive: true});

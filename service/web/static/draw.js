@@ -4,7 +4,12 @@
 
 // the legend below the plot, under the x axis title (in the container's coordinates, so that the
 // two never overlap whatever the plot's height)
-const LAYOUT = {margin: {l: 55, r: 15, t: 40, b: 45}, font: {size: 11}, legend: {orientation: "h", yref: "container", y: 0, yanchor: "bottom"}};
+const LAYOUT = {margin: {l: 55, r: 15, t: 64, b: 45}, font: {size: 11}, legend: {orientation: "h", yref: "container", y: 0, yanchor: "bottom"}};
+
+function plotTitle(text) {
+  // a plot's title below Plotly's toolbar (its top 30 px), which would cover a long title on a phone
+  return {text, yref: "container", y: 1, yanchor: "top", pad: {t: 30}};
+}
 const JOINT_COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22"];
 
 function legendMargin(count, width) {
@@ -32,7 +37,7 @@ function drawPhasePlane(answer) {
   const yaxis = {title: {text: "ṡ (1/s)"}, rangemode: "tozero"};
   if (Math.max(...plane.sd_max.filter((v) => v != null)) > 2 * top) yaxis.range = [0, 1.6 * top];
   const margin = {...LAYOUT.margin, b: legendMargin(traces.length, $("phase-plane").clientWidth)};
-  Plotly.newPlot("phase-plane", traces, {...LAYOUT, margin, title: {text: "Phase plane"}, xaxis: {title: {text: "s", standoff: 4}, automargin: true}, yaxis}, {responsive: true});
+  Plotly.newPlot("phase-plane", traces, {...LAYOUT, margin, title: plotTitle("Phase plane"), xaxis: {title: {text: "s", standoff: 4}, automargin: true}, yaxis}, {responsive: true});
 }
 
 function interpolate(xs, ys, x) {
@@ -76,7 +81,7 @@ function drawJoints(answer, limits) {
   const rows = jointRows(answer, limits);
   const traces = [];
   const height = 160 * rows.length;
-  const layout = {...LAYOUT, title: {text: "Joints against their limits (dashed)"}, grid: {rows: rows.length, columns: 1, pattern: "independent"}, height, showlegend: true};
+  const layout = {...LAYOUT, title: plotTitle("Joints against their limits (dashed)"), grid: {rows: rows.length, columns: 1, pattern: "independent"}, height, showlegend: true};
   layout.margin = {...LAYOUT.margin, b: legendMargin(answer.joint_names.length, $("joints").clientWidth)};
   const span = [answer.samples.t[0], answer.samples.t[answer.samples.t.length - 1]];
   rows.forEach((row, index) => {
@@ -120,7 +125,7 @@ async function drawArm(answer, path) {
   });
   if (plane && plane[0] === 0 && plane[1] === 1) traces.unshift(...obstacleTraces(answer, path));
   const shown = traces.filter((trace) => trace.showlegend !== false).length;
-  const layout = {...LAYOUT, title: {text: "The arm, stroboscopically (light: start, dark: end)"}, margin: {...LAYOUT.margin, b: legendMargin(shown, $("arm").clientWidth)}};
+  const layout = {...LAYOUT, title: plotTitle("The arm, stroboscopically (light: start, dark: end)"), margin: {...LAYOUT.margin, b: legendMargin(shown, $("arm").clientWidth)}};
   if (plane) Object.assign(layout, {xaxis: {title: {text: names[plane[0]], standoff: 4}, automargin: true}, yaxis: {title: {text: names[plane[1]]}, scaleanchor: "x"}});
   else layout.scene = {aspectmode: "data", camera: {eye: {x: 1.6, y: 1.6, z: 1.1}}, xaxis: {title: {text: "x (m)"}}, yaxis: {title: {text: "y (m)"}}, zaxis: {title: {text: "z (m)"}}};
   Plotly.newPlot("arm", traces, layout, {responsive: true});
