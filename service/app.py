@@ -18,6 +18,7 @@ from toptraj.service.body_limit import BodySizeLimit
 from toptraj.service.errors import UnexpectedErrors, install_problem_handlers
 from toptraj.service.finite import FiniteJSONResponse
 from toptraj.service.jobs import JOB_MODULES, job_runner
+from toptraj.service.offline_pages import OwnImagesOnly
 from toptraj.service.routes import batches, cells, guide, health, jobs, trajectories, web
 from toptraj.service.routes import robots as robot_routes
 from toptraj.service.serving import open_connections
@@ -88,6 +89,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.jobs = job_runner(settings)
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)
+    app.add_middleware(OwnImagesOnly)
     app.add_middleware(UnexpectedErrors)  # last added, so outermost
     app.include_router(health.router)
     app.include_router(robot_routes.router)
