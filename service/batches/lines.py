@@ -88,9 +88,21 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
         return refused(422, "Invalid request", f"the line is not JSON: {str(error)[:_MAX_DETAIL]}")
     if not isinstance(body, dict):
         return refused(
-            422, "Invalid request", f"the line is a JSON {type(body).__name__}; a request is a JSON object (a POST /v1/trajectories body)"
+            422, "Invalid request", f"the line is a JSON {_JSON_TYPES.get(type(body), 'value')}; a request is a JSON object (a POST /v1/trajectories body)"
         )
-    return RequestLine(number, _digest(orjson.dumps(body, option=orjson.OPT_SORT_KEYS)), text=text)
+    try:
+        canonical = orjson.dumps(body, option=orjson.OPT_SORT_KEYS)
+    except orjson.JSONEncodeError as error:  # what JSON text allows but no JSON reader agrees on
+        return refused(
+            422, "Invalid request",
+            f"the line holds a value JSON readers do not agree on ({str(error)[:_MAX_DETAIL]}): write strings as valid "
+            "Unicode (no lone \\ud800-\\udfff escape) and integers within 64 bits",
+        )
+    return RequestLine(number, _digest(canonical), text=text)
+
+
+#: JSON's names of the values a line may hold instead of an object.
+_JSON_TYPES = {list: "array", str: "string", int: "number", float: "number", bool: "boolean", type(None): "null"}
 
 
 def request_key(text: str | bytes) -> str:
@@ -106,13 +118,14 @@ def read_requests(path: Path, skip: set[int] | frozenset[int] = frozenset()) -> 
         while raw := handle.readline(MAX_LINE_BYTES + 1):
             number += 1
             if len(raw) > MAX_LINE_BYTES and not raw.endswith(b"\n"):
-                size = len(raw)
+                size, digest = len(raw), hashlib.sha256(raw)  # the line's bytes hashed as they are skipped
                 while not raw.endswith(b"\n") and (raw := handle.readline(1 << 20)):
                     size += len(raw)
+                    digest.update(raw)
                 size -= raw.endswith(b"\n")
                 if number not in skip:
                     detail = f"line {number}: the line has {size} bytes; a request line has at most {MAX_LINE_BYTES}"
-                    yield RequestLine(number, _digest(b"%d" % size), problem=(413, problem_body(413, "Line too long", detail)))
+                    yield RequestLine(number, digest.hexdigest(), problem=(413, problem_body(413, "Line too long", detail)))
                 continue
             if number == 1:
                 raw = raw.removeprefix(b"\xef\xbb\xbf")  # a byte order mark some editors write

@@ -117,6 +117,9 @@ def _hostile_file(path: Path, monkeypatch) -> dict[int, int]:
         (b'{"robot": "ur5", "path": {"waypoints": [[0,0,0,0,0,0]]}', 422),  # cut short
         (b"{" + b'"a": {' * 40 + b"}" * 40 + b"}", 400),
         (b'{"robot": "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[", "path": 1}', 422),  # brackets in a string are no nesting
+        (b'{"robot": "\\ud800"}', 422),  # a lone surrogate: JSON text, but no Unicode
+        (b'{"robot": "ur5", "grid": 123456789012345678901234567890}', 422),  # an integer beyond 64 bits
+        (json.dumps(OTHER).encode(), 200),  # and the lines after them are planned
     ]
     path.write_bytes(b"\n".join(raw for raw, _ in lines) + b"\n")
     return {number: status for number, (_, status) in enumerate(lines, start=1)}
@@ -134,10 +137,14 @@ def test_every_line_gets_exactly_one_result_line_with_its_number(tmp_path, monke
     assert rows[1]["key"] == rows[11]["key"] == rows[17]["key"] == request_key(json.dumps(GOOD))
     assert rows[1]["body"] == rows[11]["body"] == rows[17]["body"] and rows[1]["body"]["duration"] > 0
     assert sorted(pool.keys) == sorted({rows[n]["key"] for n in (1, 13, 14, 16, 20)}) and pool.closed
+    assert rows[23]["key"] == rows[16]["key"] and rows[23]["body"] == rows[16]["body"]
     # each refusal says what and where
     assert rows[3]["body"]["title"] == "Too deeply nested" and "line 3" in rows[3]["body"]["detail"]
     assert rows[15]["body"]["title"] == "Line too long" and "30013 bytes" in rows[15]["body"]["detail"]
-    assert "JSON int" in rows[7]["body"]["detail"] and "UTF-8" in rows[12]["body"]["detail"]
+    assert "JSON number" in rows[7]["body"]["detail"] and "JSON array" in rows[8]["body"]["detail"]
+    assert "JSON string" in rows[9]["body"]["detail"] and "JSON null" in rows[10]["body"]["detail"]
+    assert "UTF-8" in rows[12]["body"]["detail"]
+    assert "no lone" in rows[21]["body"]["detail"] and "64 bits" in rows[22]["body"]["detail"]
     assert all(row["body"]["status"] == row["status"] for row in rows.values() if row["status"] != 200)
     assert all(len(row["body"].get("detail", "")) < 1000 for row in rows.values())
     # a second run has nothing left to do
@@ -339,3 +346,15 @@ def test_sigint_stops_a_ray_batch_within_seconds_and_leaves_no_process(tmp_path)
     assert output.read_bytes().endswith(b"\n")
     rows = _by_line(output)
     assert 0 < len(rows) < 3000 and all(row["status"] == 200 for row in rows.values())
+
+
+def test_two_lines_too_long_of_one_length_have_keys_of_their_own(tmp_path, monkeypatch):
+    """A line over the cap is keyed by the SHA-256 of its bytes, hashed as they are skipped (not
+    of its length, which two different lines may share)."""
+    monkeypatch.setattr(lines_, "MAX_LINE_BYTES", 1_000)
+    path = tmp_path / "long.jsonl"
+    first, second = b'{"robot": "' + b"x" * 5_000 + b'"}', b'{"robot": "' + b"y" * 5_000 + b'"}'
+    path.write_bytes(first + b"\n" + second + b"\n")
+    read = list(lines_.read_requests(path))
+    assert [line.problem[0] for line in read] == [413, 413]
+    assert read[0].key != read[1].key
