@@ -125,10 +125,19 @@ class _Running:
         self.stopped = True
         self.deadline.cancel()
 
+    @property
+    def ends_at(self) -> float | None:
+        """When the job's own budget ends (``time.monotonic()``): its deadline less the grace
+        after which its process is killed."""
+        end = self.deadline.end
+        return None if end is None else end - GRACE_S
+
 
 class JobRunner:
     """Runs the jobs of ``store``: at most ``workers`` at once over every process sharing it,
-    each in a worker process computing ``compute(kind, request, budget_s, setup, progress)``.
+    each in a worker process computing ``compute(kind, request, budget_s, setup, ends_at, progress)``
+    (``ends_at``: when the job's budget ends, ``time.monotonic()``, counted from its start here,
+    the worker's start included).
 
     Args:
         store: The job store (shared by every server process on the data directory).
@@ -308,7 +317,7 @@ class JobRunner:
         job = entry.job
         try:
             result = run_isolated(
-                self.compute, job.kind, job.request, job.budget_s, self.setup, deadline=entry.deadline, progress=True
+                self.compute, job.kind, job.request, job.budget_s, self.setup, entry.ends_at, deadline=entry.deadline, progress=True
             )
         except BudgetExceeded:
             if entry.stopped:

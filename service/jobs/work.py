@@ -89,9 +89,20 @@ def _not_reached(budget_s: float | None) -> tuple[int, bytes]:
 
 
 def _line_budget(deadline: Deadline) -> float:
-    """Seconds a line may take: its own budget, within what is left of the job's."""
+    """Seconds a line may take: its own budget, within what is left of the job's less a
+    reserve (``batch_reserve_s``): a solver step that cannot check its deadline runs past it
+    (about a second for a six-joint collocation), and a batch whose process outlives its
+    budget is killed with every answer it holds, where a line past its own is that line's 504."""
     remaining = deadline.remaining()
-    return BATCH_REQUEST_BUDGET_S if remaining is None else min(BATCH_REQUEST_BUDGET_S, remaining)
+    if remaining is None:
+        return BATCH_REQUEST_BUDGET_S
+    return min(BATCH_REQUEST_BUDGET_S, remaining - batch_reserve_s(deadline.budget_s))
+
+
+def batch_reserve_s(budget_s: float | None) -> float:
+    """Seconds of a batch job's budget kept from its lines: a quarter of it, at most
+    ``BATCH_RESERVE_S``."""
+    return 0.0 if budget_s is None else min(BATCH_RESERVE_S, 0.25 * budget_s)
 
 
 def _here(texts: list[str], deadline: Deadline, room: AnswerRoom, setup: WorkerSetup) -> list[tuple[int, bytes]]:
@@ -155,11 +166,15 @@ KINDS = {"trajectory": _trajectory, "compare": _compare, "batch": _batch}
 BATCH_REQUEST_BUDGET_S = 20.0
 #: Least time left of a batch job's budget in which another request is started, in s.
 MIN_LINE_BUDGET_S = 0.05
+#: Most seconds of a batch job's budget kept from its lines (``batch_reserve_s``).
+BATCH_RESERVE_S = 5.0
 
 
-def compute(kind: str, request: str, budget_s: float, setup: WorkerSetup, progress: Progress) -> bytes:
-    """The JSON body answering ``request`` of ``kind``, computed within ``budget_s`` seconds,
-    reporting to ``progress(fraction, stage)``.
+def compute(kind: str, request: str, budget_s: float, setup: WorkerSetup, ends_at: float | None, progress: Progress) -> bytes:
+    """The JSON body answering ``request`` of ``kind``, computed within ``budget_s`` seconds
+    ending at ``ends_at`` (``time.monotonic()``, the same clock in every process: the job's
+    runner counts them from the job's start, this process's start included; ``None``: from
+    now), reporting to ``progress(fraction, stage)``.
 
     Raises:
         ToptrajError: what the synchronous endpoint would answer as a problem (e.g.
@@ -174,4 +189,5 @@ def compute(kind: str, request: str, budget_s: float, setup: WorkerSetup, progre
         cache_size=setup.upload_cache_size,
     )
     progress(0.0, "starting")
-    return KINDS[kind](request, Deadline(budget_s, progress=progress), setup)
+    deadline = Deadline(budget_s, progress=progress) if ends_at is None else Deadline.ending_at(ends_at, budget_s, progress)
+    return KINDS[kind](request, deadline, setup)

@@ -552,3 +552,22 @@ def test_the_store_keeps_the_newest_jobs_within_its_bounds(tmp_path):
     aged.prune()
     assert aged.jobs(10) == []
     assert os.path.getsize(tmp_path / "jobs.sqlite3") < 200_000
+
+
+def test_a_batch_out_of_budget_keeps_every_answer_it_has(client):
+    """A batch of six-joint collocations (each runs about a second past its line's deadline in
+    an SLSQP step) under a budget that ends inside one: the lines stop before the job's budget
+    (a reserve kept from them), so the job is done with every answer, the lines it did not
+    finish 504s, rather than killed past its budget with all of them."""
+    free = {"robot": "ur5", "path": {"kind": "free", "start": [0.0, -1.2, 1.0, 0.0, 0.6, 0.0], "goal": [2.0, -1.3, 1.2, 0.2, 0.4, 1.2]},
+            "timing": {"method": "collocation", "grid_points": 100}}
+    requests = [QUICK, *({**free, "output": {"dt": 0.01 + 0.001 * k}} for k in range(12)), QUICK]
+    response = client.post("/v1/batches", json={"requests": requests, "budget_s": 6.0})
+    assert response.status_code == 202, response.text
+    job = _wait(client, response.json()["id"])
+    assert job["status"] == "done", job["error"]
+    results = job["result"]["results"]
+    assert [row["line"] for row in results] == list(range(1, 15))
+    assert results[0]["status"] == 200 and results[0]["body"]["duration"] > 0
+    assert results[-1]["status"] == 504  # the job's budget did not reach it
+    assert {row["status"] for row in results[1:-1]} <= {200, 504}
