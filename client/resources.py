@@ -11,7 +11,7 @@ from typing import Any, cast
 import numpy as np
 
 from toptraj.client.errors import ProblemError
-from toptraj.client.results import Comparison, Trajectory, comparisons
+from toptraj.client.results import Comparison, CsvTrajectory, Trajectory, comparisons
 
 #: Job statuses after which nothing changes any more.
 ENDED = frozenset({"done", "failed", "cancelled", "interrupted"})
@@ -124,17 +124,18 @@ class BatchItem:
     Attributes:
         line: The request's position in the batch, from 1.
         status: The HTTP status its own endpoint would have answered.
-        result: Its answer (a ``Trajectory``, or a list of ``Comparison`` for a comparison);
-            None when it failed.
+        result: Its answer (a ``Trajectory``, a ``CsvTrajectory`` for a request asking
+            ``output.format`` ``csv``, or a list of ``Comparison`` for a comparison); None when
+            it failed.
         error: Its problem when it failed, else None.
-        body: Its answer or problem as the service sent it.
+        body: Its answer or problem as the service sent it (a CSV answer: its text).
     """
 
     line: int
     status: int
-    result: Trajectory | list[Comparison] | None
+    result: Trajectory | CsvTrajectory | list[Comparison] | None
     error: ProblemError | None
-    body: dict = field(repr=False)
+    body: dict | str = field(repr=False)
 
     @classmethod
     def from_body(cls, body: dict) -> BatchItem:
@@ -142,6 +143,8 @@ class BatchItem:
         status, answer = int(body["status"]), body["body"]
         if status >= 400:
             return cls(int(body["line"]), status, None, ProblemError(answer), answer)
+        if isinstance(answer, str):  # a request asking CSV: the text its endpoint would send
+            return cls(int(body["line"]), status, CsvTrajectory.from_text(answer, {}), None, answer)
         result = cast("Trajectory | list[Comparison]", answer_of(answer))  # a batch holds no batch
         return cls(int(body["line"]), status, result, None, answer)
 

@@ -274,13 +274,18 @@ def test_job_answers_keep_their_format_and_kind(toptraj, server):
 
 def test_a_batch_is_followed_and_read_request_by_request(toptraj, server):
     compare = {"robot": "ur5", "path": QUICK["path"], "methods": ["phase_plane", "quintic"]}
-    requests = [QUICK, compare, {**QUICK, "path": {"kind": "waypoints", "waypoints": OUTSIDE}}]
+    as_csv = {**QUICK, "output": {"format": "csv"}}
+    requests = [QUICK, compare, {**QUICK, "path": {"kind": "waypoints", "waypoints": OUTSIDE}}, as_csv]
     seen: list[float] = []
     items = toptraj.run_batch(requests, progress=lambda fraction, stage: seen.append(fraction), poll_s=0.02, timeout_s=300)
-    assert all(isinstance(item, BatchItem) for item in items) and [item.line for item in items] == [1, 2, 3]
+    assert all(isinstance(item, BatchItem) for item in items) and [item.line for item in items] == [1, 2, 3, 4]
     assert isinstance(items[0].result, Trajectory) and items[0].result.duration == _served(server, "/v1/trajectories", QUICK)["duration"]
     assert [r.method for r in items[1].result] == ["phase_plane", "quintic"]
     assert items[2].result is None and items[2].status == items[2].error.status == 422
+    # a request asking CSV: its text, read as the endpoint's CSV is
+    assert isinstance(items[3].result, CsvTrajectory) and items[3].result.duration == items[0].result.duration
+    status, _, served_csv = server.request("POST", "/v1/trajectories", as_csv)
+    assert status == 200 and items[3].body == served_csv.decode()
     assert seen == sorted(seen) and seen[-1] == 1.0
     batch = toptraj.jobs(limit=1).jobs[0]  # the newest job
     assert batch.kind == "batch" and [item.body for item in toptraj.batch_results(batch)] == [item.body for item in items]
