@@ -12,7 +12,15 @@ from toptraj.service.jobs.work import WorkerSetup
 #: the compiled kernels (0.5 s) again.
 JOB_MODULES = ("toptraj.service.jobs.preload",)
 
-__all__ = ["JOB_MODULES", "JobRunner", "JobStore", "WorkerSetup", "job_runner"]
+__all__ = ["JOB_MODULES", "JobRunner", "JobStore", "WorkerSetup", "job_answer_bytes", "job_runner"]
+
+
+def job_answer_bytes(settings) -> int:
+    """The largest answer a job keeps, in bytes: the largest body served, within half the job
+    store (``max_job_store_bytes``), so that the newest job's answer always fits in the store
+    (a larger one would be pruned as soon as it was written, the job gone without a word); a
+    larger answer fails the job with a 422 naming the ``output.dt`` that fits."""
+    return min(settings.max_response_bytes, settings.max_job_store_bytes // 2)
 
 
 def job_runner(settings) -> JobRunner:
@@ -24,7 +32,7 @@ def job_runner(settings) -> JobRunner:
         max_uploads=settings.max_uploads,
         max_upload_bytes=settings.max_upload_bytes,
         upload_cache_size=settings.upload_cache_size,
-        max_response_bytes=settings.max_response_bytes,
+        max_response_bytes=job_answer_bytes(settings),
         ray_address=settings.ray_address,
         search_memory_bytes=settings.search_memory_bytes,
         job_budget_s=settings.job_budget_s,

@@ -14,8 +14,8 @@ older than ``STALE_S``). Queued jobs survive a restart and run when a runner is 
 
 What is kept is bounded: at most ``max_jobs`` jobs, none finished longer ago than ``max_age_s``,
 and at most ``max_bytes`` of requests, results and errors together; the oldest finished jobs go
-first (``prune``). A result is at most the service's ``max_response_bytes`` (its planning
-refuses larger bodies), so the newest jobs always fit.
+first (``prune``). A result is at most half of ``max_bytes`` (``jobs.job_answer_bytes``: its
+planning refuses larger bodies), so the newest job always fits.
 """
 
 from __future__ import annotations

@@ -16,6 +16,7 @@ from starlette.concurrency import run_in_threadpool
 from toptraj import robots
 from toptraj.robots.errors import ToptrajError, excerpt
 from toptraj.service.formats import CSV_MEDIA_TYPE, chosen_format, csv_bytes
+from toptraj.service.jobs import job_answer_bytes
 from toptraj.service.jobs.records import Job, JobEnded
 from toptraj.service.jobs.store import JobStore
 from toptraj.service.planning import check_request
@@ -171,7 +172,7 @@ async def create_job(body: Annotated[JobCreate, Body(openapi_examples=EXAMPLES)]
         )
     runner = request.app.state.jobs
     if body.trajectory is not None:  # refused now as the synchronous endpoint would before any work, not minutes later
-        await run_in_threadpool(check_request, body.trajectory, settings.max_response_bytes, settings.search_memory_bytes)
+        await run_in_threadpool(check_request, body.trajectory, job_answer_bytes(settings), settings.search_memory_bytes)
     else:  # a comparison answers each method's refusal in its entry, as its endpoint does
         await run_in_threadpool(robots.load, body.request.robot)  # an unknown robot is a 404 now, not a failed job
     request_json = body.request.model_dump_json(exclude_unset=True)  # what was given: its rules read again as given

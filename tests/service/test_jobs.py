@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import time
 
@@ -571,3 +572,24 @@ def test_a_batch_out_of_budget_keeps_every_answer_it_has(client):
     assert results[0]["status"] == 200 and results[0]["body"]["duration"] > 0
     assert results[-1]["status"] == 504  # the job's budget did not reach it
     assert {row["status"] for row in results[1:-1]} <= {200, 504}
+
+
+def test_an_answer_larger_than_the_job_store_keeps_fails_the_job_saying_what_fits(tmp_path):
+    """A job store of 3 MB under a response cap of 20 MB: a job answering 4 MB of samples was
+    pruned as soon as written (404 a second later). The job's answer is held to half the store:
+    the job fails with the 422 naming the output.dt that fits, and following it is done."""
+    settings = Settings(preload_robots=False, data_dir=tmp_path, job_workers=1, max_job_store_bytes=3_000_000)
+    fine = {**QUICK, "output": {"dt": 0.0001}}
+    with TestClient(create_app(settings)) as client:
+        response = client.post("/v1/jobs", json={"trajectory": fine})
+        if response.status_code == 202:
+            job = _wait(client, response.json()["id"])
+            assert job["status"] == "failed", job["status"]
+            problem = job["error"]
+        else:
+            problem = response.json()
+        assert problem["status"] == 422 and "output.dt" in problem["detail"], problem
+        smallest = float(re.search(r"output\.dt >= ([\d.e-]+)", problem["detail"]).group(1))
+        done = _wait(client, _submit(client, {"trajectory": {**QUICK, "output": {"dt": smallest}}}))
+        assert done["status"] == "done", done["error"]
+        assert client.get(f"/v1/jobs/{done['id']}").status_code == 200
