@@ -55,7 +55,7 @@ def _free(robot: str, start, goal, box: dict, clearance: float) -> dict:
 #: name: (request, budget in s, the goal's ratio)
 CASES = {
     "geering": (json.loads((ROOT.parent / "examples" / "geering_search_obstacle.json").read_text()), 20.0, 200),
-    # the box of tests/test_search.py, where the tool is halfway along the straight joint line
+    # the box of tests/planners/generators/test_search.py, where the tool is halfway along the straight joint line
     "ur5": (_free("ur5", UR5_START, UR5_GOAL, {"kind": "box", "center": [0.626, 0.109, 0.29], "size": [0.15, 0.15, 0.15]}, 0.02), 45.0, 1_000),
     # the box of benchmarks/search_growth.py, where the tool is halfway along the straight joint line
     "panda": (_free("panda", PANDA_START, PANDA_GOAL, {"kind": "box", "center": [0.4854, 0.0, 0.491], "size": [0.1, 0.1, 0.1]}, 0.01), 45.0, 2_000),

@@ -37,7 +37,10 @@ class JobCalls(Transport):
             The job, ``queued``; follow it with ``wait``.
 
         Raises:
-            ProblemError: 404 unknown robot, 422 malformed request, 503 the queue is full.
+            ProblemError: 404 unknown robot, 422 malformed request or, for a trajectory,
+                one the service refuses before planning (as ``plan`` would: a waypoint of
+                the wrong length, a free path's end too close to an obstacle, a grid over the
+                memory cap), 503 the queue is full.
         """
         kind = "compare" if "methods" in request else "trajectory"
         body: dict[str, Any] = {kind: request}

@@ -107,11 +107,13 @@ def _no_limit_bounds_speed(facts: dict) -> str:
 def _stretch_unbounded(facts: dict) -> str:
     joints = facts["joints"]
     moving = f"{'joint ' if len(joints) == 1 else 'joints '}{', '.join(repr(j) for j in joints)}" if joints else "no joint"
-    where = f"{facts['field']}: " if str(facts["field"]).startswith("arms[") else ""
+    cell = str(facts["field"]).startswith("arms[")
+    where = f"{facts['field']}: " if cell else ""
+    tool = "" if cell else " (or a tool-speed limit that holds there)"  # a cell has none
     return (
         f"{where}from s = {facts['s_from']:.4f} to {facts['s_to']:.4f} nothing bounds the motion: {moving} "
-        f"{'moves' if len(joints) == 1 else 'move'} there without a finite {_either(facts['kinds'])} limit (or a "
-        f"tool-speed limit that holds there), so the shortest time would be zero; {_bounding_remedies(facts, next((k for k in facts['kinds'] if k != 'torque'), 'velocity'))}"
+        f"{'moves' if len(joints) == 1 else 'move'} there without a finite {_either(facts['kinds'])} limit{tool}, "
+        f"so the shortest time would be zero; {_bounding_remedies(facts, next((k for k in facts['kinds'] if k != 'torque'), 'velocity'))}"
     )
 
 

@@ -11,7 +11,7 @@ import orjson
 
 from toptraj import robots
 from toptraj.planners import Deadline, PlannedTrajectory, plan
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY, MAX_SAMPLES
 from toptraj.planners.plan import check
@@ -118,7 +118,8 @@ def check_request(request: TrajectoryRequest, max_body_bytes: int | None = None,
     estimate (``toptraj.planners.plan.check``). A job is checked so before it is queued.
 
     Raises:
-        InvalidRequest, InfeasiblePath, InvalidLimits, UnknownRobot: as ``plan_request`` would.
+        InvalidRequest, InfeasiblePath, InvalidLimits, InvalidEquipment, OverMemory,
+        UnknownRobot: as ``plan_request`` would.
     """
     robot = equipped_robot(request)
     with payload_named(robot):
@@ -180,7 +181,7 @@ def compare_results(request: CompareRequest, deadline: Deadline, dt: float = 1.0
             result = plan_request(method_request(request, method, dt), part)
         except UnknownRobot:
             raise
-        except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits) as error:
+        except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits, OverMemory) as error:
             results.append(({"method": method, "error": {"status": status_of(error), "title": title_of(error), "detail": detail(error)}}, None))
             continue
         body = trajectory_body(result)

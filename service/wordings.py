@@ -140,9 +140,9 @@ def _path_in_collision(facts: dict) -> str:
         advice = f"no joint moves that link: move path.obstacles[{index}] away from it, or the robot by its mounting"
     else:
         advice = "move the waypoints away from the obstacle"
-        least = math.floor(1e4 * facts.get("least", -1.0)) / 1e4  # a lower bound on the path's distance, 0.1 mm down
-        if least > 0.0:
-            advice += f" or lower path.clearance to {least:g} m"
+    least = math.floor(1e4 * facts.get("least", -1.0)) / 1e4  # a lower bound on the path's distance, 0.1 mm down
+    if least > 0.0:
+        advice += f"{',' if facts.get('fixed') else ''} or lower path.clearance to {least:g} m"
     return f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): {advice}"
 
 
@@ -155,9 +155,9 @@ def _end_too_close(facts: dict) -> str:
         advice = f"no joint moves that link: move path.obstacles[{index}] away from it, or the robot by its mounting"
     else:
         advice = f"move {field} away from the obstacle"
-        below = math.floor(1e4 * distance) / 1e4  # the end's distance, 0.1 mm down
-        if below > 0.0:
-            advice += f" or lower path.clearance to {below:g} m"
+    below = math.floor(1e4 * distance) / 1e4  # the end's distance, 0.1 mm down
+    if below > 0.0:
+        advice += f"{',' if facts.get('fixed') else ''} or lower path.clearance to {below:g} m"
     return f"at {field}, link {facts['link']!r} {how} (the clearance is {facts['clearance']:g} m): {advice}"
 
 

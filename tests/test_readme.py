@@ -107,6 +107,15 @@ def test_every_file_the_guide_and_the_readme_name_exists():
     proof of a figure) lead to a file; ``design.md`` records the tree as it was before its
     reshaping and is left out."""
     pattern = re.compile(r"(?<![\w/.])(?:planners|service|robots|client|compiled|benchmarks|tests|examples)/[\w./-]*\.(?:py|json|js|jsonl|urdf|yaml)")
-    pages = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "design.md")]
-    missing = [f"{page.name}: {path}" for page in pages for path in sorted(set(pattern.findall(page.read_text()))) if not (ROOT / path).exists()]
+    pages = [ROOT / "README.md", ROOT / "benchmarks" / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "design.md")]
+    named = {(page, path) for page in pages if page.exists() for path in pattern.findall(page.read_text()) if "NAME" not in path}  # NAME: a placeholder
+    missing = sorted(f"{page.name}: {path}" for page, path in named if not (ROOT / path).exists())
+    assert not missing, missing
+
+
+def test_every_test_file_the_code_names_exists():
+    """A test named in a docstring or comment of the code (where a figure is proven) leads to a file."""
+    pattern = re.compile(r"(?<![\w/.])tests/[\w./-]*\.py")
+    sources = [p for folder in ("planners", "service", "robots", "client", "compiled", "benchmarks", "tests") for p in (ROOT / folder).rglob("*.py")]
+    missing = [f"{source.relative_to(ROOT)}: {path}" for source in sources for path in set(pattern.findall(source.read_text())) if not (ROOT / path).exists()]
     assert not missing, missing

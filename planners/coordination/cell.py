@@ -27,6 +27,8 @@ from toptraj.robots.collision import robot_capsules, world_capsules
 #: prioritized planning over every order of the arms (``prioritized``: 4! = 24 orders, 6 pairwise
 #: diagrams).
 MAX_ARMS = 4
+#: The limit kinds a cell holds (its timings are TOPP-RA's: no jerk).
+CELL_KINDS = ("velocity", "acceleration", "torque")
 
 
 @dataclass(frozen=True)
@@ -90,7 +92,7 @@ class Cell:
             InvalidRequest: field ``arms[i]``, rule "no_limit_bounds_speed".
         """
         for index, arm in enumerate(self.arms):
-            check_speed_bounded(arm.robot, arm.limits, self.kinds, field=f"arms[{index}]")
+            check_speed_bounded(arm.robot, arm.limits, self.kinds, served=CELL_KINDS, field=f"arms[{index}]")
 
 
 def pair_distances(first: tuple[np.ndarray, np.ndarray, np.ndarray], second: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

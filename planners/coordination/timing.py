@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.constraints.path_constraints import PathConstraints, build_path_constraints, grid_rows, speed_bound
-from toptraj.planners.coordination.cell import Cell, CellArm
+from toptraj.planners.coordination.cell import CELL_KINDS, Cell, CellArm
 from toptraj.planners.coordination.curve import SmoothCurve
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.problem.bounded import check_stretches_bounded
@@ -46,7 +46,7 @@ def solo_timing(
             "stretch_unbounded", ``toptraj.planners.problem.bounded``; ``field`` names the arm).
     """
     constraints = build_path_constraints(arm.path, arm.robot, arm.limits, kinds, _timing_grid(arm, intervals), deadline)
-    check_stretches_bounded(constraints, arm.path, arm.robot, arm.limits, kinds, field=field)
+    check_stretches_bounded(constraints, arm.path, arm.robot, arm.limits, kinds, served=CELL_KINDS, field=field)
     return solve_well_scaled(ToppraMethod(), constraints, AT_REST, None, deadline)  # type: ignore[return-value]
 
 

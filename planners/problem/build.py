@@ -69,6 +69,8 @@ def build_problem(
 
     Raises:
         InvalidRequest: malformed or conflicting input (the error names the field).
+        InfeasiblePath, SelfCollision: a motion generator's own checks (``validate``), e.g. a
+            searched free path's start or goal too close to an obstacle or folded on itself.
     """
     if method.supporting_points is not None and boundary.moving:
         raise Conflicting("law.supporting_points", method.supporting_points, ("boundary",), rule="law_from_rest")

@@ -49,7 +49,7 @@ BUDGET_S = 20.0
 APP = create_app(Settings(preload_robots=False, plan_budget_s=BUDGET_S, plan_workers=8))
 SCHEMA = schemathesis.openapi.from_asgi("/openapi.json", APP)
 SCHEMA.config.request_timeout = 3 * BUDGET_S
-# The OpenAPI's examples are the files of examples/, answered by tests/test_examples.py with the
+# The OpenAPI's examples are the files of examples/, answered by tests/service/test_examples.py with the
 # budget a free-path collocation needs; here they would only meet the short fuzz budget.
 SCHEMA.config.phases.examples.enabled = False
 # A body over the size cap (a string far beyond its maxLength) is refused with 413 before its

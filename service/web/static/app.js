@@ -115,9 +115,9 @@ function applyPresetFields(name) {
 }
 
 function formatPath(path) {
-  // one key per line, and each waypoint (a list of numbers) on a line of its own
+  // one key per line, and each waypoint (a list of numbers), or each arm of a cell, on a line of its own
   const lines = Object.entries(path).map(([key, value]) => {
-    const text = Array.isArray(value) && value.every(Array.isArray)
+    const text = Array.isArray(value) && value.length && value.every((item) => item !== null && typeof item === "object")
       ? "[\n    " + value.map((row) => JSON.stringify(row)).join(",\n    ") + "\n  ]"
       : JSON.stringify(value);
     return `  ${JSON.stringify(key)}: ${text}`;
@@ -271,10 +271,11 @@ async function planAsCell(request) {
   $("status").textContent = "planning the cell…";
   try {
     const dt = Number($("dt").value);
+    // the cell in the URL, before planning as a trajectory's request is (robot, methods and
+    // constraints are the form's: a cell takes its own from its body)
+    const note = await keepInURL({robot: $("robot").value, path: request, methods: checked($("methods")), constraints: checked($("constraints")), dt});
     const answer = await planCell(request, dt);
-    // the cell in the URL as a trajectory's request is (robot, methods and constraints are the
-    // form's: a cell takes its own from its body)
-    $("link-note").textContent = await keepInURL({robot: $("robot").value, path: request, methods: checked($("methods")), constraints: checked($("constraints")), dt});
+    $("link-note").textContent = note;
     $("status").textContent = `planned: ${answer.arms.length} arms on one clock`;
     document.body.dataset.planned = "true";
   } catch (error) {

@@ -173,6 +173,14 @@ def test_an_obstacle_on_a_link_no_joint_moves_advises_moving_it_or_the_robot(cli
     ), refused.json()["detail"]
     lowered = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [{**floor, "center": [0.0, 0.0, -0.5]}]}})
     assert lowered.status_code == 200, lowered.text[:300]
+    # near the base, not inside: a lower clearance is advised too, and following it plans the path
+    near = {**floor, "center": [0.0, 0.0, -0.2]}
+    close = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [near], "clearance": 0.2}})
+    assert close.status_code == 422 and close.json()["link"] == "base_link", close.text[:300]
+    advised = re.search(r"or the robot by its mounting, or lower path\.clearance to ([\d.]+) m$", close.json()["detail"])
+    assert advised, close.json()["detail"]
+    followed = client.post("/v1/trajectories", json={"robot": "ur5", "path": {**PATH, "obstacles": [near], "clearance": float(advised.group(1))}})
+    assert followed.status_code == 200, followed.text[:300]
 
 
 def test_the_planar_paper_arm_uses_link_capsules(client):

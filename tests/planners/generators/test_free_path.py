@@ -133,7 +133,7 @@ def test_the_collocations_own_timing_states_the_gap_of_its_own_cost(monkeypatch)
 def test_ur5_smoke():
     """Any fixed-base revolute arm: a 6-joint free motion over HTTP (a generous budget, so that
     a loaded shared machine does not turn the smoke test into a timing test; 4 intervals keep
-    it quick, tests/test_sparse_collocation.py solves 30)."""
+    it quick, tests/planners/generators/test_sparse_collocation.py solves 30)."""
     from fastapi.testclient import TestClient
 
     from toptraj.service.app import create_app

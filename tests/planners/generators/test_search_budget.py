@@ -193,3 +193,16 @@ def test_fewer_roadmap_points_than_neighbors_are_advised_as_such():
     text = detail(refusal)
     assert f"at most {refusal.most_points} roadmap points are served (fewer than the 50 neighbors asked, which beyond the number of points join nothing more)" in text, text
     assert "with 50 neighbors" not in text.split(";", 1)[1]
+
+
+def test_a_comparison_answers_a_search_over_memory_in_the_search_s_entry():
+    """As every other refusal of one method: the comparison is answered, the search's entry
+    holding its 422 (it failed the whole comparison, and a compare job after its queue)."""
+    body = _ur5_search({"roadmap_points": 2000, "neighbors": 50}, 5.0)
+    compare = {"robot": body["robot"], "path": body["path"], "methods": ["collocation", "search"], "timing": {"search": body["timing"]["search"]}}
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=5.0))) as client:
+        response = client.post("/v1/trajectories/compare", json=compare)
+    assert response.status_code == 200, response.text[:300]
+    search = response.json()["results"][1]
+    assert search["method"] == "search" and search["error"]["status"] == 422, search
+    assert "roadmap_points 2000 with neighbors 50" in search["error"]["detail"]

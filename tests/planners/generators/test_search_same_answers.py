@@ -1,5 +1,5 @@
 """The compiled search answers what the search answered before it was compiled, on the cases of
-``tests/test_search.py`` and ``benchmarks/search_growth.py``: the same best grid path time, the
+``tests/planners/generators/test_search.py`` and ``benchmarks/search_growth.py``: the same best grid path time, the
 same pieces removed by the obstacles and the same count of subsets expanded (figures recorded
 from the pure-Python search on the same cases); and the local optimization with its compiled
 objective takes the rounds it took with the reference objective (the same evaluations per

@@ -142,3 +142,24 @@ def test_a_cell_arm_moving_only_a_joint_without_a_limit_is_refused_naming_the_ar
     # both arms turning phi, which has its limit: planned, the slower arm at 1 rad / 2 rad/s
     planned = coordinate(Cell((arm([[0.0, 0.0], [1.0, 0.0]], 0.0), arm([[0.0, 0.0], [0.5, 0.0]], 5.0)), 0.01, ("velocity",)))
     assert planned.solo[0] == pytest.approx(0.5, rel=0.02)
+
+
+def test_a_cell_arm_is_advised_only_the_kinds_a_cell_holds():
+    """An arm whose moving joint has a jerk limit but no velocity one: a cell holds no jerk, so
+    the advice names torque (which the cell's constraints take), not jerk, and no tool speed."""
+    from toptraj.planners.coordination import Cell, CellArm, coordinate
+    from toptraj.planners.problem.waypoints import make_path
+    from toptraj.robots.equipment import equip, mounting
+
+    bare = robots.load("geering_2r")
+    limits = dataclasses.replace(bare.limits, velocity=np.array([2.0, np.inf]), jerk=np.array([np.inf, 100.0]))
+    limited = dataclasses.replace(bare, limits=limits)
+
+    def arm(waypoints, x):
+        robot = equip(limited, None, mounting([x, 0.0, 0.0]))
+        return CellArm(robot, make_path(robot, WaypointPath(np.array(waypoints, dtype=float))), robot.limits)
+
+    with pytest.raises(InvalidRequest) as refused:
+        coordinate(Cell((arm([[0.0, 0.0], [0.0, 1.0]], 0.0), arm([[0.0, 0.0], [1.0, 0.0]], 5.0)), 0.01, ("velocity",)))
+    text = detail(refused.value)
+    assert "add 'torque' to constraints" in text and "jerk" not in text and "tool-speed" not in text, text
