@@ -39,11 +39,18 @@ def _roadmap_over_memory(facts: dict) -> str:
 
 
 def _search_incomplete(facts: dict) -> str:
+    """A search ended by its max_expansions or its node table's memory (its time share ending is
+    a 504, ``BudgetExceeded``)."""
     smaller = "timing.search.roadmap_points or timing.search.neighbors" if facts["graph"] == "roadmap" else "timing.search.cells"
+    expanded = facts["statistics"].expanded
+    if facts.get("stopped") == "memory":
+        return (
+            f"the search found no grid path before its node table reached its memory ({expanded} partial paths expanded): "
+            f"use fewer {smaller}"
+        )
     return (
-        f"the search found no grid path within its share of the time budget or its max_expansions "
-        f"({facts['statistics'].expanded} partial paths expanded): give it a larger budget (a job's budget_s), fewer "
-        f"{smaller} or more timing.search.max_expansions"
+        f"the search found no grid path within its max_expansions ({expanded} partial paths expanded): "
+        f"raise timing.search.max_expansions or use fewer {smaller}"
     )
 
 

@@ -76,6 +76,7 @@ class _Search:
         self.stop_at = stop_at
         self.found: list[GridPath] = []
         self.timed: list[int] = []  # the spans of every grid path timed (a lazy problem checks them)
+        self.stopped = ""  # what ended an incomplete search: "memory", "expansions" or "time"
         self.stats = SearchStatistics(
             graph=graph.kind,
             grid_points=len(graph.points),
@@ -159,7 +160,7 @@ class _Search:
             status, index = tables.chunk(self.options.max_expansions)
             if status == kernels.FULL:
                 if not tables.grow():
-                    self.stats.complete = False  # the node table is at its most bytes
+                    self.stats.complete, self.stopped = False, "memory"  # the node table is at its most bytes
                     break
             elif status == kernels.NEED_T4:
                 self.timed += tables.pieces(index)
@@ -169,11 +170,12 @@ class _Search:
                 self.found.append(GridPath(self.points_of(tables.edges(index)), float(t4), (float(g1), float(g2), float(t3))))
             elif status in (kernels.CHUNK, kernels.MAX_EXPANSIONS):
                 self.stats.complete = status == kernels.CHUNK
+                self.stopped = "" if self.stats.complete else "expansions"
             if status == kernels.DONE or not self.stats.complete:
                 break
             self.deadline.check()
             if time.monotonic() > self.stop_at:
-                self.stats.complete = False
+                self.stats.complete, self.stopped = False, "time"
                 break
             if status == kernels.CHUNK and np.isfinite(tables.upper[0]):
                 t_u = float(tables.upper[0])
@@ -238,9 +240,8 @@ def branch_and_bound(
         stats = search.stats
         if not stats.complete:
             raise NoGridPath(
-                f"the search found no grid path within its share of the time budget or its max_expansions "
-                f"({stats.expanded} partial paths expanded)",
-                stats, timed, rule="search_incomplete", graph=problem.graph.kind,
+                f"the search found no grid path within its {_STOPPED[search.stopped]} ({stats.expanded} partial paths expanded)",
+                stats, timed, rule="search_incomplete", graph=problem.graph.kind, stopped=search.stopped,
             )
         below = f" faster than {cap:.4g} s" if np.isfinite(cap) else ""
         raise NoGridPath(
@@ -253,6 +254,10 @@ def branch_and_bound(
     radius = options.tube_radius if options.tube_radius is not None else 3.0 * float(np.linalg.norm(scale))
     tubes = select_tubes(search.found, radius, max(1, options.tubes))
     return SearchResult(tuple(tubes), tuple(search.found), search.stats, radius, timed)
+
+
+#: What ended an incomplete search (``_Search.stopped``), in a sentence.
+_STOPPED = {"memory": "node table's memory", "expansions": "max_expansions", "time": "share of the time budget"}
 
 
 def enumerate_grid_paths(problem: SearchProblem, deadline: Deadline = NO_DEADLINE, limit: int = 100_000) -> list[GridPath]:

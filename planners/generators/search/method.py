@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.collision import Obstacle
+from toptraj.planners.errors import BudgetExceeded
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.branch_and_bound import branch_and_bound
 from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, LATTICE_MAX_JOINTS, SearchOptions
@@ -93,7 +94,8 @@ def global_search(
     Raises:
         InvalidRequest, InfeasiblePath: see ``build_problem`` and ``branch_and_bound`` (the
             latter when no variant has a grid path).
-        BudgetExceeded: ``deadline`` passed.
+        BudgetExceeded: ``deadline`` passed, or the searches' share of it ended before any
+            found a grid path (more time may find one).
     """
     options = options or DEFAULT_OPTIONS
     if options.lazy is None:  # lazily on a roadmap
@@ -129,6 +131,12 @@ def _lazily_searched(problem: SearchProblem, options: SearchOptions, deadline: D
     checked = int(problem.checked.sum())
     if not results:
         failures[0].statistics.spans_checked, failures[0].statistics.searches = checked, attempt + 1
+        if all(getattr(failure, "stopped", "") == "time" for failure in failures):  # more time may find one: a 504
+            expanded = sum(failure.statistics.expanded for failure in failures)
+            raise BudgetExceeded(
+                f"the search found no grid path within its share of the time budget ({expanded} partial paths expanded)",
+                stage="search: branch and bound",
+            ) from failures[0]
         raise failures[0]
     result = _merged(results, [f.statistics for f in failures], problem.prepare_s, options.tubes, earlier)
     result.statistics.spans_checked, result.statistics.searches = checked, attempt + 1

@@ -206,3 +206,31 @@ def test_a_comparison_answers_a_search_over_memory_in_the_search_s_entry():
     search = response.json()["results"][1]
     assert search["method"] == "search" and search["error"]["status"] == 422, search
     assert "roadmap_points 2000 with neighbors 50" in search["error"]["detail"]
+
+
+def test_a_search_whose_time_share_ends_before_any_grid_path_is_a_504(monkeypatch):
+    """More time may find a grid path: a budget error (504, which a batch's --retry-failed plans
+    again), not a 422 saying no path can be followed. Its share of the time is made nothing
+    here (the first chunk of branch and bound finds no grid path of this problem)."""
+    import toptraj.planners.generators.search.method as method
+
+    monkeypatch.setattr(method, "SEARCH_SHARE", 0.0)
+    robot = robots.load("ur5")
+    box = BoxObstacle(np.array(UR5_BOX["center"]), np.array(UR5_BOX["size"]))
+    with pytest.raises(BudgetExceeded) as stopped:
+        global_search(robot, robot.limits, ("velocity", "acceleration"), np.array(UR5_START), np.array(UR5_GOAL),
+                      obstacles=(box,), clearance=0.02, deadline=Deadline(60.0))
+    assert "no grid path within its share of the time budget" in stopped.value.detail
+    # a search without a budget runs to its end and finds one
+    found = global_search(robot, robot.limits, ("velocity", "acceleration"), np.array(UR5_START), np.array(UR5_GOAL),
+                          obstacles=(box,), clearance=0.02)
+    assert found.result.tubes
+
+
+def test_a_search_ended_by_max_expansions_is_a_422_naming_it():
+    body = _ur5_search({"max_expansions": 1}, 20.0)
+    with TestClient(create_app(Settings(preload_robots=False, plan_budget_s=20.0))) as client:
+        response = client.post("/v1/trajectories", json=body)
+    assert response.status_code == 422, response.text[:300]
+    assert "no grid path within its max_expansions" in response.json()["detail"]
+    assert "raise timing.search.max_expansions" in response.json()["detail"]
