@@ -31,6 +31,7 @@ class AnswerRoom:
         self.left = cap_bytes - ENVELOPE_BYTES - count * LINE_BYTES
         self.full_from: int | None = None  # the 0-based index of the first request not kept
         self.kept = 0  # answers kept
+        self.largest = 0  # bytes of the largest answer kept, or of the one that did not fit
 
     def full(self) -> bool:
         """Whether an answer did not fit: no more requests are planned."""
@@ -39,6 +40,7 @@ class AnswerRoom:
     def keep(self, index: int, status: int, body: bytes) -> tuple[int, bytes]:
         """Request ``index``'s answer when it fits (its bytes taken from the room), else its 422
         and the room marked full."""
+        self.largest = max(self.largest, len(body))
         if len(body) <= self.left and self.full_from is None:
             self.left -= len(body)
             self.kept += 1
@@ -52,8 +54,11 @@ class AnswerRoom:
         if self.full_from is None:
             self.full_from = index
         what = "was not planned" if size is None else f"has {size} bytes, which do not fit"
-        if self.kept:
-            advice = f"in batches of at most {self.kept} requests like the ones answered"
+        # as many answers as large as the largest seen as a batch's answer holds, whatever the
+        # others: the number kept counts small answers too
+        fit = (self.cap_bytes - ENVELOPE_BYTES) // (self.largest + LINE_BYTES) if self.largest else 0
+        if fit >= 2:
+            advice = f"in batches of at most {fit} requests (answers of up to {self.largest} bytes, the largest here)"
         else:
             advice = "each as a job of its own (POST /v1/jobs)"
         detail = (

@@ -6,6 +6,7 @@ a 422 saying from which request on to submit them again, which then are answered
 from __future__ import annotations
 
 import json
+import re
 
 import orjson
 
@@ -45,7 +46,7 @@ def test_a_batch_stops_planning_once_its_answers_fill_the_cap(tmp_path, monkeypa
     for row in results[first - 1 :]:
         assert row["status"] == 422 and row["body"]["title"] == "Answer too large", row
         assert f"at most {CAP} bytes" in row["body"]["detail"]
-        assert f"(from request {first} on) in batches of at most {len(kept)} requests" in row["body"]["detail"]
+        assert f"(from request {first} on) in batches of at most {len(kept)} requests" in row["body"]["detail"], row["body"]["detail"]
 
 
 def test_the_requests_left_are_answered_when_submitted_as_the_advice_says(tmp_path, monkeypatch):
@@ -65,3 +66,19 @@ def test_a_request_whose_samples_exceed_the_room_gets_the_dt_that_fits(tmp_path,
     rows = json.loads(result)["results"]
     assert rows[0]["status"] == 422 and "output.dt" in rows[0]["body"]["detail"], rows[0]
     assert rows[1]["status"] == 200
+
+
+def test_the_advised_batch_size_counts_the_largest_answers_not_the_small_ones_kept(tmp_path, monkeypatch):
+    """Large and small answers mixed: the number kept counts the small ones too, so advising it
+    was wrong (six advised, five of the large ones fitting); the advice is the number of answers
+    as large as the largest that the cap holds, and a batch of that many large ones is answered."""
+    small = {"robot": "ur5", "path": DENSE["path"]}  # dt 0.01: a few kB
+    result, _ = _run([DENSE, small, DENSE, small, small, DENSE, DENSE, small], tmp_path, monkeypatch)
+    rows = json.loads(result)["results"]
+    refused = [row for row in rows if row["status"] == 422]
+    assert refused, [row["status"] for row in rows]
+    advised = int(re.search(r"in batches of at most (\d+) requests", refused[0]["body"]["detail"]).group(1))
+    kept = sum(row["status"] == 200 for row in rows)
+    assert advised < kept  # the small answers do not count
+    again, _ = _run([DENSE] * advised, tmp_path, monkeypatch)
+    assert [row["status"] for row in json.loads(again)["results"]] == [200] * advised
