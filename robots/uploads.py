@@ -202,6 +202,9 @@ def register_urdf(urdf: str, name: str | None = None, options: UploadOptions | N
     check_name(name)
     if is_catalog_robot(name):
         raise RobotConflict(f"name {name!r} belongs to a catalog robot; choose another")
+    alike = next((known for known in catalog_names() if known.lower() == name.lower()), None)
+    if alike is not None:  # a request naming one, mistyped in case, would plan the other
+        raise RobotConflict(f"name {name!r} differs from the catalog robot {alike!r} only in case; choose another")
     store = upload_store()
     held = store.key(name)
     if held is not None and held[0] != digest:

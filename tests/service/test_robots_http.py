@@ -72,6 +72,11 @@ def test_upload_under_a_name(client):
     other = MINIMAL.format(effort=6, inertial=INERTIAL)
     assert client.post("/v1/robots", json={"name": "my_arm", "urdf": other}).status_code == 409
     assert client.post("/v1/robots", json={"name": "ur5", "urdf": urdf}).status_code == 409
+    # a catalog name in other case: a request mistyping the catalog robot's would plan this one
+    for alike, known in (("UR5", "ur5"), ("Geering_2R", "geering_2r")):
+        refused = client.post("/v1/robots", json={"name": alike, "urdf": urdf})
+        assert refused.status_code == 409, refused.text
+        assert refused.json()["detail"] == f"name {alike!r} differs from the catalog robot {known!r} only in case; choose another"
 
 
 @pytest.mark.parametrize(
