@@ -150,12 +150,14 @@ class ForeignOutput(ValueError):
     as ``--output``, the request file itself): it is left as it is."""
 
 
-def resume_output(path: Path, retry_failed: bool = False) -> dict[int, int]:
+def resume_output(path: Path, retry_failed: bool = False, requests_path: Path | None = None) -> dict[int, int]:
     """The status of each line number already answered in ``path`` (none if it does not
     exist), with ``path`` made ready for appending: its last line cut when it has no newline
-    (the last one of an interrupted run), a line number's second result dropped, and with
-    ``retry_failed`` the retryable results dropped (written to a new file that replaces the old
-    one, so an interruption leaves one or the other).
+    (the last one of an interrupted run), a line number's second result dropped, with
+    ``retry_failed`` the retryable results dropped, and with ``requests_path`` the results of
+    lines whose request changed since (their key is no longer the line's: a request fixed after
+    its 4xx is planned again). What is dropped is written to a new file that replaces the old
+    one, so an interruption leaves one or the other.
 
     Raises:
         ForeignOutput: a whole line of ``path`` is no result line; nothing is changed.
@@ -163,7 +165,8 @@ def resume_output(path: Path, retry_failed: bool = False) -> dict[int, int]:
     if not path.exists():
         return {}
     done: dict[int, int] = {}
-    keep: list[tuple[int, int]] = []  # (offset, length) of the lines kept
+    keys: dict[int, str] = {}
+    kept: dict[int, tuple[int, int]] = {}  # line number -> (offset, length) of its result kept
     offset, dropped = 0, False
     with open(path, "rb") as handle:
         for count, raw in enumerate(handle, start=1):
@@ -171,8 +174,8 @@ def resume_output(path: Path, retry_failed: bool = False) -> dict[int, int]:
                 break  # cut short by an interruption: written again
             try:
                 row = orjson.loads(raw)
-                number, status = int(row["line"]), int(row["status"])
-                if not isinstance(row.get("key"), str) or "body" not in row:
+                number, status, key = int(row["line"]), int(row["status"]), row.get("key")
+                if not isinstance(key, str) or "body" not in row:
                     raise KeyError("key")
             except (ValueError, KeyError, TypeError, AttributeError):
                 raise ForeignOutput(
@@ -183,9 +186,15 @@ def resume_output(path: Path, retry_failed: bool = False) -> dict[int, int]:
             if number in done or (retry_failed and retryable(status)):
                 dropped = True
             else:
-                done[number] = status
-                keep.append((offset, len(raw)))
+                done[number], keys[number] = status, key
+                kept[number] = (offset, len(raw))
             offset += len(raw)
+    if requests_path is not None and done and requests_path.exists():
+        changed = [line.number for line in read_requests(requests_path) if line.number in keys and keys[line.number] != line.key]
+        for number in changed:
+            del done[number], kept[number]
+        dropped = dropped or bool(changed)
+    keep = sorted(kept.values())
     if not dropped:
         with open(path, "r+b") as handle:
             handle.truncate(offset)

@@ -268,7 +268,7 @@ def run_batch(
     if output_path.exists() and requests_path.exists() and output_path.samefile(requests_path):
         raise ForeignOutput("--output is the request file itself; give another file for the results")
     total = count_lines(requests_path)
-    done = resume_output(output_path, retry_failed)
+    done = resume_output(output_path, retry_failed, requests_path)
     skipped = sum(1 for number in done if number <= total)
 
     def report(written: int) -> None:

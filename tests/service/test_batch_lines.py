@@ -358,3 +358,21 @@ def test_two_lines_too_long_of_one_length_have_keys_of_their_own(tmp_path, monke
     read = list(lines_.read_requests(path))
     assert [line.problem[0] for line in read] == [413, 413]
     assert read[0].key != read[1].key
+
+
+def test_a_line_fixed_after_its_4xx_is_planned_again_and_answered_once(tmp_path):
+    """A resumed run plans the lines whose request changed since their result (the result's key
+    is no longer the line's), in place of the old result, and leaves the others as they are."""
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text(json.dumps(GOOD) + "\nnot json\n" + json.dumps(OTHER) + "\n")
+    run_batch(requests, output, pool=InProcessPool)
+    assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 200, 2: 422, 3: 200}
+    requests.write_text(json.dumps(GOOD) + "\n" + json.dumps({**OTHER, "output": {"dt": 0.02}}) + "\n" + json.dumps(OTHER) + "\n")
+    pool = InProcessPool()
+    report = run_batch(requests, output, pool=lambda: pool)
+    assert (report.skipped, report.planned) == (2, 1)
+    rows = _by_line(output)  # one result a line
+    assert {n: row["status"] for n, row in rows.items()} == {1: 200, 2: 200, 3: 200}
+    assert rows[2]["key"] == request_key(json.dumps({**OTHER, "output": {"dt": 0.02}}))
+    assert len(pool.chunks) == 1 and [key for key, _ in pool.chunks[0]] == [rows[2]["key"]]
+    assert run_batch(requests, output, pool=InProcessPool).planned == 0
