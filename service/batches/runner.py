@@ -1,12 +1,13 @@
 """The batch driver: request lines planned on Ray, a result line per request line appended as
 they come, and an interruption (Ctrl-C) that stops within seconds and leaves a file to resume.
 
-Each line is read and checked first (``lines.read_requests``); a line that cannot be read is
-written as its 4xx result at once. The readable requests are grouped by key (identical requests
-computed once, a result line written for each of their lines) and planned by ``RayPool``: tasks
+Each line is read and checked as the tasks need more (``lines.read_requests``); a line that
+cannot be read is written as its 4xx result at once. Identical requests (one key) are computed
+once: a line of a request under way waits for its answer, and one of a request answered gets a
+copy of its result line (``results.ResultWriter``). The others are planned by ``RayPool``: tasks
 of ``CHUNK`` requests each (a typical request plans in tens of milliseconds; a task costs about
-a millisecond of Ray's own), at most ``2 x workers + 1`` tasks in flight, so memory stays
-bounded whatever the batch's length. What travels to the workers: the request texts and the
+a millisecond of Ray's own), at most ``2 x workers + 1`` tasks in flight, and only their texts
+are held, so memory stays bounded whatever the batch's length. What travels to the workers: the request texts and the
 URDF texts of the uploaded robots the batch names (a catalog robot is built by each worker from
 its own installation). What stays with the driver: the output file, the upload store, the
 progress.
@@ -25,7 +26,7 @@ import sys
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
@@ -34,7 +35,8 @@ import orjson
 
 from toptraj import robots
 from toptraj.robots.catalog import is_catalog_robot
-from toptraj.service.batches.lines import ForeignOutput, problem_body, read_requests, result_line, resume_output
+from toptraj.service.batches.lines import ForeignOutput, RequestLine, problem_body, read_requests, resume_output
+from toptraj.service.batches.results import ResultWriter
 from toptraj.service.budget_advice import advised_line, for_batch_line
 
 #: Requests per Ray task.
@@ -188,24 +190,13 @@ class RayPool:
             self._ray.shutdown()
 
 
-def _write(out, numbers: dict[str, list[int]], answers: list[tuple[str, int, bytes]]) -> int:
-    """Write a result line per line number of each answered request; how many were written."""
-    written = 0
-    for key, status, body in answers:
-        for number in numbers.pop(key, ()):
-            out.write(result_line(number, key, status, body))
-            written += 1
-    out.flush()
-    return written
-
-
 def _failed(chunk: list[tuple[str, str]], error: BaseException) -> list[tuple[str, int, bytes]]:
     """The 500 of each request of a task that failed as a whole (its worker died)."""
     detail = f"the worker planning this line failed ({type(error).__name__}); run the batch again with --retry-failed"
     return [(key, 500, problem_body(500, "Worker failed", detail)) for key, _ in chunk]
 
 
-def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, out, numbers: dict[str, list[int]]) -> int:
+def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, results: ResultWriter) -> int:
     """Kill the tasks that ran past their requests' budgets plus ``TASK_SLACK_S`` (a solver
     step that cannot check its deadline) and write their requests as 504 lines; how many
     lines were written. A task counts as started once it is among the ``runner.cpus`` oldest
@@ -223,7 +214,7 @@ def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, out,
     written = 0
     for handle in overdue:
         del started_at[handle]
-        written += _write(out, numbers, [(key, 504, problem_body(504, "Time budget exceeded", detail)) for key, _ in running.pop(handle)])
+        written += results.answers([(key, 504, problem_body(504, "Time budget exceeded", detail)) for key, _ in running.pop(handle)])
     return written
 
 
@@ -276,97 +267,107 @@ def run_batch(
             progress(written, total - skipped, time.perf_counter() - started)
 
     with open(output_path, "ab") as out:
-        numbers, texts, written, stopped = _read_lines(out, requests_path, set(done), stop)
-        if stopped:  # before any planning: what was read is resumed later
-            return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=True)
-        report(written)
-        if not texts or stop.is_set():
-            return BatchReport(total, skipped, written, time.perf_counter() - started, interrupted=bool(texts))
-        runner = (pool or (lambda: RayPool(ray_address, workers)))()
+        results = ResultWriter(out, output_path)
+        lines = read_requests(requests_path, skip=set(done))
+        runner: Any = None
+
+        def make_runner() -> Any:
+            nonlocal runner
+            runner = (pool or (lambda: RayPool(ray_address, workers)))()
+            return runner
+
         try:
-            planned, interrupted = _plan_lines(runner, texts, numbers, out, budget_s, stop, lambda count: report(written + count))
+            interrupted = _plan_lines(lines, results, make_runner, budget_s, stop, report)
         finally:
-            runner.close()
+            if runner is not None:
+                runner.close()
     return BatchReport(
-        total, skipped, written + planned, time.perf_counter() - started, interrupted, dict(getattr(runner, "nodes", {}))
+        total, skipped, results.written, time.perf_counter() - started, interrupted, dict(getattr(runner, "nodes", {}))
     )
 
 
-def _read_lines(out, requests_path: Path, done: set[int], stop: threading.Event) -> tuple[dict[str, list[int]], dict[str, str], int, bool]:
-    """The lines of ``requests_path`` not in ``done``: those refused before planning answered in
-    ``out`` at once, the others gathered by key. Returns the line numbers of each key, each
-    key's request text, the result lines written and whether ``stop`` ended the reading."""
-    numbers: dict[str, list[int]] = {}  # key -> the line numbers of its request
-    texts: dict[str, str] = {}
-    written = 0
-    for line in read_requests(requests_path, skip=done):
-        if stop.is_set():
-            out.flush()
-            return numbers, texts, written, True
-        if line.problem is not None:
-            out.write(result_line(line.number, line.key, *line.problem))
-            written += 1
-        else:
-            numbers.setdefault(line.key, []).append(line.number)
-            texts.setdefault(line.key, line.text)
-    out.flush()
-    return numbers, texts, written, False
-
-
 def _plan_lines(
-    runner, texts: dict[str, str], numbers: dict[str, list[int]], out, budget_s: float, stop: threading.Event,
-    report: Callable[[int], None],
-) -> tuple[int, bool]:
-    """Every request of ``texts`` (emptied: the tasks hold the texts) planned by ``runner`` in
-    chunks of ``CHUNK``, at most ``2 * runner.cpus + 1`` chunks at a time, each answer written to
-    ``out`` as it comes, a chunk past its budget answered 504; ``report(written)`` after each
-    step that wrote. Returns the result lines written and whether ``stop`` interrupted it."""
-    runner.share(_uploads_named(list(texts.values())))
-    keys = list(texts)
-    chunks = [[(key, texts[key]) for key in keys[k : k + CHUNK]] for k in range(0, len(keys), CHUNK)]
-    texts.clear()
-    del keys
-    window = 2 * runner.cpus + 1
+    lines: Iterator[RequestLine], results: ResultWriter, make_runner: Callable[[], Any], budget_s: float,
+    stop: threading.Event, report: Callable[[int], None],
+) -> bool:
+    """Every request of ``lines`` answered in ``results``, read as the tasks need them: a line
+    refused before planning at once, a line whose request is already answered or under way
+    sharing its answer, the others planned by the runner (``make_runner()``, made at the first
+    request to plan) in chunks of ``CHUNK``, at most ``2 * runner.cpus + 1`` chunks at a time, a
+    chunk past its budget answered 504. So only the texts of the chunks in flight are held,
+    whatever the file's length. ``report(written)`` after each step that wrote; returns
+    whether ``stop`` interrupted the run."""
     advice = for_batch_line(budget_s, MAX_BUDGET_S)
+    runner: Any = None
     running: dict[Any, list[tuple[str, str]]] = {}  # in the order submitted
     started_at: dict[Any, float] = {}
-    next_chunk, written = 0, 0
-    while (running or next_chunk < len(chunks)) and not stop.is_set():
-        while next_chunk < len(chunks) and len(running) < window and not stop.is_set():
-            running[runner.submit(chunks[next_chunk], budget_s)] = chunks[next_chunk]
-            chunks[next_chunk] = []  # its texts are the task's now
-            next_chunk += 1
+    chunk: list[tuple[str, str]] = []
+    uploads: dict[str, tuple[str, str]] = {}
+    exhausted = False
+
+    def submit() -> None:
+        nonlocal runner, chunk
+        fresh = runner is None
+        runner = runner or make_runner()
+        named = _uploads_named([text for _, text in chunk])
+        if fresh or not named.keys() <= uploads.keys():  # the tasks from here on get every upload named so far
+            uploads.update(named)
+            runner.share(dict(uploads))
+        running[runner.submit(chunk, budget_s)] = chunk
+        chunk = []
+
+    while not stop.is_set():
+        wrote = results.written
+        while not exhausted and (runner is None or len(running) < 2 * runner.cpus + 1) and not stop.is_set():
+            line = next(lines, None)
+            if line is None:
+                exhausted = True
+            elif line.problem is not None:
+                results.write(line.number, line.key, *line.problem)
+            elif line.key in results.pending:
+                results.pending[line.key].append(line.number)
+            elif results.answered(line.key):
+                results.copy(line.number, line.key)
+            else:
+                results.pending[line.key] = [line.number]
+                chunk.append((line.key, line.text))
+            if len(chunk) == CHUNK or (exhausted and chunk):
+                submit()
+        if results.written > wrote:
+            results.out.flush()
+            report(results.written)
+        if not running:
+            if exhausted:
+                break
+            continue
         ready, _ = runner.wait(list(running), WAIT_S)
         for handle in ready:
             started_at.pop(handle, None)
-            chunk = running.pop(handle)
+            done = running.pop(handle)
             try:
                 answers = runner.result(handle)
             except Exception as error:  # the task as a whole: a worker died
                 if stop.is_set():
                     continue  # cancelled by the stop: resumed later
-                answers = _failed(chunk, error)
-            answers = [(key, status, advised_line(status, body, advice)) for key, status, body in answers]
-            written += _write(out, numbers, answers)
-        overdue = _kill_overdue(runner, running, started_at, budget_s, out, numbers)
-        written += overdue
+                answers = _failed(done, error)
+            results.answers([(key, status, advised_line(status, body, advice)) for key, status, body in answers])
+        overdue = _kill_overdue(runner, running, started_at, budget_s, results)
         if ready or overdue:
-            report(written)
-    interrupted = bool(running) or next_chunk < len(chunks)
-    if interrupted:
-        written += _collect_finished(runner, running, out, numbers)
-    return written, interrupted
+            report(results.written)
+    interrupted = bool(running) or not exhausted or bool(chunk)
+    if running:
+        _collect_finished(runner, running, results)
+    results.out.flush()
+    return interrupted
 
 
-def _collect_finished(runner, running: dict, out, numbers: dict[str, list[int]]) -> int:
+def _collect_finished(runner, running: dict, results: ResultWriter) -> None:
     """On a stop: the answers of the tasks already finished written, the others cancelled (they
-    are resumed later). Returns the result lines written."""
-    written = 0
+    are resumed later)."""
     ready, rest = runner.wait(list(running), 0) if running else ([], [])
     for handle in ready:
         try:
-            written += _write(out, numbers, runner.result(handle))
+            results.answers(runner.result(handle))
         except Exception:  # noqa: S112 - cancelled or failed: resumed later
             continue
     runner.cancel(rest)
-    return written

@@ -376,3 +376,27 @@ def test_a_line_fixed_after_its_4xx_is_planned_again_and_answered_once(tmp_path)
     assert rows[2]["key"] == request_key(json.dumps({**OTHER, "output": {"dt": 0.02}}))
     assert len(pool.chunks) == 1 and [key for key, _ in pool.chunks[0]] == [rows[2]["key"]]
     assert run_batch(requests, output, pool=InProcessPool).planned == 0
+
+
+def test_the_driver_holds_only_the_lines_in_flight(tmp_path):
+    """A file of 60 requests of 200 kB each (12 MB): the driver reads them as the tasks need
+    them, so its memory at peak holds a few chunks of them, not the file (it gathered every
+    line's text before planning: 488 MB for 200 lines of 1 MB)."""
+    import tracemalloc
+
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    with open(requests, "w") as handle:
+        for k in range(60):  # each its own request (a 422: an unknown field), answered at once
+            handle.write(json.dumps({**GOOD, "note": "x" * (200_000 + k)}) + "\n")
+    class Forgetful(InProcessPool):  # keeps no chunk (InProcessPool keeps them all for its keys)
+        def submit(self, chunk, budget_s):
+            return _Done(answer_chunk(chunk, self.uploads, budget_s))
+
+    tracemalloc.start()
+    try:
+        report = run_batch(requests, output, pool=Forgetful)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert report.planned == 60 and {row["status"] for row in _by_line(output).values()} == {422}
+    assert peak < 9_000_000, f"{peak / 1e6:.1f} MB at peak"  # the file is 12 MB
