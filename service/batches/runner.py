@@ -290,59 +290,27 @@ def _plan_lines(
     lines: Iterator[RequestLine], results: ResultWriter, make_runner: Callable[[], Any], budget_s: float,
     stop: threading.Event, report: Callable[[int], None],
 ) -> bool:
-    """Every request of ``lines`` answered in ``results``, read as the tasks need them: a line
-    refused before planning at once, a line whose request is already answered or under way
-    sharing its answer, the others planned by the runner (``make_runner()``, made at the first
-    request to plan) in chunks of ``CHUNK``, at most ``2 * runner.cpus + 1`` chunks at a time, a
-    chunk past its budget answered 504. So only the texts of the chunks in flight are held,
-    whatever the file's length. ``report(written)`` after each step that wrote; returns
-    whether ``stop`` interrupted the run."""
+    """Every request of ``lines`` answered in ``results``, read as the tasks need them
+    (``_Flight.read``), planned by the runner (``make_runner()``, made at the first request to
+    plan) in chunks of ``CHUNK``, at most ``2 * runner.cpus + 1`` chunks at a time, a chunk
+    past its budget answered 504. So only the texts of the chunks in flight are held, whatever
+    the file's length. ``report(written)`` after each step that wrote; returns whether
+    ``stop`` interrupted the run."""
     advice = for_batch_line(budget_s, MAX_BUDGET_S)
-    runner: Any = None
-    running: dict[Any, list[tuple[str, str]]] = {}  # in the order submitted
-    started_at: dict[Any, float] = {}
-    chunk: list[tuple[str, str]] = []
-    uploads: dict[str, tuple[str, str]] = {}
-    exhausted = False
-
-    def submit() -> None:
-        nonlocal runner, chunk
-        fresh = runner is None
-        runner = runner or make_runner()
-        named = _uploads_named([text for _, text in chunk])
-        if fresh or not named.keys() <= uploads.keys():  # the tasks from here on get every upload named so far
-            uploads.update(named)
-            runner.share(dict(uploads))
-        running[runner.submit(chunk, budget_s)] = chunk
-        chunk = []
-
+    flight = _Flight(make_runner, budget_s)
     while not stop.is_set():
         wrote = results.written
-        while not exhausted and (runner is None or len(running) < 2 * runner.cpus + 1) and not stop.is_set():
-            line = next(lines, None)
-            if line is None:
-                exhausted = True
-            elif line.problem is not None:
-                results.write(line.number, line.key, *line.problem)
-            elif line.key in results.pending:
-                results.pending[line.key].append(line.number)
-            elif results.answered(line.key):
-                results.copy(line.number, line.key)
-            else:
-                results.pending[line.key] = [line.number]
-                chunk.append((line.key, line.text))
-            if len(chunk) == CHUNK or (exhausted and chunk):
-                submit()
+        exhausted = flight.read(lines, results, stop)
         if results.written > wrote:
-            results.out.flush()
             report(results.written)
-        if not running:
+        if not flight.running:
             if exhausted:
                 break
             continue
+        runner, running = flight.runner, flight.running
         ready, _ = runner.wait(list(running), WAIT_S)
         for handle in ready:
-            started_at.pop(handle, None)
+            flight.started_at.pop(handle, None)
             done = running.pop(handle)
             try:
                 answers = runner.result(handle)
@@ -351,14 +319,61 @@ def _plan_lines(
                     continue  # cancelled by the stop: resumed later
                 answers = _failed(done, error)
             results.answers([(key, status, advised_line(status, body, advice)) for key, status, body in answers])
-        overdue = _kill_overdue(runner, running, started_at, budget_s, results)
+        overdue = _kill_overdue(runner, running, flight.started_at, budget_s, results)
         if ready or overdue:
             report(results.written)
-    interrupted = bool(running) or not exhausted or bool(chunk)
-    if running:
-        _collect_finished(runner, running, results)
+    if flight.running:
+        _collect_finished(flight.runner, flight.running, results)
     results.out.flush()
-    return interrupted
+    return bool(flight.running) or not flight.exhausted or bool(flight.chunk)
+
+
+class _Flight:
+    """The tasks of a run in flight (``running``: handle -> its chunk, in the order submitted),
+    the chunk being gathered, and the uploads shared with the runner's tasks."""
+
+    def __init__(self, make_runner: Callable[[], Any], budget_s: float):
+        self.make_runner, self.budget_s = make_runner, budget_s
+        self.runner: Any = None
+        self.running: dict[Any, list[tuple[str, str]]] = {}
+        self.started_at: dict[Any, float] = {}
+        self.chunk: list[tuple[str, str]] = []
+        self.uploads: dict[str, tuple[str, str]] = {}
+        self.exhausted = False
+
+    def read(self, lines: Iterator[RequestLine], results: ResultWriter, stop: threading.Event) -> bool:
+        """Read lines until ``2 * cpus + 1`` tasks are in flight or the file ends: a line refused
+        before planning answered at once, a line of a request under way or answered sharing its
+        answer, the others gathered into chunks and submitted. Returns whether the file ended."""
+        while not self.exhausted and (self.runner is None or len(self.running) < 2 * self.runner.cpus + 1) and not stop.is_set():
+            line = next(lines, None)
+            if line is None:
+                self.exhausted = True
+            elif line.problem is not None:
+                results.write(line.number, line.key, *line.problem)
+            elif line.key in results.pending:
+                results.pending[line.key].append(line.number)
+            elif results.answered(line.key):
+                results.copy(line.number, line.key)
+            else:
+                results.pending[line.key] = [line.number]
+                self.chunk.append((line.key, line.text))
+            if len(self.chunk) == CHUNK or (self.exhausted and self.chunk):
+                self._submit()
+        results.out.flush()
+        return self.exhausted
+
+    def _submit(self) -> None:
+        """The chunk gathered as a task; the runner made at the first, and the uploads its
+        requests name shared first where they are new."""
+        fresh = self.runner is None
+        self.runner = self.runner or self.make_runner()
+        named = _uploads_named([text for _, text in self.chunk])
+        if fresh or not named.keys() <= self.uploads.keys():  # the tasks from here on get every upload named so far
+            self.uploads.update(named)
+            self.runner.share(dict(self.uploads))
+        self.running[self.runner.submit(self.chunk, self.budget_s)] = self.chunk
+        self.chunk = []
 
 
 def _collect_finished(runner, running: dict, results: ResultWriter) -> None:
