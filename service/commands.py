@@ -326,7 +326,7 @@ def batch(
 
     from toptraj.service.batches import run_batch
     from toptraj.service.batches.lines import ForeignOutput
-    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, progress_bar
+    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, RayUnreachable, progress_bar
 
     if workers is not None and workers < 1:
         print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)
@@ -347,6 +347,9 @@ def batch(
         report = run_batch(requests, output, workers, ray_address, progress_bar(), budget, retry_failed, stop)
     except RayMissing as error:
         print(json.dumps(_problem("Ray is not installed", 400, str(error))), file=sys.stderr)
+        return 2
+    except RayUnreachable as error:
+        print(json.dumps(_problem("Ray cluster unreachable", 400, str(error))), file=sys.stderr)
         return 2
     except ForeignOutput as error:
         print(json.dumps(_problem("Not a result file", 400, str(error))), file=sys.stderr)

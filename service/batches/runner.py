@@ -48,6 +48,10 @@ MAX_BUDGET_S = 3600.0
 #: Time a task may take beyond its requests' budgets (a worker process starting and importing
 #: the planning stack), in s; past it the task is killed and its requests are 504 lines.
 TASK_SLACK_S = 10.0
+#: Time a task may take beyond that while no task of the run has answered yet, in s: Ray's
+#: workers starting (a process each, importing the planning stack and preparing: ten seconds
+#: and more on a busy machine) is no line's planning.
+STARTUP_S = 60.0
 #: Longest wait for a task before the driver looks at ``stop`` again, in s.
 WAIT_S = 0.2
 
@@ -57,6 +61,41 @@ RAY_MISSING = "toptraj batch plans on Ray, which is not installed: pip install '
 
 class RayMissing(RuntimeError):
     """Ray (the ``ray`` extra) is not installed."""
+
+
+class RayUnreachable(RuntimeError):
+    """No Ray cluster answers at the address given."""
+
+
+#: Seconds a cluster's address is given to accept a connection before the batch starts.
+CONNECT_S = 5.0
+
+
+def check_reachable(address: str) -> None:
+    """Refuse at once a ``host:port`` (or ``ray://host:port``) where nothing accepts a
+    connection: Ray itself retries such an address for minutes, deaf to Ctrl-C.
+
+    Raises:
+        RayUnreachable: nothing listens there (within ``CONNECT_S``), with how to start one.
+    """
+    import socket
+
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    host = host.strip("[]")  # an IPv6 address in brackets
+    if not host or not port.isdigit():
+        raise RayUnreachable(
+            f"--ray-address {address!r} is no cluster address: give host:port of its head (as `ray start --head` "
+            "prints it), ray://host:port for a Ray client server, auto for the cluster started on this machine, or "
+            "leave it out for a local Ray"
+        )
+    try:
+        socket.create_connection((host, int(port)), timeout=CONNECT_S).close()
+    except OSError as error:
+        raise RayUnreachable(
+            f"nothing accepts a connection at --ray-address {address} ({error.strerror or error}): start the cluster's "
+            f"head there (ray start --head --port={port}), check the address it printed, or leave --ray-address out "
+            "for a local Ray on this machine"
+        ) from None
 
 
 @dataclass(frozen=True)
@@ -151,7 +190,16 @@ class RayPool:
                     runtime_env=hook,
                 )
             else:
-                ray.init(address=address, log_to_driver=False, configure_logging=False, runtime_env=hook)
+                if address != "auto":
+                    check_reachable(address)
+                try:
+                    ray.init(address=address, log_to_driver=False, configure_logging=False, runtime_env=hook)
+                except ConnectionError as error:  # "auto" without a cluster on this machine
+                    raise RayUnreachable(
+                        f"no Ray cluster runs on this machine for --ray-address {address} ({str(error)[:200]}): start "
+                        "one (ray start --head), give a cluster's head as --ray-address host:port, or leave "
+                        "--ray-address out for a local Ray"
+                    ) from None
             self._started_here = True
         self._remote = ray.remote(num_cpus=1, max_retries=2, scheduling_strategy="SPREAD")(answer_on_worker)
         self._uploads: Any = ray.put({})
@@ -196,15 +244,17 @@ def _failed(chunk: list[tuple[str, str]], error: BaseException) -> list[tuple[st
     return [(key, 500, problem_body(500, "Worker failed", detail)) for key, _ in chunk]
 
 
-def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, results: ResultWriter) -> int:
+def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, results: ResultWriter, warm: bool = True) -> int:
     """Kill the tasks that ran past their requests' budgets plus ``TASK_SLACK_S`` (a solver
-    step that cannot check its deadline) and write their requests as 504 lines; how many
-    lines were written. A task counts as started once it is among the ``runner.cpus`` oldest
-    still running (Ray starts tasks in the order submitted, one per CPU)."""
+    step that cannot check its deadline), and ``STARTUP_S`` more until a task has answered
+    (not ``warm``: the workers may still be starting), and write their requests as 504 lines;
+    how many lines were written. A task counts as started once it is among the
+    ``runner.cpus`` oldest still running (Ray starts tasks in the order submitted, one per CPU)."""
     now = time.monotonic()
     for handle in list(running)[: runner.cpus]:
         started_at.setdefault(handle, now)
-    overdue = [h for h, since in started_at.items() if now > since + len(running[h]) * budget_s + TASK_SLACK_S]
+    slack = TASK_SLACK_S if warm else TASK_SLACK_S + STARTUP_S  # warm: a task of the run has answered
+    overdue = [h for h, since in started_at.items() if now > since + len(running[h]) * budget_s + slack]
     if not overdue:
         return 0
     runner.cancel(overdue)
@@ -319,7 +369,8 @@ def _plan_lines(
                     continue  # cancelled by the stop: resumed later
                 answers = _failed(done, error)
             results.answers([(key, status, advised_line(status, body, advice)) for key, status, body in answers])
-        overdue = _kill_overdue(runner, running, flight.started_at, budget_s, results)
+        flight.warm = flight.warm or bool(ready)
+        overdue = _kill_overdue(runner, running, flight.started_at, budget_s, results, flight.warm)
         if ready or overdue:
             report(results.written)
     if flight.running:
@@ -340,6 +391,7 @@ class _Flight:
         self.chunk: list[tuple[str, str]] = []
         self.uploads: dict[str, tuple[str, str]] = {}
         self.exhausted = False
+        self.warm = False  # a task has answered: the workers are up
 
     def read(self, lines: Iterator[RequestLine], results: ResultWriter, stop: threading.Event) -> bool:
         """Read lines until ``2 * cpus + 1`` tasks are in flight or the file ends: a line refused

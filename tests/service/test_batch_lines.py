@@ -267,6 +267,23 @@ def test_batch_without_ray_names_the_extra_to_install(tmp_path, monkeypatch, cap
     assert problem["status"] == 400 and problem["title"] == "Ray is not installed"
 
 
+@pytest.mark.parametrize("address, words", [("127.0.0.1:1", "nothing accepts a connection at --ray-address 127.0.0.1:1"), ("nohost", "is no cluster address")])
+def test_batch_on_a_cluster_address_where_nothing_listens_says_so_at_once(tmp_path, capsys, address, words):
+    """Ray retries such an address for minutes, deaf to Ctrl-C: the address is tried first."""
+    pytest.importorskip("ray")
+    import ray
+
+    if ray.is_initialized():
+        pytest.skip("a Ray of this process is running")
+    (tmp_path / "in.jsonl").write_text(json.dumps(GOOD) + "\n")
+    started = time.monotonic()
+    assert main(["batch", str(tmp_path / "in.jsonl"), "-o", str(tmp_path / "out.jsonl"), "--ray-address", address]) == 2
+    assert time.monotonic() - started < 30.0
+    problem = json.loads(capsys.readouterr().err.strip().splitlines()[-1])
+    assert problem["title"] == "Ray cluster unreachable" and words in problem["detail"], problem
+    assert not ray.is_initialized()
+
+
 def _fails_on_panda(monkeypatch):
     planned = batch_work.plan_request
 
@@ -400,3 +417,27 @@ def test_the_driver_holds_only_the_lines_in_flight(tmp_path):
         tracemalloc.stop()
     assert report.planned == 60 and {row["status"] for row in _by_line(output).values()} == {422}
     assert peak < 9_000_000, f"{peak / 1e6:.1f} MB at peak"  # the file is 12 MB
+
+
+def test_a_run_s_first_tasks_get_time_for_the_workers_to_start(tmp_path, monkeypatch):
+    """Before any task has answered, a task is not killed at its lines' budgets plus the slack:
+    Ray's workers may still be starting (ten seconds and more), which is no line's planning
+    (a --budget 0.5 made every line a 504 that way). Here the workers take 1 s to answer."""
+    monkeypatch.setattr(runner, "TASK_SLACK_S", 0.2)
+    monkeypatch.setattr(runner, "STARTUP_S", 5.0)
+
+    class Slow(InProcessPool):
+        def __init__(self):
+            super().__init__()
+            self.started = time.monotonic()
+
+        def wait(self, handles, timeout_s):
+            if time.monotonic() - self.started < 1.0:  # the workers starting
+                time.sleep(min(timeout_s, 0.05))
+                return [], list(handles)
+            return list(handles), []
+
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text(json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n")
+    run_batch(requests, output, budget_s=0.2, pool=Slow)
+    assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 200, 2: 200}
