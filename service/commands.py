@@ -326,7 +326,8 @@ def batch(
 
     from toptraj.service.batches import run_batch
     from toptraj.service.batches.lines import ForeignOutput
-    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, RayMissing, RayUnreachable, progress_bar
+    from toptraj.service.batches.ray_pool import RayMissing, RayUnreachable
+    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, progress_bar
 
     if workers is not None and workers < 1:
         print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)
@@ -345,17 +346,9 @@ def batch(
     previous = signal.signal(signal.SIGINT, interrupted)
     try:
         report = run_batch(requests, output, workers, ray_address, progress_bar(), budget, retry_failed, stop)
-    except RayMissing as error:
-        print(json.dumps(_problem("Ray is not installed", 400, str(error))), file=sys.stderr)
-        return 2
-    except RayUnreachable as error:
-        print(json.dumps(_problem("Ray cluster unreachable", 400, str(error))), file=sys.stderr)
-        return 2
-    except ForeignOutput as error:
-        print(json.dumps(_problem("Not a result file", 400, str(error))), file=sys.stderr)
-        return 2
-    except OSError as error:
-        print(json.dumps(_problem("Cannot read or write", 400, str(error))), file=sys.stderr)
+    except (RayMissing, RayUnreachable, ForeignOutput, OSError) as error:
+        titles = {RayMissing: "Ray is not installed", RayUnreachable: "Ray cluster unreachable", ForeignOutput: "Not a result file"}
+        print(json.dumps(_problem(titles.get(type(error), "Cannot read or write"), 400, str(error))), file=sys.stderr)
         return 2
     finally:
         signal.signal(signal.SIGINT, previous)

@@ -10,6 +10,7 @@ line number where an earlier run stopped (``--retry-failed``: the 504s and 5xx t
   stop that keeps what finished.
 """
 
-from toptraj.service.batches.runner import BatchReport, RayMissing, run_batch
+from toptraj.service.batches.ray_pool import RayMissing
+from toptraj.service.batches.runner import BatchReport, run_batch
 
 __all__ = ["BatchReport", "RayMissing", "run_batch"]

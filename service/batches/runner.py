@@ -21,11 +21,9 @@ are cancelled (their workers killed), and a Ray started here is shut down with i
 
 from __future__ import annotations
 
-import os
 import sys
 import threading
 import time
-from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,6 +34,7 @@ import orjson
 from toptraj import robots
 from toptraj.robots.catalog import is_catalog_robot
 from toptraj.service.batches.lines import ForeignOutput, RequestLine, problem_body, read_requests, resume_output
+from toptraj.service.batches.ray_pool import RayPool
 from toptraj.service.batches.results import ResultWriter
 from toptraj.service.budget_advice import advised_line, for_batch_line
 
@@ -54,49 +53,6 @@ TASK_SLACK_S = 10.0
 STARTUP_S = 60.0
 #: Longest wait for a task before the driver looks at ``stop`` again, in s.
 WAIT_S = 0.2
-
-#: What ``toptraj batch`` needs and how to get it.
-RAY_MISSING = "toptraj batch plans on Ray, which is not installed: pip install 'toptraj[ray]'"
-
-
-class RayMissing(RuntimeError):
-    """Ray (the ``ray`` extra) is not installed."""
-
-
-class RayUnreachable(RuntimeError):
-    """No Ray cluster answers at the address given."""
-
-
-#: Seconds a cluster's address is given to accept a connection before the batch starts.
-CONNECT_S = 5.0
-
-
-def check_reachable(address: str) -> None:
-    """Refuse at once a ``host:port`` (or ``ray://host:port``) where nothing accepts a
-    connection: Ray itself retries such an address for minutes, deaf to Ctrl-C.
-
-    Raises:
-        RayUnreachable: nothing listens there (within ``CONNECT_S``), with how to start one.
-    """
-    import socket
-
-    host, _, port = address.removeprefix("ray://").rpartition(":")
-    host = host.strip("[]")  # an IPv6 address in brackets
-    if not host or not port.isdigit():
-        raise RayUnreachable(
-            f"--ray-address {address!r} is no cluster address: give host:port of its head (as `ray start --head` "
-            "prints it), ray://host:port for a Ray client server, auto for the cluster started on this machine, or "
-            "leave it out for a local Ray"
-        )
-    try:
-        socket.create_connection((host, int(port)), timeout=CONNECT_S).close()
-    except OSError as error:
-        raise RayUnreachable(
-            f"nothing accepts a connection at --ray-address {address} ({error.strerror or error}): start the cluster's "
-            f"head there (ray start --head --port={port}), check the address it printed, or leave --ray-address out "
-            "for a local Ray on this machine"
-        ) from None
-
 
 @dataclass(frozen=True)
 class BatchReport:
@@ -152,90 +108,6 @@ def progress_bar(stream: TextIO = sys.stderr) -> Callable[[int, int, float], Non
         stream.flush()
 
     return show
-
-
-class RayPool:
-    """Chunks of requests computed as Ray tasks (``work.answer_on_worker``): on the cluster at
-    ``address`` (``auto``, ``host:port``, ``ray://host:port``), or on a local Ray with
-    ``workers`` CPUs (default: the cores) started here and shut down by ``close`` with its
-    processes. Each worker is prepared once (``prepare``: Ray's worker setup hook, in this
-    job's ``runtime_env``); tasks are spread over the nodes (``SPREAD``); ``nodes`` counts the
-    requests answered by each node (by Ray node id).
-
-    Raises:
-        RayMissing: Ray is not installed.
-    """
-
-    def __init__(self, address: str | None = None, workers: int | None = None):
-        try:
-            import ray
-        except ImportError:
-            raise RayMissing(RAY_MISSING) from None
-        from toptraj.service.batches.prepare import SETUP_HOOK
-        from toptraj.service.batches.work import answer_on_worker
-
-        self._ray = ray
-        self._started_here = False
-        self.nodes: Counter[str] = Counter()
-        if not ray.is_initialized():
-            hook = {"worker_process_setup_hook": SETUP_HOOK}
-            if address in (None, "local"):
-                cpus = workers or os.cpu_count() or 1
-                ray.init(
-                    num_cpus=cpus,
-                    include_dashboard=False,
-                    object_store_memory=100 * 1024 * 1024,
-                    log_to_driver=False,
-                    configure_logging=False,
-                    runtime_env=hook,
-                )
-            else:
-                if address != "auto":
-                    check_reachable(address)
-                try:
-                    ray.init(address=address, log_to_driver=False, configure_logging=False, runtime_env=hook)
-                except ConnectionError as error:  # "auto" without a cluster on this machine
-                    raise RayUnreachable(
-                        f"no Ray cluster runs on this machine for --ray-address {address} ({str(error)[:200]}): start "
-                        "one (ray start --head), give a cluster's head as --ray-address host:port, or leave "
-                        "--ray-address out for a local Ray"
-                    ) from None
-            self._started_here = True
-        self._remote = ray.remote(num_cpus=1, max_retries=2, scheduling_strategy="SPREAD")(answer_on_worker)
-        self._uploads: Any = ray.put({})
-        self.cpus = int(ray.available_resources().get("CPU", workers or 1) or 1)
-
-    def share(self, uploads: dict[str, tuple[str, str]]) -> None:
-        """The uploaded robots (``_uploads_named``) every later task receives."""
-        self._uploads = self._ray.put(uploads)
-
-    def submit(self, chunk: list[tuple[str, str]], budget_s: float) -> Any:
-        """Start computing ``chunk`` of (key, text); a handle for ``wait`` and ``result``."""
-        return self._remote.remote(chunk, self._uploads, budget_s, None)  # no body cap: a file's lines
-
-    def wait(self, handles: list, timeout_s: float) -> tuple[list, list]:
-        """(finished, still running) of ``handles``, once one finished or after ``timeout_s``."""
-        ready, rest = self._ray.wait(handles, num_returns=1, timeout=timeout_s)
-        if ready and rest:
-            more, rest = self._ray.wait(rest, num_returns=len(rest), timeout=0)
-            ready += more
-        return ready, rest
-
-    def result(self, handle: Any) -> list[tuple[str, int, bytes]]:
-        """(key, status, body) of each request of a finished task (raises its failure)."""
-        node, answers = self._ray.get(handle)
-        self.nodes[node] += len(answers)
-        return answers
-
-    def cancel(self, handles: list) -> None:
-        """Stop these tasks, killing the workers that run them."""
-        for handle in handles:
-            self._ray.cancel(handle, force=True)
-
-    def close(self) -> None:
-        """Shut down a Ray started here (its processes with it)."""
-        if self._started_here:
-            self._ray.shutdown()
 
 
 def _failed(chunk: list[tuple[str, str]], error: BaseException) -> list[tuple[str, int, bytes]]:
@@ -326,6 +198,8 @@ def run_batch(
             runner = (pool or (lambda: RayPool(ray_address, workers)))()
             return runner
 
+        if total and not stop.is_set():
+            report(0)  # "nothing left to do" where every line has its result
         try:
             interrupted = _plan_lines(lines, results, make_runner, budget_s, stop, report)
         finally:
