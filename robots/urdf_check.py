@@ -312,6 +312,25 @@ def _check_joint_space_inertia(model: pin.Model) -> None:
         )
 
 
+#: Deepest nesting of elements accepted (a URDF's deepest is some five: robot > link >
+#: collision > geometry > mesh; Pinocchio's parser refuses about 500 without a reason).
+MAX_XML_DEPTH = 32
+
+
+def _check_depth(root: ElementTree.Element) -> None:
+    """Refuse elements nested deeper than ``MAX_XML_DEPTH``, naming the first too deep (counted
+    without recursion)."""
+    stack = [(root, 1, "robot")]
+    while stack:
+        element, depth, path = stack.pop()
+        if depth > MAX_XML_DEPTH:
+            raise InvalidURDF(
+                f"the URDF nests elements {MAX_XML_DEPTH + 1} levels deep and more ({path[:200]}); a URDF nests a few "
+                "(robot > link > collision > geometry > mesh): remove the elements nested inside one another"
+            )
+        stack.extend((child, depth + 1, f"{path} > {str(child.tag)[:40]}" if depth < 4 else path) for child in element)
+
+
 def check_urdf(urdf: str) -> pin.Model:
     """Validate ``urdf`` and return its Pinocchio model (fixed base).
 
@@ -341,6 +360,7 @@ def check_urdf(urdf: str) -> pin.Model:
     if root.tag != "robot":
         tag = root.tag if len(root.tag) <= 40 else f"{root.tag[:40]}..."
         raise InvalidURDF(f"the root element is <{tag}>, expected <robot>")
+    _check_depth(root)
     links, joints, _ = check_structure(root)
     masses = {}
     for name, link in links.items():

@@ -25,6 +25,8 @@ from toptraj.service.serving import open_connections
 from toptraj.service.settings import Settings
 from toptraj.service.workers import PlanningWorkers
 
+#: Seconds a 503 of the heavy plannings' lane asks to wait: each holds its worker for seconds.
+HEAVY_RETRY_AFTER_S = 5
 #: Where a server process says what it does while it starts (uvicorn's own log).
 _log = logging.getLogger("uvicorn.error")
 
@@ -85,7 +87,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     app.state.planning = PlanningWorkers(settings.plan_workers, settings.plan_queue, settings.plan_leash_s, open_connections)
-    app.state.heavy_planning = PlanningWorkers(settings.plan_heavy_workers, settings.plan_heavy_queue, label="heavy planning")
+    app.state.heavy_planning = PlanningWorkers(settings.plan_heavy_workers, settings.plan_heavy_queue, label="heavy planning", retry_after=HEAVY_RETRY_AFTER_S)
     app.state.jobs = job_runner(settings)
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_bytes=settings.max_body_bytes)

@@ -12,6 +12,17 @@ REMEDY = (
     "split a batch into several POST /v1/batches, or plan a large file of requests with `toptraj batch` "
     "(no body cap); the cap is the server's TOPTRAJ_MAX_BODY_BYTES"
 )
+#: What to do about an upload over the cap: a robot's description is no list of requests.
+UPLOAD_REMEDY = (
+    "leave out of the URDF what planning does not read (comments, <gazebo> and <transmission> elements, materials; "
+    "meshes are referenced by file name, never inlined), and give joint_limits without comments; or raise the "
+    "server's TOPTRAJ_MAX_BODY_BYTES"
+)
+
+
+def remedy_for(path: str) -> str:
+    """What to do about a body over the cap sent to ``path``."""
+    return UPLOAD_REMEDY if path.rstrip("/") == "/v1/robots" else REMEDY
 
 
 class BodySizeLimit:
@@ -27,7 +38,7 @@ class BodySizeLimit:
             return
         announced = dict(scope.get("headers") or []).get(b"content-length")
         if announced is not None and announced.isdigit() and int(announced) > self.max_bytes:
-            await self._refuse(send)
+            await self._refuse(send, scope.get("path", ""))
             return
         state = {"received": 0, "too_large": False, "answered": False}
 
@@ -47,17 +58,17 @@ class BodySizeLimit:
                 await send(message)
             elif not state["answered"]:
                 state["answered"] = True
-                await self._refuse(send)
+                await self._refuse(send, scope.get("path", ""))
 
         await self.app(scope, limited_receive, guarded_send)
 
-    async def _refuse(self, send):
+    async def _refuse(self, send, path: str):
         body = json.dumps(
             {
                 "type": "about:blank",
                 "title": "Request body too large",
                 "status": 413,
-                "detail": f"the request body exceeds {self.max_bytes} bytes: {REMEDY}",
+                "detail": f"the request body exceeds {self.max_bytes} bytes: {remedy_for(path)}",
             }
         ).encode()
         await send(

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import email.message
 import json
+import sys
 from collections.abc import Callable, Coroutine
 from typing import Any
 
@@ -87,6 +88,11 @@ class StrictJSONRequest(Request):
                 raise DuplicateKeyRefused(duplicate) from None
             except json.JSONDecodeError as error:
                 raise _unreadable(decode_error(error)) from None
+            except ValueError:  # an integer of more digits than Python converts (4,300)
+                raise _unreadable(
+                    f"a number has more than {sys.get_int_max_str_digits()} digits; a request's numbers (joint values, "
+                    "limits, settings) need a few"
+                ) from None
             except RecursionError:  # never with the depth counted above; kept as the same answer
                 raise _too_deep(nesting_depth(body)) from None
         return self._json

@@ -80,9 +80,11 @@ class PlanningWorkers:
     """
 
     def __init__(
-        self, workers: int, queue: int, leash_s: float = 0.0, connections: Callable[[], int] = lambda: 0, label: str = "planning"
+        self, workers: int, queue: int, leash_s: float = 0.0, connections: Callable[[], int] = lambda: 0, label: str = "planning",
+        retry_after: int = 1,
     ):
         self.workers, self.queue, self.leash_s, self.label = workers, queue, leash_s, label
+        self.retry_after = retry_after  # seconds a full lane's 503 asks to wait (a heavy planning holds its worker for seconds)
         self._connections = connections
         self._executor: ThreadPoolExecutor | None = None
         # Thread primitives, not asyncio ones: a slot is freed by the planning thread itself when
@@ -92,10 +94,11 @@ class PlanningWorkers:
         self._admitted = 0
         self._waiting: deque[_Waiter] = deque()  # first come, first served
 
-    async def run(self, function, budget_s: float, leashed: bool = False, advice: str = ""):
+    async def run(self, function, budget_s: float, leashed: bool = False, advice: str = "", busy_advice: str = ""):
         """``function(deadline)`` in a worker thread; past ``budget_s`` seconds from now (waiting
         for a worker included), cancel its deadline and raise ``BudgetExceeded``, its message
-        ending with ``advice`` (what the caller can do instead, ``toptraj.service.budget_advice``).
+        ending with ``advice`` (what the caller can do instead, ``toptraj.service.budget_advice``);
+        a ``ServiceBusy`` ends with ``busy_advice`` (what else the caller can do than wait).
 
         With ``leashed``, when no other planning runs or waits (``_alone``), ``function`` is
         first tried on the event loop itself under a ``Leash`` of ``leash_s`` (shorter than the
@@ -114,13 +117,19 @@ class PlanningWorkers:
             return await self._run(function, budget_s, leashed)
         except BudgetExceeded as error:
             raise advised(error, advice) from None
+        except ServiceBusy as error:
+            if not busy_advice:
+                raise
+            raise ServiceBusy(f"{error.detail}, or {busy_advice}", error.retry_after) from None
 
     async def _run(self, function, budget_s: float, leashed: bool):
         """``run`` without the advice."""
         with self._lock:
             if self._admitted >= self.workers + self.queue:
                 raise ServiceBusy(
-                    f"all {self.workers} {self.label} workers are busy and {self.queue} requests wait already; retry shortly"
+                    f"all {self.workers} {self.label} workers are busy and {self.queue} requests wait already; retry "
+                    + ("shortly" if self.retry_after <= 1 else f"in {self.retry_after} s"),
+                    self.retry_after,
                 )
             self._admitted += 1
         deadline = Deadline(budget_s)

@@ -67,7 +67,10 @@ async def create_batch(body: BatchCreate, request: Request) -> Response:
     settings = request.app.state.settings
     budget_s = settings.job_budget_s if body.budget_s is None else body.budget_s
     if budget_s > settings.job_max_budget_s:
-        raise RequestRefused(f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= {settings.job_max_budget_s:g}")
+        raise RequestRefused(
+            f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= {settings.job_max_budget_s:g} "
+            "(setting TOPTRAJ_JOB_MAX_BUDGET_S)"
+        )
     runner = request.app.state.jobs
     from starlette.concurrency import run_in_threadpool
 

@@ -52,7 +52,7 @@ async def create_trajectory(
 
     advice = as_job("trajectory", settings.plan_budget_s, settings.job_budget_s, settings.job_max_budget_s)
     if heavy_request(body):  # admitted apart, so that it never holds up the short requests
-        content, media_type = await request.app.state.heavy_planning.run(planned, settings.plan_budget_s, advice=advice)
+        content, media_type = await request.app.state.heavy_planning.run(planned, settings.plan_budget_s, advice=advice, busy_advice=advice)
     else:
         content, media_type = await request.app.state.planning.run(
             planned, settings.plan_budget_s, leashed=worth_a_leash(body), advice=advice
@@ -69,5 +69,8 @@ async def compare_trajectories(
     settings = request.app.state.settings
     lane = request.app.state.heavy_planning if heavy_request(body) else request.app.state.planning
     advice = as_job("compare", settings.plan_budget_s, settings.job_budget_s, settings.job_max_budget_s)
-    content = await lane.run(lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s, advice=advice)
+    content = await lane.run(
+        lambda deadline: encode_json(compare_request(body, deadline)), settings.plan_budget_s, advice=advice,
+        busy_advice=advice if lane is request.app.state.heavy_planning else "",
+    )
     return Response(content, media_type="application/json")

@@ -110,7 +110,9 @@ class BatchCreate(Schema):
         description="The requests, each checked now against its schema (a 422 names the first bad one).",
     )
     budget_s: float | None = Field(
-        default=None, ge=0.1, description="Computing time of the whole batch once it runs, in s (as a job's)."
+        default=None, ge=0.1, description="Computing time of the whole batch once it runs, in s (as a job's). Each request gets at most "
+        "20 s of it (the synchronous budget), within what is left; a request that needs more is planned alone as a job "
+        "(`POST /v1/jobs`), as its 504 says."
     )
 
 

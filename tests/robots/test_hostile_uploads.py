@@ -251,3 +251,17 @@ def test_a_stored_upload_whose_limits_left_their_range_no_longer_loads(tmp_path)
         assert "joint 'elbow_joint': the acceleration limit 1e-300 rad/s^2 from joint_limits.yaml" in raised.value.detail
     finally:
         robots.configure_uploads(previous.data_dir, max_uploads=previous.max_uploads, max_bytes=previous.max_bytes)
+
+
+@pytest.mark.parametrize("levels, refused", [(20, False), (600, True)])
+def test_elements_nested_deeper_than_a_urdf_has_are_refused_saying_so(client, levels, refused):
+    """Pinocchio's parser refused some 500 nested elements with "not a valid URDF model" and no
+    reason; deeper than 32 levels is refused naming the nesting, a few are read as ever."""
+    urdf = (Path(__file__).resolve().parents[1] / "data" / "pendulum_1r.urdf").read_text()
+    urdf = urdf.replace('<link name="base"/>', '<link name="base">' + "<junk>" * levels + "</junk>" * levels + "</link>")
+    answer = client.post("/v1/robots", json={"name": f"nested_{levels}", "urdf": urdf})
+    if not refused:
+        assert answer.status_code == 201, answer.text[:300]
+        return
+    assert answer.status_code == 422, answer.text[:300]
+    assert "nests elements 33 levels deep and more (robot > link > junk > junk)" in answer.json()["detail"], answer.json()["detail"]

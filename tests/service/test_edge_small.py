@@ -64,3 +64,20 @@ def test_the_progress_line_leaves_out_the_time_left_until_there_is_a_rate():
     stream = io.StringIO()
     progress_bar(stream)(0, 5, 0.0)
     assert stream.getvalue() == "\r0/5 requests, 0.0/s   "
+
+
+def test_an_upload_over_the_body_cap_is_told_about_its_urdf_not_waypoints(tmp_path):
+    settings = Settings(preload_robots=False, data_dir=tmp_path, max_body_bytes=1000)
+    with TestClient(create_app(settings)) as small:
+        answer = small.post("/v1/robots", json={"name": "big", "urdf": "<robot>" + " " * 2000 + "</robot>"})
+    assert answer.status_code == 413
+    detail = answer.json()["detail"]
+    assert detail.startswith("the request body exceeds 1000 bytes: leave out of the URDF what planning does not read"), detail
+    assert "waypoints" not in detail and "TOPTRAJ_MAX_BODY_BYTES" in detail
+
+
+def test_a_number_of_thousands_of_digits_is_a_422_saying_so(client):
+    body = '{"robot": "ur5", "path": {"waypoints": [[0, 0, 0, 0, 0, 0], [1, 0, 0, 0, 0, ' + "9" * 5000 + "]]}}"
+    answer = client.post("/v1/trajectories", content=body, headers={"content-type": "application/json"})
+    assert answer.status_code == 422, answer.text[:300]
+    assert answer.json()["detail"].startswith("body: a number has more than 4300 digits")

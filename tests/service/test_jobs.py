@@ -367,6 +367,8 @@ def test_a_finished_job_is_read_after_a_restart_and_running_ones_are_interrupted
         assert after.get(f"/v1/jobs/{done}").json()["result"] == answer
         job = after.get(f"/v1/jobs/{running}").json()
         assert job["status"] == "interrupted" and job["error"]["title"] == "Job interrupted"
+        result = after.get(f"/v1/jobs/{running}/result")  # no answer will ever come: said so, with what to do
+        assert result.status_code == 409 and result.json()["detail"].endswith("has no answer; submit its request again (POST /v1/jobs)")
         # A job still queued when the server stopped runs after the restart.
         assert _wait(after, queued)["status"] == "done"
 
