@@ -122,6 +122,12 @@ class BudgetExceeded(ToptrajError):
     """The computation ran past its time budget (``budget_s``, ``stage`` when known)."""
 
 
+class ShareSpent(BudgetExceeded):
+    """A method's own share of the time budget ran out before it had an answer (the global
+    search's searches): more time may find one, and the budget as a whole may have time left
+    (a comparison goes on with its other methods)."""
+
+
 @contextmanager
 def numerical_breakdown_is_failure(method: str) -> Iterator[None]:
     """Turn a numerical breakdown inside a timing method (an overflow or division by zero in

@@ -56,7 +56,7 @@ def _unique_keys(source: str, text: str) -> str:
     """``text``, once it nests no deeper than a request may and is JSON (``_Unreadable`` saying
     how deep, or where it goes wrong, otherwise) and no object of it gives a key twice
     (``DuplicateKey`` otherwise)."""
-    from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, refused_depth, too_deep
+    from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, NumberTooLong, decode_error, loads, refused_depth, too_deep
 
     if not text.strip():
         raise _Unreadable(f"{source}: {EMPTY_BODY}".replace("the body is", "the request is"))
@@ -69,6 +69,8 @@ def _unique_keys(source: str, text: str) -> str:
         raise
     except json.JSONDecodeError as error:
         raise _Unreadable(f"{source}: {decode_error(error)}") from None
+    except NumberTooLong as error:
+        raise _Unreadable(f"{source}: {error}") from None
     except (ValueError, RecursionError):
         pass
     return text

@@ -11,7 +11,7 @@ import orjson
 
 from toptraj import robots
 from toptraj.planners import Deadline, PlannedTrajectory, plan
-from toptraj.planners.errors import InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, InvalidRequest, OverMemory, ShareSpent, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE
 from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY, MAX_SAMPLES
 from toptraj.planners.plan import check
@@ -181,7 +181,7 @@ def compare_results(request: CompareRequest, deadline: Deadline, dt: float = 1.0
             result = plan_request(method_request(request, method, dt), part)
         except UnknownRobot:
             raise
-        except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits, OverMemory) as error:
+        except (InvalidRequest, InfeasiblePath, TimingFailed, InvalidLimits, OverMemory, ShareSpent) as error:
             results.append(({"method": method, "error": {"status": status_of(error), "title": title_of(error), "detail": detail(error)}}, None))
             continue
         body = trajectory_body(result)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import re
+import sys
 from collections import Counter
 from typing import Any
 
@@ -80,6 +81,16 @@ def decode_error(error: json.JSONDecodeError) -> str:
     return message
 
 
+class NumberTooLong(ValueError):
+    """A JSON text holds an integer of more digits than Python converts (``sys.get_int_max_str_digits``)."""
+
+    def __init__(self) -> None:
+        super().__init__(
+            f"a number has more than {sys.get_int_max_str_digits()} digits; a request's numbers (joint values, limits, "
+            "settings) need a few"
+        )
+
+
 class DuplicateKey(ValueError):
     """An object of a JSON text gives ``key`` ``count`` times; ``where`` is the key's place
     (``timing.zones[0].tool_speed``)."""
@@ -114,6 +125,7 @@ def loads(data: str | bytes, finite: bool = False) -> Any:
     Raises:
         json.JSONDecodeError: ``data`` is no JSON (a ``ValueError``).
         ValueError: with ``finite``, ``data`` holds ``NaN``, ``Infinity`` or ``-Infinity``.
+        NumberTooLong: an integer of more digits than Python converts.
         DuplicateKey: an object gives a key more than once (the first such object to end that
             the parsed value still holds: an object a later repeated key replaced has no place).
         RecursionError: ``data`` nests deeper than the interpreter's recursion limit.
@@ -127,7 +139,14 @@ def loads(data: str | bytes, finite: bool = False) -> Any:
             duplicated.append((value, key, count))
         return value
 
-    value = json.loads(data, object_pairs_hook=pairs, parse_constant=_refuse_constant if finite else None)
+    try:
+        value = json.loads(data, object_pairs_hook=pairs, parse_constant=_refuse_constant if finite else None)
+    except json.JSONDecodeError:
+        raise
+    except ValueError as error:
+        if "digits" in str(error) and "integer" in str(error):  # int("9" * 5000): Python's conversion limit
+            raise NumberTooLong() from None
+        raise
     if duplicated:
         places = _places_of(value, {id(holder) for holder, _, _ in duplicated})
         holder, key, count = next(item for item in duplicated if id(item[0]) in places)

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import email.message
 import json
-import sys
 from collections.abc import Callable, Coroutine
 from typing import Any
 
@@ -21,7 +20,16 @@ from fastapi import Request, Response, params
 from fastapi.routing import APIRoute
 from starlette.exceptions import HTTPException
 
-from toptraj.service.strict_json import EMPTY_BODY, DuplicateKey, decode_error, loads, nesting_depth, refused_depth, too_deep
+from toptraj.service.strict_json import (
+    EMPTY_BODY,
+    DuplicateKey,
+    NumberTooLong,
+    decode_error,
+    loads,
+    nesting_depth,
+    refused_depth,
+    too_deep,
+)
 
 #: The 415's advice.
 SEND_JSON = "send the header Content-Type: application/json (curl: -H 'Content-Type: application/json')"
@@ -88,11 +96,8 @@ class StrictJSONRequest(Request):
                 raise DuplicateKeyRefused(duplicate) from None
             except json.JSONDecodeError as error:
                 raise _unreadable(decode_error(error)) from None
-            except ValueError:  # an integer of more digits than Python converts (4,300)
-                raise _unreadable(
-                    f"a number has more than {sys.get_int_max_str_digits()} digits; a request's numbers (joint values, "
-                    "limits, settings) need a few"
-                ) from None
+            except NumberTooLong as error:
+                raise _unreadable(str(error)) from None
             except RecursionError:  # never with the depth counted above; kept as the same answer
                 raise _too_deep(nesting_depth(body)) from None
         return self._json

@@ -31,7 +31,7 @@ from pathlib import Path
 import orjson
 
 from toptraj.robots.errors import excerpt
-from toptraj.service.strict_json import DuplicateKey, decode_error, loads, refused_depth, too_deep
+from toptraj.service.strict_json import DuplicateKey, NumberTooLong, decode_error, loads, refused_depth, too_deep
 
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000
@@ -84,6 +84,8 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
     except json.JSONDecodeError as error:
         # a line is one line of JSON text: its column is the place
         return refused(422, "Invalid request", decode_error(error).replace("line 1, column", "column", 1)[:_MAX_DETAIL])
+    except NumberTooLong as error:
+        return refused(422, "Invalid request", str(error))
     except ValueError as error:  # NaN or Infinity
         return refused(422, "Invalid request", f"the line is not JSON: {str(error)[:_MAX_DETAIL]}")
     if not isinstance(body, dict):
@@ -156,11 +158,13 @@ def resume_output(path: Path, retry_failed: bool = False, requests_path: Path | 
     (the last one of an interrupted run), a line number's second result dropped, with
     ``retry_failed`` the retryable results dropped, and with ``requests_path`` the results of
     lines whose request changed since (their key is no longer the line's: a request fixed after
-    its 4xx is planned again). What is dropped is written to a new file that replaces the old
+    its 4xx is planned again), unless they are more than half (``ForeignOutput``: the output of
+    another request file, whose results would all be dropped). What is dropped is written to a new file that replaces the old
     one, so an interruption leaves one or the other.
 
     Raises:
-        ForeignOutput: a whole line of ``path`` is no result line; nothing is changed.
+        ForeignOutput: a whole line of ``path`` is no result line, or most of its results are of
+            other requests; nothing is changed.
     """
     if not path.exists():
         return {}
@@ -190,7 +194,7 @@ def resume_output(path: Path, retry_failed: bool = False, requests_path: Path | 
                 kept[number] = (offset, len(raw))
             offset += len(raw)
     if requests_path is not None and done and requests_path.exists():
-        changed = [line.number for line in read_requests(requests_path) if line.number in keys and keys[line.number] != line.key]
+        changed = _changed(path, requests_path, keys)
         for number in changed:
             del done[number], kept[number]
         dropped = dropped or bool(changed)
@@ -208,3 +212,22 @@ def resume_output(path: Path, retry_failed: bool = False, requests_path: Path | 
         os.fsync(target.fileno())
     os.replace(fresh, path)
     return done
+
+
+def _changed(path: Path, requests_path: Path, keys: dict[int, str]) -> list[int]:
+    """The line numbers of ``requests_path`` whose request is no longer the one the result in
+    ``path`` answered (``keys``: each result's key by line number).
+
+    Raises:
+        ForeignOutput: more than half of them (and more than one): ``path`` is the output of
+            another request file.
+    """
+    changed = [line.number for line in read_requests(requests_path) if line.number in keys and keys[line.number] != line.key]
+    if len(changed) > 1 and 2 * len(changed) > len(keys):
+        raise ForeignOutput(
+            f"{excerpt(str(path))}: {len(changed)} of its {len(keys)} results are of other requests than the lines of "
+            f"{excerpt(str(requests_path))} hold now, so it is the output of another request file and is left as it "
+            "is; give another --output, or the request file that made it (lines changed since, fewer than half, are "
+            "planned again)"
+        )
+    return changed

@@ -8,6 +8,8 @@ import os
 from collections import Counter
 from typing import Any
 
+from toptraj.robots.errors import ToptrajError
+
 #: What ``toptraj batch`` needs and how to get it.
 RAY_MISSING = "toptraj batch plans on Ray, which is not installed: pip install 'toptraj[ray]'"
 
@@ -16,17 +18,22 @@ class RayMissing(RuntimeError):
     """Ray (the ``ray`` extra) is not installed."""
 
 
-class RayUnreachable(RuntimeError):
-    """No Ray cluster answers at the address given."""
+class RayUnreachable(ToptrajError):
+    """No Ray cluster answers at the address given (503: the server's ``TOPTRAJ_RAY_ADDRESS``
+    for a batch job; ``toptraj batch`` says it as its own problem)."""
+
+    status = 503
+    title = "Ray cluster unreachable"
 
 
 #: Seconds a cluster's address is given to accept a connection before the batch starts.
 CONNECT_S = 5.0
 
 
-def check_reachable(address: str) -> None:
+def check_reachable(address: str, option: str = "--ray-address") -> None:
     """Refuse at once a ``host:port`` (or ``ray://host:port``) where nothing accepts a
-    connection: Ray itself retries such an address for minutes, deaf to Ctrl-C.
+    connection: Ray itself retries such an address for minutes, deaf to Ctrl-C. ``option``
+    names where the address was given (the CLI's option, or the server's setting).
 
     Raises:
         RayUnreachable: nothing listens there (within ``CONNECT_S``), with how to start one.
@@ -37,19 +44,23 @@ def check_reachable(address: str) -> None:
     host = host.strip("[]")  # an IPv6 address in brackets
     if not host or not port.isdigit():
         raise RayUnreachable(
-            f"--ray-address {address!r} is no cluster address: give host:port of its head (as `ray start --head` "
+            f"{option} {address!r} is no cluster address: give host:port of its head (as `ray start --head` "
             "prints it), ray://host:port for a Ray client server, auto for the cluster started on this machine, or "
-            "leave it out for a local Ray"
+            f"{_local(option)}"
         )
     try:
         socket.create_connection((host, int(port)), timeout=CONNECT_S).close()
     except OSError as error:
         raise RayUnreachable(
-            f"nothing accepts a connection at --ray-address {address} ({error.strerror or error}): start the cluster's "
-            f"head there (ray start --head --port={port}), check the address it printed, or leave --ray-address out "
-            "for a local Ray on this machine"
+            f"nothing accepts a connection at {option} {address} ({error.strerror or error}): start the cluster's "
+            f"head there (ray start --head --port={port}), check the address it printed, or {_local(option)}"
         ) from None
 
+
+
+def _local(option: str) -> str:
+    """How to plan on a local Ray instead, where the address was given as ``option``."""
+    return "leave --ray-address out for a local Ray" if option.startswith("--") else f"set {option}=local for a Ray of the job's own"
 
 
 class RayPool:

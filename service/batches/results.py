@@ -3,7 +3,8 @@
 Identical requests (one key) are computed once: the lines waiting for a key's answer are
 ``pending`` while it is computed, and a line read after that answer was written gets a copy of
 its result line with its own number, read back from the output file (``_first``: where each
-key's first result line lies, a few dozen bytes per key), so that no answer is held in memory.
+planned request's first result line lies, about 200 bytes per distinct request), so that no
+answer is held in memory.
 """
 
 from __future__ import annotations
@@ -25,18 +26,21 @@ class ResultWriter:
         self.pending: dict[str, list[int]] = {}  # key -> the line numbers waiting for its answer
         self._first: dict[str, tuple[int, int, int, int]] = {}  # key -> (offset, length, line, status) of its first result
         self.written = 0
+        out.flush()
+        self._end = os.fstat(out.fileno()).st_size  # where the next line goes (the file is only appended to)
 
     def answered(self, key: str) -> bool:
         """Whether a result of ``key`` is in the file (a later line of it is copied from it)."""
         return key in self._first
 
-    def write(self, number: int, key: str, status: int, body: bytes) -> None:
-        """Line ``number``'s result line."""
+    def write(self, number: int, key: str, status: int, body: bytes, shared: bool = True) -> None:
+        """Line ``number``'s result line; ``shared``: a later line of the same request may be
+        copied from it (a line refused at reading is not planned, and not remembered)."""
         line = result_line(number, key, status, body)
-        if key not in self._first:
-            self.out.flush()
-            self._first[key] = (os.fstat(self.out.fileno()).st_size, len(line), number, status)
+        if shared and key not in self._first:
+            self._first[key] = (self._end, len(line), number, status)
         self.out.write(line)
+        self._end += len(line)
         self.written += 1
 
     def answers(self, answers: list[tuple[str, int, bytes]]) -> int:

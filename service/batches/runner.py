@@ -12,7 +12,8 @@ URDF texts of the uploaded robots the batch names (a catalog robot is built by e
 its own installation). What stays with the driver: the output file, the upload store, the
 progress.
 
-Resuming: the lines already answered in the output file are skipped by line number; with
+Resuming: the lines already answered in the output file are skipped by line number, but for
+those whose request changed since (planned again in place of their result); with
 ``retry_failed``, those answered with a budget error (504) or another 5xx are planned again
 (``lines.resume_output``). Stopping (``stop`` set, as ``toptraj batch`` does on Ctrl-C): no task
 is submitted any more, the result lines of the tasks already finished are written, the others
@@ -44,8 +45,8 @@ CHUNK = 4
 BUDGET_S = 20.0
 #: Largest planning budget of one request, in s.
 MAX_BUDGET_S = 3600.0
-#: Time a task may take beyond its requests' budgets (a worker process starting and importing
-#: the planning stack), in s; past it the task is killed and its requests are 504 lines.
+#: Time a task may take beyond its requests' budgets (a solver step that cannot check its
+#: deadline), in s; past it the task is killed and its requests are 504 lines.
 TASK_SLACK_S = 10.0
 #: Time a task may take beyond that while no task of the run has answered yet, in s: Ray's
 #: workers starting (a process each, importing the planning stack and preparing: ten seconds
@@ -116,17 +117,20 @@ def _failed(chunk: list[tuple[str, str]], error: BaseException) -> list[tuple[st
     return [(key, 500, problem_body(500, "Worker failed", detail)) for key, _ in chunk]
 
 
-def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, results: ResultWriter, warm: bool = True) -> int:
+def _kill_overdue(runner, running: dict, started_at: dict, budget_s: float, results: ResultWriter, warm_at: float | None = 0.0) -> int:
     """Kill the tasks that ran past their requests' budgets plus ``TASK_SLACK_S`` (a solver
-    step that cannot check its deadline), and ``STARTUP_S`` more until a task has answered
-    (not ``warm``: the workers may still be starting), and write their requests as 504 lines;
+    step that cannot check its deadline), and ``STARTUP_S`` more for a task started before
+    ``warm_at`` (when a task first answered since the run began or a worker was killed; ``None``:
+    not yet): its worker may have been starting. Write their requests as 504 lines;
     how many lines were written. A task counts as started once it is among the
     ``runner.cpus`` oldest still running (Ray starts tasks in the order submitted, one per CPU)."""
     now = time.monotonic()
     for handle in list(running)[: runner.cpus]:
         started_at.setdefault(handle, now)
-    slack = TASK_SLACK_S if warm else TASK_SLACK_S + STARTUP_S  # warm: a task of the run has answered
-    overdue = [h for h, since in started_at.items() if now > since + len(running[h]) * budget_s + slack]
+    def slack(since: float) -> float:
+        return TASK_SLACK_S + (STARTUP_S if warm_at is None or since < warm_at else 0.0)
+
+    overdue = [h for h, since in started_at.items() if now > since + len(running[h]) * budget_s + slack(since)]
     if not overdue:
         return 0
     runner.cancel(overdue)
@@ -243,12 +247,15 @@ def _plan_lines(
                     continue  # cancelled by the stop: resumed later
                 answers = _failed(done, error)
             results.answers([(key, status, advised_line(status, body, advice)) for key, status, body in answers])
-        flight.warm = flight.warm or bool(ready)
-        overdue = _kill_overdue(runner, running, flight.started_at, budget_s, results, flight.warm)
+        overdue = _kill_overdue(runner, running, flight.started_at, budget_s, results, flight.warm_at)
+        if overdue:  # their workers were killed: the tasks after them may wait for new ones
+            flight.warm_at = None
+        elif ready and flight.warm_at is None:  # the tasks started so far began while workers started
+            flight.warm_at = time.monotonic()
         if ready or overdue:
             report(results.written)
     if flight.running:
-        _collect_finished(flight.runner, flight.running, results)
+        _collect_finished(flight.runner, flight.running, results, advice)
     results.out.flush()
     return bool(flight.running) or not flight.exhausted or bool(flight.chunk)
 
@@ -265,7 +272,7 @@ class _Flight:
         self.chunk: list[tuple[str, str]] = []
         self.uploads: dict[str, tuple[str, str]] = {}
         self.exhausted = False
-        self.warm = False  # a task has answered: the workers are up
+        self.warm_at: float | None = None  # when a task first answered since the start or the last kill
 
     def read(self, lines: Iterator[RequestLine], results: ResultWriter, stop: threading.Event) -> bool:
         """Read lines until ``2 * cpus + 1`` tasks are in flight or the file ends: a line refused
@@ -276,7 +283,7 @@ class _Flight:
             if line is None:
                 self.exhausted = True
             elif line.problem is not None:
-                results.write(line.number, line.key, *line.problem)
+                results.write(line.number, line.key, *line.problem, shared=False)
             elif line.key in results.pending:
                 results.pending[line.key].append(line.number)
             elif results.answered(line.key):
@@ -302,13 +309,13 @@ class _Flight:
         self.chunk = []
 
 
-def _collect_finished(runner, running: dict, results: ResultWriter) -> None:
-    """On a stop: the answers of the tasks already finished written, the others cancelled (they
-    are resumed later)."""
+def _collect_finished(runner, running: dict, results: ResultWriter, advice: str) -> None:
+    """On a stop: the answers of the tasks already finished written (a 504 ending with
+    ``advice``), the others cancelled (they are resumed later)."""
     ready, rest = runner.wait(list(running), 0) if running else ([], [])
     for handle in ready:
         try:
-            results.answers(runner.result(handle))
+            results.answers([(key, status, advised_line(status, body, advice)) for key, status, body in runner.result(handle)])
         except Exception:  # noqa: S112 - cancelled or failed: resumed later
             continue
     runner.cancel(rest)

@@ -27,7 +27,7 @@ import uuid
 from dataclasses import dataclass, field
 
 from toptraj.planners import Deadline
-from toptraj.planners.errors import BudgetExceeded
+from toptraj.planners.errors import BudgetExceeded, ShareSpent
 from toptraj.planners.execution.isolated import run_isolated
 from toptraj.robots.errors import ToptrajError
 from toptraj.service.budget_advice import larger_job_budget
@@ -319,10 +319,12 @@ class JobRunner:
             result = run_isolated(
                 self.compute, job.kind, job.request, job.budget_s, self.setup, entry.ends_at, deadline=entry.deadline, progress=True
             )
-        except BudgetExceeded:
+        except BudgetExceeded as error:
             if entry.stopped:
                 return None
             advice = larger_job_budget(job.budget_s, self.setup.job_max_budget_s)
+            if isinstance(error, ShareSpent):  # a method's share of the budget, not the whole of it
+                return "failed", None, problem_of(ShareSpent(f"{error.detail}; {advice}"))
             return "failed", None, problem_of(BudgetExceeded(f"the job exceeded its time budget of {job.budget_s:g} s; {advice}"))
         except Exception as error:
             if entry.stopped:  # its process killed, or its fork server gone: not its failure

@@ -125,10 +125,13 @@ def _here(texts: list[str], deadline: Deadline, room: AnswerRoom, setup: WorkerS
 def _on_ray(texts: list[str], setup: WorkerSetup, deadline: Deadline, room: AnswerRoom) -> list[tuple[int, bytes]]:
     import ray
 
+    from toptraj.service.batches.ray_pool import check_reachable
     from toptraj.service.batches.runner import _uploads_named
     from toptraj.service.batches.work import answer_on_worker
 
     if not ray.is_initialized():
+        if setup.ray_address not in ("local", "auto"):
+            check_reachable(str(setup.ray_address), "TOPTRAJ_RAY_ADDRESS")  # Ray would retry it for minutes, the job's whole budget
         ray.init(address=None if setup.ray_address == "local" else setup.ray_address, log_to_driver=False, configure_logging=False)
     remote = ray.remote(num_cpus=1, scheduling_strategy="SPREAD")(answer_on_worker)
     uploads = ray.put(_uploads_named(texts))

@@ -243,7 +243,8 @@ def get_job_result(job_id: str, request: Request) -> Response:
     if job.status == "failed" and job.error is not None:
         return Response(orjson.dumps(job.error), status_code=int(job.error.get("status", 500)), media_type=PROBLEM_JSON)
     if job.status in ("cancelled", "interrupted"):  # no answer will come: it ended without one
-        raise JobNotDone(f"job {job_id} was {job.status} and has no answer; submit its request again (POST /v1/jobs)")
+        route = "POST /v1/batches" if job.kind == "batch" else "POST /v1/jobs"
+        raise JobNotDone(f"job {job_id} was {job.status} and has no answer; submit its request again ({route})")
     raise JobNotDone(f"job {job_id} is {job.status}; GET /v1/jobs/{job_id} shows its progress")
 
 

@@ -120,6 +120,7 @@ def _hostile_file(path: Path, monkeypatch) -> dict[int, int]:
         (b'{"robot": "\\ud800"}', 422),  # a lone surrogate: JSON text, but no Unicode
         (b'{"robot": "ur5", "grid": 123456789012345678901234567890}', 422),  # an integer beyond 64 bits
         (json.dumps(OTHER).encode(), 200),  # and the lines after them are planned
+        (b'{"robot": "ur5", "grid": ' + b"9" * 5000 + b"}", 422),  # more digits than Python converts
     ]
     path.write_bytes(b"\n".join(raw for raw, _ in lines) + b"\n")
     return {number: status for number, (_, status) in enumerate(lines, start=1)}
@@ -145,6 +146,7 @@ def test_every_line_gets_exactly_one_result_line_with_its_number(tmp_path, monke
     assert "JSON string" in rows[9]["body"]["detail"] and "JSON null" in rows[10]["body"]["detail"]
     assert "UTF-8" in rows[12]["body"]["detail"]
     assert "no lone" in rows[21]["body"]["detail"] and "64 bits" in rows[22]["body"]["detail"]
+    assert rows[24]["body"]["detail"] == "line 24: a number has more than 4300 digits; a request's numbers (joint values, limits, settings) need a few"
     assert all(row["body"]["status"] == row["status"] for row in rows.values() if row["status"] != 200)
     assert all(len(row["body"].get("detail", "")) < 1000 for row in rows.values())
     # a second run has nothing left to do
@@ -239,6 +241,7 @@ class HangingPool(InProcessPool):
 def test_a_task_past_its_budget_is_killed_and_its_lines_are_504s(tmp_path, monkeypatch):
     monkeypatch.setattr(runner, "CHUNK", 1)
     monkeypatch.setattr(runner, "TASK_SLACK_S", 0.5)
+    monkeypatch.setattr(runner, "STARTUP_S", 0.0)  # the workers' start is another test's
     requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
     requests.write_text(json.dumps(OTHER) + "\n" + json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n")
     pool = HangingPool()
@@ -441,3 +444,50 @@ def test_a_run_s_first_tasks_get_time_for_the_workers_to_start(tmp_path, monkeyp
     requests.write_text(json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n")
     run_batch(requests, output, budget_s=0.2, pool=Slow)
     assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 200, 2: 200}
+
+
+def test_a_batch_job_on_a_cluster_address_where_nothing_listens_fails_at_once(tmp_path):
+    """The server's TOPTRAJ_RAY_ADDRESS is tried first: a 503 naming it within seconds, not a
+    job spending its whole budget on Ray's retries."""
+    pytest.importorskip("ray")
+    import ray
+
+    from toptraj.service.batches.ray_pool import RayUnreachable
+    from toptraj.service.problems import status_of
+
+    if ray.is_initialized():
+        pytest.skip("a Ray of this process is running")
+    setup = WorkerSetup(str(tmp_path), 10, 1_000_000, 4, 50_000_000, ray_address="127.0.0.1:1")
+    started = time.monotonic()
+    with pytest.raises(RayUnreachable) as refused:
+        _batch(orjson.dumps({"requests": [GOOD]}).decode(), Deadline(60.0), setup)
+    assert time.monotonic() - started < 30.0 and status_of(refused.value) == 503
+    assert "nothing accepts a connection at TOPTRAJ_RAY_ADDRESS 127.0.0.1:1" in refused.value.detail
+    assert refused.value.detail.endswith("set TOPTRAJ_RAY_ADDRESS=local for a Ray of the job's own")
+
+
+def test_a_first_task_that_hangs_is_still_killed_after_the_workers_start_allowance(tmp_path, monkeypatch):
+    """The start allowance is bounded: a task of the first wave that never answers is killed
+    at its lines' budgets plus the slack plus ``STARTUP_S``, and its lines are 504s."""
+    monkeypatch.setattr(runner, "CHUNK", 1)
+    monkeypatch.setattr(runner, "TASK_SLACK_S", 0.2)
+    monkeypatch.setattr(runner, "STARTUP_S", 0.8)
+    requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
+    requests.write_text(json.dumps(OTHER) + "\n" + json.dumps(GOOD) + "\n")
+    started = time.monotonic()
+    run_batch(requests, output, budget_s=0.2, pool=HangingPool)
+    assert 0.2 + 0.2 + 0.8 <= time.monotonic() - started < 0.2 + 0.2 + 0.8 + 1.0
+    assert {n: row["status"] for n, row in _by_line(output).items()} == {1: 504, 2: 200}
+
+
+def test_an_output_of_another_request_file_is_left_as_it_is(tmp_path):
+    """Most results of other requests than the lines hold: the output of another file given by
+    mistake, refused whole (planning its lines again would have dropped every result)."""
+    first, second, output = tmp_path / "a.jsonl", tmp_path / "b.jsonl", tmp_path / "out.jsonl"
+    first.write_text(json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n" + json.dumps({**GOOD, "output": {"dt": 0.02}}) + "\n")
+    second.write_text("".join(json.dumps({**OTHER, "output": {"dt": 0.01 + 0.001 * k}}) + "\n" for k in range(3)))
+    run_batch(first, output, pool=InProcessPool)
+    kept = output.read_bytes()
+    with pytest.raises(lines_.ForeignOutput, match="3 of its 3 results are of other requests"):
+        run_batch(second, output, pool=InProcessPool)
+    assert output.read_bytes() == kept

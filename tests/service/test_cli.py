@@ -39,6 +39,9 @@ def test_plan_reports_bad_input_on_stderr(tmp_path, capsys):
     request.write_text('{"robot": "ur5", "path": {"waypoints": [[0, 0]]}}')
     assert main(["plan", str(request)]) == 1
     assert json.loads(capsys.readouterr().err)["status"] == 422
+    request.write_text('{"robot": "ur5", "grid_points": ' + "9" * 5000 + "}")  # JSON, but no number Python reads
+    assert main(["plan", str(request)]) == 2
+    assert json.loads(capsys.readouterr().err)["detail"].endswith("a number has more than 4300 digits; a request's numbers (joint values, limits, settings) need a few")
 
 
 def test_plan_reports_where_and_which_limit_as_the_http_problem_does(tmp_path, capsys, client):

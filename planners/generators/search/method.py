@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from toptraj.planners.collision import Obstacle
-from toptraj.planners.errors import BudgetExceeded
+from toptraj.planners.errors import ShareSpent
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.search.branch_and_bound import branch_and_bound
 from toptraj.planners.generators.search.graph import DEFAULT_OPTIONS, LATTICE_MAX_JOINTS, SearchOptions
@@ -94,8 +94,8 @@ def global_search(
     Raises:
         InvalidRequest, InfeasiblePath: see ``build_problem`` and ``branch_and_bound`` (the
             latter when no variant has a grid path).
-        BudgetExceeded: ``deadline`` passed, or the searches' share of it ended before any
-            found a grid path (more time may find one).
+        BudgetExceeded: ``deadline`` passed; ``ShareSpent``, the searches' share of it ended
+            before they found a grid path toward some goal variant (more time may find one).
     """
     options = options or DEFAULT_OPTIONS
     if options.lazy is None:  # lazily on a roadmap
@@ -131,9 +131,9 @@ def _lazily_searched(problem: SearchProblem, options: SearchOptions, deadline: D
     checked = int(problem.checked.sum())
     if not results:
         failures[0].statistics.spans_checked, failures[0].statistics.searches = checked, attempt + 1
-        if all(getattr(failure, "stopped", "") == "time" for failure in failures):  # more time may find one: a 504
+        if any(getattr(failure, "stopped", "") == "time" for failure in failures):  # more time may find one: a 504
             expanded = sum(failure.statistics.expanded for failure in failures)
-            raise BudgetExceeded(
+            raise ShareSpent(
                 f"the search found no grid path within its share of the time budget ({expanded} partial paths expanded)",
                 stage="search: branch and bound",
             ) from failures[0]

@@ -234,3 +234,27 @@ def test_a_search_ended_by_max_expansions_is_a_422_naming_it():
     assert response.status_code == 422, response.text[:300]
     assert "no grid path within its max_expansions" in response.json()["detail"]
     assert "raise timing.search.max_expansions" in response.json()["detail"]
+
+
+def test_a_comparison_answers_a_search_out_of_its_share_in_the_search_s_entry(monkeypatch):
+    """A search whose share of the time ran out is a 504 of its own (``ShareSpent``); in a
+    comparison it is the search's entry, the other methods answered (it failed the whole
+    comparison as a 504 without any entry)."""
+    import toptraj.service.planning as planning
+    from toptraj.planners.errors import ShareSpent
+    from toptraj.service.schemas.trajectories import CompareRequest
+
+    planned = planning.plan_request
+
+    def plan(request, *args, **kwargs):
+        if request.timing.method == "search":
+            raise ShareSpent("the search found no grid path within its share of the time budget (12 partial paths expanded)")
+        return planned(request, *args, **kwargs)
+
+    monkeypatch.setattr(planning, "plan_request", plan)
+    body = {"robot": "ur5", "path": {"kind": "free", "start": UR5_START, "goal": UR5_GOAL}, "methods": ["collocation", "search"],
+            "timing": {"constraints": ["velocity", "acceleration"]}}
+    results = planning.compare_request(CompareRequest.model_validate(body), Deadline(120.0))["results"]
+    assert results[1]["method"] == "search" and results[1]["error"]["status"] == 504, results[1]
+    assert "share of the time budget" in results[1]["error"]["detail"]
+    assert results[0]["method"] == "collocation" and results[0]["duration"] > 0
