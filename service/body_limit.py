@@ -20,9 +20,21 @@ UPLOAD_REMEDY = (
 )
 
 
+#: ... sent to a cell, or for a skeleton.
+CELL_REMEDY = "give each arm fewer waypoints (its path is a spline through them); or raise the server's TOPTRAJ_MAX_BODY_BYTES"
+SKELETON_REMEDY = "send fewer configurations in q, in several requests; or raise the server's TOPTRAJ_MAX_BODY_BYTES"
+
+
 def remedy_for(path: str) -> str:
     """What to do about a body over the cap sent to ``path``."""
-    return UPLOAD_REMEDY if path.rstrip("/") == "/v1/robots" else REMEDY
+    path = path.rstrip("/")
+    if path == "/v1/robots":
+        return UPLOAD_REMEDY
+    if path == "/v1/cells":
+        return CELL_REMEDY
+    if path.startswith("/v1/robots/") and path.endswith("/skeleton"):
+        return SKELETON_REMEDY
+    return REMEDY
 
 
 class BodySizeLimit:

@@ -9,6 +9,7 @@ duplicate is looked for only when there is one, by a walk without recursion."""
 from __future__ import annotations
 
 import json
+import math
 import re
 import sys
 from collections import Counter
@@ -91,6 +92,22 @@ class NumberTooLong(ValueError):
         )
 
 
+class NumberOutOfRange(ValueError):
+    """A JSON text holds a number beyond a double's range (``1e400``), which would be read as an
+    infinity."""
+
+    def __init__(self, text: str) -> None:
+        shown = text if len(text) <= 24 else f"{text[:24]}..."
+        super().__init__(f"the number {shown} is beyond the range of a double (about ±1.8e308); give a finite number")
+
+
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise NumberOutOfRange(text)
+    return value
+
+
 class DuplicateKey(ValueError):
     """An object of a JSON text gives ``key`` ``count`` times; ``where`` is the key's place
     (``timing.zones[0].tool_speed``)."""
@@ -126,6 +143,7 @@ def loads(data: str | bytes, finite: bool = False) -> Any:
         json.JSONDecodeError: ``data`` is no JSON (a ``ValueError``).
         ValueError: with ``finite``, ``data`` holds ``NaN``, ``Infinity`` or ``-Infinity``.
         NumberTooLong: an integer of more digits than Python converts.
+        NumberOutOfRange: with ``finite``, a number beyond a double's range (``1e400``).
         DuplicateKey: an object gives a key more than once (the first such object to end that
             the parsed value still holds: an object a later repeated key replaced has no place).
         RecursionError: ``data`` nests deeper than the interpreter's recursion limit.
@@ -140,8 +158,10 @@ def loads(data: str | bytes, finite: bool = False) -> Any:
         return value
 
     try:
-        value = json.loads(data, object_pairs_hook=pairs, parse_constant=_refuse_constant if finite else None)
-    except json.JSONDecodeError:
+        value = json.loads(
+            data, object_pairs_hook=pairs, parse_constant=_refuse_constant if finite else None, parse_float=_finite_float if finite else None
+        )
+    except (json.JSONDecodeError, NumberOutOfRange):
         raise
     except ValueError as error:
         if "digits" in str(error) and "integer" in str(error):  # int("9" * 5000): Python's conversion limit

@@ -75,7 +75,7 @@ def admit_samples(problem: Problem, duration: float) -> None:
     """
     dt, asked = problem.sampling.dt, problem.requested
     max_samples = memory.most_samples(problem.sampling.max_samples, problem.robot.dof)
-    if duration / dt <= max_samples - 2:
+    if math.ceil(duration / dt) + 1 <= max_samples:  # every dt from 0, and the final instant
         return
     needed = _round_up(duration / max(max_samples - 2, 1))
     raise TooLarge(

@@ -31,7 +31,15 @@ from pathlib import Path
 import orjson
 
 from toptraj.robots.errors import excerpt
-from toptraj.service.strict_json import DuplicateKey, NumberTooLong, decode_error, loads, refused_depth, too_deep
+from toptraj.service.strict_json import (
+    DuplicateKey,
+    NumberOutOfRange,
+    NumberTooLong,
+    decode_error,
+    loads,
+    refused_depth,
+    too_deep,
+)
 
 #: Longest request line read, in bytes (the HTTP API's default body cap).
 MAX_LINE_BYTES = 2_000_000
@@ -84,7 +92,7 @@ def parse_line(number: int, raw: bytes) -> RequestLine:
     except json.JSONDecodeError as error:
         # a line is one line of JSON text: its column is the place
         return refused(422, "Invalid request", decode_error(error).replace("line 1, column", "column", 1)[:_MAX_DETAIL])
-    except NumberTooLong as error:
+    except (NumberTooLong, NumberOutOfRange) as error:
         return refused(422, "Invalid request", str(error))
     except ValueError as error:  # NaN or Infinity
         return refused(422, "Invalid request", f"the line is not JSON: {str(error)[:_MAX_DETAIL]}")

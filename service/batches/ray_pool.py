@@ -85,6 +85,8 @@ class RayPool:
 
         self._ray = ray
         self._started_here = False
+        if address is None and os.environ.get("RAY_ADDRESS"):  # Ray's own variable names the cluster
+            address = os.environ["RAY_ADDRESS"]
         self.nodes: Counter[str] = Counter()
         if not ray.is_initialized():
             hook = {"worker_process_setup_hook": SETUP_HOOK}
@@ -103,9 +105,10 @@ class RayPool:
                     check_reachable(address)
                 try:
                     ray.init(address=address, log_to_driver=False, configure_logging=False, runtime_env=hook)
-                except ConnectionError as error:  # "auto" without a cluster on this machine
+                except ConnectionError as error:  # no cluster there ("auto": none on this machine)
+                    where = "runs on this machine" if address == "auto" else "answers"
                     raise RayUnreachable(
-                        f"no Ray cluster runs on this machine for --ray-address {address} ({str(error)[:200]}): start "
+                        f"no Ray cluster {where} for --ray-address {address} ({str(error)[:200]}): start "
                         "one (ray start --head), give a cluster's head as --ray-address host:port, or leave "
                         "--ray-address out for a local Ray"
                     ) from None

@@ -121,6 +121,8 @@ def _hostile_file(path: Path, monkeypatch) -> dict[int, int]:
         (b'{"robot": "ur5", "grid": 123456789012345678901234567890}', 422),  # an integer beyond 64 bits
         (json.dumps(OTHER).encode(), 200),  # and the lines after them are planned
         (b'{"robot": "ur5", "grid": ' + b"9" * 5000 + b"}", 422),  # more digits than Python converts
+        (json.dumps({**GOOD, "payload": None}).encode(), 200),
+        (b'{"robot": "ur5", "path": {"waypoints": [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [0.4, 0.3, -0.2, 0.1, 0.2, 0.3]]}, "payload": 1e400}', 422),
     ]
     path.write_bytes(b"\n".join(raw for raw, _ in lines) + b"\n")
     return {number: status for number, (_, status) in enumerate(lines, start=1)}
@@ -137,7 +139,7 @@ def test_every_line_gets_exactly_one_result_line_with_its_number(tmp_path, monke
     # identical requests (whatever their formatting) are computed once, each line written
     assert rows[1]["key"] == rows[11]["key"] == rows[17]["key"] == request_key(json.dumps(GOOD))
     assert rows[1]["body"] == rows[11]["body"] == rows[17]["body"] and rows[1]["body"]["duration"] > 0
-    assert sorted(pool.keys) == sorted({rows[n]["key"] for n in (1, 13, 14, 16, 20)}) and pool.closed
+    assert sorted(pool.keys) == sorted({rows[n]["key"] for n in (1, 13, 14, 16, 20, 25)}) and pool.closed
     assert rows[23]["key"] == rows[16]["key"] and rows[23]["body"] == rows[16]["body"]
     # each refusal says what and where
     assert rows[3]["body"]["title"] == "Too deeply nested" and "line 3" in rows[3]["body"]["detail"]
@@ -147,6 +149,8 @@ def test_every_line_gets_exactly_one_result_line_with_its_number(tmp_path, monke
     assert "UTF-8" in rows[12]["body"]["detail"]
     assert "no lone" in rows[21]["body"]["detail"] and "64 bits" in rows[22]["body"]["detail"]
     assert rows[24]["body"]["detail"] == "line 24: a number has more than 4300 digits; a request's numbers (joint values, limits, settings) need a few"
+    # a number beyond a double's range is no infinity (which would read as null, one key with line 25's)
+    assert rows[26]["body"]["detail"].startswith("line 26: the number 1e400 is beyond the range of a double") and rows[25]["key"] != rows[26]["key"]
     assert all(row["body"]["status"] == row["status"] for row in rows.values() if row["status"] != 200)
     assert all(len(row["body"].get("detail", "")) < 1000 for row in rows.values())
     # a second run has nothing left to do
@@ -491,3 +495,18 @@ def test_an_output_of_another_request_file_is_left_as_it_is(tmp_path):
     with pytest.raises(lines_.ForeignOutput, match="3 of its 3 results are of other requests"):
         run_batch(second, output, pool=InProcessPool)
     assert output.read_bytes() == kept
+
+
+def test_ray_s_own_address_variable_names_the_cluster(tmp_path, capsys, monkeypatch):
+    """RAY_ADDRESS set and no --ray-address: that cluster, tried as --ray-address is (a local Ray
+    started with it set crashed with a traceback)."""
+    pytest.importorskip("ray")
+    import ray
+
+    if ray.is_initialized():
+        pytest.skip("a Ray of this process is running")
+    monkeypatch.setenv("RAY_ADDRESS", "127.0.0.1:1")
+    (tmp_path / "in.jsonl").write_text(json.dumps(GOOD) + "\n")
+    assert main(["batch", str(tmp_path / "in.jsonl"), "-o", str(tmp_path / "out.jsonl")]) == 2
+    problem = json.loads(capsys.readouterr().err.strip().splitlines()[-1])
+    assert problem["title"] == "Ray cluster unreachable" and "127.0.0.1:1" in problem["detail"], problem

@@ -81,3 +81,13 @@ def test_a_number_of_thousands_of_digits_is_a_422_saying_so(client):
     answer = client.post("/v1/trajectories", content=body, headers={"content-type": "application/json"})
     assert answer.status_code == 422, answer.text[:300]
     assert answer.json()["detail"].startswith("body: a number has more than 4300 digits")
+
+
+def test_a_cell_or_a_skeleton_over_the_body_cap_is_advised_what_it_holds(tmp_path):
+    settings = Settings(preload_robots=False, data_dir=tmp_path, max_body_bytes=1000)
+    with TestClient(create_app(settings)) as small:
+        cell = small.post("/v1/cells", content=b"{" + b" " * 2000 + b"}", headers={"content-type": "application/json"})
+        skeleton = small.post("/v1/robots/ur5/skeleton", content=b"{" + b" " * 2000 + b"}", headers={"content-type": "application/json"})
+    assert cell.status_code == skeleton.status_code == 413
+    assert "give each arm fewer waypoints" in cell.json()["detail"] and "batch" not in cell.json()["detail"]
+    assert "send fewer configurations in q" in skeleton.json()["detail"] and "waypoints" not in skeleton.json()["detail"]

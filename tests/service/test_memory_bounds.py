@@ -118,3 +118,22 @@ def test_an_app_started_again_keeps_planning_and_loses_no_worker():
             assert outer.post("/v1/trajectories", json=short).status_code == 200
     after_stop = TestClient(app)  # no lifespan at all
     assert [after_stop.post("/v1/trajectories", json=short).status_code for _ in range(3)] == [200] * 3
+
+
+def test_a_period_giving_exactly_the_most_samples_served_is_served(tmp_path):
+    """The refusal counts the samples as the sampling makes them (every dt from 0, and the
+    final instant: ceil(T / dt) + 1); a period whose count is the most served was refused while
+    the message said it gave that many ("gives 1952 samples ... at most 1952 are served")."""
+    from fastapi.testclient import TestClient
+
+    settings = Settings(preload_robots=False, data_dir=tmp_path, max_response_bytes=1_000_000)
+    body = {"robot": "ur5", "path": {"waypoints": UR5_WAYPOINTS}, "output": {"dt": 0.00001}}
+    with TestClient(create_app(settings)) as client:
+        refused = client.post("/v1/trajectories", json=body)
+        assert refused.status_code == 422, refused.text[:300]
+        most = int(re.search(r"at most (\d+) are served", refused.json()["detail"]).group(1))
+        duration = client.post("/v1/trajectories", json={**body, "output": {"dt": 0.01}}).json()["duration"]
+        dt = duration / (most - 1.5)  # ceil(T / dt) + 1 = most
+        served = client.post("/v1/trajectories", json={**body, "output": {"dt": dt}})
+        assert served.status_code == 200, served.text[:300]
+        assert len(served.json()["samples"]["t"]) == most
