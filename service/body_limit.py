@@ -20,7 +20,7 @@ UPLOAD_REMEDY = (
 )
 
 
-#: ... sent to a cell, or for a skeleton.
+#: What to do about a cell over the cap, and about a skeleton's configurations over it.
 CELL_REMEDY = "give each arm fewer waypoints (its path is a spline through them); or raise the server's TOPTRAJ_MAX_BODY_BYTES"
 SKELETON_REMEDY = "send fewer configurations in q, in several requests; or raise the server's TOPTRAJ_MAX_BODY_BYTES"
 
