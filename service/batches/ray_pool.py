@@ -36,7 +36,8 @@ def check_reachable(address: str, option: str = "--ray-address") -> None:
     names where the address was given (the CLI's option, or the server's setting).
 
     Raises:
-        RayUnreachable: nothing listens there (within ``CONNECT_S``), with how to start one.
+        RayUnreachable: nothing listens there (within ``CONNECT_S``), or a server that is no
+            Ray head (``_answers_http2``), with how to start one.
     """
     import socket
 
@@ -49,12 +50,45 @@ def check_reachable(address: str, option: str = "--ray-address") -> None:
             f"{_local(option)}"
         )
     try:
-        socket.create_connection((host, int(port)), timeout=CONNECT_S).close()
+        with socket.create_connection((host, int(port)), timeout=CONNECT_S) as connection:
+            speaks_grpc = _answers_http2(connection)
     except OSError as error:
         raise RayUnreachable(
             f"nothing accepts a connection at {option} {address} ({error.strerror or error}): start the cluster's "
             f"head there (ray start --head --port={port}), check the address it printed, or {_local(option)}"
         ) from None
+    if not speaks_grpc:
+        raise RayUnreachable(
+            f"{option} {address} is no Ray cluster: a server answers there, but not as Ray's head does (gRPC); "
+            "give the address `ray start --head` printed (its GCS port, 6379 by default), ray://host:10001 for "
+            f"a Ray client server, or {_local(option)}"
+        )
+
+
+#: The client's opening of an HTTP/2 connection (RFC 9113, section 3.4): the preface and an
+#: empty SETTINGS frame. A gRPC server (a Ray head's GCS, a Ray client server) answers with its
+#: own SETTINGS frame (type 0x4); another server (HTTP/1, SSH, a database) with something else,
+#: or nothing until it closes.
+_HTTP2_PREFACE = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + bytes([0, 0, 0, 4, 0, 0, 0, 0, 0])
+
+
+def _answers_http2(connection) -> bool:
+    """Whether the server on ``connection`` opens HTTP/2 as a gRPC server does, within
+    ``CONNECT_S``; ``True`` under ``RAY_USE_TLS`` (its gRPC is then behind TLS, which this
+    plain probe cannot open). Ray itself would retry any other server for minutes."""
+    if os.environ.get("RAY_USE_TLS", "0").lower() in ("1", "true"):
+        return True
+    connection.sendall(_HTTP2_PREFACE)
+    head = b""
+    try:
+        while len(head) < 9:
+            chunk = connection.recv(9 - len(head))
+            if not chunk:
+                break
+            head += chunk
+    except TimeoutError:
+        return False
+    return len(head) == 9 and head[3] == 4
 
 
 

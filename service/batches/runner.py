@@ -22,6 +22,7 @@ are cancelled (their workers killed), and a Ray started here is shut down with i
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import threading
 import time
@@ -192,7 +193,7 @@ def run_batch(
         if progress:
             progress(written, total - skipped, time.perf_counter() - started)
 
-    with open(output_path, "ab") as out:
+    with _no_empty_output_on_failure(output_path), open(output_path, "ab") as out:
         results = ResultWriter(out, output_path)
         lines = read_requests(requests_path, skip=set(done))
         runner: Any = None
@@ -212,6 +213,19 @@ def run_batch(
     return BatchReport(
         total, skipped, results.written, time.perf_counter() - started, interrupted, dict(getattr(runner, "nodes", {}))
     )
+
+
+@contextlib.contextmanager
+def _no_empty_output_on_failure(output_path: Path) -> Iterator[None]:
+    """Remove ``output_path`` where the run that created it fails before writing a result (a
+    cluster that cannot be joined, say): no empty output left to mistake for one."""
+    created = not output_path.exists()
+    try:
+        yield
+    except BaseException:
+        if created and output_path.exists() and output_path.stat().st_size == 0:
+            output_path.unlink()
+        raise
 
 
 def _plan_lines(

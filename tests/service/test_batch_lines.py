@@ -248,6 +248,7 @@ def test_a_task_past_its_budget_is_killed_and_its_lines_are_504s(tmp_path, monke
     monkeypatch.setattr(runner, "STARTUP_S", 0.0)  # the workers' start is another test's
     requests, output = tmp_path / "in.jsonl", tmp_path / "out.jsonl"
     requests.write_text(json.dumps(OTHER) + "\n" + json.dumps(GOOD) + "\n" + json.dumps(OTHER) + "\n")
+    answer(json.dumps(GOOD), 20.0)  # the robot loaded and the kernels compiled before the 0.5 s budget
     pool = HangingPool()
     started = time.monotonic()
     report = run_batch(requests, output, budget_s=0.5, pool=lambda: pool)
@@ -289,6 +290,47 @@ def test_batch_on_a_cluster_address_where_nothing_listens_says_so_at_once(tmp_pa
     problem = json.loads(capsys.readouterr().err.strip().splitlines()[-1])
     assert problem["title"] == "Ray cluster unreachable" and words in problem["detail"], problem
     assert not ray.is_initialized()
+    assert not (tmp_path / "out.jsonl").exists()  # no empty output to mistake for one
+
+
+@pytest.mark.parametrize("reply", [b"HTTP/1.1 400 Bad Request\r\n\r\n", b"SSH-2.0-OpenSSH_9.6\r\n", None])
+def test_batch_on_an_address_where_another_server_listens_says_so_at_once(tmp_path, capsys, monkeypatch, reply):
+    """A web server, an SSH server, or one that never answers at --ray-address: Ray would retry
+    it for minutes, deaf to Ctrl-C; the HTTP/2 opening a Ray head answers is tried first."""
+    pytest.importorskip("ray")
+    import socket
+
+    import ray
+
+    from toptraj.service.batches import ray_pool
+
+    if ray.is_initialized():
+        pytest.skip("a Ray of this process is running")
+    monkeypatch.setattr(ray_pool, "CONNECT_S", 1.0)
+    listener = socket.create_server(("127.0.0.1", 0))
+    held = []
+
+    def serve():
+        connection, _ = listener.accept()
+        held.append(connection)
+        if reply is not None:
+            connection.sendall(reply)
+
+    threading.Thread(target=serve, daemon=True).start()
+    address = f"127.0.0.1:{listener.getsockname()[1]}"
+    (tmp_path / "in.jsonl").write_text(json.dumps(GOOD) + "\n")
+    started = time.monotonic()
+    try:
+        assert main(["batch", str(tmp_path / "in.jsonl"), "-o", str(tmp_path / "out.jsonl"), "--ray-address", address]) == 2
+    finally:
+        listener.close()
+        for connection in held:
+            connection.close()
+    assert time.monotonic() - started < 10.0
+    problem = json.loads(capsys.readouterr().err.strip().splitlines()[-1])
+    assert problem["title"] == "Ray cluster unreachable", problem
+    assert f"--ray-address {address} is no Ray cluster" in problem["detail"] and "6379" in problem["detail"], problem
+    assert not ray.is_initialized() and not (tmp_path / "out.jsonl").exists()
 
 
 def _fails_on_panda(monkeypatch):
