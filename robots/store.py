@@ -143,6 +143,14 @@ class UploadStore:
             ).fetchone()
         return None if row is None else (row[0], row[1], row[2])
 
+    def alike(self, name: str) -> str | None:
+        """The stored name that differs from ``name`` only in case (``NAME_PATTERN`` is ASCII),
+        ``None`` when there is none."""
+        with self._connect(write=False) as connection:
+            if connection is None:
+                return None
+            return _alike(connection, name)
+
     def uploads(self) -> list[StoredUpload]:
         """Every stored upload, by name."""
         with self._connect(write=False) as connection:
@@ -196,6 +204,9 @@ class UploadStore:
                         )
                     connection.execute("ROLLBACK")
                     return False
+                alike = _alike(connection, name)
+                if alike is not None:  # a request naming one, mistyped in case, would plan the other
+                    raise RobotConflict(f"name {excerpt(name)} differs from the upload {alike!r} only in case; choose another")
                 count, stored = self._usage(connection)
                 known = connection.execute("SELECT 1 FROM urdfs WHERE digest = ?", (digest,)).fetchone()
                 added = 0 if known else size
@@ -242,3 +253,9 @@ class UploadStore:
                 raise
             connection.execute("PRAGMA incremental_vacuum")  # give the freed pages back to the file system
         return True
+
+
+def _alike(connection: sqlite3.Connection, name: str) -> str | None:
+    """The name in ``robots`` equal to ``name`` but for case, ``None`` when there is none."""
+    row = connection.execute("SELECT name FROM robots WHERE lower(name) = lower(?) AND name != ?", (name, name)).fetchone()
+    return None if row is None else row[0]

@@ -77,6 +77,11 @@ def test_upload_under_a_name(client):
         refused = client.post("/v1/robots", json={"name": alike, "urdf": urdf})
         assert refused.status_code == 409, refused.text
         assert refused.json()["detail"] == f"name {alike!r} differs from the catalog robot {known!r} only in case; choose another"
+    # an upload's name in other case, likewise
+    refused = client.post("/v1/robots", json={"name": "My_Arm", "urdf": urdf})
+    assert refused.status_code == 409, refused.text
+    assert refused.json()["detail"] == "name 'My_Arm' differs from the upload 'my_arm' only in case; choose another"
+    assert client.get("/v1/robots/My_Arm").status_code == 404
 
 
 @pytest.mark.parametrize(

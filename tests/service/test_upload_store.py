@@ -115,6 +115,18 @@ def test_the_byte_cap_gives_409(tmp_path):
         assert full.status_code == 409 and "bytes" in full.json()["detail"]
 
 
+def test_a_name_differing_from_a_stored_one_only_in_case_is_refused_in_the_store_itself(tmp_path):
+    """Checked inside the store's transaction too, so that two processes uploading ``Arm`` and
+    ``arm`` at once cannot both store theirs."""
+    from toptraj.robots.errors import RobotConflict
+
+    store = UploadStore(tmp_path)
+    assert store.put("Arm", "1" * 64, "text one", 1) and store.alike("ARM") == "Arm" and store.alike("Arm") is None
+    with pytest.raises(RobotConflict, match="name 'arm' differs from the upload 'Arm' only in case"):
+        store.put("arm", "2" * 64, "text two", 1)
+    assert [upload.name for upload in store.uploads()] == ["Arm"]
+
+
 def test_the_model_cache_stays_bounded(tmp_path):
     with app_client(tmp_path, upload_cache_size=2) as client:
         names = [client.post("/v1/robots", json={"urdf": arm(effort)}).json()["name"] for effort in (1.0, 2.0, 3.0, 4.0, 5.0)]
