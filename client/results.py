@@ -199,6 +199,9 @@ class Trajectory:
         switching_times: ``collocation`` with bang-bang torques: per joint, the times (s) at
             which its saturated torque changes sides.
         search: ``search``: what the global search did (the service's ``SearchPublic``).
+        zones: With ``timing.zones``: where each lies on the path and whether it bound the timing.
+        payload: The payload the torques include (mass (kg), centre of mass (m), ...), else None.
+        mounting: With ``mounting``: the base pose (m) and the world's gravity (m/s^2) applied.
         joint_trajectory: With ``format = "joint_trajectory"``: the ROS message as JSON
             (``joint_names``, ``points``), ready for a ``FollowJointTrajectory`` goal.
         body: The whole answer as the service sent it.
@@ -227,6 +230,9 @@ class Trajectory:
     solver: dict | None = None
     switching_times: dict[str, list[float]] | None = None
     search: dict | None = None
+    zones: list[dict] | None = None
+    payload: dict | None = None
+    mounting: dict | None = None
     joint_trajectory: dict | None = field(default=None, repr=False)
     body: dict = field(default_factory=dict, repr=False)
 
@@ -268,6 +274,7 @@ class Trajectory:
             solver=body.get("solver"),
             switching_times=body.get("switching_times"),
             search=body.get("search"),
+            **{name: body.get(name) for name in ("zones", "payload", "mounting")},
             joint_trajectory=message,
             body=body,
             **arrays,

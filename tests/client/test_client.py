@@ -388,7 +388,10 @@ def test_payload_and_mounting_are_request_fields(toptraj, server):
     served = _served(server, "/v1/trajectories", body)
     assert planned.duration == served["duration"]
     np.testing.assert_array_equal(planned.tau, np.array(served["samples"]["tau"]))
+    assert planned.payload == served["payload"] and planned.payload["mass"] == 3.0
+    assert planned.mounting == served["mounting"] and planned.mounting["rotation"][1] == [0.0, -1.0, 0.0]  # x turned half
     bare = toptraj.plan("ur5", UR5_WAYPOINTS, constraints=["velocity", "acceleration", "torque"])
+    assert bare.payload is None and bare.mounting is None and bare.zones is None
     assert np.abs(planned.tau[0] - bare.tau[0]).max() > 1.0  # N m: the payload's weight, pulling the other way
     compared = toptraj.compare("ur5", UR5_WAYPOINTS, methods=["phase_plane"], payload=payload, mounting=mounting)
     assert compared[0].duration == served["duration"]
