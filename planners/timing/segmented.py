@@ -16,6 +16,10 @@ import numpy as np
 
 from toptraj.planners.timing.base import Binding, DenseStates, PathTiming
 
+#: Relative distance (of the duration, or of a second) within which an instant is a stretch's
+#: start: sample times such as ``np.arange`` makes them miss it by a rounding.
+STOP_ROUNDING = 1e-12
+
 
 @dataclass(frozen=True)
 class SegmentedTiming(PathTiming):
@@ -92,7 +96,12 @@ class SegmentedTiming(PathTiming):
     def at_times(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
         starts = self.starts
-        index = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.parts) - 1)
+        # An instant within rounding of a stop between stretches is the next stretch's start,
+        # as the path's derivatives there are its right side's (``GeometricPath.evaluate``): the
+        # last instant of the stretch before would pair its deceleration with the next
+        # stretch's direction.
+        index = np.searchsorted(starts, t + STOP_ROUNDING * max(1.0, self.duration), side="right") - 1
+        index = np.clip(index, 0, len(self.parts) - 1)
         s, sd, sdd = np.empty_like(t), np.empty_like(t), np.empty_like(t)
         for k, part in enumerate(self.parts):
             mine = index == k

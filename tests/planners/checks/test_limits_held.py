@@ -157,6 +157,25 @@ def test_stop_and_go_paths_with_a_short_segment_are_timed(client, length):
         assert ratio <= 1.005, (method, kind, ratio)
 
 
+@pytest.mark.parametrize("dt", [0.01, 0.002])
+def test_a_sample_on_a_stop_between_stretches_pairs_its_acceleration_with_the_next_stretch(client, dt):
+    """A linear path stops at its middle waypoint after exactly 0.6 s of a trapezoid: the
+    sample at t = 0.6 s (``np.arange``'s, a rounding short of the stop) paired the first
+    stretch's deceleration with the second stretch's direction, 1.5 times the acceleration
+    limit, and the answer was a 422."""
+    waypoints = [[0.0, -1.2, 1.0, 0.0, 0.5, 0.0], [0.8, -1.0, 1.4, -0.5, 0.9, 0.3], [2.0, -1.3, 1.2, 0.2, 0.6, 1.2]]
+    response = client.post("/v1/trajectories", json={
+        "robot": "ur5", "path": {"kind": "waypoints", "interpolation": "linear", "waypoints": waypoints},
+        "timing": {"method": "trapezoidal"}, "output": {"dt": dt},
+    })
+    assert response.status_code == 200, response.text
+    body = response.json()
+    t = np.array(body["samples"]["t"])
+    assert np.min(np.abs(t - 0.6)) < 1e-12  # a sample on the stop
+    ratio, kind = worst_ratio(body, robot_limits(client, "ur5"))
+    assert ratio <= 1.005, (kind, ratio)
+
+
 @pytest.mark.parametrize(
     "method", ["phase_plane", "toppra", "min_cost", "cubic", "quintic", "trapezoidal", "cycloidal", "ruckig", "jerk_limited"]
 )
