@@ -38,12 +38,14 @@ class ViaPath(GeometricPath):
     Args:
         coefficients: Shape (n_segments, n_dof, order + 1), polynomial in local time per joint.
         durations: Segment durations in s.
+        total: Their sum T (s) as given (a duration asked for, of which the sum is a rounding);
+            default the sum.
     """
 
-    def __init__(self, coefficients: np.ndarray, durations: np.ndarray):
+    def __init__(self, coefficients: np.ndarray, durations: np.ndarray, total: float | None = None):
         self.coefficients = coefficients
         self.durations = np.asarray(durations, dtype=float)
-        self.total = float(self.durations.sum())
+        self.total = float(self.durations.sum()) if total is None else float(total)
         self.dof = coefficients.shape[1]
         self.starts = np.concatenate(([0.0], np.cumsum(self.durations)))
         self.knots = self.starts / self.total
@@ -205,8 +207,6 @@ def via_point_trajectory(
         velocities[1:-1] = np.where(agree, 0.5 * (slopes[:-1] + slopes[1:]), 0.0)
         if law == "quintic":
             accelerations[1:-1] = (slopes[1:] - slopes[:-1]) / (0.5 * (durations[:-1] + durations[1:]))[:, None]
-        if duration is not None:
-            break
         durations = np.array([
             _shortest(
                 robot, limits, kinds, law,
@@ -217,14 +217,14 @@ def via_point_trajectory(
             for k in range(n_segments)
         ])
     if duration is not None:
-        durations = durations * (duration / durations.sum())
-        slopes = steps / durations[:, None]
-        velocities[1:-1] = np.where(np.sign(slopes[:-1]) == np.sign(slopes[1:]), 0.5 * (slopes[:-1] + slopes[1:]), 0.0)
-        if law == "quintic":
-            accelerations[1:-1] = (slopes[1:] - slopes[:-1]) / (0.5 * (durations[:-1] + durations[1:]))[:, None]
+        # The shortest motion run k times as slowly: velocities scale by 1 / k, accelerations by
+        # 1 / k^2, so that a duration above the shortest holds every joint limit it holds (its
+        # own share of the duration per segment, not one shared otherwise).
+        k = duration / durations.sum()
+        durations, velocities, accelerations = durations * k, velocities / k, accelerations / k**2
     coefficients = np.array([
         _segment(law, waypoints[k], velocities[k], accelerations[k], waypoints[k + 1], velocities[k + 1], accelerations[k + 1], durations[k])
         for k in range(n_segments)
     ])
-    path = ViaPath(coefficients, durations)
+    path = ViaPath(coefficients, durations, duration)
     return path, ConstantSpeedTiming(path.total, path.knots)

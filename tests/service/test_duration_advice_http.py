@@ -48,3 +48,20 @@ def test_the_duration_advised_is_answered(client, path, timing):
     assert followed.status_code == 200, followed.text
     assert followed.json()["duration"] == pytest.approx(seconds, rel=1e-9)
     assert client.post("/v1/trajectories", json={**body, "timing": {**timing, "duration": 1.5 * seconds}}).status_code == 200
+
+
+@pytest.mark.parametrize("law", ["cubic", "quintic"])
+def test_a_via_point_motion_given_any_duration_above_its_shortest_is_answered(client, law):
+    """A given duration runs the shortest motion more slowly as a whole: 1.25 s, above the
+    shortest 1.2488 s, broke the acceleration limit by 3 % (the duration was shared among the
+    segments otherwise than the shortest shares it) with advice no grid could follow."""
+    path = {**VIA, "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [0.8, -1, 1.4, -0.5, 0.9, 0.3], [2, -1.3, 1.2, 0.2, 0.6, 1.2]]}
+    body = {"robot": "ur5", "path": path, "timing": {"method": law}, "output": {"dt": 0.01}}
+    shortest = client.post("/v1/trajectories", json=body).json()
+    for factor in (1.0005, 1.01, 1.5):
+        given = round(factor * shortest["duration"], 4)
+        answered = client.post("/v1/trajectories", json={**body, "timing": {"method": law, "duration": given}})
+        assert answered.status_code == 200, (factor, answered.text)
+        assert answered.json()["duration"] == given
+        peaks = answered.json()["peak_utilization"]
+        assert max(max(peaks["velocity"]), max(peaks["acceleration"])) <= 1.0 / factor**1 + 1e-9
