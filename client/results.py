@@ -274,7 +274,7 @@ class Trajectory:
             solver=body.get("solver"),
             switching_times=body.get("switching_times"),
             search=body.get("search"),
-            **{name: body.get(name) for name in ("zones", "payload", "mounting")},
+            zones=body.get("zones"), payload=body.get("payload"), mounting=body.get("mounting"),
             joint_trajectory=message,
             body=body,
             **arrays,
