@@ -20,6 +20,7 @@ recently used ``CACHE_SIZE`` of them; the catalog robot it starts from is never 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import threading
 from collections import OrderedDict
@@ -287,7 +288,9 @@ def _build(bare: Robot, payload: Payload | None, mounting: Mounting | None) -> R
                 frame.placement = base * frame.placement
         if mounting.gravity is not None:
             model.gravity = pin.Motion(np.array(mounting.gravity), np.zeros(3))
-    return Robot.from_model(
+    made = Robot.from_model(
         bare.name, model, bare.source, bare.end_effector, bare.limits, bare.limit_sources, bare.locked_joints,
         tuple(notes), payload=payload, mounting=mounting, bare=bare,
     )
+    # The links allowed to touch (an upload's option) are the same links, wherever the base is.
+    return dataclasses.replace(made, allowed_collisions=bare.allowed_collisions)

@@ -131,12 +131,15 @@ def pair_distances(robot: Robot, pairs: SelfPairs, q: np.ndarray) -> np.ndarray:
 
 
 def touching_at_zero(robot: Robot) -> frozenset[tuple[str, str]]:
-    """The link pairs whose capsules overlap at the zero configuration."""
+    """The link pairs whose capsules overlap at the zero configuration (the arm's own
+    geometry, which its joints keep in contact), the payload's sphere left out: a payload
+    overlapping a link there is checked like anywhere else."""
     pairs = candidate_pairs(robot)
     if not len(pairs.first):
         return frozenset()
     distances = pair_distances(robot, pairs, np.zeros((1, robot.dof)))[0]
-    return frozenset(pair(*pairs.links[k]) for k in np.flatnonzero(distances <= 0.0))
+    touching = (pair(*pairs.links[k]) for k in np.flatnonzero(distances <= 0.0))
+    return frozenset(item for item in touching if "payload" not in item)
 
 
 def default_allowed(robot: Robot) -> frozenset[tuple[str, str]]:

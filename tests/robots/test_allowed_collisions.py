@@ -78,3 +78,21 @@ def test_an_upload_with_a_bad_list_is_refused_naming_it(client, allowed, words):
     refused = client.post("/v1/robots", json={"name": "bad_3r", "urdf": ARM_3R, "allowed_collisions": allowed})
     assert refused.status_code == 422, refused.text
     assert words in refused.text
+
+
+def test_the_pairs_allowed_at_upload_hold_with_a_payload_a_mounting_and_in_a_cell(client):
+    """The equipped robot (payload, mounting; every arm of a cell has a base) kept the upload's
+    model but dropped its list: the pair allowed was refused again, with the advice to allow it."""
+    assert client.post("/v1/robots", json={"name": "listed_3r_eq", "urdf": ARM_3R, "allowed_collisions": [["forearm", "turret"]]}).status_code == 201
+    for equipment in ({"payload": {"mass": 0.1}}, {"mounting": {"position": [0.0, 0.0, 0.5]}}):
+        served = client.post("/v1/trajectories", json={"robot": "listed_3r_eq", "path": FOLDING, **equipment})
+        assert served.status_code == 200, (equipment, served.text)
+    cell = {"arms": [
+        {"robot": "listed_3r_eq", "waypoints": FOLDING["waypoints"]},
+        {"robot": "listed_3r_eq", "base": {"position": [5.0, 0.0, 0.0]}, "waypoints": [[0.0, 0.5, 0.0], [0.5, 0.5, 0.0]]},
+    ]}
+    answered = client.post("/v1/cells", json=cell)
+    assert answered.status_code == 200, answered.text
+    plain = {**cell, "arms": [{**arm, "robot": "lecture_3r"} for arm in cell["arms"]]}
+    refused = client.post("/v1/cells", json=plain)  # the same cell without the list: the fold is refused
+    assert refused.status_code == 422 and "turret" in refused.text and "forearm" in refused.text, refused.text

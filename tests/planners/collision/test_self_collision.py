@@ -204,3 +204,17 @@ def test_a_refusal_says_what_the_capsules_are_and_offers_allowing_a_pair_only_wh
     with pytest.raises(SelfCollision) as refused:
         check_self_collision(folded, uploaded)
     assert refused.value.detail.endswith("or, if the links may touch, allow the pair among the robot's allowed collisions when uploading it")
+
+
+def test_a_payload_sphere_overlapping_links_at_the_zero_pose_is_checked_against_them():
+    """The pairs touching at the zero pose are allowed (the arm's own geometry), but not the
+    payload's: a 2 m sphere engulfing the arm was planned without a word."""
+    from toptraj.robots import equipment
+
+    robot = robots.load("ur5")
+    path = SplinePath(np.array([[0.0, -1.2, 1.0, 0.0, 0.5, 0.0], [0.8, -1.0, 1.4, -0.5, 0.9, 0.3]]))
+    assert check_self_collision(path, robot).distance > 0.0
+    engulfing = equipment.equip(robot, equipment.payload(1.0, [0.0, 0.0, 0.0], radius=2.0))
+    with pytest.raises(SelfCollision) as refused:
+        check_self_collision(path, engulfing)
+    assert "payload" in (refused.value.link_a, refused.value.link_b) and refused.value.s == 0.0
