@@ -40,7 +40,8 @@ def _collocation_gap(facts: dict) -> str:
         f": more timing.grid_points (collocation intervals, up to {facts['most_intervals']}) bring it closer"
         if facts["most_intervals"] is not None else ""
     )
-    return f"the duration may lie up to {100 * facts['gap']:.2g} % above the optimum ({facts['basis']}){advice}"
+    what = "duration" if facts.get("what", "duration") == "duration" else "cost, the integral of (1 + beta |tau|^2) dt,"
+    return f"the {what} may lie up to {100 * facts['gap']:.2g} % above the optimum ({facts['basis']}){advice}"
 
 
 def _limit_far_above_own(facts: dict) -> str:

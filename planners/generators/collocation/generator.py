@@ -109,13 +109,15 @@ class Collocation(MotionGenerator):
         )
 
     def _gap_note(self, source, collocation) -> tuple[str, ...]:
-        """A note when the minimum time found may lie farther than ``GAP_TARGET`` above the
-        optimum, with the advice that brings it closer where there is one."""
-        if self.torque_weight != 0.0 or source.optimality_gap is None or source.optimality_gap <= GAP_TARGET:
+        """A note when the minimum time (with a torque weight, the cost) found may lie farther
+        than ``GAP_TARGET`` above the optimum, with the advice that brings it closer where there
+        is one."""
+        if source.optimality_gap is None or source.optimality_gap <= GAP_TARGET:
             return ()
+        what = "duration" if self.torque_weight == 0.0 else "cost"
         return (Note(
-            f"the duration may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis})",
-            "collocation_gap", gap=source.optimality_gap, basis=source.gap_basis,
+            f"the {what} may lie up to {100 * source.optimality_gap:.2g} % above the optimum ({source.gap_basis})",
+            "collocation_gap", gap=source.optimality_gap, basis=source.gap_basis, what=what,
             most_intervals=MAX_INTERVALS if len(collocation.t) - 1 < MAX_INTERVALS else None,
         ),)
 
