@@ -47,16 +47,17 @@ def _halved(grid: np.ndarray) -> np.ndarray:
     return fine
 
 
-def converged_duration(path, robot) -> tuple[float, float]:
+def converged_duration(path, robot, limits=None, kinds=KINDS) -> tuple[float, float]:
     """T* and its relative gap to the midpoint estimate (see the module docstring): on 10,000
     and 20,000 intervals, or on 20,000 and 40,000 where those two disagree by more than
-    CONVERGED."""
+    CONVERGED; under ``limits`` (default the robot's) of ``kinds``."""
+    limits = robot.limits if limits is None else limits
     unrefined = PhasePlaneMethod(max_refinements=0)
     coarse_grid = path_grid(path, 10_000)
-    coarse = unrefined.solve(build_path_constraints(path, robot, robot.limits, KINDS, coarse_grid)).duration
+    coarse = unrefined.solve(build_path_constraints(path, robot, limits, kinds, coarse_grid)).duration
     for _ in range(2):
         fine_grid = _halved(coarse_grid)
-        constraints = build_path_constraints(path, robot, robot.limits, KINDS, fine_grid)
+        constraints = build_path_constraints(path, robot, limits, kinds, fine_grid)
         fine = unrefined.solve(constraints).duration
         richardson = 2.0 * fine - coarse
         gap = abs(midpoint_duration(constraints) / richardson - 1.0)

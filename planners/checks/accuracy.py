@@ -183,6 +183,11 @@ def finer_constraints(
     cap = min(method.max_grid_intervals(len(constraints.joint_names)), MAX_POINTS)
     if extra.size == 0 or intervals + extra.size > cap:
         return None
-    if not _affordable(deadline, spent * (intervals + extra.size) / intervals):
+    # What does not grow with the grid (a worker process started: ``CostTimeScaling.fixed_seconds``)
+    # is paid again as it is; the rest grows with the intervals plus the method's set-up, counted
+    # in intervals (``TimingMethod.setup_intervals``).
+    fixed = min(float(getattr(result, "fixed_seconds", 0.0)), spent)
+    setup = method.setup_intervals
+    if not _affordable(deadline, fixed + (spent - fixed) * (intervals + extra.size + setup) / (intervals + setup)):
         return None
     return constraints.with_points(extra)

@@ -224,6 +224,10 @@ class TimingMethod(abc.ABC):
             1.3 kB for phase_plane, 2.3 kB for toppra, 9 kB for min_cost;
             ``benchmarks/budgets.py``): the runner admits a grid by it against the one memory
             cap (``toptraj.planners.execution.memory``).
+        setup_intervals: The method's set-up time per solve (building its program), counted in
+            grid intervals solved in the same time: a finer grid's solve is expected to take
+            the last one's times (intervals + setup) / (last intervals + setup)
+            (``toptraj.planners.checks.accuracy.finer_constraints``).
         interruptible: Whether the method checks its deadline between steps; one that cannot
             (a convex solver's single call) runs that step through ``Isolation`` (a worker
             process killed at the deadline) when the runner isolates the planning.
@@ -246,6 +250,7 @@ class TimingMethod(abc.ABC):
     continuous_acceleration: bool = False
     absolute_tolerances: bool = False
     bytes_per_interval_joint: int = 2_300
+    setup_intervals: int = 0
     interruptible: bool = True
     supporting_points: int | None = None
     pointwise: bool = True
