@@ -45,9 +45,17 @@ def solo_timing(
         InvalidRequest: a stretch of the path that no limit of ``kinds`` bounds (rule
             "stretch_unbounded", ``toptraj.planners.problem.bounded``; ``field`` names the arm).
     """
+    from toptraj.planners.checks.gate import LIMIT_TOLERANCE, gated
+
     constraints = build_path_constraints(arm.path, arm.robot, arm.limits, kinds, _timing_grid(arm, intervals), deadline)
     check_stretches_bounded(constraints, arm.path, arm.robot, arm.limits, kinds, served=CELL_KINDS, field=field)
-    return solve_well_scaled(ToppraMethod(), constraints, AT_REST, None, deadline)  # type: ignore[return-value]
+    # Through the limit gate, as a single arm's path: the grid refined where a limit is exceeded
+    # between its points (else the whole cell's clock is slowed for it, ``limits.within_limits``)
+    # and, for accuracy, where the error lies.
+    timing, _, _ = gated(
+        arm.robot, arm.path, ToppraMethod(), constraints, AT_REST, None, kinds, arm.limits, LIMIT_TOLERANCE, deadline,
+    )
+    return timing  # type: ignore[return-value]
 
 
 def _composed(arm: CellArm, s: np.ndarray, ds: np.ndarray, dds: np.ndarray):
