@@ -16,6 +16,10 @@ ZONE_WORDING: dict[str, str | Callable[[dict], str]] = {
         "timing.zones cover more than {most} stretches of the path from timing.zones[{index}] on: the tool point "
         "enters and leaves a region many times; give fewer or larger regions, or an s_range instead"
     ),
+    "zone_kind_not_held": (
+        "timing.zones[{index}].{kind}_scale scales the {kind} limit, which timing.constraints does not hold: add "
+        "'{kind}' to timing.constraints, or leave timing.zones[{index}].{kind}_scale out"
+    ),
     "zones_not_served": lambda facts: (
         f"timing.zones are held by timing.method {' or '.join(facts['methods'])} along a given path (path.kind "
         f"'waypoints' with interpolation 'spline', 'linear' or 'blend', or 'cartesian'), not by {facts['method']!r} "

@@ -36,7 +36,7 @@ from toptraj.planners.problem.raised_limits import raised_limits
 from toptraj.planners.problem.ranges import check_numbers, check_scaled_limits
 from toptraj.planners.problem.requests import WaypointPath, check_constraint_kinds, default_kinds
 from toptraj.planners.problem.waypoints import continuous_turns, without_repeats
-from toptraj.planners.problem.zones import check_zones, check_zones_served
+from toptraj.planners.problem.zones import check_zones, check_zones_held, check_zones_served
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.robots import JointLimits, Robot, ToolSpeedLimit
 
@@ -81,6 +81,7 @@ def build_problem(
     else:
         kinds = check_constraint_kinds(limits.kinds, method)
     check_numbers(limits, boundary, duration, sampling.dt)
+    check_zones_held(limits.zones, kinds)
     check_obstacles(obstacles)
     if sampling.exact_period and boundary.velocities_moving:
         raise Conflicting("sampling.exact_period", sampling.exact_period, ("boundary",), rule="exact_period_with_moving_ends")

@@ -91,6 +91,20 @@ def check_zones(zones: tuple[Zone, ...]) -> None:
             raise _refused(f"zones[{index}].tool_speed", f"zone {index} has a tool speed of {zone.tool_speed:g} m/s; give a positive finite speed")
 
 
+def check_zones_held(zones: tuple[Zone, ...], kinds: tuple[str, ...]) -> None:
+    """InvalidRequest naming the first zone whose factor scales a kind of limit that ``kinds``
+    (the limits the timing holds) leaves out: that limit would be neither held nor its zone's."""
+    for index, zone in enumerate(zones):
+        for kind in ("velocity", "acceleration", "torque"):
+            if getattr(zone, kind) is not None and kind not in kinds:
+                raise _refused(
+                    f"zones[{index}].{kind}",
+                    f"zone {index} scales the {kind} limit, which is not among the limits held ({', '.join(kinds)}): "
+                    f"hold {kind} too, or leave the zone's {kind} factor out",
+                    rule="zone_kind_not_held", index=index, kind=kind, value=getattr(zone, kind),
+                )
+
+
 def _check_region(index: int, region) -> None:
     """InvalidRequest naming the zone unless its region is a sphere of positive radius or a
     box of positive edges with a unit orientation."""

@@ -128,3 +128,22 @@ def test_the_zone_remedy_holds_the_whole_path_or_is_not_given(client):
     scaled = {"limits": {"torque_scale": 0.3}, "zones": [{"s_range": [0.0, 0.3], "torque_scale": 0.05}]}
     detail = client.post("/v1/trajectories", json={"robot": "ur5", "path": lift, "timing": scaled}).json()["detail"]
     assert "timing.zones" not in detail and "timing.limits.torque_scale 3.61" in detail, detail
+
+
+def test_a_zone_scaling_a_limit_that_is_not_held_is_refused_and_the_advice_works(client):
+    """torque_scale in a zone with torque left out of the constraints was answered without
+    holding it (at 0.1, the zone's peak 3 times its limit, reported ``binding: true``). Refused
+    naming the zone; adding torque to the constraints holds it."""
+    body = {
+        "robot": "ur5", "path": {"kind": "waypoints", "waypoints": UR5_WAYPOINTS},
+        "timing": {"constraints": ["velocity", "acceleration"], "zones": [{"s_range": [0.4, 0.6], "torque_scale": 0.5}]},
+    }
+    refused = client.post("/v1/trajectories", json=body)
+    assert refused.status_code == 422, refused.text
+    assert refused.json()["detail"] == (
+        "timing.zones[0].torque_scale scales the torque limit, which timing.constraints does not hold: add 'torque' to "
+        "timing.constraints, or leave timing.zones[0].torque_scale out"
+    )
+    followed = client.post("/v1/trajectories", json={**body, "timing": {**body["timing"], "constraints": ["velocity", "acceleration", "torque"]}})
+    assert followed.status_code == 200, followed.text
+    assert followed.json()["zones"][0]["peak"] <= 1.003
