@@ -98,6 +98,12 @@ class Mounting:
         return pin.SE3(np.array(self.rotation, dtype=float).reshape(3, 3), np.array(self.position, dtype=float))
 
 
+def _shown(value: object) -> str:
+    """A number as a request gave it (``1200``, not numpy's ``np.float64(1200.0)``); anything
+    else as its repr."""
+    return f"{float(value):g}" if isinstance(value, int | float | np.number) and not isinstance(value, bool) else repr(value)
+
+
 def _vector(values, field: str, accepted: Range, length: int = 3, signed: bool = True) -> tuple[float, ...]:
     """``values`` as a tuple of ``length`` finite floats, each within ``accepted`` (by magnitude
     when ``signed``)."""
@@ -108,7 +114,7 @@ def _vector(values, field: str, accepted: Range, length: int = 3, signed: bool =
         inside = accepted.holds_signed(value) if signed else accepted.holds(value)
         if not (math.isfinite(value) and inside):
             shown = f"[-{accepted.high:g}, {accepted.high:g}] {accepted.unit}" if signed else accepted.describe()
-            raise InvalidEquipment(f"{field}[{index}] = {value!r} is outside the accepted range {shown}", field)
+            raise InvalidEquipment(f"{field}[{index}] = {_shown(value)} is outside the accepted range {shown}", field)
     return tuple(float(value) for value in array)
 
 
@@ -156,9 +162,9 @@ def payload(
         InvalidEquipment: a quantity out of its range or not physical.
     """
     if not (isinstance(mass, int | float) and math.isfinite(mass) and PAYLOAD_MASS.holds(mass)):
-        raise InvalidEquipment(f"mass = {mass!r} is outside the accepted range {PAYLOAD_MASS.describe()}", "mass")
+        raise InvalidEquipment(f"mass = {_shown(mass)} is outside the accepted range {PAYLOAD_MASS.describe()}", "mass")
     if not (isinstance(radius, int | float) and math.isfinite(radius) and PAYLOAD_RADIUS.holds(radius)):
-        raise InvalidEquipment(f"radius = {radius!r} is outside the accepted range {PAYLOAD_RADIUS.describe()}", "radius")
+        raise InvalidEquipment(f"radius = {_shown(radius)} is outside the accepted range {PAYLOAD_RADIUS.describe()}", "radius")
     matrix = np.zeros((3, 3)) if inertia is None else inertia_matrix(inertia)
     center = _vector(center_of_mass, "center_of_mass", CENTER_OF_MASS)
     return Payload(float(mass), center, tuple(matrix.ravel().tolist()), frame, float(radius))

@@ -141,6 +141,20 @@ CELL_ELSEWHERE = (
     ": a cell (several arms, each along its own path) is planned by POST /v1/cells or `toptraj plan FILE`, "
     "not by this route; its other fields (clearance, dt) belong to that body"
 )
+#: Fields of a trajectory request that a cell does not take.
+_CELL_NO_ZONES = (
+    ": a cell holds each arm's limits along its whole path (the arm's velocity_scale, acceleration_scale, "
+    "torque_scale); limits on part of a path (timing.zones) are served for one arm by POST /v1/trajectories"
+)
+_CELL_NO_OBSTACLES = (
+    ": a cell keeps its arms `clearance` apart from each other; obstacles are served for one arm by "
+    "POST /v1/trajectories (path.obstacles)"
+)
+_CELL_SELF_COLLISION = ": a cell always checks each arm's links against each other; leave it out"
+_CELL_TIMING = (
+    ": a cell times its arms time-optimally under each arm's velocity, acceleration and torque limits; give "
+    "velocity_scale, acceleration_scale or torque_scale on the arm itself"
+)
 #: What to do with a field that belongs to another route or to no body at all, by the body's
 #: schema and the field's place ("*": any unknown field at the top of that schema).
 ELSEWHERE = {
@@ -155,6 +169,14 @@ ELSEWHERE = {
     ("JobCreate", "arms"): CELL_ELSEWHERE,
     ("CellArmRequest", "mounting"): ": a cell arm's pose in the world is its `base` ({\"position\": [x, y, z], "
     "\"orientation\": [qx, qy, qz, qw]} or a 3x3 \"rotation\"), and the world's gravity is the cell's `gravity`",
+    ("CellRequest", "zones"): _CELL_NO_ZONES,
+    ("CellArmRequest", "zones"): _CELL_NO_ZONES,
+    ("CellRequest", "obstacles"): _CELL_NO_OBSTACLES,
+    ("CellArmRequest", "obstacles"): _CELL_NO_OBSTACLES,
+    ("CellRequest", "self_collision"): _CELL_SELF_COLLISION,
+    ("CellArmRequest", "self_collision"): _CELL_SELF_COLLISION,
+    ("CellRequest", "timing"): _CELL_TIMING,
+    ("CellArmRequest", "timing"): _CELL_TIMING,
     ("JobCreate", "*"): ": put the request under `trajectory` (a POST /v1/trajectories body) or `compare` "
     "(a POST /v1/trajectories/compare body), e.g. {\"trajectory\": {\"robot\": \"ur5\", \"path\": ...}}",
 }

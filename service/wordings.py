@@ -183,8 +183,14 @@ def _unknown_robot(facts: dict) -> str:
 
 
 WORDING: dict[str, Wording] = {
-    "too_many_arms": "a cell has {value:~arm}; from {fewest} to {most} are served (every order of the arms is tried): "
-    "give between {fewest} and {most} arms, or split the cell",
+    "too_many_arms": lambda facts: (
+        f"a cell has {facts['value']} arm{'' if facts['value'] == 1 else 's'}; from {facts['fewest']} to {facts['most']} "
+        "are served (every order of the arms is tried): "
+        + (
+            "plan a single arm with POST /v1/trajectories (its base as mounting), or add the arms it shares the workspace with"
+            if facts["value"] < facts["fewest"] else f"give between {facts['fewest']} and {facts['most']} arms, or split the cell"
+        )
+    ),
     "out_of_range": _out_of_range,
     "scaled_limit_out_of_range": _scaled_limit,
     "not_numbers": "{field} must be a list of numbers",

@@ -9,15 +9,21 @@ from pydantic import Field, field_validator, model_validator
 
 from toptraj.robots.ranges import GRAVITY
 from toptraj.service.schemas.common import Schema, signed
-from toptraj.service.schemas.equipment import PayloadRequest, checked_orientation, checked_rotation
-from toptraj.service.schemas.trajectories import JointVector, Name, Point
+from toptraj.service.schemas.equipment import (
+    BasePosition,
+    PayloadRequest,
+    Quaternion,
+    RotationMatrix,
+    checked_orientation,
+    checked_rotation,
+)
+from toptraj.service.schemas.trajectories import JointVector, Name
 
 #: Arms a request may list (the planner serves up to ``coordination.cell.MAX_ARMS``; more are
 #: refused with a 422 saying so).
 MAX_CELL_ARMS = 8
 #: Waypoints per arm.
 MAX_CELL_WAYPOINTS = 100
-RotationRow = Annotated[list[Annotated[float, Field(ge=-2.0, le=2.0)]], Field(min_length=3, max_length=3)]
 #: Fields of other kinds of path (the trajectory endpoint's ``path``), refused with advice.
 _PATH_FIELDS = ("interpolation", "max_deviation", "continuous", "revolutions")
 OTHER_PATH_KEYS = ("path", "kind", "points", "positions", "poses", "line", "start", "goal", "frame", *_PATH_FIELDS)
@@ -27,14 +33,14 @@ class BasePose(Schema):
     """Where an arm's base stands in the world: p_world = rotation p_base + position (the
     rotation given as a matrix or, as a trajectory's ``mounting``, a unit quaternion)."""
 
-    position: Point = Field(default=[0.0, 0.0, 0.0], description="The base's origin [x, y, z] (m), world frame.")
-    rotation: Annotated[list[RotationRow], Field(min_length=3, max_length=3)] | None = Field(
+    position: BasePosition = Field(default=[0.0, 0.0, 0.0], description="The base's origin [x, y, z] (m), world frame.")
+    rotation: RotationMatrix | None = Field(
         default=None,
         description="Rotation matrix (rows) from the base's axes to the world's: orthonormal within 1e-3 (then made "
         "exact), determinant +1; default the identity. [[-1,0,0],[0,-1,0],[0,0,1]] turns the base half a turn about z. "
         "Give this or orientation.",
     )
-    orientation: Annotated[list[Annotated[float, Field(ge=-2.0, le=2.0)]], Field(min_length=4, max_length=4)] | None = Field(
+    orientation: Quaternion | None = Field(
         default=None,
         description="The base's orientation as a unit quaternion [qx, qy, qz, qw] (norm 1 within 1e-3); [0, 0, 1, 0] "
         "turns it half a turn about z. Give this or rotation.",

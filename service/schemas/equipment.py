@@ -15,6 +15,12 @@ from toptraj.service.schemas.common import Schema, bounded, signed
 
 _Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 _Row = Annotated[list[float], Field(min_length=3, max_length=3)]
+#: A base's position (m), each coordinate within ``BASE_POSITION``; its orientation (a
+#: quaternion, checked by ``checked_orientation``) and rotation matrix (``checked_rotation``):
+#: the forms a trajectory's ``mounting`` and a cell arm's ``base`` share.
+BasePosition = Annotated[list[Annotated[float, signed(BASE_POSITION)]], Field(min_length=3, max_length=3)]
+Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
+RotationMatrix = Annotated[list[_Row], Field(min_length=3, max_length=3)]
 
 
 def _checked(check, *args, **kwargs):
@@ -101,15 +107,13 @@ class MountingRequest(Schema):
     Obstacles, Cartesian positions and poses are then in the world frame; torques follow the
     gravity as the base feels it."""
 
-    position: Annotated[list[Annotated[float, signed(BASE_POSITION)]], Field(min_length=3, max_length=3)] = Field(
-        default=[0.0, 0.0, 0.0], description="The base frame's origin [x, y, z] in the world (m)."
-    )
-    orientation: Annotated[list[float], Field(min_length=4, max_length=4)] | None = Field(
+    position: BasePosition = Field(default=[0.0, 0.0, 0.0], description="The base frame's origin [x, y, z] in the world (m).")
+    orientation: Quaternion | None = Field(
         default=None,
         description="The base frame's orientation in the world as a unit quaternion [qx, qy, qz, qw] (norm 1 "
         "within 1e-3); a ceiling mount is [1, 0, 0, 0]. Give this or rotation; default the identity.",
     )
-    rotation: Annotated[list[_Row], Field(min_length=3, max_length=3)] | None = Field(
+    rotation: RotationMatrix | None = Field(
         default=None,
         description="The base frame's orientation as a 3x3 rotation matrix, base axes to world axes (orthonormal "
         "within 1e-3, then made exact; determinant +1). Give this or orientation.",

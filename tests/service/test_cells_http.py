@@ -310,3 +310,46 @@ def test_arms_that_never_come_near_run_at_their_own_optimum_together(patient_cli
     assert body["schedule"] == "simultaneous"
     assert body["solo_durations"][0] == pytest.approx(alone["duration"], rel=2e-3)
     assert body["duration"] <= 1.003 * body["solo_durations"][0] and body["time_lost"] <= 0.003 * body["duration"]
+
+
+@pytest.mark.parametrize(
+    "base, detail",
+    [
+        ({"position": [1200, 0, 0]}, "arms[1].base.position[0]: 1200 is not within the accepted range [-1000, 1000] m"),
+        (
+            {"orientation": [0, 0, 180, 0]},
+            "arms[1].base.orientation: orientation has norm above 2: not a rotation; give a unit quaternion [qx, qy, qz, qw] "
+            "(norm 1 within 0.001)",
+        ),
+    ],
+)
+def test_a_base_out_of_range_is_worded_as_a_trajectory_s_mounting_is(patient_client, base, detail):
+    """A cell arm's base took numpy's repr (``np.float64(1200.0)``) and pydantic's bare bound
+    (``Input should be less than or equal to 2``) where a mounting says what it accepts."""
+    response = patient_client.post("/v1/cells", json=_cell(a1={"base": base}))
+    assert response.status_code == 422 and response.json()["detail"] == detail, response.text
+
+
+def test_a_cell_of_one_arm_is_pointed_to_the_trajectory_endpoint(patient_client):
+    body = copy.deepcopy(EXAMPLE)
+    body["arms"] = body["arms"][:1]
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 422 and "plan a single arm with POST /v1/trajectories" in response.json()["detail"]
+    assert "split the cell" not in response.json()["detail"]
+
+
+@pytest.mark.parametrize(
+    "where, field, words",
+    [
+        ("top", "zones", "timing.zones) are served for one arm by POST /v1/trajectories"),
+        ("top", "obstacles", "obstacles are served for one arm by POST /v1/trajectories"),
+        ("arm", "self_collision", "a cell always checks each arm's links against each other; leave it out"),
+        ("arm", "timing", "give velocity_scale, acceleration_scale or torque_scale on the arm itself"),
+    ],
+)
+def test_a_trajectory_field_in_a_cell_says_what_the_cell_does_instead(patient_client, where, field, words):
+    """A bare "Extra inputs are not permitted" for a field a trajectory request takes."""
+    body = copy.deepcopy(EXAMPLE)
+    (body if where == "top" else body["arms"][0])[field] = {"method": "toppra"} if field == "timing" else [] if field != "self_collision" else True
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 422 and words in response.json()["detail"], response.text
