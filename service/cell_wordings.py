@@ -14,11 +14,16 @@ def _arms_collide_at_start(facts: dict) -> str:
     (a, b), (link_a, link_b), (robot_a, robot_b) = (facts["first"], facts["second"]), facts["links"], facts["robots"]
     distance, clearance = facts["distance"], facts["clearance"]
     lower = f", or lower clearance to {rounded_down(distance, 4):g} m or less" if distance > 0.0 else ""
+    position = facts.get("position")
+    move = (
+        f"set arms[{b}].base.position to [{', '.join(f'{x:g}' for x in position)}] (those two links "
+        f"{'overlap' if distance < 0.0 else 'are too close'}; there, every link of the two arms clears the other's at the start)"
+        if position is not None else f"move arms[{b}].base farther from arms[{a}]'s"
+    )
     return (
         f"the arms collide at their start: link {link_a!r} of arms[{a}] ({robot_a}) is {distance:.4g} m "
         f"from link {link_b!r} of arms[{b}] ({robot_b}) at s = 0 (the clearance is {clearance:g} m): "
-        f"move arms[{b}].base at least {rounded_up(clearance - distance, 4):g} m farther from arms[{a}]'s (those two "
-        f"links {'overlap' if distance < 0.0 else 'are too close'}), change either arm's first waypoint{lower}"
+        f"{move}, change either arm's first waypoint{lower}"
     )
 
 

@@ -139,12 +139,37 @@ def test_arms_that_collide_at_their_start_are_a_422_naming_the_links(patient_cli
     detail = response.json()["detail"]
     assert detail.startswith("the arms collide at their start") and "link '" in detail
     assert "_0' of arms" not in detail  # the URDF's link names, not the capsules' names
-    # the advice names how far to move and what clearance would do, from the distance found
-    match = re.search(r"is (-?[\d.e-]+) m from link .*the clearance is ([\d.e-]+) m\): move arms\[1\]\.base at least ([\d.e-]+) m farther", detail)
+    # the advice names where to put the base (followed below) and what clearance would do
+    match = re.search(r"is (-?[\d.e-]+) m from link .*the clearance is ([\d.e-]+) m\): set arms\[1\]\.base\.position to \[([^\]]+)\]", detail)
     assert match, detail
-    distance, clearance, move = (float(group) for group in match.groups())
-    assert move == pytest.approx(clearance - distance, rel=1e-3, abs=1e-4)
+    distance = float(match.group(1))
     assert ("lower clearance to" in detail) == (distance > 0.0)
+
+
+#: Two ur5s reaching along x, the second turned half a turn (facing the first) 0.6 m away.
+FACING = [[0, -0.5, 0.5, 0, 0.3, 0], [1.5, -0.5, 0.5, 0, 0.3, 0]]
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        _cell(a1={"base": {"position": [0.1, 0.0, 0.0]}}),
+        _cell(a1={"base": {"position": [0.0, 0.0, 0.0]}}),
+        {"arms": [{"robot": "ur5", "waypoints": FACING},
+                  {"robot": "ur5", "base": {"position": [0.6, 0, 0], "orientation": [0, 0, 1, 0]}, "waypoints": FACING}]},
+    ],
+    ids=["near", "same-point", "turned-towards"],
+)
+def test_the_base_position_advised_for_arms_that_collide_at_their_start_clears_them(patient_client, body):
+    """The advice said how far to move the base, not where: moving it along the line between
+    the bases made a turned arm's overlap worse, and two bases at one point had no direction."""
+    detail = patient_client.post("/v1/cells", json=body).json()["detail"]
+    match = re.search(r"set arms\[1\]\.base\.position to \[([^\]]+)\]", detail)
+    assert match, detail
+    followed = copy.deepcopy(body)
+    followed["arms"][1]["base"]["position"] = [float(x) for x in match.group(1).split(",")]
+    answered = patient_client.post("/v1/cells", json=followed)
+    assert "collide at their start" not in answered.text, answered.text
 
 
 def test_three_arms_are_answered_on_one_clock_with_every_pairs_diagram(patient_client):
