@@ -97,6 +97,11 @@ def _arm_not_held(facts: dict) -> str:
 
 CELL_WORDING: dict[str, str | Callable[[dict], str]] = {
     "arm_not_held": _arm_not_held,
+    "clearance_samples": (
+        "checking the arms' clearance needs {count} samples (one for every 5 mm any point of an arm moves), more than "
+        "{most}: split the motion into {parts} cells or more, each arm's waypoints into as many parts (the waypoint "
+        "where one part ends starting the next)"
+    ),
     "arms_collide_at_start": _arms_collide_at_start,
     "arms_never_apart": _arms_never_apart,
     "no_order_of_arms": _no_order_of_arms,
