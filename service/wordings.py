@@ -104,10 +104,7 @@ def _needs_two_waypoints(facts: dict) -> str:
 
 def _where(facts: dict) -> str:
     """Where along a Cartesian line: the point's field, the next point, how far along."""
-    return (
-        f"{facts['field']} on the way to point {facts['index'] + 1}, {100 * facts['fraction']:.1f} % along "
-        f"(at {facts['position']} m)"
-    )
+    return f"{100 * facts['fraction']:.1f} % along the line to {facts['field']} (at {facts['position']} m)"
 
 
 def _law_acceleration_steps(facts: dict) -> str:
@@ -319,11 +316,17 @@ WORDING: dict[str, Wording] = {
     "line_too_long": "the line to {field} is {length:.4g} m long: it leaves the workspace of {robot}",
     "repeated_point": "{field} repeats the previous point",
     "point_out_of_reach": lambda facts: (
-        f"the line leaves the workspace of {facts['robot']}: no joint solution reaches the point {_where(facts)}"
+        f"the line leaves the workspace of {facts['robot']}: no joint solution reaches the point {_where(facts)}; bring "
+        f"{facts['field']} within the arm's reach, or go around the unreachable part through a point added before it"
     ),
-    "line_crosses_singularity": lambda facts: f"the line crosses a singularity of {facts['robot']} near the point {_where(facts)}",
+    "line_crosses_singularity": lambda facts: (
+        f"the line crosses a singularity of {facts['robot']} near the point {_where(facts)}; move {facts['field']} so "
+        "that the line passes that pose at a distance, or add a point before it so that the path goes around it"
+    ),
     "joint_jump": lambda facts: (
-        f"the line needs a joint jump of {facts['jump']:.3g} rad on joint {facts['joint_name']!r} near the point {_where(facts)}"
+        f"the line needs a joint jump of {facts['jump']:.3g} rad on joint {facts['joint_name']!r} near the point "
+        f"{_where(facts)}; start from another configuration (path.start, another solution of the same pose) or "
+        "add a point before it so that the path goes around that pose"
     ),
     "joint_path_strays": lambda facts: (
         f"the joint path strays {facts['deviation'] * 1e3:.3g} mm from the line after {facts['field']} "

@@ -116,8 +116,8 @@ def test_ur5_pose_line_keeps_orientation(client):
 @pytest.mark.parametrize(
     "points, words",
     [
-        ([[0.0, 0.5, 0.3]], ["leaves the workspace"]),
-        ([[0.0, 0.0, 0.6]], ["singularity"]),
+        ([[0.0, 0.5, 0.3]], ["leaves the workspace", "% along the line to path.positions[0] (at [", "bring path.positions[0] within"]),
+        ([[0.0, 0.0, 0.6]], ["singularity", "% along the line to path.positions[0]", "move path.positions[0] so that"]),
         ([[0.0, 0.5]], ["path.positions[0]"]),
         ([[1e9, 0.1, 0.2]], ["m long", "leaves the workspace"]),
     ],
