@@ -99,7 +99,13 @@ def allowed_pairs(given: object) -> frozenset[tuple[str, str]]:
     for index, item in enumerate(given):
         if not isinstance(item, list | tuple) or len(item) != 2:
             raise InvalidCollisionList(f"allowed_collisions[{index}] must be a pair [link, link], got {excerpt(item, 40)}")
-        pairs.add(pair(_name(item[0], f"allowed_collisions[{index}][0]"), _name(item[1], f"allowed_collisions[{index}][1]")))
+        first, second = _name(item[0], f"allowed_collisions[{index}][0]"), _name(item[1], f"allowed_collisions[{index}][1]")
+        if first == second:
+            raise InvalidCollisionList(
+                f"allowed_collisions[{index}] pairs link {excerpt(first, 40)} with itself, which is never checked: give two "
+                "different links"
+            )
+        pairs.add(pair(first, second))
     return frozenset(pairs)
 
 

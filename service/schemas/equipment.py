@@ -48,8 +48,10 @@ def checked_rotation(cls, value):
 
 def _inertia_shape(value: object) -> str | None:
     """Which form of an inertia ``value`` is: ``"values"`` (a list of 6), ``"matrix"`` (a list of
-    3) or ``None`` (neither: a 422 saying both forms)."""
+    3 rows) or ``None`` (neither, three numbers among them: a 422 saying both forms)."""
     if isinstance(value, list | tuple):
+        if len(value) == 3 and not any(isinstance(item, list | tuple) for item in value):
+            return None  # three numbers: principal moments, neither form
         return {6: "values", 3: "matrix"}.get(len(value))
     return None
 
@@ -62,7 +64,8 @@ _Inertia = Annotated[
     Discriminator(
         _inertia_shape,
         custom_error_type="inertia_shape",
-        custom_error_message="give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows of 3), in kg m^2",
+        custom_error_message="give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows of 3), in kg m^2 "
+        "(principal moments [a, b, c] about the centre of mass are [a, b, c, 0, 0, 0])",
     ),
 ]
 

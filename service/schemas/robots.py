@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, field_validator
 
 from toptraj.robots.uploads import MAX_NAME_CHARS, NAME_PATTERN
 from toptraj.service.schemas.common import Schema
@@ -117,6 +117,20 @@ class RobotCreate(Schema):
         "characters, no DOCTYPE) or a list of `[link, link]` pairs (at most 2,000). Adjacent links are never "
         "checked; an allowed pair also covers the links fixed to its links.",
     )
+
+    @field_validator("allowed_collisions", mode="before")
+    @classmethod
+    def _pairs(cls, value):
+        """A list of pairs checked by the library's rules first: its words, not the union's."""
+        if value is None or isinstance(value, str):
+            return value
+        from toptraj.robots.srdf import InvalidCollisionList, allowed_pairs
+
+        try:
+            allowed_pairs(value)
+        except InvalidCollisionList as error:
+            raise ValueError(error.detail) from None
+        return value
 
 
 MAX_CONFIGURATIONS = 1_000

@@ -72,12 +72,20 @@ def test_an_uploads_srdf_allows_its_pairs_along_a_path(client):
 
 @pytest.mark.parametrize(
     ("allowed", "words"),
-    [([["turret", "elbow"]], "'elbow', which is not a link"), (BILLION_LAUGHS, "DOCTYPE"), ([["a"]], "at least 2")],
+    [
+        ([["turret", "elbow"]], "'elbow', which is not a link"),
+        (BILLION_LAUGHS, "DOCTYPE"),
+        ([["a"]], "allowed_collisions[0] must be a pair [link, link], got a list of 1 item"),
+        ([["turret", "turret"]], "allowed_collisions[0] pairs link 'turret' with itself, which is never checked"),
+        ([[1, 2]], "allowed_collisions[0][0] must be a link name"),
+    ],
 )
 def test_an_upload_with_a_bad_list_is_refused_naming_it(client, allowed, words):
+    """In the list's own words: pydantic's union named the type (``list[list[str]]``) and said
+    "Input should be a valid string" of a list; a link paired with itself was accepted."""
     refused = client.post("/v1/robots", json={"name": "bad_3r", "urdf": ARM_3R, "allowed_collisions": allowed})
     assert refused.status_code == 422, refused.text
-    assert words in refused.text
+    assert words in refused.text and "list[list[str]]" not in refused.text and "valid string" not in refused.text
 
 
 def test_the_pairs_allowed_at_upload_hold_with_a_payload_a_mounting_and_in_a_cell(client):

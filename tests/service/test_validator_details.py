@@ -78,7 +78,10 @@ def test_the_cli_and_a_batch_line_write_places_as_the_http_422(client, tmp_path,
     assert json.loads(capsys.readouterr().err)["detail"] == expected["detail"]
 
 
-SHAPES = "give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows of 3), in kg m^2"
+SHAPES = (
+    "give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows of 3), in kg m^2 (principal moments [a, b, c] "
+    "about the centre of mass are [a, b, c, 0, 0, 0])"
+)
 
 
 @pytest.mark.parametrize(
@@ -87,6 +90,7 @@ SHAPES = "give 6 values [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3x3 matrix (3 rows o
         ([[1, 0, 0], [0, 1, 0]], f"payload.inertia: {SHAPES}"),
         ([1, 1, 1, 0, 0], f"payload.inertia: {SHAPES}"),
         ("diagonal", f"payload.inertia: {SHAPES}"),
+        ([0.1, 0.1, 0.1], f"payload.inertia: {SHAPES}"),  # was read as 3 rows: "put each item's values in brackets"
         ([1e9, 1, 1, 0, 0, 0], "payload.inertia[0]: 1e+09 is not within the accepted range [-10000, 10000] kg m^2"),
         ([[1, 0, 0], [0, 1, 0], [0, 0]], "payload.inertia[2]: List should have at least 3 items, not 2"),
         ([1, 1, "a", 0, 0, 0], "payload.inertia[2]: Input should be a valid number; got the string 'a'"),
