@@ -11,6 +11,7 @@ from toptraj import robots
 from toptraj.planners.coordination import Cell, CellArm, coordinate
 from toptraj.planners.errors import InvalidRequest, WrongLength
 from toptraj.planners.execution.deadline import Deadline
+from toptraj.planners.problem.gravity_notes import gravity_notes
 from toptraj.planners.problem.requests import WaypointPath
 from toptraj.planners.problem.waypoints import make_path, without_repeats
 from toptraj.robots.equipment import InvalidEquipment, equip, mounting
@@ -85,6 +86,9 @@ def plan_cell(body: CellRequest, deadline: Deadline, format_: str | None = None)
     ``samples`` body that ``cell_answers.csv_bytes`` writes)."""
     warnings: list[str] = []
     arms = tuple(_arm(index, arm, body.gravity, deadline, warnings) for index, arm in enumerate(body.arms))
+    # The cell's gravity, unusual as a trajectory's mounting.gravity is noted, in the cell's field.
+    warnings[:0] = [note_text(note).replace("mounting.gravity", "gravity").replace("mounting.orientation", "arms[i].base.orientation")
+                    for note in gravity_notes(arms[0].robot)]
     cell = Cell(arms, body.clearance, tuple(body.constraints))
     format_ = format_ or body.format
     exact = exact_period_for(format_, body.exact_period)

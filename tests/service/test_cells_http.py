@@ -378,3 +378,13 @@ def test_a_trajectory_field_in_a_cell_says_what_the_cell_does_instead(patient_cl
     (body if where == "top" else body["arms"][0])[field] = {"method": "toppra"} if field == "timing" else [] if field != "self_collision" else True
     response = patient_client.post("/v1/cells", json=body)
     assert response.status_code == 422 and words in response.json()["detail"], response.text
+
+
+def test_a_cell_gravity_pointing_up_is_warned_of_as_a_mounting_s_is(patient_client):
+    body = copy.deepcopy(EXAMPLE)
+    body["gravity"] = [0.0, 0.0, 9.81]
+    response = patient_client.post("/v1/cells", json=body)
+    assert response.status_code == 200, response.text
+    (warning,) = [text for text in response.json()["warnings"] if "points up" in text]
+    assert warning.startswith("gravity [0, 0, 9.81] points up (+z in the world)") and "arms[i].base.orientation" in warning
+    assert not [text for text in patient_client.post("/v1/cells", json=EXAMPLE).json()["warnings"] if "points up" in text]
