@@ -38,7 +38,7 @@ from scipy.interpolate import CubicSpline
 
 from tests.paths import DATA
 from toptraj import robots
-from toptraj.planners import METHODS, CartesianLine, TimingFailed, WaypointPath, build_problem, plan
+from toptraj.planners import METHODS, CartesianLine, WaypointPath, build_problem, plan
 from toptraj.planners.generators.collocation.generator import Collocation
 from toptraj.planners.generators.joint_moves import Unsynchronized, ViaPoints
 from toptraj.planners.generators.search.generator import Search
@@ -290,8 +290,7 @@ def _given_path_cases() -> list:
             if method in ("phase_plane", "toppra", *LAWS) or (method == "min_cost" and robot == "ur5"):
                 # jerk_limited: a blend's curvature jumps, no finite jerk passes it; min_cost on
                 # one arm only (its solver takes seconds on a blend).
-                blend = Case(robot, method, "blend")
-                cases.append(pytest.param(blend, marks=LAW_ON_BLEND) if (robot, method) == ("lift_rp", "quintic") else blend)
+                cases.append(Case(robot, method, "blend"))
         cases += [Case(robot, law, "via") for law in ("quintic", "cubic")]
         if joint_limited(robot):
             cases.append(Case(robot, "ruckig", "straight"))
@@ -302,10 +301,6 @@ def _given_path_cases() -> list:
         cases += [Case(robot, method, "tool_speed") for method in ("phase_plane", "toppra", "min_cost", "cycloidal")]
     return cases
 
-
-#: The quintic law on the lift arm's blend (a 23 s motion) is refused by the runner's own sample
-#: check ("exceeds the acceleration limit of joint 'lift' although its dense check holds").
-LAW_ON_BLEND = pytest.mark.xfail(reason="the quintic law's blend answer fails its sample check", strict=True, raises=TimingFailed)
 
 CASES = _given_path_cases()
 TOOL_SPEED = 0.3  # m/s

@@ -50,12 +50,17 @@ class LawSegment:
             low, high = np.where(below, middle, low), np.where(below, high, middle)
         return 0.5 * (low + high)
 
-    def sample_times(self) -> np.ndarray:
-        """Local times for checking limits: uniform, plus the profile's own knots."""
+    def sample_times(self, grid: np.ndarray | None = None) -> np.ndarray:
+        """Local times for checking limits: uniform, plus the profile's own knots and the
+        instants at which the segment passes the values of s in ``grid`` inside it."""
         tau = np.linspace(0.0, 1.0, SAMPLES_PER_SEGMENT + 1)
         if self.profile is not None:
             tau = np.union1d(tau, self.profile.knots())
-        return tau * self.duration
+        t = tau * self.duration
+        if grid is not None:
+            inside = grid[(grid > self.s_start) & (grid < self.s_end)]
+            t = np.union1d(t, self.time_at(inside))
+        return t
 
 
 @dataclass(frozen=True)
@@ -65,10 +70,13 @@ class LawTiming(PathTiming):
     Attributes:
         segments: The segments in order.
         binding: The limit that set the duration, when the method minimized it.
+        grid: Values of s its limit check passes through too (the constraints' grid, which
+            holds every waypoint), beside uniform samples in time; ``None``: none.
     """
 
     segments: tuple[LawSegment, ...]
     binding: Binding | None = None
+    grid: np.ndarray | None = None
 
     @property
     def duration(self) -> float:
@@ -82,7 +90,7 @@ class LawTiming(PathTiming):
             return None
         return LawTiming(
             tuple(LawSegment(seg.s_start, seg.s_end, seg.duration * factor, profile=seg.profile) for seg in self.segments),
-            binding=self.binding,
+            binding=self.binding, grid=self.grid,
         )
 
     @property
@@ -104,7 +112,7 @@ class LawTiming(PathTiming):
     def dense_states(self, points_per_interval: int = 3) -> DenseStates:
         pieces = []
         for segment in self.segments:
-            t = segment.sample_times()
+            t = segment.sample_times(self.grid)
             s, sd, sdd, sddd = segment.states(t)
             left = np.zeros(len(t), dtype=bool)
             left[-1] = True

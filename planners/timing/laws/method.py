@@ -164,9 +164,9 @@ class ClassicalMethod(TimingMethod):
             factor = duration / sum(minimal)
             segments = [self._retimed(segment, segment.duration * factor, k, len(segments), boundary)
                         for k, segment in enumerate(segments)]
-            return LawTiming(tuple(segments), binding=None)
+            return LawTiming(tuple(segments), binding=None, grid=constraints.s)
         slowest = int(np.argmax(minimal))
-        return LawTiming(tuple(segments), binding=bindings[slowest])
+        return LawTiming(tuple(segments), binding=bindings[slowest], grid=constraints.s)
 
     def _samples(self, constraints, start, end, s):
         inside = np.clip(s, start + _INSIDE * (end - start), end - _INSIDE * (end - start))
@@ -176,7 +176,11 @@ class ClassicalMethod(TimingMethod):
         """Shortest rest-to-rest segment: y* over 401 samples of tau, then twice over 33 samples
         between the neighbours of the binding sample (the extremum lies between them)."""
         span = end - start
-        tau = np.union1d(np.linspace(0.0, 1.0, 401), self.profile.knots())
+        # The instants at which the law passes the constraints' grid points too: the grid holds
+        # every waypoint and intervals between them, where a spline through nearly repeated
+        # waypoints bends sharply over a stretch of s too short for uniform samples in time.
+        grid = constraints.s[(constraints.s > start) & (constraints.s < end)]
+        tau = np.union1d(np.union1d(np.linspace(0.0, 1.0, 401), self.profile.knots()), self.profile.tau_at((grid - start) / span))
         best = np.inf
         for _ in range(3):
             sigma, d1, d2, d3 = self.profile.derivatives(tau)
