@@ -18,6 +18,7 @@ timing. Joint friction enters the limits (conservatively linearized) but not the
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from dataclasses import dataclass
@@ -74,25 +75,35 @@ class MinCostMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> CostTimeScaling:
-        s = constraints.s
-        reference = friction_reference(constraints)
+        """The convex program on ``constraints``' grid (module docstring); with a torque weight
+        and viscous friction, solved again with the friction's tangent taken at the motion
+        found, and the cost reported that of the motion's own torques."""
         torque = [column for column, (kind, _) in enumerate(constraints.rows) if kind == "torque"]
+        viscous = _midpoint(constraints.d, constraints.d_left, torque) if constraints.has_friction else None
+        if viscous is not None and not viscous.any():
+            viscous = None
+        result, program = self._solved(constraints, boundary, friction_reference(constraints), torque, viscous, deadline)
+        if viscous is not None and self.torque_weight > 0:
+            result, program = self._solved(constraints, boundary, result.sd**2, torque, viscous, deadline)
+        return dataclasses.replace(result, cost=motion_cost(program, result.sd**2))
 
-        def midpoint(right, left):
-            return 0.5 * (right[:-1, torque] + left[1:, torque])
-
+    def _solved(self, constraints, boundary, reference, torque, viscous, deadline) -> tuple[CostTimeScaling, MinCostProgram]:
+        """One solve, the viscous friction of the rows and of the cost's torques linearized at
+        ``reference`` (x = sd^2 at the grid points, 1/s^2)."""
         program = MinCostProgram(
-            ds=np.diff(s),
+            ds=np.diff(constraints.s),
             x_bound=constraints.sd_max**2,
             right=constraints.linearized(reference),
             left=constraints.linearized(reference, "left"),
-            torque_a=midpoint(constraints.a, constraints.a_left),
-            torque_b=midpoint(constraints.b, constraints.b_left),
-            torque_c=midpoint(constraints.c, constraints.c_left),
+            torque_a=_midpoint(constraints.a, constraints.a_left, torque),
+            torque_b=_midpoint(constraints.b, constraints.b_left, torque),
+            torque_c=_midpoint(constraints.c, constraints.c_left, torque),
             sd_start=boundary.sd_start,
             sd_end=boundary.sd_end,
             torque_weight=self.torque_weight,
             torque_unit=_torque_units(constraints, torque),
+            torque_d=viscous,
+            viscous_reference=None if viscous is None else 0.5 * (reference[:-1] + reference[1:]),
         )
         deadline.check()
         # cvxpy's canonicalization and Clarabel cannot check a deadline: they run in a child
@@ -101,7 +112,31 @@ class MinCostMethod(TimingMethod):
         interior, value, status, computing = run_isolated(timed_solve, program, deadline=deadline, nice=LOW_PRIORITY)
         fixed = max(time.perf_counter() - started - computing, 0.0)
         x = np.concatenate(([boundary.sd_start**2], interior, [boundary.sd_end**2]))
-        return CostTimeScaling(s, np.sqrt(x), cost=value, solver_status=status, fixed_seconds=fixed)
+        return CostTimeScaling(constraints.s, np.sqrt(x), cost=value, solver_status=status, fixed_seconds=fixed), program
+
+
+def _midpoint(right: np.ndarray, left: np.ndarray, columns: list[int]) -> np.ndarray:
+    """The rows ``columns`` at the middle of each grid interval (n, k): the mean of the right
+    side of its start and the left side of its end."""
+    return 0.5 * (right[:-1, columns] + left[1:, columns])
+
+
+def motion_cost(program: MinCostProgram, x: np.ndarray) -> float:
+    """J (s) of the motion x = sd^2 at the grid points (n + 1,) in the program's discretization,
+    with its own torques, viscous friction d sqrt(x) included exactly: sum over the intervals of
+    their time 2 ds / (sqrt(x_i) + sqrt(x_i+1)) times 1 + beta |tau|^2 at their middle, tau =
+    a u + b x_mid + c + d sqrt(x_mid), u = (x_i+1 - x_i) / (2 ds). The program's objective where
+    it has no viscous friction (its cone constraints are tight at the optimum)."""
+    ds, root = program.ds, np.sqrt(np.maximum(x, 0.0))
+    with np.errstate(divide="ignore"):
+        time = np.where(ds > 0.0, 2.0 * ds / (root[:-1] + root[1:]), 0.0)
+    if program.torque_weight == 0.0:
+        return float(time.sum())
+    u, middle = (x[1:] - x[:-1]) / (2.0 * ds), 0.5 * (x[:-1] + x[1:])
+    tau = program.torque_a * u[:, None] + program.torque_b * middle[:, None] + program.torque_c
+    if program.torque_d is not None:
+        tau = tau + program.torque_d * np.sqrt(np.maximum(middle, 0.0))[:, None]
+    return float((time * (1.0 + program.torque_weight * (tau**2).sum(axis=1))).sum())
 
 
 @dataclass(frozen=True)
@@ -119,6 +154,10 @@ class MinCostProgram:
         torque_unit: A typical torque of each torque row (k,), N m (its limit): the torques
             enter the cone constraints in this unit, so that they are of order one (Clarabel's
             tolerances are absolute; in N m, tau^2 of thousands failed it on fine grids).
+        torque_d: Viscous friction coefficients at the interval midpoints (n, k), N m s (the
+            torque's term d sd); ``None`` without viscous friction.
+        viscous_reference: x at the midpoints (n,), 1/s^2, at which d sqrt(x) is replaced by its
+            tangent d (x + x_ref) / (2 sqrt(x_ref)) in the cost's torques.
     """
 
     ds: np.ndarray
@@ -132,6 +171,8 @@ class MinCostProgram:
     sd_end: float
     torque_weight: float
     torque_unit: np.ndarray | None = None
+    torque_d: np.ndarray | None = None
+    viscous_reference: np.ndarray | None = None
 
 
 def _torque_units(constraints: PathConstraints, torque: list[int]) -> np.ndarray:
@@ -196,6 +237,11 @@ def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
                 cp.multiply(program.torque_a[:, column] / unit, a) + cp.multiply(program.torque_b[:, column] / unit, middle)
                 + program.torque_c[:, column] / unit
             )  # in units of ``unit``: w is then (tau / unit)^2 / z
+            if program.torque_d is not None and program.viscous_reference is not None:
+                root = np.sqrt(np.maximum(program.viscous_reference, 1e-6))
+                tau = tau + cp.multiply(program.torque_d[:, column] / (2.0 * unit * root), middle) + (
+                    program.torque_d[:, column] * root / (2.0 * unit)
+                )
             w = cp.Variable(n, nonneg=True)
             limits.append(cp.SOC(w + z, cp.vstack([2 * tau, w - z]), axis=0))
             cost = cost + program.torque_weight * unit**2 * cp.sum(cp.multiply(2 * ds, w))
