@@ -43,6 +43,8 @@ STRAIGHT = 1e-12
 #: path exceeded the acceleration limit by 23 %, and min_cost's solver failed up to 1e-6 of the
 #: path); the speed such a blend allows, sqrt(acceleration limit x radius), is nearly a stop.
 MIN_BLEND = 1e-5
+#: Distance (relative to the path's length) below which two points are one: a rounding.
+SAME_POINT = 1e-12
 
 
 class BlendedPath(GeometricPath):
@@ -87,7 +89,9 @@ class BlendedPath(GeometricPath):
                 continue
             center, x, y, radius, angle, distance = blend
             start = waypoints[i] - distance * directions[i - 1]
-            if np.linalg.norm(start - position) > MIN_BLEND * scale:
+            # The straight piece up to the blend, however short (a short first segment: the path
+            # must leave the first waypoint); only a gap of a rounding is closed by the arc itself.
+            if np.linalg.norm(start - position) > SAME_POINT * scale:
                 pieces.append(_line(position, start))
                 corners.append(False)
             pieces.append(("arc", center, x, y, radius, angle * radius))

@@ -256,3 +256,25 @@ def test_a_blend_too_small_to_follow_is_a_corner_where_the_motion_stops(client, 
         and "the motion stops there" in warning
         for warning in answers["blend"]["warnings"]
     )
+
+
+@pytest.mark.parametrize(
+    "waypoints",
+    [
+        # geering_2r: a first segment of 9e-5 rad, half of it the blend's; then a long one
+        [[-2.601765, -2.399498], [-2.60183, -2.399563], [0.297917, 2.923878], [0.297964, 2.923937], [0.294114, -2.487892]],
+        # a short segment between two blends, shorter than 1e-5 of the path
+        [[0.0, 0.0], [1.0, 0.0], [1.0, 4e-5], [2.0, 1.0]],
+    ],
+    ids=["short-first-segment", "short-middle-segment"],
+)
+def test_a_blended_path_leaves_the_first_waypoint_and_has_no_gap(waypoints):
+    """A straight piece shorter than 1e-5 of the path, up to a blend, was left out: the path
+    started 3.25e-5 rad from the first waypoint (half the short segment), and between two blends
+    it jumped over such a gap."""
+    path = BlendedPath(np.array(waypoints, dtype=float), 0.13)
+    assert path.evaluate(np.array([0.0])).q[0] == pytest.approx(waypoints[0], abs=1e-15)
+    assert path.evaluate(np.array([1.0])).q[0] == pytest.approx(waypoints[-1], abs=1e-15)
+    junctions = path.knots[1:-1]
+    left, right = path.evaluate(junctions, "left").q, path.evaluate(junctions, "right").q
+    assert np.abs(left - right).max() <= 1e-12
