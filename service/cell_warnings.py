@@ -1,5 +1,5 @@
 """The warnings of a cell's answer, as a trajectory's answer gives them: a limit kind not held
-(left out of ``constraints``) that the motion exceeds, a sample period longer than the motion,
+(left out of ``constraints``) that the motion exceeds, a sample period longer than a tenth of the motion,
 and samples put on whole periods (``exact_period``) that slow the motion noticeably."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import numpy as np
 
 from toptraj.planners.coordination import Cell
 from toptraj.planners.runner.answer import UNASKED_EXCESS
-from toptraj.planners.runner.sampling_notes import SAMPLES_ADVISED, STRETCH_NOTED, percent
+from toptraj.planners.runner.sampling_notes import FEWEST_PERIODS, SAMPLES_ADVISED, STRETCH_NOTED, percent
 
 
 def cell_warnings(
@@ -27,9 +27,10 @@ def cell_warnings(
                     f"arms[{index}]: the {kind} of joint {arm.robot.joint_names[joint]!r} reaches {finite[joint]:.4g} times "
                     f"its limit, which was not asked for: add {kind!r} to constraints to hold it"
                 )
-    if duration > 0.0 and dt > duration:
+    if duration > 0.0 and dt > duration / FEWEST_PERIODS:
         warnings.append(
-            f"dt = {dt:g} s is longer than the motion ({duration:.6g} s): its {count} samples do not follow the motion. "
+            f"dt = {dt:g} s is {'longer than the motion' if dt > duration else 'more than a tenth of the motion'} "
+            f"({duration:.6g} s): its {count} samples do not follow the motion. "
             f"dt is in seconds; dt <= {duration / SAMPLES_ADVISED:.3g} s gives {SAMPLES_ADVISED} samples or more"
         )
     if duration > 0.0 and sampled / duration - 1.0 > STRETCH_NOTED:

@@ -84,9 +84,9 @@ def _missed_region(facts: dict) -> str:
 
 def _too_few_samples(facts: dict) -> str:
     return (
-        f"output.dt = {facts['value']:g} s is longer than the motion ({facts['duration']:.6g} s): its {facts['count']} "
-        f"samples do not follow the motion. output.dt is in seconds; output.dt <= {facts['advised']:.3g} s gives "
-        f"{facts['samples']} samples or more"
+        f"output.dt = {facts['value']:g} s is {'longer than the motion' if facts['value'] > facts['duration'] else 'more than a tenth of the motion'} "
+        f"({facts['duration']:.6g} s): its {facts['count']} samples do not follow the motion. output.dt is in seconds; "
+        f"output.dt <= {facts['advised']:.3g} s gives {facts['samples']} samples or more"
     )
 
 

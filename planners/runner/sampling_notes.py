@@ -1,5 +1,5 @@
 """Notes on how an answer's samples render its motion: too few samples to follow it (a period
-``dt`` longer than the motion), and a motion slowed to end on a whole period (``exact_period``,
+``dt`` longer than a tenth of the motion), and a motion slowed to end on a whole period (``exact_period``,
 ``toptraj.planners.trajectory.exact_period_scale``) by more than ``STRETCH_NOTED``."""
 
 from __future__ import annotations
@@ -9,6 +9,9 @@ from toptraj.robots.notes import Note
 
 #: Samples per motion that a period of at most duration / ``SAMPLES_ADVISED`` gives.
 SAMPLES_ADVISED = 100
+#: Fewest periods per motion below which the samples are noted as not following it (a period
+#: longer than a tenth of the motion: a 1.55 s motion sampled every 0.9 s has 3 samples).
+FEWEST_PERIODS = 10
 #: Relative stretch of the motion (k - 1) beyond which it is noted.
 STRETCH_NOTED = 0.01
 
@@ -22,9 +25,9 @@ def sampling_notes(duration: float, dt: float, exact_period: bool, count: int) -
     """The notes for a motion of ``duration`` (s) sampled every ``dt`` (s) into ``count``
     samples, on whole periods with ``exact_period``."""
     notes = []
-    if duration > 0 and dt > duration:
+    if duration > 0 and dt > duration / FEWEST_PERIODS:
         notes.append(Note(
-            f"sampling.dt = {dt:g} s exceeds the motion's duration {duration:.6g} s: its {count} samples do not "
+            f"sampling.dt = {dt:g} s is more than a tenth of the motion's duration {duration:.6g} s: its {count} samples do not "
             f"follow the motion; a period of at most {duration / SAMPLES_ADVISED:.3g} s (dt is in seconds) gives "
             f"{SAMPLES_ADVISED} samples or more",
             "too_few_samples", field="sampling.dt", value=dt, duration=duration, count=count,
