@@ -13,7 +13,11 @@ a sum of convex functions (1 / concave, and quadratic over concave), as in Versc
 tau_i is taken at the interval's midpoint. The limits are the same rows as for the other methods,
 at both ends of every interval. cvxpy states the problem and Clarabel, an interior-point conic
 solver, solves it; with beta = 0 it is a third, independent computation of the time-optimal
-timing. Joint friction enters the limits (conservatively linearized) but not the cost.
+timing. Joint friction enters the limits (conservatively linearized) and the cost: Coulomb
+friction in C, viscous friction d sd = d sqrt(b), concave in b, by its tangent at the maximum
+velocity curve (so that the program stays convex, its optimum that of the tangent's cost); the
+cost reported is that of the motion found with its own torques, the friction as it is
+(``motion_cost``).
 """
 
 from __future__ import annotations
@@ -75,16 +79,14 @@ class MinCostMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> CostTimeScaling:
-        """The convex program on ``constraints``' grid (module docstring); with a torque weight
-        and viscous friction, solved again with the friction's tangent taken at the motion
-        found, and the cost reported that of the motion's own torques."""
+        """The convex program on ``constraints``' grid (module docstring), the cost reported that
+        of the motion's own torques (``motion_cost``: viscous friction as it is, where the
+        program holds its tangent)."""
         torque = [column for column, (kind, _) in enumerate(constraints.rows) if kind == "torque"]
         viscous = _midpoint(constraints.d, constraints.d_left, torque) if constraints.has_friction else None
         if viscous is not None and not viscous.any():
             viscous = None
         result, program = self._solved(constraints, boundary, friction_reference(constraints), torque, viscous, deadline)
-        if viscous is not None and self.torque_weight > 0:
-            result, program = self._solved(constraints, boundary, result.sd**2, torque, viscous, deadline)
         return dataclasses.replace(result, cost=motion_cost(program, result.sd**2))
 
     def _solved(self, constraints, boundary, reference, torque, viscous, deadline) -> tuple[CostTimeScaling, MinCostProgram]:
@@ -175,6 +177,33 @@ class MinCostProgram:
     viscous_reference: np.ndarray | None = None
 
 
+def _torque_cost(program: MinCostProgram, a, b, z):
+    """beta times the integral of |tau|^2 dt over the grid (cvxpy expressions of the interval
+    accelerations ``a`` (n,), the b = sd^2 at the points (n + 1,) and z (n,), module docstring),
+    and its rotated second-order cones: w_ij >= (tau_ij / unit_j)^2 / z_i, tau at the middles,
+    its viscous friction d sqrt(b) by its tangent at ``program.viscous_reference``."""
+    import cvxpy as cp
+
+    n, ds = len(program.ds), program.ds
+    middle = 0.5 * (b[:-1] + b[1:])
+    units = np.ones(program.torque_a.shape[1]) if program.torque_unit is None else program.torque_unit
+    cost, cones = 0.0, []
+    for column, unit in enumerate(units):
+        tau = (
+            cp.multiply(program.torque_a[:, column] / unit, a) + cp.multiply(program.torque_b[:, column] / unit, middle)
+            + program.torque_c[:, column] / unit
+        )  # in units of ``unit``: w is then (tau / unit)^2 / z
+        if program.torque_d is not None and program.viscous_reference is not None:
+            root = np.sqrt(np.maximum(program.viscous_reference, 1e-6))
+            tau = tau + cp.multiply(program.torque_d[:, column] / (2.0 * unit * root), middle) + (
+                program.torque_d[:, column] * root / (2.0 * unit)
+            )
+        w = cp.Variable(n, nonneg=True)
+        cones.append(cp.SOC(w + z, cp.vstack([2 * tau, w - z]), axis=0))
+        cost = cost + program.torque_weight * unit**2 * cp.sum(cp.multiply(2 * ds, w))
+    return cost, cones
+
+
 def _torque_units(constraints: PathConstraints, torque: list[int]) -> np.ndarray:
     """(k,) the largest finite torque limit of each torque row along the path (N m), 1 where
     none is finite."""
@@ -230,21 +259,8 @@ def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
     limits.append(z <= roots[:-1] + roots[1:])
     cost = cp.sum(cp.multiply(2 * ds, cp.inv_pos(z)))
     if program.torque_weight > 0:
-        middle = 0.5 * (b[:-1] + b[1:])
-        units = np.ones(program.torque_a.shape[1]) if program.torque_unit is None else program.torque_unit
-        for column, unit in enumerate(units):
-            tau = (
-                cp.multiply(program.torque_a[:, column] / unit, a) + cp.multiply(program.torque_b[:, column] / unit, middle)
-                + program.torque_c[:, column] / unit
-            )  # in units of ``unit``: w is then (tau / unit)^2 / z
-            if program.torque_d is not None and program.viscous_reference is not None:
-                root = np.sqrt(np.maximum(program.viscous_reference, 1e-6))
-                tau = tau + cp.multiply(program.torque_d[:, column] / (2.0 * unit * root), middle) + (
-                    program.torque_d[:, column] * root / (2.0 * unit)
-                )
-            w = cp.Variable(n, nonneg=True)
-            limits.append(cp.SOC(w + z, cp.vstack([2 * tau, w - z]), axis=0))
-            cost = cost + program.torque_weight * unit**2 * cp.sum(cp.multiply(2 * ds, w))
+        torque_cost, cones = _torque_cost(program, a, b, z)
+        cost, limits = cost + torque_cost, limits + cones
     problem = cp.Problem(cp.Minimize(cost), limits)
     try:
         with warnings.catch_warnings():

@@ -242,8 +242,8 @@ def test_one_arm_or_one_value_is_counted_in_the_singular(patient_client):
 def test_a_cell_warns_of_limits_it_was_not_asked_to_hold_and_of_its_sampling(patient_client):
     """As a trajectory's answer: with velocity limits only, the arms' accelerations and torques
     run far past their limits (66 and 17 times), each named with how to hold it; samples a second
-    apart on whole periods slow the 1.88 s motion to 2 s (6.3 %), which is said; the example as it
-    is warns of nothing."""
+    apart on whole periods are too few to follow the 1.88 s motion and slow it to 2 s (6.3 %),
+    both of which are said; the example as it is warns of nothing."""
     velocity_only = patient_client.post("/v1/cells", json=EXAMPLE | {"constraints": ["velocity"]}).json()
     found = {re.match(r"arms\[(\d)\]: the (\w+) of", text).groups() for text in velocity_only["warnings"]}
     assert found == {("0", "acceleration"), ("0", "torque"), ("1", "acceleration"), ("1", "torque")}, velocity_only["warnings"]
@@ -251,8 +251,9 @@ def test_a_cell_warns_of_limits_it_was_not_asked_to_hold_and_of_its_sampling(pat
     tau = np.abs(np.asarray(arm0["tau"])).max()  # the answer's own samples exceed the torque limit (150 N m)
     assert tau > 150.0 and all(text.endswith("to constraints to hold it") for text in velocity_only["warnings"])
     coarse = patient_client.post("/v1/cells", json=EXAMPLE | {"dt": 1.0, "format": "joint_trajectory"}).json()
-    [slowed] = coarse["warnings"]
+    few, slowed = coarse["warnings"]  # three samples of a 1.88 s motion, and the slowing
     scale = coarse["sampled_duration"] / coarse["duration"]
+    assert few.startswith("dt = 1 s is more than a tenth of the motion") and "its 3 samples do not follow" in few
     assert coarse["sampled_duration"] == 2.0 and slowed.startswith(f"exact_period slows the motion by {100 * (scale - 1):.3g} %")
     assert patient_client.post("/v1/cells", json=EXAMPLE).json()["warnings"] == []
 
