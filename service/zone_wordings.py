@@ -5,6 +5,7 @@ zones), as ``toptraj.service.wordings`` words the other errors (``ZONE_WORDING``
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 
 ZONE_WORDING: dict[str, str | Callable[[dict], str]] = {
@@ -16,9 +17,10 @@ ZONE_WORDING: dict[str, str | Callable[[dict], str]] = {
         "timing.zones cover more than {most} stretches of the path from timing.zones[{index}] on: the tool point "
         "enters and leaves a region many times; give fewer or larger regions, or an s_range instead"
     ),
-    "zone_kind_not_held": (
-        "timing.zones[{index}].{kind}_scale scales the {kind} limit, which timing.constraints does not hold: add "
-        "'{kind}' to timing.constraints, or leave timing.zones[{index}].{kind}_scale out"
+    "zone_kind_not_held": lambda facts: (
+        f"timing.zones[{facts['index']}].{facts['kind']}_scale scales the {facts['kind']} limit, which is not among the "
+        f"limits held ({', '.join(facts['kinds_held'])}): give timing.constraints with {facts['kind']!r} among them "
+        f"({json.dumps([*facts['kinds_held'], facts['kind']])}), or leave timing.zones[{facts['index']}].{facts['kind']}_scale out"
     ),
     "zones_not_served": lambda facts: (
         f"timing.zones are held by timing.method {' or '.join(facts['methods'])} along a given path (path.kind "

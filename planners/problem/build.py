@@ -81,7 +81,6 @@ def build_problem(
     else:
         kinds = check_constraint_kinds(limits.kinds, method)
     check_numbers(limits, boundary, duration, sampling.dt)
-    check_zones_held(limits.zones, kinds)
     check_obstacles(obstacles)
     if sampling.exact_period and boundary.velocities_moving:
         raise Conflicting("sampling.exact_period", sampling.exact_period, ("boundary",), rule="exact_period_with_moving_ends")
@@ -89,7 +88,8 @@ def build_problem(
     margin = limits.margin
     if not (np.isfinite(margin) and 0.0 <= margin <= MAX_LIMIT_MARGIN):
         raise OutOfRange("limits.margin", margin, 0.0, MAX_LIMIT_MARGIN, rule="margin_out_of_range")
-    held = _limits(robot, motion, method, limits)
+    held = _limits(robot, motion, method, limits)  # zones checked and refused where not served
+    check_zones_held(limits.zones, kinds)
     held = held.tightened(margin) if margin else held
     notes: tuple[str, ...] = (*raised_limits(robot, limits, kinds), *gravity_notes(robot))
     if isinstance(motion, WaypointPath):

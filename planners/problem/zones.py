@@ -101,7 +101,7 @@ def check_zones_held(zones: tuple[Zone, ...], kinds: tuple[str, ...]) -> None:
                     f"zones[{index}].{kind}",
                     f"zone {index} scales the {kind} limit, which is not among the limits held ({', '.join(kinds)}): "
                     f"hold {kind} too, or leave the zone's {kind} factor out",
-                    rule="zone_kind_not_held", index=index, kind=kind, value=getattr(zone, kind),
+                    rule="zone_kind_not_held", index=index, kind=kind, value=getattr(zone, kind), kinds_held=tuple(kinds),
                 )
 
 

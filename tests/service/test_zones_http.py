@@ -141,9 +141,13 @@ def test_a_zone_scaling_a_limit_that_is_not_held_is_refused_and_the_advice_works
     refused = client.post("/v1/trajectories", json=body)
     assert refused.status_code == 422, refused.text
     assert refused.json()["detail"] == (
-        "timing.zones[0].torque_scale scales the torque limit, which timing.constraints does not hold: add 'torque' to "
-        "timing.constraints, or leave timing.zones[0].torque_scale out"
+        "timing.zones[0].torque_scale scales the torque limit, which is not among the limits held (velocity, acceleration): "
+        'give timing.constraints with \'torque\' among them (["velocity", "acceleration", "torque"]), or leave '
+        "timing.zones[0].torque_scale out"
     )
+    # a method that holds no zones is told so first (its own advice; torque would not help ruckig)
+    ruckig = client.post("/v1/trajectories", json={**body, "timing": {**body["timing"], "method": "ruckig", "constraints": None}})
+    assert ruckig.status_code == 422 and "not by 'ruckig'" in ruckig.json()["detail"], ruckig.text
     followed = client.post("/v1/trajectories", json={**body, "timing": {**body["timing"], "constraints": ["velocity", "acceleration", "torque"]}})
     assert followed.status_code == 200, followed.text
     assert followed.json()["zones"][0]["peak"] <= 1.003

@@ -15,6 +15,7 @@ from toptraj.planners.constraints.path_constraints import build_path_constraints
 from toptraj.planners.errors import InfeasiblePath, NotServed, OutOfRange
 from toptraj.planners.generators.collocation import collocation_path, optimize_motion
 from toptraj.planners.generators.collocation.bang_bang import switching_times
+from toptraj.planners.generators.collocation.motion import StatedGap
 from toptraj.planners.generators.collocation.report import CollocationReport
 from toptraj.planners.generators.collocation.switching import refine_collocation, switched_path
 from toptraj.planners.paths.grid import path_grid
@@ -99,7 +100,10 @@ class Collocation(MotionGenerator):
         cost = getattr(result, "cost", None) if self.torque_weight else result.duration
         if cost is None:  # the collocation's own timing, returned: its cost is the collocation's
             cost = collocation.cost
-        if source is collocation:  # the answer's own objective against the collocation's optimum
+        if source is collocation and self.torque_weight and problem.robot.has_friction:
+            # The collocation's dynamics leave the joint friction out; the answer's cost holds it.
+            source = StatedGap(None, FRICTION_GAP)
+        elif source is collocation:  # the answer's own objective against the collocation's optimum
             source = collocation.gap_of(cost)
         solver = CollocationReport.of(winner, how, source)
         notes = (*notes, *self._gap_note(source, collocation))
@@ -120,6 +124,13 @@ class Collocation(MotionGenerator):
             "collocation_gap", gap=source.optimality_gap, basis=source.gap_basis, what=what,
             most_intervals=MAX_INTERVALS if len(collocation.t) - 1 < MAX_INTERVALS else None,
         ),)
+
+
+#: Why a free path with a torque weight on an arm with joint friction states no gap.
+FRICTION_GAP = (
+    "none: the collocation's dynamics leave the joint friction out, so its optimum is not that of the "
+    "answer's cost, which holds the friction"
+)
 
 
 def _optimized(problem: Problem, execution: Execution):
