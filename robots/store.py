@@ -204,7 +204,7 @@ class UploadStore:
                         )
                     connection.execute("ROLLBACK")
                     return False
-                alike = _alike(connection, name)
+                alike = _alike(connection, name)  # the name itself is not stored (row is None)
                 if alike is not None:  # a request naming one, mistyped in case, would plan the other
                     raise RobotConflict(f"name {excerpt(name)} differs from the upload {alike!r} only in case; choose another")
                 count, stored = self._usage(connection)

@@ -206,10 +206,10 @@ def register_urdf(urdf: str, name: str | None = None, options: UploadOptions | N
     if alike is not None:  # a request naming one, mistyped in case, would plan the other
         raise RobotConflict(f"name {name!r} differs from the catalog robot {alike!r} only in case; choose another")
     store = upload_store()
-    alike = store.alike(name)
+    held = store.key(name)
+    alike = None if held is not None else store.alike(name)
     if alike is not None:  # refused before the model is built; ``put`` refuses it too, atomically
         raise RobotConflict(f"name {name!r} differs from the upload {alike!r} only in case; choose another")
-    held = store.key(name)
     if held is not None and held[0] != digest:
         raise RobotConflict(f"name {name!r} already holds a different URDF; choose another name or delete it first")
     if held is not None and held[1] != stored_options:

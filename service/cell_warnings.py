@@ -31,7 +31,7 @@ def cell_warnings(
         warnings.append(
             f"dt = {dt:g} s is {'longer than the motion' if dt > duration else 'more than a tenth of the motion'} "
             f"({duration:.6g} s): its {count} samples do not follow the motion. "
-            f"dt is in seconds; dt <= {duration / SAMPLES_ADVISED:.3g} s gives {SAMPLES_ADVISED} samples or more"
+            + _advice(duration)
         )
     if duration > 0.0 and sampled / duration - 1.0 > STRETCH_NOTED:
         warnings.append(
@@ -41,3 +41,15 @@ def cell_warnings(
             f"{100 * STRETCH_NOTED:g} %; exact_period false keeps the planned timing"
         )
     return warnings
+
+
+#: A cell's shortest sample period (s): its schema's bound on ``dt``.
+SHORTEST_DT = 1e-3
+
+
+def _advice(duration: float) -> str:
+    """The period that gives ``SAMPLES_ADVISED`` samples of a motion of ``duration`` (s), or the
+    shortest a cell takes where that is shorter, with the samples it gives."""
+    advised = max(duration / SAMPLES_ADVISED, SHORTEST_DT)
+    samples = min(SAMPLES_ADVISED, int(duration / advised + 1e-9) + 1)
+    return f"dt is in seconds; dt <= {advised:.3g} s gives {samples} samples or more"

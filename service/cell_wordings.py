@@ -10,13 +10,19 @@ from collections.abc import Callable
 from toptraj.planners.runner.duration import rounded_down, rounded_up
 
 
+def _millimetres(value: float) -> str:
+    """A position in m to its millimetres, as short as it prints (``-0.207``, ``0.96``, ``1000.123``)."""
+    text = f"{round(value, 3):.3f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
+
+
 def _arms_collide_at_start(facts: dict) -> str:
     (a, b), (link_a, link_b), (robot_a, robot_b) = (facts["first"], facts["second"]), facts["links"], facts["robots"]
     distance, clearance = facts["distance"], facts["clearance"]
     lower = f", or lower clearance to {rounded_down(distance, 4):g} m or less" if distance > 0.0 else ""
     position = facts.get("position")
     move = (
-        f"set arms[{b}].base.position to [{', '.join(f'{x:g}' for x in position)}] (those two links "
+        f"set arms[{b}].base.position to [{', '.join(_millimetres(x) for x in position)}] (those two links "
         f"{'overlap' if distance < 0.0 else 'are too close'}; there, every link of the two arms clears the other's at the start)"
         if position is not None else f"move arms[{b}].base farther from arms[{a}]'s"
     )

@@ -87,7 +87,7 @@ def plan_cell(body: CellRequest, deadline: Deadline, format_: str | None = None)
     warnings: list[str] = []
     arms = tuple(_arm(index, arm, body.gravity, deadline, warnings) for index, arm in enumerate(body.arms))
     # The cell's gravity, unusual as a trajectory's mounting.gravity is noted, in the cell's field.
-    warnings[:0] = [note_text(note).replace("mounting.gravity", "gravity").replace("mounting.orientation", "arms[i].base.orientation")
+    warnings[:0] = [note_text(note).replace("mounting.gravity", "gravity").replace("mounting.orientation", "an arm's base.orientation")
                     for note in gravity_notes(arms[0].robot)]
     cell = Cell(arms, body.clearance, tuple(body.constraints))
     format_ = format_ or body.format

@@ -94,7 +94,7 @@ def check_ends(cell: Cell) -> None:
         if distance[0] < cell.clearance:
             links = (first.link_names()[int(i[0])], second.link_names()[int(j[0])])
             shift = separating_shift(arm_capsules(first, np.zeros(1)), arm_capsules(second, np.zeros(1)), int(i[0]), int(j[0]),
-                                     second.base_position - first.base_position, cell.clearance)
+                                     first.base_position, second.base_position, cell.clearance)
             raise InvalidRequest(
                 f"arms[{b}]", None, rule="arms_collide_at_start", first=a, second=b, links=links,
                 robots=(first.robot.name, second.robot.name), distance=float(distance[0]), clearance=cell.clearance,
@@ -110,19 +110,19 @@ MOST_SHIFT = 10.0
 
 def separating_shift(
     first: tuple[np.ndarray, np.ndarray, np.ndarray], second: tuple[np.ndarray, np.ndarray, np.ndarray], i: int, j: int,
-    base: np.ndarray, clearance: float,
+    first_base: np.ndarray, base: np.ndarray, clearance: float,
 ) -> np.ndarray | None:
-    """A move (3,) in m of the second arm's base, to whole millimetres of its position, that
-    puts every capsule of the second arm (``second``, at one configuration: a, b (1, k, 3),
-    radius (k,)) at least ``clearance`` from the first's: the shortest (to 1 mm) in the
-    horizontal direction from capsule ``i`` of the first arm to capsule ``j`` of the second (the
-    two closest; else along the bases' offset ``base``, else along x); ``None`` within
-    ``MOST_SHIFT``. Moving a base translates its capsules."""
+    """A move (3,) in m of the second arm's base (at ``base``, m), to a position of whole
+    millimetres, that puts every capsule of the second arm (``second``, at one configuration:
+    a, b (1, k, 3), radius (k,)) at least ``clearance`` from the first's: the shortest (to 1 mm)
+    in the horizontal direction from capsule ``i`` of the first arm to capsule ``j`` of the
+    second (the two closest; else from the first base ``first_base`` to the second, else along
+    x); ``None`` within ``MOST_SHIFT``. Moving a base translates its capsules."""
     a1, b1, _ = first
     a2, b2, r2 = second
     direction = 0.5 * (a2[0, j] + b2[0, j]) - 0.5 * (a1[0, i] + b1[0, i])
     horizontal = np.array([1.0, 0.0, 0.0])
-    for candidate in (direction, np.asarray(base, dtype=float)):
+    for candidate in (direction, np.asarray(base, dtype=float) - np.asarray(first_base, dtype=float)):
         if np.hypot(candidate[0], candidate[1]) > 1e-9:
             horizontal = np.array([candidate[0], candidate[1], 0.0])
             break
@@ -138,8 +138,8 @@ def separating_shift(
     while high - low > 1e-3:
         middle = 0.5 * (low + high)
         low, high = (low, middle) if clear(middle * unit) else (middle, high)
-    for extra in range(5):  # whole millimetres that still clear
-        shift = np.round((high + 1e-3 * extra) * unit, 3)
+    for extra in range(5):  # a position of whole millimetres that still clears, checked as printed
+        shift = np.round(base + (high + 1e-3 * extra) * unit, 3) - base
         if clear(shift):
             return shift
     return None

@@ -21,6 +21,7 @@ import numpy as np
 from toptraj.planners.constraints.path_constraints import PathConstraints, build_path_constraints, grid_rows, speed_bound
 from toptraj.planners.coordination.cell import CELL_KINDS, Cell, CellArm
 from toptraj.planners.coordination.curve import SmoothCurve
+from toptraj.planners.errors import LimitExceeded
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.problem.bounded import check_stretches_bounded
 from toptraj.planners.timing.base import AT_REST, TimeScaling
@@ -52,9 +53,14 @@ def solo_timing(
     # Through the limit gate, as a single arm's path: the grid refined where a limit is exceeded
     # between its points (else the whole cell's clock is slowed for it, ``limits.within_limits``)
     # and, for accuracy, where the error lies.
-    timing, _, _ = gated(
-        arm.robot, arm.path, ToppraMethod(), constraints, AT_REST, None, kinds, arm.limits, LIMIT_TOLERANCE, deadline,
-    )
+    try:
+        timing, _, _ = gated(
+            arm.robot, arm.path, ToppraMethod(), constraints, AT_REST, None, kinds, arm.limits, LIMIT_TOLERANCE, deadline,
+        )
+    except LimitExceeded:
+        # The gate's refinements did not bring an excess between grid points within its
+        # tolerance: the grid's own timing, the cell's clock then slowed where a limit needs it.
+        timing = solve_well_scaled(ToppraMethod(), constraints, AT_REST, None, deadline)
     return timing  # type: ignore[return-value]
 
 

@@ -78,15 +78,15 @@ def _answers_http2(connection) -> bool:
     plain probe cannot open). Ray itself would retry any other server for minutes."""
     if os.environ.get("RAY_USE_TLS", "0").lower() in ("1", "true"):
         return True
-    connection.sendall(_HTTP2_PREFACE)
     head = b""
     try:
+        connection.sendall(_HTTP2_PREFACE)
         while len(head) < 9:
             chunk = connection.recv(9 - len(head))
             if not chunk:
                 break
             head += chunk
-    except TimeoutError:
+    except OSError:  # a timeout, or a server that resets the connection: it accepted one, so not "nothing listens"
         return False
     return len(head) == 9 and head[3] == 4
 

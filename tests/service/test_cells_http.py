@@ -155,10 +155,11 @@ FACING = [[0, -0.5, 0.5, 0, 0.3, 0], [1.5, -0.5, 0.5, 0, 0.3, 0]]
     [
         _cell(a1={"base": {"position": [0.1, 0.0, 0.0]}}),
         _cell(a1={"base": {"position": [0.0, 0.0, 0.0]}}),
+        _cell(a1={"base": {"position": [0.1234567, -0.0456789, 0.0001234]}}),  # advised to whole millimetres, as printed
         {"arms": [{"robot": "ur5", "waypoints": FACING},
                   {"robot": "ur5", "base": {"position": [0.6, 0, 0], "orientation": [0, 0, 1, 0]}, "waypoints": FACING}]},
     ],
-    ids=["near", "same-point", "turned-towards"],
+    ids=["near", "same-point", "unround", "turned-towards"],
 )
 def test_the_base_position_advised_for_arms_that_collide_at_their_start_clears_them(patient_client, body):
     """The advice said how far to move the base, not where: moving it along the line between
@@ -387,5 +388,20 @@ def test_a_cell_gravity_pointing_up_is_warned_of_as_a_mounting_s_is(patient_clie
     response = patient_client.post("/v1/cells", json=body)
     assert response.status_code == 200, response.text
     (warning,) = [text for text in response.json()["warnings"] if "points up" in text]
-    assert warning.startswith("gravity [0, 0, 9.81] points up (+z in the world)") and "arms[i].base.orientation" in warning
+    assert warning.startswith("gravity [0, 0, 9.81] points up (+z in the world)") and "an arm's base.orientation" in warning
     assert not [text for text in patient_client.post("/v1/cells", json=EXAMPLE).json()["warnings"] if "points up" in text]
+
+
+def test_the_sampling_advice_for_a_short_cell_motion_is_a_period_a_cell_takes(patient_client):
+    """A motion of 0.06 s at the default dt (0.01 s) has 7 samples: the advice was dt <= 0.0006 s,
+    below the 1 ms a cell takes; it is 1 ms and the samples that gives (followed here)."""
+    body = {"arms": [
+        {"robot": "ur5", "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [0.01, -1.2, 1, 0, 0.5, 0]]},
+        {"robot": "ur5", "base": {"position": [3.0, 0.0, 0.0]}, "waypoints": [[0, -1.2, 1, 0, 0.5, 0], [0.01, -1.2, 1, 0, 0.5, 0]]},
+    ]}
+    answer = patient_client.post("/v1/cells", json=body).json()
+    (few,) = [text for text in answer["warnings"] if "samples do not follow" in text]
+    match = re.search(r"dt <= ([\d.e-]+) s gives (\d+) samples", few)
+    assert match and float(match.group(1)) == 0.001, few
+    followed = patient_client.post("/v1/cells", json=body | {"dt": 0.001}).json()
+    assert len(followed["t"]) >= int(match.group(2)) and not [t for t in followed["warnings"] if "samples do not follow" in t]

@@ -85,7 +85,7 @@ def interval_times(s: np.ndarray, x: np.ndarray, u: np.ndarray, rest_start: bool
     x_end = np.maximum(x0 + 2.0 * u0 * h + w * h**2, 0.0)
     width = np.broadcast_to(h, x0.shape)
     times = _quadrature(width, x0, u0, w, x0 <= x_end, _NODES, _WEIGHTS)
-    steep = _steep(x0, x_end)
+    steep = _steep(x0, x[:, 1:])  # by the grid's x at both ends, as ``JerkTimeScaling._times_to`` decides
     if steep.any():
         times[steep] = _quadrature(width[steep], x0[steep], u0[steep], w[steep], (x0 <= x_end)[steep], _FINE_NODES, _FINE_WEIGHTS)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -100,3 +100,18 @@ def test_an_arm_whose_own_path_folds_onto_itself_is_refused_naming_the_links_and
     ) as refused:
         coordinate(Cell((cell.arms[0], folding), cell.clearance))
     assert {refused.value.link_a, refused.value.link_b} == {"shoulder_link", "forearm_link"} and 0.0 < refused.value.s < 1.0
+
+
+def test_an_arm_the_gate_cannot_refine_within_its_tolerance_is_timed_on_its_grid(monkeypatch):
+    """The limit gate gives up (``LimitExceeded``) after its rounds of refinement: the arm's grid
+    timing is kept and the cell answered, its clock slowed where a limit needs it (the cell was
+    refused with advice, another method or more grid points, that a cell cannot take)."""
+    from toptraj.planners.checks import gate
+    from toptraj.planners.errors import LimitExceeded
+
+    def gives_up(*args, **kwargs):
+        raise LimitExceeded("the toppra timing exceeds the torque limit of joint 'elbow_joint' by 1 % at s = 0.5")
+
+    monkeypatch.setattr(gate, "gated", gives_up)
+    found = coordinate(facing_cell(distance=3.0))
+    assert found.schedule.duration > 0.0 and len(found.solo) == 2
