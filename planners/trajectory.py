@@ -43,10 +43,12 @@ class SwitchingTimes:
 
 
 def _joint_motion(path: GeometricPath, s, sd, sdd, side: str = "right"):
+    """q, qd, qdd and the path's tangent q' at ``s`` (each (n, n_dof)) for the path speeds
+    ``sd`` and accelerations ``sdd`` (n,)."""
     points = path.evaluate(s, side)
     qd = points.dq * sd[:, None]
     qdd = points.dq * sdd[:, None] + points.ddq * (sd**2)[:, None]
-    return points.q, qd, qdd
+    return points.q, qd, qdd, points.dq
 
 
 def exact_period_scale(duration: float, dt: float) -> float:
@@ -80,5 +82,7 @@ def sample_trajectory(
         if t.size == 0 or duration - t[-1] > 1e-9 * max(1.0, duration):
             t = np.append(t, duration)
         s, sd, sdd = scaling.at_times(t)
-    q, qd, qdd = _joint_motion(path, s, sd, sdd)
-    return Samples(t=t, q=q, qd=qd, qdd=qdd, tau=robot.inverse_dynamics(q, qd, qdd), s=s)
+    q, qd, qdd, dq = _joint_motion(path, s, sd, sdd)
+    # At rest (the first and last samples, a stop), Coulomb friction opposes the motion along the
+    # path's tangent, as the planning held it: the torque is the limit of the moving ones.
+    return Samples(t=t, q=q, qd=qd, qdd=qdd, tau=robot.inverse_dynamics(q, qd, qdd, dq), s=s)

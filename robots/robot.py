@@ -239,13 +239,17 @@ class Robot:
         )
         return np.ascontiguousarray(np.asarray(tau).T).reshape(qd.shape)
 
-    def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, direction: np.ndarray | None = None) -> np.ndarray:
         """Joint torques for rows of ``q, qd, qdd`` (each (n_samples, n_dof)): the RNEA
-        (``rnea``) plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``."""
+        (``rnea``) plus the URDF's viscous and Coulomb joint friction, ``D qd + F sign(qd)``.
+        ``direction`` (same shape): where a joint's qd is zero, the sign of the motion its
+        Coulomb friction opposes (along a path, its tangent q' at a stop: the friction just
+        before or after it, as the planning held it); ``None``: none there."""
         qd = np.atleast_2d(qd)
         tau = self.rnea(q, qd, qdd)
         if self.has_friction:
-            tau += self.viscous_friction * qd + self.coulomb_friction * np.sign(qd)
+            sign = np.sign(qd) if direction is None else np.where(qd != 0.0, np.sign(qd), np.sign(direction))
+            tau += self.viscous_friction * qd + self.coulomb_friction * sign
         return tau
 
     def outside_position_limits(self, q: np.ndarray, slack: float = 1e-9) -> tuple[int, int] | None:

@@ -104,7 +104,20 @@ def joint_motion(path: GeometricPath, states: DenseStates) -> tuple[np.ndarray, 
     return q, qd, qdd, jerk
 
 
-def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | None) -> np.ndarray:
+def _at_rest(robot: Robot, path: GeometricPath, states) -> np.ndarray | None:
+    """The path's tangent q' (n, n_dof) at the states at rest (zero elsewhere), on the side each
+    belongs to, for the sign of Coulomb friction there (``Robot.inverse_dynamics``); ``None``
+    without Coulomb friction or a state at rest."""
+    rest = states.sd == 0.0
+    if not (robot.has_coulomb_friction and rest.any()):
+        return None
+    direction = np.zeros((len(states.s), robot.dof))
+    s, left = states.s[rest], states.left[rest]
+    direction[rest] = np.where(left[:, None], path.evaluate(s, "left").dq, path.evaluate(s, "right").dq)
+    return direction
+
+
+def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | None, direction: np.ndarray | None = None) -> np.ndarray:
     """Joint torques (n, n_dof) at ``states``. At a moving state on the grid of ``constraints``
     (when they hold a torque row for every joint) the torque is the row ``a u + b x + c + d sd``
     the build computed there with the RNEA (the same number, to rounding), on the side
@@ -112,10 +125,11 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
     (``toptraj.planners.constraints.torque_interpolation.dense_torques``) where the grid resolves them, the
     interpolation's estimated error is within ``INTERPOLATION_TOLERANCE`` of the limit and no
     joint has Coulomb friction (whose sign, inside c, is the grid point's). The RNEA runs,
-    batched, at every other state."""
+    batched, at every other state, Coulomb friction at a state at rest opposing the path's
+    tangent ``direction`` there (as the rows hold it)."""
     column = {} if constraints is None else {joint: k for k, (kind, joint) in enumerate(constraints.rows) if kind == "torque"}
     if constraints is None or len(column) != robot.dof:
-        return robot.inverse_dynamics(q, qd, qdd)
+        return robot.inverse_dynamics(q, qd, qdd, direction)
     columns = np.array([column[joint] for joint in range(robot.dof)], dtype=np.int64)
     travel = grid_travel(constraints)
     interpolate = travel is not None and not robot.has_coulomb_friction
@@ -128,7 +142,7 @@ def _torques(robot: Robot, states, q, qd, qdd, constraints: PathConstraints | No
         states.s, states.sd, states.sdd, states.left, interpolate, INTERPOLATION_TOLERANCE, tau, exact,
     )
     if exact.any():
-        tau[exact] = robot.inverse_dynamics(q[exact], qd[exact], qdd[exact])
+        tau[exact] = robot.inverse_dynamics(q[exact], qd[exact], qdd[exact], None if direction is None else direction[exact])
     return tau
 
 
@@ -183,7 +197,7 @@ def check_limits(
     else:
         states = timing.dense_states(POINTS_PER_INTERVAL)
     q, qd, qdd, jerk = joint_motion(path, states)
-    values = {"velocity": qd, "acceleration": qdd, "torque": _torques(robot, states, q, qd, qdd, constraints)}
+    values = {"velocity": qd, "acceleration": qdd, "torque": _torques(robot, states, q, qd, qdd, constraints, _at_rest(robot, path, states))}
     if jerk is not None:
         values["jerk"] = jerk
     limit_of = {kind: getattr(limits, kind) for kind in values}
