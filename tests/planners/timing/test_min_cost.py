@@ -137,3 +137,22 @@ def test_the_cost_reported_with_viscous_friction_is_that_of_the_motion_s_own_tor
     answer = plan_request(TrajectoryRequest.model_validate(body))
     integral = np.trapezoid(1.0 + 0.01 * (answer.samples.tau**2).sum(axis=1), answer.samples.t)
     assert answer.cost == pytest.approx(integral, rel=2e-3)
+
+
+def test_a_solver_failure_is_told_in_the_request_s_terms(monkeypatch):
+    """Clarabel failing (on a spline through waypoints 6e-7 rad apart) was answered with cvxpy's
+    advice to its caller: "Try another solver, or solve with verbose=True"."""
+    import cvxpy as cp
+
+    from toptraj.planners.errors import TimingFailed
+
+    def fails(self, *args, **kwargs):
+        raise cp.error.SolverError("Solver 'CLARABEL' failed. Try another solver, or solve with verbose=True for more information.")
+
+    monkeypatch.setattr(cp.Problem, "solve", fails)
+    arm = robots.load("yamamoto_2r")
+    problem = build_problem(arm, WaypointPath(YAMAMOTO_LINE), MinCostMethod(BETA), limits=LimitRequest(kinds=("torque",)), sampling=Sampling(dt=0.01))
+    with pytest.raises(TimingFailed) as failed:
+        plan(problem)
+    assert "verbose" not in failed.value.detail and "another solver" not in failed.value.detail
+    assert "time the path with phase_plane or toppra" in failed.value.detail
