@@ -193,6 +193,8 @@ class JerkLimitedMethod(TimingMethod):
             chain.append(best.duration)
         if gap is not None:
             gap, how = self._stated_gap(constraints, boundary, best, chain, how, elapsed, deadline)
+        if gap is not None and not np.isfinite(gap):  # a grid's solution, solved for the estimate, stops mid-path
+            gap, how = None, UNESTIMATED
         best = dataclasses.replace(best, optimality_gap=gap, gap_basis=how)
         if self.polish and _uniform(constraints):
             polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
@@ -294,6 +296,14 @@ class JerkLimitedMethod(TimingMethod):
             return False
         remaining = deadline.remaining()
         return remaining is None or remaining > REFINEMENT_COST * elapsed + 1.0
+
+
+#: Why an answer states no gap where a grid solved for the estimate stopped the motion (x = 0
+#: at an inner point: an infinite duration; seen on splines through nearly repeated waypoints).
+UNESTIMATED = (
+    "none: the solution on a grid solved for the estimate stops the motion inside the path (its duration is "
+    "infinite); more timing.grid_points, or dropping waypoints that nearly repeat, give an estimate"
+)
 
 
 def _uniform(constraints: PathConstraints, tolerance: float = 1e-9) -> bool:

@@ -301,3 +301,24 @@ def test_positions_follow_the_velocities_where_the_path_speed_grows_many_fold_in
     residual = np.abs(np.diff(q, axis=0) - 0.5 * (qd[1:] + qd[:-1]) * step)
     jerk_limit = robots.load("z1").limits.jerk
     assert np.all(residual <= 1.005 * step**3 * jerk_limit / 12.0 + 1e-12)
+
+
+def test_a_grid_solved_for_the_estimate_that_stops_mid_path_leaves_the_gap_unstated_with_advice_that_works():
+    """Geering's arm ending on two waypoints 4e-5 rad apart: grids solved for the estimate stop the
+    motion inside the path (infinite durations), the gap came out NaN and the answer was refused
+    as "not representable". The answer stands with no gap, saying why; the advice (more grid
+    points) gives one."""
+    from toptraj.service.planning import plan_request
+    from toptraj.service.schemas.trajectories import TrajectoryRequest
+
+    body = {
+        "robot": "geering_2r",
+        "path": {"waypoints": [[1.5200490308855918, -1.3187796758833268], [1.888342032802192, -1.3481432432491909],
+                               [2.710646690223219, -1.2029718320976668], [2.7106706186076357, -1.2029408588577613]]},
+        "timing": {"method": "jerk_limited", "constraints": ["velocity", "acceleration", "torque", "jerk"]},
+        "output": {"dt": 0.001},
+    }
+    answer = plan_request(TrajectoryRequest.model_validate(body))
+    assert answer.accuracy.relative_gap is None and "stops the motion inside the path" in answer.accuracy.basis
+    followed = plan_request(TrajectoryRequest.model_validate({**body, "timing": {**body["timing"], "grid_points": 1000}}))
+    assert followed.accuracy.relative_gap is not None and followed.accuracy.relative_gap < 1e-3
