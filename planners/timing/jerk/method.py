@@ -193,16 +193,20 @@ class JerkLimitedMethod(TimingMethod):
             chain.append(best.duration)
         if gap is not None:
             gap, how = self._stated_gap(constraints, boundary, best, chain, how, elapsed, deadline)
-        if gap is not None and not np.isfinite(gap):  # a grid's solution, solved for the estimate, stops mid-path
+        if gap is not None and not np.isfinite(gap):  # a grid solved for the estimate stops mid-path
             gap, how = None, UNESTIMATED
-        best = dataclasses.replace(best, optimality_gap=gap, gap_basis=how)
+        return self._polished(constraints, boundary, dataclasses.replace(best, optimality_gap=gap, gap_basis=how), deadline)
+
+    def _polished(self, constraints: PathConstraints, boundary: Boundary, best: JerkTimeScaling, deadline: Deadline):
+        """``best`` refined in time (``toptraj.planners.timing.jerk.polish``) where every limit is
+        the same along the path and the polish finds it shorter, with ``best``'s estimate."""
         if self.polish and _uniform(constraints):
             polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
             if polished is not None:
                 # Shorter than the grid solution and feasible: no farther from the optimum.
                 return dataclasses.replace(
-                    polished, optimality_gap=gap,
-                    gap_basis=f"bounded by the grid solution's estimate, which it improves on ({how})",
+                    polished, optimality_gap=best.optimality_gap,
+                    gap_basis=f"bounded by the grid solution's estimate, which it improves on ({best.gap_basis})",
                 )
         return best
 
@@ -302,7 +306,7 @@ class JerkLimitedMethod(TimingMethod):
 #: at an inner point: an infinite duration; seen on splines through nearly repeated waypoints).
 UNESTIMATED = (
     "none: the solution on a grid solved for the estimate stops the motion inside the path (its duration is "
-    "infinite); more timing.grid_points, or dropping waypoints that nearly repeat, give an estimate"
+    "infinite); a finer grid, or dropping waypoints that nearly repeat, gives an estimate"
 )
 
 

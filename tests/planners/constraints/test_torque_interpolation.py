@@ -35,9 +35,9 @@ class _CountingRnea:
         self.states = 0
         original = Robot.inverse_dynamics
 
-        def counted(robot, q, qd, qdd):
+        def counted(robot, q, qd, qdd, direction=None):
             self.states += len(np.atleast_2d(q))
-            return original(robot, q, qd, qdd)
+            return original(robot, q, qd, qdd, direction)
 
         monkeypatch.setattr(Robot, "inverse_dynamics", counted)
 
