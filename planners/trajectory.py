@@ -84,5 +84,6 @@ def sample_trajectory(
         s, sd, sdd = scaling.at_times(t)
     q, qd, qdd, dq = _joint_motion(path, s, sd, sdd)
     # At rest (the first and last samples, a stop), Coulomb friction opposes the motion along the
-    # path's tangent, as the planning held it: the torque is the limit of the moving ones.
+    # path's tangent, as the planning held it: where that tangent is not zero, the torque is the
+    # limit of the moving ones.
     return Samples(t=t, q=q, qd=qd, qdd=qdd, tau=robot.inverse_dynamics(q, qd, qdd, dq), s=s)

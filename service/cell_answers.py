@@ -63,9 +63,11 @@ def _joint_trajectory(names, t: np.ndarray, samples: dict) -> dict:
     return {"joint_names": list(names), "points": points}
 
 
-def _arm_body(arm, t: np.ndarray, states, peaks: dict, format_: str) -> dict:
+def _arm_body(arm, t: np.ndarray, states, peaks: dict, format_: str, s: np.ndarray) -> dict:
     q, qd, qdd = states
-    samples = {"t": t, "q": q, "qd": qd, "qdd": qdd, "tau": arm.robot.inverse_dynamics(q, qd, qdd)}
+    # At rest, Coulomb friction opposes the path's tangent at ``s``, as the arm's planning holds it.
+    direction = arm.path.evaluate(s).dq if arm.robot.has_coulomb_friction else None
+    samples = {"t": t, "q": q, "qd": qd, "qdd": qdd, "tau": arm.robot.inverse_dynamics(q, qd, qdd, direction)}
     body = {
         "robot": arm.robot.name,
         "joint_names": list(arm.robot.joint_names),
@@ -120,8 +122,8 @@ def cell_body(cell: Cell, found: Coordination, dt: float, format_: str, exact_pe
         "schedule": schedule.kind,
         "t": t,
         "arms": [
-            _arm_body(arm, t, states, reported_utilization(arm_peaks, arm.limits), format_)
-            for arm, states, arm_peaks in zip(cell.arms, schedule.states(cell, t), peaks)
+            _arm_body(arm, t, states, reported_utilization(arm_peaks, arm.limits), format_, s)
+            for arm, states, arm_peaks, s in zip(cell.arms, schedule.states(cell, t), peaks, schedule.path_parameters(t).T)
         ],
         "min_distance": {
             "distance": clearance.distance,

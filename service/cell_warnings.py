@@ -27,7 +27,7 @@ def cell_warnings(
                     f"arms[{index}]: the {kind} of joint {arm.robot.joint_names[joint]!r} reaches {finite[joint]:.4g} times "
                     f"its limit, which was not asked for: add {kind!r} to constraints to hold it"
                 )
-    if duration > 0.0 and dt > duration / FEWEST_PERIODS:
+    if duration > 0.0 and dt > duration / FEWEST_PERIODS and dt > SHORTEST_DT:  # at the shortest period: nothing to advise
         warnings.append(
             f"dt = {dt:g} s is {'longer than the motion' if dt > duration else 'more than a tenth of the motion'} "
             f"({duration:.6g} s): its {count} samples do not follow the motion. "

@@ -110,7 +110,10 @@ def _smoothed(cell: Cell, diagram: Diagram, points: np.ndarray, deadline: Deadli
         s = curve.evaluate(np.linspace(0.0, 1.0, DIAGRAM_SAMPLES + 1))[0]
         if not diagram.free_at(s[:, 0], s[:, 1]).all():
             continue
-        scaling = pair_timing(cell, curve, deadline=deadline)
+        try:
+            scaling = pair_timing(cell, curve, deadline=deadline)
+        except InfeasiblePath:  # a curve along which the pair cannot be timed: the other candidates stand
+            continue
         schedule = within_limits(cell, Schedule((CurveMotion(scaling, curve, 0), CurveMotion(scaling, curve, 1)), "coordinated"))
         if (best is None or schedule.duration < best.duration) and _free(diagram, schedule):
             best = schedule

@@ -65,9 +65,12 @@ def cannot_hold_still(index: int, arm: CellArm, s: float, torque: float, joint: 
 def arm_load(arm: CellArm, s: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> ArmLoad:
     """The arm's samples (each (n, n_dof)) split as ``ArmLoad`` (module docstring)."""
     robot = arm.robot
-    tau = robot.inverse_dynamics(q, qd, qdd)
+    # At rest, Coulomb friction opposes the path's tangent, as the arm's planning holds it.
+    direction = arm.path.evaluate(s).dq if robot.has_coulomb_friction else None
+    tau = robot.inverse_dynamics(q, qd, qdd, direction)
     gravity = robot.rnea(q, np.zeros_like(qd), np.zeros_like(qdd))
-    static = gravity + robot.coulomb_friction * np.sign(qd) if robot.has_friction else gravity
+    sign = np.sign(qd) if direction is None else np.where(qd != 0.0, np.sign(qd), np.sign(direction))
+    static = gravity + robot.coulomb_friction * sign if robot.has_friction else gravity
     linear = robot.viscous_friction * qd if robot.has_friction else np.zeros_like(qd)
     return ArmLoad(s, qd, qdd, static, linear, tau - static - linear)
 

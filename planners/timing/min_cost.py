@@ -269,9 +269,9 @@ def solve_program(program: MinCostProgram) -> tuple[np.ndarray, float, str]:
     except cp.error.SolverError:
         # cvxpy's own advice (another solver, verbose=True) is for its callers, not for a request.
         raise TimingFailed(
-            "min_cost's convex solver (Clarabel) failed on this path: waypoints that nearly repeat bend the spline "
-            "sharply between them, which a solver's tolerances may not resolve; drop them, or time the path with "
-            "phase_plane or toppra (the time-optimal timing, min_cost's torque_weight 0)"
+            "min_cost's convex solver (Clarabel) failed on this path (as it can where waypoints that nearly repeat "
+            "bend the spline sharply between them: drop such waypoints); phase_plane or toppra time the path (the "
+            "time-optimal timing, min_cost's torque_weight 0)"
         ) from None
     if problem.status in ("infeasible", "infeasible_inaccurate"):
         raise InfeasiblePath("no timing along the path meets the limits (the convex program is infeasible)")

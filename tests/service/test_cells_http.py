@@ -405,3 +405,26 @@ def test_the_sampling_advice_for_a_short_cell_motion_is_a_period_a_cell_takes(pa
     assert match and float(match.group(1)) == 0.001, few
     followed = patient_client.post("/v1/cells", json=body | {"dt": 0.001}).json()
     assert len(followed["t"]) >= int(match.group(2)) and not [t for t in followed["warnings"] if "samples do not follow" in t]
+
+
+def test_arms_with_coulomb_friction_under_torque_limits_alone_are_timed_as_one_arm_is(patient_client):
+    """Two z1s (joint friction) 3 m apart, torque limits alone: a coordinated curve the pair could
+    not be timed along refused the whole cell ("no motion can follow the path"), though both arms
+    can run at once; and the cell took the torque at rest without the friction the planning
+    holds. The arms now run at once as the trajectory endpoint times one, their torques at rest
+    with the friction opposing the path's tangent, every one within the limits."""
+    path = [[0, 1.0, -1.0, 0, 0, 0], [0.5, 1.2, -1.2, 0.2, 0.2, 0.2]]
+    cell = {"arms": [{"robot": "z1", "waypoints": path}, {"robot": "z1", "base": {"position": [3, 0, 0]}, "waypoints": path}],
+            "constraints": ["torque"]}
+    answered = patient_client.post("/v1/cells", json=cell)
+    assert answered.status_code == 200, answered.text
+    body = answered.json()
+    alone = patient_client.post("/v1/trajectories", json={
+        "robot": "z1", "path": {"waypoints": path}, "timing": {"method": "toppra", "constraints": ["torque"]}, "output": {"dt": 0.01},
+    }).json()
+    assert body["schedule"] == "simultaneous" and body["duration"] == pytest.approx(alone["duration"], rel=2e-3)
+    torque_limit = np.array([30.0, 60.0, 30.0, 30.0, 30.0, 30.0])
+    for arm in body["arms"]:
+        tau = np.asarray(arm["samples"]["tau"])
+        assert np.abs(tau / torque_limit).max() <= 1.003
+        np.testing.assert_allclose(tau[-1], np.asarray(alone["samples"]["tau"])[-1], rtol=2e-2)  # at rest, with its friction

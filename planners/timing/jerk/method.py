@@ -204,10 +204,10 @@ class JerkLimitedMethod(TimingMethod):
             polished = polish(constraints, best, boundary.sd_start, boundary.sd_end, deadline)
             if polished is not None:
                 # Shorter than the grid solution and feasible: no farther from the optimum.
-                return dataclasses.replace(
-                    polished, optimality_gap=best.optimality_gap,
-                    gap_basis=f"bounded by the grid solution's estimate, which it improves on ({best.gap_basis})",
+                basis = best.gap_basis if best.optimality_gap is None else (
+                    f"bounded by the grid solution's estimate, which it improves on ({best.gap_basis})"
                 )
+                return dataclasses.replace(polished, optimality_gap=best.optimality_gap, gap_basis=basis)
         return best
 
     def _grid_solution(

@@ -155,4 +155,4 @@ def test_a_solver_failure_is_told_in_the_request_s_terms(monkeypatch):
     with pytest.raises(TimingFailed) as failed:
         plan(problem)
     assert "verbose" not in failed.value.detail and "another solver" not in failed.value.detail
-    assert "time the path with phase_plane or toppra" in failed.value.detail
+    assert "phase_plane or toppra time the path" in failed.value.detail
