@@ -248,8 +248,7 @@ class Robot:
         qd = np.atleast_2d(qd)
         tau = self.rnea(q, qd, qdd)
         if self.has_friction:
-            sign = np.sign(qd) if direction is None else np.where(qd != 0.0, np.sign(qd), np.sign(direction))
-            tau += self.viscous_friction * qd + self.coulomb_friction * sign
+            tau += self.viscous_friction * qd + self.coulomb_friction * friction_sign(qd, direction)
         return tau
 
     def outside_position_limits(self, q: np.ndarray, slack: float = 1e-9) -> tuple[int, int] | None:
@@ -297,3 +296,9 @@ def _rebuilt(name, model, source, end_effector, limits, limit_sources, locked_jo
     """A pickled ``Robot`` rebuilt (``Robot.__reduce__``)."""
     robot = Robot.from_model(name, model, source, end_effector, limits, limit_sources, locked_joints, notes, payload, mounting, bare)
     return dataclasses.replace(robot, allowed_collisions=allowed_collisions) if allowed_collisions else robot
+
+
+def friction_sign(qd: np.ndarray, direction: np.ndarray | None = None) -> np.ndarray:
+    """The sign of the motion Coulomb friction opposes, per sample and joint (the shape of
+    ``qd``): sign(qd), and where qd is zero the sign of ``direction`` (``Robot.inverse_dynamics``)."""
+    return np.sign(qd) if direction is None else np.where(qd != 0.0, np.sign(qd), np.sign(direction))

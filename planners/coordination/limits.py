@@ -23,6 +23,7 @@ import numpy as np
 from toptraj.planners.coordination.cell import Cell, CellArm
 from toptraj.planners.coordination.timing import Schedule
 from toptraj.planners.errors import InfeasiblePath
+from toptraj.robots.robot import friction_sign
 
 #: Samples of the limit check per second of motion, and at least.
 LIMIT_RATE, LIMIT_MIN = 2_000, 4_000
@@ -69,8 +70,7 @@ def arm_load(arm: CellArm, s: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np
     direction = arm.path.evaluate(s).dq if robot.has_coulomb_friction else None
     tau = robot.inverse_dynamics(q, qd, qdd, direction)
     gravity = robot.rnea(q, np.zeros_like(qd), np.zeros_like(qdd))
-    sign = np.sign(qd) if direction is None else np.where(qd != 0.0, np.sign(qd), np.sign(direction))
-    static = gravity + robot.coulomb_friction * sign if robot.has_friction else gravity
+    static = gravity + robot.coulomb_friction * friction_sign(qd, direction) if robot.has_friction else gravity
     linear = robot.viscous_friction * qd if robot.has_friction else np.zeros_like(qd)
     return ArmLoad(s, qd, qdd, static, linear, tau - static - linear)
 
