@@ -56,7 +56,7 @@ def _arm(index: int, request: CellArmRequest, gravity, deadline: Deadline, warni
             if len(waypoint) != robot.dof:
                 raise WrongLength(f"waypoints[{row}]", waypoint, len(waypoint), robot.dof, robot=robot.name, joint_names=robot.joint_names)
         try:
-            motion, dropped = without_repeats(WaypointPath(np.asarray(request.waypoints, dtype=float)))
+            motion, dropped = without_repeats(WaypointPath(np.asarray(request.waypoints, dtype=float)), settable=False)
         except InvalidRequest as error:
             if getattr(error, "rule", None) != "all_waypoints_coincide":
                 raise

@@ -198,4 +198,4 @@ def motion_of(spec, robot: robots.Robot, timing: TimingRequest) -> MotionSpec:
     for index, row in enumerate(spec.waypoints):
         if len(row) != robot.dof:
             raise WrongLength(f"waypoints[{index}]", row, len(row), robot.dof, robot=robot.name, joint_names=robot.joint_names)
-    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous)
+    return WaypointPath(np.asarray(spec.waypoints, dtype=float), spec.interpolation, spec.max_deviation, spec.continuous, spec.min_spacing)

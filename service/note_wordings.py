@@ -28,11 +28,23 @@ def _gap_above_target(facts: dict) -> str:
 
 
 def _waypoints_dropped(facts: dict) -> str:
-    repeats = facts["indices"]
+    repeats, field = facts["indices"], facts["field"]
     shown = ", ".join(map(str, repeats[:10])) + (", ..." if len(repeats) > 10 else "")
+    if facts.get("coincident", True):
+        if len(repeats) == 1:
+            return f"{field}[{repeats[0]}] repeats the waypoint before it and was dropped"
+        return f"{field} [{shown}] repeat the waypoint before each of them and were dropped ({len(repeats)} in all)"
+    near = f"{facts['nearest']:.2g} rad or m"
+    share = f"nearer than {facts['share']:g} of the path's joint-space length ({facts['length']:.4g})"
+    why = "the path would turn sharply between waypoints so near, and the arm nearly stop there"
+    keeps = "keeps it" if len(repeats) == 1 else "keeps them"
+    advice = f"; path.min_spacing = 0 {keeps}" if facts.get("settable") else ""
     if len(repeats) == 1:
-        return f"{facts['field']}[{repeats[0]}] repeats the waypoint before it and was dropped"
-    return f"{facts['field']} [{shown}] repeat the waypoint before each of them and were dropped ({len(repeats)} in all)"
+        return f"{field}[{repeats[0]}] lies {near} from a neighbouring waypoint, {share}, and was dropped: {why}{advice}"
+    return (
+        f"{field} [{shown}] ({len(repeats)} in all) lie within {near} of a neighbouring waypoint, {share}, and were "
+        f"dropped: {why}{advice}"
+    )
 
 
 def _collocation_gap(facts: dict) -> str:

@@ -117,6 +117,7 @@ REQUEST_FIELD: dict[str, str] = {
     "interpolation": "path.interpolation",
     "max_deviation": "path.max_deviation",
     "continuous": "path.continuous",
+    "min_spacing": "path.min_spacing",
     "start": "path.start",
     "goal": "path.goal",
     "revolutions": "path.revolutions",

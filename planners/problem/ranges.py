@@ -46,6 +46,9 @@ TOOL_SPEED = Range(1e-6, 1e3, "m/s")
 TOOL_ANGULAR_SPEED = Range(1e-6, 1e3, "rad/s")
 #: Largest distance of a blended corner from its waypoint (joint-space norm, rad or m).
 MAX_DEVIATION = Range(1e-9, 1e4, "rad or m")
+#: Spacing below which a waypoint repeats its neighbour, as a share of the path's joint-space
+#: length (beyond a hundredth it would resample the path, not merge repeats).
+MIN_SPACING = Range(0.0, 1e-2, "")
 #: Factors on a robot's limits.
 SCALE = Range(1e-3, 1e3, "")
 #: Switching fractions of the trapezoidal law (acceleration ends at tau1, cruise at tau2).

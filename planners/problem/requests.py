@@ -19,6 +19,11 @@ if TYPE_CHECKING:
 #: Largest distance of a blend from its waypoint when a request names none (joint units): the
 #: default path tolerance of MoveIt's time-optimal trajectory generation.
 DEFAULT_MAX_DEVIATION = 0.1
+#: Default ``min_spacing``: a waypoint nearer its kept neighbour than this share of the path's
+#: joint-space length is a repeat. Grid timings (toppra, min_cost) fail on a spline through a
+#: waypoint 1e-5 of the path's length from another (the Geering arm, seeded trials; the bend's
+#: sharpness, about 1 / spacing, outruns the grid's conditioning); at 1e-4 they answered.
+DEFAULT_MIN_SPACING = 1e-4
 #: Limit kinds respected when a caller names none (those of them the method holds).
 DEFAULT_KINDS = ("velocity", "acceleration", "torque")
 
@@ -31,12 +36,15 @@ class WaypointPath:
     waypoint, joint-space norm in joint units; default ``DEFAULT_MAX_DEVIATION``) or ``"via"``
     (per-joint cubic or quintic segments in time through the via points, the law named by the
     timing method). Continuous joints (no position limits) follow the numbers given
-    (``continuous = "as_given"``) or turn the short way between waypoints (``"shortest"``)."""
+    (``continuous = "as_given"``) or turn the short way between waypoints (``"shortest"``).
+    A waypoint within ``min_spacing`` times the path's joint-space length of the waypoint kept
+    before it (after it, for the last) is dropped as a repeat."""
 
     waypoints: np.ndarray
     interpolation: str = "spline"
     max_deviation: float | None = None
     continuous: str = "as_given"
+    min_spacing: float = DEFAULT_MIN_SPACING
 
 
 def default_kinds(method: TimingMethod | MotionGenerator) -> tuple[tuple[str, ...], tuple[str, ...]]:

@@ -14,7 +14,7 @@ from toptraj.planners.paths import GeometricPath, SplinePath, StopAndGoPath
 from toptraj.planners.paths.blended import BlendedPath
 from toptraj.planners.paths.cartesian import CartesianLine, cartesian_path
 from toptraj.planners.paths.waypoints import COINCIDENT
-from toptraj.planners.problem.ranges import COORDINATE, MAX_DEVIATION, check
+from toptraj.planners.problem.ranges import COORDINATE, MAX_DEVIATION, MIN_SPACING, check
 from toptraj.planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
 from toptraj.robots import Robot
 from toptraj.robots.notes import Note
@@ -55,9 +55,21 @@ def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
     return waypoints
 
 
-def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
-    """``spec`` without waypoints that repeat the one before them (a recorded path that stands
-    still for a while), and a note saying which were dropped.
+def without_repeats(spec: WaypointPath, settable: bool = True) -> tuple[WaypointPath, tuple[Note, ...]]:
+    """``spec`` without waypoints that repeat a neighbour (a recorded path that stands still for
+    a while, or whose encoders jitter there), and a note saying which were dropped.
+
+    A waypoint repeats when it lies within ``spec.min_spacing`` times the path's joint-space
+    length (at least ``COINCIDENT``) of the waypoint kept before it; the first and the last
+    waypoint are kept, a waypoint before the last that lies so near the last is dropped instead.
+    A spline through two such waypoints turns within a stretch of s about spacing / length long:
+    the arm nearly stops there, and the grid timings lose their conditioning (toppra and
+    min_cost refused the Geering arm's recorded path with waypoints 1e-7 of its length apart).
+
+    Args:
+        spec: The waypoints, shape (n_waypoints, n_dof) in joint units.
+        settable: Whether the caller can set ``min_spacing`` (the note then says that 0 keeps
+            the waypoints).
 
     Raises:
         InvalidRequest: every waypoint is the same: there is nothing to move.
@@ -65,17 +77,48 @@ def without_repeats(spec: WaypointPath) -> tuple[WaypointPath, tuple[str, ...]]:
     waypoints = np.asarray(spec.waypoints, dtype=float)
     if waypoints.ndim != 2 or len(waypoints) < 2 or not np.all(np.isfinite(waypoints)):
         return spec, ()
-    repeats = np.flatnonzero(np.linalg.norm(np.diff(waypoints, axis=0), axis=1) <= COINCIDENT) + 1
-    if repeats.size == 0:
+    check(spec.min_spacing, "min_spacing", MIN_SPACING)
+    steps = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
+    length = float(steps.sum())
+    spacing = max(spec.min_spacing * length, COINCIDENT)
+    if np.all(steps > spacing):
         return spec, ()
-    if repeats.size == len(waypoints) - 1:
+    kept, merged = spread_waypoints(waypoints, spacing)
+    if len(kept) < 2:
         raise InvalidRequest("waypoints", waypoints, rule="all_waypoints_coincide", count=len(waypoints), tolerance=COINCIDENT)
-    shown = ", ".join(map(str, repeats[:10])) + (", ..." if repeats.size > 10 else "")
+    dropped = np.setdiff1d(np.arange(len(waypoints)), kept)
+    near = float(max(merged))
+    shown = ", ".join(map(str, dropped[:10])) + (", ..." if dropped.size > 10 else "")
     note = Note(
-        f"waypoints [{shown}] repeat the waypoint before them and were dropped ({repeats.size} in all)",
-        "waypoints_dropped", field="waypoints", indices=tuple(int(i) for i in repeats),
+        f"waypoints [{shown}] lie within {near:.2g} of a waypoint kept and were dropped ({dropped.size} in all)",
+        "waypoints_dropped", field="waypoints", indices=tuple(int(i) for i in dropped), nearest=near,
+        coincident=near <= COINCIDENT, share=spec.min_spacing, length=length, settable=settable,
     )
-    return dataclasses.replace(spec, waypoints=np.delete(waypoints, repeats, axis=0)), (note,)
+    return dataclasses.replace(spec, waypoints=waypoints[kept]), (note,)
+
+
+def spread_waypoints(waypoints: np.ndarray, spacing: float) -> tuple[list[int], list[float]]:
+    """(kept, merged): the indices of the waypoints (n, n_dof) kept, each farther than
+    ``spacing`` from the one kept before it, the first and the last always kept (a kept waypoint
+    within ``spacing`` of the last dropped in its place, the first excepted); and the distance of
+    each dropped waypoint from the kept one it was dropped for."""
+    kept, merged = [0], []
+    for index in range(1, len(waypoints) - 1):
+        distance = float(np.linalg.norm(waypoints[index] - waypoints[kept[-1]]))
+        if distance > spacing:
+            kept.append(index)
+        else:
+            merged.append(distance)
+    last = len(waypoints) - 1
+    while len(kept) > 1 and (distance := float(np.linalg.norm(waypoints[last] - waypoints[kept[-1]]))) <= spacing:
+        kept.pop()
+        merged.append(distance)
+    distance = float(np.linalg.norm(waypoints[last] - waypoints[kept[-1]]))
+    if distance > COINCIDENT:
+        kept.append(last)
+    else:
+        merged.append(distance)
+    return kept, merged
 
 
 CONTINUOUS = ("as_given", "shortest")

@@ -110,7 +110,7 @@ def test_min_cost_on_a_recorded_path_is_within_a_tenth_of_a_percent():
     robot = robots.load("ur5")
     waypoints = recorded_waypoints(robot, np.random.default_rng(0), 5)
     reference, _ = converged(SplinePath(waypoints), robot)
-    result = plan(build_problem(robot, WaypointPath(waypoints), METHODS["min_cost"], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.05)))
+    result = plan(build_problem(robot, WaypointPath(waypoints, min_spacing=0.0), METHODS["min_cost"], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.05)))
     true_gap = result.duration / reference - 1.0
     assert -1e-4 <= true_gap <= 1e-3
     assert result.accuracy is not None
@@ -270,7 +270,7 @@ def test_a_finer_grid_that_breaks_a_limit_leaves_the_default_answer_with_a_warni
     for _ in range(10):
         waypoints = recorded_waypoints(robot, rng, 5)
     reference, _ = converged(SplinePath(waypoints), robot)
-    result = plan(build_problem(robot, WaypointPath(waypoints), METHODS["toppra"], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.05)))
+    result = plan(build_problem(robot, WaypointPath(waypoints, min_spacing=0.0), METHODS["toppra"], limits=LimitRequest(kinds=KINDS), sampling=Sampling(dt=0.05)))
     true_gap = result.duration / reference - 1.0
     assert true_gap > 1e-3
     assert result.accuracy is not None and result.accuracy.relative_gap == pytest.approx(true_gap, abs=1e-4)

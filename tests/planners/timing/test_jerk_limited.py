@@ -290,7 +290,8 @@ def test_positions_follow_the_velocities_where_the_path_speed_grows_many_fold_in
         "robot": "z1",
         "path": {"waypoints": [[-0.323877, 0.971782, -0.117204, -1.323393, -0.348684, 1.567179],
                                [-0.323875, 0.971781, -0.117203, -1.323389, -0.348686, 1.567178],
-                               [-2.198344, 0.34406, -1.031142, -0.072382, 0.944312, 2.195181]]},
+                               [-2.198344, 0.34406, -1.031142, -0.072382, 0.944312, 2.195181]],
+                 "min_spacing": 0},
         "timing": {"method": "jerk_limited", "constraints": ["velocity", "acceleration", "torque", "jerk"],
                    "limits": {"velocity_scale": 0.981}},
         "output": {"dt": 0.0005},
@@ -314,7 +315,8 @@ def test_a_grid_solved_for_the_estimate_that_stops_mid_path_leaves_the_gap_unsta
     body = {
         "robot": "geering_2r",
         "path": {"waypoints": [[1.5200490308855918, -1.3187796758833268], [1.888342032802192, -1.3481432432491909],
-                               [2.710646690223219, -1.2029718320976668], [2.7106706186076357, -1.2029408588577613]]},
+                               [2.710646690223219, -1.2029718320976668], [2.7106706186076357, -1.2029408588577613]],
+                 "min_spacing": 0},
         "timing": {"method": "jerk_limited", "constraints": ["velocity", "acceleration", "torque", "jerk"]},
         "output": {"dt": 0.001},
     }

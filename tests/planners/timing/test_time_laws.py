@@ -223,7 +223,8 @@ def test_a_law_on_a_spline_through_nearly_repeated_waypoints_is_checked_where_th
     arm = robots.load("ur10")
     waypoints = np.array(NEAR_REPEATS)
     limits = LimitRequest(kinds=("velocity", "acceleration"), scales={"velocity": 0.838})
-    result = plan(build_problem(arm, WaypointPath(waypoints), METHODS["cubic"], limits=limits, sampling=Sampling(dt=0.01)))
+    path = WaypointPath(waypoints, min_spacing=0.0)  # the spline through every waypoint, as recorded
+    result = plan(build_problem(arm, path, METHODS["cubic"], limits=limits, sampling=Sampling(dt=0.01)))
     knots = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))))
     spline = CubicSpline(knots / knots[-1], waypoints, bc_type="natural")
     T = result.duration
@@ -235,5 +236,5 @@ def test_a_law_on_a_spline_through_nearly_repeated_waypoints_is_checked_where_th
     assert result.peak_utilization["acceleration"] == pytest.approx(peaks, abs=1e-3)
     assert result.accuracy.relative_gap < 1e-3
     with pytest.raises(InfeasiblePath) as refused:
-        plan(build_problem(arm, WaypointPath(waypoints), METHODS["cubic"], limits=limits, duration=0.9 * T))
+        plan(build_problem(arm, path, METHODS["cubic"], limits=limits, duration=0.9 * T))
     assert detail(refused.value).startswith(f"timing.duration {0.9 * T:g} s is too short for the cubic law")
