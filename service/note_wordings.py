@@ -47,6 +47,14 @@ def _waypoints_dropped(facts: dict) -> str:
     )
 
 
+def _points_dropped(facts: dict) -> str:
+    repeats, field = facts["indices"], facts["field"]
+    if len(repeats) == 1:
+        return f"{field}[{repeats[0]}] repeats the point before it and was dropped (the line stops at each point)"
+    shown = ", ".join(map(str, repeats[:10])) + (", ..." if len(repeats) > 10 else "")
+    return f"{field} [{shown}] repeat the point before each of them and were dropped ({len(repeats)} in all; the line stops at each point)"
+
+
 def _collocation_gap(facts: dict) -> str:
     advice = (
         f": more timing.grid_points (collocation intervals, up to {facts['most_intervals']}) bring it closer"
@@ -155,6 +163,7 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     "duration_given": "not estimated: timing.duration sets the duration, which is no optimum",
     "not_estimated": "not estimated for timing.method {method}",
     "waypoints_dropped": _waypoints_dropped,
+    "points_dropped": _points_dropped,
     "turned_the_short_way": lambda facts: (
         f"{facts['field']} 'shortest': continuous joint(s) {', '.join(map(repr, facts['joints']))} turn the short "
         "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"

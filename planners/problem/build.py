@@ -26,6 +26,7 @@ from toptraj.planners.collision.obstacles import check_obstacles
 from toptraj.planners.constraints.tool_speed import tool_speed_limit
 from toptraj.planners.errors import Conflicting, NotServed, OutOfRange
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
+from toptraj.planners.paths.cartesian import CartesianLine
 from toptraj.planners.paths.grid import MAX_POINTS
 from toptraj.planners.problem.bounded import check_speed_bounded
 from toptraj.planners.problem.free_motion import FreeMotion
@@ -35,7 +36,7 @@ from toptraj.planners.problem.problem import AT_REST, BoundaryStates, LimitReque
 from toptraj.planners.problem.raised_limits import raised_limits
 from toptraj.planners.problem.ranges import check_numbers, check_scaled_limits
 from toptraj.planners.problem.requests import WaypointPath, check_constraint_kinds, default_kinds
-from toptraj.planners.problem.waypoints import continuous_turns, without_repeats
+from toptraj.planners.problem.waypoints import continuous_turns, without_repeated_points, without_repeats
 from toptraj.planners.problem.zones import check_zones, check_zones_held, check_zones_served
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.robots import JointLimits, Robot, ToolSpeedLimit
@@ -96,6 +97,9 @@ def build_problem(
         motion, turns = continuous_turns(robot, motion)
         motion, dropped = without_repeats(motion)
         notes = (*notes, *turns, *dropped)
+    elif isinstance(motion, CartesianLine):
+        motion, dropped = without_repeated_points(motion)
+        notes = (*notes, *dropped)
     check_speed_bounded(robot, held, kinds, served=method.kinds)
     problem = Problem(
         robot=robot, motion=motion, method=method, requested=limits, grid=grid, boundary=boundary, duration=duration,

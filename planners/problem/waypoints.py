@@ -121,6 +121,35 @@ def spread_waypoints(waypoints: np.ndarray, spacing: float) -> tuple[list[int], 
     return kept, merged
 
 
+#: Distance (m, and rad of turn for poses) within which a Cartesian point repeats the one before it.
+SAME_POINT = 1e-9
+
+
+def without_repeated_points(line: CartesianLine) -> tuple[CartesianLine, tuple[Note, ...]]:
+    """``line`` without the points that repeat the one before them (within ``SAME_POINT``), and a
+    note saying which were dropped: a polyline stops at each of its points, so a repeat adds
+    nothing. Malformed points are left for ``cartesian_path`` to refuse."""
+    field = "positions" if line.poses is None else "poses"
+    points = np.asarray(line.positions if line.poses is None else line.poses, dtype=float)
+    if points.ndim != 2 or points.shape[1] not in (3, 7) or len(points) < 2 or not np.all(np.isfinite(points)):
+        return line, ()
+    same = np.linalg.norm(np.diff(points[:, :3], axis=0), axis=1) <= SAME_POINT
+    if points.shape[1] == 7:  # the same rotation: unit q or -q, within SAME_POINT / 2 (half the angle)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            unit = points[:, 3:] / np.linalg.norm(points[:, 3:], axis=1, keepdims=True)
+        turn = np.minimum(np.linalg.norm(unit[1:] - unit[:-1], axis=1), np.linalg.norm(unit[1:] + unit[:-1], axis=1))
+        same &= turn <= SAME_POINT / 2
+    repeats = np.flatnonzero(same) + 1
+    if repeats.size == 0:
+        return line, ()
+    note = Note(
+        f"{field} {repeats.tolist()} repeat the point before them and were dropped", "points_dropped",
+        field=field, indices=tuple(int(i) for i in repeats),
+    )
+    kept = np.delete(points, repeats, axis=0)
+    return (dataclasses.replace(line, positions=kept) if field == "positions" else dataclasses.replace(line, poses=kept)), (note,)
+
+
 CONTINUOUS = ("as_given", "shortest")
 
 

@@ -129,3 +129,29 @@ def test_bad_lines_are_422(client, points, words):
     assert response.status_code == 422, response.text
     for word in words:
         assert word in response.json()["detail"]
+
+
+def test_repeated_points_of_a_line_are_dropped_with_a_warning(client):
+    """A polyline stops at each point: a point repeated (positions), or a pose repeated with its
+    quaternion scaled or negated (the same rotation), is dropped with a warning, and the answer
+    is that of the line without it; it was refused ("repeats the previous point")."""
+    arm = robots.load("ur5")
+    start = np.array([0.3, -1.6, 1.7, -1.6, -1.57, 0.2])
+    pose = frame_pose(arm, start, arm.frame_id("tool0"))
+    quaternion = pin.Quaternion(pose.rotation)
+    turn = [quaternion.x, quaternion.y, quaternion.z, quaternion.w]
+    a, b = [*(pose.translation + [0.0, 0.15, 0.0]), *turn], [*(pose.translation + [0.1, 0.15, -0.1]), *turn]
+    cases = [
+        ("poses", [a, a[:3] + [-1.0004 * value for value in turn], b, b], [1, 3]),
+        ("positions", [a[:3], b[:3], b[:3]], [2]),
+    ]
+    for field, points, dropped in cases:
+        single = [point for index, point in enumerate(points) if index not in dropped]
+        bodies = [{"robot": "ur5", "path": {"kind": "cartesian", "start": start.tolist(), field: given}, "output": {"dt": 0.005}}
+                  for given in (points, single)]
+        answer, reference = (client.post("/v1/trajectories", json=body) for body in bodies)
+        assert answer.status_code == 200, answer.text[:300]
+        assert answer.json()["duration"] == reference.json()["duration"]
+        (warning,) = [text for text in answer.json()["warnings"] if "dropped" in text]
+        shown = f"path.{field}[{dropped[0]}] repeats" if len(dropped) == 1 else f"path.{field} [1, 3] repeat"
+        assert warning.startswith(shown) and "the line stops at each point" in warning
