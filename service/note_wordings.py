@@ -35,15 +35,18 @@ def _waypoints_dropped(facts: dict) -> str:
             return f"{field}[{repeats[0]}] repeats the waypoint before it and was dropped"
         return f"{field} [{shown}] repeat the waypoint before each of them and were dropped ({len(repeats)} in all)"
     near = f"{facts['nearest']:.2g} rad or m"
-    share = f"nearer than {facts['share']:g} of the path's joint-space length ({facts['length']:.4g})"
+    share = f"{facts['share']:g} of the path's joint-space length ({facts['length']:.4g})"
     why = "the path would turn sharply between waypoints so near, and the arm nearly stop there"
-    keeps = "keeps it" if len(repeats) == 1 else "keeps them"
-    advice = f"; path.min_spacing = 0 {keeps}" if facts.get("settable") else ""
     if len(repeats) == 1:
-        return f"{field}[{repeats[0]}] lies {near} from a neighbouring waypoint, {share}, and was dropped: {why}{advice}"
+        advice = "; path.min_spacing = 0 keeps it" if facts.get("settable") else ""
+        return (
+            f"{field}[{repeats[0]}] lies {near} from a waypoint kept, within {share} of the one kept before it or of "
+            f"the last, and was dropped: {why}{advice}"
+        )
+    advice = "; path.min_spacing = 0 keeps them" if facts.get("settable") else ""
     return (
-        f"{field} [{shown}] ({len(repeats)} in all) lie within {near} of a neighbouring waypoint, {share}, and were "
-        f"dropped: {why}{advice}"
+        f"{field} [{shown}] ({len(repeats)} in all) lie within {near} of a waypoint kept, each within {share} of the "
+        f"one kept before it or of the last, and were dropped: {why}{advice}"
     )
 
 

@@ -314,7 +314,6 @@ WORDING: dict[str, Wording] = {
     "not_finite_joint_values": "{field} must hold {expected} finite joint values",
     "outside_joint_limits": "{field} = {value:.6g} is outside the limits of joint {joint_name!r}",
     "line_too_long": "the line to {field} is {length:.4g} m long: it leaves the workspace of {robot}",
-    "repeated_point": "{field} repeats the previous point",
     "point_out_of_reach": lambda facts: (
         f"the line leaves the workspace of {facts['robot']}: no joint solution reaches the point {_where(facts)}; bring "
         f"{facts['field']} within the arm's reach, or go around the unreachable part through a point added before it"

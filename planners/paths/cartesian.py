@@ -110,8 +110,8 @@ def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DE
         if span / STEP_LENGTH_M > MAX_STEPS_PER_LINE:
             raise InvalidRequest(f"{field}[{k + offset}]", positions[k + 1], rule="line_too_long", length=float(span), robot=robot.name)
         samples = _line_samples(positions[k], positions[k + 1], rotations[k], rotations[k + 1])
-        if samples is None:
-            raise InvalidRequest(f"{field}[{k + offset}]", positions[k + 1], rule="repeated_point")
+        if samples is None:  # a point repeated: the line stops there anyway (told by the problem's notes)
+            continue
         solutions = [q]
         for fraction, (position, rotation) in samples:
             deadline.check()
@@ -133,6 +133,8 @@ def cartesian_path(robot: Robot, line: CartesianLine, deadline: Deadline = NO_DE
         pieces.append(piece)
         lengths.append(float(np.sum(np.linalg.norm(np.diff(joint_points, axis=0), axis=1))))
         q = joint_points[-1]
+    if not pieces:
+        raise InvalidRequest(field, None, rule="only_the_start_pose")
     return ConcatenatedPath(pieces, np.array(lengths))
 
 

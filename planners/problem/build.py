@@ -36,7 +36,7 @@ from toptraj.planners.problem.problem import AT_REST, BoundaryStates, LimitReque
 from toptraj.planners.problem.raised_limits import raised_limits
 from toptraj.planners.problem.ranges import check_numbers, check_scaled_limits
 from toptraj.planners.problem.requests import WaypointPath, check_constraint_kinds, default_kinds
-from toptraj.planners.problem.waypoints import continuous_turns, without_repeated_points, without_repeats
+from toptraj.planners.problem.waypoints import checked_waypoints, continuous_turns, repeated_points, without_repeats
 from toptraj.planners.problem.zones import check_zones, check_zones_held, check_zones_served
 from toptraj.planners.timing.base import TimingMethod
 from toptraj.robots import JointLimits, Robot, ToolSpeedLimit
@@ -92,14 +92,8 @@ def build_problem(
     held = _limits(robot, motion, method, limits)  # zones checked and refused where not served
     check_zones_held(limits.zones, kinds)
     held = held.tightened(margin) if margin else held
-    notes: tuple[str, ...] = (*raised_limits(robot, limits, kinds), *gravity_notes(robot))
-    if isinstance(motion, WaypointPath):
-        motion, turns = continuous_turns(robot, motion)
-        motion, dropped = without_repeats(motion)
-        notes = (*notes, *turns, *dropped)
-    elif isinstance(motion, CartesianLine):
-        motion, dropped = without_repeated_points(motion)
-        notes = (*notes, *dropped)
+    motion, told = _prepared(robot, motion)
+    notes: tuple[str, ...] = (*raised_limits(robot, limits, kinds), *gravity_notes(robot), *told)
     check_speed_bounded(robot, held, kinds, served=method.kinds)
     problem = Problem(
         robot=robot, motion=motion, method=method, requested=limits, grid=grid, boundary=boundary, duration=duration,
@@ -109,6 +103,19 @@ def build_problem(
     )
     _check_method_serves(problem)
     return problem
+
+
+def _prepared(robot: Robot, motion: MotionSpec) -> tuple[MotionSpec, tuple[str, ...]]:
+    """``motion`` as it is planned (joint waypoints checked, then turned the short way as asked
+    and their repeats dropped), and the notes that say what changed."""
+    if isinstance(motion, WaypointPath):
+        checked_waypoints(robot, motion)  # before any is dropped: refusals name the waypoints as given
+        motion, turns = continuous_turns(robot, motion)
+        motion, dropped = without_repeats(motion)
+        return motion, (*turns, *dropped)
+    if isinstance(motion, CartesianLine):
+        return motion, repeated_points(motion)
+    return motion, ()
 
 
 def _check_grid(grid: int | None, method: TimingMethod | MotionGenerator, robot: Robot) -> None:

@@ -38,13 +38,16 @@ class WaypointPath:
     timing method). Continuous joints (no position limits) follow the numbers given
     (``continuous = "as_given"``) or turn the short way between waypoints (``"shortest"``).
     A waypoint within ``min_spacing`` times the path's joint-space length of the waypoint kept
-    before it (after it, for the last) is dropped as a repeat."""
+    before it is dropped as a repeat (a waypoint so near the last, in the last's place);
+    ``None``: ``DEFAULT_MIN_SPACING`` on a spline or blend, 0 otherwise. ``origin``: the
+    index as given of each waypoint, once repeats are dropped (``None``: as given)."""
 
     waypoints: np.ndarray
     interpolation: str = "spline"
     max_deviation: float | None = None
     continuous: str = "as_given"
-    min_spacing: float = DEFAULT_MIN_SPACING
+    min_spacing: float | None = None
+    origin: tuple[int, ...] | None = None
 
 
 def default_kinds(method: TimingMethod | MotionGenerator) -> tuple[tuple[str, ...], tuple[str, ...]]:

@@ -15,7 +15,7 @@ from toptraj.planners.paths.blended import BlendedPath
 from toptraj.planners.paths.cartesian import CartesianLine, cartesian_path
 from toptraj.planners.paths.waypoints import COINCIDENT
 from toptraj.planners.problem.ranges import COORDINATE, MAX_DEVIATION, MIN_SPACING, check
-from toptraj.planners.problem.requests import DEFAULT_MAX_DEVIATION, WaypointPath
+from toptraj.planners.problem.requests import DEFAULT_MAX_DEVIATION, DEFAULT_MIN_SPACING, WaypointPath
 from toptraj.robots import Robot
 from toptraj.robots.notes import Note
 
@@ -55,21 +55,30 @@ def checked_waypoints(robot: Robot, spec: WaypointPath) -> np.ndarray:
     return waypoints
 
 
-def without_repeats(spec: WaypointPath, settable: bool = True) -> tuple[WaypointPath, tuple[Note, ...]]:
-    """``spec`` without waypoints that repeat a neighbour (a recorded path that stands still for
-    a while, or whose encoders jitter there), and a note saying which were dropped.
+#: Interpolations whose path turns between near waypoints (``DEFAULT_MIN_SPACING`` applies); a
+#: ``"linear"`` path stops at each waypoint and via points pass each in its own segment, so only
+#: exact repeats are dropped from them unless ``min_spacing`` is given.
+TURNING = ("spline", "blend")
 
-    A waypoint repeats when it lies within ``spec.min_spacing`` times the path's joint-space
-    length (at least ``COINCIDENT``) of the waypoint kept before it; the first and the last
-    waypoint are kept, a waypoint before the last that lies so near the last is dropped instead.
-    A spline through two such waypoints turns within a stretch of s about spacing / length long:
-    the arm nearly stops there, and the grid timings lose their conditioning (toppra and
-    min_cost refused the Geering arm's recorded path with waypoints 1e-7 of its length apart).
+
+def without_repeats(spec: WaypointPath, settable: bool = True) -> tuple[WaypointPath, tuple[Note, ...]]:
+    """``spec`` without waypoints that repeat a neighbour, and notes saying which were dropped:
+    exact repeats (within ``COINCIDENT``: a recorded path that stands still for a while) and
+    near ones (a standing arm's encoders jittering).
+
+    A waypoint repeats nearly when it lies within the spacing, ``spec.min_spacing`` (default
+    ``DEFAULT_MIN_SPACING`` on ``TURNING`` interpolations, else 0) times the path's joint-space
+    length, of the waypoint kept before it; the first and the last waypoint are kept, a waypoint
+    kept before the last that lies so near the last is dropped instead. A spline through two
+    such waypoints turns within a stretch of s about spacing / length long: the arm nearly
+    stops there, and the grid timings lose their conditioning (toppra and min_cost refused the
+    Geering arm's recorded path with waypoints 1e-7 of its length apart). The waypoints kept
+    carry their index in ``spec`` (``origin``), for notes that name waypoints.
 
     Args:
-        spec: The waypoints, shape (n_waypoints, n_dof) in joint units.
+        spec: The waypoints, shape (n_waypoints, n_dof) in joint units, checked (``checked_waypoints``).
         settable: Whether the caller can set ``min_spacing`` (the note then says that 0 keeps
-            the waypoints).
+            the near waypoints).
 
     Raises:
         InvalidRequest: every waypoint is the same: there is nothing to move.
@@ -77,62 +86,73 @@ def without_repeats(spec: WaypointPath, settable: bool = True) -> tuple[Waypoint
     waypoints = np.asarray(spec.waypoints, dtype=float)
     if waypoints.ndim != 2 or len(waypoints) < 2 or not np.all(np.isfinite(waypoints)):
         return spec, ()
-    check(spec.min_spacing, "min_spacing", MIN_SPACING)
+    share = spec.min_spacing
+    if share is None:
+        share = DEFAULT_MIN_SPACING if spec.interpolation in TURNING else 0.0
+    check(share, "min_spacing", MIN_SPACING)
     steps = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
-    length = float(steps.sum())
-    spacing = max(spec.min_spacing * length, COINCIDENT)
-    if np.all(steps > spacing):
-        return spec, ()
-    kept, merged = spread_waypoints(waypoints, spacing)
-    if len(kept) < 2:
+    exact = np.flatnonzero(steps <= COINCIDENT) + 1
+    if exact.size == len(waypoints) - 1:
         raise InvalidRequest("waypoints", waypoints, rule="all_waypoints_coincide", count=len(waypoints), tolerance=COINCIDENT)
-    dropped = np.setdiff1d(np.arange(len(waypoints)), kept)
-    near = float(max(merged))
-    shown = ", ".join(map(str, dropped[:10])) + (", ..." if dropped.size > 10 else "")
-    note = Note(
-        f"waypoints [{shown}] lie within {near:.2g} of a waypoint kept and were dropped ({dropped.size} in all)",
-        "waypoints_dropped", field="waypoints", indices=tuple(int(i) for i in dropped), nearest=near,
-        coincident=near <= COINCIDENT, share=spec.min_spacing, length=length, settable=settable,
-    )
-    return dataclasses.replace(spec, waypoints=waypoints[kept]), (note,)
+    index = np.delete(np.arange(len(waypoints)), exact)
+    length = float(steps.sum())
+    kept = index[spread_waypoints(waypoints[index], share * length)]
+    near = np.setdiff1d(index, kept)
+    notes = []
+    if exact.size:
+        notes.append(_dropped(exact, "repeat the waypoint before them", coincident=True))
+    if near.size:
+        notes.append(_dropped(near, f"lie within {share:g} of the path's length of a waypoint kept", coincident=False,
+                              nearest=nearest_kept(waypoints, kept, near), share=share, length=length, settable=settable))
+    if not notes:
+        return spec, ()
+    return dataclasses.replace(spec, waypoints=waypoints[kept], origin=tuple(int(i) for i in kept)), tuple(notes)
 
 
-def spread_waypoints(waypoints: np.ndarray, spacing: float) -> tuple[list[int], list[float]]:
-    """(kept, merged): the indices of the waypoints (n, n_dof) kept, each farther than
-    ``spacing`` from the one kept before it, the first and the last always kept (a kept waypoint
-    within ``spacing`` of the last dropped in its place, the first excepted); and the distance of
-    each dropped waypoint from the kept one it was dropped for."""
-    kept, merged = [0], []
+def _dropped(indices: np.ndarray, words: str, **facts) -> Note:
+    shown = ", ".join(map(str, indices[:10])) + (", ..." if indices.size > 10 else "")
+    return Note(f"waypoints [{shown}] {words} and were dropped ({indices.size} in all)", "waypoints_dropped",
+                field="waypoints", indices=tuple(int(i) for i in indices), **facts)
+
+
+def spread_waypoints(waypoints: np.ndarray, spacing: float) -> np.ndarray:
+    """The indices of the waypoints (n, n_dof) kept, each farther than ``spacing`` from the one
+    kept before it; the first and the last are kept, a kept waypoint within ``spacing`` of the
+    last dropped in its place (the first excepted)."""
+    steps = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
+    if np.all(steps > spacing):
+        return np.arange(len(waypoints))
+    kept = [0]
     for index in range(1, len(waypoints) - 1):
-        distance = float(np.linalg.norm(waypoints[index] - waypoints[kept[-1]]))
-        if distance > spacing:
+        if np.linalg.norm(waypoints[index] - waypoints[kept[-1]]) > spacing:
             kept.append(index)
-        else:
-            merged.append(distance)
     last = len(waypoints) - 1
-    while len(kept) > 1 and (distance := float(np.linalg.norm(waypoints[last] - waypoints[kept[-1]]))) <= spacing:
+    while len(kept) > 1 and np.linalg.norm(waypoints[last] - waypoints[kept[-1]]) <= spacing:
         kept.pop()
-        merged.append(distance)
-    distance = float(np.linalg.norm(waypoints[last] - waypoints[kept[-1]]))
-    if distance > COINCIDENT:
-        kept.append(last)
-    else:
-        merged.append(distance)
-    return kept, merged
+    return np.array([*kept, last])
+
+
+def nearest_kept(waypoints: np.ndarray, kept: np.ndarray, dropped: np.ndarray) -> float:
+    """The largest distance of a dropped waypoint from the nearer of the two waypoints kept on
+    either side of it (``kept`` and ``dropped`` ascending indices into ``waypoints`` (n, n_dof))."""
+    after = np.searchsorted(kept, dropped)
+    before_distance = np.linalg.norm(waypoints[dropped] - waypoints[kept[after - 1]], axis=1)
+    after_distance = np.linalg.norm(waypoints[dropped] - waypoints[kept[np.minimum(after, len(kept) - 1)]], axis=1)
+    return float(np.minimum(before_distance, after_distance).max())
 
 
 #: Distance (m, and rad of turn for poses) within which a Cartesian point repeats the one before it.
 SAME_POINT = 1e-9
 
 
-def without_repeated_points(line: CartesianLine) -> tuple[CartesianLine, tuple[Note, ...]]:
-    """``line`` without the points that repeat the one before them (within ``SAME_POINT``), and a
-    note saying which were dropped: a polyline stops at each of its points, so a repeat adds
-    nothing. Malformed points are left for ``cartesian_path`` to refuse."""
+def repeated_points(line: CartesianLine) -> tuple[Note, ...]:
+    """A note naming the points of ``line`` that repeat the one before them (within
+    ``SAME_POINT``), which ``cartesian_path`` passes over: a polyline stops at each of its
+    points, so a repeat adds nothing. Malformed points are left for ``cartesian_path`` to refuse."""
     field = "positions" if line.poses is None else "poses"
     points = np.asarray(line.positions if line.poses is None else line.poses, dtype=float)
     if points.ndim != 2 or points.shape[1] not in (3, 7) or len(points) < 2 or not np.all(np.isfinite(points)):
-        return line, ()
+        return ()
     same = np.linalg.norm(np.diff(points[:, :3], axis=0), axis=1) <= SAME_POINT
     if points.shape[1] == 7:  # the same rotation: unit q or -q, within SAME_POINT / 2 (half the angle)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -141,13 +161,9 @@ def without_repeated_points(line: CartesianLine) -> tuple[CartesianLine, tuple[N
         same &= turn <= SAME_POINT / 2
     repeats = np.flatnonzero(same) + 1
     if repeats.size == 0:
-        return line, ()
-    note = Note(
-        f"{field} {repeats.tolist()} repeat the point before them and were dropped", "points_dropped",
-        field=field, indices=tuple(int(i) for i in repeats),
-    )
-    kept = np.delete(points, repeats, axis=0)
-    return (dataclasses.replace(line, positions=kept) if field == "positions" else dataclasses.replace(line, poses=kept)), (note,)
+        return ()
+    return (Note(f"{field} {repeats.tolist()} repeat the point before them and are passed over", "points_dropped",
+                 field=field, indices=tuple(int(i) for i in repeats)),)
 
 
 CONTINUOUS = ("as_given", "shortest")

@@ -55,7 +55,7 @@ def answer(problem: Problem, timed: Timed, checked_first: Clearance | None, star
     """The answer to ``problem`` from its timed motion (``checked_first``: the clearance of a
     given path, found before its timing; ``started``: ``time.perf_counter()`` at the start)."""
     robot, deadline, result = problem.robot, problem.deadline, timed.timing
-    notes = [*problem.notes, *timed.notes, *_blend_notes(timed.path)]
+    notes = [*problem.notes, *timed.notes, *_blend_notes(timed.path, getattr(problem.motion, 'origin', None))]
     deadline.check()
     found_clearance = None
     if problem.obstacles:
@@ -105,15 +105,17 @@ def _zone_reports(zones, stretches_: tuple[TimedStretch, ...], margin: float) ->
     return tuple(reports)
 
 
-def _blend_notes(path) -> list[Note]:
-    """Corners a blend could not round within the path's deviation: the motion stops there."""
+def _blend_notes(path, origin: tuple[int, ...] | None) -> list[Note]:
+    """Corners a blend could not round within the path's deviation: the motion stops there.
+    ``origin``: the index as given of each waypoint of the path (``None``: as given)."""
     if not (isinstance(path, BlendedPath) and path.tight_corners):
         return []
+    corners = tuple(path.tight_corners if origin is None else (origin[corner] for corner in path.tight_corners))
     return [Note(
         f"the largest deviation {path.max_deviation:g} is too small to blend the corners at waypoints "
-        f"{', '.join(map(str, path.tight_corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
+        f"{', '.join(map(str, corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
         "stops there",
-        "corners_not_blended", field="max_deviation", value=path.max_deviation, corners=tuple(path.tight_corners),
+        "corners_not_blended", field="max_deviation", value=path.max_deviation, corners=corners,
         min_blend=MIN_BLEND,
     )]
 

@@ -58,12 +58,12 @@ class WaypointsPath(Schema):
         "when one turns more than pi between waypoints), `shortest` turns the short way, waypoints "
         "after the first reached as equivalent angles.",
     )
-    min_spacing: Annotated[float, bounded(ranges.MIN_SPACING)] = Field(
-        default=DEFAULT_MIN_SPACING,
-        description="A waypoint nearer than this share of the path's joint-space length to the waypoint kept "
-        "before it (after it, for the last) is dropped, with a warning, as a repeat: a path through waypoints "
-        "so near turns sharply and the arm nearly stops there (recorded paths that stand still, or whose "
-        "encoders jitter). 0 keeps every waypoint that differs.",
+    min_spacing: Annotated[float, bounded(ranges.MIN_SPACING)] | None = Field(
+        default=None,
+        description="A waypoint within this share of the path's joint-space length of the waypoint kept before it "
+        "is dropped as a repeat, with a warning (one so near the last, in the last's place): a spline or blend "
+        f"through waypoints so near turns sharply and the arm nearly stops there. Default {DEFAULT_MIN_SPACING:g} "
+        "for `spline` and `blend`, 0 for `linear` and `via`; 0 keeps every waypoint that differs.",
     )
     obstacles: list[ObstacleRequest] = OBSTACLES
     clearance: float = CLEARANCE

@@ -39,13 +39,40 @@ def test_the_goal_is_kept_and_the_waypoint_nearly_on_it_is_dropped():
     assert note.facts["indices"] == (3,)
 
 
-def test_exact_repeats_say_so_and_min_spacing_zero_keeps_every_waypoint_that_differs():
+def test_exact_repeats_and_near_ones_are_told_apart_and_min_spacing_zero_keeps_the_near_ones():
     waypoints = np.vstack([STRAIGHT[:2], STRAIGHT[1:2], STRAIGHT[1:2] + 1e-9, STRAIGHT[2:]])
-    spec, (note,) = without_repeats(WaypointPath(waypoints, min_spacing=0.0))
-    assert note.facts["coincident"] and note.facts["indices"] == (2,)
-    assert np.array_equal(spec.waypoints, np.delete(waypoints, 2, axis=0))
-    spec, (note,) = without_repeats(WaypointPath(waypoints))
-    assert note.facts["indices"] == (2, 3) and not note.facts["coincident"]
+    spec, (exact,) = without_repeats(WaypointPath(waypoints, min_spacing=0.0))
+    assert exact.facts["coincident"] and exact.facts["indices"] == (2,)
+    assert np.array_equal(spec.waypoints, np.delete(waypoints, 2, axis=0)) and spec.origin == (0, 1, 3, 4, 5)
+    spec, (exact, near) = without_repeats(WaypointPath(waypoints))
+    assert exact.facts["indices"] == (2,) and near.facts["indices"] == (3,) and not near.facts["coincident"]
+    assert spec.origin == (0, 1, 4, 5)
+
+
+def test_a_repeated_goal_drops_the_later_one():
+    spec, (note,) = without_repeats(WaypointPath(np.vstack([STRAIGHT, STRAIGHT[-1:]])))
+    assert note.facts["indices"] == (4,) and note.facts["coincident"] and len(spec.waypoints) == 4
+
+
+def test_stop_and_go_and_via_points_keep_near_waypoints_unless_asked():
+    """A ``linear`` path stops at each waypoint and via points pass each in its own segment: the
+    spline's sharp turn does not arise, so only exact repeats go by default."""
+    waypoints = np.vstack([STRAIGHT[:2], STRAIGHT[1:2] + [1e-6, 0.0], STRAIGHT[2:]])
+    for interpolation in ("linear", "via"):
+        assert without_repeats(WaypointPath(waypoints, interpolation)) == (WaypointPath(waypoints, interpolation), ())
+        spec, (note,) = without_repeats(WaypointPath(waypoints, interpolation, min_spacing=1e-4))
+        assert note.facts["indices"] == (2,) and len(spec.waypoints) == 4
+    assert len(without_repeats(WaypointPath(waypoints, "blend"))[0].waypoints) == 4
+
+
+def test_the_distance_told_is_from_the_nearest_waypoint_kept():
+    """Waypoint 3 is dropped for waypoint 2, which is then dropped for the goal: 3 lies twice its
+    step from the nearest waypoint kept, and the note says so (not the step)."""
+    step = 1.8e-4
+    waypoints = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0 - step, 0.0], [2.0 + step, 0.0]])
+    spec, (note,) = without_repeats(WaypointPath(waypoints, min_spacing=2e-4 / _length(waypoints)))
+    assert note.facts["indices"] == (2, 3) and spec.origin == (0, 1, 4)
+    assert note.facts["nearest"] == pytest.approx(2 * step)
 
 
 def test_the_spacing_is_a_share_of_the_path_length():
