@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.errors import Conflicting, InfeasiblePath
+from toptraj.planners.errors import Conflicting, InfeasiblePath, LimitExceeded
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.generators.via_points import ConstantSpeedTiming
 from toptraj.planners.paths.base import GeometricPath, PathPoints
@@ -37,6 +37,9 @@ from toptraj.robots import JointLimits, Robot
 PEAK_SAMPLES = 4001
 #: Samples of s for the torque check while searching the common factor.
 TORQUE_SAMPLES = 801
+#: Share by which a given duration may fall short of the slowest joint's own before it is
+#: refused (rounding of a duration the answer printed).
+SHORTER = 1e-9
 
 
 class JointLawPath(GeometricPath):
@@ -165,6 +168,14 @@ def unsynchronized_trajectory(
     factor = 1.0
     if duration is not None:
         factor, binding = duration / durations[slowest], None
+        if factor < 1.0 - SHORTER:  # every joint over by the same factor: the slowest one is named
+            kind = setting[slowest]
+            raise LimitExceeded(
+                f"the {profile.name} law exceeds the {kind} limit of joint {robot.joint_names[slowest]!r} by "
+                f"{100 * (factor ** -(orders[kind] + 1) - 1):.2f} % at s = {peak_at:.4f}: the duration is too short",
+                s=peak_at, joint=robot.joint_names[slowest], limit=kind, ratio=float(factor ** -(orders[kind] + 1)),
+                method=profile.name,
+            )
     elif "torque" in kinds and _torque_ratio(robot, path(1.0), limits)[0] > 1.0:
         low, high = 1.0, 2.0
         for _ in range(60):

@@ -65,3 +65,18 @@ def test_a_via_point_motion_given_any_duration_above_its_shortest_is_answered(cl
         assert answered.json()["duration"] == given
         peaks = answered.json()["peak_utilization"]
         assert max(max(peaks["velocity"]), max(peaks["acceleration"])) <= 1.0 / factor**1 + 1e-9
+
+
+def test_a_duration_too_short_joint_by_joint_names_the_slowest_joint(client):
+    """Joint by joint, a duration shorter than the slowest joint's own speeds every joint up by
+    the same factor, and every joint exceeds its limit by the same share: the refusal named the
+    first joint (shoulder_pan_joint); it names the joint whose own duration is the motion's,
+    the one the answer without a duration reports as binding, and the excess the factor gives."""
+    path = {"waypoints": [[0, 0, 0, 0, 0, 0], [0.2, 1.5, 0.3, 0.1, 0.1, 0.1]], "interpolation": "linear"}
+    timing = {"method": "trapezoidal", "synchronization": "none", "constraints": ["velocity", "acceleration"]}
+    shortest = client.post("/v1/trajectories", json={"robot": "ur5", "path": path, "timing": timing}).json()
+    assert shortest["binding"]["joint"] == "shoulder_lift_joint"
+    refused = client.post("/v1/trajectories", json={"robot": "ur5", "path": path, "timing": {**timing, "duration": 0.5}})
+    detail = refused.json()["detail"]
+    excess = 100 * ((shortest["duration"] / 0.5) ** 2 - 1)  # accelerations scale with 1 / T^2
+    assert f"the acceleration limit of joint 'shoulder_lift_joint' is exceeded by {excess:.2f} %" in detail
