@@ -178,8 +178,13 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     ),
     "corners_not_blended": lambda facts: (
         f"{facts['field']} = {facts['value']:g} is too small to blend the corners at waypoints "
-        f"{', '.join(map(str, facts['corners']))} (a blend shorter than {facts['min_blend']:g} of the path): the motion "
-        "stops there"
+        f"{', '.join(map(str, facts['corners']))} (a blend of radius below {facts['min_blend']:g} of the path): the "
+        "motion stops there"
+    ),
+    "corners_between_short_segments": lambda facts: (
+        f"the corners at {facts['field']} {', '.join(map(str, facts['corners']))} turn too sharply for the segments "
+        f"beside them (a blend within half of each has a radius below {facts['min_blend']:g} of the path): the motion "
+        "stops there; path.interpolation 'spline' passes them without stopping"
     ),
     "collocation_gap": _collocation_gap,
     "limit_far_above_own": _limit_far_above_own,

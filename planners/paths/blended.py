@@ -24,7 +24,7 @@ and along its start tangent and theta = sigma_local / r,
 so dq/ds is continuous everywhere and d2q/ds2 jumps where a line meets a circle (``breaks``: the
 motion does not stop there, but the limits seen from either side differ). A corner that turns
 back on itself (alpha = pi) cannot be blended and is a corner where the motion stops
-(``kinks``), as is one whose blend would be shorter than ``MIN_BLEND`` of the path
+(``kinks``), as is one whose blend's radius would be below ``MIN_BLEND`` of the path
 (``tight_corners`` names those, for a note in the answer).
 """
 
@@ -37,14 +37,19 @@ from toptraj.planners.paths.base import GeometricPath, PathPoints
 #: 1 - cos(alpha) below this: the segments continue straight on (no blend needed, the direction
 #: changes by less than 1.5e-6 rad).
 STRAIGHT = 1e-12
-#: A blend shorter than this fraction of the path (its angle times its tangent distance) is a
-#: corner where the motion stops: a fifth of the finest spacing of a timing grid (20,000 points),
-#: below which the grids cannot resolve the blend's curvature (max_deviation 1e-9 rad on a UR5
-#: path exceeded the acceleration limit by 23 %, and min_cost's solver failed up to 1e-6 of the
-#: path); the speed such a blend allows, sqrt(acceleration limit x radius), is nearly a stop.
+#: A blend whose radius is below this fraction of the path is a corner where the motion stops:
+#: its curvature, L / radius in s, outruns what the timing grids resolve (max_deviation 1e-9 rad
+#: on a UR5 path exceeded the acceleration limit by 23 %, and min_cost's solver failed up to
+#: 1e-6 of the path), and the speed it allows, sqrt(acceleration limit x radius), is nearly a
+#: stop. The radius, not the blend's length, decides: a corner between two short segments that
+#: turns by little (a dense recording of a smooth curve) has a short blend of a large radius,
+#: which the motion follows at speed.
 MIN_BLEND = 1e-5
 #: Distance (relative to the path's length) below which two points are one: a rounding.
 SAME_POINT = 1e-12
+#: Shortest line left between two blends (relative to the path's length): a blend that would
+#: leave a shorter one shrinks (toppra's grid failed on a line of 7.6e-8 of a dense recording).
+MIN_LINE = 1e-5
 
 
 class BlendedPath(GeometricPath):
@@ -59,8 +64,10 @@ class BlendedPath(GeometricPath):
         length: Total arc length L in joint space (joint units).
         deviations: Distance of each interior waypoint from its blend, shape (n_waypoints - 2,)
             (0 where the path passes the waypoint: a straight continuation or a stop).
-        tight_corners: Indices of the waypoints whose blend would be shorter than ``MIN_BLEND``
-            of the path: corners where the motion stops.
+        tight_by_deviation: Those of ``tight_corners`` whose blend ``max_deviation`` limits
+            (the others are limited by half of a segment beside them).
+        tight_corners: Indices of the waypoints whose blend's radius would be below
+            ``MIN_BLEND`` of the path: corners where the motion stops.
     """
 
     def __init__(self, waypoints: np.ndarray, max_deviation: float):
@@ -68,37 +75,7 @@ class BlendedPath(GeometricPath):
         self.waypoints = waypoints
         self.dof = waypoints.shape[1]
         self.max_deviation = float(max_deviation)
-        segments = np.diff(waypoints, axis=0)
-        lengths = np.linalg.norm(segments, axis=1)
-        directions = segments / lengths[:, None]
-        scale = lengths.sum()
-        # Pieces: (kind, start point, direction or x, y, center, radius, length); kind 0 line, 1 arc.
-        pieces, corners, deviations, tight = [], [], [], []
-        position = waypoints[0]
-        for i in range(1, len(waypoints) - 1):
-            blend = _blend(waypoints[i], directions[i - 1], directions[i], lengths[i - 1], lengths[i], self.max_deviation)
-            if blend is not None and blend[4] * blend[5] <= MIN_BLEND * scale:
-                tight.append(i)
-            if blend is None or blend[4] * blend[5] <= MIN_BLEND * scale:
-                # Straight on (the segments are one line), or a corner that cannot be blended.
-                reverse = directions[i - 1] @ directions[i] < 1.0 - STRAIGHT
-                pieces.append(_line(position, waypoints[i]))
-                corners.append(reverse)
-                position = waypoints[i]
-                deviations.append(0.0)
-                continue
-            center, x, y, radius, angle, distance = blend
-            start = waypoints[i] - distance * directions[i - 1]
-            # The straight piece up to the blend, however short (a short first segment: the path
-            # must leave the first waypoint); only a gap of a rounding is closed by the arc itself.
-            if np.linalg.norm(start - position) > SAME_POINT * scale:
-                pieces.append(_line(position, start))
-                corners.append(False)
-            pieces.append(("arc", center, x, y, radius, angle * radius))
-            corners.append(False)
-            position = center + radius * (x * np.cos(angle) + y * np.sin(angle))
-            deviations.append(float(np.linalg.norm(center - waypoints[i]) - radius))
-        pieces.append(_line(position, waypoints[-1]))
+        pieces, corners, deviations, tight, by_deviation = _pieces(waypoints, self.max_deviation)
         self._pieces = pieces
         piece_lengths = np.array([piece[-1] for piece in pieces])
         self.length = float(piece_lengths.sum())
@@ -111,6 +88,7 @@ class BlendedPath(GeometricPath):
         self.breaks = junctions[~stop]
         self.deviations = np.array(deviations)
         self.tight_corners = tuple(tight)
+        self.tight_by_deviation = tuple(by_deviation)
         self._is_arc = np.array([piece[0] == "arc" for piece in pieces])
         n_pieces = len(pieces)
         # Per piece: origin and direction (lines) or center, x, y (arcs), and the radius.
@@ -158,13 +136,62 @@ class BlendedPath(GeometricPath):
         return self._derivatives(s, side, 4)[3] * self.length**3
 
 
+def _pieces(waypoints: np.ndarray, max_deviation: float) -> tuple[list, list, list, list, list]:
+    """The path's pieces through ``waypoints`` (n, n_dof), each (kind, start point, direction or
+    x, y, center, radius, length) with kind "line" or "arc"; whether the junction after each is
+    a stop; each interior waypoint's distance from its blend; the corners left unblended, and
+    those of them ``max_deviation`` limits."""
+    segments = np.diff(waypoints, axis=0)
+    lengths = np.linalg.norm(segments, axis=1)
+    directions = segments / lengths[:, None]
+    scale = lengths.sum()
+    pieces, corners, deviations, tight, by_deviation = [], [], [], [], []
+    position = waypoints[0]
+    for i in range(1, len(waypoints) - 1):
+        blend = _blend(waypoints[i], directions[i - 1], directions[i], lengths[i - 1], lengths[i], max_deviation)
+        tight_here = blend is not None and blend[3] <= MIN_BLEND * scale
+        if tight_here:
+            tight.append(i)
+            if blend[5] < 0.5 * min(lengths[i - 1], lengths[i]):
+                by_deviation.append(i)
+        if blend is None or tight_here:
+            # Straight on (the segments are one line), or a corner that cannot be blended.
+            reverse = directions[i - 1] @ directions[i] < 1.0 - STRAIGHT
+            pieces.append(_line(position, waypoints[i]))
+            corners.append(reverse)
+            position = waypoints[i]
+            deviations.append(0.0)
+            continue
+        center, x, y, radius, angle, distance = blend
+        start = waypoints[i] - distance * directions[i - 1]
+        gap = float(np.linalg.norm(start - position))
+        if SAME_POINT * scale < gap < MIN_LINE * scale and distance - (MIN_LINE * scale - gap) > 0.5 * distance:
+            # A sliver of line between two blends: this blend shrinks to leave a line of MIN_LINE.
+            blend = _blend(waypoints[i], directions[i - 1], directions[i], lengths[i - 1], lengths[i], max_deviation,
+                           most=distance - (MIN_LINE * scale - gap))
+            assert blend is not None
+            center, x, y, radius, angle, distance = blend
+            start = waypoints[i] - distance * directions[i - 1]
+        # The straight piece up to the blend, however short (a short first segment: the path
+        # must leave the first waypoint); only a gap of a rounding is closed by the arc itself.
+        if np.linalg.norm(start - position) > SAME_POINT * scale:
+            pieces.append(_line(position, start))
+            corners.append(False)
+        pieces.append(("arc", center, x, y, radius, angle * radius))
+        corners.append(False)
+        position = center + radius * (x * np.cos(angle) + y * np.sin(angle))
+        deviations.append(float(np.linalg.norm(center - waypoints[i]) - radius))
+    pieces.append(_line(position, waypoints[-1]))
+    return pieces, corners, deviations, tight, by_deviation
+
+
 def _line(start: np.ndarray, end: np.ndarray):
     span = end - start
     length = float(np.linalg.norm(span))
     return ("line", start, span / length if length > 0 else np.zeros_like(span), length)
 
 
-def _blend(corner, incoming, outgoing, before, after, max_deviation):
+def _blend(corner, incoming, outgoing, before, after, max_deviation, most=np.inf):
     """(center, x, y, radius, angle, distance) of the circle that replaces the corner at
     ``corner`` between unit directions ``incoming`` and ``outgoing`` (segments of lengths
     ``before`` and ``after``), or ``None`` when the segments continue straight on or turn back."""
@@ -173,7 +200,7 @@ def _blend(corner, incoming, outgoing, before, after, max_deviation):
         return None
     angle = np.arccos(cosine)
     half = 0.5 * angle
-    distance = min(0.5 * before, 0.5 * after, max_deviation * np.sin(half) / (2.0 * np.sin(0.5 * half) ** 2))
+    distance = min(0.5 * before, 0.5 * after, max_deviation * np.sin(half) / (2.0 * np.sin(0.5 * half) ** 2), most)
     radius = distance / np.tan(half)
     bisector = outgoing - incoming
     center = corner + bisector / np.linalg.norm(bisector) * radius / np.cos(half)

@@ -106,18 +106,31 @@ def _zone_reports(zones, stretches_: tuple[TimedStretch, ...], margin: float) ->
 
 
 def _blend_notes(path, origin: tuple[int, ...] | None) -> list[Note]:
-    """Corners a blend could not round within the path's deviation: the motion stops there.
-    ``origin``: the index as given of each waypoint of the path (``None``: as given)."""
+    """Corners a blend could not round (its radius below ``MIN_BLEND`` of the path): the motion
+    stops there. Those the path's deviation limits, and those two short segments limit (a larger
+    deviation does not round them), in a note each. ``origin``: the index as given of each
+    waypoint of the path (``None``: as given)."""
     if not (isinstance(path, BlendedPath) and path.tight_corners):
         return []
-    corners = tuple(path.tight_corners if origin is None else (origin[corner] for corner in path.tight_corners))
-    return [Note(
-        f"the largest deviation {path.max_deviation:g} is too small to blend the corners at waypoints "
-        f"{', '.join(map(str, corners))} (a blend shorter than {MIN_BLEND:g} of the path): the motion "
-        "stops there",
-        "corners_not_blended", field="max_deviation", value=path.max_deviation, corners=corners,
-        min_blend=MIN_BLEND,
-    )]
+    named = (lambda corner: corner) if origin is None else origin.__getitem__
+    by_deviation = tuple(named(corner) for corner in path.tight_by_deviation)
+    by_segments = tuple(named(corner) for corner in path.tight_corners if corner not in path.tight_by_deviation)
+    notes = []
+    if by_deviation:
+        notes.append(Note(
+            f"the largest deviation {path.max_deviation:g} is too small to blend the corners at waypoints "
+            f"{', '.join(map(str, by_deviation))} (a blend of radius below {MIN_BLEND:g} of the path): the motion "
+            "stops there",
+            "corners_not_blended", field="max_deviation", value=path.max_deviation, corners=by_deviation,
+            min_blend=MIN_BLEND,
+        ))
+    if by_segments:
+        notes.append(Note(
+            f"the corners at waypoints {', '.join(map(str, by_segments))} turn too sharply for the segments beside "
+            f"them (a blend within half of each has a radius below {MIN_BLEND:g} of the path): the motion stops there",
+            "corners_between_short_segments", field="waypoints", corners=by_segments, min_blend=MIN_BLEND,
+        ))
+    return notes
 
 
 def _samples(problem: Problem, timed: Timed) -> Samples:

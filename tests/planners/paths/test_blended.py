@@ -278,3 +278,48 @@ def test_a_blended_path_leaves_the_first_waypoint_and_has_no_gap(waypoints):
     junctions = path.knots[1:-1]
     left, right = path.evaluate(junctions, "left").q, path.evaluate(junctions, "right").q
     assert np.abs(left - right).max() <= 1e-12
+
+
+def _recorded_curve(count: int) -> np.ndarray:
+    """``count`` samples of a smooth ur5 motion recorded at a fixed rate, the arm slowing to rest
+    at both ends (samples crowd there)."""
+    u = (1.0 - np.cos(np.pi * np.linspace(0.0, 1.0, count))) / 2.0
+    amplitude = np.array([0.8, 0.5, 0.6, 0.7, 0.6, 0.8])
+    frequency, phase = np.array([0.5, 0.7, 0.4, 0.6, 0.3, 0.8]), np.array([0.3, 1.9, 4.0, 2.5, 5.1, 0.9])
+    return amplitude * (np.sin(2 * np.pi * frequency * u[:, None] + phase) - np.sin(phase)) + [0.0, -1.5, 1.5, -1.5, 0.0, 0.0]
+
+
+def test_a_dense_recording_blends_every_corner_and_leaves_no_sliver_of_line():
+    """A corner between two short segments that turns by little has a short blend of large
+    radius: it was a stop (its angle times its length, 2e-7 of the path, under MIN_BLEND), so
+    300 samples of a smooth motion were 300 stops. Only a blend of small radius is one now; and
+    a line between two blends is never shorter than MIN_LINE of the path (a line of 7.6e-8 of the
+    path between two blends made toppra exceed the acceleration limit 8,000 fold)."""
+    from toptraj.planners.paths.blended import MIN_BLEND, MIN_LINE
+
+    path = BlendedPath(_recorded_curve(300), 0.1)
+    assert path.tight_corners == ()
+    assert np.min(np.diff(path.knots)) >= MIN_LINE * (1 - 1e-9)
+    sharp = BlendedPath(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1e-6], [2.0, 1e-6]]), 0.1)
+    assert sharp.tight_corners == (1, 2) and sharp.tight_by_deviation == ()  # radius 5e-7 of the path
+    assert 5e-7 < MIN_BLEND
+
+
+@pytest.mark.parametrize("method", ["phase_plane", "toppra"])
+def test_a_dense_recording_blended_takes_as_long_as_its_spline(client, method):
+    """300 samples of a smooth motion: blended, every corner was a stop (7.4 s against the
+    spline's 1.25 s); now the blend's motion takes the spline's time within 1 %, holding the
+    limits, with no corner left unblended."""
+    from tests.service.answer_limits import assert_limits_held
+
+    waypoints = _recorded_curve(300).tolist()
+    answers = {}
+    for interpolation in ("spline", "blend"):
+        body = {"robot": "ur5", "path": {"waypoints": waypoints, "interpolation": interpolation},
+                "timing": {"method": method}, "output": {"dt": 0.002}}
+        response = client.post("/v1/trajectories", json=body)
+        assert response.status_code == 200, response.text[:300]
+        answers[interpolation] = response.json()
+        assert_limits_held(body, answers[interpolation])
+    assert answers["blend"]["duration"] == pytest.approx(answers["spline"]["duration"], rel=0.01)
+    assert not [warning for warning in answers["blend"]["warnings"] if "stops there" in warning]
