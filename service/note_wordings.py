@@ -35,18 +35,21 @@ def _waypoints_dropped(facts: dict) -> str:
             return f"{field}[{repeats[0]}] repeats the waypoint before it and was dropped"
         return f"{field} [{shown}] repeat the waypoint before each of them and were dropped ({len(repeats)} in all)"
     near = f"{facts['nearest']:.2g} rad or m"
-    share = f"{facts['share']:g} of the path's joint-space length ({facts['length']:.4g})"
-    why = "the path would turn sharply between waypoints so near, and the arm nearly stop there"
+    rule = (
+        f"(the rule: a waypoint within {facts['share']:g} of the path's joint-space length, {facts['length']:.4g}, of "
+        "the one kept before it, or of the last, goes)"
+    )
+    why = "a path through waypoints so near would turn sharply and the arm nearly stop there"
     if len(repeats) == 1:
         advice = "; path.min_spacing = 0 keeps it" if facts.get("settable") else ""
         return (
-            f"{field}[{repeats[0]}] lies {near} from a waypoint kept, within {share} of the one kept before it or of "
-            f"the last, and was dropped: {why}{advice}"
+            f"{field}[{repeats[0]}] was dropped as a near repeat {rule}; it lies {near} from a waypoint kept: "
+            f"{why}{advice}"
         )
     advice = "; path.min_spacing = 0 keeps them" if facts.get("settable") else ""
     return (
-        f"{field} [{shown}] ({len(repeats)} in all) lie within {near} of a waypoint kept, each within {share} of the "
-        f"one kept before it or of the last, and were dropped: {why}{advice}"
+        f"{field} [{shown}] ({len(repeats)} in all) were dropped as near repeats {rule}; none lies farther than "
+        f"{near} from a waypoint kept: {why}{advice}"
     )
 
 

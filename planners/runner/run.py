@@ -29,6 +29,7 @@ from toptraj.planners.runner.answer import answer
 from toptraj.planners.runner.duration import too_short
 from toptraj.planners.runner.given_path import timed_path
 from toptraj.planners.runner.holding import with_torque_remedy, zone_remedy
+from toptraj.planners.runner.other_method import with_other_method
 from toptraj.planners.timing.base import TimingMethod
 
 
@@ -52,6 +53,8 @@ def run(problem: Problem) -> PlannedTrajectory:
         stated = error
         if isinstance(error, LimitExceeded) and problem.duration is not None:
             stated = too_short(problem, error, _run)
+        elif not getattr(error, "joints", None):  # not the torque of holding still: a timing's own failure
+            stated = with_other_method(problem, error, _run)
         if getattr(stated, "joints", None):
             stated = with_torque_remedy(problem, stated)
         if stated is error:

@@ -39,8 +39,9 @@ def test_nearly_repeated_waypoints_are_dropped_and_every_method_times_the_path_w
     answer = answer.json()
     assert_limits_held(body, answer)
     (warning,) = [w for w in answer["warnings"] if "were dropped" in w]
-    assert warning.startswith("path.waypoints [1, 3, 5, 7, 8] (5 in all) lie within 2.5e-07 rad or m of a waypoint kept")
-    assert "each within 0.0001 of the path's joint-space length (1.51) of the one kept before it or of the last" in warning
+    assert warning.startswith("path.waypoints [1, 3, 5, 7, 8] (5 in all) were dropped as near repeats (the rule: a waypoint")
+    assert "within 0.0001 of the path's joint-space length, 1.51, of the one kept before it, or of the last, goes)" in warning
+    assert "none lies farther than 2.5e-07 rad or m from a waypoint kept" in warning
     assert warning.endswith("path.min_spacing = 0 keeps them")
     assert answer["samples"]["q"][0] == pytest.approx(RECORDED[0], abs=1e-12)  # both ends as given
     assert answer["samples"]["q"][-1] == pytest.approx(RECORDED[-1], abs=1e-12)
@@ -69,7 +70,8 @@ def test_a_min_spacing_out_of_range_is_a_422_naming_the_field(client):
 def test_a_single_near_waypoint_says_it_and_its_distance(client):
     waypoints = [RECORDED[0], RECORDED[2], list(np.add(RECORDED[2], [3e-6, 0.0])), RECORDED[4]]
     (warning,) = client.post("/v1/trajectories", json=_body("toppra", waypoints)).json()["warnings"]
-    assert warning.startswith("path.waypoints[2] lies 3e-06 rad or m from a waypoint kept, within 0.0001 of the path's")
+    assert warning.startswith("path.waypoints[2] was dropped as a near repeat (the rule: a waypoint within 0.0001 of")
+    assert "it lies 3e-06 rad or m from a waypoint kept" in warning
     assert warning.endswith("path.min_spacing = 0 keeps it")
 
 
@@ -87,6 +89,7 @@ def test_exact_and_near_repeats_are_told_apart(client):
     waypoints = [RECORDED[0], RECORDED[2], RECORDED[2], RECORDED[3], RECORDED[4]]
     exact, near = client.post("/v1/trajectories", json=_body("toppra", waypoints)).json()["warnings"]
     assert exact == "path.waypoints[2] repeats the waypoint before it and was dropped"
-    assert near.startswith("path.waypoints[3] lies 1.8e-07 rad or m") and near.endswith("path.min_spacing = 0 keeps it")
+    assert near.startswith("path.waypoints[3] was dropped as a near repeat") and "it lies 1.8e-07 rad or m" in near
+    assert near.endswith("path.min_spacing = 0 keeps it")
     (kept,) = client.post("/v1/trajectories", json=_body("phase_plane", waypoints, min_spacing=0)).json()["warnings"]
     assert kept == exact
