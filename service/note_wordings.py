@@ -53,6 +53,18 @@ def _waypoints_dropped(facts: dict) -> str:
     )
 
 
+def _sharp_near_pairs(facts: dict) -> str:
+    pairs, field = facts["pairs"], facts["field"]
+    named = "; ".join(
+        f"{field}[{a}] and [{b}], {distance:.2g} rad or m apart ({distance / facts['length']:.2g} of the path's joint-space "
+        f"length), the path turning by {turn:.0f} degrees"
+        for a, b, distance, turn in pairs[: facts["shown"]]
+    )
+    more = f" (and {len(pairs) - facts['shown']} more pairs)" if len(pairs) > facts["shown"] else ""
+    advice = f"; path.min_spacing = {facts['spacing']:g} drops one of each pair" if facts.get("settable") else ""
+    return f"the arm nearly stops between waypoints so near where the path turns sharply: {named}{more}{advice}"
+
+
 def _points_dropped(facts: dict) -> str:
     repeats, field = facts["indices"], facts["field"]
     if len(repeats) == 1:
@@ -170,6 +182,7 @@ NOTE_WORDING: dict[str, str | Callable[[dict], str]] = {
     "not_estimated": "not estimated for timing.method {method}",
     "waypoints_dropped": _waypoints_dropped,
     "points_dropped": _points_dropped,
+    "sharp_near_pairs": _sharp_near_pairs,
     "turned_the_short_way": lambda facts: (
         f"{facts['field']} 'shortest': continuous joint(s) {', '.join(map(repr, facts['joints']))} turn the short "
         "way; their waypoints after the first are reached as equivalent angles (whole turns apart)"

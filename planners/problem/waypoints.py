@@ -5,6 +5,7 @@ in ``toptraj.planners.generators.via_points``, Cartesian lines in ``toptraj.plan
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -104,9 +105,46 @@ def without_repeats(spec: WaypointPath, settable: bool = True) -> tuple[Waypoint
     if near.size:
         notes.append(_dropped(near, f"lie within {share:g} of the path's length of a waypoint kept", coincident=False,
                               nearest=nearest_kept(waypoints, kept, near), share=share, length=length, settable=settable))
+    if spec.interpolation in TURNING:
+        notes += sharp_near_pairs(waypoints[kept], kept, length, settable)
     if not notes:
         return spec, ()
     return dataclasses.replace(spec, waypoints=waypoints[kept], origin=tuple(int(i) for i in kept)), tuple(notes)
+
+
+#: Two waypoints kept nearer than this share of the path's length, the path turning by more than
+#: ``SHARP_TURN`` (rad) at either of them, are told of: the arm nearly stops between them (a
+#: recording's jitter just beyond the spacing made the motion twice as long).
+NEAR_PAIR = 1e-3
+SHARP_TURN = np.pi / 3
+#: Pairs named in the note, the first ones along the path.
+PAIRS_SHOWN = 3
+
+
+def sharp_near_pairs(waypoints: np.ndarray, origin: np.ndarray, length: float, settable: bool) -> list[Note]:
+    """A note on the waypoints (n, n_dof, their indices as given ``origin``) nearer than
+    ``NEAR_PAIR`` times ``length`` to the next, where the chords before or after turn by more
+    than ``SHARP_TURN``: each pair's indices, distance and turn (degrees), and the
+    ``min_spacing`` that drops one of each (the largest share rounded up, 1 % above)."""
+    chords = np.diff(waypoints, axis=0)
+    steps = np.linalg.norm(chords, axis=1)
+    units = chords / steps[:, None]
+    turns = np.arccos(np.clip(np.sum(units[1:] * units[:-1], axis=1), -1.0, 1.0))  # at each interior waypoint
+    before = np.concatenate(([0.0], turns))
+    after = np.concatenate((turns, [0.0]))
+    sharp = np.flatnonzero((steps <= NEAR_PAIR * length) & (np.maximum(before, after) > SHARP_TURN))
+    if sharp.size == 0:
+        return []
+    pairs = tuple((int(origin[k]), int(origin[k + 1]), float(steps[k]), float(np.degrees(max(before[k], after[k])))) for k in sharp)
+    share = 1.01 * float(steps[sharp].max()) / length
+    digit = 10.0 ** (math.floor(math.log10(share)) - 1)  # rounded up to two significant digits
+    spacing = round(math.ceil(share / digit) * digit, 12)
+    return [Note(
+        f"waypoints {', '.join(f'{a} and {b}' for a, b, _, _ in pairs[:PAIRS_SHOWN])} lie nearer than {NEAR_PAIR:g} of the "
+        "path's length and the path turns sharply there: the arm nearly stops between them",
+        "sharp_near_pairs", field="waypoints", pairs=pairs, shown=PAIRS_SHOWN, length=length, spacing=spacing,
+        settable=settable,
+    )]
 
 
 def _dropped(indices: np.ndarray, words: str, **facts) -> Note:

@@ -93,3 +93,24 @@ def test_exact_and_near_repeats_are_told_apart(client):
     assert near.endswith("path.min_spacing = 0 keeps it")
     (kept,) = client.post("/v1/trajectories", json=_body("phase_plane", waypoints, min_spacing=0)).json()["warnings"]
     assert kept == exact
+
+
+def test_a_sharp_turn_between_waypoints_just_beyond_the_spacing_is_told_with_a_spacing_that_drops_it(client):
+    """Two z1 waypoints 6.1e-4 rad apart (2e-4 of the path's length, kept) between which the
+    path turns by 152 degrees: the arm nearly stops there, which went unsaid. The warning names
+    the pair and a path.min_spacing that drops one of them; followed, the motion is 14 % shorter
+    and toppra, which refused the path, times it too."""
+    from tests.service.test_other_method_advice import SHARP_PAIR
+
+    body = {**SHARP_PAIR, "timing": {**SHARP_PAIR["timing"], "method": "phase_plane"}}
+    answer = client.post("/v1/trajectories", json=body).json()
+    (warning,) = [w for w in answer["warnings"] if "turns sharply" in w]
+    assert "path.waypoints[2] and [3], 0.00061 rad or m apart" in warning and "turning by 152 degrees" in warning
+    advised = float(warning.rsplit("path.min_spacing = ", 1)[1].split()[0])
+    followed = {**body, "path": {**body["path"], "min_spacing": advised}}
+    shorter = client.post("/v1/trajectories", json=followed).json()
+    assert not [w for w in shorter["warnings"] if "turns sharply" in w]
+    assert [w for w in shorter["warnings"] if w.startswith("path.waypoints[3] was dropped as a near repeat")]
+    assert shorter["duration"] < 0.87 * answer["duration"]
+    timed = client.post("/v1/trajectories", json={**followed, "timing": SHARP_PAIR["timing"]})
+    assert timed.status_code == 200 and timed.json()["duration"] == pytest.approx(shorter["duration"], rel=1e-3)

@@ -93,3 +93,19 @@ def test_a_spacing_out_of_range_is_refused_and_a_path_that_stays_put_too():
     with pytest.raises(InvalidRequest) as refused:
         without_repeats(WaypointPath(np.zeros((3, 2))))
     assert refused.value.rule == "all_waypoints_coincide"
+
+
+def test_sharp_turns_between_near_waypoints_are_told_and_smooth_dense_paths_are_not():
+    from toptraj.planners.problem.waypoints import NEAR_PAIR
+
+    t = np.linspace(0.0, 1.0, 1000)
+    dense = np.column_stack([np.cos(3 * t), np.sin(2 * t)])  # near waypoints, gentle turns
+    assert without_repeats(WaypointPath(dense)) == (WaypointPath(dense), ())
+    step = 0.5 * NEAR_PAIR * _length(STRAIGHT)
+    hook = np.vstack([STRAIGHT[:2], STRAIGHT[1:2] + [0.0, step], STRAIGHT[2:]])  # a right angle and back
+    spec, (note,) = without_repeats(WaypointPath(hook))
+    assert note.rule == "sharp_near_pairs" and [pair[:2] for pair in note.facts["pairs"]] == [(1, 2)]
+    assert note.facts["pairs"][0][3] == pytest.approx(90.0)
+    assert without_repeats(WaypointPath(hook, "linear")) == (WaypointPath(hook, "linear"), ())  # it stops there anyway
+    followed, (dropped,) = without_repeats(WaypointPath(hook, min_spacing=note.facts["spacing"]))
+    assert dropped.facts["indices"] == (2,) and len(followed.waypoints) == 4
