@@ -61,7 +61,10 @@ def _sharp_near_pairs(facts: dict) -> str:
         for a, b, distance, turn in pairs[: facts["shown"]]
     )
     more = f" (and {len(pairs) - facts['shown']} more pairs)" if len(pairs) > facts["shown"] else ""
-    advice = f"; path.min_spacing = {facts['spacing']:g} drops one of each pair" if facts.get("settable") else ""
+    advice = (
+        f"; path.min_spacing = {facts['spacing']:g} drops one of each pair (and any waypoint as near the one kept "
+        "before it)" if facts.get("settable") else ""
+    )
     return f"the arm nearly stops between waypoints so near where the path turns sharply: {named}{more}{advice}"
 
 

@@ -136,6 +136,24 @@ def _torque_ratio(robot: Robot, path: JointLawPath, limits: JointLimits) -> tupl
     return float(ratio[sample, joint]), float(s[sample]), int(joint)
 
 
+def _too_short(robot: Robot, profile: NormalizedProfile, durations: np.ndarray, setting: list[str], factor: float) -> LimitExceeded:
+    """The limit most exceeded when every joint's own duration (``durations``, s, each set by
+    the kind ``setting`` names) is shortened by ``factor`` < 1: a joint set by a limit of order k
+    (velocity 1, acceleration 2, jerk 3) is over it by factor^-k, so the highest order among the
+    joints is most exceeded, on the slowest joint it sets; its limits of lower order less."""
+    orders = {"velocity": 1, "acceleration": 2, "jerk": 3}
+    moving = np.flatnonzero(durations > 0)
+    order = max(orders[setting[j]] for j in moving)
+    joint = max((j for j in moving if orders[setting[j]] == order), key=lambda j: durations[j])
+    kind, ratio = setting[joint], float(factor ** -order)
+    s = float(_peaks(profile)[1][order - 1]) * durations[joint] / durations.max()
+    return LimitExceeded(
+        f"the {profile.name} law exceeds the {kind} limit of joint {robot.joint_names[joint]!r} by "
+        f"{100 * (ratio - 1):.2f} % at s = {s:.4f}: the duration is too short",
+        s=s, joint=robot.joint_names[joint], limit=kind, ratio=ratio, method=profile.name,
+    )
+
+
 def unsynchronized_trajectory(
     robot: Robot,
     start: np.ndarray,
@@ -168,14 +186,8 @@ def unsynchronized_trajectory(
     factor = 1.0
     if duration is not None:
         factor, binding = duration / durations[slowest], None
-        if factor < 1.0 - SHORTER:  # every joint over by the same factor: the slowest one is named
-            kind = setting[slowest]
-            raise LimitExceeded(
-                f"the {profile.name} law exceeds the {kind} limit of joint {robot.joint_names[slowest]!r} by "
-                f"{100 * (factor ** -(orders[kind] + 1) - 1):.2f} % at s = {peak_at:.4f}: the duration is too short",
-                s=peak_at, joint=robot.joint_names[slowest], limit=kind, ratio=float(factor ** -(orders[kind] + 1)),
-                method=profile.name,
-            )
+        if factor < 1.0 - SHORTER:
+            raise _too_short(robot, profile, durations, setting, factor)
     elif "torque" in kinds and _torque_ratio(robot, path(1.0), limits)[0] > 1.0:
         low, high = 1.0, 2.0
         for _ in range(60):

@@ -47,8 +47,10 @@ STRAIGHT = 1e-12
 MIN_BLEND = 1e-5
 #: Distance (relative to the path's length) below which two points are one: a rounding.
 SAME_POINT = 1e-12
-#: Shortest line left between two blends (relative to the path's length): a blend that would
-#: leave a shorter one shrinks (toppra's grid failed on a line of 7.6e-8 of a dense recording).
+#: Shortest line a blend leaves before it (relative to the path's length): a blend that would
+#: leave a shorter one shrinks, by at most half and keeping its radius above ``MIN_BLEND``
+#: (toppra's grid failed on a line of 7.6e-8 of the path between two blends of a dense
+#: recording). A line may still come out shorter where the blend cannot shrink so far.
 MIN_LINE = 1e-5
 
 
@@ -152,7 +154,8 @@ def _pieces(waypoints: np.ndarray, max_deviation: float) -> tuple[list, list, li
         tight_here = blend is not None and blend[3] <= MIN_BLEND * scale
         if tight_here:
             tight.append(i)
-            if blend[5] < 0.5 * min(lengths[i - 1], lengths[i]):
+            # A larger deviation rounds it: the blend that takes half the shorter segment is wide enough.
+            if 0.5 * min(lengths[i - 1], lengths[i]) / np.tan(0.5 * blend[4]) > MIN_BLEND * scale:
                 by_deviation.append(i)
         if blend is None or tight_here:
             # Straight on (the segments are one line), or a corner that cannot be blended.
@@ -166,12 +169,13 @@ def _pieces(waypoints: np.ndarray, max_deviation: float) -> tuple[list, list, li
         start = waypoints[i] - distance * directions[i - 1]
         gap = float(np.linalg.norm(start - position))
         if SAME_POINT * scale < gap < MIN_LINE * scale and distance - (MIN_LINE * scale - gap) > 0.5 * distance:
-            # A sliver of line between two blends: this blend shrinks to leave a line of MIN_LINE.
-            blend = _blend(waypoints[i], directions[i - 1], directions[i], lengths[i - 1], lengths[i], max_deviation,
-                           most=distance - (MIN_LINE * scale - gap))
-            assert blend is not None
-            center, x, y, radius, angle, distance = blend
-            start = waypoints[i] - distance * directions[i - 1]
+            # A sliver of line before this blend: it shrinks (by at most half, its radius staying
+            # above MIN_BLEND) to leave a line of MIN_LINE.
+            smaller = _blend(waypoints[i], directions[i - 1], directions[i], lengths[i - 1], lengths[i], max_deviation,
+                             most=distance - (MIN_LINE * scale - gap))
+            if smaller is not None and smaller[3] > MIN_BLEND * scale:
+                center, x, y, radius, angle, distance = smaller
+                start = waypoints[i] - distance * directions[i - 1]
         # The straight piece up to the blend, however short (a short first segment: the path
         # must leave the first waypoint); only a gap of a rounding is closed by the arc itself.
         if np.linalg.norm(start - position) > SAME_POINT * scale:

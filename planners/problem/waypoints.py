@@ -138,7 +138,7 @@ def sharp_near_pairs(waypoints: np.ndarray, origin: np.ndarray, length: float, s
     pairs = tuple((int(origin[k]), int(origin[k + 1]), float(steps[k]), float(np.degrees(max(before[k], after[k])))) for k in sharp)
     share = 1.01 * float(steps[sharp].max()) / length
     digit = 10.0 ** (math.floor(math.log10(share)) - 1)  # rounded up to two significant digits
-    spacing = round(math.ceil(share / digit) * digit, 12)
+    spacing = float(f"{math.ceil(share / digit) * digit:.2e}")  # 2 significant digits, never rounded to 0
     return [Note(
         f"waypoints {', '.join(f'{a} and {b}' for a, b, _, _ in pairs[:PAIRS_SHOWN])} lie nearer than {NEAR_PAIR:g} of the "
         "path's length and the path turns sharply there: the arm nearly stops between them",

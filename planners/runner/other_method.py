@@ -14,10 +14,11 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 
-from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, TimingFailed
+from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, LimitExceeded
 from toptraj.planners.problem.problem import Problem
 from toptraj.planners.results import PlannedTrajectory
 from toptraj.planners.timing import METHODS
+from toptraj.robots.errors import ToptrajError
 
 #: Methods whose refusals are checked against the phase-plane integrator.
 CHECKED = ("toppra",)
@@ -30,15 +31,16 @@ def with_other_method(problem: Problem, error: InfeasiblePath, run: Callable[[Pr
     ``alternative`` ("phase_plane") and ``alternative_duration`` (s) when the phase-plane
     integrator times the same problem within ``SHARE`` of the deadline; otherwise ``error``."""
     alternative = METHODS["phase_plane"]
-    if problem.method.name not in CHECKED or problem.duration is not None or not set(problem.kinds) <= set(alternative.kinds):
-        return error
+    if (problem.method.name not in CHECKED or problem.duration is not None or not set(problem.kinds) <= set(alternative.kinds)
+            or type(error) not in (InfeasiblePath, LimitExceeded) or getattr(error, "rule", None) is not None):
+        return error  # the path's own refusals (collisions, ranges) and worded rules are told as they are
     part = problem.deadline.share(SHARE)
     try:
         answer = run(dataclasses.replace(problem, method=alternative, deadline=part))
     except BudgetExceeded:
         problem.deadline.check()  # a caller's cancellation or the whole budget spent stops here
         return error
-    except (InfeasiblePath, TimingFailed):
+    except ToptrajError:  # no answer within the limits, or none the answer's caps allow: no advice
         return error
     facts = {key: value for key, value in vars(error).items() if key != "detail"}
     facts.update(alternative="phase_plane", alternative_duration=answer.duration)

@@ -80,3 +80,17 @@ def test_a_duration_too_short_joint_by_joint_names_the_slowest_joint(client):
     detail = refused.json()["detail"]
     excess = 100 * ((shortest["duration"] / 0.5) ** 2 - 1)  # accelerations scale with 1 / T^2
     assert f"the acceleration limit of joint 'shoulder_lift_joint' is exceeded by {excess:.2f} %" in detail
+
+
+def test_a_duration_too_short_joint_by_joint_names_the_limit_most_exceeded(client):
+    """Shortened by a factor f, a joint whose own duration a velocity limit sets is over it by
+    1/f, one that an acceleration limit sets by 1/f^2: geering_2r's first joint is velocity-bound
+    (and the slowest), its second acceleration-bound; at 0.8 of the shortest duration the second
+    is over by 56.25 %, the first by 25 %, and the second is named."""
+    timing = {"method": "trapezoidal", "synchronization": "none", "constraints": ["velocity", "acceleration"],
+              "limits": {"velocity": [1, 1], "acceleration": [10, 0.1]}}
+    body = {"robot": "geering_2r", "path": {"waypoints": [[0, 0], [2.7, 0.35]], "interpolation": "linear"}, "timing": timing}
+    shortest = client.post("/v1/trajectories", json=body).json()
+    assert shortest["binding"] == {"kind": "velocity", "joint": "phi", "s": pytest.approx(1 / 3)}
+    refused = client.post("/v1/trajectories", json={**body, "timing": {**timing, "duration": 0.8 * shortest["duration"]}})
+    assert "the acceleration limit of joint 'psi' is exceeded by 56.25 %" in refused.json()["detail"]

@@ -280,6 +280,10 @@ def test_a_blended_path_leaves_the_first_waypoint_and_has_no_gap(waypoints):
     assert np.abs(left - right).max() <= 1e-12
 
 
+def _length_of(waypoints: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum())
+
+
 def _recorded_curve(count: int) -> np.ndarray:
     """``count`` samples of a smooth ur5 motion recorded at a fixed rate, the arm slowing to rest
     at both ends (samples crowd there)."""
@@ -289,12 +293,14 @@ def _recorded_curve(count: int) -> np.ndarray:
     return amplitude * (np.sin(2 * np.pi * frequency * u[:, None] + phase) - np.sin(phase)) + [0.0, -1.5, 1.5, -1.5, 0.0, 0.0]
 
 
-def test_a_dense_recording_blends_every_corner_and_leaves_no_sliver_of_line():
+def test_a_dense_recording_blends_every_corner_and_leaves_no_sliver_of_line_on_it():
     """A corner between two short segments that turns by little has a short blend of large
     radius: it was a stop (its angle times its length, 2e-7 of the path, under MIN_BLEND), so
     300 samples of a smooth motion were 300 stops. Only a blend of small radius is one now; and
-    a line between two blends is never shorter than MIN_LINE of the path (a line of 7.6e-8 of the
-    path between two blends made toppra exceed the acceleration limit 8,000 fold)."""
+    a blend shrinks rather than leave a line shorter than MIN_LINE of the path before it (a line
+    of 7.6e-8 of the path between two blends made toppra exceed the acceleration limit 8,000
+    fold), its radius kept above MIN_BLEND: a zigzag whose blends would fall below it if shrunk
+    keeps them as they are, and a corner too tight for any deviation is not blamed on it."""
     from toptraj.planners.paths.blended import MIN_BLEND, MIN_LINE
 
     path = BlendedPath(_recorded_curve(300), 0.1)
@@ -303,6 +309,15 @@ def test_a_dense_recording_blends_every_corner_and_leaves_no_sliver_of_line():
     sharp = BlendedPath(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1e-6], [2.0, 1e-6]]), 0.1)
     assert sharp.tight_corners == (1, 2) and sharp.tight_by_deviation == ()  # radius 5e-7 of the path
     assert 5e-7 < MIN_BLEND
+    assert BlendedPath(sharp.waypoints, 1e-12).tight_by_deviation == ()  # no deviation rounds it
+    assert BlendedPath(np.array(UR5_WAYPOINTS), 1e-9).tight_by_deviation == (1, 2)
+    turn = np.radians(170.0)  # a zigzag of two blends of radius 1.02e-5 of the path, 1e-6 apart:
+    distance = 1.02e-5 * np.tan(turn / 2)  # the second, shrunk to leave MIN_LINE, would fall below MIN_BLEND
+    unit = [np.array([np.cos(k * turn), np.sin(k * turn)]) for k in range(3)]
+    zigzag = np.cumsum([[0.0, 0.0], 0.5 * unit[0], (2 * distance + 1e-6) * unit[1], 0.5 * unit[2]], axis=0)
+    deviation = distance * 2 * np.sin(turn / 4) ** 2 / np.sin(turn / 2)
+    for corner in BlendedPath(zigzag, deviation)._pieces:
+        assert corner[0] == "line" or corner[4] > MIN_BLEND * _length_of(zigzag)
 
 
 @pytest.mark.parametrize("method", ["phase_plane", "toppra"])
