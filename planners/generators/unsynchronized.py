@@ -37,6 +37,8 @@ from toptraj.robots import JointLimits, Robot
 PEAK_SAMPLES = 4001
 #: Samples of s for the torque check while searching the common factor.
 TORQUE_SAMPLES = 801
+#: The order of the derivative of q each limit kind bounds (``_peaks`` lists them from 1).
+ORDERS = {"velocity": 1, "acceleration": 2, "jerk": 3}
 #: Share by which a given duration may fall short of the slowest joint's own before it is
 #: refused (rounding of a duration the answer printed).
 SHORTER = 1e-9
@@ -141,10 +143,9 @@ def _too_short(robot: Robot, profile: NormalizedProfile, durations: np.ndarray, 
     the kind ``setting`` names) is shortened by ``factor`` < 1: a joint set by a limit of order k
     (velocity 1, acceleration 2, jerk 3) is over it by factor^-k, so the highest order among the
     joints is most exceeded, on the slowest joint it sets; its limits of lower order less."""
-    orders = {"velocity": 1, "acceleration": 2, "jerk": 3}
     moving = np.flatnonzero(durations > 0)
-    order = max(orders[setting[j]] for j in moving)
-    joint = max((j for j in moving if orders[setting[j]] == order), key=lambda j: durations[j])
+    order = max(ORDERS[setting[j]] for j in moving)
+    joint = max((j for j in moving if ORDERS[setting[j]] == order), key=lambda j: durations[j])
     kind, ratio = setting[joint], float(factor ** -order)
     s = float(_peaks(profile)[1][order - 1]) * durations[joint] / durations.max()
     return LimitExceeded(
@@ -180,8 +181,7 @@ def unsynchronized_trajectory(
     def path(k):
         return JointLawPath(start, goal, profile, durations * k)
 
-    orders = {"velocity": 0, "acceleration": 1, "jerk": 2}
-    peak_at = float(_peaks(profile)[1][orders[setting[slowest]]])
+    peak_at = float(_peaks(profile)[1][ORDERS[setting[slowest]] - 1])
     binding: Binding | None = Binding(setting[slowest], robot.joint_names[slowest], peak_at)
     factor = 1.0
     if duration is not None:

@@ -8,11 +8,9 @@ from typing import Annotated, Any, Literal
 from pydantic import Field
 
 from toptraj.planners.collision.self_collision import PADDING
-from toptraj.planners.problem import ranges
-from toptraj.service.schemas.common import Schema, signed
+from toptraj.service.schemas.common import Schema
+from toptraj.service.schemas.geometry import OrientedBox, Point
 
-Coordinate = Annotated[float, signed(ranges.COORDINATE)]
-Point = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
 MAX_OBSTACLES = 100
 
 
@@ -24,17 +22,10 @@ class SphereObstacleRequest(Schema):
     radius: Annotated[float, Field(gt=0.0, le=100.0)] = Field(description="Radius (m).")
 
 
-class BoxObstacleRequest(Schema):
+class BoxObstacleRequest(OrientedBox):
     """An oriented box in the world frame."""
 
     kind: Literal["box"] = Field(description="`box`.")
-    center: Point = Field(description="Center [x, y, z] (m), world frame.")
-    size: Annotated[list[Annotated[float, Field(gt=0.0, le=100.0)]], Field(min_length=3, max_length=3)] = Field(
-        description="Edge lengths [sx, sy, sz] (m) along the box's own axes."
-    )
-    orientation: Annotated[list[Annotated[float, Field(ge=-1.0, le=1.0)]], Field(min_length=4, max_length=4)] = Field(
-        default=[0.0, 0.0, 0.0, 1.0], description="Unit quaternion [qx, qy, qz, qw] from the box's axes to the world's (norm 1 within 1e-3)."
-    )
 
 
 class CapsuleObstacleRequest(Schema):

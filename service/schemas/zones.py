@@ -9,9 +9,9 @@ from pydantic import Field, model_validator
 
 from toptraj.planners.problem import ranges
 from toptraj.planners.problem.zones import MAX_ZONES
-from toptraj.service.schemas.common import Schema, bounded, signed
+from toptraj.service.schemas.common import Schema, bounded
+from toptraj.service.schemas.geometry import OrientedBox, Point
 
-Point = Annotated[list[Annotated[float, signed(ranges.COORDINATE)]], Field(min_length=3, max_length=3)]
 Factor = Annotated[float, Field(gt=0.0, le=1.0)]
 
 
@@ -22,16 +22,8 @@ class ZoneSphere(Schema):
     radius: Annotated[float, Field(gt=0.0, le=100.0)] = Field(description="Radius (m).")
 
 
-class ZoneBox(Schema):
+class ZoneBox(OrientedBox):
     """An oriented box in the world frame."""
-
-    center: Point = Field(description="Center [x, y, z] (m), world frame.")
-    size: Annotated[list[Annotated[float, Field(gt=0.0, le=100.0)]], Field(min_length=3, max_length=3)] = Field(
-        description="Edge lengths [sx, sy, sz] (m) along the box's own axes."
-    )
-    orientation: Annotated[list[Annotated[float, Field(ge=-1.0, le=1.0)]], Field(min_length=4, max_length=4)] = Field(
-        default=[0.0, 0.0, 0.0, 1.0], description="Unit quaternion [qx, qy, qz, qw] from the box's axes to the world's (norm 1 within 1e-3)."
-    )
 
 
 class ZoneRequest(Schema):

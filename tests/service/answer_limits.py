@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from toptraj import robots
+from toptraj.planners.problem.requests import DEFAULT_KINDS
+from toptraj.planners.timing import METHODS
 
 #: Largest |value| / limit a 200 may show (the project's promise: 0.5 %).
 LIMIT_SHARE = 1.005
@@ -16,11 +18,15 @@ REQUIRED_KINDS = {"jerk_limited": {"jerk"}, "ruckig": {"jerk"}, "min_cost": {"to
 def asked_limits(body: dict, method: str) -> dict[str, np.ndarray]:
     """The limits a trajectory request asks ``method`` to hold, by kind: the robot's catalog
     limits, each replaced by the request's per-joint override and multiplied by its scale, for
-    the asked kinds (default velocity, acceleration, torque) and those the method applies always."""
+    the asked kinds (left out: those of velocity, acceleration and torque the method holds) and
+    those the method applies always."""
     catalog = robots.load(body["robot"]).limits
     timing = body.get("timing") or {}
     request = timing.get("limits") or {}
-    kinds = set(timing.get("constraints") or ("velocity", "acceleration", "torque")) | REQUIRED_KINDS.get(method, set())
+    # Left out, timing.constraints means the defaults the method holds (the answer warns of the rest).
+    served = METHODS[method].kinds if method in METHODS else DEFAULT_KINDS
+    asked = timing.get("constraints") or [kind for kind in DEFAULT_KINDS if kind in served]
+    kinds = set(asked) | REQUIRED_KINDS.get(method, set())
     limits = {}
     for kind in kinds:
         value = np.asarray(request[kind] if request.get(kind) is not None else getattr(catalog, kind), dtype=float)
