@@ -32,7 +32,7 @@ import pinocchio as pin
 
 from toptraj.robots.errors import ToptrajError
 from toptraj.robots.ranges import BASE_POSITION, CENTER_OF_MASS, GRAVITY, PAYLOAD_INERTIA, PAYLOAD_MASS, PAYLOAD_RADIUS, Range
-from toptraj.robots.robot import Robot
+from toptraj.robots.robot import Robot, frame_index
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -280,7 +280,7 @@ def _build(bare: Robot, payload: Payload | None, mounting: Mounting | None) -> R
             frames = [item.name for item in model.frames if item.name != "universe"]
             shown = ", ".join(repr(item) for item in frames[:60]) + (", ..." if len(frames) > 60 else "")
             raise InvalidEquipment(f"the payload's frame {frame_name[:100]!r} is not a frame of {bare.name}; its frames are {shown}", "frame")
-        frame = model.frames[model.getFrameId(frame_name)]
+        frame = model.frames[frame_index(model, frame_name)]
         body = pin.Inertia(payload.mass, np.array(payload.center_of_mass), np.array(payload.inertia).reshape(3, 3))
         model.appendBodyToJoint(frame.parentJoint, body, frame.placement)
         notes.append(f"payload of {payload.mass:g} kg at {frame_name}")

@@ -266,9 +266,7 @@ class Robot:
         once per name: the model never changes)."""
         known = self._frame_ids
         if frame not in known:
-            if not self.model.existFrame(frame):
-                raise KeyError(frame)
-            known[frame] = self.model.getFrameId(frame)
+            known[frame] = frame_index(self.model, frame)
         return known[frame]
 
     def frame_anchor(self, frame_id: int) -> tuple[int, np.ndarray]:
@@ -302,3 +300,14 @@ def friction_sign(qd: np.ndarray, direction: np.ndarray | None = None) -> np.nda
     """The sign of the motion Coulomb friction opposes, per sample and joint (the shape of
     ``qd``): sign(qd), and where qd is zero the sign of ``direction`` (``Robot.inverse_dynamics``)."""
     return np.sign(qd) if direction is None else np.where(qd != 0.0, np.sign(qd), np.sign(direction))
+
+
+def frame_index(model: pin.Model, name: str) -> int:
+    """Index of the frame ``name`` in ``model``: its link (a body frame) where a joint bears the
+    same name, as a URDF may give a link and a joint one name (pinocchio's ``getFrameId``
+    refuses the ambiguity); ``KeyError`` when no frame has that name."""
+    matches = [index for index, frame in enumerate(model.frames) if frame.name == name]
+    if not matches:
+        raise KeyError(name)
+    bodies = [index for index in matches if model.frames[index].type == pin.FrameType.BODY]
+    return (bodies or matches)[0]

@@ -38,6 +38,7 @@ from toptraj.robots.srdf import check_links
 from toptraj.robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, StoredUpload, UploadStore, default_data_dir
 from toptraj.robots.upload_options import InvalidUpload, UploadOptions, apply_locks, yaml_limit_arrays
 from toptraj.robots.urdf_check import check_urdf, mesh_count
+from toptraj.robots.urdf_tree import mimic_joints
 
 DEFAULT_CACHE_SIZE = 32
 MAX_NAME_CHARS = 64
@@ -138,6 +139,13 @@ def build_upload(name: str, urdf: str, options: UploadOptions) -> Robot:
             f"the URDF's {meshes} mesh files are not loaded: the dynamics come from its <inertial> elements, "
             "and obstacle checks use a capsule of 0.03 m radius along each link"
         )
+    for joint, mimicked, multiplier, offset in mimic_joints(urdf):
+        if joint not in options.locked_joints:
+            notes.append(
+                f"joint {excerpt(joint)} mimics joint {excerpt(mimicked)} in the URDF (its position {multiplier:g} times "
+                f"that joint's plus {offset:g}), which is not modelled: it is planned as a joint of its own, with its "
+                "own limits and torque; give waypoints that keep the coupling, or lock it (locked_joints) where it does not move"
+            )
     if options.locked_joints:
         notes.append("joints locked: " + ", ".join(f"{joint} = {value:g}" for joint, value in options.locked_joints.items()))
     if options.allowed_collisions:

@@ -52,7 +52,7 @@ import pinocchio as pin
 
 from toptraj.robots.errors import InvalidURDF, excerpt
 from toptraj.robots.ranges import TORQUE, VELOCITY
-from toptraj.robots.urdf_tree import MOVING_JOINTS, check_structure
+from toptraj.robots.urdf_tree import MOVING_JOINTS, check_mimic, check_structure
 
 MAX_OFFSET = 100.0  # m, each coordinate of an origin
 MAX_ANGLE = 100.0  # rad, each angle of an origin's rpy
@@ -359,6 +359,11 @@ def check_urdf(urdf: str) -> pin.Model:
         raise InvalidURDF(f"malformed XML: {excerpt(str(error), 200)}") from None
     if root.tag != "robot":
         tag = root.tag if len(root.tag) <= 40 else f"{root.tag[:40]}..."
+        if root.tag.startswith("{") and root.tag.endswith("}robot"):
+            raise InvalidURDF(
+                f"the root element <robot> declares the XML namespace {excerpt(root.tag[1:-6], 80)}, and a URDF's "
+                "elements carry none: remove the xmlns attribute from <robot>"
+            )
         raise InvalidURDF(f"the root element is <{tag}>, expected <robot>")
     _check_depth(root)
     links, joints, _ = check_structure(root)
@@ -369,6 +374,7 @@ def check_urdf(urdf: str) -> pin.Model:
         _check_geometry(link, where)
     for name, joint in joints.items():
         _check_joint_numbers(joint, joint.get("type"), f"joint {excerpt(name)}")
+        check_mimic(joint, joints, f"joint {excerpt(name)}")
     _check_mass_behind_moving_joints(links, joints, masses)
     try:
         model = pin.buildModelFromXML(urdf)

@@ -1,7 +1,7 @@
 """The structure of an uploaded URDF (``toptraj.robots.urdf_check``): one tree of links, each link the
 child of at most one joint, a single root, no cycle, every link and joint named once, only
 revolute, continuous, prismatic and fixed joints, and at most ``MAX_LINKS`` links,
-``MAX_JOINTS`` joints and ``MAX_MOVING_JOINTS`` moving joints. Each refusal is an
+``MAX_JOINTS`` joints and ``MAX_MOVING_JOINTS`` moving joints; a ``<mimic>`` names a moving joint. Each refusal is an
 ``InvalidURDF`` naming the joint or link. The walk is iterative: a chain of any length is
 checked in linear time and constant stack.
 """
@@ -106,3 +106,28 @@ def check_structure(root: ElementTree.Element) -> tuple[dict, dict, dict[str, st
     if len(moving) > MAX_MOVING_JOINTS:
         raise InvalidURDF(f"the URDF has {len(moving)} moving joints; at most {MAX_MOVING_JOINTS} are served")
     return links, joints, _parent_joints(links, joints)
+
+
+def check_mimic(joint: ElementTree.Element, joints: dict, where: str) -> None:
+    """A ``<mimic>`` names a moving joint of the URDF."""
+    element = joint.find("mimic")
+    if element is None:
+        return
+    mimicked = element.get("joint")
+    if mimicked is None or joints.get(mimicked) is None or joints[mimicked].get("type") not in MOVING_JOINTS:
+        raise InvalidURDF(
+            f"{where}: <mimic joint={excerpt(str(mimicked))}> names no revolute, continuous or prismatic joint of the URDF; "
+            "name the joint it follows, or remove the <mimic> element"
+        )
+
+
+def mimic_joints(urdf: str) -> list[tuple[str, str, float, float]]:
+    """(joint, the joint it mimics, multiplier, offset) of each ``<mimic>`` in ``urdf`` (already
+    checked by ``toptraj.robots.urdf_check.check_urdf``), in the URDF's order."""
+    found = []
+    for joint in ElementTree.fromstring(urdf).iter("joint"):
+        element = joint.find("mimic")
+        if element is not None:
+            multiplier, offset = (float(element.get(name, default)) for name, default in (("multiplier", "1"), ("offset", "0")))
+            found.append((joint.get("name", ""), element.get("joint", ""), multiplier, offset))
+    return found

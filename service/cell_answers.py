@@ -20,6 +20,7 @@ arms' smallest distance (the closest pair), and the coordination diagram of arms
 
 from __future__ import annotations
 
+import csv
 import io
 import math
 
@@ -179,7 +180,7 @@ def csv_bytes(body: dict) -> bytes:
             header += [f"arms[{index}].{quantity}.{name}" for name in arm["joint_names"]]
             columns.append(np.asarray(arm["samples"][quantity], dtype=float))
     out = io.StringIO()
-    out.write(",".join(header) + "\n")
+    csv.writer(out, lineterminator="\n").writerow(header)  # quoted where a joint's name needs it (RFC 4180)
     out.write("\n".join(_metadata(body)) + "\n")
     for row in np.hstack(columns):
         out.write(",".join(repr(float(v)) for v in row) + "\n")

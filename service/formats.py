@@ -25,6 +25,7 @@ samples on whole periods by default (``output.exact_period``, see
 
 from __future__ import annotations
 
+import csv
 import io
 from collections.abc import Mapping
 
@@ -141,7 +142,8 @@ def csv_bytes(body: Mapping) -> bytes:
     header = ["t"] + [f"{quantity}.{name}" for quantity in ("q", "qd", "qdd", "tau") for name in names]
     table = np.column_stack([np.asarray(samples[key], dtype=float) for key in ("t", "q", "qd", "qdd", "tau")])
     out = io.StringIO()
-    out.write(",".join(header) + "\n")
+    # quoted as RFC 4180 asks where a joint's name holds a comma, a quote or a line break
+    csv.writer(out, lineterminator="\n").writerow(header)
     out.write("\n".join(csv_metadata(body)) + "\n")
     for row in table:
         out.write(",".join(repr(float(v)) for v in row) + "\n")

@@ -101,6 +101,9 @@ def test_upload_under_a_name(client):
         (MINIMAL.replace('type="revolute"', 'type="floating"').format(effort=1, inertial=INERTIAL), ["floating", "not supported"]),
         (MINIMAL.replace('<child link="arm"/>', '<child link="ghost"/>').format(effort=1, inertial=INERTIAL), ["link 'ghost'"]),
         ('<robot name="x"><link name="a"/></robot>', ["no revolute, continuous or prismatic joint"]),
+        # a default namespace puts every element in it: the advice removes it
+        (MINIMAL.replace("<robot ", '<robot xmlns="http://www.ros.org" ').format(effort=1, inertial=INERTIAL), ["remove the xmlns attribute"]),
+        (MINIMAL.replace("</joint>", '<mimic joint="nope"/></joint>').format(effort=1, inertial=INERTIAL), ["joint 'j'", "<mimic joint='nope'>"]),
     ],
 )
 def test_bad_urdf_is_422_saying_what_and_where(client, urdf, words):
@@ -115,3 +118,52 @@ def test_oversized_urdf(client):
     response = client.post("/v1/robots", json={"urdf": "<robot>" + " " * 1_200_000 + "</robot>"})
     assert response.status_code == 422
     assert "urdf" in response.json()["detail"]
+
+
+def _two_joints(first_child: str = "l1", second_child: str = "l2", names: tuple[str, str] = ("j1", "j2"), mimic: str = "") -> str:
+    link = '<link name="{}">' + INERTIAL.replace("<mass", '<origin xyz="0 0 0.25"/><mass') + "</link>"
+    joint = (
+        '<joint name="{}" type="revolute"><parent link="{}"/><child link="{}"/><origin xyz="0 0 0.5"/><axis xyz="0 1 0"/>'
+        '<limit lower="-2" upper="2" effort="50" velocity="2"/>{}</joint>'
+    )
+    return (
+        '<robot name="two"><link name="base"/>' + link.format(first_child) + link.format(second_child)
+        + joint.format(names[0], "base", first_child, "") + joint.format(names[1], first_child, second_child, mimic) + "</robot>"
+    )
+
+
+def _plan(client, robot: str, **output):
+    return client.post("/v1/trajectories", json={
+        "robot": robot, "path": {"kind": "waypoints", "waypoints": [[0, 0], [1, 1]]},
+        "timing": {"method": "toppra", "constraints": ["velocity", "acceleration", "torque"]}, "output": {"dt": 0.01, **output},
+    })
+
+
+def test_a_link_named_as_a_joint_plans(client):
+    """A URDF may give a link and a joint one name (here the last link and the first joint): the
+    tool is the link, and planning and the skeleton work (pinocchio's lookup by name refused
+    the ambiguity, a 500 on every request)."""
+    assert client.post("/v1/robots", json={"name": "shared_name", "urdf": _two_joints(second_child="j1")}).status_code == 201
+    planned = _plan(client, "shared_name")
+    assert planned.status_code == 200, planned.text
+    assert client.post("/v1/robots/shared_name/skeleton", json={"q": [[0, 0], [1, 1]]}).status_code == 200
+
+
+def test_a_mimic_joint_is_told(client):
+    created = client.post("/v1/robots", json={"urdf": _two_joints(mimic='<mimic joint="j1" multiplier="-1"/>')})
+    assert created.status_code == 201, created.text
+    assert any("joint 'j2' mimics joint 'j1'" in note and "times" in note for note in created.json()["notes"]), created.json()["notes"]
+    locked = client.post("/v1/robots", json={"urdf": _two_joints(mimic='<mimic joint="j1"/>'), "locked_joints": {"j2": 0.0}})
+    assert locked.status_code == 201 and not any("mimic" in note for note in locked.json()["notes"])
+
+
+def test_csv_quotes_a_joint_name_that_needs_it(client):
+    import csv
+    import io
+
+    names = ("a,b", "x&quot;y")  # the XML's escape of x"y
+    assert client.post("/v1/robots", json={"name": "odd_names", "urdf": _two_joints(names=names)}).status_code == 201
+    text = _plan(client, "odd_names", format="csv").text
+    rows = list(csv.reader(line for line in io.StringIO(text) if not line.startswith("#")))
+    assert rows[0][:3] == ["t", "q.a,b", 'q.x"y']
+    assert {len(row) for row in rows} == {9}
