@@ -219,18 +219,55 @@ def midpoint_duration(constraints: PathConstraints, boundary: Boundary = AT_REST
 
 def _solve_on_grid(grid: Grid, boundary: tuple[float, float], deadline, midpoint: bool, x_ref=None, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> Profile:
     """Integrate on one grid, in the interpolation (conservative) or the midpoint
-    discretization. Viscous friction is linearized around ``x_ref`` (default: a first pass
-    around the frictionless maximum velocity curve, then one around its answer). ``kept`` and
+    discretization. Viscous friction is linearized around ``x_ref`` (default: the passes of
+    ``_friction_passes``). ``kept`` and
     ``before``: the intervals this grid keeps whole from a coarser one and that grid's bounds
     in the same discretization (``Profile.bounds``), copied instead of computed again."""
-    passes = 1
-    if x_ref is None:
-        passes = 2 if grid.friction else 1
-        x_ref = grid.friction_reference() if grid.friction else grid.x_bound
+    x_start, x_end = boundary
+    if x_ref is None and grid.friction:
+        return _friction_passes(grid, x_start, x_end, deadline, midpoint, kept, before)
+    x_ref = grid.x_bound if x_ref is None else x_ref
+    return _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), x_start, x_end, deadline, midpoint, kept, before)
+
+
+#: Factor by which the reference of viscous friction's tangent is lowered after a pass that
+#: finds no motion (``_friction_passes``), and the most references tried.
+FRICTION_LOWERING = 1.0 / 16.0
+FRICTION_REFERENCES = 5
+#: Most passes around the last pass's answer after a lowered reference, and the relative change
+#: of the duration below which they stop.
+FRICTION_PASSES = 6
+FRICTION_SETTLED = 1e-6
+
+
+def _friction_passes(grid: Grid, x_start: float, x_end: float, deadline, midpoint: bool, kept, before) -> Profile:
+    """The profile with viscous friction, linearized around a reference that the passes move
+    onto the answer: a first pass around the frictionless maximum velocity curve
+    (``Grid.friction_reference``), then one around its answer.
+
+    The tangent of D sqrt(x) at x_ref adds D sqrt(x_ref) / 2 to a row at x = 0: under strong
+    damping, a reference as fast as the maximum velocity curve asks torque the motion does not
+    need near rest, and the pass finds no motion ("not even at rest") where slower motions
+    exist. The reference is then lowered (``FRICTION_LOWERING``, at most ``FRICTION_REFERENCES``
+    references; the last failure raised), and the passes around each answer, whose tangent is
+    exact at the answer, so that it stays feasible and the duration can only fall, go on until
+    it settles (``FRICTION_PASSES``, ``FRICTION_SETTLED``)."""
+    reference = np.ascontiguousarray(grid.friction_reference(), dtype=np.float64)
+    for attempt in range(FRICTION_REFERENCES):
+        try:
+            profile = _integrate(grid, reference, x_start, x_end, deadline, midpoint, kept, before)
+            break
+        except InfeasiblePath:
+            if attempt == FRICTION_REFERENCES - 1:
+                raise
+            reference = reference * FRICTION_LOWERING
+    passes = 1 if attempt == 0 else FRICTION_PASSES
+    duration = np.inf
     for _ in range(passes):
-        x_start, x_end = boundary
-        profile = _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), x_start, x_end, deadline, midpoint, kept, before)
-        x_ref = profile.x
+        profile = _integrate(grid, np.ascontiguousarray(profile.x, dtype=np.float64), x_start, x_end, deadline, midpoint, kept, before)
+        previous, duration = duration, float(interval_times(grid.s, profile.x).sum())
+        if abs(previous - duration) <= FRICTION_SETTLED * duration:
+            break
     return profile
 
 

@@ -1,0 +1,50 @@
+"""A joint with strong viscous damping: phase_plane times the path (its tangent of D sqrt(x),
+taken first at the frictionless maximum velocity curve, asked torque no slow motion needs, and
+refused the path "not even at rest"), and the torques of the answer, recomputed independently
+(pinocchio's RNEA plus D qd + F sign(qd)), stay within the effort limit."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+EFFORT = 9.0
+WAYPOINTS = [[0.0, -1.0, 1.0], [1.0, 0.5, -0.8], [-0.5, 1.2, 0.4]]
+
+
+def _urdf(damping: float, friction: float = 2.0) -> str:
+    inertial = (
+        '<inertial><origin xyz="0 0 0.25"/><mass value="1"/>'
+        '<inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.002"/></inertial>'
+    )
+    joints = []
+    for index, (parent, axis, height) in enumerate((("base", "0 0 1", 0.1), ("l1", "0 1 0", 0.5), ("l2", "0 1 0", 0.5)), start=1):
+        joints.append(
+            f'<link name="l{index}">{inertial}</link><joint name="j{index}" type="revolute"><parent link="{parent}"/>'
+            f'<child link="l{index}"/><origin xyz="0 0 {height}"/><axis xyz="{axis}"/>'
+            f'<limit effort="{EFFORT}" velocity="2" lower="-2" upper="2"/><dynamics damping="{damping}" friction="{friction}"/></joint>'
+        )
+    return '<robot name="damped"><link name="base"/>' + "".join(joints) + "</robot>"
+
+
+@pytest.mark.parametrize("damping", [3.0, 10.0])
+def test_strong_damping_is_timed_within_the_effort(client, damping):
+    urdf = _urdf(damping)
+    name = f"damped_{int(damping)}"
+    assert client.post("/v1/robots", json={"name": name, "urdf": urdf}).status_code == 201
+    answer = client.post("/v1/trajectories", json={
+        "robot": name, "path": {"kind": "waypoints", "interpolation": "spline", "waypoints": WAYPOINTS},
+        "timing": {"method": "phase_plane", "constraints": ["velocity", "acceleration", "torque"]}, "output": {"dt": 0.01},
+    })
+    assert answer.status_code == 200, answer.text
+    samples = answer.json()["samples"]
+    q, qd, qdd, tau = (np.asarray(samples[key]) for key in ("q", "qd", "qdd", "tau"))
+    model = pin.buildModelFromXML(urdf)
+    data = model.createData()
+    moving = np.abs(qd) > 1e-9
+    independent = np.array([pin.rnea(model, data, *row) for row in zip(q, qd, qdd)]) + damping * qd + 2.0 * np.sign(qd)
+    assert np.abs(independent[moving.all(axis=1)]).max() <= EFFORT * 1.005
+    assert np.allclose(independent[moving.all(axis=1)], tau[moving.all(axis=1)], atol=1e-6 * EFFORT)
+    # the motion is not slowed beyond need: some joint's torque reaches its limit
+    assert np.abs(tau).max() >= EFFORT * 0.999
