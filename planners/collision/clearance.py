@@ -169,7 +169,7 @@ def check_clearance(
         least, at = closest_approach(path, robot, obstacles, deadline)
         facts = {key: value for key, value in vars(error).items() if key not in ("detail", "rule")}
         raise PathInCollision(
-            f"{error.detail}; the path comes no closer than {least:.4g} m, near s = {at:.4g}", **facts, least=least
+            f"{error.detail}; the path comes no closer than {least:.4g} m, near s = {at:.4g}", **facts, least=least, least_s=at
         ) from None
 
 

@@ -228,8 +228,12 @@ def _utilization(stretches_: tuple[TimedStretch, ...], margin: float, limits: Jo
     """Peak |value| / limit per kind and joint over every stretch, against the limits as
     requested (before any margin); ``nan`` for a joint and kind without a finite limit (in
     ``limits``, (n_dof,) each) that no zone limited either (its peak stays 0)."""
-    kinds = stretches_[0].check.utilization.keys()
-    peaks = {kind: np.max([item.check.utilization[kind] for item in stretches_], axis=0) for kind in kinds}
+    # a kind a zone limits on some stretches only (a tool speed) counts where it is checked
+    kinds = dict.fromkeys(kind for item in stretches_ for kind in item.check.utilization)
+    peaks = {
+        kind: np.max([item.check.utilization[kind] for item in stretches_ if kind in item.check.utilization], axis=0)
+        for kind in kinds
+    }
     for kind, peak in peaks.items():
         limit = getattr(limits, kind, None)
         if limit is not None and np.shape(limit) == np.shape(peak):

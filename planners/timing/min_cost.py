@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.constraints.admissible import friction_reference
+from toptraj.planners.constraints.admissible import FRICTION_LOWERING, FRICTION_REFERENCES, friction_reference
 from toptraj.planners.constraints.linear_rows import LinearRows
 from toptraj.planners.constraints.path_constraints import PathConstraints
 from toptraj.planners.errors import InfeasiblePath, OutOfRange, TimingFailed
@@ -86,7 +86,19 @@ class MinCostMethod(TimingMethod):
         viscous = _midpoint(constraints.d, constraints.d_left, torque) if constraints.has_friction else None
         if viscous is not None and not viscous.any():
             viscous = None
-        result, program = self._solved(constraints, boundary, friction_reference(constraints), torque, viscous, deadline)
+        reference = friction_reference(constraints)
+        for attempt in range(FRICTION_REFERENCES if viscous is not None else 1):
+            try:
+                result, program = self._solved(constraints, boundary, reference, torque, viscous, deadline)
+                break
+            except InfeasiblePath:
+                if viscous is None or attempt == FRICTION_REFERENCES - 1:
+                    raise
+                # the tangent at the reference asks torque no slow motion needs: lowered, then
+                # moved onto the answer (``toptraj.planners.constraints.admissible.FRICTION_LOWERING``)
+                reference = reference * FRICTION_LOWERING
+        if attempt:
+            result, program = self._solved(constraints, boundary, result.sd**2, torque, viscous, deadline)
         return dataclasses.replace(result, cost=motion_cost(program, result.sd**2))
 
     def _solved(self, constraints, boundary, reference, torque, viscous, deadline) -> tuple[CostTimeScaling, MinCostProgram]:

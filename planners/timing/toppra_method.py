@@ -15,7 +15,15 @@ import logging
 
 import numpy as np
 
-from toptraj.planners.constraints.admissible import acceleration_bounds, admissible_set, friction_reference
+from toptraj.planners.constraints.admissible import (
+    FRICTION_LOWERING,
+    FRICTION_PASSES,
+    FRICTION_REFERENCES,
+    FRICTION_SETTLED,
+    acceleration_bounds,
+    admissible_set,
+    friction_reference,
+)
 from toptraj.planners.constraints.held_load import blocked_even_at_rest, holding_facts, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
@@ -99,28 +107,46 @@ class ToppraMethod(TimingMethod):
         duration: float | None = None,
         deadline: Deadline = NO_DEADLINE,
     ) -> TimeScaling:
-        TOPPRA, PrecomputedRows, GridPath = _toppra_classes()
-        sd_start, sd_end = boundary.sd_start, boundary.sd_end
-        x_bound = constraints.sd_max**2
         x_ref = friction_reference(constraints)
-        scaling = None
-        for _ in range(2 if constraints.has_friction else 1):
-            rows = constraints.linearized(x_ref).normalized()
-            left_rows = constraints.linearized(x_ref, side="left").normalized()
-            deadline.check()
-            instance = TOPPRA(
-                [PrecomputedRows(*_singular_rows_as_bounds(rows, x_bound), left_rows)],
-                GridPath(constraints.s),
-                gridpoints=constraints.s,
-                solver_wrapper="seidel",
-            )
-            sdd, sd, _, K = instance.compute_parameterization(sd_start, sd_end, return_data=True)
-            if sd is None:
-                raise _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end)
-            scaling = TimeScaling(constraints.s, np.asarray(sd, dtype=float))
-            x_ref = scaling.sd**2
-        assert scaling is not None  # one pass at least
+        if not constraints.has_friction:
+            return _solved(constraints, x_ref, boundary, deadline)
+        # Viscous friction, linearized around a reference the passes move onto the answer (as
+        # phase_plane's ``_friction_passes``): lowered where its tangent finds no motion.
+        for attempt in range(FRICTION_REFERENCES):
+            try:
+                scaling = _solved(constraints, x_ref, boundary, deadline)
+                break
+            except InfeasiblePath:
+                if attempt == FRICTION_REFERENCES - 1:
+                    raise
+                x_ref = x_ref * FRICTION_LOWERING
+        duration = np.inf
+        for _ in range(1 if attempt == 0 else FRICTION_PASSES):
+            scaling = _solved(constraints, scaling.sd**2, boundary, deadline)
+            previous, duration = duration, scaling.duration
+            if abs(previous - duration) <= FRICTION_SETTLED * duration:
+                break
         return scaling
+
+
+def _solved(constraints: PathConstraints, x_ref: np.ndarray, boundary: Boundary, deadline: Deadline) -> TimeScaling:
+    """toppra's timing of ``constraints``, viscous friction linearized around ``x_ref`` (N + 1,)."""
+    TOPPRA, PrecomputedRows, GridPath = _toppra_classes()
+    sd_start, sd_end = boundary.sd_start, boundary.sd_end
+    x_bound = constraints.sd_max**2
+    rows = constraints.linearized(x_ref).normalized()
+    left_rows = constraints.linearized(x_ref, side="left").normalized()
+    deadline.check()
+    instance = TOPPRA(
+        [PrecomputedRows(*_singular_rows_as_bounds(rows, x_bound), left_rows)],
+        GridPath(constraints.s),
+        gridpoints=constraints.s,
+        solver_wrapper="seidel",
+    )
+    sdd, sd, _, K = instance.compute_parameterization(sd_start, sd_end, return_data=True)
+    if sd is None:
+        raise _explain_failure(constraints, rows, x_bound, K, sd_start, sd_end)
+    return TimeScaling(constraints.s, np.asarray(sd, dtype=float))
 
 
 def _singular_rows_as_bounds(rows: LinearRows, x_bound: np.ndarray) -> tuple[LinearRows, np.ndarray]:

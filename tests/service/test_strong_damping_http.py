@@ -1,7 +1,8 @@
-"""A joint with strong viscous damping: phase_plane times the path (its tangent of D sqrt(x),
-taken first at the frictionless maximum velocity curve, asked torque no slow motion needs, and
-refused the path "not even at rest"), and the torques of the answer, recomputed independently
-(pinocchio's RNEA plus D qd + F sign(qd)), stay within the effort limit."""
+"""A joint with strong viscous damping: phase_plane, toppra and min_cost time the path (their
+tangent of D sqrt(x), taken first at the frictionless maximum velocity curve, asked torque no
+slow motion needs, and they refused the path, "not even at rest"), and the torques of the
+answer, recomputed independently (pinocchio's RNEA plus D qd + F sign(qd)), stay within the
+effort limit."""
 
 from __future__ import annotations
 
@@ -28,14 +29,15 @@ def _urdf(damping: float, friction: float = 2.0) -> str:
     return '<robot name="damped"><link name="base"/>' + "".join(joints) + "</robot>"
 
 
+@pytest.mark.parametrize("method", ["phase_plane", "toppra", "min_cost"])
 @pytest.mark.parametrize("damping", [3.0, 10.0])
-def test_strong_damping_is_timed_within_the_effort(client, damping):
+def test_strong_damping_is_timed_within_the_effort(client, damping, method):
     urdf = _urdf(damping)
     name = f"damped_{int(damping)}"
-    assert client.post("/v1/robots", json={"name": name, "urdf": urdf}).status_code == 201
+    assert client.post("/v1/robots", json={"name": name, "urdf": urdf}).status_code in (200, 201)
     answer = client.post("/v1/trajectories", json={
         "robot": name, "path": {"kind": "waypoints", "interpolation": "spline", "waypoints": WAYPOINTS},
-        "timing": {"method": "phase_plane", "constraints": ["velocity", "acceleration", "torque"]}, "output": {"dt": 0.01},
+        "timing": {"method": method, "constraints": ["velocity", "acceleration", "torque"]}, "output": {"dt": 0.01},
     })
     assert answer.status_code == 200, answer.text
     samples = answer.json()["samples"]
@@ -46,5 +48,5 @@ def test_strong_damping_is_timed_within_the_effort(client, damping):
     independent = np.array([pin.rnea(model, data, *row) for row in zip(q, qd, qdd)]) + damping * qd + 2.0 * np.sign(qd)
     assert np.abs(independent[moving.all(axis=1)]).max() <= EFFORT * 1.005
     assert np.allclose(independent[moving.all(axis=1)], tau[moving.all(axis=1)], atol=1e-6 * EFFORT)
-    # the motion is not slowed beyond need: some joint's torque reaches its limit
-    assert np.abs(tau).max() >= EFFORT * 0.999
+    if method != "min_cost":  # a time-optimal motion is not slowed beyond need: a torque reaches its limit
+        assert np.abs(tau).max() >= EFFORT * 0.999

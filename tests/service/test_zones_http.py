@@ -151,3 +151,17 @@ def test_a_zone_scaling_a_limit_that_is_not_held_is_refused_and_the_advice_works
     followed = client.post("/v1/trajectories", json={**body, "timing": {**body["timing"], "constraints": ["velocity", "acceleration", "torque"]}})
     assert followed.status_code == 200, followed.text
     assert followed.json()["zones"][0]["peak"] <= 1.003
+
+
+@pytest.mark.parametrize("method", ["phase_plane", "toppra"])
+def test_a_tool_speed_zone_on_the_first_stretch_of_a_linear_path_is_reported(client, method):
+    """A linear path stops at its waypoints, each segment timed alone: a zone reaching the first
+    segment only limits the tool speed there, and the answer's peaks take it from the segments
+    that hold it (the others' lacking it was a 500)."""
+    path = {"kind": "waypoints", "interpolation": "linear", "waypoints": UR5_WAYPOINTS[:3]}
+    answer = client.post("/v1/trajectories", json={
+        "robot": "ur5", "path": path, "timing": {"method": method, "zones": [{"s_range": [0.0, 0.2], "tool_speed": 0.1}]},
+        "output": {"dt": 0.01},
+    })
+    assert answer.status_code == 200, answer.text
+    assert 0.99 <= answer.json()["peak_utilization"]["tool_speed"] <= 1.005

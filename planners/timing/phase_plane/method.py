@@ -45,7 +45,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from toptraj.planners.constraints.admissible import admissible_set
+from toptraj.planners.constraints.admissible import (
+    FRICTION_LOWERING,
+    FRICTION_PASSES,
+    FRICTION_REFERENCES,
+    FRICTION_SETTLED,
+    admissible_set,
+)
 from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, zero_inertia_intervals
 from toptraj.planners.constraints.held_load import blocked_even_at_rest, holding_facts, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
@@ -228,16 +234,6 @@ def _solve_on_grid(grid: Grid, boundary: tuple[float, float], deadline, midpoint
         return _friction_passes(grid, x_start, x_end, deadline, midpoint, kept, before)
     x_ref = grid.x_bound if x_ref is None else x_ref
     return _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), x_start, x_end, deadline, midpoint, kept, before)
-
-
-#: Factor by which the reference of viscous friction's tangent is lowered after a pass that
-#: finds no motion (``_friction_passes``), and the most references tried.
-FRICTION_LOWERING = 1.0 / 16.0
-FRICTION_REFERENCES = 5
-#: Most passes around the last pass's answer after a lowered reference, and the relative change
-#: of the duration below which they stop.
-FRICTION_PASSES = 6
-FRICTION_SETTLED = 1e-6
 
 
 def _friction_passes(grid: Grid, x_start: float, x_end: float, deadline, midpoint: bool, kept, before) -> Profile:
