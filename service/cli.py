@@ -24,6 +24,13 @@ def _commands():  # noqa: ANN202 - the module
     return commands
 
 
+def _batch_command():  # noqa: ANN202 - the module
+    """``toptraj.service.batch_command``, imported when ``toptraj batch`` runs."""
+    from toptraj.service import batch_command
+
+    return batch_command
+
+
 def plan_threads_per_process(workers: int, cores: int | None = None) -> int:
     """Planning threads of each of ``workers`` server processes sharing ``cores`` cores: the
     cores divided among the processes, at least 1. A process's planning threads share one
@@ -60,6 +67,9 @@ def _serve(args) -> int:
 
     if args.workers < 1:
         print(f"toptraj serve: --workers must be at least 1, not {args.workers}", file=sys.stderr)
+        return 2
+    if not 1 <= args.port <= 65535:  # uvicorn would take it modulo 65536 and say the port given
+        print(f"toptraj serve: --port must be a port number from 1 to 65535, not {args.port}", file=sys.stderr)
         return 2
     # Each server process reads its settings from the environment, which it inherits from here.
     os.environ.setdefault("TOPTRAJ_PLAN_WORKERS", str(plan_threads_per_process(args.workers)))
@@ -187,7 +197,7 @@ def main(argv: list[str] | None = None) -> int:
         "--retry-failed", action="store_true", help="plan again the lines answered with a budget error (504) or another 5xx"
     )
     batch.set_defaults(
-        run=lambda args: _commands().batch(args.requests, args.output, args.workers, args.ray_address, args.budget, args.retry_failed)
+        run=lambda args: _batch_command().batch(args.requests, args.output, args.workers, args.ray_address, args.budget, args.retry_failed)
     )
     args = parser.parse_args(argv)
     if args.command in ONE_SHOT:
@@ -196,6 +206,11 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
         # the kernels the install compiled ahead of time, without numba's start (toptraj.compiled)
         os.environ.setdefault("TOPTRAJ_KERNELS", "library")
+        try:
+            return args.run(args)
+        except KeyboardInterrupt:  # Ctrl-C: the status a shell gives an interrupted command, no traceback
+            print(f"toptraj {args.command}: interrupted", file=sys.stderr)
+            return 130
     return args.run(args)
 
 

@@ -35,12 +35,29 @@ def _problem(title: str, status: int, detail: str) -> dict:
     return {"type": "about:blank", "title": title, "status": status, "detail": detail}
 
 
+#: Largest request read (bytes): the server's default body cap (``Settings.max_body_bytes``),
+#: checked before the request is read whole.
+MAX_REQUEST_BYTES = 2_000_000
+
+
 def _read(source: str) -> str:
+    """The request at ``source`` (a file, or ``-`` for standard input), at most
+    ``MAX_REQUEST_BYTES`` read, a byte order mark ignored as over HTTP."""
     try:
         if source == "-":
-            return sys.stdin.read().removeprefix("\ufeff")
-        with open(source, encoding="utf-8-sig") as handle:  # a byte order mark is ignored, as over HTTP
-            return handle.read()
+            if sys.stdin is None:
+                raise _Unreadable("cannot read the request from standard input: it is closed")
+            binary = getattr(sys.stdin, "buffer", None)  # a text stream without one (a test's) is read as text
+            raw = binary.read(MAX_REQUEST_BYTES + 1) if binary is not None else sys.stdin.read(MAX_REQUEST_BYTES + 1).encode()
+        else:
+            with open(source, "rb") as handle:
+                raw = handle.read(MAX_REQUEST_BYTES + 1)
+        if len(raw) > MAX_REQUEST_BYTES:
+            raise _Unreadable(
+                f"the request {source!r} holds more than {MAX_REQUEST_BYTES:,} bytes, the most a request holds (as the "
+                "server's body cap): is it a request? A path of many points is better given by fewer waypoints"
+            )
+        return raw.decode("utf-8-sig")
     except (OSError, UnicodeDecodeError) as error:
         raise _Unreadable(f"cannot read the request {source!r}: {error}") from None
 
@@ -186,6 +203,9 @@ def _schema_named(title: str) -> type | None:
 
 
 def _write(content: bytes, out=None) -> int:
+    if out is None and sys.stdout is None:
+        print(json.dumps(_problem("Cannot write the answer", 400, "standard output is closed: redirect it to a file")), file=sys.stderr)
+        return 2
     stream = out or sys.stdout.buffer
     try:
         stream.write(content if content.endswith(b"\n") else content + b"\n")
@@ -197,6 +217,9 @@ def _write(content: bytes, out=None) -> int:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         except (OSError, ValueError, io.UnsupportedOperation):  # stdout is no file (a test's capture)
             pass
+    except OSError as error:  # a full disk, a closed descriptor
+        print(json.dumps(_problem("Cannot write the answer", 400, f"standard output: {error}")), file=sys.stderr)
+        return 2
     return 0
 
 
@@ -298,6 +321,10 @@ def plot(source: str, output: str, methods: list[str] | None = None) -> int:
             return compare_html(CompareRequest.model_validate_json(compare_body(text, methods)), NO_DEADLINE).encode()
         return figures_html(plan_request(TrajectoryRequest.model_validate_json(text))).encode()
 
+    unwritable = _unwritable(output)
+    if unwritable:  # said before planning, which may take minutes
+        print(json.dumps(_problem("Cannot write the page", 400, f"{output!r}: {unwritable}")), file=sys.stderr)
+        return 2
     buffer = io.BytesIO()
     status = _run(source, page, out=buffer)
     if status != 0:
@@ -311,67 +338,13 @@ def plot(source: str, output: str, methods: list[str] | None = None) -> int:
         return 2
 
 
-def batch(
-    requests: str,
-    output: str,
-    workers: int | None,
-    ray_address: str | None,
-    budget_s: float | None = None,
-    retry_failed: bool = False,
-) -> int:
-    """``toptraj batch FILE -o OUT``: every request line planned (on Ray), one result line per
-    line, resumable (``toptraj.service.batches``). Ctrl-C stops within seconds, keeps what finished,
-    prints the command that resumes and exits with 130; a second Ctrl-C changes nothing."""
-    import shlex
-    import signal
-    import threading
-
-    from toptraj.service.batches import run_batch
-    from toptraj.service.batches.lines import ForeignOutput
-    from toptraj.service.batches.ray_pool import RayMissing, RayUnreachable
-    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, progress_bar
-
-    if workers is not None and workers < 1:
-        print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)
-        return 2
-    budget = BUDGET_S if budget_s is None else budget_s
-    if not 0.0 < budget <= MAX_BUDGET_S:  # NaN too
-        print(json.dumps(_problem("Invalid option", 400, f"--budget must be in (0, {MAX_BUDGET_S:g}] s, not {budget_s:g}")), file=sys.stderr)
-        return 2
-    stop = threading.Event()
-
-    def interrupted(signum, frame) -> None:
-        if not stop.is_set():  # a raw write: the handler may interrupt a write to sys.stderr
-            os.write(2, b"\nstopping: keeping the finished lines, cancelling the others ...\n")
-        stop.set()
-
-    previous = signal.signal(signal.SIGINT, interrupted)
-    try:
-        report = run_batch(requests, output, workers, ray_address, progress_bar(), budget, retry_failed, stop)
-    except (RayMissing, RayUnreachable, ForeignOutput, OSError) as error:
-        titles = {RayMissing: "Ray is not installed", RayUnreachable: "Ray cluster unreachable", ForeignOutput: "Not a result file"}
-        print(json.dumps(_problem(titles.get(type(error), "Cannot read or write"), 400, str(error))), file=sys.stderr)
-        return 2
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    summary = _batch_summary(report, output)
-    if not report.interrupted:
-        print(summary, file=sys.stderr)
-        return 0
-    command = ["toptraj", "batch", requests, "-o", output]
-    for option, value in (("--workers", workers), ("--ray-address", ray_address), ("--budget", budget_s)):
-        if value is not None:
-            command += [option, f"{value:g}" if isinstance(value, float) else str(value)]
-    print(f"interrupted: {summary}\nresume with: {shlex.join(command)}", file=sys.stderr)
-    return 130
-
-
-def _batch_summary(report, output: str) -> str:
-    """What a batch did: lines answered, found done, in all, its time and rate, and the Ray
-    nodes that answered (when more than one)."""
-    nodes = sorted(report.nodes.values(), reverse=True)
-    return (
-        f"{report.planned} answered, {report.skipped} already in {output}, {report.total} in all, "
-        f"{report.seconds:.1f} s ({report.rate:.1f} lines/s)"
-        + (f", on {len(nodes)} Ray nodes ({', '.join(map(str, nodes))} requests)" if len(nodes) > 1 else "")
-    )
+def _unwritable(output: str) -> str | None:
+    """Why no file can be written at ``output``, or ``None``."""
+    directory = os.path.dirname(os.path.abspath(output))
+    if os.path.isdir(output):
+        return "is a directory: give a file's path"
+    if not os.path.isdir(directory):
+        return f"its directory {directory!r} does not exist"
+    if not os.access(output if os.path.exists(output) else directory, os.W_OK):
+        return "cannot be written (permission denied)"
+    return None

@@ -127,6 +127,7 @@ class RayPool:
             if address in (None, "local"):
                 cpus = workers or os.cpu_count() or 1
                 ray.init(
+                    address="local",  # a Ray of its own, not a cluster started on this machine
                     num_cpus=cpus,
                     include_dashboard=False,
                     object_store_memory=100 * 1024 * 1024,
@@ -139,6 +140,14 @@ class RayPool:
                     check_reachable(address)
                 try:
                     ray.init(address=address, log_to_driver=False, configure_logging=False, runtime_env=hook)
+                except ValueError as error:  # ray://: Ray Client needs packages of its own
+                    if "ray[client]" not in str(error):
+                        raise
+                    raise RayMissing(
+                        f"--ray-address {address} connects through Ray Client, which needs Ray's client packages "
+                        "(pip install 'ray[client]'); or give the head's host:port (the address `ray start --head` "
+                        "printed) to connect without it"
+                    ) from None
                 except ConnectionError as error:  # no cluster there ("auto": none on this machine)
                     where = "runs on this machine" if address == "auto" else "answers"
                     raise RayUnreachable(
