@@ -78,6 +78,8 @@ def batch(
     summary = _batch_summary(report, output)
     if not report.interrupted:
         print(summary, file=sys.stderr)
+        if report.total == 0:
+            print(f"toptraj batch: {requests} holds no line: give a file of one request body per line", file=sys.stderr)
         return 0
     command = ["toptraj", "batch", requests, "-o", output]
     for option, value in (("--workers", workers), ("--ray-address", ray_address), ("--budget", budget_s)):

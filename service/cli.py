@@ -187,7 +187,14 @@ def main(argv: list[str] | None = None) -> int:
     serve.add_argument("--access-log", action="store_true", help="log a line per request (uvicorn's access log; default off)")
     serve.set_defaults(run=_serve)
     _request_commands(commands)
-    batch = commands.add_parser("batch", help="plan a file of requests (JSON Lines) on Ray, resumably")
+    batch = commands.add_parser(
+        "batch",
+        help="plan a file of requests (JSON Lines) on Ray, resumably",
+        description="Plan a file of requests, one POST /v1/trajectories (or compare) body per line, on Ray: a result line "
+        "per request line in the output as each finishes (its line number, status and body); run again, it plans only "
+        "the lines without a result. Exit status: 0 every line answered (a line's error is its result), 2 the files or "
+        "options cannot be used, 130 interrupted (the command that resumes is printed).",
+    )
     batch.add_argument("requests", help="a JSON Lines file: a POST /v1/trajectories (or compare) body per line")
     batch.add_argument("-o", "--output", required=True, help="the JSON Lines file of results (appended; resumed)")
     batch.add_argument("--workers", type=int, default=None, help="Ray workers (CPUs) of a local Ray (default: the cores)")

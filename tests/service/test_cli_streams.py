@@ -131,3 +131,10 @@ def test_a_local_ray_is_its_own_and_ray_client_without_its_packages_is_said(monk
     monkeypatch.setattr(ray_pool, "check_reachable", lambda address: None)
     with pytest.raises(ray_pool.RayMissing, match=r"pip install 'ray\[client\]'"):
         ray_pool.RayPool("ray://head:10001", None)
+
+
+def test_an_empty_batch_says_it_holds_no_line(tmp_path, capsys):
+    requests = tmp_path / "empty.jsonl"
+    requests.write_text("")
+    assert main(["batch", str(requests), "-o", str(tmp_path / "out.jsonl")]) == 0
+    assert "empty.jsonl holds no line: give a file of one request body per line" in capsys.readouterr().err
