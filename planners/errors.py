@@ -108,6 +108,17 @@ class TimingFailed(ToptrajError):
     (``method``, when known; ``solver_status``: the solver's own word)."""
 
 
+class WorkerStopped(TimingFailed):
+    """The worker process computing the request ended without an answer (``exit_code``: -9 when
+    killed, by the system for memory or by an operator): nothing in the request is known to be
+    wrong, and the same request may be answered when computed again."""
+
+    def __init__(self, exit_code: int | None):
+        super().__init__(
+            f"the worker process stopped without an answer (exit code {exit_code})", rule="worker_stopped", exit_code=exit_code
+        )
+
+
 class NonFinite(TimingFailed):
     """A method's ``quantity`` holds ``count`` NaN or infinite numbers."""
 

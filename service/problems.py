@@ -19,7 +19,7 @@ import numpy as np
 from pydantic import BaseModel, ValidationError
 
 from toptraj.planners.collision.clearance import PathInCollision
-from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, OverMemory, TimingFailed
+from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, InvalidRequest, OverMemory, TimingFailed, WorkerStopped
 from toptraj.robots import ToptrajError
 from toptraj.robots.errors import (
     MAX_DETAIL_CHARS,
@@ -65,6 +65,7 @@ STATUS: dict[type[ToptrajError], int] = {
     UploadStoreFull: 409,
     UploadStoreUnavailable: 503,
     BudgetExceeded: 504,
+    WorkerStopped: 503,
 }
 
 
@@ -84,6 +85,7 @@ TITLE: dict[type[ToptrajError], str] = {
     InfeasiblePath: "Path cannot be followed within the limits",
     PathInCollision: "Path comes too close to an obstacle",
     TimingFailed: "Timing method failed",
+    WorkerStopped: "Worker stopped",
     OverMemory: "Computation over its memory cap",
     BudgetExceeded: "Computation over its time budget",
 }

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from pydantic import Field
+from pydantic import Field, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY
@@ -91,3 +91,16 @@ class Settings(BaseSettings):
     telemetry: bool = False
     ray_address: str | None = None
     guide_dir: Path = GUIDE
+
+    @model_validator(mode="after")
+    def _room_for_ended_jobs(self) -> Settings:
+        """The job store keeps more jobs than may wait and run at once: else a job's answer is
+        deleted as it ends, to make room for those still waiting."""
+        active = self.job_queue + self.job_workers
+        if self.max_jobs <= active:
+            raise ValueError(
+                f"TOPTRAJ_MAX_JOBS = {self.max_jobs} leaves no room for an ended job's answer beside the "
+                f"{active} jobs that may wait and run at once (TOPTRAJ_JOB_QUEUE + TOPTRAJ_JOB_WORKERS): "
+                f"set it above {active}, or lower those"
+            )
+        return self

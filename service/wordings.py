@@ -372,6 +372,11 @@ WORDING: dict[str, Wording] = {
         "[qx, qy, qz, qw] (norm 1 within 1e-3), e.g. [0, 0, 0, 1] for a box along the world's axes"
     ),
     "path_in_collision": _path_in_collision,
+    "worker_stopped": (
+        "the worker process computing this request stopped without an answer (exit code {exit_code}; -9: killed, "
+        "by the system for memory or by an operator); nothing in the request is known to be wrong: submit it again, "
+        "and if it stops again, ask for a smaller computation (fewer timing.grid_points, fewer waypoints)"
+    ),
     "jerk_program_unsolved": (
         "the jerk-limited timing's linear program ended without a solution (HiGHS: {solver_status}); "
         "try other timing.grid_points"

@@ -46,7 +46,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from toptraj.planners.errors import OverMemory, TimingFailed
+from toptraj.planners.errors import OverMemory, TimingFailed, WorkerStopped
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.execution.threads import single_blas_thread
 
@@ -278,7 +278,7 @@ def run_isolated(
     Raises:
         OverMemory: the child needed more than ``memory_bytes``.
         BudgetExceeded: the deadline passed or was cancelled (the child is killed first).
-        TimingFailed: the child died without an answer (e.g. killed by the system for memory).
+        WorkerStopped: the child died without an answer (e.g. killed by the system for memory).
         Whatever ``function`` raised, re-raised here.
     """
     if inline or deadline is NO_DEADLINE or _in_worker:
@@ -304,7 +304,7 @@ def run_isolated(
                 except EOFError:
                     process.join()
                     deadline.check()  # killed on cancel: the budget, not the worker, ended it
-                    raise TimingFailed(f"the worker process stopped without an answer (exit code {process.exitcode})") from None
+                    raise WorkerStopped(process.exitcode) from None
                 if kind != "progress":
                     break
                 deadline.progress(*value)

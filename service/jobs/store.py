@@ -13,8 +13,8 @@ A job's life: ``queued`` -> ``running`` -> ``done`` | ``failed``; ``queued`` or 
 older than ``STALE_S``). Queued jobs survive a restart and run when a runner is free.
 
 What is kept is bounded: at most ``max_jobs`` jobs, none finished longer ago than ``max_age_s``,
-and at most ``max_bytes`` of requests, results and errors together; the oldest finished jobs go
-first (``prune``). A result is at most half of ``max_bytes`` (``jobs.job_answer_bytes``: its
+and at most ``max_bytes`` of requests, results and errors together; the jobs that finished
+first go first (``prune``). A result is at most half of ``max_bytes`` (``jobs.job_answer_bytes``: its
 planning refuses larger bodies), so the newest job always fits.
 """
 
@@ -331,15 +331,16 @@ class JobStore:
         count, size = connection.execute("SELECT COUNT(*), COALESCE(SUM(bytes), 0) FROM jobs").fetchone()
         if count <= self.max_jobs and size <= self.max_bytes:
             return deleted
-        # The oldest ended jobs go until both bounds hold (queued and running ones stay).
-        cut = None
-        for seq, job_bytes in connection.execute(f"SELECT seq, bytes FROM jobs WHERE {ended} ORDER BY seq"):
+        # The jobs that ended first go until both bounds hold (queued and running ones stay): a
+        # job submitted early that has just ended keeps its answer over one read long ago.
+        doomed = []
+        for seq, job_bytes in connection.execute(f"SELECT seq, bytes FROM jobs WHERE {ended} ORDER BY finished, seq"):
             if count <= self.max_jobs and size <= self.max_bytes:
                 break
-            cut, count, size = seq, count - 1, size - job_bytes
-        if cut is not None:
-            deleted += connection.execute(f"DELETE FROM jobs WHERE {ended} AND seq <= ?", (cut,)).rowcount
-        return deleted
+            doomed.append((seq,))
+            count, size = count - 1, size - job_bytes
+        connection.executemany("DELETE FROM jobs WHERE seq = ?", doomed)
+        return deleted + len(doomed)
 
     def _vacuum(self) -> None:
         """Give pages freed by deletions back to the file system."""

@@ -65,7 +65,7 @@ async def create_batch(body: BatchCreate, request: Request) -> Response:
     how to submit them again."""
     _checked(body.requests)
     settings = request.app.state.settings
-    budget_s = settings.job_budget_s if body.budget_s is None else body.budget_s
+    budget_s = min(settings.job_budget_s, settings.job_max_budget_s) if body.budget_s is None else body.budget_s
     if budget_s > settings.job_max_budget_s:
         raise RequestRefused(
             f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= {settings.job_max_budget_s:g} "

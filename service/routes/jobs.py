@@ -191,7 +191,7 @@ def list_jobs(
     """The jobs the store keeps, newest first, without their answers, a page at a time."""
     before = None
     if cursor is not None:
-        if not cursor.isdigit():
+        if not (cursor.isascii() and cursor.isdigit()) or int(cursor) >= 2**63:  # "²" is a digit to isdigit
             raise RequestRefused(f"cursor {excerpt(cursor)} is not a next_cursor of GET /v1/jobs")
         before = int(cursor)
     jobs = _store(request).jobs(limit + 1, before, status)

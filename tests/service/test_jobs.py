@@ -205,6 +205,9 @@ def test_the_list_is_paginated_newest_first(client):
     assert second["jobs"][0]["id"] == ids[0]
     assert client.get("/v1/jobs", params={"limit": 101}).status_code == 422
     assert client.get("/v1/jobs", params={"cursor": "x"}).status_code == 422
+    for cursor in ("99999999999999999999", "\u00b2"):  # beyond 64 bits; a digit to str.isdigit, not to int()
+        refused = client.get("/v1/jobs", params={"cursor": cursor})
+        assert refused.status_code == 422 and "is not a next_cursor" in refused.json()["detail"], refused.text
     done = client.get("/v1/jobs", params={"status": "done", "limit": 100}).json()["jobs"]
     assert done and all(job["status"] == "done" for job in done)
 
@@ -555,6 +558,36 @@ def test_the_store_keeps_the_newest_jobs_within_its_bounds(tmp_path):
     aged.prune()
     assert aged.jobs(10) == []
     assert os.path.getsize(tmp_path / "jobs.sqlite3") < 200_000
+
+
+def test_a_job_that_ends_last_keeps_its_answer_over_those_ended_before(tmp_path):
+    """The store's bound removes the jobs that ended first: a job submitted first but ended
+    last keeps its answer (by submission order it went at once, a 404 to its client)."""
+    store = JobStore(tmp_path, max_jobs=3, max_age_s=3600, max_bytes=10_000)
+    first = store.submit("trajectory", "{}", 10.0, max_queued=10)
+    assert store.claim("here|1|x", max_running=5).id == first.id
+    later = []
+    for _ in range(2):
+        job = store.submit("trajectory", "{}", 10.0, max_queued=10)
+        assert store.claim("here|1|x", max_running=5).id == job.id
+        assert store.finish(job.id, "here|1|x", "done", b"x")
+        later.append(job.id)
+    assert store.finish(first.id, "here|1|x", "done", b"answer")
+    waiting = store.submit("trajectory", "{}", 10.0, max_queued=10)  # four jobs: one ended goes
+    assert {job.id for job in store.jobs(10)} == {first.id, later[1], waiting.id}
+
+
+def test_a_store_bound_that_leaves_no_room_for_answers_is_refused(tmp_path):
+    with pytest.raises(ValueError, match=r"TOPTRAJ_MAX_JOBS = 3 leaves no room .* set it above 5"):
+        Settings(preload_robots=False, data_dir=tmp_path, max_jobs=3, job_queue=3, job_workers=2)
+
+
+def test_a_batch_without_a_budget_gets_the_default_within_the_servers_maximum(tmp_path):
+    settings = Settings(preload_robots=False, data_dir=tmp_path, job_budget_s=100.0, job_max_budget_s=50.0)
+    with TestClient(create_app(settings)) as client:
+        response = client.post("/v1/batches", json={"requests": [QUICK]})
+        assert response.status_code == 202, response.text
+        assert client.get(f"/v1/jobs/{response.json()['id']}").json()["budget_s"] == 50.0
 
 
 def test_a_batch_out_of_budget_keeps_every_answer_it_has(client):

@@ -196,3 +196,23 @@ def test_workers_allocate_without_huge_pages_unless_asked():
     if os.environ.get("NUMPY_MADVISE_HUGEPAGE", "0") != "0":
         pytest.skip("this environment asks for huge pages")
     assert run_isolated(_huge_pages, deadline=Deadline(60)) is False
+
+
+def _kills_itself() -> None:
+    import signal
+
+    os.kill(os.getpid(), signal.SIGKILL)  # as the system kills a process for memory
+
+
+def test_a_worker_killed_is_a_worker_stopped_not_a_refusal_of_the_request():
+    """A worker that dies without an answer says so, with its exit code; the service answers it
+    503 with the advice to submit again (a 422 said the request was at fault)."""
+    from toptraj.planners.errors import WorkerStopped
+    from toptraj.service.problems import detail, status_of
+
+    with pytest.raises(WorkerStopped) as raised:
+        run_isolated(_kills_itself, deadline=Deadline(30.0))
+    assert raised.value.exit_code == -9
+    assert status_of(raised.value) == 503
+    assert detail(raised.value).startswith("the worker process computing this request stopped without an answer (exit code -9")
+    assert "submit it again" in detail(raised.value)
