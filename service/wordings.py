@@ -20,6 +20,7 @@ from toptraj.service.counts import counted
 from toptraj.service.field_hints import closest
 from toptraj.service.limit_wordings import LIMIT_WORDING
 from toptraj.service.note_wordings import NOTE_WORDING
+from toptraj.service.obstacle_wordings import OBSTACLE_WORDING
 from toptraj.service.search_wordings import SEARCH_WORDING
 from toptraj.service.zone_wordings import ZONE_WORDING
 
@@ -127,49 +128,6 @@ def _outside_joint_range(facts: dict) -> str:
         if low <= value * factor <= high:
             text += f"; joint values are in {unit}: if it is in {given}, give {value * factor:.6g} {unit}"
     return text
-
-
-def _below(distance: float, clearance: float) -> str:
-    """``distance`` (m, below ``clearance``) to four significant digits, or as many more as
-    tell it from the clearance (0.029996 m, not 0.03 m, under a clearance of 0.03 m)."""
-    for digits in range(4, 10):
-        text = f"{distance:.{digits}g}"
-        if float(text) < clearance:
-            return text
-    return text
-
-
-def _path_in_collision(facts: dict) -> str:
-    index, distance = facts["obstacle"], facts["distance"]
-    within = _below(distance, facts["clearance"])
-    how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {within} m of path.obstacles[{index}]"
-    closest = "" if facts["closest"] is None else f"; the closest approach is {facts['closest'][0]:.4g} m at s = {facts['closest'][1]:.4g}"
-    if facts.get("fixed"):
-        advice = f"no joint moves that link: move path.obstacles[{index}] away from it, or the robot by its mounting"
-    else:
-        advice = "move the waypoints away from the obstacle"
-    least = math.floor(1e4 * facts.get("least", -1.0)) / 1e4  # a lower bound on the path's distance, 0.1 mm down
-    if least > 0.0:
-        advice += f"{',' if facts.get('fixed') else ''} or lower path.clearance to {least:g} m"
-    elif "least_s" in facts and not facts.get("fixed"):
-        advice += f" (near s = {facts['least_s']:.4g} the path touches or enters an obstacle: no lower clearance lets it through)"
-    return f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): {advice}"
-
-
-def _end_too_close(facts: dict) -> str:
-    """A free path's start or goal within the clearance of an obstacle; a link no joint moves is
-    advised to move the obstacle or the robot, since no start or goal moves it."""
-    field, index, distance = facts["field"], facts["obstacle"], facts["distance"]
-    within = _below(distance, facts["clearance"])
-    how = f"is inside path.obstacles[{index}] (by {-distance:.4g} m)" if distance < 0 else f"comes within {within} m of path.obstacles[{index}]"
-    if facts.get("fixed"):
-        advice = f"no joint moves that link: move path.obstacles[{index}] away from it, or the robot by its mounting"
-    else:
-        advice = f"move {field} away from the obstacle"
-    below = math.floor(1e4 * distance) / 1e4  # the end's distance, 0.1 mm down
-    if below > 0.0:
-        advice += f"{',' if facts.get('fixed') else ''} or lower path.clearance to {below:g} m"
-    return f"at {field}, link {facts['link']!r} {how} (the clearance is {facts['clearance']:g} m): {advice}"
 
 
 def _unknown_frame(facts: dict) -> str:
@@ -358,7 +316,6 @@ WORDING: dict[str, Wording] = {
         f"at most {facts['cap']} are searched: use fewer cells, or timing.search.graph 'roadmap'"
     ),
     "unknown_graph": "{field} {value!e} is unknown; use one of {allowed}",
-    "end_too_close": _end_too_close,
     "max_turn_out_of_range": "{field} must lie in (0, 180) degrees, got {value}",
     "frame_without_speed": "{field} is given without timing.limits.tool_speed or tool_angular_speed",
     "unknown_tool_frame": _unknown_frame,
@@ -371,7 +328,6 @@ WORDING: dict[str, Wording] = {
         "{field} has norm {norm:.6g}; a box's orientation is a unit quaternion "
         "[qx, qy, qz, qw] (norm 1 within 1e-3), e.g. [0, 0, 0, 1] for a box along the world's axes"
     ),
-    "path_in_collision": _path_in_collision,
     "worker_stopped": (
         "the worker process computing this request stopped without an answer (exit code {exit_code}; -9: killed, "
         "by the system for memory or by an operator); nothing in the request is known to be wrong: submit it again, "
@@ -400,4 +356,5 @@ WORDING: dict[str, Wording] = {
     **ZONE_WORDING,
     **SEARCH_WORDING,
     **CELL_WORDING,
+    **OBSTACLE_WORDING,
 }
