@@ -331,6 +331,18 @@ def _check_depth(root: ElementTree.Element) -> None:
         stack.extend((child, depth + 1, f"{path} > {str(child.tag)[:40]}" if depth < 4 else path) for child in element)
 
 
+def _check_namespaces(root: ElementTree.Element) -> None:
+    """No element in an XML namespace: the checks read a URDF's elements by their plain names,
+    and would pass over a namespaced ``<joint>`` that Pinocchio's parser still builds."""
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.tag.startswith("{"):
+            namespace, _, tag = element.tag[1:].partition("}")
+            raise InvalidURDF(
+                f"the element <{tag[:40]}> is in the XML namespace {excerpt(namespace, 80)}, and a URDF's "
+                "elements are in none: remove the xmlns attribute that puts it there"
+            )
+
+
 def check_urdf(urdf: str) -> pin.Model:
     """Validate ``urdf`` and return its Pinocchio model (fixed base).
 
@@ -357,13 +369,9 @@ def check_urdf(urdf: str) -> pin.Model:
                 "guide's Uploads page shows)"
             ) from None
         raise InvalidURDF(f"malformed XML: {excerpt(str(error), 200)}") from None
+    _check_namespaces(root)
     if root.tag != "robot":
         tag = root.tag if len(root.tag) <= 40 else f"{root.tag[:40]}..."
-        if root.tag.startswith("{") and root.tag.endswith("}robot"):
-            raise InvalidURDF(
-                f"the root element <robot> declares the XML namespace {excerpt(root.tag[1:-6], 80)}, and a URDF's "
-                "elements carry none: remove the xmlns attribute from <robot>"
-            )
         raise InvalidURDF(f"the root element is <{tag}>, expected <robot>")
     _check_depth(root)
     links, joints, _ = check_structure(root)

@@ -26,6 +26,9 @@ def _named(elements: list[ElementTree.Element], tag: str) -> dict[str, ElementTr
             raise InvalidURDF(f"a <{tag}> has no name")
         if name in named:
             raise InvalidURDF(f"two <{tag}> elements are named {excerpt(name)}; names must be unique")
+        if any(ord(character) < 32 or ord(character) == 127 for character in name):
+            # a name is a column of the answers' CSV, a line of its own: no line break, no tab
+            raise InvalidURDF(f"{tag} {excerpt(name)}: its name holds a control character (a line break, a tab); rename it")
         named[name] = element
     return named
 
@@ -114,20 +117,24 @@ def check_mimic(joint: ElementTree.Element, joints: dict, where: str) -> None:
     if element is None:
         return
     mimicked = element.get("joint")
-    if mimicked is None or joints.get(mimicked) is None or joints[mimicked].get("type") not in MOVING_JOINTS:
+    if mimicked is None:
+        raise InvalidURDF(f"{where}: <mimic> names no joint; give the joint it follows (joint=...), or remove the <mimic> element")
+    if joints.get(mimicked) is None or joints[mimicked].get("type") not in MOVING_JOINTS:
         raise InvalidURDF(
-            f"{where}: <mimic joint={excerpt(str(mimicked))}> names no revolute, continuous or prismatic joint of the URDF; "
+            f"{where}: <mimic joint={excerpt(mimicked)}> names no revolute, continuous or prismatic joint of the URDF; "
             "name the joint it follows, or remove the <mimic> element"
         )
 
 
 def mimic_joints(urdf: str) -> list[tuple[str, str, float, float]]:
-    """(joint, the joint it mimics, multiplier, offset) of each ``<mimic>`` in ``urdf`` (already
-    checked by ``toptraj.robots.urdf_check.check_urdf``), in the URDF's order."""
+    """(joint, the joint it mimics, multiplier, offset) of each ``<mimic>`` of a moving joint of
+    ``urdf`` (already checked by ``toptraj.robots.urdf_check.check_urdf``), in the URDF's order:
+    the joints of the ``<robot>`` element itself, as the checks read them (a ``<joint>`` inside
+    another element, a ``<gazebo>``'s, is none of the robot's)."""
     found = []
-    for joint in ElementTree.fromstring(urdf).iter("joint"):
+    for joint in ElementTree.fromstring(urdf).findall("joint"):
         element = joint.find("mimic")
-        if element is not None:
+        if element is not None and joint.get("type") in MOVING_JOINTS:
             multiplier, offset = (float(element.get(name, default)) for name, default in (("multiplier", "1"), ("offset", "0")))
             found.append((joint.get("name", ""), element.get("joint", ""), multiplier, offset))
     return found

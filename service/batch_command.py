@@ -27,6 +27,21 @@ def _not_regular(path: str, role: str) -> str | None:
     )
 
 
+def _refused(requests: str, output: str, workers: int | None, budget_s: float | None) -> tuple[str, int, str] | None:
+    """(title, status, detail) of the options or files a batch cannot take, or ``None``."""
+    from toptraj.service.batches.runner import MAX_BUDGET_S
+
+    if workers is not None and workers < 1:
+        return "Invalid option", 400, f"--workers must be at least 1, not {workers}"
+    if budget_s is not None and not 0.0 < budget_s <= MAX_BUDGET_S:  # NaN too
+        return "Invalid option", 400, f"--budget must be in (0, {MAX_BUDGET_S:g}] s, not {budget_s:g}"
+    for path, role in ((requests, "requests"), (output, "output")):
+        problem = _not_regular(path, role)
+        if problem:
+            return "Cannot read or write", 400, problem
+    return None
+
+
 def batch(
     requests: str,
     output: str,
@@ -44,21 +59,14 @@ def batch(
 
     from toptraj.service.batches import run_batch
     from toptraj.service.batches.lines import ForeignOutput
-    from toptraj.service.batches.ray_pool import RayMissing, RayUnreachable
-    from toptraj.service.batches.runner import BUDGET_S, MAX_BUDGET_S, progress_bar
+    from toptraj.service.batches.ray_pool import RayClientMissing, RayMissing, RayUnreachable
+    from toptraj.service.batches.runner import BUDGET_S, progress_bar
 
-    if workers is not None and workers < 1:
-        print(json.dumps(_problem("Invalid option", 400, f"--workers must be at least 1, not {workers}")), file=sys.stderr)
+    refused = _refused(requests, output, workers, budget_s)
+    if refused:
+        print(json.dumps(_problem(*refused)), file=sys.stderr)
         return 2
     budget = BUDGET_S if budget_s is None else budget_s
-    if not 0.0 < budget <= MAX_BUDGET_S:  # NaN too
-        print(json.dumps(_problem("Invalid option", 400, f"--budget must be in (0, {MAX_BUDGET_S:g}] s, not {budget_s:g}")), file=sys.stderr)
-        return 2
-    for path, role in ((requests, "requests"), (output, "output")):
-        problem = _not_regular(path, role)
-        if problem:
-            print(json.dumps(_problem("Cannot read or write", 400, problem)), file=sys.stderr)
-            return 2
     stop = threading.Event()
 
     def interrupted(signum, frame) -> None:
@@ -70,7 +78,10 @@ def batch(
     try:
         report = run_batch(requests, output, workers, ray_address, progress_bar(), budget, retry_failed, stop)
     except (RayMissing, RayUnreachable, ForeignOutput, OSError) as error:
-        titles = {RayMissing: "Ray is not installed", RayUnreachable: "Ray cluster unreachable", ForeignOutput: "Not a result file"}
+        titles = {
+            RayMissing: "Ray is not installed", RayClientMissing: "Ray Client is not installed",
+            RayUnreachable: "Ray cluster unreachable", ForeignOutput: "Not a result file",
+        }
         print(json.dumps(_problem(titles.get(type(error), "Cannot read or write"), 400, str(error))), file=sys.stderr)
         return 2
     finally:

@@ -71,6 +71,10 @@ def _serve(args) -> int:
     if not 1 <= args.port <= 65535:  # uvicorn would take it modulo 65536 and say the port given
         print(f"toptraj serve: --port must be a port number from 1 to 65535, not {args.port}", file=sys.stderr)
         return 2
+    refused = _settings_refused()
+    if refused:  # said once here: each server process would refuse them and be started again, forever
+        print(f"toptraj serve: {refused}", file=sys.stderr)
+        return 2
     # Each server process reads its settings from the environment, which it inherits from here.
     os.environ.setdefault("TOPTRAJ_PLAN_WORKERS", str(plan_threads_per_process(args.workers)))
     # One process (workers=1) serves in this process; more are spawned processes sharing this
@@ -106,6 +110,22 @@ def _serve(args) -> int:
     return 0
 
 
+def _settings_refused() -> str | None:
+    """Why the ``TOPTRAJ_*`` settings of the environment cannot serve, or ``None``."""
+    from pydantic import ValidationError
+
+    from toptraj.service.settings import Settings
+
+    try:
+        Settings()
+    except ValidationError as error:
+        return "; ".join(
+            (f"TOPTRAJ_{'_'.join(map(str, item['loc'])).upper()}: " if item["loc"] else "") + item["msg"].removeprefix("Value error, ")
+            for item in error.errors()
+        )
+    return None
+
+
 def _methods(text: str) -> list[str]:
     """``--methods a,b``: the names, spaces and empty items left out."""
     names = [name.strip() for name in text.split(",") if name.strip()]
@@ -116,7 +136,10 @@ def _methods(text: str) -> list[str]:
 
 def _request_commands(commands) -> None:
     """``toptraj plan``, ``toptraj compare`` and ``toptraj plot``: one request each."""
-    exits = "Exit status: 0 answered, 1 answered with an error (printed on stderr as problem+json), 2 the request could not be read."
+    exits = (
+        "Exit status: 0 answered, 1 answered with an error (printed on stderr as problem+json), 2 the request could not "
+        "be read or the answer not written, 130 interrupted (Ctrl-C)."
+    )
     plan = commands.add_parser(
         "plan",
         help="plan one request and print the answer (errors on stderr)",
@@ -231,7 +254,8 @@ def run() -> None:
     if sys.argv[1:2] and sys.argv[1] in ONE_SHOT:
         for stream in (sys.stdout, sys.stderr):
             try:
-                stream.flush()
+                if stream is not None:  # None: closed when the command started (>&-)
+                    stream.flush()
             except (OSError, ValueError):  # a reader gone (| head) or a stream closed
                 pass
         atexit._run_exitfuncs()  # logging's flush, pending finalizers, llvmlite's and numba's flags

@@ -283,7 +283,7 @@ def compare(source: str, methods: list[str] | None = None, as_json: bool | None 
     """``toptraj compare FILE|- [--methods a,b] [--json]``: a compare body, or a trajectory body
     compared under ``methods`` (``compare_body``); a table on a terminal, JSON when piped or
     when ``as_json``. Exit status 1 when every method failed (their errors are in the answer)."""
-    as_table = sys.stdout.isatty() if as_json is None else not as_json
+    as_table = (sys.stdout is not None and sys.stdout.isatty()) if as_json is None else not as_json
     why = "toptraj compare times one arm's path under several methods"
     left_out: list[str] = []
     outcome: dict = {}

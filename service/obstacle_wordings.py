@@ -11,7 +11,7 @@ from collections.abc import Callable
 def _below(distance: float, clearance: float) -> str:
     """``distance`` (m, below ``clearance``) to four significant digits, or as many more as
     tell it from the clearance (0.029996 m, not 0.03 m, under a clearance of 0.03 m)."""
-    for digits in range(4, 10):
+    for digits in range(4, 18):
         text = f"{distance:.{digits}g}"
         if float(text) < clearance:
             return text
@@ -27,11 +27,11 @@ def _path_in_collision(facts: dict) -> str:
         advice = f"no joint moves that link: move path.obstacles[{index}] away from it, or the robot by its mounting"
     else:
         advice = "move the waypoints away from the obstacle"
-    least = math.floor(1e4 * facts.get("least", -1.0)) / 1e4  # a lower bound on the path's distance, 0.1 mm down
-    if least > 0.0:
-        advice += f"{',' if facts.get('fixed') else ''} or lower path.clearance to {least:g} m"
+    least = facts.get("least", -1.0)  # a lower bound on the path's distance, good to about half a millimetre
+    if least > 0.0:  # advised 0.1 mm down (0 m at worst): a clearance the check then confirms
+        advice += f"{',' if facts.get('fixed') else ''} or lower path.clearance to {math.floor(1e4 * least) / 1e4:g} m"
     elif "least_s" in facts and not facts.get("fixed"):
-        advice += f" (near s = {facts['least_s']:.4g} the path touches or enters an obstacle: no lower clearance lets it through)"
+        advice += f" (near s = {facts['least_s']:.4g} the path touches an obstacle, or comes within about half a millimetre of one)"
     return f"link {facts['link']!r} {how} at s = {facts['s']:.4g} (the clearance is {facts['clearance']:g} m{closest}): {advice}"
 
 

@@ -15,7 +15,9 @@ at both ends of every interval. cvxpy states the problem and Clarabel, an interi
 solver, solves it; with beta = 0 it is a third, independent computation of the time-optimal
 timing. Joint friction enters the limits (conservatively linearized) and the cost: Coulomb
 friction in C, viscous friction d sd = d sqrt(b), concave in b, by its tangent at the maximum
-velocity curve (so that the program stays convex, its optimum that of the tangent's cost); the
+velocity curve (so that the program stays convex, its optimum that of the tangent's cost; where
+that tangent leaves no feasible timing, as under strong damping, at speeds 16 times lower, and
+then once more at the motion found: ``toptraj.planners.constraints.admissible.FRICTION_LOWERING``); the
 cost reported is that of the motion found with its own torques, the friction as it is
 (``motion_cost``).
 """
@@ -32,7 +34,7 @@ import numpy as np
 from toptraj.planners.constraints.admissible import FRICTION_LOWERING, FRICTION_REFERENCES, friction_reference
 from toptraj.planners.constraints.linear_rows import LinearRows
 from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import InfeasiblePath, OutOfRange, TimingFailed
+from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, OutOfRange, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
@@ -87,16 +89,22 @@ class MinCostMethod(TimingMethod):
         if viscous is not None and not viscous.any():
             viscous = None
         reference = friction_reference(constraints)
+        first: InfeasiblePath | None = None
         for attempt in range(FRICTION_REFERENCES if viscous is not None else 1):
             try:
                 result, program = self._solved(constraints, boundary, reference, torque, viscous, deadline)
                 break
-            except InfeasiblePath:
+            except InfeasiblePath as error:
+                first = first or error
                 if viscous is None or attempt == FRICTION_REFERENCES - 1:
-                    raise
+                    raise first from None
                 # the tangent at the reference asks torque no slow motion needs: lowered, then
                 # moved onto the answer (``toptraj.planners.constraints.admissible.FRICTION_LOWERING``)
                 reference = reference * FRICTION_LOWERING
+            except BudgetExceeded:
+                if first is None:
+                    raise
+                raise first from None  # the refusal known, rather than the budget its retries spent
         if attempt:
             result, program = self._solved(constraints, boundary, result.sd**2, torque, viscous, deadline)
         return dataclasses.replace(result, cost=motion_cost(program, result.sd**2))

@@ -112,13 +112,15 @@ class ToppraMethod(TimingMethod):
             return _solved(constraints, x_ref, boundary, deadline)
         # Viscous friction, linearized around a reference the passes move onto the answer (as
         # phase_plane's ``_friction_passes``): lowered where its tangent finds no motion.
+        first: InfeasiblePath | None = None
         for attempt in range(FRICTION_REFERENCES):
             try:
                 scaling = _solved(constraints, x_ref, boundary, deadline)
                 break
-            except InfeasiblePath:
+            except InfeasiblePath as error:
+                first = first or error
                 if attempt == FRICTION_REFERENCES - 1:
-                    raise
+                    raise first from None  # the first tangent's numbers, not the low speed's
                 x_ref = x_ref * FRICTION_LOWERING
         duration = np.inf
         for _ in range(1 if attempt == 0 else FRICTION_PASSES):

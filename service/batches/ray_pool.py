@@ -18,6 +18,10 @@ class RayMissing(RuntimeError):
     """Ray (the ``ray`` extra) is not installed."""
 
 
+class RayClientMissing(RayMissing):
+    """Ray is installed, but not the packages Ray Client (``ray://``) needs."""
+
+
 class RayUnreachable(ToptrajError):
     """No Ray cluster answers at the address given (503: the server's ``TOPTRAJ_RAY_ADDRESS``
     for a batch job; ``toptraj batch`` says it as its own problem)."""
@@ -143,7 +147,7 @@ class RayPool:
                 except ValueError as error:  # ray://: Ray Client needs packages of its own
                     if "ray[client]" not in str(error):
                         raise
-                    raise RayMissing(
+                    raise RayClientMissing(
                         f"--ray-address {address} connects through Ray Client, which needs Ray's client packages "
                         "(pip install 'ray[client]'); or give the head's host:port (the address `ray start --head` "
                         "printed) to connect without it"

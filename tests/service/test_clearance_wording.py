@@ -17,4 +17,9 @@ def test_a_distance_just_below_the_clearance_is_told_apart_from_it():
 def test_a_path_that_touches_an_obstacle_says_where():
     detail = WORDING["path_in_collision"]({**FACTS, "distance": 0.02, "least": -0.001, "least_s": 0.8312})
     assert "comes within 0.02 m" in detail
-    assert detail.endswith("(near s = 0.8312 the path touches or enters an obstacle: no lower clearance lets it through)")
+    assert detail.endswith("(near s = 0.8312 the path touches an obstacle, or comes within about half a millimetre of one)")
+
+
+def test_a_path_that_stays_clear_by_less_than_the_rounding_is_advised_a_clearance_of_zero():
+    detail = WORDING["path_in_collision"]({**FACTS, "distance": 0.02, "least": 5e-5, "least_s": 0.8312})
+    assert detail.endswith("or lower path.clearance to 0 m")

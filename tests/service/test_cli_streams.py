@@ -129,7 +129,7 @@ def test_a_local_ray_is_its_own_and_ray_client_without_its_packages_is_said(monk
     fake = _FakeRay(ValueError("Ray Client requires pip package `ray[client]`."))
     monkeypatch.setitem(sys.modules, "ray", fake)
     monkeypatch.setattr(ray_pool, "check_reachable", lambda address: None)
-    with pytest.raises(ray_pool.RayMissing, match=r"pip install 'ray\[client\]'"):
+    with pytest.raises(ray_pool.RayClientMissing, match=r"pip install 'ray\[client\]'"):
         ray_pool.RayPool("ray://head:10001", None)
 
 
@@ -138,3 +138,25 @@ def test_an_empty_batch_says_it_holds_no_line(tmp_path, capsys):
     requests.write_text("")
     assert main(["batch", str(requests), "-o", str(tmp_path / "out.jsonl")]) == 0
     assert "empty.jsonl holds no line: give a file of one request body per line" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", ["plan", "compare"])
+def test_a_closed_standard_output_ends_with_2_and_no_traceback(tmp_path, command):
+    import subprocess
+
+    request = tmp_path / "request.json"
+    request.write_text(json.dumps(REQUEST))
+    ended = subprocess.run(
+        [sys.executable, "-m", "toptraj.service.cli", command, str(request)], stdin=subprocess.DEVNULL,
+        stderr=subprocess.PIPE, text=True, preexec_fn=lambda: os.close(1), timeout=120,  # as the shell's >&-
+    )
+    assert ended.returncode == 2, ended.stderr
+    assert "Traceback" not in ended.stderr and "standard output is closed" in ended.stderr
+
+
+def test_settings_that_cannot_serve_are_refused_before_any_server_process(monkeypatch, capsys):
+    """Refused in each server process, they would be started again forever by uvicorn's
+    supervisor: ``serve`` says so once and ends."""
+    monkeypatch.setenv("TOPTRAJ_MAX_JOBS", "50")
+    assert main(["serve", "--port", "8555", "--workers", "2"]) == 2
+    assert "TOPTRAJ_MAX_JOBS = 50 leaves no room for an ended job's answer" in capsys.readouterr().err

@@ -104,6 +104,12 @@ def test_upload_under_a_name(client):
         # a default namespace puts every element in it: the advice removes it
         (MINIMAL.replace("<robot ", '<robot xmlns="http://www.ros.org" ').format(effort=1, inertial=INERTIAL), ["remove the xmlns attribute"]),
         (MINIMAL.replace("</joint>", '<mimic joint="nope"/></joint>').format(effort=1, inertial=INERTIAL), ["joint 'j'", "<mimic joint='nope'>"]),
+        (MINIMAL.replace("</joint>", "<mimic/></joint>").format(effort=1, inertial=INERTIAL), ["joint 'j'", "<mimic> names no joint"]),
+        # a name is a CSV column on the answers' first line
+        (MINIMAL.replace('name="j"', 'name="j&#10;k"').format(effort=1, inertial=INERTIAL), ["its name holds a control character"]),
+        # a namespaced element below the root: no check reads it, and Pinocchio builds it
+        (MINIMAL.replace('<joint name="j"', '<joint xmlns="urn:x" name="j"').format(effort=1, inertial=INERTIAL),
+         ["the element <joint> is in the XML namespace 'urn:x'", "remove the xmlns attribute"]),
     ],
 )
 def test_bad_urdf_is_422_saying_what_and_where(client, urdf, words):
@@ -155,6 +161,15 @@ def test_a_mimic_joint_is_told(client):
     assert any("joint 'j2' mimics joint 'j1'" in note and "times" in note for note in created.json()["notes"]), created.json()["notes"]
     locked = client.post("/v1/robots", json={"urdf": _two_joints(mimic='<mimic joint="j1"/>'), "locked_joints": {"j2": 0.0}})
     assert locked.status_code == 201 and not any("mimic" in note for note in locked.json()["notes"])
+
+
+def test_a_joint_inside_another_element_is_none_of_the_robots(client):
+    """A ``<joint>`` inside a ``<gazebo>`` (with a xacro expression left in it) is not read as
+    the robot's: no mimic note about it, no 500 on its number."""
+    nested = '<gazebo><joint name="g"><mimic joint="j1" multiplier="${2*pi}"/></joint></gazebo></robot>'
+    created = client.post("/v1/robots", json={"urdf": _two_joints().replace("</robot>", nested)})
+    assert created.status_code == 201, created.text
+    assert not any("mimic" in note for note in created.json()["notes"])
 
 
 def test_csv_quotes_a_joint_name_that_needs_it(client):

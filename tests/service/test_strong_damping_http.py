@@ -50,3 +50,25 @@ def test_strong_damping_is_timed_within_the_effort(client, damping, method):
     assert np.allclose(independent[moving.all(axis=1)], tau[moving.all(axis=1)], atol=1e-6 * EFFORT)
     if method != "min_cost":  # a time-optimal motion is not slowed beyond need: a torque reaches its limit
         assert np.abs(tau).max() >= EFFORT * 0.999
+
+
+def test_a_refusal_under_damping_states_the_first_tangents_numbers():
+    """A path no reference of the damping's tangent lets through (a start faster than the path
+    allows) is refused with the numbers of the first tangent, at the speed limit: the lowest one
+    tried, at 1/65536 of it, understates the speeds allowed ninefold."""
+    from toptraj.planners.constraints.path_constraints import build_path_constraints
+    from toptraj.planners.errors import InfeasiblePath
+    from toptraj.planners.paths import SplinePath
+    from toptraj.planners.paths.grid import path_grid
+    from toptraj.planners.timing.base import Boundary
+    from toptraj.planners.timing.phase_plane.method import PhasePlaneMethod
+    from toptraj.planners.timing.toppra_method import ToppraMethod
+    from toptraj.robots.upload_options import UploadOptions
+    from toptraj.robots.uploads import build_upload
+
+    robot = build_upload("damped", _urdf(0.5), UploadOptions())
+    path = SplinePath(np.array(WAYPOINTS))
+    constraints = build_path_constraints(path, robot, robot.limits, ("velocity", "acceleration", "torque"), path_grid(path))
+    for method in (PhasePlaneMethod(), ToppraMethod()):
+        with pytest.raises(InfeasiblePath, match=r"0\.408814"):
+            method.solve(constraints, Boundary(sd_start=0.5))

@@ -245,17 +245,20 @@ def _friction_passes(grid: Grid, x_start: float, x_end: float, deadline, midpoin
     damping, a reference as fast as the maximum velocity curve asks torque the motion does not
     need near rest, and the pass finds no motion ("not even at rest") where slower motions
     exist. The reference is then lowered (``FRICTION_LOWERING``, at most ``FRICTION_REFERENCES``
-    references; the last failure raised), and the passes around each answer, whose tangent is
+    references; the first failure raised, whose numbers a tangent at low speed would understate),
+    and the passes around each answer, whose tangent is
     exact at the answer, so that it stays feasible and the duration can only fall, go on until
     it settles (``FRICTION_PASSES``, ``FRICTION_SETTLED``)."""
     reference = np.ascontiguousarray(grid.friction_reference(), dtype=np.float64)
+    first: InfeasiblePath | None = None
     for attempt in range(FRICTION_REFERENCES):
         try:
             profile = _integrate(grid, reference, x_start, x_end, deadline, midpoint, kept, before)
             break
-        except InfeasiblePath:
+        except InfeasiblePath as error:
+            first = first or error
             if attempt == FRICTION_REFERENCES - 1:
-                raise
+                raise first from None  # its numbers are the first tangent's, close to the limits' own
             reference = reference * FRICTION_LOWERING
     passes = 1 if attempt == 0 else FRICTION_PASSES
     duration = np.inf

@@ -50,7 +50,9 @@ function csvText(answer) {
   // the samples as shown, laid out as the service's CSV (service/formats.py): its header, then a
   // row per sample (without the service's "#" lines of metadata, which the JSON download holds)
   const names = answer.joint_names;
-  const header = ["t", ...["q", "qd", "qdd", "tau"].flatMap((quantity) => names.map((name) => `${quantity}.${name}`))];
+  // a name holding a comma or a quote is quoted, as the service writes it (RFC 4180)
+  const field = (text) => (/[",]/.test(text) ? `"${text.replaceAll('"', '""')}"` : text);
+  const header = ["t", ...["q", "qd", "qdd", "tau"].flatMap((quantity) => names.map((name) => field(`${quantity}.${name}`)))];
   const s = answer.samples;
   const rows = s.t.map((t, k) => [t, ...s.q[k], ...s.qd[k], ...s.qdd[k], ...s.tau[k]].join(","));
   return [header.join(","), ...rows].join("\n") + "\n";
