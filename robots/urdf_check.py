@@ -317,30 +317,26 @@ def _check_joint_space_inertia(model: pin.Model) -> None:
 MAX_XML_DEPTH = 32
 
 
-def _check_depth(root: ElementTree.Element) -> None:
-    """Refuse elements nested deeper than ``MAX_XML_DEPTH``, naming the first too deep (counted
-    without recursion)."""
+def _check_tree(root: ElementTree.Element) -> None:
+    """Refuse, in one walk without recursion, an element in an XML namespace (the checks read a
+    URDF's elements by their plain names, and would pass over a namespaced ``<joint>`` that
+    Pinocchio's parser still builds) and elements nested deeper than ``MAX_XML_DEPTH``, naming
+    the first."""
     stack = [(root, 1, "robot")]
     while stack:
         element, depth, path = stack.pop()
-        if depth > MAX_XML_DEPTH:
-            raise InvalidURDF(
-                f"the URDF nests elements {MAX_XML_DEPTH + 1} levels deep and more ({path[:200]}); a URDF nests a few "
-                "(robot > link > collision > geometry > mesh): remove the elements nested inside one another"
-            )
-        stack.extend((child, depth + 1, f"{path} > {str(child.tag)[:40]}" if depth < 4 else path) for child in element)
-
-
-def _check_namespaces(root: ElementTree.Element) -> None:
-    """No element in an XML namespace: the checks read a URDF's elements by their plain names,
-    and would pass over a namespaced ``<joint>`` that Pinocchio's parser still builds."""
-    for element in root.iter():
         if isinstance(element.tag, str) and element.tag.startswith("{"):
             namespace, _, tag = element.tag[1:].partition("}")
             raise InvalidURDF(
                 f"the element <{tag[:40]}> is in the XML namespace {excerpt(namespace, 80)}, and a URDF's "
                 "elements are in none: remove the xmlns attribute that puts it there"
             )
+        if depth > MAX_XML_DEPTH:
+            raise InvalidURDF(
+                f"the URDF nests elements {MAX_XML_DEPTH + 1} levels deep and more ({path[:200]}); a URDF nests a few "
+                "(robot > link > collision > geometry > mesh): remove the elements nested inside one another"
+            )
+        stack.extend((child, depth + 1, f"{path} > {str(child.tag)[:40]}" if depth < 4 else path) for child in element)
 
 
 def check_urdf(urdf: str) -> pin.Model:
@@ -369,11 +365,10 @@ def check_urdf(urdf: str) -> pin.Model:
                 "guide's Uploads page shows)"
             ) from None
         raise InvalidURDF(f"malformed XML: {excerpt(str(error), 200)}") from None
-    _check_namespaces(root)
+    _check_tree(root)
     if root.tag != "robot":
         tag = root.tag if len(root.tag) <= 40 else f"{root.tag[:40]}..."
         raise InvalidURDF(f"the root element is <{tag}>, expected <robot>")
-    _check_depth(root)
     links, joints, _ = check_structure(root)
     masses = {}
     for name, link in links.items():

@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 
 #: What to do about a body over the cap (the cap is the server's ``TOPTRAJ_MAX_BODY_BYTES``).
+#: The default cap on a request body, in bytes (``Settings.max_body_bytes``; ``toptraj plan`` reads no more).
+DEFAULT_MAX_BODY_BYTES = 2_000_000
 REMEDY = (
     "send fewer waypoints (the path is a spline through them, so a coarser list often gives the same motion), "
     "split a batch into several POST /v1/batches, or plan a large file of requests with `toptraj batch` "

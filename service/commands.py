@@ -21,6 +21,8 @@ from collections.abc import Callable
 
 from pydantic import ValidationError
 
+from toptraj.service.body_limit import DEFAULT_MAX_BODY_BYTES
+
 
 class _Unreadable(Exception):
     """The request cannot be read: exit status 2."""
@@ -35,9 +37,9 @@ def _problem(title: str, status: int, detail: str) -> dict:
     return {"type": "about:blank", "title": title, "status": status, "detail": detail}
 
 
-#: Largest request read (bytes): the server's default body cap (``Settings.max_body_bytes``),
-#: checked before the request is read whole.
-MAX_REQUEST_BYTES = 2_000_000
+#: Largest request read (bytes): the server's default body cap, checked before the request is
+#: read whole.
+MAX_REQUEST_BYTES = DEFAULT_MAX_BODY_BYTES
 
 
 def _read(source: str) -> str:

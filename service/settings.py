@@ -11,6 +11,7 @@ from pydantic_settings import BaseSettings, SettingsConfigDict
 from toptraj.planners.execution.memory import DEFAULT_SEARCH_MEMORY
 from toptraj.robots.store import DEFAULT_MAX_BYTES, DEFAULT_MAX_UPLOADS, default_data_dir
 from toptraj.robots.uploads import DEFAULT_CACHE_SIZE
+from toptraj.service.body_limit import DEFAULT_MAX_BODY_BYTES
 from toptraj.service.web import GUIDE
 
 
@@ -67,7 +68,7 @@ class Settings(BaseSettings):
 
     model_config = SettingsConfigDict(env_prefix="TOPTRAJ_")
 
-    max_body_bytes: int = 2_000_000
+    max_body_bytes: int = DEFAULT_MAX_BODY_BYTES
     plan_budget_s: float = 20.0
     preload_robots: bool = True
     data_dir: Path = Field(default_factory=default_data_dir)

@@ -100,17 +100,6 @@ def _blocking_pair(point, bounds, x_min, static_fail, singular, rows):
     return int(np.argmax(low)), int(np.argmin(high))
 
 
-#: Where the tangent of viscous friction at ``friction_reference`` finds no motion: the factor
-#: by which the reference is lowered, and the most references tried (the tangent of D sqrt(x)
-#: at x_ref adds D sqrt(x_ref) / 2 to a row at x = 0, torque that no motion near rest needs);
-#: then the most passes around each answer, and the relative change of the duration at which
-#: they stop (each pass's tangent is exact at the answer before, which stays feasible).
-FRICTION_LOWERING = 1.0 / 16.0
-FRICTION_REFERENCES = 5
-FRICTION_PASSES = 6
-FRICTION_SETTLED = 1e-6
-
-
 def friction_reference(constraints: PathConstraints) -> np.ndarray:
     """A first guess of the optimal x = sd^2 (N + 1,) around which viscous friction is
     linearized (``PathConstraints.linearized``): the maximum velocity curve without friction,

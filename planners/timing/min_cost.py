@@ -17,7 +17,7 @@ timing. Joint friction enters the limits (conservatively linearized) and the cos
 friction in C, viscous friction d sd = d sqrt(b), concave in b, by its tangent at the maximum
 velocity curve (so that the program stays convex, its optimum that of the tangent's cost; where
 that tangent leaves no feasible timing, as under strong damping, at speeds 16 times lower, and
-then once more at the motion found: ``toptraj.planners.constraints.admissible.FRICTION_LOWERING``); the
+then once more at the motion found: ``toptraj.planners.timing.friction``); the
 cost reported is that of the motion found with its own torques, the friction as it is
 (``motion_cost``).
 """
@@ -31,13 +31,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from toptraj.planners.constraints.admissible import FRICTION_LOWERING, FRICTION_REFERENCES, friction_reference
+from toptraj.planners.constraints.admissible import friction_reference
 from toptraj.planners.constraints.linear_rows import LinearRows
 from toptraj.planners.constraints.path_constraints import PathConstraints
-from toptraj.planners.errors import BudgetExceeded, InfeasiblePath, OutOfRange, TimingFailed
+from toptraj.planners.errors import InfeasiblePath, OutOfRange, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.execution.isolated import LOW_PRIORITY, run_isolated
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from toptraj.planners.timing.friction import friction_passes
 
 
 @dataclass(frozen=True)
@@ -88,25 +89,17 @@ class MinCostMethod(TimingMethod):
         viscous = _midpoint(constraints.d, constraints.d_left, torque) if constraints.has_friction else None
         if viscous is not None and not viscous.any():
             viscous = None
-        reference = friction_reference(constraints)
-        first: InfeasiblePath | None = None
-        for attempt in range(FRICTION_REFERENCES if viscous is not None else 1):
-            try:
-                result, program = self._solved(constraints, boundary, reference, torque, viscous, deadline)
-                break
-            except InfeasiblePath as error:
-                first = first or error
-                if viscous is None or attempt == FRICTION_REFERENCES - 1:
-                    raise first from None
-                # the tangent at the reference asks torque no slow motion needs: lowered, then
-                # moved onto the answer (``toptraj.planners.constraints.admissible.FRICTION_LOWERING``)
-                reference = reference * FRICTION_LOWERING
-            except BudgetExceeded:
-                if first is None:
-                    raise
-                raise first from None  # the refusal known, rather than the budget its retries spent
-        if attempt:
-            result, program = self._solved(constraints, boundary, result.sd**2, torque, viscous, deadline)
+
+        def solve(reference: np.ndarray) -> tuple[CostTimeScaling, MinCostProgram]:
+            return self._solved(constraints, boundary, reference, torque, viscous, deadline)
+
+        if viscous is None:
+            result, program = solve(friction_reference(constraints))
+        else:  # one solve around the tangent's reference, or, lowered, one more around its answer
+            result, program = friction_passes(
+                solve, friction_reference(constraints), lambda pair: pair[0].sd**2, lambda pair: pair[0].duration,
+                passes=0, lowered_passes=1,
+            )
         return dataclasses.replace(result, cost=motion_cost(program, result.sd**2))
 
     def _solved(self, constraints, boundary, reference, torque, viscous, deadline) -> tuple[CostTimeScaling, MinCostProgram]:

@@ -15,20 +15,13 @@ import logging
 
 import numpy as np
 
-from toptraj.planners.constraints.admissible import (
-    FRICTION_LOWERING,
-    FRICTION_PASSES,
-    FRICTION_REFERENCES,
-    FRICTION_SETTLED,
-    acceleration_bounds,
-    admissible_set,
-    friction_reference,
-)
+from toptraj.planners.constraints.admissible import acceleration_bounds, admissible_set, friction_reference
 from toptraj.planners.constraints.held_load import blocked_even_at_rest, holding_facts, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.errors import InfeasiblePath, TimingFailed
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from toptraj.planners.timing.friction import friction_passes
 
 logging.getLogger("toppra").setLevel(logging.ERROR)
 
@@ -110,25 +103,11 @@ class ToppraMethod(TimingMethod):
         x_ref = friction_reference(constraints)
         if not constraints.has_friction:
             return _solved(constraints, x_ref, boundary, deadline)
-        # Viscous friction, linearized around a reference the passes move onto the answer (as
-        # phase_plane's ``_friction_passes``): lowered where its tangent finds no motion.
-        first: InfeasiblePath | None = None
-        for attempt in range(FRICTION_REFERENCES):
-            try:
-                scaling = _solved(constraints, x_ref, boundary, deadline)
-                break
-            except InfeasiblePath as error:
-                first = first or error
-                if attempt == FRICTION_REFERENCES - 1:
-                    raise first from None  # the first tangent's numbers, not the low speed's
-                x_ref = x_ref * FRICTION_LOWERING
-        duration = np.inf
-        for _ in range(1 if attempt == 0 else FRICTION_PASSES):
-            scaling = _solved(constraints, scaling.sd**2, boundary, deadline)
-            previous, duration = duration, scaling.duration
-            if abs(previous - duration) <= FRICTION_SETTLED * duration:
-                break
-        return scaling
+        # Viscous friction, its tangent moved onto the answer (``toptraj.planners.timing.friction``).
+        return friction_passes(
+            lambda reference: _solved(constraints, reference, boundary, deadline), x_ref,
+            lambda scaling: scaling.sd**2, lambda scaling: scaling.duration, passes=1,
+        )
 
 
 def _solved(constraints: PathConstraints, x_ref: np.ndarray, boundary: Boundary, deadline: Deadline) -> TimeScaling:

@@ -45,19 +45,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from toptraj.planners.constraints.admissible import (
-    FRICTION_LOWERING,
-    FRICTION_PASSES,
-    FRICTION_REFERENCES,
-    FRICTION_SETTLED,
-    admissible_set,
-)
+from toptraj.planners.constraints.admissible import admissible_set
 from toptraj.planners.constraints.admissible_kernels import NOTHING_BEFORE, NOTHING_KEPT, zero_inertia_intervals
 from toptraj.planners.constraints.held_load import blocked_even_at_rest, holding_facts, static_load
 from toptraj.planners.constraints.path_constraints import LinearRows, PathConstraints
 from toptraj.planners.errors import InfeasiblePath
 from toptraj.planners.execution.deadline import NO_DEADLINE, Deadline
 from toptraj.planners.timing.base import AT_REST, Boundary, TimeScaling, TimingMethod
+from toptraj.planners.timing.friction import friction_passes
 from toptraj.planners.timing.phase_plane.grid import (
     Grid,
     Profile,
@@ -237,37 +232,17 @@ def _solve_on_grid(grid: Grid, boundary: tuple[float, float], deadline, midpoint
 
 
 def _friction_passes(grid: Grid, x_start: float, x_end: float, deadline, midpoint: bool, kept, before) -> Profile:
-    """The profile with viscous friction, linearized around a reference that the passes move
-    onto the answer: a first pass around the frictionless maximum velocity curve
-    (``Grid.friction_reference``), then one around its answer.
+    """The profile with viscous friction, its tangent taken around the frictionless maximum
+    velocity curve (``Grid.friction_reference``), then around its answer
+    (``toptraj.planners.timing.friction``: lowered where it finds no motion)."""
 
-    The tangent of D sqrt(x) at x_ref adds D sqrt(x_ref) / 2 to a row at x = 0: under strong
-    damping, a reference as fast as the maximum velocity curve asks torque the motion does not
-    need near rest, and the pass finds no motion ("not even at rest") where slower motions
-    exist. The reference is then lowered (``FRICTION_LOWERING``, at most ``FRICTION_REFERENCES``
-    references; the first failure raised, whose numbers a tangent at low speed would understate),
-    and the passes around each answer, whose tangent is
-    exact at the answer, so that it stays feasible and the duration can only fall, go on until
-    it settles (``FRICTION_PASSES``, ``FRICTION_SETTLED``)."""
-    reference = np.ascontiguousarray(grid.friction_reference(), dtype=np.float64)
-    first: InfeasiblePath | None = None
-    for attempt in range(FRICTION_REFERENCES):
-        try:
-            profile = _integrate(grid, reference, x_start, x_end, deadline, midpoint, kept, before)
-            break
-        except InfeasiblePath as error:
-            first = first or error
-            if attempt == FRICTION_REFERENCES - 1:
-                raise first from None  # its numbers are the first tangent's, close to the limits' own
-            reference = reference * FRICTION_LOWERING
-    passes = 1 if attempt == 0 else FRICTION_PASSES
-    duration = np.inf
-    for _ in range(passes):
-        profile = _integrate(grid, np.ascontiguousarray(profile.x, dtype=np.float64), x_start, x_end, deadline, midpoint, kept, before)
-        previous, duration = duration, float(interval_times(grid.s, profile.x).sum())
-        if abs(previous - duration) <= FRICTION_SETTLED * duration:
-            break
-    return profile
+    def solve(x_ref: np.ndarray) -> Profile:
+        return _integrate(grid, np.ascontiguousarray(x_ref, dtype=np.float64), x_start, x_end, deadline, midpoint, kept, before)
+
+    def duration(profile: Profile) -> float:
+        return float(interval_times(grid.s, profile.x).sum())
+
+    return friction_passes(solve, grid.friction_reference(), lambda profile: profile.x, duration, passes=1)
 
 
 def _integrate(grid: Grid, x_ref, x_start, x_end, deadline, midpoint, kept=NOTHING_KEPT, before=NOTHING_BEFORE) -> Profile:
