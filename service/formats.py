@@ -142,7 +142,7 @@ def csv_bytes(body: Mapping) -> bytes:
     header = ["t"] + [f"{quantity}.{name}" for quantity in ("q", "qd", "qdd", "tau") for name in names]
     table = np.column_stack([np.asarray(samples[key], dtype=float) for key in ("t", "q", "qd", "qdd", "tau")])
     out = io.StringIO()
-    # quoted as RFC 4180 asks where a joint's name holds a comma, a quote or a line break
+    # quoted as RFC 4180 asks where a joint's name holds a comma or a quote
     csv.writer(out, lineterminator="\n").writerow(header)
     out.write("\n".join(csv_metadata(body)) + "\n")
     for row in table:

@@ -16,8 +16,8 @@ from pydantic import BaseModel, ValidationError
 
 from toptraj.service.field_hints import unknown_field_hint
 from toptraj.service.locations import where
-from toptraj.service.problems import LISTED_ERRORS, RequestRefused
-from toptraj.service.routes.jobs import _job_response, _problem
+from toptraj.service.problems import LISTED_ERRORS
+from toptraj.service.routes.jobs import _job_response, _problem, job_budget
 from toptraj.service.schemas.jobs import BatchCreate, JobPublic
 from toptraj.service.schemas.trajectories import CompareRequest, TrajectoryRequest
 from toptraj.service.strict_routes import StrictJSONRoute
@@ -65,12 +65,7 @@ async def create_batch(body: BatchCreate, request: Request) -> Response:
     how to submit them again."""
     _checked(body.requests)
     settings = request.app.state.settings
-    budget_s = min(settings.job_budget_s, settings.job_max_budget_s) if body.budget_s is None else body.budget_s
-    if budget_s > settings.job_max_budget_s:
-        raise RequestRefused(
-            f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= {settings.job_max_budget_s:g} "
-            "(setting TOPTRAJ_JOB_MAX_BUDGET_S)"
-        )
+    budget_s = job_budget(settings, body.budget_s)
     runner = request.app.state.jobs
     from starlette.concurrency import run_in_threadpool
 

@@ -142,6 +142,18 @@ async def _strictly(request: Request) -> None:
         ) from None
 
 
+def job_budget(settings, asked: float | None) -> float:
+    """The budget (s) of a job or batch asking ``asked`` (``None``: the server's default, within
+    its maximum); ``RequestRefused`` above the maximum."""
+    budget_s = min(settings.job_budget_s, settings.job_max_budget_s) if asked is None else asked
+    if budget_s > settings.job_max_budget_s:
+        raise RequestRefused(
+            f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= "
+            f"{settings.job_max_budget_s:g} (setting TOPTRAJ_JOB_MAX_BUDGET_S)"
+        )
+    return budget_s
+
+
 @router.post(
     "",
     status_code=202,
@@ -164,12 +176,7 @@ async def create_job(body: Annotated[JobCreate, Body(openapi_examples=EXAMPLES)]
     The answer, once `done`, is the very body the synchronous endpoint would give."""
     await _strictly(request)
     settings = request.app.state.settings
-    budget_s = min(settings.job_budget_s, settings.job_max_budget_s) if body.budget_s is None else body.budget_s
-    if budget_s > settings.job_max_budget_s:
-        raise RequestRefused(
-            f"budget_s = {budget_s:g} s is more than this server allows: use budget_s <= "
-            f"{settings.job_max_budget_s:g} (setting TOPTRAJ_JOB_MAX_BUDGET_S)"
-        )
+    budget_s = job_budget(settings, body.budget_s)
     runner = request.app.state.jobs
     if body.trajectory is not None:  # refused now as the synchronous endpoint would before any work, not minutes later
         await run_in_threadpool(check_request, body.trajectory, job_answer_bytes(settings), settings.search_memory_bytes)
